@@ -204,7 +204,8 @@ Context::Context(const ContextOptions& options) {
     queueInfo.queueFamilyIndex = queueFamily_;
     queueInfo.queueCount = 1;
     queueInfo.pQueuePriorities = &priority;
-    std::vector<const char*> deviceExtensions;
+    // Push descriptors: per-dispatch bindings without pools (post-process, mip generation).
+    std::vector<const char*> deviceExtensions{VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
     if (options.presentation) deviceExtensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &f2};
     dci.queueCreateInfoCount = 1;
@@ -212,6 +213,7 @@ Context::Context(const ContextOptions& options) {
     dci.enabledExtensionCount = uint32_t(deviceExtensions.size());
     dci.ppEnabledExtensionNames = deviceExtensions.data();
     VK_CHECK(vkCreateDevice(physical_, &dci, nullptr, &device_));
+    pushDescriptorFn_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
     vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
     VmaAllocatorCreateInfo ai{};

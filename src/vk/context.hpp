@@ -47,6 +47,8 @@ class Context {
   static uint32_t validationMessageCount();
   static void resetValidationMessageCount();
 
+  PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn() const { return pushDescriptorFn_; }
+
   // Names an object in validation messages and debuggers (no-op without validation).
   void setName(uint64_t handle, VkObjectType type, const char* name) const;
 
@@ -65,6 +67,7 @@ class Context {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queueFamily_ = 0;
   VmaAllocator allocator_ = nullptr;
+  PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn_ = nullptr;
 };
 
 }  // namespace rtr::vk

@@ -1,5 +1,6 @@
 #include "vk/pipeline.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <unistd.h>
 
@@ -37,6 +38,9 @@ PipelineLayout::PipelineLayout(const Context& ctx, PipelineInterface interface, 
     fi.bindingCount = uint32_t(flags.size());
     fi.pBindingFlags = flags.data();
     VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, variable ? &fi : nullptr};
+    const auto& pushSets = options_.pushDescriptorSets;
+    if (std::find(pushSets.begin(), pushSets.end(), set) != pushSets.end())
+      li.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
     li.bindingCount = uint32_t(bindings.size());
     li.pBindings = bindings.data();
     VkDescriptorSetLayout raw;
@@ -217,7 +221,8 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
 
 DescriptorSets::DescriptorSets(const Context& ctx, const PipelineLayout& layout, uint32_t copies) : copies_(copies) {
   std::map<VkDescriptorType, uint32_t> counts;
-  for (const auto& b : layout.interface().bindings) counts[b.type] += layout.arrayCount(b) * copies;
+  for (const auto& b : layout.interface().bindings)
+    if (!layout.isPushDescriptorSet(b.set)) counts[b.type] += layout.arrayCount(b) * copies;
   std::vector<VkDescriptorPoolSize> sizes;
   for (auto [type, n] : counts) sizes.push_back({type, n});
   if (sizes.empty()) return;
@@ -229,6 +234,10 @@ DescriptorSets::DescriptorSets(const Context& ctx, const PipelineLayout& layout,
   VK_CHECK(vkCreateDescriptorPool(ctx.device(), &pi, nullptr, &raw));
   pool_ = DescriptorPool(ctx.device(), raw);
   for (uint32_t set = 0; set < layout.setCount(); ++set) {
+    if (layout.isPushDescriptorSet(set)) {
+      for (uint32_t c = 0; c < copies; ++c) sets_.push_back(VK_NULL_HANDLE);
+      continue;
+    }
     uint32_t variable = 0;
     for (const auto& b : layout.interface().bindings)
       if (b.set == set && b.count == 0) variable = layout.arrayCount(b);
@@ -283,6 +292,11 @@ DescriptorWriter& DescriptorWriter::images(uint32_t binding, const std::vector<V
   w.pImageInfo = imageInfos_.back().data();
   writes_.push_back(w);
   return *this;
+}
+
+void DescriptorWriter::push(VkCommandBuffer cb, const Pipeline& pipeline) {
+  ctx_.pushDescriptorFn()(cb, pipeline.bindPoint, pipeline.layout.handle(), set_, uint32_t(writes_.size()), writes_.data());
+  writes_.clear();
 }
 
 void DescriptorWriter::commit() {

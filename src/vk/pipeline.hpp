@@ -1,6 +1,7 @@
 #pragma once
 // Pipelines whose layouts come from reflection: descriptor set layouts, push-constant ranges and vertex
 // inputs are read from the shaders' SPIR-V (vk/reflect.hpp), never written by hand.
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -23,6 +24,8 @@ struct LayoutOptions {
   // Size of each runtime-sized array binding, keyed by (set, binding). Such bindings are made
   // partially bound with a variable count, so a scene's texture count decides the size.
   std::map<std::pair<uint32_t, uint32_t>, uint32_t> runtimeArrayCounts;
+  // Sets bound with vkCmdPushDescriptorSetKHR (DescriptorWriter::push) instead of allocated sets.
+  std::vector<uint32_t> pushDescriptorSets;
 };
 
 class PipelineLayout {
@@ -35,6 +38,10 @@ class PipelineLayout {
   const PipelineInterface& interface() const { return interface_; }
   const ReflectedBinding& binding(uint32_t set, uint32_t binding) const;
   uint32_t arrayCount(const ReflectedBinding& b) const;  // the count the layout was made with
+  bool isPushDescriptorSet(uint32_t set) const {
+    return std::find(options_.pushDescriptorSets.begin(), options_.pushDescriptorSets.end(), set) !=
+           options_.pushDescriptorSets.end();
+  }
 
  private:
   PipelineInterface interface_;
@@ -100,7 +107,10 @@ class DescriptorWriter {
   DescriptorWriter& buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE);
   DescriptorWriter& image(uint32_t binding, VkImageView view, VkImageLayout layout, VkSampler sampler = VK_NULL_HANDLE);
   DescriptorWriter& images(uint32_t binding, const std::vector<VkDescriptorImageInfo>& infos);
-  void commit();
+  void commit();  // updates an allocated set
+  // Records the writes as push descriptors for `set` of `pipeline` (its layout must list the set in
+  // LayoutOptions::pushDescriptorSets); the writer was made with ds = VK_NULL_HANDLE.
+  void push(VkCommandBuffer cb, const struct Pipeline& pipeline);
 
  private:
   const Context& ctx_;

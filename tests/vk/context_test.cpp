@@ -33,6 +33,26 @@ TEST_F(VulkanTest, ComputeDispatchWritesEveryValue) {
   for (uint32_t i = 0; i < kCount; ++i) ASSERT_EQ(v[i], i * i + kOffset) << "at index " << i;
 }
 
+TEST_F(VulkanTest, PushDescriptorsBindWithoutAPool) {
+  constexpr uint32_t kCount = 300;
+  vk::LayoutOptions options;
+  options.pushDescriptorSets = {0};
+  vk::Pipeline fill = vk::makeComputePipeline(*ctx, vk::loadShader("fill.comp"), options);
+  vk::Buffer out(*ctx, kCount * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Readback);
+  struct { uint32_t count, offset; } push{kCount, 3};
+  vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
+    fill.bind(cb);
+    vk::DescriptorWriter(*ctx, fill.layout, 0, VK_NULL_HANDLE).buffer(0, out.handle()).push(cb, fill);
+    fill.push(cb, push);
+    vkCmdDispatch(cb, (kCount + 63) / 64, 1, 1);
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+  });
+  out.invalidate();
+  const uint32_t* v = static_cast<const uint32_t*>(out.mapped());
+  for (uint32_t i = 0; i < kCount; ++i) ASSERT_EQ(v[i], i * i + 3) << "at index " << i;
+}
+
 TEST_F(VulkanTest, GpuTimerMeasuresAPass) {
   vk::GpuTimer timer(*ctx, 2);
   vk::Pipeline fill = vk::makeComputePipeline(*ctx, vk::loadShader("fill.comp"));
