@@ -158,6 +158,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
   staging = {};
 
   MipGenerator mipGen(ctx);
+  std::vector<MipViews> mipViews;  // alive until the submission has completed
   vk::GpuTimer timer(ctx, 1);
   vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
     auto copy = [&](const vk::Buffer& dst, size_t offset) {
@@ -190,7 +191,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     }
     timer.reset(cb);
     timer.begin(cb);
-    for (auto& img : textures_) mipGen.record(cb, img, mipMode);
+    for (auto& img : textures_) mipViews.push_back(mipGen.record(cb, img, mipMode));
     timer.mark(cb, "mips");
   });
   if (!textures_.empty()) stats_.mipGpuMs = timer.results().at(0).second;

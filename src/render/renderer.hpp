@@ -65,7 +65,7 @@ class Renderer {
   uint32_t framesInFlight_;
   std::vector<vk::Buffer> uniforms_;  // FrameUniforms, one per frame in flight
   std::array<ScenePipelines, kDrawKindCount> shaded_, debug_;
-  PostProcess post_;
+  MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;
   vk::Image color_, depth_;
   VkExtent2D extent_{0, 0};

@@ -8,6 +8,7 @@
 
 #include "camera_controller.hpp"
 #include "core/error.hpp"
+#include "core/image.hpp"
 #include "options.hpp"
 #include "scene/load.hpp"
 #include "vk/check.hpp"
