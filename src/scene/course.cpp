@@ -152,8 +152,17 @@ Scene decodeCourseMesh(std::span<const uint8_t> bytes, const std::string& file) 
     remap[t] = uint32_t(scene.textures.size());
     scene.textures.push_back(raw.textures[t]);
   }
-  for (Material& m : raw.materials)
+  // The format has no scalar factors: its textures (fallbacks included) are the values. A fallback of
+  // value one becomes factor 1 with no texture; the black emissive fallback becomes factor 0.
+  for (Material& m : raw.materials) {
+    const uint32_t emissive = m.texture(TextureSlot::Emissive);
+    const bool emits = emissive != kNoTexture && !isFallbackTexture(raw.textures.at(emissive).path);
+    m.baseColor = glm::vec3(1.0f);
+    m.roughness = 1.0f;
+    m.metalness = 1.0f;
+    m.emissive = glm::vec3(emits ? 1.0f : 0.0f);
     for (uint32_t& id : m.textures) id = id == kNoTexture ? kNoTexture : remap[id];
+  }
   scene.materials = std::move(raw.materials);
   scene.meshes = std::move(raw.meshes);
   return scene;
