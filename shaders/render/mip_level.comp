@@ -18,6 +18,7 @@ layout(push_constant) uniform Push { MipPush pc; };
 
 void main() {
   const bool srgb = pc.srgb != 0;
+  initSrgbDecodeLut();  // before any thread returns
   const ivec2 srcSize = ivec2(pc.srcWidth, pc.srcHeight);
   const ivec2 dstSize = mipNext(srcSize);
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -30,7 +31,7 @@ void main() {
     for (int a = 0; a < tx.count; ++a)
     {
       const ivec2 q = ivec2(tx.first + a, ty.first + b);
-      row += tx.w[a] * (pc.fromScratch != 0 ? srcTexels[q.y * srcSize.x + q.x] : decode8(texelFetch(srcLevel, q, 0), srgb));
+      row += tx.w[a] * (pc.fromScratch != 0 ? srcTexels[q.y * srcSize.x + q.x] : decodeLut(texelFetch(srcLevel, q, 0), srgb));
     }
     sum += ty.w[b] * row;
   }
