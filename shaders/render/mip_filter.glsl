@@ -23,6 +23,19 @@ MipTaps mipTaps(int x, int n, int m) {
   return t;
 }
 
+// sRGB decode of the 256 byte values, built once per workgroup (both mip shaders have 256 threads):
+// one pow per thread instead of three per texel read.
+shared float srgbDecodeLut[256];
+void initSrgbDecodeLut() {
+  srgbDecodeLut[gl_LocalInvocationIndex] = srgbToLinear(float(gl_LocalInvocationIndex) / 255.0);
+  barrier();
+}
+vec4 decodeLut(vec4 stored, bool srgb) {
+  if (!srgb) return stored;
+  const ivec4 b = ivec4(stored * 255.0 + 0.5);
+  return vec4(srgbDecodeLut[b.r], srgbDecodeLut[b.g], srgbDecodeLut[b.b], stored.a);
+}
+
 // Level sizes as Vulkan defines them.
 ivec2 mipNext(ivec2 size) { return max(size >> 1, ivec2(1)); }
 

@@ -34,6 +34,7 @@ void storeLevel(int j, ivec2 p, vec4 v) {
 void main() {
   const int L = pc.levels;
   const bool srgb = pc.srgb != 0;
+  initSrgbDecodeLut();
   ivec2 size[MIP_MAX_LEVELS_PER_DISPATCH + 1];
   ivec2 lo[MIP_MAX_LEVELS_PER_DISPATCH + 1], hi[MIP_MAX_LEVELS_PER_DISPATCH + 1];
   size[0] = ivec2(pc.srcWidth, pc.srcHeight);
@@ -61,7 +62,7 @@ void main() {
         for (int a = 0; a < tx.count; ++a) {
           const ivec2 q = ivec2(tx.first + a, ty.first + b);
           vec4 v;
-          if (j == 1) v = decode8(texelFetch(srcLevel, q, 0), srgb);
+          if (j == 1) v = decodeLut(texelFetch(srcLevel, q, 0), srgb);
           else {
             const int i = (q.y - srcLo.y) * srcStride + (q.x - srcLo.x);
             v = (j % 2 == 0) ? tileOdd[i] : tileEven[i];

@@ -21,6 +21,7 @@ struct MipPush {
   int srcHeight;
   int levels;     // levels written (1 .. MIP_MAX_LEVELS_PER_DISPATCH)
   int srgb;       // 1: decode sRGB on read and encode on write (R, G, B; alpha stays linear)
+  int fromScratch;  // mip_level.comp: 1 reads the source level's float copy instead of its 8-bit texels
 };
 
 #ifdef __cplusplus

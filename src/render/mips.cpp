@@ -157,14 +157,32 @@ MipViews MipGenerator::record(VkCommandBuffer cb, const vk::Image& image, MipMod
   vk::barrier(cb, start);
   if (n == 1) return views;
 
+  // Per level: level k's float copy goes to region k % 2 (odd levels: the size of level 1, even: level 2).
+  const std::vector<MipDispatch> plan = planMipDispatches(image.extent(), mode);
+  VkDeviceSize region[2] = {16, 16};  // [even, odd] sizes; never empty
+  if (std::any_of(plan.begin(), plan.end(), [](const MipDispatch& d) { return !d.multiLevel; })) {
+    const VkExtent2D e = image.extent();
+    region[1] = VkDeviceSize(levelSize(e.width, 1)) * levelSize(e.height, 1) * 16;
+    if (n > 2) region[0] = VkDeviceSize(levelSize(e.width, 2)) * levelSize(e.height, 2) * 16;
+    const VkDeviceSize align = std::max<VkDeviceSize>(256, ctx_.properties().limits.minStorageBufferOffsetAlignment);
+    region[1] = (region[1] + align - 1) / align * align;
+    views.scratch = vk::Buffer(ctx_, region[1] + region[0], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device,
+                               "mip scratch");
+  }
+  auto scratchRegion = [&](uint32_t level, vk::DescriptorWriter& w, uint32_t binding) {
+    w.buffer(binding, views.scratch.handle(), level % 2 ? 0 : region[1], region[level % 2]);
+  };
+
   const int srgb = (image.format() == VK_FORMAT_R8G8B8A8_SRGB || image.format() == VK_FORMAT_B8G8R8A8_SRGB) ? 1 : 0;
-  bool first = true;
-  for (const MipDispatch& d : planMipDispatches(image.extent(), mode)) {
-    // The previous dispatch's last level is this one's source.
-    if (!first)
+  const MipDispatch* prev = nullptr;
+  for (const MipDispatch& d : plan) {
+    // The previous dispatch's last level (or its float copy) is this one's source; the scratch
+    // regions are also rewritten every other level (WAR and WAW).
+    if (prev)
       vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-    first = false;
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
+                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     const vk::Pipeline& p = d.multiLevel ? multi_ : perLevel_;
     p.bind(cb);
     vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
@@ -177,12 +195,16 @@ MipViews MipGenerator::record(VkCommandBuffer cb, const vk::Image& image, MipMod
       w.images(1, outs);
     } else {
       w.image(1, views.storage[d.srcLevel + 1], VK_IMAGE_LAYOUT_GENERAL);
+      scratchRegion(d.srcLevel, w, 2);  // not read by the first dispatch, but must be valid
+      scratchRegion(d.srcLevel + 1, w, 3);
     }
     w.push(cb, p);
     const shader::MipPush push{int(levelSize(image.extent().width, d.srcLevel)),
-                               int(levelSize(image.extent().height, d.srcLevel)), int(d.levels), srgb};
+                               int(levelSize(image.extent().height, d.srcLevel)), int(d.levels), srgb,
+                               prev && !prev->multiLevel ? 1 : 0};
     p.push(cb, push);
     vkCmdDispatch(cb, d.groups.width, d.groups.height, 1);
+    prev = &d;
   }
   vk::barrier(cb, {{img, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, readers, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,

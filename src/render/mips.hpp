@@ -38,10 +38,12 @@ struct MipDispatch {
 };
 std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, MipMode mode);
 
-// Views a recorded generation uses; keep them until the command buffer has completed.
+// Views (and, per level mode, a float scratch buffer) a recorded generation uses; keep them until the
+// command buffer has completed.
 struct MipViews {
   std::vector<vk::ImageView> sampled;  // per level, UNORM-equivalent format, sampled usage
   std::vector<vk::ImageView> storage;  // per level, UNORM-equivalent format, storage usage
+  vk::Buffer scratch;                  // ComputePerLevel: float copies of odd and even levels
 };
 
 class MipGenerator {

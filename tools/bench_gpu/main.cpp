@@ -1,0 +1,175 @@
+// rtr-bench-gpu: times mip generation (64 textures, three modes) and the mosaic post-process (compute,
+// graphics, off) with GPU timestamps; min / median over --runs submissions after --warmup ones.
+// Prints a Markdown table and "csv," lines. Headless: no window, no validation unless RTR_VALIDATION=1.
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <glm/gtc/packing.hpp>
+
+#include "render/mips.hpp"
+#include "render/post.hpp"
+#include "vk/commands.hpp"
+#include "vk/context.hpp"
+
+namespace {
+
+using namespace rtr;
+
+struct Row {
+  std::string pass, size, mode;
+  double minMs = 0, medianMs = 0;
+  int runs = 0;
+};
+
+// Times `record` (between two timestamps) over warmup + runs submissions.
+template <class Prepare, class Record>
+Row measure(const vk::Context& ctx, int warmup, int runs, Prepare prepare, Record record) {
+  vk::GpuTimer timer(ctx, 1);
+  std::vector<double> ms;
+  for (int i = 0; i < warmup + runs; ++i) {
+    std::vector<render::MipViews> keep;  // alive until submitAndWait has waited
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+      timer.reset(cb);
+      prepare(cb);
+      timer.begin(cb);
+      record(cb, keep);
+      timer.mark(cb, "pass");
+    });
+    if (i >= warmup) ms.push_back(timer.results().at(0).second);
+  }
+  std::sort(ms.begin(), ms.end());
+  Row r;
+  r.minMs = ms.front();
+  r.medianMs = ms.size() % 2 ? ms[ms.size() / 2] : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]);
+  r.runs = runs;
+  return r;
+}
+
+std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count, int warmup, int runs) {
+  std::vector<vk::Image> textures;
+  const size_t bytes = size_t(extent.width) * extent.height * 4;
+  vk::Buffer upload(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
+  std::mt19937 rng(42);
+  for (size_t i = 0; i < bytes; ++i) static_cast<uint8_t*>(upload.mapped())[i] = uint8_t(rng());
+  upload.flush();
+  for (int i = 0; i < count; ++i) textures.emplace_back(ctx, render::textureDesc(extent, VK_FORMAT_R8G8B8A8_SRGB));
+  render::MipGenerator gen(ctx);
+  // Upload level 0 of every texture once (same content) and leave each chain complete, SHADER_READ_ONLY.
+  vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+    std::vector<render::MipViews> unused;
+    for (auto& t : textures) {
+      vk::barrier(cb, {{t.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1}});
+      VkBufferImageCopy c{};
+      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      c.imageExtent = {extent.width, extent.height, 1};
+      vkCmdCopyBufferToImage(cb, upload.handle(), t.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+      gen.record(cb, t, render::MipMode::Blit);
+    }
+  });
+  // Before each timed run: level 0 back to the "just uploaded" layout of the contract (content kept).
+  auto prepare = [&](VkCommandBuffer cb) {
+    std::vector<vk::ImageBarrier> bs;
+    for (auto& t : textures)
+      bs.push_back({t.handle(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
+                    VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
+    vk::barrier(cb, bs);
+  };
+  std::vector<Row> rows;
+  const std::string size = std::to_string(count) + " x " + std::to_string(extent.width) + "x" + std::to_string(extent.height) + " sRGB";
+  for (render::MipMode mode : {render::MipMode::Blit, render::MipMode::ComputePerLevel, render::MipMode::Compute}) {
+    Row r = measure(ctx, warmup, runs, prepare, [&](VkCommandBuffer cb, std::vector<render::MipViews>& keep) {
+      for (auto& t : textures) keep.push_back(gen.record(cb, t, mode));
+    });
+    r.pass = "mips";
+    r.size = size;
+    r.mode = render::toString(mode);
+    rows.push_back(r);
+    std::fprintf(stderr, "  %s %s: median %.3f ms\n", size.c_str(), r.mode.c_str(), r.medianMs);
+  }
+  return rows;
+}
+
+std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warmup, int runs) {
+  vk::Image input(ctx, {extent, VK_FORMAT_R16G16B16A16_SFLOAT, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  vk::Image output(ctx, {extent, VK_FORMAT_R8G8B8A8_UNORM, 1,
+                         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+  const size_t texels = size_t(extent.width) * extent.height * 4;
+  vk::Buffer upload(ctx, texels * 2, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  auto* h = static_cast<uint16_t*>(upload.mapped());
+  for (size_t i = 0; i < texels; ++i) h[i] = glm::packHalf1x16(u(rng));
+  upload.flush();
+  vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+    vk::barrier(cb, {{input.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+    VkBufferImageCopy c{};
+    c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    c.imageExtent = {extent.width, extent.height, 1};
+    vkCmdCopyBufferToImage(cb, upload.handle(), input.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
+    vk::barrier(cb, {{input.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
+  });
+  render::MosaicPass pass(ctx);
+  std::vector<Row> rows;
+  const std::string size = std::to_string(extent.width) + "x" + std::to_string(extent.height);
+  for (render::MosaicMode mode : {render::MosaicMode::Compute, render::MosaicMode::Graphics, render::MosaicMode::Off}) {
+    Row r = measure(ctx, warmup, runs, [](VkCommandBuffer) {}, [&](VkCommandBuffer cb, std::vector<render::MipViews>&) {
+      pass.record(cb, input.view(), output.handle(), output.view(), VK_FORMAT_R8G8B8A8_UNORM, extent, mode,
+                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    });
+    r.pass = "mosaic 5x3";
+    r.size = size;
+    r.mode = render::toString(mode);
+    rows.push_back(r);
+    std::fprintf(stderr, "  mosaic %s %s: median %.3f ms\n", size.c_str(), r.mode.c_str(), r.medianMs);
+  }
+  return rows;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("GPU timings of the mip and mosaic passes");
+  int runs = 25, warmup = 3, textures = 64;
+  std::string only;
+  app.add_option("--runs", runs, "timed submissions per case (min / median)")->check(CLI::Range(1, 10000));
+  app.add_option("--warmup", warmup, "untimed submissions first")->check(CLI::Range(0, 1000));
+  app.add_option("--textures", textures, "textures per mip case")->check(CLI::Range(1, 1024));
+  app.add_option("--only", only, "mips or mosaic")->check(CLI::IsMember({"mips", "mosaic"}));
+  CLI11_PARSE(app, argc, argv);
+  try {
+    vk::Context ctx(vk::optionsFromEnvironment());
+    std::fprintf(stderr, "device: %s (%s)\n", ctx.deviceName().c_str(), ctx.driverInfo().c_str());
+    std::vector<Row> rows;
+    auto add = [&](std::vector<Row> r) { rows.insert(rows.end(), r.begin(), r.end()); };
+    if (only != "mosaic") {
+      add(benchMips(ctx, {1024, 1024}, textures, warmup, runs));
+      add(benchMips(ctx, {1000, 600}, textures, warmup, runs));
+    }
+    if (only != "mips") {
+      add(benchMosaic(ctx, {1920, 1080}, warmup, runs));
+      add(benchMosaic(ctx, {3840, 2160}, warmup, runs));
+    }
+    std::printf("Device: %s (%s)\n\n", ctx.deviceName().c_str(), ctx.driverInfo().c_str());
+    std::printf("| pass | size | mode | min ms | median ms | runs |\n|---|---|---|---:|---:|---:|\n");
+    for (const Row& r : rows)
+      std::printf("| %s | %s | %s | %.3f | %.3f | %d |\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs,
+                  r.medianMs, r.runs);
+    std::printf("\n");
+    for (const Row& r : rows)
+      std::printf("csv,%s,%s,%s,%.4f,%.4f,%d\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs, r.medianMs, r.runs);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rtr-bench-gpu: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
