@@ -11,7 +11,7 @@ function(rtr_compile_shaders target)
       OUTPUT ${spv}
       COMMAND ${CMAKE_COMMAND} -E make_directory ${RTR_SPIRV_DIR}
       COMMAND Vulkan::glslangValidator -V --target-env vulkan1.3 --quiet
-              -I${CMAKE_CURRENT_SOURCE_DIR} --depfile ${spv}.d -o ${spv} ${src}
+              -I${PROJECT_SOURCE_DIR}/shaders -I${PROJECT_SOURCE_DIR}/shaders/shared --depfile ${spv}.d -o ${spv} ${src}
       COMMAND ${SPIRV_VAL} --target-env vulkan1.3 ${spv}
       MAIN_DEPENDENCY ${src}
       DEPFILE ${spv}.d

@@ -1,0 +1,165 @@
+#include "bake.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "core/error.hpp"
+#include "core/image.hpp"
+#include "scene/binio.hpp"
+#include "scene/course.hpp"
+#include "scene/rtrscene.hpp"
+
+namespace rtr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+bool endsWith(const std::string& s, std::string_view e) {
+  return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
+}
+
+// Removes what it tracked unless told the job succeeded, so a failed bake leaves nothing behind.
+struct CreatedFiles {
+  std::vector<std::filesystem::path> files;
+  bool keep = false;
+  ~CreatedFiles() {
+    if (keep) return;
+    std::error_code ec;
+    for (auto it = files.rbegin(); it != files.rend(); ++it) std::filesystem::remove(*it, ec);
+  }
+};
+
+void copyFileAtomic(const std::filesystem::path& src, const std::filesystem::path& dst) {
+  std::filesystem::path tmp = dst;
+  tmp += ".tmp";
+  std::error_code ec;
+  std::filesystem::copy_file(src, tmp, std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) throw fileError(dst.string(), "", "cannot copy texture from '" + src.string() + "': " + ec.message());
+  std::filesystem::rename(tmp, dst, ec);
+  if (ec) {
+    std::filesystem::remove(tmp);
+    throw fileError(dst.string(), "", "cannot rename temporary texture: " + ec.message());
+  }
+}
+
+// Decodes every source texture with the channel count of its slot, on a few threads.
+void verifyTextures(const TexturePlan& plan, unsigned threads) {
+  std::atomic<size_t> next{0};
+  std::vector<std::string> errors(plan.sources.size());
+  auto work = [&] {
+    for (size_t i; (i = next.fetch_add(1)) < plan.sources.size();) {
+      const auto& src = plan.sources[i];
+      if (src.empty()) continue;
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(src, ec)) {
+        errors[i] = src.string() + ": texture file named in the MTL does not exist";
+        continue;
+      }
+      try {
+        loadImage(src, plan.scene.textures[i].channels);
+      } catch (const Error& e) {
+        errors[i] = std::string(e.what()) + " (texture named in the MTL is not a readable image)";
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  for (const std::string& e : errors)
+    if (!e.empty()) throw Error(e);
+}
+
+void writeFallback(const std::filesystem::path& file, const std::string& name) {
+  ImageRGBA8 img{1, 1, {255, 255, 255, 255}};
+  if (name == kFallbackEmissive) img.pixels = {0, 0, 0, 255};
+  savePng(file, img);
+}
+
+}  // namespace
+
+BakeReport bake(const BakeOptions& opt) {
+  const auto start = Clock::now();
+  BakeReport rep;
+  const std::string out = opt.output.filename().string();
+  const bool course = endsWith(out, ".comp5892mesh");
+  if (!course && !endsWith(out, ".rtrscene"))
+    throw fileError(opt.output.string(), "", "unknown output format (expected .rtrscene or .comp5892mesh)");
+  std::error_code ec;
+  if (std::filesystem::exists(opt.output, ec) && !opt.force)
+    throw fileError(opt.output.string(), "", "output exists; use --force to overwrite it");
+  std::filesystem::path outDir = opt.output.parent_path();
+  if (outDir.empty()) outDir = ".";
+  if (!std::filesystem::is_directory(outDir, ec))
+    throw fileError(opt.output.string(), "", "output folder '" + outDir.string() + "' does not exist");
+  if (::access(outDir.c_str(), W_OK) != 0)
+    throw fileError(opt.output.string(), "", "output folder '" + outDir.string() + "' is not writable");
+  if (opt.view && course && opt.warn) opt.warn("the .comp5892mesh format has no default view; --view ignored");
+  const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+
+  // 1. Parse and weld.
+  ObjOptions oo;
+  oo.warn = opt.warn;
+  oo.threads = threads;
+  if (opt.progress)
+    oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
+  Scene scene = loadObj(opt.input, oo, &rep.obj);
+  rep.parseSeconds = rep.obj.parseSeconds;
+  rep.weldSeconds = rep.obj.weldSeconds;
+  if (opt.view) scene.defaultView = opt.view;
+
+  // 2. Textures: plan, check every source decodes and no destination would be overwritten, then copy.
+  auto t0 = Clock::now();
+  std::string sceneName = opt.output.filename().string();
+  sceneName = sceneName.substr(0, sceneName.rfind('.'));
+  TexturePlan plan = planTextures(scene, sceneName, course);
+  scene = Scene{};
+  if (opt.progress) opt.progress("checking textures", 0.0);
+  verifyTextures(plan, threads);
+  const std::filesystem::path texDir = outDir / (sceneName + "-tex");
+  for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
+    const auto dst = outDir / plan.scene.textures[i].path;
+    if (std::filesystem::exists(dst, ec) && !opt.force)
+      throw fileError(dst.string(), "", "texture exists; refusing to overwrite it without --force");
+  }
+  CreatedFiles created;
+  if (!plan.scene.textures.empty() && !std::filesystem::is_directory(texDir, ec)) {
+    if (!std::filesystem::create_directory(texDir, ec))
+      throw fileError(texDir.string(), "", "cannot create texture folder: " + ec.message());
+    created.files.push_back(texDir);
+  }
+  for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
+    const auto dst = outDir / plan.scene.textures[i].path;
+    const bool existed = std::filesystem::exists(dst, ec);
+    if (plan.sources[i].empty()) {
+      writeFallback(dst, dst.filename().string());
+      ++rep.fallbackTextures;
+    } else {
+      copyFileAtomic(plan.sources[i], dst);
+    }
+    if (!existed) created.files.push_back(dst);
+    if (opt.progress) opt.progress("copying textures", double(i + 1) / double(plan.scene.textures.size()));
+  }
+  rep.textureSeconds = since(t0);
+
+  // 3. Encode and write (temporary file, then rename).
+  t0 = Clock::now();
+  if (opt.progress) opt.progress("writing", 0.0);
+  const std::string bytes = course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene);
+  writeFileAtomic(opt.output, bytes);
+  created.keep = true;
+  rep.writeSeconds = since(t0);
+  rep.outputBytes = bytes.size();
+  rep.meshes = plan.scene.meshes.size();
+  rep.materials = plan.scene.materials.size();
+  rep.textures = plan.scene.textures.size() - rep.fallbackTextures;
+  rep.totalSeconds = since(start);
+  return rep;
+}
+
+}  // namespace rtr

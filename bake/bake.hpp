@@ -1,0 +1,44 @@
+#pragma once
+// rtr-bake's work as a library (the executable, the tests and the benchmark share it):
+// OBJ in, .rtrscene or .comp5892mesh out, textures copied into "<scene>-tex/" beside the output.
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera.hpp"
+#include "scene/obj.hpp"
+#include "scene/scene.hpp"
+
+namespace rtr {
+
+struct BakeOptions {
+  std::filesystem::path input, output;
+  bool force = false;                     // overwrite an existing output and texture files
+  std::optional<CameraPose> view;         // stored as the default view (.rtrscene only)
+  std::function<void(const std::string&)> warn;
+  std::function<void(const char* phase, double fraction)> progress;
+  unsigned threads = 0;
+};
+
+struct BakeReport {
+  ObjStats obj;
+  size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0;
+  uint64_t outputBytes = 0;
+  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, writeSeconds = 0, totalSeconds = 0;
+};
+
+// Throws rtr::Error naming the file and place; on failure nothing it created is left behind.
+BakeReport bake(const BakeOptions& options);
+
+// The texture plan for an output named `sceneName`: paths become "<sceneName>-tex/<file name>", ids are
+// re-given at first appearance (materials in order, slots in course order), and with `courseFallbacks`
+// missing baseColor/roughness/metalness/emissive slots point at fallback textures (FORMATS.md §1).
+struct TexturePlan {
+  Scene scene;                                       // the scene to encode (shares nothing with the input)
+  std::vector<std::filesystem::path> sources;        // per texture of `scene`: the file to copy; empty for fallbacks
+};
+TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks);
+
+}  // namespace rtr

@@ -1,0 +1,151 @@
+// The one BRDF of the project (brief part 2, §1.5): Lambertian diffuse + Cook-Torrance specular with the
+// Beckmann NDF, Cook-Torrance V-cavity masking and Schlick Fresnel. Not GGX, on purpose.
+//
+// This file is both GLSL 4.60 (#include "brdf.h" with GL_GOOGLE_include_directive) and C++20 with GLM
+// (namespace rtr::shader), so the GPU renderer and the CPU reference ray tracer evaluate the same code.
+// Keep it in the common subset: no in/out parameters, no swizzles, float literals with an f suffix,
+// no GLSL keywords as names (sample, half, ...), struct members assigned one by one.
+//
+// Every result is finite and >= 0 for every input (see docs/shading.md for why each guard is needed):
+//   * roughness 0 .. 1e-2: alpha = roughness^2 is clamped to BRDF_ALPHA_MIN;
+//   * D uses tan^2(theta_h) computed from the tangential part of the unnormalised half vector
+//     (no 1 - cos^2 cancellation), capped at BRDF_TAN2_MAX where D underflows to 0 anyway;
+//   * G / (4 n.v n.l) is cancelled algebraically (no division by n.v or n.l);
+//   * |v + l|^2 is clamped to BRDF_HH_MIN inside the masking term only (v = -l, both grazing);
+//   * light below the shading normal: f = 0; view below it: specular = 0, diffuse kept;
+//   * n may be unnormalised or zero (zero n gives no direct light: ambient + emissive only).
+#ifndef RTR_SHADERS_SHARED_BRDF_H
+#define RTR_SHADERS_SHARED_BRDF_H
+
+// RTR_FN / RTR_CONST qualify functions and constants in headers shared by GLSL and C++.
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace rtr::shader {
+using namespace glm;
+#ifndef RTR_FN
+#define RTR_FN inline
+#define RTR_CONST inline constexpr
+#endif
+#else
+#ifndef RTR_FN
+#define RTR_FN
+#define RTR_CONST const
+#endif
+#endif
+
+RTR_CONST float BRDF_PI = 3.14159265358979f;
+// Smallest Beckmann alpha. Below it the lobe is narrower than a pixel at ordinary resolutions, and a
+// point light would give D -> infinity at h = n (alpha = 0 is a delta: exactly zero almost everywhere).
+// Clamping keeps a tiny finite highlight (peak D = 1/(pi alpha^2) ~ 3.2e5) instead of nothing.
+RTR_CONST float BRDF_ALPHA_MIN = 1e-3f;
+// Cap of tan^2(theta_h): exp(-1e4 / alpha^2) is 0 in float for alpha <= 1, so the cap never changes
+// D; it only keeps (1 + tan^2)^2 finite when n.h -> 0.
+RTR_CONST float BRDF_TAN2_MAX = 1e4f;
+// Floor of |v + l|^2 in the masking term. |v + l| -> 0 only when v = -l; with both above the surface
+// that forces n.v + n.l <= |v + l|, i.e. both within ~0.06 deg of the horizon, where the V-cavity model
+// really diverges (forward grazing mirror). It bounds G / (4 n.v n.l) <= 4 / BRDF_HH_MIN.
+RTR_CONST float BRDF_HH_MIN = 1e-6f;
+// Floor of |n|^2 before normalising: a zero normal stays zero instead of becoming NaN.
+RTR_CONST float BRDF_NN_MIN = 1e-30f;
+
+struct BrdfTerms {
+  float D;        // Beckmann NDF at h
+  vec3 F;         // Schlick Fresnel
+  float G;        // Cook-Torrance masking, in [0, 1]
+  vec3 diffuse;   // BRDF value f_diffuse (before the cosine)
+  vec3 specular;  // BRDF value f_spec = D F G / (4 n.v n.l) (before the cosine)
+};
+
+// Beckmann alpha from the texture roughness (brief: alpha = roughness^2), clamped to BRDF_ALPHA_MIN.
+RTR_FN float brdfAlpha(float roughness) {
+  float r = clamp(roughness, 0.0f, 1.0f);
+  return max(r * r, BRDF_ALPHA_MIN);
+}
+
+// Unit normal, or zero for a zero-length one.
+RTR_FN vec3 brdfSafeNormal(vec3 n) { return n * inversesqrt(max(dot(n, n), BRDF_NN_MIN)); }
+
+// Beckmann D from the unnormalised half vector H = v + l and unit n:
+// D = exp(-tan^2/alpha^2) / (pi alpha^2 cos^4) with 1/cos^4 = (1 + tan^2)^2. tan^2 = |H_t|^2 / (n.H)^2,
+// H_t = H - (n.H) n, which keeps full precision near h = n (where tiny alphas need it).
+RTR_FN float brdfBeckmannD(vec3 n, vec3 H, float alpha) {
+  float nH = dot(n, H);
+  vec3 Ht = H - nH * n;
+  float ht2 = dot(Ht, Ht);
+  float nH2 = nH * nH;
+  // Division-free guard: if n.H = 0 the comparison fails and the cap is used.
+  float t2 = (ht2 < BRDF_TAN2_MAX * nH2) ? ht2 / nH2 : BRDF_TAN2_MAX;
+  float a2 = alpha * alpha;
+  float d = exp(-t2 / a2) * (1.0f + t2) * (1.0f + t2) / (BRDF_PI * a2);
+  return nH > 0.0f ? d : 0.0f;
+}
+
+// Cook-Torrance masking G = min(1, 2 (n.h)(n.v)/(v.h), 2 (n.h)(n.l)/(v.h)). With h = H/|H| and
+// v.h = |H|/2 for unit v, l: (n.h)/(v.h) = 2 (n.H)/|H|^2, so G = min(1, 4 (n.H) min(nv, nl) / |H|^2).
+RTR_FN float brdfMaskingG(float nv, float nl, float nH, float hh) {
+  if (nv <= 0.0f || nl <= 0.0f) return 0.0f;
+  float hhc = max(hh, BRDF_HH_MIN);
+  return min(1.0f, 4.0f * max(nH, 0.0f) * min(nv, nl) / hhc);
+}
+
+// V = G / (4 n.v n.l), cancelled: with m = min(nv, nl), M = max(nv, nl), n.H = m + M,
+//   G = 1 branch (|H|^2 <= 4 n.H m): V = 1 / (4 m M), and there m >= |H|/4 so 4 m M >= |H|^2/4;
+//   G < 1 branch:                     V = n.H / (M |H|^2) = (1 + m/M) / |H|^2.
+// Neither divides by a cosine that can be ~0, so V <= 4 / BRDF_HH_MIN.
+RTR_FN float brdfVisibility(float nv, float nl, float nH, float hh) {
+  if (nv <= 0.0f || nl <= 0.0f) return 0.0f;
+  float hhc = max(hh, BRDF_HH_MIN);
+  float m = min(nv, nl);
+  float M = max(nv, nl);
+  if (hhc <= 4.0f * nH * m) return 1.0f / (4.0f * m * M);
+  // max(M, 1e-30): only a guard for denormal cosines on hardware that flushes them; m/M stays in [0, 1].
+  return (1.0f + m / max(M, 1e-30f)) / hhc;
+}
+
+// Schlick: F = F0 + (1 - F0)(1 - v.h)^5, F0 = (1 - M) 0.04 + M c_mat.
+RTR_FN vec3 brdfFresnel(float vh, vec3 baseColor, float metalness) {
+  vec3 F0 = mix(vec3(0.04f), baseColor, metalness);
+  float x = 1.0f - clamp(vh, 0.0f, 1.0f);
+  float x2 = x * x;
+  return F0 + (vec3(1.0f) - F0) * (x2 * x2 * x);
+}
+
+// All terms for unit v, l and any n. f = 0 for light below the shading hemisphere (n.l <= 0); for the
+// view below it (back-facing interpolated normal) the specular is 0 (G = 0 by (n.v)_+) but the
+// Lambertian diffuse is kept, so silhouettes do not turn black.
+RTR_FN BrdfTerms brdfTerms(vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughness, float metalness) {
+  vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
+  float metal = clamp(metalness, 0.0f, 1.0f);
+  vec3 nn = brdfSafeNormal(n);
+  vec3 H = v + l;  // unnormalised half vector; h = H / |H|
+  float hh = dot(H, H);
+  float nH = dot(nn, H);
+  float nv = dot(nn, v);
+  float nl = dot(nn, l);
+  float vh = 0.5f * sqrt(hh);  // v.h for unit v, l (exact, no division)
+
+  BrdfTerms t;
+  t.D = brdfBeckmannD(nn, H, brdfAlpha(roughness));
+  t.F = brdfFresnel(vh, c, metal);
+  t.G = brdfMaskingG(nv, nl, nH, hh);
+  bool lit = nl > 0.0f;
+  t.diffuse = lit ? c * (1.0f / BRDF_PI) * (vec3(1.0f) - t.F) * (1.0f - metal) : vec3(0.0f);
+  t.specular = t.D * t.F * brdfVisibility(nv, nl, nH, hh);
+  return t;
+}
+
+// Outgoing radiance for one point light (brief eq. 1):
+// L = c_ambient c_mat + c_emit + (f_diffuse + f_spec) c_light (n.l)_+.
+RTR_FN vec3 shadePbr(vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 ambient, vec3 baseColor, float roughness,
+                     float metalness, vec3 emissive) {
+  BrdfTerms t = brdfTerms(n, v, l, baseColor, roughness, metalness);
+  float nl = max(dot(brdfSafeNormal(n), l), 0.0f);
+  vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
+  return ambient * c + emissive + (t.diffuse + t.specular) * lightColor * nl;
+}
+
+#ifdef __cplusplus
+}  // namespace rtr::shader
+#endif
+
+#endif

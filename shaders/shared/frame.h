@@ -1,0 +1,60 @@
+// Structs shared by the renderer's C++ and its shaders: one definition on both sides of the boundary.
+// Layouts use only vec4/mat4/uvec4 so std140 and std430 agree with C++ (GLM) without padding rules.
+#ifndef RTR_SHADERS_SHARED_FRAME_H
+#define RTR_SHADERS_SHARED_FRAME_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace rtr::shader {
+using namespace glm;
+typedef uint32_t uint;
+#endif
+
+// View modes (keys 1-7 and BRDF-term views; --mode N).
+#define VIEW_SHADED 1
+#define VIEW_MIP_LEVEL 2
+#define VIEW_LINEAR_DEPTH 3
+#define VIEW_DEPTH_DERIVATIVES 4
+#define VIEW_NORMAL 5
+#define VIEW_VIEW_DIR 6
+#define VIEW_LIGHT_DIR 7
+#define VIEW_BRDF_D 8
+#define VIEW_BRDF_F 9
+#define VIEW_BRDF_G 10
+#define VIEW_DIFFUSE 11
+#define VIEW_SPECULAR 12
+#define VIEW_COUNT 12
+
+// Per-frame constants (uniform buffer, std140).
+struct FrameUniforms {
+  mat4 viewProj;
+  mat4 view;
+  vec4 cameraPos;     // xyz world position
+  vec4 lightPos;      // xyz world position
+  vec4 lightColor;    // rgb colour x intensity; w: 1 = inverse-square falloff, 0 = none
+  vec4 ambient;       // rgb constant ambient illumination
+  vec4 params;        // x: view mode, y: mip LOD bias, z: near, w: far
+};
+
+// Material factors (storage buffer, std430). Texture indices index the scene's texture array;
+// 0xFFFFFFFF: no texture (the factor alone is used).
+struct GpuMaterial {
+  vec4 baseColor;     // rgb factor, a unused
+  vec4 emissive;      // rgb factor
+  vec4 roughMetal;    // x roughness, y metalness
+  uvec4 textures;     // x baseColor, y roughness, z metalness, w alphaMask
+  uvec4 textures2;    // x emissive
+};
+
+// Per-draw push constants.
+struct DrawPush {
+  uint material;
+};
+
+#define NO_TEXTURE 0xFFFFFFFFu
+
+#ifdef __cplusplus
+}  // namespace rtr::shader
+#endif
+#endif

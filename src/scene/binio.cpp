@@ -1,0 +1,66 @@
+#include "scene/binio.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <memory>
+
+namespace rtr {
+namespace {
+struct FileCloser {
+  void operator()(std::FILE* f) const { if (f) std::fclose(f); }
+};
+}  // namespace
+
+std::vector<uint8_t> readFileBytes(const std::filesystem::path& file) {
+  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(file.c_str(), "rb"));
+  if (!f) throw fileError(file.string(), "", std::string("cannot open: ") + std::strerror(errno));
+  std::vector<uint8_t> out;
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  if (!ec) out.reserve(size);
+  uint8_t buf[1 << 16];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f.get())) > 0;) out.insert(out.end(), buf, buf + n);
+  if (std::ferror(f.get())) throw fileError(file.string(), "", "read error");
+  return out;
+}
+
+void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes) {
+  std::filesystem::path tmp = file;
+  tmp += ".tmp";
+  {
+    std::unique_ptr<std::FILE, FileCloser> f(std::fopen(tmp.c_str(), "wb"));
+    if (!f) throw fileError(file.string(), "", std::string("cannot create output: ") + std::strerror(errno));
+    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f.get()) == bytes.size();
+    ok = std::fflush(f.get()) == 0 && ok;
+    if (!ok) {
+      int err = errno;
+      f.reset();
+      std::filesystem::remove(tmp);
+      throw fileError(file.string(), "", std::string("cannot write output: ") + std::strerror(err));
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::filesystem::remove(tmp);
+    throw fileError(file.string(), "", "cannot rename temporary output: " + ec.message());
+  }
+}
+
+uint64_t checksum64(std::span<const uint8_t> data) {
+  uint64_t h = 0x243F6A8885A308D3ull ^ data.size();
+  size_t i = 0;
+  for (; i + 8 <= data.size(); i += 8) {
+    uint64_t w;
+    std::memcpy(&w, data.data() + i, 8);
+    h = (h ^ w) * 0x9E3779B97F4A7C15ull;
+    h ^= h >> 29;
+  }
+  uint64_t tail = 0;
+  std::memcpy(&tail, data.data() + i, data.size() - i);
+  h = (h ^ tail) * 0xBF58476D1CE4E5B9ull;
+  h ^= h >> 31;
+  return h;
+}
+
+}  // namespace rtr

@@ -1,0 +1,105 @@
+#pragma once
+// Little-endian binary encoding helpers for the baked formats: an appending writer and a bounds-checked
+// reader whose every fault names the file, the byte offset and what was wrong.
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace rtr {
+
+static_assert(std::endian::native == std::endian::little, "the baked formats are little-endian");
+
+class ByteWriter {
+public:
+  void bytes(const void* p, size_t n) { out_.append(static_cast<const char*>(p), n); }
+  template <class T>
+  void pod(const T& v) { bytes(&v, sizeof v); }
+  void u8(uint8_t v) { pod(v); }
+  void u32(uint32_t v) { pod(v); }
+  void f32(float v) { pod(v); }
+  template <class T>
+  void array(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
+  void pad(size_t align) { out_.append((align - out_.size() % align) % align, '\0'); }
+  size_t size() const { return out_.size(); }
+  std::string& data() { return out_; }
+
+private:
+  std::string out_;
+};
+
+class ByteReader {
+public:
+  ByteReader(std::span<const uint8_t> data, std::string file) : d_(data), file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& what) const { failAt(pos_, what); }
+  [[noreturn]] void failAt(size_t at, const std::string& what) const {
+    throw fileError(file_, "at byte " + std::to_string(at), what);
+  }
+  size_t pos() const { return pos_; }
+  size_t remaining() const { return d_.size() - pos_; }
+  void need(size_t n, const char* what) const {
+    if (n > remaining())
+      fail(std::string("file ends inside ") + what + " (needs " + std::to_string(n) + " bytes, " +
+           std::to_string(remaining()) + " left)");
+  }
+  void raw(void* dst, size_t n, const char* what) {
+    need(n, what);
+    std::memcpy(dst, d_.data() + pos_, n);
+    pos_ += n;
+  }
+  template <class T>
+  T pod(const char* what) {
+    T v;
+    raw(&v, sizeof v, what);
+    return v;
+  }
+  uint8_t u8(const char* what) { return pod<uint8_t>(what); }
+  uint32_t u32(const char* what) { return pod<uint32_t>(what); }
+  float f32(const char* what) { return pod<float>(what); }
+  // A count of records of at least `minBytes` each must fit in what is left: checked before allocating.
+  uint32_t count(const char* what, size_t minBytes) {
+    const size_t at = pos_;
+    uint32_t n = u32(what);
+    if (minBytes && uint64_t(n) * minBytes > remaining())
+      failAt(at, std::string(what) + " " + std::to_string(n) + " cannot fit in the " + std::to_string(remaining()) +
+                     " bytes left");
+    return n;
+  }
+  template <class T>
+  void array(std::vector<T>& v, size_t n, const char* what) {
+    if (n > remaining() / sizeof(T))
+      fail(std::string("file ends inside ") + what + " (" + std::to_string(n) + " elements of " +
+           std::to_string(sizeof(T)) + " bytes, " + std::to_string(remaining()) + " bytes left)");
+    v.resize(n);
+    raw(v.data(), n * sizeof(T), what);
+  }
+  void skip(size_t n, const char* what) { need(n, what); pos_ += n; }
+  void align(size_t a, const char* what) { skip((a - pos_ % a) % a, what); }
+  std::string_view view(size_t n, const char* what) {
+    need(n, what);
+    std::string_view s(reinterpret_cast<const char*>(d_.data() + pos_), n);
+    pos_ += n;
+    return s;
+  }
+
+private:
+  std::span<const uint8_t> d_;
+  std::string file_;
+  size_t pos_ = 0;
+};
+
+// Whole file into memory; throws rtr::Error naming the file.
+std::vector<uint8_t> readFileBytes(const std::filesystem::path& file);
+// Writes to "<file>.tmp" beside it, then renames, so a failure never leaves a partial `file`.
+void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes);
+// 64-bit checksum over bytes (word-wise multiply-xorshift; detects corruption, not tampering).
+uint64_t checksum64(std::span<const uint8_t> data);
+
+}  // namespace rtr

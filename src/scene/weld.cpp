@@ -1,0 +1,220 @@
+#include "scene/weld.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+namespace rtr {
+namespace {
+
+inline uint64_t mix(uint64_t h) {
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdull;
+  h ^= h >> 33;
+  h *= 0xc4ceb9fe1a85ec53ull;
+  h ^= h >> 33;
+  return h;
+}
+
+// Open-addressing map from a key to a dense id (0, 1, 2, ... in insertion order).
+template <class Key, class Hash>
+class DenseIds {
+public:
+  explicit DenseIds(size_t expected) {
+    size_t cap = 16;
+    while (cap < expected * 2) cap <<= 1;
+    slots_.assign(cap, kAbsent);
+    mask_ = cap - 1;
+    keys_.reserve(expected);
+  }
+  // Returns the id of `k`, adding it when new.
+  uint32_t id(const Key& k) {
+    size_t i = Hash{}(k) & mask_;
+    for (;;) {
+      uint32_t s = slots_[i];
+      if (s == kAbsent) {
+        if ((keys_.size() + 1) * 2 > slots_.size()) { grow(); return id(k); }
+        slots_[i] = uint32_t(keys_.size());
+        keys_.push_back(k);
+        return slots_[i];
+      }
+      if (keys_[s] == k) return s;
+      i = (i + 1) & mask_;
+    }
+  }
+  const std::vector<Key>& keys() const { return keys_; }
+
+private:
+  void grow() {
+    std::vector<uint32_t> old(slots_.size() * 2, kAbsent);
+    slots_.swap(old);
+    mask_ = slots_.size() - 1;
+    for (uint32_t s = 0; s < keys_.size(); ++s) {
+      size_t i = Hash{}(keys_[s]) & mask_;
+      while (slots_[i] != kAbsent) i = (i + 1) & mask_;
+      slots_[i] = s;
+    }
+  }
+  std::vector<uint32_t> slots_;
+  std::vector<Key> keys_;
+  size_t mask_ = 0;
+};
+
+struct CornerHash {
+  size_t operator()(const Corner& c) const { return mix(uint64_t(c.p) * 0x9E3779B97F4A7C15ull ^ (uint64_t(c.t) << 21) ^ (uint64_t(c.n) << 42) ^ c.n); }
+};
+struct U32Hash {
+  size_t operator()(uint32_t v) const { return mix(v); }
+};
+
+// Grid for the tolerance weld: cells much larger than the tolerance, so a vertex usually has its
+// neighbours in its own cell and only looks next door when it lies within the tolerance of a face.
+constexpr float kCellScale = 1024.0f;
+
+inline int64_t cellOf(float x) {
+  double c = std::floor(double(x) * kCellScale);
+  if (c > 1e15) c = 1e15;  // huge coordinates share a cell; values are compared exactly anyway
+  if (c < -1e15) c = -1e15;
+  return int64_t(c);
+}
+
+inline uint64_t cellHash(int64_t x, int64_t y, int64_t z) {
+  return mix(uint64_t(x) * 0x9E3779B97F4A7C15ull ^ mix(uint64_t(y) + 0x632BE59BD9B4E019ull) ^ (uint64_t(z) << 1));
+}
+
+struct Vertex {
+  glm::vec3 p, n;
+  glm::vec2 t;
+};
+
+inline bool near(const Vertex& a, const Vertex& b) {
+  auto c = [](float x, float y) { return std::fabs(x - y) <= kWeldTolerance; };
+  return c(a.p.x, b.p.x) && c(a.p.y, b.p.y) && c(a.p.z, b.p.z) && c(a.n.x, b.n.x) && c(a.n.y, b.n.y) &&
+         c(a.n.z, b.n.z) && c(a.t.x, b.t.x) && c(a.t.y, b.t.y);
+}
+
+}  // namespace
+
+WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions,
+                    std::span<const glm::vec3> normals, std::span<const glm::vec2> texcoords, Mesh& out) {
+  WeldCounts counts;
+  const size_t triCount = corners.size() / 3;
+
+  // 1. Drop triangles with a repeated corner position or zero area.
+  std::vector<uint8_t> keep(triCount, 0);
+  bool needNormals = false, hasTex = false;
+  for (size_t t = 0; t < triCount; ++t) {
+    const Corner* c = &corners[t * 3];
+    const glm::vec3 a = positions[c[0].p], b = positions[c[1].p], d = positions[c[2].p];
+    const glm::vec3 x = glm::cross(b - a, d - a);
+    const float area2 = glm::dot(x, x);
+    if (c[0].p == c[1].p || c[1].p == c[2].p || c[0].p == c[2].p || !(area2 > 0.0f)) {
+      ++counts.degenerate;
+      continue;
+    }
+    keep[t] = 1;
+    ++counts.triangles;
+    for (int k = 0; k < 3; ++k) {
+      needNormals |= c[k].n == kAbsent;
+      hasTex |= c[k].t != kAbsent;
+    }
+  }
+
+  // 2. Area-weighted normals per position: the unnormalised cross product is twice the area times the normal.
+  DenseIds<uint32_t, U32Hash> posIds(needNormals ? counts.triangles : 0);
+  std::vector<glm::vec3> accum;
+  if (needNormals) {
+    accum.reserve(counts.triangles);
+    for (size_t t = 0; t < triCount; ++t) {
+      if (!keep[t]) continue;
+      const Corner* c = &corners[t * 3];
+      const glm::vec3 a = positions[c[0].p];
+      const glm::vec3 x = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
+      for (int k = 0; k < 3; ++k) {
+        uint32_t id = posIds.id(c[k].p);
+        if (id == accum.size()) accum.emplace_back(0.0f);
+        accum[id] += x;
+      }
+    }
+    for (glm::vec3& n : accum) {
+      float l = glm::length(n);
+      n = l > 0.0f && std::isfinite(l) ? n / l : glm::vec3(0, 0, 1);
+    }
+  }
+
+  // 3. Identical corners become one vertex; 4. vertices within the tolerance are merged (greedy,
+  // first come first kept, so the result does not depend on hashing).
+  DenseIds<Corner, CornerHash> cornerIds(counts.triangles * 3 / 4 + 16);
+  std::vector<uint32_t> cornerVertex(counts.triangles * 3);
+  size_t ci = 0;
+  for (size_t t = 0; t < triCount; ++t)
+    if (keep[t])
+      for (int k = 0; k < 3; ++k) cornerVertex[ci++] = cornerIds.id(corners[t * 3 + k]);
+
+  const auto& uniq = cornerIds.keys();
+  std::vector<uint32_t> slots;
+  size_t cap = 16;
+  while (cap < uniq.size() * 2) cap <<= 1;
+  slots.assign(cap, kAbsent);
+  const size_t mask = cap - 1;
+  std::vector<uint32_t> next;  // chain of representatives per bucket
+  std::vector<Vertex> reps;
+  std::vector<uint32_t> remap(uniq.size());
+  reps.reserve(uniq.size());
+  next.reserve(uniq.size());
+  const float edge = kWeldTolerance * kCellScale;
+
+  for (size_t u = 0; u < uniq.size(); ++u) {
+    const Corner& c = uniq[u];
+    Vertex v;
+    v.p = positions[c.p];
+    v.n = c.n != kAbsent ? normals[c.n] : accum[posIds.id(c.p)];
+    v.t = c.t != kAbsent ? texcoords[c.t] : glm::vec2(0.0f);
+    int64_t cell[3], lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) {
+      cell[d] = cellOf(v.p[d]);
+      float f = v.p[d] * kCellScale - float(cell[d]);
+      lo[d] = f < edge ? cell[d] - 1 : cell[d];
+      hi[d] = f > 1.0f - edge ? cell[d] + 1 : cell[d];
+    }
+    uint32_t found = kAbsent;
+    for (int64_t x = lo[0]; x <= hi[0] && found == kAbsent; ++x)
+      for (int64_t y = lo[1]; y <= hi[1] && found == kAbsent; ++y)
+        for (int64_t z = lo[2]; z <= hi[2] && found == kAbsent; ++z)
+          for (uint32_t r = slots[cellHash(x, y, z) & mask]; r != kAbsent; r = next[r])
+            if (near(reps[r], v)) { found = r; break; }
+    if (found == kAbsent) {
+      found = uint32_t(reps.size());
+      uint32_t& head = slots[cellHash(cell[0], cell[1], cell[2]) & mask];
+      next.push_back(head);
+      head = found;
+      reps.push_back(v);
+    }
+    remap[u] = found;
+  }
+
+  // 5. Emit.
+  out.positions.resize(reps.size());
+  out.normals.resize(reps.size());
+  out.texcoords.resize(hasTex ? reps.size() : 0);
+  out.bounds = Bounds{};
+  for (size_t r = 0; r < reps.size(); ++r) {
+    out.positions[r] = reps[r].p;
+    out.normals[r] = reps[r].n;
+    if (hasTex) out.texcoords[r] = reps[r].t;
+    out.bounds.extend(reps[r].p);
+  }
+  // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
+  out.indices.clear();
+  out.indices.reserve(cornerVertex.size());
+  for (size_t i = 0; i < cornerVertex.size(); i += 3) {
+    uint32_t a = remap[cornerVertex[i]], b = remap[cornerVertex[i + 1]], c = remap[cornerVertex[i + 2]];
+    if (a == b || b == c || a == c) { ++counts.degenerate; --counts.triangles; continue; }
+    out.indices.insert(out.indices.end(), {a, b, c});
+  }
+  counts.vertices = reps.size();
+  return counts;
+}
+
+}  // namespace rtr

@@ -1,0 +1,30 @@
+#pragma once
+// Triangle soup (corners indexing shared attribute arrays) to an indexed mesh: degenerate triangles
+// dropped, area-weighted normals generated where a corner has none, vertices welded within 1e-5.
+#include <cstdint>
+#include <span>
+
+#include "scene/scene.hpp"
+
+namespace rtr {
+
+constexpr uint32_t kAbsent = 0xFFFFFFFFu;
+
+struct Corner {
+  uint32_t p, t, n;  // 0-based into positions/texcoords/normals; kAbsent where the face gave none
+  bool operator==(const Corner&) const = default;
+};
+
+constexpr float kWeldTolerance = 1e-5f;
+
+struct WeldCounts {
+  size_t degenerate = 0;  // triangles dropped
+  size_t triangles = 0;   // triangles kept
+  size_t vertices = 0;    // vertices after welding
+};
+
+// `corners` holds 3 per triangle. Fills out.positions/normals/texcoords/indices/bounds (not name or material).
+WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions,
+                    std::span<const glm::vec3> normals, std::span<const glm::vec2> texcoords, Mesh& out);
+
+}  // namespace rtr

@@ -1,0 +1,111 @@
+#include "vk/commands.hpp"
+
+#include "vk/check.hpp"
+#include "vk/context.hpp"
+
+namespace rtr::vk {
+
+void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record) {
+  VkDevice device = ctx.device();
+  VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pi.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+  pi.queueFamilyIndex = ctx.queueFamily();
+  VkCommandPool rawPool;
+  VK_CHECK(vkCreateCommandPool(device, &pi, nullptr, &rawPool));
+  CommandPool pool(device, rawPool);
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = pool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VkCommandBuffer cb;
+  VK_CHECK(vkAllocateCommandBuffers(device, &ai, &cb));
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(cb, &bi));
+  record(cb);
+  VK_CHECK(vkEndCommandBuffer(cb));
+  VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence rawFence;
+  VK_CHECK(vkCreateFence(device, &fi, nullptr, &rawFence));
+  Fence fence(device, rawFence);
+  VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cbi.commandBuffer = cb;
+  VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  si.commandBufferInfoCount = 1;
+  si.pCommandBufferInfos = &cbi;
+  VK_CHECK(vkQueueSubmit2(ctx.queue(), 1, &si, fence));
+  VK_CHECK(vkWaitForFences(device, 1, &rawFence, VK_TRUE, UINT64_MAX));
+}
+
+void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images) {
+  std::vector<VkImageMemoryBarrier2> bs;
+  for (const ImageBarrier& b : images) {
+    VkImageMemoryBarrier2 ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    ib.srcStageMask = b.srcStage;
+    ib.srcAccessMask = b.srcAccess;
+    ib.dstStageMask = b.dstStage;
+    ib.dstAccessMask = b.dstAccess;
+    ib.oldLayout = b.oldLayout;
+    ib.newLayout = b.newLayout;
+    ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    ib.image = b.image;
+    ib.subresourceRange = {b.aspect, b.baseMip, b.mipCount, 0, 1};
+    bs.push_back(ib);
+  }
+  VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  di.imageMemoryBarrierCount = uint32_t(bs.size());
+  di.pImageMemoryBarriers = bs.data();
+  vkCmdPipelineBarrier2(cb, &di);
+}
+
+void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
+                   VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
+  VkMemoryBarrier2 mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+  mb.srcStageMask = srcStage;
+  mb.srcAccessMask = srcAccess;
+  mb.dstStageMask = dstStage;
+  mb.dstAccessMask = dstAccess;
+  VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  di.memoryBarrierCount = 1;
+  di.pMemoryBarriers = &mb;
+  vkCmdPipelineBarrier2(cb, &di);
+}
+
+GpuTimer::GpuTimer(const Context& ctx, uint32_t maxPasses)
+    : device_(ctx.device()), periodNs_(ctx.timestampPeriodNs()), capacity_(maxPasses + 1) {
+  VkQueryPoolCreateInfo qi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  qi.queryCount = capacity_;
+  VkQueryPool raw;
+  VK_CHECK(vkCreateQueryPool(device_, &qi, nullptr, &raw));
+  pool_ = QueryPool(device_, raw);
+  vkResetQueryPool(device_, raw, 0, capacity_);
+}
+
+void GpuTimer::reset(VkCommandBuffer cb) {
+  vkCmdResetQueryPool(cb, pool_, 0, capacity_);
+  names_.clear();
+}
+
+void GpuTimer::begin(VkCommandBuffer cb) {
+  vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, 0);
+}
+
+void GpuTimer::mark(VkCommandBuffer cb, const std::string& pass) {
+  if (names_.size() + 1 >= capacity_) throw Error("GpuTimer: more passes than the " + std::to_string(capacity_ - 1) + " it was made for");
+  names_.push_back(pass);
+  vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, uint32_t(names_.size()));
+}
+
+std::vector<std::pair<std::string, double>> GpuTimer::results() const {
+  std::vector<std::pair<std::string, double>> out;
+  if (names_.empty()) return out;
+  std::vector<uint64_t> ts(names_.size() + 1);
+  VkResult r = vkGetQueryPoolResults(device_, pool_, 0, uint32_t(ts.size()), ts.size() * 8, ts.data(), 8,
+                                     VK_QUERY_RESULT_64_BIT);
+  if (r != VK_SUCCESS) return out;
+  for (size_t i = 0; i < names_.size(); ++i) out.push_back({names_[i], double(ts[i + 1] - ts[i]) * periodNs_ * 1e-6});
+  return out;
+}
+
+}  // namespace rtr::vk

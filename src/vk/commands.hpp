@@ -1,0 +1,50 @@
+#pragma once
+// Command recording helpers: one-shot submission, synchronization2 barriers, and GPU timestamps.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "vk/resources.hpp"
+
+namespace rtr::vk {
+
+class Context;
+
+// Records `record` into a fresh command buffer, submits it and waits for it to finish.
+void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record);
+
+struct ImageBarrier {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageLayout oldLayout = VK_IMAGE_LAYOUT_UNDEFINED, newLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkPipelineStageFlags2 srcStage = VK_PIPELINE_STAGE_2_NONE, dstStage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 srcAccess = VK_ACCESS_2_NONE, dstAccess = VK_ACCESS_2_NONE;
+  uint32_t baseMip = 0, mipCount = VK_REMAINING_MIP_LEVELS;
+  VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
+};
+void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images);
+// A global memory barrier (buffers, and images whose layout does not change).
+void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
+                   VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
+
+// Timestamps around named passes. Usage per frame: reset(cb); begin(cb); ...pass...; mark(cb, "pass"); ...
+// then, once the frame's fence has signalled, results() gives each pass's time in milliseconds.
+class GpuTimer {
+ public:
+  GpuTimer() = default;
+  GpuTimer(const Context& ctx, uint32_t maxPasses);
+  void reset(VkCommandBuffer cb);
+  void begin(VkCommandBuffer cb);
+  void mark(VkCommandBuffer cb, const std::string& pass);
+  std::vector<std::pair<std::string, double>> results() const;  // empty until the first frame completed
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  double periodNs_ = 1.0;
+  uint32_t capacity_ = 0;
+  QueryPool pool_;
+  std::vector<std::string> names_;
+};
+
+}  // namespace rtr::vk

@@ -1,0 +1,73 @@
+#pragma once
+// The Vulkan instance, device, queue and memory allocator. Knows no window: a windowed app passes the
+// instance extensions its surface needs and creates the surface itself.
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+typedef struct VmaAllocator_T* VmaAllocator;
+
+namespace rtr::vk {
+
+struct ContextOptions {
+  bool validation = false;            // Khronos validation layer + debug messenger (fails loudly if missing)
+  bool syncValidation = false;        // synchronization validation (tests turn it on)
+  std::string device;                 // "" = best; else an index ("1") or a substring of the device name
+  std::vector<const char*> instanceExtensions;  // e.g. those GLFW needs for a surface
+  bool presentation = false;          // enable VK_KHR_swapchain on the device
+};
+
+// Options from the environment: RTR_VALIDATION=1 enables validation (+ sync validation),
+// RTR_DEVICE picks the device. Debug builds validate by default.
+ContextOptions optionsFromEnvironment();
+
+class Context {
+ public:
+  explicit Context(const ContextOptions& options);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physicalDevice() const { return physical_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queueFamily() const { return queueFamily_; }
+  VmaAllocator allocator() const { return allocator_; }
+  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  std::string deviceName() const { return properties_.deviceName; }
+  std::string driverInfo() const { return driverInfo_; }
+  bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
+  float timestampPeriodNs() const { return properties_.limits.timestampPeriod; }
+
+  // Validation messages (warnings and errors) seen so far; tests assert this stays 0.
+  static uint32_t validationMessageCount();
+  static void resetValidationMessageCount();
+
+  PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn() const { return pushDescriptorFn_; }
+
+  // Names an object in validation messages and debuggers (no-op without validation).
+  void setName(uint64_t handle, VkObjectType type, const char* name) const;
+
+  // The physical devices the loader sees, in the order of ContextOptions::device indices.
+  static std::vector<std::string> listDevices();
+
+ private:
+  void release();
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties properties_{};
+  std::string driverInfo_;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queueFamily_ = 0;
+  VmaAllocator allocator_ = nullptr;
+  PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn_ = nullptr;
+};
+
+}  // namespace rtr::vk

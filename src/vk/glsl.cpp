@@ -1,0 +1,91 @@
+#include "vk/glsl.hpp"
+
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+
+#include <glslang/Public/ResourceLimits.h>
+#include <glslang/Public/ShaderLang.h>
+#include <glslang/SPIRV/GlslangToSpv.h>
+
+#include "core/error.hpp"
+
+namespace rtr::vk {
+namespace {
+
+std::string readText(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw fileError(file.string(), "", "cannot open GLSL file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Resolves #include "x" against the including file's folder, then the include folders.
+class Includer : public glslang::TShader::Includer {
+ public:
+  explicit Includer(std::vector<std::filesystem::path> dirs) : dirs_(std::move(dirs)) {}
+  IncludeResult* includeLocal(const char* name, const char* includer, size_t) override {
+    std::vector<std::filesystem::path> where{std::filesystem::path(includer).parent_path()};
+    where.insert(where.end(), dirs_.begin(), dirs_.end());
+    for (const auto& d : where) {
+      auto p = d / name;
+      if (std::filesystem::is_regular_file(p)) {
+        auto* text = new std::string(readText(p));
+        return new IncludeResult(p.string(), text->data(), text->size(), text);
+      }
+    }
+    return nullptr;
+  }
+  IncludeResult* includeSystem(const char* name, const char* includer, size_t depth) override {
+    return includeLocal(name, includer, depth);
+  }
+  void releaseInclude(IncludeResult* r) override {
+    if (!r) return;
+    delete static_cast<std::string*>(r->userData);
+    delete r;
+  }
+
+ private:
+  std::vector<std::filesystem::path> dirs_;
+};
+
+}  // namespace
+
+bool isGlslPath(const std::filesystem::path& file) {
+  auto e = file.extension();
+  return e == ".vert" || e == ".frag" || e == ".comp";
+}
+
+SpirvModule compileGlsl(const std::filesystem::path& file, const std::vector<std::filesystem::path>& includeDirs) {
+  static std::once_flag init;
+  std::call_once(init, [] { glslang::InitializeProcess(); });  // process-wide; finalised at exit by the OS
+  const auto ext = file.extension();
+  EShLanguage stage = ext == ".vert" ? EShLangVertex : ext == ".frag" ? EShLangFragment : ext == ".comp" ? EShLangCompute : EShLangCount;
+  if (stage == EShLangCount) throw fileError(file.string(), "", "unknown shader stage: use .vert, .frag or .comp");
+  const std::string source = readText(file);
+  const std::string name = file.string();
+  const char* text = source.c_str();
+  const char* names = name.c_str();
+  const int length = int(source.size());
+
+  glslang::TShader shader(stage);
+  shader.setStringsWithLengthsAndNames(&text, &length, &names, 1);
+  shader.setEnvInput(glslang::EShSourceGlsl, stage, glslang::EShClientVulkan, 100);
+  shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_3);
+  shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_6);
+  Includer includer(includeDirs);
+  const auto messages = EShMessages(EShMsgSpvRules | EShMsgVulkanRules);
+  if (!shader.parse(GetDefaultResources(), 460, false, messages, includer))
+    throw Error("GLSL compile failed:\n" + std::string(shader.getInfoLog()));
+  glslang::TProgram program;
+  program.addShader(&shader);
+  if (!program.link(messages)) throw Error("GLSL link failed:\n" + std::string(program.getInfoLog()));
+  SpirvModule out{file.filename().string(), {}};
+  glslang::SpvOptions options;
+  glslang::GlslangToSpv(*program.getIntermediate(stage), out.code, &options);
+  return out;
+}
+
+}  // namespace rtr::vk

@@ -1,0 +1,307 @@
+#include "vk/pipeline.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <unistd.h>
+
+#include "vk/check.hpp"
+#include "vk/context.hpp"
+
+namespace rtr::vk {
+
+std::filesystem::path shaderDir() {
+  if (const char* env = std::getenv("RTR_SHADER_DIR")) return env;
+  std::error_code ec;
+  auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec && std::filesystem::exists(exe.parent_path().parent_path() / "shaders"))
+    return exe.parent_path().parent_path() / "shaders";
+  return RTR_SPIRV_DIR;
+}
+
+SpirvModule loadShader(const std::string& name) { return readSpirv(shaderDir() / (name + ".spv")); }
+
+PipelineLayout::PipelineLayout(const Context& ctx, PipelineInterface interface, const LayoutOptions& options)
+    : interface_(std::move(interface)), options_(options) {
+  VkDevice device = ctx.device();
+  for (uint32_t set = 0; set < interface_.setCount(); ++set) {
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    std::vector<VkDescriptorBindingFlags> flags;
+    bool variable = false;
+    for (const ReflectedBinding& b : interface_.bindings) {
+      if (b.set != set) continue;
+      bindings.push_back({b.binding, b.type, arrayCount(b), b.stages, nullptr});
+      // Only the highest binding of a set may have a variable count; runtime arrays are declared last.
+      flags.push_back(b.count == 0 ? VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT : 0);
+      variable |= b.count == 0;
+    }
+    VkDescriptorSetLayoutBindingFlagsCreateInfo fi{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO};
+    fi.bindingCount = uint32_t(flags.size());
+    fi.pBindingFlags = flags.data();
+    VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, variable ? &fi : nullptr};
+    const auto& pushSets = options_.pushDescriptorSets;
+    if (std::find(pushSets.begin(), pushSets.end(), set) != pushSets.end())
+      li.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+    li.bindingCount = uint32_t(bindings.size());
+    li.pBindings = bindings.data();
+    VkDescriptorSetLayout raw;
+    VK_CHECK(vkCreateDescriptorSetLayout(device, &li, nullptr, &raw));
+    sets_.emplace_back(device, raw);
+  }
+  std::vector<VkDescriptorSetLayout> raw(sets_.begin(), sets_.end());
+  std::vector<VkPushConstantRange> ranges;
+  for (const auto& pc : interface_.pushConstants) ranges.push_back({pc.stages, pc.offset, pc.size});
+  VkPipelineLayoutCreateInfo pi{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pi.setLayoutCount = uint32_t(raw.size());
+  pi.pSetLayouts = raw.data();
+  pi.pushConstantRangeCount = uint32_t(ranges.size());
+  pi.pPushConstantRanges = ranges.data();
+  VkPipelineLayout layout;
+  VK_CHECK(vkCreatePipelineLayout(device, &pi, nullptr, &layout));
+  layout_ = PipelineLayoutHandle(device, layout);
+}
+
+const ReflectedBinding& PipelineLayout::binding(uint32_t set, uint32_t binding) const {
+  for (const auto& b : interface_.bindings)
+    if (b.set == set && b.binding == binding) return b;
+  throw Error("no set " + std::to_string(set) + " binding " + std::to_string(binding) + " in the pipeline's shaders");
+}
+
+uint32_t PipelineLayout::arrayCount(const ReflectedBinding& b) const {
+  if (b.count != 0) return b.count;
+  auto it = options_.runtimeArrayCounts.find({b.set, b.binding});
+  if (it == options_.runtimeArrayCounts.end() || it->second == 0)
+    throw Error("runtime array '" + b.name + "' (set " + std::to_string(b.set) + " binding " +
+                std::to_string(b.binding) + ") needs a count in LayoutOptions");
+  return it->second;
+}
+
+void Pipeline::throwPushSizeMismatch(size_t size) const {
+  const auto& pcs = layout.interface().pushConstants;
+  throw Error("push constants of " + std::to_string(size) + " bytes, but the shaders declare " +
+              (pcs.empty() ? std::string("none") : std::to_string(pcs[0].offset + pcs[0].size) + " bytes"));
+}
+
+namespace {
+
+ShaderModuleHandle createModule(VkDevice device, const SpirvModule& m) {
+  VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  ci.codeSize = m.code.size() * 4;
+  ci.pCode = m.code.data();
+  VkShaderModule raw;
+  VK_CHECK(vkCreateShaderModule(device, &ci, nullptr, &raw));
+  return ShaderModuleHandle(device, raw);
+}
+
+struct Specialization {
+  std::vector<VkSpecializationMapEntry> entries;
+  std::vector<uint32_t> data;
+  VkSpecializationInfo info{};
+  explicit Specialization(const std::vector<SpecializationConstant>& cs) {
+    for (const auto& c : cs) {
+      entries.push_back({c.id, uint32_t(data.size() * 4), 4});
+      data.push_back(c.value);
+    }
+    info = {uint32_t(entries.size()), entries.data(), data.size() * 4, data.data()};
+  }
+  const VkSpecializationInfo* get() const { return entries.empty() ? nullptr : &info; }
+};
+
+uint32_t formatSize(VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_R32_SFLOAT: case VK_FORMAT_R32_UINT: case VK_FORMAT_R32_SINT: return 4;
+    case VK_FORMAT_R32G32_SFLOAT: case VK_FORMAT_R32G32_UINT: case VK_FORMAT_R32G32_SINT: return 8;
+    case VK_FORMAT_R32G32B32_SFLOAT: case VK_FORMAT_R32G32B32_UINT: case VK_FORMAT_R32G32B32_SINT: return 12;
+    case VK_FORMAT_R32G32B32A32_SFLOAT: case VK_FORMAT_R32G32B32A32_UINT: case VK_FORMAT_R32G32B32A32_SINT: return 16;
+    default: throw Error(std::string("vertex input of unsupported format ") + formatName(f));
+  }
+}
+
+}  // namespace
+
+Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, const LayoutOptions& options,
+                             const std::vector<SpecializationConstant>& specialization) {
+  Pipeline p;
+  p.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
+  p.layout = PipelineLayout(ctx, reflectPipeline({shader}), options);
+  ShaderModuleHandle module = createModule(ctx.device(), shader);
+  Specialization spec(specialization);
+  VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = module;
+  ci.stage.pName = p.layout.interface().stages[0].entryPoint.c_str();
+  ci.stage.pSpecializationInfo = spec.get();
+  ci.layout = p.layout.handle();
+  VkPipeline raw;
+  VK_CHECK(vkCreateComputePipelines(ctx.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &raw));
+  p.pipeline = PipelineHandle(ctx.device(), raw);
+  ctx.setName(uint64_t(raw), VK_OBJECT_TYPE_PIPELINE, shader.name.c_str());
+  return p;
+}
+
+Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const LayoutOptions& options) {
+  Pipeline p;
+  p.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+  p.layout = PipelineLayout(ctx, reflectPipeline(d.modules), options);
+  const PipelineInterface& iface = p.layout.interface();
+
+  std::vector<ShaderModuleHandle> modules;
+  std::vector<VkPipelineShaderStageCreateInfo> stages;
+  Specialization spec(d.specialization);
+  for (size_t i = 0; i < d.modules.size(); ++i) {
+    modules.push_back(createModule(ctx.device(), d.modules[i]));
+    VkPipelineShaderStageCreateInfo si{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    si.stage = iface.stages[i].stage;
+    si.module = modules.back();
+    si.pName = iface.stages[i].entryPoint.c_str();
+    si.pSpecializationInfo = spec.get();
+    stages.push_back(si);
+  }
+
+  std::vector<VkVertexInputBindingDescription> vbind;
+  std::vector<VkVertexInputAttributeDescription> vattr;
+  for (const StageInterface& s : iface.stages)
+    if (s.stage == VK_SHADER_STAGE_VERTEX_BIT)
+      for (const InterfaceVariable& v : s.inputs) {
+        vbind.push_back({v.location, formatSize(v.format), VK_VERTEX_INPUT_RATE_VERTEX});
+        vattr.push_back({v.location, v.location, v.format, 0});
+      }
+  VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  vi.vertexBindingDescriptionCount = uint32_t(vbind.size());
+  vi.pVertexBindingDescriptions = vbind.data();
+  vi.vertexAttributeDescriptionCount = uint32_t(vattr.size());
+  vi.pVertexAttributeDescriptions = vattr.data();
+
+  VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  vp.viewportCount = vp.scissorCount = 1;
+  VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  rs.polygonMode = VK_POLYGON_MODE_FILL;
+  rs.cullMode = d.cullMode;
+  rs.frontFace = d.frontFace;
+  rs.lineWidth = 1.0f;
+  VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  ds.depthTestEnable = d.depthTest;
+  ds.depthWriteEnable = d.depthWrite;
+  ds.depthCompareOp = d.depthCompare;
+  std::vector<VkPipelineColorBlendAttachmentState> blends(d.colorFormats.size());
+  for (auto& b : blends) b.colorWriteMask = 0xF;
+  VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  cb.attachmentCount = uint32_t(blends.size());
+  cb.pAttachments = blends.data();
+  VkDynamicState dyn[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dy{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+  dy.dynamicStateCount = 2;
+  dy.pDynamicStates = dyn;
+  VkPipelineRenderingCreateInfo ri{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+  ri.colorAttachmentCount = uint32_t(d.colorFormats.size());
+  ri.pColorAttachmentFormats = d.colorFormats.data();
+  ri.depthAttachmentFormat = d.depthFormat;
+
+  VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &ri};
+  gi.stageCount = uint32_t(stages.size());
+  gi.pStages = stages.data();
+  gi.pVertexInputState = &vi;
+  gi.pInputAssemblyState = &ia;
+  gi.pViewportState = &vp;
+  gi.pRasterizationState = &rs;
+  gi.pMultisampleState = &ms;
+  gi.pDepthStencilState = &ds;
+  gi.pColorBlendState = &cb;
+  gi.pDynamicState = &dy;
+  gi.layout = p.layout.handle();
+  VkPipeline raw;
+  VK_CHECK(vkCreateGraphicsPipelines(ctx.device(), VK_NULL_HANDLE, 1, &gi, nullptr, &raw));
+  p.pipeline = PipelineHandle(ctx.device(), raw);
+  return p;
+}
+
+DescriptorSets::DescriptorSets(const Context& ctx, const PipelineLayout& layout, uint32_t copies) : copies_(copies) {
+  std::map<VkDescriptorType, uint32_t> counts;
+  for (const auto& b : layout.interface().bindings)
+    if (!layout.isPushDescriptorSet(b.set)) counts[b.type] += layout.arrayCount(b) * copies;
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (auto [type, n] : counts) sizes.push_back({type, n});
+  if (sizes.empty()) return;
+  VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pi.maxSets = layout.setCount() * copies;
+  pi.poolSizeCount = uint32_t(sizes.size());
+  pi.pPoolSizes = sizes.data();
+  VkDescriptorPool raw;
+  VK_CHECK(vkCreateDescriptorPool(ctx.device(), &pi, nullptr, &raw));
+  pool_ = DescriptorPool(ctx.device(), raw);
+  for (uint32_t set = 0; set < layout.setCount(); ++set) {
+    if (layout.isPushDescriptorSet(set)) {
+      for (uint32_t c = 0; c < copies; ++c) sets_.push_back(VK_NULL_HANDLE);
+      continue;
+    }
+    uint32_t variable = 0;
+    for (const auto& b : layout.interface().bindings)
+      if (b.set == set && b.count == 0) variable = layout.arrayCount(b);
+    for (uint32_t c = 0; c < copies; ++c) {
+      VkDescriptorSetVariableDescriptorCountAllocateInfo vi{
+          VK_STRUCTURE_TYPE_DESCRIPTOR_SET_VARIABLE_DESCRIPTOR_COUNT_ALLOCATE_INFO};
+      vi.descriptorSetCount = 1;
+      vi.pDescriptorCounts = &variable;
+      VkDescriptorSetLayout sl = layout.setLayout(set);
+      VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO, variable ? &vi : nullptr};
+      ai.descriptorPool = pool_;
+      ai.descriptorSetCount = 1;
+      ai.pSetLayouts = &sl;
+      VkDescriptorSet ds;
+      VK_CHECK(vkAllocateDescriptorSets(ctx.device(), &ai, &ds));
+      sets_.push_back(ds);
+    }
+  }
+}
+
+DescriptorWriter::DescriptorWriter(const Context& ctx, const PipelineLayout& layout, uint32_t set, VkDescriptorSet ds)
+    : ctx_(ctx), layout_(layout), set_(set), ds_(ds) {
+  bufferInfos_.reserve(16);
+  imageInfos_.reserve(16);
+}
+
+DescriptorWriter& DescriptorWriter::buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset, VkDeviceSize range) {
+  if (bufferInfos_.size() == bufferInfos_.capacity()) throw Error("DescriptorWriter: too many buffer writes");
+  bufferInfos_.push_back({buffer, offset, range});
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = ds_;
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = layout_.binding(set_, binding).type;
+  w.pBufferInfo = &bufferInfos_.back();
+  writes_.push_back(w);
+  return *this;
+}
+
+DescriptorWriter& DescriptorWriter::image(uint32_t binding, VkImageView view, VkImageLayout layout, VkSampler sampler) {
+  return images(binding, {{sampler, view, layout}});
+}
+
+DescriptorWriter& DescriptorWriter::images(uint32_t binding, const std::vector<VkDescriptorImageInfo>& infos) {
+  if (imageInfos_.size() == imageInfos_.capacity()) throw Error("DescriptorWriter: too many image writes");
+  imageInfos_.push_back(infos);
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = ds_;
+  w.dstBinding = binding;
+  w.descriptorCount = uint32_t(infos.size());
+  w.descriptorType = layout_.binding(set_, binding).type;
+  w.pImageInfo = imageInfos_.back().data();
+  writes_.push_back(w);
+  return *this;
+}
+
+void DescriptorWriter::push(VkCommandBuffer cb, const Pipeline& pipeline) {
+  ctx_.pushDescriptorFn()(cb, pipeline.bindPoint, pipeline.layout.handle(), set_, uint32_t(writes_.size()), writes_.data());
+  writes_.clear();
+}
+
+void DescriptorWriter::commit() {
+  vkUpdateDescriptorSets(ctx_.device(), uint32_t(writes_.size()), writes_.data(), 0, nullptr);
+  writes_.clear();
+}
+
+}  // namespace rtr::vk

@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Sets up a fresh Debian 12 machine, builds everything and runs every test (Vulkan tests on lavapipe
+# with the validation layer; any validation message fails a test). Usage: tools/test.sh [ctest args]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/setup.sh
+cmake --preset release >/dev/null
+cmake --build --preset release -j "$(nproc)"
+export RTR_VALIDATION=1
+# The tests run headless; no display is needed. The windowed test starts its own Xvfb.
+ctest --preset release -j "$(nproc)" "$@"
