@@ -6,12 +6,8 @@
 
 #include "core/error.hpp"
 
-#if __has_include("brdf.h")
-#include "brdf.h"
+#include "brdf.h"  // shaders/shared: the GPU renderer's BRDF, compiled here as C++
 #define RTR_HAVE_BRDF 1
-#else
-#define RTR_HAVE_BRDF 0
-#endif
 
 namespace rtr::trace {
 

@@ -106,6 +106,8 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, const Frame& f, Co
     return shadePbr(sp.normal, v, l, lightColor, glm::vec3(s.pbrLight.ambient), mat.baseColor, mat.roughness,
                     mat.metalness, mat.emissive);
   }
+  // A light's own surface shows its emission only (it does not light itself).
+  if (isLightMaterial(mat)) return mat.ke;
   // Blinn-Phong over every light; in shadow a light gives only its ambient.
   glm::vec3 color = mat.ke;
   const int n = std::max(1, s.areaLightSamples);
