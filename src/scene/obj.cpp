@@ -37,7 +37,8 @@ public:
       : name_(name), readMtl_(readMtl), opt_(options), stats_(stats) {}
 
   void run(ByteSource& src) {
-    std::vector<char> buf(kChunk);
+    // Small inputs (tests, fuzzing) get a small buffer; it grows for long lines.
+    std::vector<char> buf(std::min<uint64_t>(kChunk, std::max<uint64_t>(65536, src.fileSize())));
     size_t have = 0;
     for (;;) {
       if (have == buf.size()) {

@@ -113,7 +113,7 @@ std::string encodeRtrScene(const Scene& scene) {
     w.array(m.texcoords);
     w.pad(kAlign);
     if (small)
-      for (uint32_t i : m.indices) w.pod(uint16_t(i));
+      w.array(std::vector<uint16_t>(m.indices.begin(), m.indices.end()));
     else
       w.array(m.indices);
     w.pad(kAlign);

@@ -17,57 +17,6 @@ inline uint64_t mix(uint64_t h) {
   return h;
 }
 
-// Open-addressing map from a key to a dense id (0, 1, 2, ... in insertion order).
-template <class Key, class Hash>
-class DenseIds {
-public:
-  explicit DenseIds(size_t expected) {
-    size_t cap = 16;
-    while (cap < expected * 2) cap <<= 1;
-    slots_.assign(cap, kAbsent);
-    mask_ = cap - 1;
-    keys_.reserve(expected);
-  }
-  // Returns the id of `k`, adding it when new.
-  uint32_t id(const Key& k) {
-    size_t i = Hash{}(k) & mask_;
-    for (;;) {
-      uint32_t s = slots_[i];
-      if (s == kAbsent) {
-        if ((keys_.size() + 1) * 2 > slots_.size()) { grow(); return id(k); }
-        slots_[i] = uint32_t(keys_.size());
-        keys_.push_back(k);
-        return slots_[i];
-      }
-      if (keys_[s] == k) return s;
-      i = (i + 1) & mask_;
-    }
-  }
-  const std::vector<Key>& keys() const { return keys_; }
-
-private:
-  void grow() {
-    std::vector<uint32_t> old(slots_.size() * 2, kAbsent);
-    slots_.swap(old);
-    mask_ = slots_.size() - 1;
-    for (uint32_t s = 0; s < keys_.size(); ++s) {
-      size_t i = Hash{}(keys_[s]) & mask_;
-      while (slots_[i] != kAbsent) i = (i + 1) & mask_;
-      slots_[i] = s;
-    }
-  }
-  std::vector<uint32_t> slots_;
-  std::vector<Key> keys_;
-  size_t mask_ = 0;
-};
-
-struct CornerHash {
-  size_t operator()(const Corner& c) const { return mix(uint64_t(c.p) * 0x9E3779B97F4A7C15ull ^ (uint64_t(c.t) << 21) ^ (uint64_t(c.n) << 42) ^ c.n); }
-};
-struct U32Hash {
-  size_t operator()(uint32_t v) const { return mix(v); }
-};
-
 // Grid for the tolerance weld: cells much larger than the tolerance, so a vertex usually has its
 // neighbours in its own cell and only looks next door when it lies within the tolerance of a face.
 constexpr float kCellScale = 1024.0f;
@@ -122,18 +71,26 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   }
 
   // 2. Area-weighted normals per position: the unnormalised cross product is twice the area times the normal.
-  DenseIds<uint32_t, U32Hash> posIds(needNormals ? counts.triangles : 0);
+  // Per-thread tables over all positions, reset after each mesh: neighbouring faces share nearby
+  // positions, so direct indexing stays in cache where a hash table would not.
+  thread_local std::vector<uint32_t> headByPos, normalOfPos;
+  if (headByPos.size() < positions.size()) headByPos.assign(positions.size(), kAbsent);
+  if (needNormals && normalOfPos.size() < positions.size()) normalOfPos.assign(positions.size(), kAbsent);
   std::vector<glm::vec3> accum;
+  std::vector<uint32_t> accumPos;
   if (needNormals) {
-    accum.reserve(counts.triangles);
     for (size_t t = 0; t < triCount; ++t) {
       if (!keep[t]) continue;
       const Corner* c = &corners[t * 3];
       const glm::vec3 a = positions[c[0].p];
       const glm::vec3 x = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
       for (int k = 0; k < 3; ++k) {
-        uint32_t id = posIds.id(c[k].p);
-        if (id == accum.size()) accum.emplace_back(0.0f);
+        uint32_t& id = normalOfPos[c[k].p];
+        if (id == kAbsent) {
+          id = uint32_t(accum.size());
+          accum.emplace_back(0.0f);
+          accumPos.push_back(c[k].p);
+        }
         accum[id] += x;
       }
     }
@@ -145,14 +102,30 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
 
   // 3. Identical corners become one vertex; 4. vertices within the tolerance are merged (greedy,
   // first come first kept, so the result does not depend on hashing).
-  DenseIds<Corner, CornerHash> cornerIds(counts.triangles * 3 / 4 + 16);
+  // Corners are found through their position index (headByPos), chained when they differ in t or n.
+  std::vector<Corner> uniq;
+  std::vector<uint32_t> nextSame;  // chain of corners sharing a position
+  uniq.reserve(counts.triangles + 16);
+  nextSame.reserve(counts.triangles + 16);
   std::vector<uint32_t> cornerVertex(counts.triangles * 3);
   size_t ci = 0;
-  for (size_t t = 0; t < triCount; ++t)
-    if (keep[t])
-      for (int k = 0; k < 3; ++k) cornerVertex[ci++] = cornerIds.id(corners[t * 3 + k]);
+  for (size_t t = 0; t < triCount; ++t) {
+    if (!keep[t]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const Corner& c = corners[t * 3 + k];
+      uint32_t id = headByPos[c.p];
+      while (id != kAbsent && !(uniq[id] == c)) id = nextSame[id];
+      if (id == kAbsent) {
+        id = uint32_t(uniq.size());
+        uniq.push_back(c);
+        nextSame.push_back(headByPos[c.p]);
+        headByPos[c.p] = id;
+      }
+      cornerVertex[ci++] = id;
+    }
+  }
+  for (const Corner& c : uniq) headByPos[c.p] = kAbsent;
 
-  const auto& uniq = cornerIds.keys();
   std::vector<uint32_t> slots;
   size_t cap = 16;
   while (cap < uniq.size() * 2) cap <<= 1;
@@ -169,7 +142,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     const Corner& c = uniq[u];
     Vertex v;
     v.p = positions[c.p];
-    v.n = c.n != kAbsent ? normals[c.n] : accum[posIds.id(c.p)];
+    v.n = c.n != kAbsent ? normals[c.n] : accum[normalOfPos[c.p]];
     v.t = c.t != kAbsent ? texcoords[c.t] : glm::vec2(0.0f);
     int64_t cell[3], lo[3], hi[3];
     for (int d = 0; d < 3; ++d) {
@@ -193,6 +166,8 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     }
     remap[u] = found;
   }
+
+  for (uint32_t p : accumPos) normalOfPos[p] = kAbsent;
 
   // 5. Emit.
   out.positions.resize(reps.size());

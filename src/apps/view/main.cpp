@@ -1,0 +1,133 @@
+// rtr-view: the Vulkan viewer. Headless (--headless: no window, no display) or in a GLFW window.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <map>
+
+#include <CLI/CLI.hpp>
+
+#include "core/error.hpp"
+#include "options.hpp"
+#include "render/headless.hpp"
+#include "scene/load.hpp"
+#include "vk/context.hpp"
+
+namespace rtr::view {
+
+CameraPose startPose(const ViewOptions& o, const std::optional<CameraPose>& sceneView, const Bounds& bounds) {
+  if (o.camera) return *o.camera;
+  if (sceneView) return *sceneView;
+  return frameBounds(bounds, o.lens, float(o.width) / float(o.height));
+}
+
+namespace {
+
+void printBench(const std::vector<std::vector<std::pair<std::string, double>>>& frames, const std::string& device) {
+  std::map<std::string, std::vector<double>> perPass;
+  std::vector<std::string> order;
+  for (const auto& f : frames) {
+    double total = 0;
+    for (const auto& [name, ms] : f) {
+      if (!perPass.count(name)) order.push_back(name);
+      perPass[name].push_back(ms);
+      total += ms;
+    }
+    if (!perPass.count("total")) order.push_back("total");
+    perPass["total"].push_back(total);
+  }
+  std::printf("| pass | min ms | median ms |  (%zu frames, %s)\n|---|---|---|\n", frames.size(), device.c_str());
+  std::string csv;
+  for (const auto& name : order) {
+    auto v = perPass[name];
+    std::sort(v.begin(), v.end());
+    std::printf("| %s | %.4f | %.4f |\n", name.c_str(), v.front(), v[v.size() / 2]);
+    csv += "csv," + name + "," + std::to_string(v.front()) + "," + std::to_string(v[v.size() / 2]) + "\n";
+  }
+  std::printf("%s", csv.c_str());
+}
+
+}  // namespace
+
+int runHeadless(const ViewOptions& o) {
+  vk::ContextOptions co = vk::optionsFromEnvironment();
+  if (o.validation) co.validation = true;
+  if (!o.device.empty()) co.device = o.device;
+  vk::Context ctx(co);
+  Scene scene = loadScene(o.scene);
+  render::GpuScene gpuScene(ctx, scene, o.mips);
+  const auto& st = gpuScene.stats();
+  std::fprintf(stderr, "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
+               "decode %.0f ms, upload %.0f ms, mips %.3f ms GPU\n",
+               o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16,
+               st.triangles, st.textures, st.decodeMs, st.uploadMs, st.mipGpuMs);
+  const CameraPose pose = startPose(o, scene.defaultView, scene.bounds());
+  const Lens lens = fitDepthRange(o.lens, scene.bounds(), pose);
+  render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  if (o.bench > 0) {
+    renderer.bench(pose, lens, o.settings, 10);  // warm-up
+    printBench(renderer.bench(pose, lens, o.settings, o.bench), ctx.deviceName());
+  }
+  if (!o.screenshot.empty() || o.bench == 0) {
+    render::HeadlessFrame frame = renderer.render(pose, lens, o.settings, std::max(1, o.frames));
+    const std::string out = o.screenshot.empty() ? "rtr-view.png" : o.screenshot;
+    savePng(out, frame.image);
+    for (const auto& [name, ms] : frame.gpuTimes) std::fprintf(stderr, "  %s: %.3f ms GPU\n", name.c_str(), ms);
+    std::printf("%s\n", std::filesystem::absolute(out).c_str());
+  }
+  return 0;
+}
+
+}  // namespace rtr::view
+
+int main(int argc, char** argv) {
+  using namespace rtr;
+  view::ViewOptions o;
+  CLI::App app{"rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
+               "Keys: W/S/A/D/E/Q move, Shift faster, Ctrl slower, right mouse button toggles mouse-look,\n"
+               "1-7 views (shaded, mip level, linear depth, depth derivatives, normal, view dir, light dir),\n"
+               "8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic off/compute/graphics, [ ] LOD bias,\n"
+               "C print camera pose, F1 or H timing overlay, Esc quit."};
+  std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light;
+  app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
+  app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
+  app.add_option("--size", size, "image size WxH")->capture_default_str();
+  app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)");
+  app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str();
+  app.add_option("--mode", o.settings.mode, "view mode 1-12 (1 shaded)")->check(CLI::Range(1, VIEW_COUNT))->capture_default_str();
+  app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(CLI::PositiveNumber);
+  app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay) to this PNG");
+  app.add_option("--mips", mips, "mip generation: compute | compute-per-level | blit")->capture_default_str();
+  app.add_option("--mosaic", mosaic, "post process: off | compute | graphics")->capture_default_str();
+  app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias");
+  app.add_option("--light", light, "light position x,y,z");
+  app.add_flag("--falloff", o.settings.inverseSquareFalloff, "inverse-square light falloff");
+  app.add_option("--bench", o.bench, "time N frames after 10 warm-up frames; print per-pass GPU min/median");
+  app.add_flag("--watch", o.watch, "recompile edited shaders at run time (windowed)");
+  app.add_option("--device", o.device, "Vulkan device index or name substring (default: discrete GPU first)");
+  app.add_flag("--validation", o.validation, "enable the Vulkan validation layer");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (std::sscanf(size.c_str(), "%ux%u", &o.width, &o.height) != 2 || o.width == 0 || o.height == 0 ||
+        o.width > 16384 || o.height > 16384)
+      throw Error("--size '" + size + "': expected WxH, e.g. 1920x1080");
+    if (!camera.empty()) o.camera = parsePose(camera);
+    if (!light.empty()) {
+      CameraPose p = parsePose(light + ",0,0");
+      o.settings.lightPos = p.position;
+    }
+    const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
+                                                          {"compute-per-level", render::MipMode::ComputePerLevel},
+                                                          {"blit", render::MipMode::Blit}};
+    const std::map<std::string, render::MosaicMode> mosaicModes{
+        {"off", render::MosaicMode::Off}, {"compute", render::MosaicMode::Compute}, {"graphics", render::MosaicMode::Graphics}};
+    if (!mipModes.count(mips)) throw Error("--mips '" + mips + "': expected compute, compute-per-level or blit");
+    if (!mosaicModes.count(mosaic)) throw Error("--mosaic '" + mosaic + "': expected off, compute or graphics");
+    o.mips = mipModes.at(mips);
+    o.settings.mosaic = mosaicModes.at(mosaic);
+    return o.headless ? view::runHeadless(o) : view::runWindowed(o);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rtr-view: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,279 @@
+// The windowed viewer: GLFW window and input, swapchain, frames in flight, and the renderer.
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+
+#define GLFW_INCLUDE_VULKAN
+#include <GLFW/glfw3.h>
+
+#include "camera_controller.hpp"
+#include "core/error.hpp"
+#include "core/image.hpp"
+#include "options.hpp"
+#include "scene/load.hpp"
+#include "vk/check.hpp"
+#include "vk/context.hpp"
+#include "vk/swapchain.hpp"
+
+namespace rtr::view {
+namespace {
+
+constexpr uint32_t kFramesInFlight = 2;
+
+struct App {
+  CameraController camera{{}, {}};
+  render::RenderSettings settings;
+  bool overlay = false, resized = false;
+};
+
+void onKey(GLFWwindow* w, int key, int, int action, int) {
+  App& app = *static_cast<App*>(glfwGetWindowUserPointer(w));
+  if (action == GLFW_REPEAT) return;
+  const bool down = action == GLFW_PRESS;
+  switch (key) {  // held keys: state from press/release events
+    case GLFW_KEY_W: app.camera.setKey(Move::Forward, down); return;
+    case GLFW_KEY_S: app.camera.setKey(Move::Back, down); return;
+    case GLFW_KEY_A: app.camera.setKey(Move::Left, down); return;
+    case GLFW_KEY_D: app.camera.setKey(Move::Right, down); return;
+    case GLFW_KEY_E: app.camera.setKey(Move::Up, down); return;
+    case GLFW_KEY_Q: app.camera.setKey(Move::Down, down); return;
+    case GLFW_KEY_LEFT_SHIFT: case GLFW_KEY_RIGHT_SHIFT: app.camera.setKey(Move::Fast, down); return;
+    case GLFW_KEY_LEFT_CONTROL: case GLFW_KEY_RIGHT_CONTROL: app.camera.setKey(Move::Slow, down); return;
+    default: break;
+  }
+  if (!down) return;
+  if (key >= GLFW_KEY_1 && key <= GLFW_KEY_7) app.settings.mode = key - GLFW_KEY_0;
+  else if (key == GLFW_KEY_8) app.settings.mode = VIEW_BRDF_D;
+  else if (key == GLFW_KEY_9) app.settings.mode = VIEW_BRDF_F;
+  else if (key == GLFW_KEY_0) app.settings.mode = VIEW_BRDF_G;
+  else if (key == GLFW_KEY_MINUS) app.settings.mode = VIEW_DIFFUSE;
+  else if (key == GLFW_KEY_EQUAL) app.settings.mode = VIEW_SPECULAR;
+  else if (key == GLFW_KEY_M) app.settings.mosaic = render::MosaicMode((int(app.settings.mosaic) + 1) % 3);
+  else if (key == GLFW_KEY_LEFT_BRACKET) app.settings.lodBias -= 0.5f;
+  else if (key == GLFW_KEY_RIGHT_BRACKET) app.settings.lodBias += 0.5f;
+  else if (key == GLFW_KEY_C) std::printf("--camera %s\n", formatPose(app.camera.pose()).c_str()), std::fflush(stdout);
+  else if (key == GLFW_KEY_F1 || key == GLFW_KEY_H) app.overlay = !app.overlay;
+  else if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, GLFW_TRUE);
+}
+
+void onMouseButton(GLFWwindow* w, int button, int action, int) {
+  App& app = *static_cast<App*>(glfwGetWindowUserPointer(w));
+  if (button == GLFW_MOUSE_BUTTON_RIGHT && action == GLFW_PRESS) {
+    app.camera.toggleMouseLook();
+    glfwSetInputMode(w, GLFW_CURSOR, app.camera.mouseLook() ? GLFW_CURSOR_DISABLED : GLFW_CURSOR_NORMAL);
+  }
+}
+
+void onCursor(GLFWwindow* w, double x, double y) { static_cast<App*>(glfwGetWindowUserPointer(w))->camera.mouseMoved(x, y); }
+void onResize(GLFWwindow* w, int, int) { static_cast<App*>(glfwGetWindowUserPointer(w))->resized = true; }
+
+const char* modeName(int m) {
+  static const char* names[] = {"", "shaded", "mip level", "linear depth", "depth derivatives", "normal", "view dir",
+                                "light dir", "BRDF D", "BRDF F", "BRDF G", "diffuse", "specular"};
+  return m >= 1 && m <= VIEW_COUNT ? names[m] : "?";
+}
+
+struct GlfwSession {
+  GlfwSession() {
+    if (!glfwInit()) throw Error("cannot initialise GLFW (no display? use --headless)");
+  }
+  ~GlfwSession() { glfwTerminate(); }
+};
+
+// Copies a presented-format image (BGRA or RGBA UNORM) to an RGBA PNG.
+void saveSwapchainImage(const vk::Buffer& buf, VkFormat format, VkExtent2D e, const std::string& path) {
+  buf.invalidate();
+  ImageRGBA8 img{e.width, e.height, std::vector<uint8_t>(size_t(e.width) * e.height * 4)};
+  std::memcpy(img.pixels.data(), buf.mapped(), img.pixels.size());
+  if (format == VK_FORMAT_B8G8R8A8_UNORM)
+    for (size_t i = 0; i < img.pixels.size(); i += 4) std::swap(img.pixels[i], img.pixels[i + 2]);
+  savePng(path, img);
+  std::printf("%s\n", std::filesystem::absolute(path).c_str());
+}
+
+}  // namespace
+
+int runWindowed(const ViewOptions& o) {
+  GlfwSession glfw;
+  glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+  App app;
+  app.settings = o.settings;
+  Scene scene = loadScene(o.scene);
+
+  uint32_t extCount = 0;
+  const char** exts = glfwGetRequiredInstanceExtensions(&extCount);
+  if (!exts) throw Error("GLFW found no Vulkan surface support");
+  vk::ContextOptions co = vk::optionsFromEnvironment();
+  if (o.validation) co.validation = true;
+  if (!o.device.empty()) co.device = o.device;
+  co.instanceExtensions.assign(exts, exts + extCount);
+  co.presentation = true;
+  vk::Context ctx(co);
+
+  GLFWwindow* window = glfwCreateWindow(int(o.width), int(o.height), "rtr-view", nullptr, nullptr);
+  if (!window) throw Error("cannot create a window");
+  struct WindowGuard { GLFWwindow* w; ~WindowGuard() { glfwDestroyWindow(w); } } windowGuard{window};
+  VkSurfaceKHR surface;
+  VK_CHECK(glfwCreateWindowSurface(ctx.instance(), window, nullptr, &surface));
+  struct SurfaceGuard { VkInstance i; VkSurfaceKHR s; ~SurfaceGuard() { vkDestroySurfaceKHR(i, s, nullptr); } } surfaceGuard{ctx.instance(), surface};
+
+  glfwSetWindowUserPointer(window, &app);
+  glfwSetKeyCallback(window, onKey);
+  glfwSetMouseButtonCallback(window, onMouseButton);
+  glfwSetCursorPosCallback(window, onCursor);
+  glfwSetFramebufferSizeCallback(window, onResize);
+
+  const Bounds bounds = scene.bounds();
+  CameraSpeeds speeds;
+  // Cross the scene in about 5 s with Shift held.
+  if (!bounds.empty()) speeds.base = glm::length(bounds.extent()) / (5.0f * speeds.fastFactor);
+  app.camera = CameraController(startPose(o, scene.defaultView, bounds), speeds);
+
+  render::GpuScene gpuScene(ctx, scene, o.mips);
+  {
+    vk::Swapchain swapchain(ctx, surface, {o.width, o.height});
+    render::Renderer renderer(ctx, gpuScene, kFramesInFlight);
+
+    struct Frame { vk::CommandPool pool; VkCommandBuffer cb; vk::Fence fence; vk::Semaphore acquired; };
+    std::vector<Frame> frames(kFramesInFlight);
+    for (Frame& f : frames) {
+      VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+      pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+      pi.queueFamilyIndex = ctx.queueFamily();
+      VkCommandPool pool;
+      VK_CHECK(vkCreateCommandPool(ctx.device(), &pi, nullptr, &pool));
+      f.pool = vk::CommandPool(ctx.device(), pool);
+      VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+      ai.commandPool = pool;
+      ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+      ai.commandBufferCount = 1;
+      VK_CHECK(vkAllocateCommandBuffers(ctx.device(), &ai, &f.cb));
+      VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+      fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+      VkFence fence;
+      VK_CHECK(vkCreateFence(ctx.device(), &fi, nullptr, &fence));
+      f.fence = vk::Fence(ctx.device(), fence);
+      VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+      VkSemaphore sem;
+      VK_CHECK(vkCreateSemaphore(ctx.device(), &si, nullptr, &sem));
+      f.acquired = vk::Semaphore(ctx.device(), sem);
+    }
+    vk::Buffer shot;  // screenshot readback
+
+    auto last = std::chrono::steady_clock::now();
+    double titleTimer = 0, cpuFrameMs = 0;
+    uint64_t frameNumber = 0;
+    while (!glfwWindowShouldClose(window)) {
+      glfwPollEvents();
+      int fbw = 0, fbh = 0;
+      glfwGetFramebufferSize(window, &fbw, &fbh);
+      if (fbw == 0 || fbh == 0) {  // minimised: pause rendering until restored
+        glfwWaitEvents();
+        last = std::chrono::steady_clock::now();
+        continue;
+      }
+      if (app.resized || swapchain.extent().width != uint32_t(fbw) || swapchain.extent().height != uint32_t(fbh)) {
+        swapchain.recreate({uint32_t(fbw), uint32_t(fbh)});
+        app.resized = false;
+      }
+      const auto now = std::chrono::steady_clock::now();
+      const float dt = std::chrono::duration<float>(now - last).count();
+      last = now;
+      cpuFrameMs = 0.9 * cpuFrameMs + 0.1 * dt * 1000.0;
+      app.camera.update(dt);
+
+      Frame& f = frames[frameNumber % kFramesInFlight];
+      VkFence fence = f.fence;
+      VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
+      uint32_t imageIndex = 0;
+      VkResult acq = vkAcquireNextImageKHR(ctx.device(), swapchain.handle(), UINT64_MAX, f.acquired, VK_NULL_HANDLE, &imageIndex);
+      if (acq == VK_ERROR_OUT_OF_DATE_KHR) { app.resized = true; continue; }
+      if (acq != VK_SUBOPTIMAL_KHR) VK_CHECK(acq);
+      VK_CHECK(vkResetFences(ctx.device(), 1, &fence));
+
+      const bool takeShot = !o.screenshot.empty() && frameNumber + 1 == uint64_t(std::max(1, o.frames));
+      const bool canShot = swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+      if (takeShot && !canShot) throw Error("this surface's images cannot be read back for --screenshot");
+      const VkExtent2D e = swapchain.extent();
+      if (takeShot) shot = vk::Buffer(ctx, VkDeviceSize(e.width) * e.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+
+      VK_CHECK(vkResetCommandBuffer(f.cb, 0));
+      VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+      bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+      VK_CHECK(vkBeginCommandBuffer(f.cb, &bi));
+      const render::RenderTarget target{swapchain.image(imageIndex), swapchain.view(imageIndex), swapchain.format(), e,
+                                        takeShot ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
+      const Lens lens = fitDepthRange(o.lens, bounds, app.camera.pose());
+      renderer.record(f.cb, uint32_t(frameNumber % kFramesInFlight), app.camera.pose(), lens, app.settings, target);
+      if (takeShot) {
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {e.width, e.height, 1};
+        vkCmdCopyImageToBuffer(f.cb, target.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, shot.handle(), 1, &region);
+        vk::barrier(f.cb, {{target.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_ACCESS_2_NONE}});
+        vk::memoryBarrier(f.cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                          VK_ACCESS_2_HOST_READ_BIT);
+      }
+      VK_CHECK(vkEndCommandBuffer(f.cb));
+
+      VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+      wait.semaphore = f.acquired;
+      // The post pass is the first to touch the swapchain image, in compute or as a colour attachment.
+      wait.stageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+      VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+      signal.semaphore = swapchain.renderDone(imageIndex);
+      signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+      VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+      cbi.commandBuffer = f.cb;
+      VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+      si.waitSemaphoreInfoCount = 1;
+      si.pWaitSemaphoreInfos = &wait;
+      si.commandBufferInfoCount = 1;
+      si.pCommandBufferInfos = &cbi;
+      si.signalSemaphoreInfoCount = 1;
+      si.pSignalSemaphoreInfos = &signal;
+      VK_CHECK(vkQueueSubmit2(ctx.queue(), 1, &si, fence));
+
+      VkSemaphore done = swapchain.renderDone(imageIndex);
+      VkSwapchainKHR sc = swapchain.handle();
+      VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+      pi.waitSemaphoreCount = 1;
+      pi.pWaitSemaphores = &done;
+      pi.swapchainCount = 1;
+      pi.pSwapchains = &sc;
+      pi.pImageIndices = &imageIndex;
+      VkResult pr = vkQueuePresentKHR(ctx.queue(), &pi);
+      if (pr == VK_ERROR_OUT_OF_DATE_KHR || pr == VK_SUBOPTIMAL_KHR) app.resized = true;
+      else VK_CHECK(pr);
+
+      if (takeShot) {
+        VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
+        saveSwapchainImage(shot, swapchain.format(), e, o.screenshot);
+        glfwSetWindowShouldClose(window, GLFW_TRUE);
+      }
+      ++frameNumber;
+
+      titleTimer += dt;
+      if (titleTimer > 0.25) {  // the overlay: window title (and stdout when toggled on)
+        titleTimer = 0;
+        std::string text = std::string("rtr-view | ") + modeName(app.settings.mode) + " | mosaic " +
+                           (app.settings.mosaic == render::MosaicMode::Off ? "off" : app.settings.mosaic == render::MosaicMode::Compute ? "compute" : "graphics") +
+                           " | lod bias " + std::to_string(app.settings.lodBias).substr(0, 4);
+        char buf[64];
+        std::snprintf(buf, sizeof buf, " | CPU %.2f ms", cpuFrameMs);
+        text += buf;
+        for (const auto& [name, ms] : renderer.gpuTimes(uint32_t(frameNumber % kFramesInFlight))) {
+          std::snprintf(buf, sizeof buf, " | %s %.3f ms", name.c_str(), ms);
+          text += buf;
+        }
+        glfwSetWindowTitle(window, text.c_str());
+        if (app.overlay) std::printf("%s\n", text.c_str()), std::fflush(stdout);
+      }
+    }
+    vkDeviceWaitIdle(ctx.device());
+  }
+  return 0;
+}
+
+}  // namespace rtr::view

@@ -1,0 +1,77 @@
+#include "render/headless.hpp"
+
+#include <cstring>
+
+#include <glm/gtc/packing.hpp>
+
+#include "vk/context.hpp"
+
+namespace rtr::render {
+
+HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent)
+    : ctx_(ctx), extent_(extent), renderer_(ctx, scene, 1) {
+  target_ = vk::Image(ctx, {extent, VK_FORMAT_R8G8B8A8_UNORM, 1,
+                            VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                            0, 0, "headless target"});
+  const VkDeviceSize pixels = VkDeviceSize(extent.width) * extent.height;
+  readback_ = vk::Buffer(ctx, pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "target readback");
+}
+
+HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
+                                       int frames, bool readSceneColor) {
+  const RenderTarget target{target_.handle(), target_.view(), target_.format(), extent_,
+                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+  const VkDeviceSize pixels = VkDeviceSize(extent_.width) * extent_.height;
+  if (readSceneColor && !colorReadback_.handle())
+    colorReadback_ = vk::Buffer(ctx_, pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "colour readback");
+  for (int f = 0; f < frames; ++f) {
+    const bool last = f + 1 == frames;
+    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
+      renderer_.record(cb, 0, pose, lens, settings, target);
+      if (!last) return;
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.imageExtent = {extent_.width, extent_.height, 1};
+      vkCmdCopyImageToBuffer(cb, target_.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.handle(), 1, &region);
+      if (readSceneColor) {
+        const VkImage color = renderer_.sceneColor().handle();
+        vk::barrier(cb, {{color, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                          VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_READ_BIT}});
+        vkCmdCopyImageToBuffer(cb, color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorReadback_.handle(), 1, &region);
+        vk::barrier(cb, {{color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
+                          VK_ACCESS_2_NONE}});
+      }
+      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                        VK_ACCESS_2_HOST_READ_BIT);
+    });
+  }
+  HeadlessFrame out;
+  out.gpuTimes = renderer_.gpuTimes(0);
+  readback_.invalidate();
+  out.image = {extent_.width, extent_.height, std::vector<uint8_t>(pixels * 4)};
+  std::memcpy(out.image.pixels.data(), readback_.mapped(), pixels * 4);
+  if (readSceneColor) {
+    colorReadback_.invalidate();
+    const auto* half = static_cast<const uint16_t*>(colorReadback_.mapped());
+    out.sceneColor = {extent_.width, extent_.height, std::vector<glm::vec4>(pixels)};
+    for (VkDeviceSize i = 0; i < pixels; ++i)
+      for (int c = 0; c < 4; ++c) out.sceneColor.pixels[i][c] = glm::unpackHalf1x16(half[i * 4 + c]);
+  }
+  return out;
+}
+
+std::vector<std::vector<std::pair<std::string, double>>> HeadlessRenderer::bench(const CameraPose& pose, const Lens& lens,
+                                                                                 const RenderSettings& settings, int frames) {
+  const RenderTarget target{target_.handle(), target_.view(), target_.format(), extent_,
+                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+  std::vector<std::vector<std::pair<std::string, double>>> out;
+  for (int f = 0; f < frames; ++f) {
+    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) { renderer_.record(cb, 0, pose, lens, settings, target); });
+    out.push_back(renderer_.gpuTimes(0));
+  }
+  return out;
+}
+
+}  // namespace rtr::render

@@ -1,0 +1,36 @@
+#pragma once
+// Offscreen rendering with no window and no display: the frame goes to an image that is read back.
+#include <string>
+#include <vector>
+
+#include "core/image.hpp"
+#include "render/renderer.hpp"
+
+namespace rtr::render {
+
+struct HeadlessFrame {
+  ImageRGBA8 image;   // the post-processed target, as a viewer would show it (sRGB-encoded)
+  ImageF sceneColor;  // the linear-light intermediate image (filled when asked for)
+  std::vector<std::pair<std::string, double>> gpuTimes;  // ms per pass, of the last frame
+};
+
+class HeadlessRenderer {
+ public:
+  HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent);
+
+  // Renders `frames` frames (the last one is read back).
+  HeadlessFrame render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings, int frames = 1,
+                       bool readSceneColor = false);
+  // Renders `frames` frames, one submission each, and returns every frame's per-pass GPU times.
+  std::vector<std::vector<std::pair<std::string, double>>> bench(const CameraPose& pose, const Lens& lens,
+                                                                 const RenderSettings& settings, int frames);
+
+ private:
+  const vk::Context& ctx_;
+  VkExtent2D extent_;
+  Renderer renderer_;
+  vk::Image target_;
+  vk::Buffer readback_, colorReadback_;
+};
+
+}  // namespace rtr::render

@@ -1,0 +1,193 @@
+#include "render/mips.hpp"
+
+#include <algorithm>
+
+#include "core/error.hpp"
+#include "mips_shared.h"
+#include "vk/commands.hpp"
+#include "vk/context.hpp"
+
+namespace rtr::render {
+namespace {
+
+bool isSrgb(VkFormat f) { return f == VK_FORMAT_R8G8B8A8_SRGB || f == VK_FORMAT_B8G8R8A8_SRGB; }
+
+// The format of the views the compute passes read and write: sRGB images are accessed as UNORM
+// (storage sRGB is not generally supported) and the shaders do the transfer functions.
+VkFormat unormOf(VkFormat f) {
+  if (f == VK_FORMAT_R8G8B8A8_SRGB) return VK_FORMAT_R8G8B8A8_UNORM;
+  if (f == VK_FORMAT_B8G8R8A8_SRGB) return VK_FORMAT_B8G8R8A8_UNORM;
+  return f;
+}
+
+uint32_t levelSize(uint32_t size, uint32_t level) { return std::max(1u, size >> level); }
+
+// Widest range of level-(srcLevel + k) texels any workgroup of a multi-level dispatch needs along one
+// axis, for k = 1 .. levels - 1 (the same recursion as mips.comp), against the shared tile sides.
+bool axisFits(uint32_t size0, uint32_t levels) {
+  std::vector<uint32_t> n(levels + 1);
+  n[0] = size0;
+  for (uint32_t j = 1; j <= levels; ++j) n[j] = std::max(1u, n[j - 1] >> 1);
+  for (uint32_t w = 0; w < n[levels]; ++w) {
+    uint64_t lo = w, hi = w + 1;
+    for (uint32_t j = levels - 1; j >= 1; --j) {
+      lo = lo * n[j] / n[j + 1];
+      hi = (hi * n[j] + n[j + 1] - 1) / n[j + 1];
+      if (hi - lo > uint64_t(j % 2 ? MIP_CAP_ODD : MIP_CAP_EVEN)) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+const char* toString(MipMode mode) {
+  switch (mode) {
+    case MipMode::Blit: return "blit";
+    case MipMode::ComputePerLevel: return "compute-per-level";
+    case MipMode::Compute: return "compute";
+  }
+  return "?";
+}
+
+uint32_t mipLevelCount(VkExtent2D e) {
+  uint32_t m = std::max(e.width, e.height), n = 0;
+  while (m) { ++n; m >>= 1; }
+  return n;
+}
+
+vk::ImageDesc textureDesc(VkExtent2D extent, VkFormat format, const char* name) {
+  vk::ImageDesc d;
+  d.extent = extent;
+  d.format = format;
+  d.mipLevels = mipLevelCount(extent);
+  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+            VK_IMAGE_USAGE_STORAGE_BIT;
+  if (isSrgb(format)) {
+    d.flags = VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT | VK_IMAGE_CREATE_EXTENDED_USAGE_BIT;
+    d.viewUsage = d.usage & ~VK_IMAGE_USAGE_STORAGE_BIT;
+  }
+  d.name = name;
+  return d;
+}
+
+std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, MipMode mode) {
+  std::vector<MipDispatch> plan;
+  if (mode == MipMode::Blit) return plan;
+  const uint32_t total = mipLevelCount(extent);
+  for (uint32_t s = 0; s + 1 < total;) {
+    MipDispatch d;
+    d.srcLevel = s;
+    d.levels = mode == MipMode::Compute ? std::min<uint32_t>(MIP_MAX_LEVELS_PER_DISPATCH, total - 1 - s) : 1;
+    while (d.levels > 1 && !(axisFits(levelSize(extent.width, s), d.levels) &&
+                             axisFits(levelSize(extent.height, s), d.levels)))
+      --d.levels;
+    // One output level gains nothing from shared memory: the per-level shader does it with full groups.
+    d.multiLevel = d.levels > 1;
+    const VkExtent2D last{levelSize(extent.width, s + d.levels), levelSize(extent.height, s + d.levels)};
+    d.groups = d.multiLevel ? last
+                            : VkExtent2D{(last.width + MIP_LEVEL_GROUP - 1) / MIP_LEVEL_GROUP,
+                                         (last.height + MIP_LEVEL_GROUP - 1) / MIP_LEVEL_GROUP};
+    plan.push_back(d);
+    s += d.levels;
+  }
+  return plan;
+}
+
+MipGenerator::MipGenerator(const vk::Context& ctx) : ctx_(ctx) {
+  vk::LayoutOptions push{.pushDescriptorSets = {0}};
+  multi_ = vk::makeComputePipeline(ctx, vk::loadShader("mips.comp"), push);
+  perLevel_ = vk::makeComputePipeline(ctx, vk::loadShader("mip_level.comp"), push);
+}
+
+void MipGenerator::recordBlit(VkCommandBuffer cb, const vk::Image& image) const {
+  const uint32_t n = image.mipLevels();
+  const VkImage img = image.handle();
+  for (uint32_t i = 1; i < n; ++i) {
+    // Level i-1 was just written (upload or previous blit): make it a blit source; level i a destination.
+    vk::barrier(cb, {{img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                      VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_PIPELINE_STAGE_2_BLIT_BIT,
+                      VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, i - 1, 1},
+                     {img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                      VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_BLIT_BIT,
+                      VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, i, 1}});
+    VkImageBlit b{};
+    b.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, i - 1, 0, 1};
+    b.srcOffsets[1] = {int32_t(levelSize(image.extent().width, i - 1)), int32_t(levelSize(image.extent().height, i - 1)), 1};
+    b.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, i, 0, 1};
+    b.dstOffsets[1] = {int32_t(levelSize(image.extent().width, i)), int32_t(levelSize(image.extent().height, i)), 1};
+    vkCmdBlitImage(cb, img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &b,
+                   VK_FILTER_LINEAR);
+  }
+  const VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  std::vector<vk::ImageBarrier> done;
+  if (n > 1)  // sources: only reads to wait for (WAR), nothing to make visible
+    done.push_back({img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                    VK_PIPELINE_STAGE_2_BLIT_BIT, readers, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, n - 1});
+  done.push_back({img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                  VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, readers, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, n - 1, 1});
+  vk::barrier(cb, done);
+}
+
+MipViews MipGenerator::record(VkCommandBuffer cb, const vk::Image& image, MipMode mode) const {
+  MipViews views;
+  if (mode == MipMode::Blit) {
+    recordBlit(cb, image);
+    return views;
+  }
+  const uint32_t n = image.mipLevels();
+  const VkImage img = image.handle();
+  const VkFormat viewFormat = unormOf(image.format());
+  const VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  for (uint32_t i = 0; i < n; ++i) {
+    views.sampled.push_back(image.createView(viewFormat, i, 1, VK_IMAGE_USAGE_SAMPLED_BIT));
+    if (i > 0) views.storage.push_back(image.createView(viewFormat, i, 1, VK_IMAGE_USAGE_STORAGE_BIT));
+    else views.storage.emplace_back();
+  }
+
+  // Level 0 is only read: straight to its final layout. The others are written (and re-read) in GENERAL.
+  std::vector<vk::ImageBarrier> start{{img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                       VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, readers, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, 1}};
+  if (n > 1)
+    start.push_back({img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
+                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
+                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1});
+  vk::barrier(cb, start);
+  if (n == 1) return views;
+
+  const int srgb = (image.format() == VK_FORMAT_R8G8B8A8_SRGB || image.format() == VK_FORMAT_B8G8R8A8_SRGB) ? 1 : 0;
+  bool first = true;
+  for (const MipDispatch& d : planMipDispatches(image.extent(), mode)) {
+    // The previous dispatch's last level is this one's source.
+    if (!first)
+      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    first = false;
+    const vk::Pipeline& p = d.multiLevel ? multi_ : perLevel_;
+    p.bind(cb);
+    vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
+    w.image(0, views.sampled[d.srcLevel], d.srcLevel == 0 ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_GENERAL);
+    if (d.multiLevel) {
+      // Unused slots repeat the last level written, so every descriptor is valid and no extra level is touched.
+      std::vector<VkDescriptorImageInfo> outs;
+      for (uint32_t k = 1; k <= MIP_MAX_LEVELS_PER_DISPATCH; ++k)
+        outs.push_back({VK_NULL_HANDLE, views.storage[d.srcLevel + std::min(k, d.levels)], VK_IMAGE_LAYOUT_GENERAL});
+      w.images(1, outs);
+    } else {
+      w.image(1, views.storage[d.srcLevel + 1], VK_IMAGE_LAYOUT_GENERAL);
+    }
+    w.push(cb, p);
+    const shader::MipPush push{int(levelSize(image.extent().width, d.srcLevel)),
+                               int(levelSize(image.extent().height, d.srcLevel)), int(d.levels), srgb};
+    p.push(cb, push);
+    vkCmdDispatch(cb, d.groups.width, d.groups.height, 1);
+  }
+  vk::barrier(cb, {{img, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, readers, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1}});
+  return views;
+}
+
+}  // namespace rtr::render

@@ -1,0 +1,60 @@
+#pragma once
+// Mip-chain generation for 2D textures, three ways: the vkCmdBlitImage chain (baseline), one compute
+// dispatch per level, and (default) a multi-level compute pass that writes up to 6 levels per dispatch
+// through shared memory. The compute paths filter in linear light with the box rule of
+// src/core/mip_reference.hpp (exact fractional coverage for odd sizes), each level from the previous one
+// (MipSource::PreviousLevel), and are within 1 LSB of that float64 reference. See docs/post-and-mips.md.
+//
+// Layout contract of MipGenerator::record:
+//   on entry  level 0 is in TRANSFER_DST_OPTIMAL (its upload recorded earlier), other levels UNDEFINED;
+//   on exit   every level is in SHADER_READ_ONLY_OPTIMAL, its writes visible to fragment and compute
+//             shader reads that follow in the same queue.
+#include <cstdint>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "vk/pipeline.hpp"
+#include "vk/resources.hpp"
+
+namespace rtr::render {
+
+enum class MipMode { Blit, ComputePerLevel, Compute };
+const char* toString(MipMode mode);
+
+uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1
+
+// An image description for a texture of `format` (R8G8B8A8_SRGB, R8G8B8A8_UNORM, R8_UNORM) with its full
+// mip chain and the usage every MipMode needs (sampled, transfer src/dst, storage). sRGB formats get
+// MUTABLE_FORMAT + EXTENDED_USAGE (levels are written through UNORM storage views) and their own view
+// drops storage usage.
+vk::ImageDesc textureDesc(VkExtent2D extent, VkFormat format, const char* name = nullptr);
+
+// The dispatches of a compute mode: source level, levels written, and whether it is a multi-level one.
+struct MipDispatch {
+  uint32_t srcLevel = 0, levels = 1;
+  bool multiLevel = false;
+  VkExtent2D groups{1, 1};
+};
+std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, MipMode mode);
+
+// Views a recorded generation uses; keep them until the command buffer has completed.
+struct MipViews {
+  std::vector<vk::ImageView> sampled;  // per level, UNORM-equivalent format, sampled usage
+  std::vector<vk::ImageView> storage;  // per level, UNORM-equivalent format, storage usage
+};
+
+class MipGenerator {
+ public:
+  explicit MipGenerator(const vk::Context& ctx);  // once per context: builds the two compute pipelines
+
+  // Records the generation of levels 1.. of `image` from level 0 (see the layout contract above).
+  [[nodiscard]] MipViews record(VkCommandBuffer cb, const vk::Image& image, MipMode mode = MipMode::Compute) const;
+
+ private:
+  void recordBlit(VkCommandBuffer cb, const vk::Image& image) const;
+  const vk::Context& ctx_;
+  vk::Pipeline multi_, perLevel_;
+};
+
+}  // namespace rtr::render

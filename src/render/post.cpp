@@ -1,0 +1,91 @@
+#include "render/post.hpp"
+
+#include "core/error.hpp"
+#include "mosaic.h"
+#include "vk/commands.hpp"
+#include "vk/context.hpp"
+
+namespace rtr::render {
+
+const char* toString(MosaicMode mode) {
+  switch (mode) {
+    case MosaicMode::Off: return "off";
+    case MosaicMode::Compute: return "compute";
+    case MosaicMode::Graphics: return "graphics";
+  }
+  return "?";
+}
+
+MosaicPass::MosaicPass(const vk::Context& ctx) : ctx_(ctx) {
+  compute_ = vk::makeComputePipeline(ctx, vk::loadShader("mosaic.comp"), {.pushDescriptorSets = {0}});
+}
+
+void MosaicPass::setBlock(VkExtent2D block) {
+  if (block.width == 0 || block.height == 0) throw Error("MosaicPass: empty block");
+  block_ = block;
+}
+
+const vk::Pipeline& MosaicPass::graphics(VkFormat format) {
+  auto it = graphics_.find(format);
+  if (it != graphics_.end()) return it->second;
+  vk::GraphicsDesc d;
+  d.modules = {vk::loadShader("mosaic.vert"), vk::loadShader("mosaic.frag")};
+  d.cullMode = VK_CULL_MODE_NONE;
+  d.depthTest = d.depthWrite = false;
+  d.colorFormats = {format};
+  return graphics_.emplace(format, vk::makeGraphicsPipeline(ctx_, d, {.pushDescriptorSets = {0}})).first->second;
+}
+
+void MosaicPass::record(VkCommandBuffer cb, VkImageView input, VkImage output, VkImageView outputView,
+                        VkFormat outputFormat, VkExtent2D extent, MosaicMode mode, VkImageLayout outputFinalLayout) {
+  const VkExtent2D block = mode == MosaicMode::Off ? VkExtent2D{1, 1} : block_;
+  const shader::MosaicPush push{{int(block.width), int(block.height)}, {int(extent.width), int(extent.height)}};
+  const bool raster = mode == MosaicMode::Graphics;
+  const VkImageLayout work = raster ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_GENERAL;
+  const VkPipelineStageFlags2 stage = raster ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  const VkAccessFlags2 write = raster ? VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT : VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+
+  // Discard: after every earlier command (previous readers of the output, the acquire wait), no access
+  // to make visible since nothing is kept.
+  vk::barrier(cb, {{output, VK_IMAGE_LAYOUT_UNDEFINED, work, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, stage,
+                    VK_ACCESS_2_NONE, write, 0, 1}});
+  if (raster) {
+    const vk::Pipeline& p = graphics(outputFormat);
+    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    color.imageView = outputView;
+    color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    color.loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;  // the triangle covers every pixel
+    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, extent};
+    ri.layerCount = 1;
+    ri.colorAttachmentCount = 1;
+    ri.pColorAttachments = &color;
+    vkCmdBeginRendering(cb, &ri);
+    p.bind(cb);
+    const VkViewport vp{0, 0, float(extent.width), float(extent.height), 0, 1};
+    const VkRect2D sc{{0, 0}, extent};
+    vkCmdSetViewport(cb, 0, 1, &vp);
+    vkCmdSetScissor(cb, 0, 1, &sc);
+    vk::DescriptorWriter(ctx_, p.layout, 0, VK_NULL_HANDLE)
+        .image(0, input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
+        .push(cb, p);
+    p.push(cb, push);
+    vkCmdDraw(cb, 3, 1, 0, 0);
+    vkCmdEndRendering(cb);
+  } else {
+    compute_.bind(cb);
+    vk::DescriptorWriter(ctx_, compute_.layout, 0, VK_NULL_HANDLE)
+        .image(0, input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
+        .image(1, outputView, VK_IMAGE_LAYOUT_GENERAL)
+        .push(cb, compute_);
+    compute_.push(cb, push);
+    vkCmdDispatch(cb, (extent.width + MOSAIC_GROUP - 1) / MOSAIC_GROUP, (extent.height + MOSAIC_GROUP - 1) / MOSAIC_GROUP, 1);
+  }
+  // Presentation is ordered by the submit's signal semaphore: only the layout change is needed then.
+  const bool present = outputFinalLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+  vk::barrier(cb, {{output, work, outputFinalLayout, stage, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, write,
+                    present ? VK_ACCESS_2_NONE : VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, 0, 1}});
+}
+
+}  // namespace rtr::render

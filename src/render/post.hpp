@@ -1,0 +1,45 @@
+#pragma once
+// The mosaic post-process (brief part 2, section 1.7): every block of 5x3 output pixels takes the value
+// of one pixel inside it (the block's centre, clamped into the image; shaders/shared/mosaic.h), read
+// from the scene's linear-light colour image and written sRGB-encoded into a UNORM output (swapchain
+// image or headless target). Compute (default) and graphics (full-screen triangle, dynamic rendering,
+// no subpasses) give bit-identical bytes; Off is a plain copy with the same encode, in compute.
+//
+// Contract of MosaicPass::record:
+//   input   in SHADER_READ_ONLY_OPTIMAL, its writes already made visible to compute (Compute, Off) or
+//           fragment (Graphics) shader reads by the caller (the barrier after the scene pass);
+//   output  previous contents discarded (UNDEFINED -> GENERAL or COLOR_ATTACHMENT_OPTIMAL, after all
+//           earlier commands, so it chains with an acquire semaphore waited at any stage); it needs
+//           STORAGE usage for Compute/Off and COLOR_ATTACHMENT usage for Graphics; left in
+//           `outputFinalLayout` (e.g. PRESENT_SRC_KHR or TRANSFER_SRC_OPTIMAL), writes made available to
+//           all later commands.
+#include <map>
+
+#include <vulkan/vulkan.h>
+
+#include "vk/pipeline.hpp"
+
+namespace rtr::render {
+
+enum class MosaicMode { Off, Compute, Graphics };
+const char* toString(MosaicMode mode);
+
+class MosaicPass {
+ public:
+  explicit MosaicPass(const vk::Context& ctx);  // builds the compute pipeline; graphics ones per format
+
+  void setBlock(VkExtent2D block);  // 5x3 by default
+  VkExtent2D block() const { return block_; }
+
+  void record(VkCommandBuffer cb, VkImageView input, VkImage output, VkImageView outputView, VkFormat outputFormat,
+              VkExtent2D extent, MosaicMode mode, VkImageLayout outputFinalLayout);
+
+ private:
+  const vk::Pipeline& graphics(VkFormat format);
+  const vk::Context& ctx_;
+  VkExtent2D block_{5, 3};
+  vk::Pipeline compute_;
+  std::map<VkFormat, vk::Pipeline> graphics_;
+};
+
+}  // namespace rtr::render

@@ -1,0 +1,87 @@
+// rtr-bake's bad-input cases: each gets a clear error, and nothing is left behind.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "bake.hpp"
+#include "core/error.hpp"
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+namespace {
+
+struct Fixture : ::testing::Test {
+  fs::path dir = fs::temp_directory_path() / ("rtr_bake_err_" + std::to_string(::getpid()));
+  fs::path out = dir / "out";
+  void SetUp() override {
+    fs::remove_all(dir);
+    fs::create_directories(out);
+    write("s.obj", "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+    write("s.mtl", "newmtl a\nmap_Kd tex.png\n");
+    fs::copy_file(fs::path(RTR_SOURCE_DIR) / "assets-src/temple/textures/gold_col.png", dir / "tex.png");
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  void write(const std::string& name, const std::string& text) { std::ofstream(dir / name, std::ios::binary) << text; }
+  std::string bakeError(const fs::path& output, bool force = false) {
+    rtr::BakeOptions o{dir / "s.obj", output, force};
+    o.threads = 1;
+    o.warn = [](const std::string&) {};
+    try {
+      rtr::bake(o);
+    } catch (const rtr::Error& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  size_t filesIn(const fs::path& d) { return size_t(std::distance(fs::recursive_directory_iterator(d), {})); }
+};
+
+}  // namespace
+
+TEST_F(Fixture, GoodBakeThenExistingOutputNeedsForce) {
+  EXPECT_EQ(bakeError(out / "s.rtrscene"), "(no error)");
+  EXPECT_TRUE(fs::is_regular_file(out / "s-tex/tex.png"));
+  EXPECT_THAT(bakeError(out / "s.rtrscene"), HasSubstr("output exists; use --force"));
+  fs::remove(out / "s.rtrscene");
+  EXPECT_THAT(bakeError(out / "s.rtrscene"), HasSubstr("s-tex/tex.png: texture exists"));
+  EXPECT_FALSE(fs::exists(out / "s.rtrscene"));
+  EXPECT_EQ(bakeError(out / "s.rtrscene", true), "(no error)");
+}
+
+TEST_F(Fixture, MissingTextureFile) {
+  fs::remove(dir / "tex.png");
+  EXPECT_THAT(bakeError(out / "s.rtrscene"), HasSubstr("tex.png: texture file named in the MTL does not exist"));
+  EXPECT_EQ(filesIn(out), 0u);
+}
+
+TEST_F(Fixture, TextureThatIsNotAPng) {
+  write("tex.png", "this is text, not a PNG");
+  EXPECT_THAT(bakeError(out / "s.comp5892mesh"), HasSubstr("tex.png: cannot decode image"));
+  EXPECT_EQ(filesIn(out), 0u);
+}
+
+TEST_F(Fixture, MissingMtl) {
+  fs::remove(dir / "s.mtl");
+  EXPECT_THAT(bakeError(out / "s.rtrscene"), HasSubstr("s.mtl' named by 'mtllib' does not exist"));
+}
+
+TEST_F(Fixture, OutputFolderMissingOrNotWritable) {
+  EXPECT_THAT(bakeError(dir / "nowhere/s.rtrscene"), HasSubstr("does not exist"));
+  // /proc refuses new files even to root, so this holds whoever runs the test.
+  EXPECT_THAT(bakeError("/proc/s.rtrscene"), HasSubstr("/proc"));
+  if (::geteuid() != 0) {
+    fs::permissions(out, fs::perms::owner_read | fs::perms::owner_exec);
+    EXPECT_THAT(bakeError(out / "s.rtrscene"), HasSubstr("is not writable"));
+    fs::permissions(out, fs::perms::owner_all);
+  }
+  EXPECT_EQ(filesIn(out), 0u);
+}
+
+TEST_F(Fixture, UnknownOutputExtension) {
+  EXPECT_THAT(bakeError(out / "s.glb"), HasSubstr("unknown output format"));
+}

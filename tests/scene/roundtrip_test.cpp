@@ -1,0 +1,130 @@
+// Both baked formats round-trip through the loader to the meshes and materials that were baked.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "bake.hpp"
+#include "scene/course.hpp"
+#include "scene/load.hpp"
+#include "scene/rtrscene.hpp"
+
+namespace fs = std::filesystem;
+using namespace rtr;
+
+namespace {
+
+fs::path tempDir(const char* tag) {
+  fs::path d = fs::temp_directory_path() / (std::string("rtr_") + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void expectSameMeshes(const Scene& a, const Scene& b) {
+  ASSERT_EQ(a.meshes.size(), b.meshes.size());
+  for (size_t i = 0; i < a.meshes.size(); ++i) {
+    const Mesh &x = a.meshes[i], &y = b.meshes[i];
+    EXPECT_EQ(x.material, y.material);
+    EXPECT_EQ(x.positions, y.positions);
+    EXPECT_EQ(x.normals, y.normals);
+    EXPECT_EQ(x.texcoords, y.texcoords);
+    EXPECT_EQ(x.indices, y.indices);
+    EXPECT_EQ(x.bounds.min, y.bounds.min);
+    EXPECT_EQ(x.bounds.max, y.bounds.max);
+  }
+}
+
+void expectSameTextures(const Scene& a, const Scene& b) {
+  ASSERT_EQ(a.textures.size(), b.textures.size());
+  for (size_t i = 0; i < a.textures.size(); ++i) {
+    EXPECT_EQ(a.textures[i].path, b.textures[i].path);
+    EXPECT_EQ(a.textures[i].srgb, b.textures[i].srgb);
+    EXPECT_EQ(a.textures[i].channels, b.textures[i].channels);
+  }
+}
+
+// The temple as the baker sees it: parsed, with paths planned for an output named "temple".
+Scene planned(bool course) {
+  Scene s = loadScene(fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst");
+  s.defaultView = CameraPose{{1, 2, 3}, 45, -10};
+  return planTextures(s, "temple", course).scene;
+}
+
+}  // namespace
+
+TEST(RoundTrip, RtrSceneKeepsEverything) {
+  const Scene want = planned(false);
+  const fs::path dir = tempDir("rt_rtrscene");
+  BakeOptions o{fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst", dir / "temple.rtrscene"};
+  o.view = want.defaultView;
+  o.threads = 2;
+  bake(o);
+  const Scene got = loadScene(o.output);
+  EXPECT_EQ(got.baseDir, dir);
+  expectSameMeshes(want, got);
+  for (size_t i = 0; i < want.meshes.size(); ++i) EXPECT_EQ(want.meshes[i].name, got.meshes[i].name);
+  expectSameTextures(want, got);
+  ASSERT_EQ(want.materials.size(), got.materials.size());
+  for (size_t i = 0; i < want.materials.size(); ++i) {
+    const Material &a = want.materials[i], &b = got.materials[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.flags, b.flags);
+    EXPECT_EQ(a.textures, b.textures);
+    EXPECT_EQ(a.baseColor, b.baseColor);
+    EXPECT_EQ(a.roughness, b.roughness);
+    EXPECT_EQ(a.metalness, b.metalness);
+    EXPECT_EQ(a.emissive, b.emissive);
+    EXPECT_EQ(a.ka, b.ka);
+    EXPECT_EQ(a.kd, b.kd);
+    EXPECT_EQ(a.ks, b.ks);
+    EXPECT_EQ(a.ke, b.ke);
+    EXPECT_EQ(a.ns, b.ns);
+    EXPECT_EQ(a.mirror, b.mirror);
+    EXPECT_EQ(a.ior, b.ior);
+    EXPECT_EQ(a.transparency, b.transparency);
+  }
+  ASSERT_TRUE(got.defaultView.has_value());
+  EXPECT_EQ(got.defaultView->position, want.defaultView->position);
+  EXPECT_EQ(got.defaultView->yawDeg, 45.0f);
+  EXPECT_EQ(got.defaultView->pitchDeg, -10.0f);
+  // Textures were copied beside the output and decode.
+  for (const Texture& t : got.textures) EXPECT_TRUE(fs::is_regular_file(got.baseDir / t.path)) << t.path;
+  fs::remove_all(dir);
+}
+
+TEST(RoundTrip, CourseFormatKeepsMeshesAndTextureSlots) {
+  const Scene want = planned(false);  // fallbacks read back as "no texture"
+  const fs::path dir = tempDir("rt_course");
+  BakeOptions o{fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst", dir / "temple.comp5892mesh"};
+  o.threads = 2;
+  bake(o);
+  const Scene got = loadScene(o.output);
+  expectSameMeshes(want, got);
+  expectSameTextures(want, got);
+  ASSERT_EQ(want.materials.size(), got.materials.size());
+  for (size_t i = 0; i < want.materials.size(); ++i) {
+    EXPECT_EQ(want.materials[i].textures, got.materials[i].textures) << want.materials[i].name;
+    EXPECT_EQ(want.materials[i].flags & kMaterialAlphaMasked, got.materials[i].flags & kMaterialAlphaMasked);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(RoundTrip, SixteenAndThirtyTwoBitIndicesAndMissingAttributes) {
+  Scene s;
+  s.materials.push_back(Material{.name = "m"});
+  Mesh big;
+  for (uint32_t i = 0; i < 70000; ++i) big.positions.push_back({float(i), float(i % 3), 0.0f});
+  big.normals.assign(big.positions.size(), glm::vec3(0, 0, 1));
+  for (uint32_t i = 0; i + 2 < 70000; i += 3) big.indices.insert(big.indices.end(), {i, i + 1, 69999 - i});
+  for (auto& p : big.positions) big.bounds.extend(p);
+  Mesh small;
+  small.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  small.texcoords = {{0, 0}, {1, 0}, {0, 1}};
+  small.indices = {0, 1, 2};
+  for (auto& p : small.positions) small.bounds.extend(p);
+  s.meshes = {big, small, Mesh{}};
+  const std::string bytes = encodeRtrScene(s);
+  const Scene got = decodeRtrScene({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "mem.rtrscene");
+  expectSameMeshes(s, got);
+  EXPECT_TRUE(got.meshes[1].normals.empty());
+}
