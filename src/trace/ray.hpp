@@ -1,0 +1,31 @@
+#pragma once
+// Rays and hits of the CPU ray tracer. World space, right-handed, y up (core/camera.hpp).
+#include <cstdint>
+#include <limits>
+
+#include <glm/vec3.hpp>
+
+namespace rtr::trace {
+
+struct Ray {
+  glm::vec3 origin{0.0f};
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // need not be unit length; t is measured in its units
+  float tMax = std::numeric_limits<float>::infinity();
+};
+
+constexpr uint32_t kNoHit = 0xFFFFFFFFu;
+
+// Closest hit: t along the ray, barycentric weights b1, b2 of vertices 1 and 2 (b0 = 1 - b1 - b2),
+// and the index of the triangle in the tracer's flattened triangle list.
+struct Hit {
+  float t = std::numeric_limits<float>::infinity();
+  float b1 = 0.0f, b2 = 0.0f;
+  uint32_t prim = kNoHit;
+  bool hit() const { return prim != kNoHit; }
+};
+
+// Which ray-triangle test to use. HalfPlane is the brief's (plane, then three edge half-plane tests);
+// Watertight is Woop, Benthin and Wald 2013; MollerTrumbore is there to be measured against.
+enum class IntersectMethod { HalfPlane, Watertight, MollerTrumbore };
+
+}  // namespace rtr::trace

@@ -1,0 +1,129 @@
+#pragma once
+// The CPU ray tracer: built once per scene, then renders images of it tile by tile over N threads.
+// Shading follows the brief's Part 1 (Blinn-Phong with the scene's geometry lights, shadow rays, impulse
+// mirrors up to N_BOUNCES), or the GPU renderer's PBR BRDF, or debug views (normals, depth).
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/camera.hpp"
+#include "core/image.hpp"
+#include "scene/scene.hpp"
+#include "trace/bvh.hpp"
+#include "trace/intersect.hpp"
+#include "trace/lights.hpp"
+#include "trace/ray.hpp"
+
+namespace rtr::trace {
+
+constexpr int N_BOUNCES = 5;  // the brief's default recursion depth for mirrors
+
+enum class Shading { Phong, Pbr, Normals, Depth };
+
+// The GPU renderer's light, for --shading pbr (world space).
+struct PbrLight {
+  glm::vec3 position{-0.2972f, 7.3100f, -11.9532f};
+  glm::vec3 color{1.0f};
+  float ambient = 0.02f;
+};
+
+struct TraceSettings {
+  uint32_t width = 1280, height = 720;
+  std::optional<CameraPose> pose;  // none: frameBounds(scene bounds), the viewer's default view
+  Lens lens{};                     // the viewer's defaults (60° vertical fov); --fov 80 is the course's
+  glm::mat4 model{1.0f};           // Task 1 model transform (a similarity); modelview = view × model
+  Shading shading = Shading::Phong;
+  bool shadows = true;
+  int bounces = N_BOUNCES;         // mirror recursion depth; 0 turns reflections off
+  IntersectMethod intersect = IntersectMethod::Watertight;
+  unsigned threads = 0;            // 0: every core
+  uint32_t tileSize = 32;
+  int areaLightSamples = 1;        // shadow rays per area light: 1 aims at its centre (hard shadows)
+  PbrLight pbrLight;
+  glm::vec3 background{0.0f};
+};
+
+struct TileRect { uint32_t x0, y0, x1, y1; };  // half-open pixel rectangle
+// Called once per finished tile, never concurrently with itself (the tracer serialises the calls).
+using TileCallback = std::function<void(const TileRect&)>;
+
+struct RenderStats {
+  double seconds = 0.0;
+  uint64_t primaryRays = 0, shadowRays = 0, reflectionRays = 0;
+  uint32_t tilesDone = 0, tilesTotal = 0;
+  bool cancelled = false;
+};
+
+// What shading needs to know about a hit, in scene (model) space.
+struct SurfacePoint {
+  glm::vec3 position;    // from the barycentrics
+  glm::vec3 geomNormal;  // unit, facing the incoming ray
+  glm::vec3 normal;      // interpolated shading normal, unit, same side as geomNormal
+  glm::vec2 uv{0.0f};
+  const Material* material = nullptr;
+  uint32_t mesh = 0;
+};
+
+// The brief's Task 1: the modelview matrix, view × model.
+glm::mat4 modelview(const CameraPose& pose, const glm::mat4& model);
+
+class Tracer {
+ public:
+  // Keeps a reference to `scene`, which must outlive the tracer. Builds a BVH unless the scene is tiny
+  // (fewer than kBruteForceMax triangles: then every ray tests every triangle, as the brief's loop does).
+  explicit Tracer(const Scene& scene, unsigned buildThreads = 0);
+  static constexpr size_t kBruteForceMax = 16;
+
+  // Renders into `out` (resized to settings.width × height, linear RGBA). Returns early with
+  // stats.cancelled set when *cancel becomes true. Throws rtr::Error on bad settings.
+  RenderStats render(const TraceSettings& settings, ImageF& out, const TileCallback& onTile = {},
+                     std::atomic<bool>* cancel = nullptr) const;
+
+  // The pose and lens a render with these settings uses (defaults filled in from the scene bounds).
+  CameraPose resolvePose(const TraceSettings& s) const;
+  Lens resolveLens(const TraceSettings& s) const;
+
+  // Task 2: the ray through the centre of pixel (px, py), in scene space (through the model transform).
+  Ray calculateRay(const TraceSettings& s, uint32_t px, uint32_t py) const;
+  // Task 3: the closest triangle along the ray (kNoHit when none); any shadow caster along it.
+  Hit closestTriangle(const Ray& r, IntersectMethod m = IntersectMethod::Watertight) const;
+  bool occluded(const Ray& r, IntersectMethod m = IntersectMethod::Watertight) const;
+  SurfacePoint surface(const Ray& r, const Hit& h) const;
+  // Task 7's TraceAndShadeWithRay: colour seen along r with `bounces` mirror bounces left.
+  glm::vec3 traceAndShade(const Ray& r, int bounces, const TraceSettings& s) const;
+
+  const std::vector<Light>& lights() const { return lights_; }
+  const std::vector<Triangle>& triangles() const { return tris_; }
+  bool usesBvh() const { return useBvh_; }
+  const Bvh& bvh() const { return bvh_; }
+  const Scene& scene() const { return scene_; }
+
+ private:
+  struct Counters { uint64_t shadow = 0, reflection = 0; };
+  // Per-render constants in scene space.
+  struct Frame {
+    const TraceSettings* s;
+    glm::mat4 toScene;      // inverse of the model transform
+    glm::vec3 pbrLightPos;  // pbr light in scene space
+    glm::vec3 depthAxis;    // t · dot(d, depthAxis) = distance along the camera's forward axis
+    float depthFar;
+  };
+  Frame makeFrame(const TraceSettings& s) const;
+  glm::vec3 shade(const Ray& r, int bounces, const Frame& f, Counters& c) const;
+  glm::vec3 local(const Ray& r, const SurfacePoint& sp, const Frame& f, Counters& c) const;
+
+  const Scene& scene_;
+  std::vector<Triangle> tris_;
+  std::vector<uint32_t> triMesh_, triLocal_;  // triangle → mesh, triangle index within the mesh
+  std::vector<uint8_t> castsShadow_;
+  std::vector<Light> lights_;
+  Bvh bvh_;
+  bool useBvh_ = false;
+};
+
+}  // namespace rtr::trace
