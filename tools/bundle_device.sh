@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Bundles the release binaries, compiled shaders, baked assets and every shared library they need that
+# a bare Ubuntu/Debian machine may lack into .device/ (git-ignored), for running the benchmarks on a GPU
+# machine that has only a driver. Run there: .device/run.sh BINARY ARGS...
+set -euo pipefail
+cd "$(dirname "$0")/.."
+B=build/release
+out=.device
+rm -rf "$out"
+mkdir -p "$out/bin" "$out/lib"
+bins=()
+for b in rtr-view rtr-bench-gpu rtr-trace rtr-bench-trace; do
+  [[ -x $B/bin/$b ]] && cp "$B/bin/$b" "$out/bin/" && bins+=("$B/bin/$b")
+done
+cp -r "$B/shaders" "$out/shaders"
+cp -r "$B/assets" "$out/assets"
+# Libraries outside the C/C++ runtime (which the target has, newer).
+ldd "${bins[@]}" | awk '/=> \//{print $3}' | sort -u |
+  grep -v -E '/(libc|libm|libdl|libpthread|librt|libgcc_s|libstdc\+\+|ld-linux-x86-64)\.so' |
+  while read -r lib; do cp -L "$lib" "$out/lib/"; done
+cat > "$out/run.sh" <<'RUN'
+#!/usr/bin/env bash
+# Runs a bundled binary with the bundled libraries and the NVIDIA Vulkan driver.
+here=$(cd "$(dirname "$0")" && pwd)
+export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+export RTR_SHADER_DIR="$here/shaders"
+[[ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]] &&
+  export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json}
+bin=$1; shift
+exec "$here/bin/$bin" "$@"
+RUN
+chmod +x "$out/run.sh"
+du -sh "$out"
