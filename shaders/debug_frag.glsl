@@ -50,6 +50,9 @@ void main() {
     c = v * 0.5 + 0.5;
   } else if (mode == VIEW_LIGHT_DIR) {
     c = l * 0.5 + 0.5;
+  } else if (mode == VIEW_ALBEDO) {
+    outColor = vec4(s.baseColor, 1.0);  // linear, like the shaded output
+    return;
   } else {
     BrdfTerms t = brdfTerms(n, v, l, s.baseColor, s.roughness, s.metalness);
     if (mode == VIEW_BRDF_D) c = vec3(t.D / (1.0 + t.D));  // tone-mapped: D is unbounded

@@ -9,7 +9,7 @@ out=.device
 rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
 bins=()
-for b in rtr-view rtr-bench-gpu rtr-trace rtr-bench-trace; do
+for b in rtr-view rtr-bench-gpu rtr-trace bench-trace rtr-bake scenegen; do
   [[ -x $B/bin/$b ]] && cp "$B/bin/$b" "$out/bin/" && bins+=("$B/bin/$b")
 done
 cp -r "$B/shaders" "$out/shaders"
@@ -18,6 +18,7 @@ cp -r "$B/assets" "$out/assets"
 ldd "${bins[@]}" | awk '/=> \//{print $3}' | sort -u |
   grep -v -E '/(libc|libm|libdl|libpthread|librt|libgcc_s|libstdc\+\+|ld-linux-x86-64)\.so' |
   while read -r lib; do cp -L "$lib" "$out/lib/"; done
+strip --strip-unneeded "$out"/bin/* "$out"/lib/* 2>/dev/null || true  # debug info stays here
 cat > "$out/run.sh" <<'RUN'
 #!/usr/bin/env bash
 # Runs a bundled binary with the bundled libraries and the NVIDIA Vulkan driver.

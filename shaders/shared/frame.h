@@ -24,7 +24,8 @@ typedef uint32_t uint;
 #define VIEW_BRDF_G 10
 #define VIEW_DIFFUSE 11
 #define VIEW_SPECULAR 12
-#define VIEW_COUNT 12
+#define VIEW_ALBEDO 13      // unlit base colour: plain textured rasterisation, the speed baseline
+#define VIEW_COUNT 13
 
 // Per-frame constants (uniform buffer, std140).
 struct FrameUniforms {

@@ -69,7 +69,7 @@ void onResize(GLFWwindow* w, int, int) { static_cast<App*>(glfwGetWindowUserPoin
 
 const char* modeName(int m) {
   static const char* names[] = {"", "shaded", "mip level", "linear depth", "depth derivatives", "normal", "view dir",
-                                "light dir", "BRDF D", "BRDF F", "BRDF G", "diffuse", "specular"};
+                                "light dir", "BRDF D", "BRDF F", "BRDF G", "diffuse", "specular", "albedo"};
   return m >= 1 && m <= VIEW_COUNT ? names[m] : "?";
 }
 
