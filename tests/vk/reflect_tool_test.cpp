@@ -1,0 +1,57 @@
+// rtr-reflect prints exactly the interface the renderer builds its pipeline layouts from.
+#include <array>
+#include <cstdio>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "render/renderer.hpp"
+#include "vk/pipeline.hpp"
+#include "vk_fixture.hpp"
+
+namespace rtr {
+namespace {
+
+std::string runTool(const std::string& args, int* status) {
+  const std::string cmd = std::string(RTR_BINARY_DIR) + "/bin/rtr-reflect " + args + " 2>&1";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), pipe.get())) out.append(buf.data(), n);
+  *status = pclose(pipe.release());
+  return out;
+}
+
+using test::VulkanTest;
+
+TEST_F(VulkanTest, ReflectToolMatchesTheRenderersPipelines) {
+  const std::string dir = vk::shaderDir().string() + "/";
+  for (auto [vert, frag] : {std::pair{"scene.vert", "pbr.frag"}, {"scene_untextured.vert", "pbr_untextured.frag"},
+                            {"scene.vert", "pbr_alpha.frag"}, {"scene.vert", "debug.frag"}}) {
+    vk::GraphicsDesc d;
+    d.modules = {vk::loadShader(vert), vk::loadShader(frag)};
+    d.colorFormats = {render::Renderer::kColorFormat};
+    d.depthFormat = render::Renderer::kDepthFormat;
+    vk::LayoutOptions o;
+    o.runtimeArrayCounts[{1, 0}] = 3;
+    vk::Pipeline p = vk::makeGraphicsPipeline(*ctx, d, o);
+    int status = -1;
+    std::string json = runTool("--json " + dir + vert + ".spv " + dir + frag + ".spv", &status);
+    EXPECT_EQ(status, 0) << json;
+    EXPECT_EQ(json, vk::toJson(p.layout.interface())) << vert << " + " << frag;
+  }
+}
+
+TEST(ReflectTool, ConflictAndBadInputExitNonZero) {
+  int status = 0;
+  const std::string data = std::string(RTR_SOURCE_DIR) + "/tests/vk/data/";
+  std::string out = runTool(data + "conflict.vert " + data + "conflict.frag", &status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("set 0 binding 1"), std::string::npos) << out;
+  out = runTool(std::string(RTR_SOURCE_DIR) + "/README.md", &status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(out.find("not SPIR-V"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace rtr
