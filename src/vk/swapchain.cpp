@@ -53,9 +53,11 @@ void Swapchain::create(VkExtent2D windowExtent, VkSwapchainKHR old) {
                 ? caps.currentExtent
                 : VkExtent2D{std::clamp(windowExtent.width, caps.minImageExtent.width, caps.maxImageExtent.width),
                              std::clamp(windowExtent.height, caps.minImageExtent.height, caps.maxImageExtent.height)};
-  // Storage lets the compute post pass write the image directly; transfer-src serves screenshots.
+  // Storage lets the compute post pass write the image directly; transfer-src serves screenshots,
+  // transfer-dst the ray-traced overlay.
   usage_ = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-           (caps.supportedUsageFlags & (VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT));
+           (caps.supportedUsageFlags &
+            (VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT));
   uint32_t count = std::max(caps.minImageCount + 1, 3u);
   if (caps.maxImageCount) count = std::min(count, caps.maxImageCount);
 

@@ -86,7 +86,8 @@ int main(int argc, char** argv) {
                "Keys: W/S/A/D/E/Q move, Shift faster, Ctrl slower, right mouse button toggles mouse-look,\n"
                "1-7 views (shaded, mip level, linear depth, depth derivatives, normal, view dir, light dir),\n"
                "8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic off/compute/graphics, [ ] LOD bias,\n"
-               "C print camera pose, F1 or H timing overlay, Esc quit."};
+               "C print camera pose, F1 or H timing overlay, R ray-trace the view on the CPU (again: hide),\n"
+               "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, Esc quit."};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light;
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");

@@ -1,4 +1,5 @@
 // The windowed viewer: GLFW window and input, swapchain, frames in flight, and the renderer.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -7,6 +8,7 @@
 #include <GLFW/glfw3.h>
 
 #include "camera_controller.hpp"
+#include "trace_overlay.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "options.hpp"
@@ -24,6 +26,10 @@ struct App {
   CameraController camera{{}, {}};
   render::RenderSettings settings;
   bool overlay = false, resized = false;
+  // Ray tracer (FORMATS.md §2's toggles, on keys that do not clash with the view modes).
+  bool traceRequested = false;
+  trace::Shading traceShading = trace::Shading::Phong;
+  bool traceShadows = true, traceReflections = true, traceOrtho = false;
 };
 
 void onKey(GLFWwindow* w, int key, int, int action, int) {
@@ -53,6 +59,11 @@ void onKey(GLFWwindow* w, int key, int, int action, int) {
   else if (key == GLFW_KEY_RIGHT_BRACKET) app.settings.lodBias += 0.5f;
   else if (key == GLFW_KEY_C) std::printf("--camera %s\n", formatPose(app.camera.pose()).c_str()), std::fflush(stdout);
   else if (key == GLFW_KEY_F1 || key == GLFW_KEY_H) app.overlay = !app.overlay;
+  else if (key == GLFW_KEY_R) app.traceRequested = true;
+  else if (key == GLFW_KEY_T) app.traceShading = trace::Shading((int(app.traceShading) + 1) % 3);  // phong, pbr, normals
+  else if (key == GLFW_KEY_Y) app.traceShadows = !app.traceShadows;
+  else if (key == GLFW_KEY_U) app.traceReflections = !app.traceReflections;
+  else if (key == GLFW_KEY_O) app.traceOrtho = !app.traceOrtho;
   else if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, GLFW_TRUE);
 }
 
@@ -128,6 +139,10 @@ int runWindowed(const ViewOptions& o) {
   // Cross the scene in about 5 s with Shift held.
   if (!bounds.empty()) speeds.base = glm::length(bounds.extent()) / (5.0f * speeds.fastFactor);
   app.camera = CameraController(startPose(o, scene.defaultView, bounds), speeds);
+  // Course scenes light themselves with "*light*" geometry (Blinn-Phong); others use the renderer's light.
+  const bool geometryLights = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                          [](const Material& m) { return m.flags & kMaterialLight; });
+  app.traceShading = geometryLights ? trace::Shading::Phong : trace::Shading::Pbr;
 
   render::GpuScene gpuScene(ctx, scene, o.mips);
   {
@@ -159,6 +174,8 @@ int runWindowed(const ViewOptions& o) {
       f.acquired = vk::Semaphore(ctx.device(), sem);
     }
     vk::Buffer shot;  // screenshot readback
+    TraceOverlay traced(scene);
+    vk::Buffer traceStaging;
 
     auto last = std::chrono::steady_clock::now();
     double titleTimer = 0, cpuFrameMs = 0;
@@ -191,6 +208,24 @@ int runWindowed(const ViewOptions& o) {
       if (acq != VK_SUBOPTIMAL_KHR) VK_CHECK(acq);
       VK_CHECK(vkResetFences(ctx.device(), 1, &fence));
 
+      if (app.traceRequested) {  // R: trace this view; R again while shown hides it
+        app.traceRequested = false;
+        if (traced.visible()) {
+          traced.stop();
+        } else {
+          trace::TraceSettings ts;
+          ts.width = swapchain.extent().width;
+          ts.height = swapchain.extent().height;
+          ts.pose = app.camera.pose();
+          ts.lens = fitDepthRange(o.lens, bounds, app.camera.pose());
+          ts.lens.orthographic = app.traceOrtho;
+          ts.shading = app.traceShading;
+          ts.shadows = app.traceShadows;
+          ts.bounces = app.traceReflections ? trace::N_BOUNCES : 0;
+          ts.pbrLight = {app.settings.lightPos, app.settings.lightColor, app.settings.ambient.x};
+          traced.start(ts);
+        }
+      }
       const bool takeShot = !o.screenshot.empty() && frameNumber + 1 == uint64_t(std::max(1, o.frames));
       const bool canShot = swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
       if (takeShot && !canShot) throw Error("this surface's images cannot be read back for --screenshot");
@@ -201,10 +236,18 @@ int runWindowed(const ViewOptions& o) {
       VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
       bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
       VK_CHECK(vkBeginCommandBuffer(f.cb, &bi));
+      const bool showTrace = traced.visible() && (swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+      const VkImageLayout finalLayout = takeShot ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
       const render::RenderTarget target{swapchain.image(imageIndex), swapchain.view(imageIndex), swapchain.format(), e,
-                                        takeShot ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
+                                        showTrace ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : finalLayout};
       const Lens lens = fitDepthRange(o.lens, bounds, app.camera.pose());
       renderer.record(f.cb, uint32_t(frameNumber % kFramesInFlight), app.camera.pose(), lens, app.settings, target);
+      if (showTrace) {  // the traced image over the raster one
+        traced.recordCopy(ctx, f.cb, target.image, swapchain.format(), e, traceStaging);
+        vk::barrier(f.cb, {{target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, finalLayout, VK_PIPELINE_STAGE_2_COPY_BIT,
+                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            VK_ACCESS_2_TRANSFER_READ_BIT}});
+      }
       if (takeShot) {
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -267,6 +310,7 @@ int runWindowed(const ViewOptions& o) {
           std::snprintf(buf, sizeof buf, " | %s %.3f ms", name.c_str(), ms);
           text += buf;
         }
+        if (traced.visible()) text += " | " + traced.status();
         glfwSetWindowTitle(window, text.c_str());
         if (app.overlay) std::printf("%s\n", text.c_str()), std::fflush(stdout);
       }

@@ -1,0 +1,64 @@
+#include "trace_overlay.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "vk/context.hpp"
+
+namespace rtr::view {
+
+void TraceOverlay::start(const trace::TraceSettings& settings) {
+  stop();
+  if (!tracer_) tracer_ = std::make_unique<trace::Tracer>(scene_);
+  {
+    std::lock_guard lock(mutex_);
+    image_ = {settings.width, settings.height, std::vector<glm::vec4>(size_t(settings.width) * settings.height)};
+  }
+  cancel_ = false;
+  tilesDone_ = 0;
+  const uint32_t tile = settings.tileSize;
+  tilesTotal_ = ((settings.width + tile - 1) / tile) * ((settings.height + tile - 1) / tile);
+  visible_ = true;
+  worker_ = std::thread([this, settings] {
+    std::lock_guard lock(mutex_);
+    tracer_->render(settings, image_, [this](const trace::TileRect&) { ++tilesDone_; dirty_ = true; }, &cancel_);
+    dirty_ = true;
+  });
+}
+
+void TraceOverlay::stop() {
+  cancel_ = true;
+  if (worker_.joinable()) worker_.join();
+  visible_ = false;
+}
+
+std::string TraceOverlay::status() const {
+  if (!visible_) return "";
+  return "ray traced " + std::to_string(tilesDone_.load()) + "/" + std::to_string(tilesTotal_.load()) + " tiles";
+}
+
+void TraceOverlay::recordCopy(const vk::Context& ctx, VkCommandBuffer cb, VkImage image, VkFormat format,
+                              VkExtent2D extent, vk::Buffer& staging) {
+  const uint32_t w = std::min(extent.width, image_.width), h = std::min(extent.height, image_.height);
+  if (w == 0 || h == 0) return;
+  const VkDeviceSize bytes = VkDeviceSize(image_.width) * image_.height * 4;
+  if (staging.size() != bytes) {
+    staging = vk::Buffer(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "trace overlay");
+    dirty_ = true;
+  }
+  if (dirty_.exchange(false)) {
+    // Tiles still being written may show half done; the next refresh completes them.
+    ImageRGBA8 srgb = toSrgb8(image_);
+    if (format == VK_FORMAT_B8G8R8A8_UNORM)
+      for (size_t i = 0; i < srgb.pixels.size(); i += 4) std::swap(srgb.pixels[i], srgb.pixels[i + 2]);
+    std::memcpy(staging.mapped(), srgb.pixels.data(), bytes);
+    staging.flush();
+  }
+  VkBufferImageCopy region{};
+  region.bufferRowLength = image_.width;
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {w, h, 1};
+  vkCmdCopyBufferToImage(cb, staging.handle(), image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+}
+
+}  // namespace rtr::view
