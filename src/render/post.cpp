@@ -18,6 +18,7 @@ const char* toString(MosaicMode mode) {
 
 MosaicPass::MosaicPass(const vk::Context& ctx) : ctx_(ctx) {
   compute_ = vk::makeComputePipeline(ctx, vk::loadShader("mosaic.comp"), {.pushDescriptorSets = {0}});
+  computeRgba8_ = vk::makeComputePipeline(ctx, vk::loadShader("mosaic_rgba8.comp"), {.pushDescriptorSets = {0}});
 }
 
 void MosaicPass::setBlock(VkExtent2D block) {
@@ -74,12 +75,13 @@ void MosaicPass::record(VkCommandBuffer cb, VkImageView input, VkImage output, V
     vkCmdDraw(cb, 3, 1, 0, 0);
     vkCmdEndRendering(cb);
   } else {
-    compute_.bind(cb);
-    vk::DescriptorWriter(ctx_, compute_.layout, 0, VK_NULL_HANDLE)
+    const vk::Pipeline& c = outputFormat == VK_FORMAT_R8G8B8A8_UNORM ? computeRgba8_ : compute_;
+    c.bind(cb);
+    vk::DescriptorWriter(ctx_, c.layout, 0, VK_NULL_HANDLE)
         .image(0, input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
         .image(1, outputView, VK_IMAGE_LAYOUT_GENERAL)
-        .push(cb, compute_);
-    compute_.push(cb, push);
+        .push(cb, c);
+    c.push(cb, push);
     vkCmdDispatch(cb, (extent.width + MOSAIC_GROUP - 1) / MOSAIC_GROUP, (extent.height + MOSAIC_GROUP - 1) / MOSAIC_GROUP, 1);
   }
   // Presentation is ordered by the submit's signal semaphore: only the layout change is needed then.
