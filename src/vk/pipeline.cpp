@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <mutex>
 #include <unistd.h>
 
 #include "vk/check.hpp"
@@ -18,7 +19,23 @@ std::filesystem::path shaderDir() {
   return RTR_SPIRV_DIR;
 }
 
-SpirvModule loadShader(const std::string& name) { return readSpirv(shaderDir() / (name + ".spv")); }
+namespace {
+std::mutex g_overrideMutex;
+std::map<std::string, SpirvModule> g_overrides;
+}  // namespace
+
+void setShaderOverride(const std::string& name, SpirvModule module) {
+  std::lock_guard lock(g_overrideMutex);
+  g_overrides[name] = std::move(module);
+}
+
+SpirvModule loadShader(const std::string& name) {
+  {
+    std::lock_guard lock(g_overrideMutex);
+    if (auto it = g_overrides.find(name); it != g_overrides.end()) return it->second;
+  }
+  return readSpirv(shaderDir() / (name + ".spv"));
+}
 
 PipelineLayout::PipelineLayout(const Context& ctx, PipelineInterface interface, const LayoutOptions& options)
     : interface_(std::move(interface)), options_(options) {

@@ -19,6 +19,8 @@ class Context;
 // Where compiled shaders live: $RTR_SHADER_DIR, else <exe>/../shaders, else the build tree's folder.
 std::filesystem::path shaderDir();
 SpirvModule loadShader(const std::string& name);  // "mosaic.comp" -> <shaderDir>/mosaic.comp.spv
+// Shader hot reload: a module compiled at run time replaces the build's <name>.spv for later loadShader calls.
+void setShaderOverride(const std::string& name, SpirvModule module);
 
 struct LayoutOptions {
   // Size of each runtime-sized array binding, keyed by (set, binding). Such bindings are made

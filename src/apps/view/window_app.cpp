@@ -1,6 +1,7 @@
 // The windowed viewer: GLFW window and input, swapchain, frames in flight, and the renderer.
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cstdio>
 #include <cstring>
 
@@ -8,6 +9,7 @@
 #include <GLFW/glfw3.h>
 
 #include "camera_controller.hpp"
+#include "shader_watch.hpp"
 #include "trace_overlay.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
@@ -175,6 +177,10 @@ int runWindowed(const ViewOptions& o) {
     }
     vk::Buffer shot;  // screenshot readback
     TraceOverlay traced(scene);
+    std::unique_ptr<ShaderWatcher> watcher;
+    if (o.watch) watcher = std::make_unique<ShaderWatcher>(RTR_SHADER_SOURCE_DIR);
+    std::string shaderError;
+    double watchTimer = 0;
     vk::Buffer traceStaging;
 
     auto last = std::chrono::steady_clock::now();
@@ -198,6 +204,24 @@ int runWindowed(const ViewOptions& o) {
       last = now;
       cpuFrameMs = 0.9 * cpuFrameMs + 0.1 * dt * 1000.0;
       app.camera.update(dt);
+      watchTimer += dt;
+      if (watcher && watchTimer > 0.5) {  // hot reload: a failure keeps the running pipelines
+        watchTimer = 0;
+        std::string err;
+        if (watcher->poll(err)) {
+          try {
+            renderer.rebuildPipelines();
+            shaderError.clear();
+            std::fprintf(stderr, "rtr-view: shaders reloaded\n");
+          } catch (const std::exception& e) {
+            err = e.what();
+          }
+        }
+        if (!err.empty()) {
+          shaderError = err;
+          std::fprintf(stderr, "rtr-view: shader reload failed, keeping the previous pipelines:\n%s\n", err.c_str());
+        }
+      }
 
       Frame& f = frames[frameNumber % kFramesInFlight];
       VkFence fence = f.fence;
@@ -311,6 +335,7 @@ int runWindowed(const ViewOptions& o) {
           text += buf;
         }
         if (traced.visible()) text += " | " + traced.status();
+        if (!shaderError.empty()) text += " | SHADER ERROR: " + shaderError.substr(0, shaderError.find('\n', 20));
         glfwSetWindowTitle(window, text.c_str());
         if (app.overlay) std::printf("%s\n", text.c_str()), std::fflush(stdout);
       }
