@@ -128,6 +128,9 @@ int runWindowed(const ViewOptions& o) {
   // Cross the scene in about 5 s with Shift held.
   if (!bounds.empty()) speeds.base = glm::length(bounds.extent()) / (5.0f * speeds.fastFactor);
   app.camera = CameraController(startPose(o, scene.defaultView, bounds), speeds);
+  // The speed depends on the scene; printed so that users (and the window test) know what W does.
+  std::fprintf(stderr, "rtr-view: move speed %.9g units/s (Shift x%g, Ctrl x%g)\n", speeds.base, speeds.fastFactor,
+               speeds.slowFactor);
 
   render::GpuScene gpuScene(ctx, scene, o.mips);
   {
