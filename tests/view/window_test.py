@@ -4,6 +4,8 @@
 Usage: window_test.py RTR_VIEW SCENE
 Exit 0: pass, 1: fail, 77: Xvfb or xdotool missing (CTest SKIP_RETURN_CODE).
 """
+import ctypes
+import ctypes.util
 import math
 import os
 import re
@@ -40,6 +42,30 @@ def start_xvfb():
         proc.kill()
         raise Fail("Xvfb did not report a display number")
     return proc, ":" + num
+
+
+def wm_iconify(display, win, iconic):
+    """Iconifies (or restores) a window the way a window manager would, through libX11."""
+    x = ctypes.CDLL(ctypes.util.find_library("X11") or "libX11.so.6")
+    x.XOpenDisplay.restype = ctypes.c_void_p
+    x.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x.XInternAtom.restype = ctypes.c_ulong
+    x.XInternAtom.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int]
+    x.XChangeProperty.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_ulong, ctypes.c_ulong, ctypes.c_int,
+                                  ctypes.c_int, ctypes.c_void_p, ctypes.c_int]
+    for f in (x.XMapWindow, x.XUnmapWindow):
+        f.argtypes = [ctypes.c_void_p, ctypes.c_ulong]
+    x.XSync.argtypes = [ctypes.c_void_p, ctypes.c_int]
+    x.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    d = x.XOpenDisplay(display.encode())
+    if not d:
+        raise Fail(f"cannot open {display} through libX11")
+    wm_state = x.XInternAtom(d, b"WM_STATE", 0)
+    data = (ctypes.c_long * 2)(3 if iconic else 1, 0)  # IconicState / NormalState, no icon window
+    x.XChangeProperty(d, win, wm_state, wm_state, 32, 0, data, 2)  # format 32 takes longs; 0: PropModeReplace
+    (x.XUnmapWindow if iconic else x.XMapWindow)(d, win)
+    x.XSync(d, 0)
+    x.XCloseDisplay(d)
 
 
 class Viewer:
@@ -211,17 +237,21 @@ def main():
         geom = xdo_out("getwindowgeometry", win)
         check(f"{SIZE[0]}x{SIZE[1]}" in geom, "the window is back at its size")
 
-        # Minimise and restore. With no window manager, windowminimize is only a request nobody answers;
-        # unmapping is what a manager would do to iconify, so do that too.
-        xdo("windowminimize", win)
-        xdo("windowunmap", "--sync", win)
+        # Minimise and restore. There is no window manager to answer `xdotool windowminimize`, so do what
+        # one does on iconify: mark WM_STATE Iconic (GLFW reads that) and unmap; restore reverses both.
+        before = title()
+        wm_iconify(display, int(win), True)
         time.sleep(0.5)
+        paused_from = title()
+        time.sleep(1.0)
         check(viewer.proc.poll() is None, "alive while minimised")
-        xdo("windowmap", "--sync", win)
+        # The title carries the smoothed CPU frame time, rewritten every 0.25 s while frames are rendered.
+        check(title() == paused_from, "minimised: rendering pauses (the title stops changing)")
+        wm_iconify(display, int(win), False)
         xdo("windowfocus", "--sync", win)
         xdo("mousemove", "--window", win, SIZE[0] // 2, SIZE[1] // 2)
-        time.sleep(0.3)
-        check(viewer.proc.poll() is None, "alive after restore")
+        time.sleep(0.5)
+        check(viewer.proc.poll() is None and title() not in (paused_from, before), "restored: rendering resumes")
         # Still rendering: movement is integrated once per rendered frame, so it only happens if frames do.
         check_move(["s"], 0.6, speed, sign=-1)  # S: backwards
     except Fail as e:

@@ -170,7 +170,9 @@ int runWindowed(const ViewOptions& o) {
       glfwPollEvents();
       int fbw = 0, fbh = 0;
       glfwGetFramebufferSize(window, &fbw, &fbh);
-      if (fbw == 0 || fbh == 0) {  // minimised: pause rendering until restored
+      // Minimised: pause rendering until restored. A minimised window has a zero framebuffer on Windows
+      // only; on X11 it keeps its size, and the iconified state is the window manager's WM_STATE.
+      if (fbw == 0 || fbh == 0 || glfwGetWindowAttrib(window, GLFW_ICONIFIED)) {
         glfwWaitEvents();
         last = std::chrono::steady_clock::now();
         continue;
