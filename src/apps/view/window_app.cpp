@@ -145,6 +145,9 @@ int runWindowed(const ViewOptions& o) {
   const bool geometryLights = std::any_of(scene.materials.begin(), scene.materials.end(),
                                           [](const Material& m) { return m.flags & kMaterialLight; });
   app.traceShading = geometryLights ? trace::Shading::Phong : trace::Shading::Pbr;
+  // The speed depends on the scene; printed so that users (and the window test) know what W does.
+  std::fprintf(stderr, "rtr-view: move speed %.9g units/s (Shift x%g, Ctrl x%g)\n", speeds.base, speeds.fastFactor,
+               speeds.slowFactor);
 
   render::GpuScene gpuScene(ctx, scene, o.mips);
   {
@@ -190,7 +193,9 @@ int runWindowed(const ViewOptions& o) {
       glfwPollEvents();
       int fbw = 0, fbh = 0;
       glfwGetFramebufferSize(window, &fbw, &fbh);
-      if (fbw == 0 || fbh == 0) {  // minimised: pause rendering until restored
+      // Minimised: pause rendering until restored. A minimised window has a zero framebuffer on Windows
+      // only; on X11 it keeps its size, and the iconified state is the window manager's WM_STATE.
+      if (fbw == 0 || fbh == 0 || glfwGetWindowAttrib(window, GLFW_ICONIFIED)) {
         glfwWaitEvents();
         last = std::chrono::steady_clock::now();
         continue;
