@@ -1,0 +1,54 @@
+#pragma once
+// Rendering one reference case on both sides, the limits, and the files a person looks at.
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "core/compare.hpp"
+#include "core/image.hpp"
+#include "reference_scenes.hpp"
+#include "scene/load.hpp"
+#include "vk/context.hpp"
+
+namespace rtr::reftest {
+
+constexpr uint32_t kW = 160, kH = 120;
+
+// GPU view mode <-> tracer shading.
+//   Shaded:  GPU mode 1 (VIEW_SHADED)       vs Tracer Shading::Pbr, shadows off, 0 bounces.
+//   Normals: GPU mode 5 (VIEW_NORMAL, |n|)  vs Shading::Normals (|n|): same definition, no mapping.
+//   Depth:   GPU mode 3 (view depth / far)  vs Shading::Depth (t·dot(d, forward) / far): same definition and
+//            the same far (the GPU gets the tracer's fitted lens); misses are 1 (white) on the CPU and the
+//            clear colour 0 on the GPU, so CPU misses are mapped to 0 (see docs/reference-tests.md).
+enum class View { Shaded, Normals, Depth };
+const char* viewName(View v);
+
+struct Limits {
+  int threshold;              // per channel, 8-bit sRGB steps, against the best of the 3x3 reference pixels
+  double maxFailingFraction;  // of all pixels
+};
+Limits limits(View v);
+
+struct CasePair {
+  ImageRGBA8 gpu;           // toSrgb8(the GPU's linear intermediate image)
+  ImageRGBA8 gpuDisplayed;  // the GPU's post-pass output (mosaic off), as the viewer shows it
+  ImageRGBA8 cpu;           // toSrgb8(the tracer's linear image)
+};
+
+// Renders a case on both sides. `shaderDir`: compiled shaders to use for the GPU instead of the build's
+// (RTR_SHADER_DIR for the lifetime of the renderer's pipeline creation); used by the broken-BRDF test.
+CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const PoseEntry& pose, View view,
+                    const std::optional<std::filesystem::path>& shaderDir = std::nullopt);
+
+std::filesystem::path posesFile();
+std::filesystem::path outDir();  // <build>/reference-out, created
+
+// Fails the current test if the image is blank: under 5% of pixels above 2/255 in some channel, or one
+// colour only (a flat plane's normal view legitimately has just two: background and the plane).
+void expectNotBlank(const ImageRGBA8& img, const std::string& label);
+
+// <id>_gpu.png, <id>_cpu.png, <id>_err.png and <id>.txt (one line: the numbers) in outDir(); the line is
+// also printed.
+void writeOutputs(const std::string& id, const CasePair& pair, const CompareResult& r, const Limits& lim);
+
+}  // namespace rtr::reftest

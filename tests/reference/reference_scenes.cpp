@@ -1,0 +1,218 @@
+#include "reference_scenes.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <glm/geometric.hpp>
+
+#include "core/error.hpp"
+#include "core/image.hpp"
+#include "scene/load.hpp"
+
+namespace rtr::reftest {
+namespace {
+
+// Appends a triangle wound counter-clockwise about its vertex normals (the GPU culls the other side).
+void addTriangle(Mesh& m, uint32_t a, uint32_t b, uint32_t c) {
+  const glm::vec3 face = glm::cross(m.positions[b] - m.positions[a], m.positions[c] - m.positions[a]);
+  const glm::vec3 n = m.normals[a] + m.normals[b] + m.normals[c];
+  if (glm::dot(face, n) < 0.0f) std::swap(b, c);
+  m.indices.insert(m.indices.end(), {a, b, c});
+}
+
+void finish(Mesh& m) {
+  for (const glm::vec3& p : m.positions) m.bounds.extend(p);
+}
+
+// A flat nu x nv grid over origin + s*u + t*v, normal u x v; texcoords (s, t) when asked for.
+Mesh grid(const std::string& name, uint32_t material, glm::vec3 origin, glm::vec3 u, glm::vec3 v, int nu, int nv,
+          bool texcoords) {
+  Mesh m;
+  m.name = name;
+  m.material = material;
+  const glm::vec3 n = glm::normalize(glm::cross(u, v));
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      const float s = float(i) / float(nu), t = float(j) / float(nv);
+      m.positions.push_back(origin + s * u + t * v);
+      m.normals.push_back(n);
+      if (texcoords) m.texcoords.emplace_back(s, t);
+    }
+  auto at = [&](int i, int j) { return uint32_t(j * (nu + 1) + i); };
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      addTriangle(m, at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      addTriangle(m, at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  finish(m);
+  return m;
+}
+
+// A UV sphere with smooth (analytic) normals.
+Mesh sphere(const std::string& name, uint32_t material, glm::vec3 centre, float radius, int slices, int stacks) {
+  Mesh m;
+  m.name = name;
+  m.material = material;
+  for (int j = 0; j <= stacks; ++j) {
+    const float theta = 3.14159265f * float(j) / float(stacks);  // from +y down
+    for (int i = 0; i <= slices; ++i) {
+      const float phi = 2.0f * 3.14159265f * float(i) / float(slices);
+      const glm::vec3 n{std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)};
+      m.positions.push_back(centre + radius * n);
+      m.normals.push_back(n);
+    }
+  }
+  auto at = [&](int i, int j) { return uint32_t(j * (slices + 1) + i); };
+  for (int j = 0; j < stacks; ++j)
+    for (int i = 0; i < slices; ++i) {
+      if (j > 0) addTriangle(m, at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      if (j + 1 < stacks) addTriangle(m, at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  finish(m);
+  return m;
+}
+
+Material material(const std::string& name, glm::vec3 base, float roughness, float metalness) {
+  Material m;
+  m.name = name;
+  m.baseColor = base;
+  m.roughness = roughness;
+  m.metalness = metalness;
+  return m;
+}
+
+// Two-sided on the GPU needs the alpha-masked pipeline (the only one that does not cull back faces): give
+// the material an all-opaque alpha mask (every fragment kept) and its meshes texture coordinates. The
+// tracer samples no textures and draws both sides of every triangle, so it sees the same surface.
+void twoSidedOnGpu(Scene& s, uint32_t material, const std::filesystem::path& workDir) {
+  std::filesystem::create_directories(workDir);
+  const std::filesystem::path mask = workDir / "opaque_mask.png";
+  if (!std::filesystem::exists(mask)) savePng(mask, ImageRGBA8{4, 4, std::vector<uint8_t>(4 * 4 * 4, 255)});
+  uint32_t tex = kNoTexture;
+  for (uint32_t i = 0; i < s.textures.size(); ++i)
+    if (s.textures[i].path == mask) tex = i;
+  if (tex == kNoTexture) {
+    tex = uint32_t(s.textures.size());
+    s.textures.push_back({mask, false, 4});
+  }
+  Material& m = s.materials.at(material);
+  m.flags |= kMaterialAlphaMasked | kMaterialDoubleSided;
+  m.textures[uint32_t(TextureSlot::AlphaMask)] = tex;
+  for (Mesh& mesh : s.meshes)
+    if (mesh.material == material && mesh.texcoords.empty()) mesh.texcoords.assign(mesh.positions.size(), glm::vec2(0.0f));
+}
+
+ReferenceScene loadFile(const std::filesystem::path& file) {
+  ReferenceScene r;
+  r.scene = loadScene(file);
+  return r;
+}
+
+}  // namespace
+
+std::map<std::string, PoseEntry> loadPoses(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": cannot open");
+  std::map<std::string, PoseEntry> out;
+  std::string line;
+  for (int lineNo = 1; std::getline(in, line); ++lineNo) {
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const size_t hash = line.find('#');
+    const std::string place = std::to_string(lineNo);
+    if (hash == std::string::npos) throw fileError(file.string(), place, "a case needs a '# comment'");
+    std::istringstream fields(line.substr(0, hash));
+    std::string name, pose, extra;
+    PoseEntry e;
+    if (!(fields >> name >> pose >> e.fovYDeg) || (fields >> extra))
+      throw fileError(file.string(), place, "expected 'name x,y,z,yaw,pitch fovY # comment'");
+    if (!(e.fovYDeg > 1.0f && e.fovYDeg < 179.0f)) throw fileError(file.string(), place, "fovY out of range");
+    try {
+      e.pose = parsePose(pose);
+    } catch (const Error& err) {
+      throw fileError(file.string(), place, err.what());
+    }
+    e.comment = line.substr(line.find_first_not_of("# \t", hash) == std::string::npos ? line.size()
+                                                                                       : line.find_first_not_of("# \t", hash));
+    if (e.comment.empty()) throw fileError(file.string(), place, "empty comment");
+    if (!out.emplace(name, e).second) throw fileError(file.string(), place, "case '" + name + "' repeated");
+  }
+  return out;
+}
+
+Scene untexturedTemple(const Scene& temple, int* removed) {
+  Scene s = temple;
+  for (Material& m : s.materials) {
+    m.textures.fill(kNoTexture);
+    m.flags &= ~uint32_t(kMaterialAlphaMasked);
+  }
+  s.textures.clear();
+  // Cards: one-sided quads (the GPU culls their backs, the tracer draws them) whose shape is the alpha mask.
+  auto isCard = [&](const Mesh& m) {
+    const Material* mat = m.material < s.materials.size() ? &s.materials[m.material] : nullptr;
+    return (mat && (mat->flags & kMaterialDoubleSided)) || m.name.rfind("fire_", 0) == 0;
+  };
+  const size_t before = s.meshes.size();
+  std::erase_if(s.meshes, isCard);
+  if (removed) *removed = int(before - s.meshes.size());
+  return s;
+}
+
+ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir) {
+  const std::filesystem::path rt = std::filesystem::path(RTR_SOURCE_DIR) / "assets-src/rt";
+  if (name == "temple_nave" || name == "temple_aisle") {
+    ReferenceScene r;
+    r.scene = untexturedTemple(loadScene(std::filesystem::path(RTR_BINARY_DIR) / "assets/temple.rtrscene"));
+    return r;  // the default light (the brief's standard light above the statue)
+  }
+  if (name == "cornell_box") {
+    ReferenceScene r = loadFile(rt / "cornell_box.obj");
+    r.light.position = {0.3f, 0.8f, -1.8f};  // inside the box, near the ceiling, towards the front
+    r.light.color = glm::vec3(1.5f);
+    return r;
+  }
+  if (name == "cube_backplane") {
+    ReferenceScene r = loadFile(rt / "cube_backplane.obj");
+    // The three emissive quads face the backplane (-z): the camera sees their backs, which the tracer draws
+    // and the GPU culls. Compare the same surfaces: make them two-sided on the GPU (docs: "Culling").
+    int lights = 0;
+    for (uint32_t i = 0; i < r.scene.materials.size(); ++i)
+      if (r.scene.materials[i].name.rfind("light_", 0) == 0) twoSidedOnGpu(r.scene, i, workDir), ++lights;
+    if (lights != 3) throw Error("cube_backplane: expected 3 light_* materials, found " + std::to_string(lights));
+    r.light.position = {-2.0f, 3.0f, 6.0f};
+    r.light.color = glm::vec3(1.2f);
+    return r;
+  }
+  ReferenceScene r;
+  Scene& s = r.scene;
+  if (name == "grazing_floor") {
+    s.materials.push_back(material("floor", {0.5f, 0.5f, 0.55f}, 0.4f, 0.0f));
+    s.meshes.push_back(grid("floor", 0, {-200, 0, 200}, {400, 0, 0}, {0, 0, -400}, 16, 16, false));
+    r.light = {{0.0f, 3.0f, -60.0f}, glm::vec3(1.0f), 0.02f};  // ahead of the camera: forward grazing specular
+    return r;
+  }
+  if (name == "metal_sphere") {
+    s.materials.push_back(material("copper", {0.95f, 0.64f, 0.54f}, 0.3f, 1.0f));
+    s.meshes.push_back(sphere("sphere", 0, {0, 0, -3}, 1.0f, 96, 48));
+    r.light = {{2.0f, 3.0f, 1.0f}, glm::vec3(2.0f), 0.02f};
+    return r;
+  }
+  if (name == "rough0_patch") {
+    s.materials.push_back(material("polished", {0.45f, 0.5f, 0.6f}, 0.0f, 0.0f));
+    s.meshes.push_back(grid("patch", 0, {-1, 0, -3}, {2, 0, 0}, {0, 0, -2}, 4, 4, false));
+    // Light at the mirror image of the camera about the patch centre (0, 0, -4): h = n there.
+    r.light = {{0.0f, 1.5f, -8.0f}, glm::vec3(4.0f), 0.02f};
+    return r;
+  }
+  if (name == "backface_quad") {
+    s.materials.push_back(material("quad.DoubleSided", {0.2f, 0.6f, 0.3f}, 0.5f, 0.0f));
+    s.meshes.push_back(grid("quad", 0, {-1, -1, -3}, {2, 0, 0}, {0, 2, 0}, 2, 2, true));  // faces +z
+    twoSidedOnGpu(s, 0, workDir);
+    r.light = {{1.0f, 2.0f, -7.0f}, glm::vec3(1.5f), 0.02f};  // on the camera's (back) side
+    return r;
+  }
+  throw Error("no reference scene named '" + name + "'");
+}
+
+}  // namespace rtr::reftest

@@ -1,0 +1,38 @@
+#pragma once
+// Scenes, poses and lights of the GPU-vs-CPU reference tests: the generated default scene (untextured
+// copy), the ray tracer's course scenes, and synthetic hard views built in code.
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "core/camera.hpp"
+#include "scene/scene.hpp"
+#include "trace/tracer.hpp"
+
+namespace rtr::reftest {
+
+struct PoseEntry {
+  CameraPose pose;
+  float fovYDeg = 60.0f;
+  std::string comment;
+};
+
+// Parses tests/reference/poses.txt ("name x,y,z,yaw,pitch fovY # comment"). Throws rtr::Error naming the
+// line for a malformed entry, a missing comment or a repeated name.
+std::map<std::string, PoseEntry> loadPoses(const std::filesystem::path& file);
+
+struct ReferenceScene {
+  Scene scene;
+  trace::PbrLight light;  // used for both renderers (GPU: lightPos/lightColor/ambient, no falloff)
+};
+
+// Builds the scene of a case by name (the names in poses.txt). `workDir` receives generated files (the
+// back-face quad's alpha-mask texture). Throws rtr::Error for an unknown name.
+ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir);
+
+// The default scene as the CPU PBR mode sees it: every texture slot cleared (the tracer samples no
+// textures), and the meshes that only make sense with an alpha mask or would need two-sided drawing
+// (foliage and ivy cards, the fire cards) removed. Returns how many meshes were removed in `removed`.
+Scene untexturedTemple(const Scene& temple, int* removed = nullptr);
+
+}  // namespace rtr::reftest
