@@ -103,10 +103,12 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
       else texcoords.insert(texcoords.end(), m.texcoords.begin(), m.texcoords.end());
     }
     const bool textured = !m.texcoords.empty();
-    DrawKind kind = !textured ? DrawKind::Untextured
-                    : (mat.flags & kMaterialAlphaMasked) && mat.texture(TextureSlot::AlphaMask) != kNoTexture
-                        ? DrawKind::AlphaMasked
-                        : DrawKind::Opaque;
+    // Two-sided materials go to the alpha-tested pipeline, which does not cull (with no mask texture
+    // the alpha is 1 and nothing is discarded).
+    const bool masked = (mat.flags & kMaterialAlphaMasked) && mat.texture(TextureSlot::AlphaMask) != kNoTexture;
+    DrawKind kind = !textured                                      ? DrawKind::Untextured
+                    : masked || (mat.flags & kMaterialDoubleSided) ? DrawKind::AlphaMasked
+                                                                   : DrawKind::Opaque;
     draws_[size_t(kind)].push_back(d);
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
