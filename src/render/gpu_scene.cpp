@@ -193,7 +193,9 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     }
     timer.reset(cb);
     timer.begin(cb);
-    for (auto& img : textures_) mipViews.push_back(mipGen.record(cb, img, mipMode));
+    std::vector<const vk::Image*> batch;
+    for (const auto& img : textures_) batch.push_back(&img);
+    mipViews.push_back(mipGen.record(cb, batch, mipMode));  // all textures, one barrier per step
     timer.mark(cb, "mips");
   });
   if (!textures_.empty()) stats_.mipGpuMs = timer.results().at(0).second;

@@ -131,84 +131,114 @@ void MipGenerator::recordBlit(VkCommandBuffer cb, const vk::Image& image) const 
 }
 
 MipViews MipGenerator::record(VkCommandBuffer cb, const vk::Image& image, MipMode mode) const {
+  const vk::Image* one[] = {&image};
+  return record(cb, one, mode);
+}
+
+MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* const> images, MipMode mode) const {
   MipViews views;
   if (mode == MipMode::Blit) {
-    recordBlit(cb, image);
+    for (const vk::Image* image : images) recordBlit(cb, *image);
     return views;
   }
-  const uint32_t n = image.mipLevels();
-  const VkImage img = image.handle();
-  const VkFormat viewFormat = unormOf(image.format());
   const VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-  for (uint32_t i = 0; i < n; ++i) {
-    views.sampled.push_back(image.createView(viewFormat, i, 1, VK_IMAGE_USAGE_SAMPLED_BIT));
-    if (i > 0) views.storage.push_back(image.createView(viewFormat, i, 1, VK_IMAGE_USAGE_STORAGE_BIT));
-    else views.storage.emplace_back();
-  }
 
-  // Level 0 is only read: straight to its final layout. The others are written (and re-read) in GENERAL.
-  std::vector<vk::ImageBarrier> start{{img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                                       VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, readers, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, 1}};
-  if (n > 1)
-    start.push_back({img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
-                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
-                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1});
-  vk::barrier(cb, start);
-  if (n == 1) return views;
-
-  // Per level: level k's float copy goes to region k % 2 (odd levels: the size of level 1, even: level 2).
-  const std::vector<MipDispatch> plan = planMipDispatches(image.extent(), mode);
-  VkDeviceSize region[2] = {16, 16};  // [even, odd] sizes; never empty
-  if (std::any_of(plan.begin(), plan.end(), [](const MipDispatch& d) { return !d.multiLevel; })) {
-    const VkExtent2D e = image.extent();
-    region[1] = VkDeviceSize(levelSize(e.width, 1)) * levelSize(e.height, 1) * 16;
-    if (n > 2) region[0] = VkDeviceSize(levelSize(e.width, 2)) * levelSize(e.height, 2) * 16;
-    const VkDeviceSize align = std::max<VkDeviceSize>(256, ctx_.properties().limits.minStorageBufferOffsetAlignment);
-    region[1] = (region[1] + align - 1) / align * align;
-    views.scratch = vk::Buffer(ctx_, region[1] + region[0], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device,
-                               "mip scratch");
-  }
-  auto scratchRegion = [&](uint32_t level, vk::DescriptorWriter& w, uint32_t binding) {
-    w.buffer(binding, views.scratch.handle(), level % 2 ? 0 : region[1], region[level % 2]);
+  // Per image: its views (from `base` in views.sampled / views.storage), plan and scratch regions.
+  struct Job {
+    const vk::Image* image;
+    uint32_t base;
+    std::vector<MipDispatch> plan;
+    int srgb;
+    VkBuffer scratch = VK_NULL_HANDLE;
+    VkDeviceSize region[2] = {16, 16};  // [even, odd] level sizes; never empty
   };
+  std::vector<Job> jobs;
+  std::vector<vk::ImageBarrier> start, done;
+  size_t steps = 0;
+  for (const vk::Image* image : images) {
+    const uint32_t n = image->mipLevels();
+    const VkImage img = image->handle();
+    Job job{image, uint32_t(views.sampled.size()), planMipDispatches(image->extent(), mode), isSrgb(image->format()) ? 1 : 0};
+    const VkFormat viewFormat = unormOf(image->format());
+    for (uint32_t i = 0; i < n; ++i) {
+      views.sampled.push_back(image->createView(viewFormat, i, 1, VK_IMAGE_USAGE_SAMPLED_BIT));
+      if (i > 0) views.storage.push_back(image->createView(viewFormat, i, 1, VK_IMAGE_USAGE_STORAGE_BIT));
+      else views.storage.emplace_back();
+    }
+    // Level 0 is only read: straight to its final layout. The others are written (and re-read) in GENERAL.
+    start.push_back({img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, readers, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, 1});
+    if (n > 1) {
+      start.push_back({img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
+                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1});
+      done.push_back({img, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, readers, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1});
+    }
+    // Per level dispatches: level k's float copy goes to region k % 2 (odd levels: the size of level 1,
+    // even: level 2).
+    if (std::any_of(job.plan.begin(), job.plan.end(), [](const MipDispatch& d) { return !d.multiLevel; })) {
+      const VkExtent2D e = image->extent();
+      job.region[1] = VkDeviceSize(levelSize(e.width, 1)) * levelSize(e.height, 1) * 16;
+      if (n > 2) job.region[0] = VkDeviceSize(levelSize(e.width, 2)) * levelSize(e.height, 2) * 16;
+      const VkDeviceSize align = std::max<VkDeviceSize>(256, ctx_.properties().limits.minStorageBufferOffsetAlignment);
+      job.region[1] = (job.region[1] + align - 1) / align * align;
+      views.scratch.emplace_back(ctx_, job.region[1] + job.region[0], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                 vk::MemoryUse::Device, "mip scratch");
+      job.scratch = views.scratch.back().handle();
+    }
+    steps = std::max(steps, job.plan.size());
+    jobs.push_back(std::move(job));
+  }
+  if (!start.empty()) vk::barrier(cb, start);
 
-  const int srgb = (image.format() == VK_FORMAT_R8G8B8A8_SRGB || image.format() == VK_FORMAT_B8G8R8A8_SRGB) ? 1 : 0;
-  const MipDispatch* prev = nullptr;
-  for (const MipDispatch& d : plan) {
-    // The previous dispatch's last level (or its float copy) is this one's source; the scratch
-    // regions are also rewritten every other level (WAR and WAW).
-    if (prev)
+  for (size_t k = 0; k < steps; ++k) {
+    // Step k - 1's last levels (or their float copies) are step k's sources; the scratch regions are
+    // also rewritten every other level (WAR and WAW). One barrier for the whole batch.
+    if (k > 0)
       vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-    const vk::Pipeline& p = d.multiLevel ? multi_ : perLevel_;
-    p.bind(cb);
-    vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
-    w.image(0, views.sampled[d.srcLevel], d.srcLevel == 0 ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_GENERAL);
-    if (d.multiLevel) {
-      // Unused slots repeat the last level written, so every descriptor is valid and no extra level is touched.
-      std::vector<VkDescriptorImageInfo> outs;
-      for (uint32_t k = 1; k <= MIP_MAX_LEVELS_PER_DISPATCH; ++k)
-        outs.push_back({VK_NULL_HANDLE, views.storage[d.srcLevel + std::min(k, d.levels)], VK_IMAGE_LAYOUT_GENERAL});
-      w.images(1, outs);
-    } else {
-      w.image(1, views.storage[d.srcLevel + 1], VK_IMAGE_LAYOUT_GENERAL);
-      scratchRegion(d.srcLevel, w, 2);  // not read by the first dispatch, but must be valid
-      scratchRegion(d.srcLevel + 1, w, 3);
+    const vk::Pipeline* bound = nullptr;
+    for (const Job& job : jobs) {
+      if (k >= job.plan.size()) continue;
+      const MipDispatch& d = job.plan[k];
+      const MipDispatch* prev = k > 0 ? &job.plan[k - 1] : nullptr;
+      const VkExtent2D extent = job.image->extent();
+      const vk::Pipeline& p = d.multiLevel ? multi_ : perLevel_;
+      if (bound != &p) {
+        p.bind(cb);
+        bound = &p;
+      }
+      auto storage = [&](uint32_t level) { return views.storage[job.base + level].get(); };
+      vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
+      w.image(0, views.sampled[job.base + d.srcLevel],
+              d.srcLevel == 0 ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_GENERAL);
+      if (d.multiLevel) {
+        // Unused slots repeat the last level written, so every descriptor is valid and no extra level is touched.
+        std::vector<VkDescriptorImageInfo> outs;
+        for (uint32_t l = 1; l <= MIP_MAX_LEVELS_PER_DISPATCH; ++l)
+          outs.push_back({VK_NULL_HANDLE, storage(d.srcLevel + std::min(l, d.levels)), VK_IMAGE_LAYOUT_GENERAL});
+        w.images(1, outs);
+      } else {
+        auto scratchRegion = [&](uint32_t level, uint32_t binding) {
+          w.buffer(binding, job.scratch, level % 2 ? 0 : job.region[1], job.region[level % 2]);
+        };
+        w.image(1, storage(d.srcLevel + 1), VK_IMAGE_LAYOUT_GENERAL);
+        scratchRegion(d.srcLevel, 2);  // not read by the first dispatch, but must be valid
+        scratchRegion(d.srcLevel + 1, 3);
+      }
+      w.push(cb, p);
+      const shader::MipPush push{int(levelSize(extent.width, d.srcLevel)), int(levelSize(extent.height, d.srcLevel)),
+                                 int(d.levels), job.srgb, prev && !prev->multiLevel ? 1 : 0};
+      p.push(cb, push);
+      vkCmdDispatch(cb, d.groups.width, d.groups.height, 1);
     }
-    w.push(cb, p);
-    const shader::MipPush push{int(levelSize(image.extent().width, d.srcLevel)),
-                               int(levelSize(image.extent().height, d.srcLevel)), int(d.levels), srgb,
-                               prev && !prev->multiLevel ? 1 : 0};
-    p.push(cb, push);
-    vkCmdDispatch(cb, d.groups.width, d.groups.height, 1);
-    prev = &d;
   }
-  vk::barrier(cb, {{img, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, readers, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1}});
+  if (!done.empty()) vk::barrier(cb, done);
   return views;
 }
 

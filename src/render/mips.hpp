@@ -5,11 +5,12 @@
 // src/core/mip_reference.hpp (exact fractional coverage for odd sizes), each level from the previous one
 // (MipSource::PreviousLevel), and are within 1 LSB of that float64 reference. See docs/post-and-mips.md.
 //
-// Layout contract of MipGenerator::record:
+// Layout contract of MipGenerator::record (for every image of a batch):
 //   on entry  level 0 is in TRANSFER_DST_OPTIMAL (its upload recorded earlier), other levels UNDEFINED;
 //   on exit   every level is in SHADER_READ_ONLY_OPTIMAL, its writes visible to fragment and compute
 //             shader reads that follow in the same queue.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -38,19 +39,27 @@ struct MipDispatch {
 };
 std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, MipMode mode);
 
-// Views (and, per level mode, a float scratch buffer) a recorded generation uses; keep them until the
-// command buffer has completed.
+// Views (and, per level mode, float scratch buffers) a recorded generation uses; keep them until the
+// command buffer has completed. For a batch, the images' levels follow each other in batch order
+// (image 0's levels 0..n0-1, then image 1's, ...); for one image, index = level.
 struct MipViews {
   std::vector<vk::ImageView> sampled;  // per level, UNORM-equivalent format, sampled usage
-  std::vector<vk::ImageView> storage;  // per level, UNORM-equivalent format, storage usage
-  vk::Buffer scratch;                  // ComputePerLevel: float copies of odd and even levels
+  std::vector<vk::ImageView> storage;  // per level, UNORM-equivalent format, storage usage (none at level 0)
+  std::vector<vk::Buffer> scratch;     // ComputePerLevel: per image, float copies of odd and even levels
 };
 
 class MipGenerator {
  public:
   explicit MipGenerator(const vk::Context& ctx);  // once per context: builds the two compute pipelines
 
-  // Records the generation of levels 1.. of `image` from level 0 (see the layout contract above).
+  // Records the generation of levels 1.. of every image from its level 0 (see the layout contract above).
+  // Batched: step k of every image's dispatch plan is recorded for all images, then ONE global barrier,
+  // then step k + 1, so independent images' dispatches overlap on the GPU and a batch of textures costs
+  // as many barriers as its longest plan has steps (2 for 1024² and 1000x600), not that many per image.
+  // Images may differ in size and format. Blit mode records each image's blit chain in turn.
+  [[nodiscard]] MipViews record(VkCommandBuffer cb, std::span<const vk::Image* const> images,
+                                MipMode mode = MipMode::Compute) const;
+  // One image: the batch of one.
   [[nodiscard]] MipViews record(VkCommandBuffer cb, const vk::Image& image, MipMode mode = MipMode::Compute) const;
 
  private:

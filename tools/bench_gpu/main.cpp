@@ -50,7 +50,9 @@ Row measure(const vk::Context& ctx, int warmup, int runs, Prepare prepare, Recor
   return r;
 }
 
-std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count, int warmup, int runs) {
+// batched: one MipGenerator::record call for all textures (the default); otherwise one call per texture
+// (each with its own barriers, as before batching) for comparison.
+std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count, int warmup, int runs, bool batched) {
   std::vector<vk::Image> textures;
   const size_t bytes = size_t(extent.width) * extent.height * 4;
   vk::Buffer upload(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
@@ -58,6 +60,8 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
   for (size_t i = 0; i < bytes; ++i) static_cast<uint8_t*>(upload.mapped())[i] = uint8_t(rng());
   upload.flush();
   for (int i = 0; i < count; ++i) textures.emplace_back(ctx, render::textureDesc(extent, VK_FORMAT_R8G8B8A8_SRGB));
+  std::vector<const vk::Image*> batch;
+  for (const auto& t : textures) batch.push_back(&t);
   render::MipGenerator gen(ctx);
   // Upload level 0 of every texture once (same content) and leave each chain complete, SHADER_READ_ONLY.
   vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
@@ -69,7 +73,7 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
       c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
       c.imageExtent = {extent.width, extent.height, 1};
       vkCmdCopyBufferToImage(cb, upload.handle(), t.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
-      gen.record(cb, t, render::MipMode::Blit);
+      unused.push_back(gen.record(cb, t, render::MipMode::Blit));
     }
   });
   // Before each timed run: level 0 back to the "just uploaded" layout of the contract (content kept).
@@ -85,11 +89,12 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
   const std::string size = std::to_string(count) + " x " + std::to_string(extent.width) + "x" + std::to_string(extent.height) + " sRGB";
   for (render::MipMode mode : {render::MipMode::Blit, render::MipMode::ComputePerLevel, render::MipMode::Compute}) {
     Row r = measure(ctx, warmup, runs, prepare, [&](VkCommandBuffer cb, std::vector<render::MipViews>& keep) {
-      for (auto& t : textures) keep.push_back(gen.record(cb, t, mode));
+      if (batched) keep.push_back(gen.record(cb, batch, mode));
+      else for (auto& t : textures) keep.push_back(gen.record(cb, t, mode));
     });
     r.pass = "mips";
     r.size = size;
-    r.mode = render::toString(mode);
+    r.mode = std::string(render::toString(mode)) + (batched ? "" : " (per texture)");
     rows.push_back(r);
     std::fprintf(stderr, "  %s %s: median %.3f ms\n", size.c_str(), r.mode.c_str(), r.medianMs);
   }
@@ -141,10 +146,12 @@ int main(int argc, char** argv) {
   CLI::App app("GPU timings of the mip and mosaic passes");
   int runs = 25, warmup = 3, textures = 64;
   std::string only;
+  bool perTexture = false;
   app.add_option("--runs", runs, "timed submissions per case (min / median)")->check(CLI::Range(1, 10000));
   app.add_option("--warmup", warmup, "untimed submissions first")->check(CLI::Range(0, 1000));
   app.add_option("--textures", textures, "textures per mip case")->check(CLI::Range(1, 1024));
   app.add_option("--only", only, "mips or mosaic")->check(CLI::IsMember({"mips", "mosaic"}));
+  app.add_flag("--mips-per-texture", perTexture, "one MipGenerator::record call per texture instead of one batch");
   CLI11_PARSE(app, argc, argv);
   try {
     vk::Context ctx(vk::optionsFromEnvironment());
@@ -152,8 +159,8 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     auto add = [&](std::vector<Row> r) { rows.insert(rows.end(), r.begin(), r.end()); };
     if (only != "mosaic") {
-      add(benchMips(ctx, {1024, 1024}, textures, warmup, runs));
-      add(benchMips(ctx, {1000, 600}, textures, warmup, runs));
+      add(benchMips(ctx, {1024, 1024}, textures, warmup, runs, !perTexture));
+      add(benchMips(ctx, {1000, 600}, textures, warmup, runs, !perTexture));
     }
     if (only != "mips") {
       add(benchMosaic(ctx, {1920, 1080}, warmup, runs));
