@@ -17,20 +17,10 @@
 #ifndef RTR_SHADERS_SHARED_BRDF_H
 #define RTR_SHADERS_SHARED_BRDF_H
 
-// RTR_FN / RTR_CONST qualify functions and constants in headers shared by GLSL and C++.
+#include "shared.h"
 #ifdef __cplusplus
-#include <glm/glm.hpp>
 namespace rtr::shader {
 using namespace glm;
-#ifndef RTR_FN
-#define RTR_FN inline
-#define RTR_CONST inline constexpr
-#endif
-#else
-#ifndef RTR_FN
-#define RTR_FN
-#define RTR_CONST const
-#endif
 #endif
 
 RTR_CONST float BRDF_PI = 3.14159265358979f;

@@ -3,20 +3,11 @@
 #ifndef RTR_SHADERS_SHARED_MOSAIC_H
 #define RTR_SHADERS_SHARED_MOSAIC_H
 
+#include "shared.h"
 #ifdef __cplusplus
-#include <glm/glm.hpp>
 namespace rtr::shader {
 using glm::ivec2;
 using glm::min;
-#ifndef RTR_FN
-#define RTR_FN inline
-#define RTR_CONST inline constexpr
-#endif
-#else
-#ifndef RTR_FN
-#define RTR_FN
-#define RTR_CONST const
-#endif
 #endif
 
 #define MOSAIC_GROUP 16  // mosaic.comp: 16x16 threads, one output pixel each
