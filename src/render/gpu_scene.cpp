@@ -132,7 +132,6 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
 
   // One staging buffer for everything; then one submission: copies, then mip generation.
   std::vector<uint8_t> staging;
-  struct Copy { VkBuffer* dst; size_t offset, size; };
   auto makeBuffer = [&](vk::Buffer& dst, const void* data, size_t size, VkBufferUsageFlags usage, const char* name) {
     if (size == 0) return size_t(0);
     dst = vk::Buffer(ctx, size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, name);

@@ -19,8 +19,7 @@ HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene
 
 HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
                                        int frames, bool readSceneColor) {
-  const RenderTarget target{target_.handle(), target_.view(), target_.format(), extent_,
-                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+  const RenderTarget target = this->target();
   const VkDeviceSize pixels = VkDeviceSize(extent_.width) * extent_.height;
   if (readSceneColor && !colorReadback_.handle())
     colorReadback_ = vk::Buffer(ctx_, pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "colour readback");
@@ -64,8 +63,7 @@ HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens,
 
 std::vector<std::vector<std::pair<std::string, double>>> HeadlessRenderer::bench(const CameraPose& pose, const Lens& lens,
                                                                                  const RenderSettings& settings, int frames) {
-  const RenderTarget target{target_.handle(), target_.view(), target_.format(), extent_,
-                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+  const RenderTarget target = this->target();
   std::vector<std::vector<std::pair<std::string, double>>> out;
   for (int f = 0; f < frames; ++f) {
     vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) { renderer_.record(cb, 0, pose, lens, settings, target); });

@@ -26,6 +26,10 @@ class HeadlessRenderer {
                                                                  const RenderSettings& settings, int frames);
 
  private:
+  RenderTarget target() const {
+    return {target_.handle(), target_.view(), target_.format(), extent_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+  }
+
   const vk::Context& ctx_;
   VkExtent2D extent_;
   Renderer renderer_;

@@ -18,7 +18,6 @@ const char* toString(MosaicMode mode) {
 
 MosaicPass::MosaicPass(const vk::Context& ctx) : ctx_(ctx) {
   compute_ = vk::makeComputePipeline(ctx, vk::loadShader("mosaic.comp"), {.pushDescriptorSets = {0}});
-  computeRgba8_ = vk::makeComputePipeline(ctx, vk::loadShader("mosaic_rgba8.comp"), {.pushDescriptorSets = {0}});
 }
 
 void MosaicPass::setBlock(VkExtent2D block) {
@@ -75,7 +74,7 @@ void MosaicPass::record(VkCommandBuffer cb, VkImageView input, VkImage output, V
     vkCmdDraw(cb, 3, 1, 0, 0);
     vkCmdEndRendering(cb);
   } else {
-    const vk::Pipeline& c = outputFormat == VK_FORMAT_R8G8B8A8_UNORM ? computeRgba8_ : compute_;
+    const vk::Pipeline& c = compute_;
     c.bind(cb);
     vk::DescriptorWriter(ctx_, c.layout, 0, VK_NULL_HANDLE)
         .image(0, input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)

@@ -38,7 +38,7 @@ class MosaicPass {
   const vk::Pipeline& graphics(VkFormat format);
   const vk::Context& ctx_;
   VkExtent2D block_{5, 3};
-  vk::Pipeline compute_, computeRgba8_;  // format-less store (any UNORM output) / rgba8 store
+  vk::Pipeline compute_;
   std::map<VkFormat, vk::Pipeline> graphics_;
 };
 

@@ -75,7 +75,6 @@ void Renderer::createTargets(VkExtent2D extent) {
                             0, 0, "scene colour"});
   depth_ = vk::Image(ctx_, {extent, kDepthFormat, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0, 0, "scene depth"});
   extent_ = extent;
-  firstFrame_ = true;
 }
 
 void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, bool debug) {
@@ -164,7 +163,6 @@ void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose
                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
   post_.record(cb, color_.view(), target.image, target.view, target.format, target.extent, s.mosaic, target.finalLayout);
   timer.mark(cb, "post");
-  firstFrame_ = false;
 }
 
 }  // namespace rtr::render

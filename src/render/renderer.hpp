@@ -69,7 +69,6 @@ class Renderer {
   std::vector<vk::GpuTimer> timers_;
   vk::Image color_, depth_;
   VkExtent2D extent_{0, 0};
-  bool firstFrame_ = true;
 };
 
 }  // namespace rtr::render

@@ -105,23 +105,6 @@ ContextOptions optionsFromEnvironment() {
 uint32_t Context::validationMessageCount() { return g_validationMessages.load(); }
 void Context::resetValidationMessageCount() { g_validationMessages = 0; }
 
-std::vector<std::string> Context::listDevices() {
-  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-  app.apiVersion = VK_API_VERSION_1_3;
-  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-  info.pApplicationInfo = &app;
-  VkInstance instance;
-  VK_CHECK(vkCreateInstance(&info, nullptr, &instance));
-  std::vector<std::string> out;
-  for (auto d : physicalDevices(instance)) {
-    VkPhysicalDeviceProperties p;
-    vkGetPhysicalDeviceProperties(d, &p);
-    out.push_back(p.deviceName);
-  }
-  vkDestroyInstance(instance, nullptr);
-  return out;
-}
-
 Context::Context(const ContextOptions& options) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "rtr";

@@ -52,9 +52,6 @@ class Context {
   // Names an object in validation messages and debuggers (no-op without validation).
   void setName(uint64_t handle, VkObjectType type, const char* name) const;
 
-  // The physical devices the loader sees, in the order of ContextOptions::device indices.
-  static std::vector<std::string> listDevices();
-
  private:
   void release();
 

@@ -11,6 +11,13 @@ namespace {
 
 using test::VulkanTest;
 
+// Reads back fill.comp's output and checks every value: out[i] = i * i + offset.
+void expectFilled(const vk::Buffer& out, uint32_t count, uint32_t offset) {
+  out.invalidate();
+  const uint32_t* v = static_cast<const uint32_t*>(out.mapped());
+  for (uint32_t i = 0; i < count; ++i) ASSERT_EQ(v[i], i * i + offset) << "at index " << i;
+}
+
 TEST_F(VulkanTest, ComputeDispatchWritesEveryValue) {
   constexpr uint32_t kCount = 1000, kOffset = 7;
   vk::Pipeline fill = vk::makeComputePipeline(*ctx, vk::loadShader("fill.comp"));
@@ -28,9 +35,7 @@ TEST_F(VulkanTest, ComputeDispatchWritesEveryValue) {
     vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
   });
-  out.invalidate();
-  const uint32_t* v = static_cast<const uint32_t*>(out.mapped());
-  for (uint32_t i = 0; i < kCount; ++i) ASSERT_EQ(v[i], i * i + kOffset) << "at index " << i;
+  expectFilled(out, kCount, kOffset);
 }
 
 TEST_F(VulkanTest, PushDescriptorsBindWithoutAPool) {
@@ -48,9 +53,7 @@ TEST_F(VulkanTest, PushDescriptorsBindWithoutAPool) {
     vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
   });
-  out.invalidate();
-  const uint32_t* v = static_cast<const uint32_t*>(out.mapped());
-  for (uint32_t i = 0; i < kCount; ++i) ASSERT_EQ(v[i], i * i + 3) << "at index " << i;
+  expectFilled(out, kCount, 3);
 }
 
 TEST_F(VulkanTest, GpuTimerMeasuresAPass) {
