@@ -2,10 +2,11 @@
 # Bundles the release binaries, compiled shaders, baked assets and every shared library they need that
 # a bare Ubuntu/Debian machine may lack into .device/ (git-ignored), for running the benchmarks on a GPU
 # machine that has only a driver. Run there: .device/run.sh BINARY ARGS...
+# Usage: tools/bundle_device.sh [BUILD_DIR [OUT_DIR]]   (defaults: build/release, .device)
 set -euo pipefail
+B=$(realpath "${1:-build/release}")
+out=$(realpath -m "${2:-.device}")
 cd "$(dirname "$0")/.."
-B=build/release
-out=.device
 rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
 bins=()
