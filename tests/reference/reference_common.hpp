@@ -33,19 +33,32 @@ struct CasePair {
   ImageRGBA8 gpu;           // toSrgb8(the GPU's linear intermediate image)
   ImageRGBA8 gpuDisplayed;  // the GPU's post-pass output (mosaic off), as the viewer shows it
   ImageRGBA8 cpu;           // toSrgb8(the tracer's linear image)
+  // Filled when PairOptions::benchFrames > 0: GPU frame time (median of the frames' summed passes) and the
+  // tracer's wall time for the same image.
+  double gpuMs = 0, cpuMs = 0;
+  uint64_t cpuRays = 0;
 };
 
-// Renders a case on both sides. `shaderDir`: compiled shaders to use for the GPU instead of the build's
-// (RTR_SHADER_DIR for the lifetime of the renderer's pipeline creation); used by the broken-BRDF test.
+struct PairOptions {
+  uint32_t width = kW, height = kH;
+  unsigned threads = 2;  // tracer threads (and BVH build threads)
+  int benchFrames = 0;   // > 0: time that many GPU frames after a warm-up, and time the trace
+  // Compiled shaders to use for the GPU instead of the build's (RTR_SHADER_DIR for the lifetime of the
+  // renderer's pipeline creation); used by the broken-BRDF test.
+  std::optional<std::filesystem::path> shaderDir;
+};
+
+// Renders a case on both sides.
 CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const PoseEntry& pose, View view,
-                    const std::optional<std::filesystem::path>& shaderDir = std::nullopt);
+                    const PairOptions& options = {});
 
 std::filesystem::path posesFile();
 std::filesystem::path outDir();  // <build>/reference-out, created
 
-// Fails the current test if the image is blank: under 5% of pixels above 2/255 in some channel, or one
-// colour only (a flat plane's normal view legitimately has just two: background and the plane).
-void expectNotBlank(const ImageRGBA8& img, const std::string& label);
+// Why an image is blank, or "" when it is not: under 5% of pixels above 2/255 in some channel, or one
+// colour only (a flat plane's normal view legitimately has just two: background and the plane). A
+// comparison of two black images proves nothing.
+std::string blankReason(const ImageRGBA8& img);
 
 // <id>_gpu.png, <id>_cpu.png, <id>_err.png and <id>.txt (one line: the numbers) in outDir(); the line is
 // also printed.

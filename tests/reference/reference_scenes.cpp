@@ -1,6 +1,7 @@
 #include "reference_scenes.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -141,6 +142,16 @@ std::map<std::string, PoseEntry> loadPoses(const std::filesystem::path& file) {
   return out;
 }
 
+std::filesystem::path sourceDir() {
+  const char* env = std::getenv("RTR_SOURCE_DIR");
+  return env && *env ? std::filesystem::path(env) : std::filesystem::path(RTR_SOURCE_DIR);
+}
+
+std::filesystem::path assetDir() {
+  const char* env = std::getenv("RTR_ASSET_DIR");
+  return env && *env ? std::filesystem::path(env) : std::filesystem::path(RTR_BINARY_DIR) / "assets";
+}
+
 Scene untexturedTemple(const Scene& temple, int* removed) {
   Scene s = temple;
   for (Material& m : s.materials) {
@@ -160,10 +171,10 @@ Scene untexturedTemple(const Scene& temple, int* removed) {
 }
 
 ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir) {
-  const std::filesystem::path rt = std::filesystem::path(RTR_SOURCE_DIR) / "assets-src/rt";
+  const std::filesystem::path rt = sourceDir() / "assets-src/rt";
   if (name == "temple_nave" || name == "temple_aisle") {
     ReferenceScene r;
-    r.scene = untexturedTemple(loadScene(std::filesystem::path(RTR_BINARY_DIR) / "assets/temple.rtrscene"));
+    r.scene = untexturedTemple(loadScene(assetDir() / "temple.rtrscene"));
     return r;  // the default light (the brief's standard light above the statue)
   }
   if (name == "cornell_box") {

@@ -11,6 +11,11 @@
 
 namespace rtr::reftest {
 
+// Where the sources (poses.txt, assets-src/) and the baked assets are: the build's folders, or the
+// environment's RTR_SOURCE_DIR / RTR_ASSET_DIR (a bundled copy on another machine, tools/bundle_device.sh).
+std::filesystem::path sourceDir();
+std::filesystem::path assetDir();
+
 struct PoseEntry {
   CameraPose pose;
   float fovYDeg = 60.0f;
