@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
 bins=()
-for b in rtr-view rtr-bench-gpu rtr-trace bench-trace rtr-bake scenegen; do
+for b in rtr-view rtr-bench-gpu rtr-trace bench-trace rtr-bake scenegen rtr-frame-compare bench_bake; do
   [[ -x $B/bin/$b ]] && cp "$B/bin/$b" "$out/bin/" && bins+=("$B/bin/$b")
 done
 cp -r "$B/shaders" "$out/shaders"
@@ -25,7 +25,8 @@ cat > "$out/run.sh" <<'RUN'
 # Runs a bundled binary with the bundled libraries and the NVIDIA Vulkan driver.
 here=$(cd "$(dirname "$0")" && pwd)
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-export RTR_SHADER_DIR="$here/shaders"
+export RTR_SHADER_DIR="$here/shaders" RTR_ASSET_DIR="$here/assets"
+export RTR_SOURCE_DIR=${RTR_SOURCE_DIR:-$(dirname "$here")}  # the bundle sits in the repository's root
 [[ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]] &&
   export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json}
 bin=$1; shift

@@ -30,11 +30,12 @@ def check(cond, msg):
     print("ok:", msg, flush=True)
 
 
-def start_xvfb():
+def start_xvfb(fbdir):
     # -displayfd lets the server pick a free display number and report it, so parallel runs never collide.
+    # -fbdir: the screen is also an XWD file there, read by screen_pixels().
     r, w = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(w), "-screen", "0", "640x480x24", "-nolisten", "tcp"],
-                            pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(w), "-screen", "0", "640x480x24", "-nolisten", "tcp",
+                             "-fbdir", fbdir], pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     os.close(w)
     with os.fdopen(r) as f:
         num = f.readline().strip()
@@ -42,6 +43,25 @@ def start_xvfb():
         proc.kill()
         raise Fail("Xvfb did not report a display number")
     return proc, ":" + num
+
+
+def screen_pixels(fbdir, x0, y0, x1, y1):
+    """(r, g, b) of the screen's pixels in [x0, x1) x [y0, y1), from Xvfb's XWD frame buffer file."""
+    import struct
+    with open(os.path.join(fbdir, "Xvfb_screen0"), "rb") as f:
+        data = f.read()
+    h = struct.unpack(">25I", data[:100])
+    header, byte_order, bpp, bpl, ncolors = h[0], h[7], h[11], h[12], h[19]
+    if bpp != 32:
+        raise Fail(f"unexpected XWD format: {bpp} bits per pixel")
+    base = header + 12 * ncolors
+    out = []
+    for y in range(y0, y1):
+        row = base + y * bpl
+        for x in range(x0, x1):
+            b, g, r = data[row + 4 * x: row + 4 * x + 3] if byte_order == 0 else data[row + 4 * x + 1: row + 4 * x + 4][::-1]
+            out.append((r, g, b))
+    return out
 
 
 def wm_iconify(display, win, iconic):
@@ -111,7 +131,9 @@ def main():
             return SKIP
 
     t0 = time.monotonic()
-    xvfb, display = start_xvfb()
+    fbtmp = tempfile.TemporaryDirectory(prefix="rtr-xvfb-")  # removed when main returns
+    fbdir = fbtmp.name
+    xvfb, display = start_xvfb(fbdir)
     env = dict(os.environ, DISPLAY=display, RTR_VALIDATION="1")
     viewer = None
     try:
@@ -224,6 +246,41 @@ def main():
         check(True, "M cycles the mosaic compute -> graphics -> off")
         xdo("key", "1")
         wait_title("shaded")
+
+        # F1: the timing overlay is drawn into the frame (dark backdrop, white text, top-left); F1 again
+        # removes it. The window sits at the screen's origin (no window manager).
+        def overlay_pixels():
+            px = screen_pixels(fbdir, 0, 0, 120, 40)
+            dark = sum(1 for p in px if max(p) < 10)
+            white = sum(1 for p in px if min(p) > 245)
+            return px, dark, white
+
+        before, _, white0 = overlay_pixels()
+        n = len(before)
+        xdo("key", "F1")
+        time.sleep(1.0)
+        _, dark1, white1 = overlay_pixels()
+        check(white1 > 50 + white0 and dark1 + white1 > 0.95 * n,
+              f"F1 draws the overlay into the frame ({dark1} dark and {white1} white of {n} pixels; {white0} white "
+              "before)")
+        xdo("key", "F1")
+        time.sleep(1.0)
+        check(overlay_pixels()[0] == before, "F1 again removes it: the same pixels as before (the camera is still)")
+
+        # X: trace the view with the renderer's model and show the error map; the title gives mean and max.
+        frame = screen_pixels(fbdir, 0, 0, SIZE[0], SIZE[1])
+        xdo("key", "x")
+        end, m = time.monotonic() + 30, None
+        while time.monotonic() < end and not m:
+            m = re.search(r"error map, raster vs CPU trace: mean ([0-9.]+), max ([0-9]+)", title())
+            time.sleep(0.1)
+        check(m is not None and 0 <= float(m.group(1)) <= float(m.group(2)) <= 255,
+              f"X shows the error map with its mean and max ({m.group(0) if m else title()!r})")
+        time.sleep(0.5)
+        check(screen_pixels(fbdir, 0, 0, SIZE[0], SIZE[1]) != frame, "the error map replaces the raster image")
+        xdo("key", "x")
+        time.sleep(1.0)
+        check("error map" not in title() and screen_pixels(fbdir, 0, 0, SIZE[0], SIZE[1]) == frame, "X again hides it")
 
         # 100 resizes as fast as xdotool can issue them (one process, chained commands).
         t_resize = time.monotonic()

@@ -1,14 +1,21 @@
 #include "trace_overlay.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
+
+#include "core/compare.hpp"
 
 #include "vk/context.hpp"
 
 namespace rtr::view {
 
-void TraceOverlay::start(const trace::TraceSettings& settings) {
+// The reference tests' per-channel threshold (docs/reference-tests.md): an error of 3 steps shows white.
+constexpr int kErrorThreshold = 3;
+
+void TraceOverlay::start(const trace::TraceSettings& settings, std::optional<ImageRGBA8> raster) {
   stop();
+  showError_ = false;
   if (!tracer_) tracer_ = std::make_unique<trace::Tracer>(scene_);
   {
     std::lock_guard lock(mutex_);
@@ -19,9 +26,22 @@ void TraceOverlay::start(const trace::TraceSettings& settings) {
   const uint32_t tile = settings.tileSize;
   tilesTotal_ = ((settings.width + tile - 1) / tile) * ((settings.height + tile - 1) / tile);
   visible_ = true;
-  worker_ = std::thread([this, settings] {
+  worker_ = std::thread([this, settings, raster = std::move(raster)] {
     std::lock_guard lock(mutex_);
-    tracer_->render(settings, image_, [this](const trace::TileRect&) { ++tilesDone_; dirty_ = true; }, &cancel_);
+    const trace::RenderStats st =
+        tracer_->render(settings, image_, [this](const trace::TileRect&) { ++tilesDone_; dirty_ = true; }, &cancel_);
+    if (raster && !st.cancelled) {
+      const CompareResult r = compareEdgeTolerant(*raster, toSrgb8(image_), kErrorThreshold);
+      errorMap_ = r.errorMap;
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "error map, raster vs CPU trace: mean %.2f, max %.0f (8-bit steps)\n"
+                    "%.2f%% of pixels > %d steps beyond 3x3 edge tolerance (red); trace %.2f s",
+                    r.meanAbsError, r.maxAbsError, 100.0 * r.failingFraction, kErrorThreshold, st.seconds);
+      errorText_ = text;
+      if (!tracer_->scene().textures.empty()) errorText_ += "\nthe tracer samples no textures: textured surfaces differ";
+      showError_ = true;
+    }
     dirty_ = true;
   });
 }
@@ -34,6 +54,7 @@ void TraceOverlay::stop() {
 
 std::string TraceOverlay::status() const {
   if (!visible_) return "";
+  if (showError_) return errorText_;
   return "ray traced " + std::to_string(tilesDone_.load()) + "/" + std::to_string(tilesTotal_.load()) + " tiles";
 }
 
@@ -48,7 +69,7 @@ void TraceOverlay::recordCopy(const vk::Context& ctx, VkCommandBuffer cb, VkImag
   }
   if (dirty_.exchange(false)) {
     // Tiles still being written may show half done; the next refresh completes them.
-    ImageRGBA8 srgb = toSrgb8(image_);
+    ImageRGBA8 srgb = showError_ ? errorMap_ : toSrgb8(image_);
     if (format == VK_FORMAT_B8G8R8A8_UNORM)
       for (size_t i = 0; i < srgb.pixels.size(); i += 4) std::swap(srgb.pixels[i], srgb.pixels[i + 2]);
     std::memcpy(staging.mapped(), srgb.pixels.data(), bytes);

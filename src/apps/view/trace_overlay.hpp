@@ -1,9 +1,11 @@
 #pragma once
 // The CPU ray tracer inside the viewer (key R): traces the current view on worker threads and shows the
 // image over the raster one, filling in tile by tile, as the course framework's ray-traced half did.
+// Key X: the same with the renderer's shading model, then the per-pixel error map against the raster frame.
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -20,8 +22,10 @@ class TraceOverlay {
   explicit TraceOverlay(const Scene& scene) : scene_(scene) {}
   ~TraceOverlay() { stop(); }
 
-  // Starts tracing `settings` (its size, pose and lens set by the caller); cancels a running trace.
-  void start(const trace::TraceSettings& settings);
+  // Starts tracing `settings` (its size, pose and lens set by the caller); cancels a running trace. With
+  // `raster` (the raster frame of the same view, sRGB bytes, same size), the finished trace is replaced by
+  // the error map of raster against it (core/compare.hpp), and status() gives the mean and max error.
+  void start(const trace::TraceSettings& settings, std::optional<ImageRGBA8> raster = std::nullopt);
   void stop();  // cancels and hides
   bool visible() const { return visible_; }
   std::string status() const;
@@ -37,8 +41,11 @@ class TraceOverlay {
   std::thread worker_;
   std::atomic<bool> cancel_{false}, dirty_{false}, visible_{false};
   std::atomic<uint32_t> tilesDone_{0}, tilesTotal_{0};
+  std::atomic<bool> showError_{false};  // errorMap_ and errorText_ are final once this is set
   std::mutex mutex_;  // guards image_ against a concurrent restart
   ImageF image_;
+  ImageRGBA8 errorMap_;
+  std::string errorText_;
 };
 
 }  // namespace rtr::view

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "options.hpp"
+#include "render/text_overlay.hpp"
 #include "scene/load.hpp"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
@@ -29,7 +30,7 @@ struct App {
   render::RenderSettings settings;
   bool overlay = false, resized = false;
   // Ray tracer (FORMATS.md §2's toggles, on keys that do not clash with the view modes).
-  bool traceRequested = false;
+  bool traceRequested = false, errorMapRequested = false;
   trace::Shading traceShading = trace::Shading::Phong;
   bool traceShadows = true, traceReflections = true, traceOrtho = false;
 };
@@ -62,6 +63,7 @@ void onKey(GLFWwindow* w, int key, int, int action, int) {
   else if (key == GLFW_KEY_C) std::printf("--camera %s\n", formatPose(app.camera.pose()).c_str()), std::fflush(stdout);
   else if (key == GLFW_KEY_F1 || key == GLFW_KEY_H) app.overlay = !app.overlay;
   else if (key == GLFW_KEY_R) app.traceRequested = true;
+  else if (key == GLFW_KEY_X) app.errorMapRequested = true;
   else if (key == GLFW_KEY_T) app.traceShading = trace::Shading((int(app.traceShading) + 1) % 3);  // phong, pbr, normals
   else if (key == GLFW_KEY_Y) app.traceShadows = !app.traceShadows;
   else if (key == GLFW_KEY_U) app.traceReflections = !app.traceReflections;
@@ -93,16 +95,22 @@ struct GlfwSession {
   ~GlfwSession() { glfwTerminate(); }
 };
 
-// Copies a presented-format image (BGRA or RGBA UNORM) to an RGBA PNG.
-void saveSwapchainImage(const vk::Buffer& buf, VkFormat format, VkExtent2D e, const std::string& path) {
+// A read-back presented-format image (BGRA or RGBA UNORM) as RGBA bytes.
+ImageRGBA8 readSwapchainImage(const vk::Buffer& buf, VkFormat format, VkExtent2D e) {
   buf.invalidate();
   ImageRGBA8 img{e.width, e.height, std::vector<uint8_t>(size_t(e.width) * e.height * 4)};
   std::memcpy(img.pixels.data(), buf.mapped(), img.pixels.size());
   if (format == VK_FORMAT_B8G8R8A8_UNORM)
     for (size_t i = 0; i < img.pixels.size(); i += 4) std::swap(img.pixels[i], img.pixels[i + 2]);
-  savePng(path, img);
-  std::printf("%s\n", std::filesystem::absolute(path).c_str());
+  return img;
 }
+
+const char* const kKeyHelp =
+    "W/S/A/D/E/Q move, Shift/Ctrl faster/slower, right mouse: mouse-look\n"
+    "1-7 views, 8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic\n"
+    "[ ] LOD bias, C print pose, F1/H this overlay, Esc quit\n"
+    "R ray-trace (T shading, Y shadows, U reflections, O ortho)\n"
+    "X error map: raster vs CPU trace of the same model";
 
 }  // namespace
 
@@ -185,6 +193,8 @@ int runWindowed(const ViewOptions& o) {
     std::string shaderError;
     double watchTimer = 0;
     vk::Buffer traceStaging;
+    render::TextOverlay text(ctx, kFramesInFlight);
+    std::string overlayText;
 
     auto last = std::chrono::steady_clock::now();
     double titleTimer = 0, cpuFrameMs = 0;
@@ -237,47 +247,62 @@ int runWindowed(const ViewOptions& o) {
       if (acq != VK_SUBOPTIMAL_KHR) VK_CHECK(acq);
       VK_CHECK(vkResetFences(ctx.device(), 1, &fence));
 
+      auto traceSettings = [&] {
+        trace::TraceSettings ts;
+        ts.width = swapchain.extent().width;
+        ts.height = swapchain.extent().height;
+        ts.pose = app.camera.pose();
+        ts.lens = fitDepthRange(o.lens, bounds, app.camera.pose());
+        ts.lens.orthographic = app.traceOrtho;
+        ts.shading = app.traceShading;
+        ts.shadows = app.traceShadows;
+        ts.bounces = app.traceReflections ? trace::N_BOUNCES : 0;
+        ts.pbrLight = {app.settings.lightPos, app.settings.lightColor, app.settings.ambient.x};
+        return ts;
+      };
       if (app.traceRequested) {  // R: trace this view; R again while shown hides it
         app.traceRequested = false;
-        if (traced.visible()) {
-          traced.stop();
-        } else {
-          trace::TraceSettings ts;
-          ts.width = swapchain.extent().width;
-          ts.height = swapchain.extent().height;
-          ts.pose = app.camera.pose();
-          ts.lens = fitDepthRange(o.lens, bounds, app.camera.pose());
-          ts.lens.orthographic = app.traceOrtho;
-          ts.shading = app.traceShading;
-          ts.shadows = app.traceShadows;
-          ts.bounces = app.traceReflections ? trace::N_BOUNCES : 0;
-          ts.pbrLight = {app.settings.lightPos, app.settings.lightColor, app.settings.ambient.x};
-          traced.start(ts);
-        }
+        if (traced.visible()) traced.stop();
+        else traced.start(traceSettings());
+      }
+      const bool canShot = swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+      // X: this frame is rendered shaded without mosaic and read back, then traced with the renderer's model
+      // (PBR, no shadows, no reflections, perspective) and compared; X again while shown hides it.
+      bool captureRaster = false;
+      if (app.errorMapRequested) {
+        app.errorMapRequested = false;
+        if (traced.visible()) traced.stop();
+        else if (canShot) captureRaster = true;
+        else std::fprintf(stderr, "rtr-view: this surface's images cannot be read back for the error map\n");
       }
       const bool takeShot = !o.screenshot.empty() && frameNumber + 1 == uint64_t(std::max(1, o.frames));
-      const bool canShot = swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
       if (takeShot && !canShot) throw Error("this surface's images cannot be read back for --screenshot");
+      const bool readBack = takeShot || captureRaster;
       const VkExtent2D e = swapchain.extent();
-      if (takeShot) shot = vk::Buffer(ctx, VkDeviceSize(e.width) * e.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+      if (readBack) shot = vk::Buffer(ctx, VkDeviceSize(e.width) * e.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+      render::RenderSettings frameSettings = app.settings;
+      if (captureRaster) {
+        frameSettings.mode = VIEW_SHADED;
+        frameSettings.mosaic = render::MosaicMode::Off;
+      }
 
       VK_CHECK(vkResetCommandBuffer(f.cb, 0));
       VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
       bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
       VK_CHECK(vkBeginCommandBuffer(f.cb, &bi));
       const bool showTrace = traced.visible() && (swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT);
-      const VkImageLayout finalLayout = takeShot ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+      const VkImageLayout finalLayout = readBack ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
       const render::RenderTarget target{swapchain.image(imageIndex), swapchain.view(imageIndex), swapchain.format(), e,
                                         showTrace ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : finalLayout};
       const Lens lens = fitDepthRange(o.lens, bounds, app.camera.pose());
-      renderer.record(f.cb, uint32_t(frameNumber % kFramesInFlight), app.camera.pose(), lens, app.settings, target);
+      renderer.record(f.cb, uint32_t(frameNumber % kFramesInFlight), app.camera.pose(), lens, frameSettings, target);
       if (showTrace) {  // the traced image over the raster one
         traced.recordCopy(ctx, f.cb, target.image, swapchain.format(), e, traceStaging);
         vk::barrier(f.cb, {{target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, finalLayout, VK_PIPELINE_STAGE_2_COPY_BIT,
                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                             VK_ACCESS_2_TRANSFER_READ_BIT}});
       }
-      if (takeShot) {
+      if (readBack) {
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.imageExtent = {e.width, e.height, 1};
@@ -287,6 +312,11 @@ int runWindowed(const ViewOptions& o) {
         vk::memoryBarrier(f.cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
                           VK_ACCESS_2_HOST_READ_BIT);
       }
+      // The overlay comes last, after any read-back copy: screenshots never contain it.
+      if (app.overlay && !readBack)
+        text.record(f.cb, uint32_t(frameNumber % kFramesInFlight), overlayText, target.image, target.view,
+                    swapchain.format(), e, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                    e.width >= 1280 ? 2.0f : 1.0f);  // the pixel font scales by whole pixels only
       VK_CHECK(vkEndCommandBuffer(f.cb));
 
       VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
@@ -319,30 +349,46 @@ int runWindowed(const ViewOptions& o) {
       if (pr == VK_ERROR_OUT_OF_DATE_KHR || pr == VK_SUBOPTIMAL_KHR) app.resized = true;
       else VK_CHECK(pr);
 
+      if (readBack) VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
       if (takeShot) {
-        VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
-        saveSwapchainImage(shot, swapchain.format(), e, o.screenshot);
+        savePng(o.screenshot, readSwapchainImage(shot, swapchain.format(), e));
+        std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());
         glfwSetWindowShouldClose(window, GLFW_TRUE);
+      }
+      if (captureRaster) {  // traced on the CPU's cores while frames go on; shown when done
+        trace::TraceSettings ts = traceSettings();
+        ts.shading = trace::Shading::Pbr;
+        ts.shadows = false;
+        ts.bounces = 0;
+        ts.lens.orthographic = false;
+        traced.start(ts, readSwapchainImage(shot, swapchain.format(), e));
       }
       ++frameNumber;
 
       titleTimer += dt;
-      if (titleTimer > 0.25) {  // the overlay: window title (and stdout when toggled on)
+      if (titleTimer > 0.25) {  // the overlay's text (drawn in the frame when F1/H is on) and the window title
         titleTimer = 0;
-        std::string text = std::string("rtr-view | ") + modeName(app.settings.mode) + " | mosaic " +
-                           (app.settings.mosaic == render::MosaicMode::Off ? "off" : app.settings.mosaic == render::MosaicMode::Compute ? "compute" : "graphics") +
-                           " | lod bias " + std::to_string(app.settings.lodBias).substr(0, 4);
-        char buf[64];
-        std::snprintf(buf, sizeof buf, " | CPU %.2f ms", cpuFrameMs);
-        text += buf;
+        std::vector<std::string> lines;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "mode %d | %s | mosaic %s | lod bias %.1f", app.settings.mode,
+                      modeName(app.settings.mode), render::toString(app.settings.mosaic), app.settings.lodBias);
+        lines.push_back(buf);
+        std::snprintf(buf, sizeof buf, "CPU frame %.2f ms", cpuFrameMs);
+        lines.push_back(buf);
+        std::string gpu = "GPU";
         for (const auto& [name, ms] : renderer.gpuTimes(uint32_t(frameNumber % kFramesInFlight))) {
           std::snprintf(buf, sizeof buf, " | %s %.3f ms", name.c_str(), ms);
-          text += buf;
+          gpu += buf;
         }
-        if (traced.visible()) text += " | " + traced.status();
-        if (!shaderError.empty()) text += " | SHADER ERROR: " + shaderError.substr(0, shaderError.find('\n', 20));
-        glfwSetWindowTitle(window, text.c_str());
-        if (app.overlay) std::printf("%s\n", text.c_str()), std::fflush(stdout);
+        lines.push_back(gpu);
+        if (traced.visible()) lines.push_back(traced.status());
+        if (!shaderError.empty()) lines.push_back("SHADER ERROR: " + shaderError);
+        std::string title = "rtr-view";
+        for (const std::string& l : lines) title += " | " + l.substr(0, l.find('\n'));
+        glfwSetWindowTitle(window, title.c_str());
+        overlayText.clear();
+        for (const std::string& l : lines) overlayText += l + "\n";
+        overlayText += kKeyHelp;
       }
     }
     vkDeviceWaitIdle(ctx.device());
