@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# Runs every benchmark and comparison of docs/BENCHMARKS.md on this machine and keeps their raw output:
+# OUT/<row>.txt (stdout + stderr of one command, the command on its first line) and OUT/meta.txt (machine,
+# driver, date). tools/report/render.py turns the folders of all machines into the report.
+#
+#   tools/report/collect.sh OUT [--quick] [--runner CMD] [--skip LIST]
+#     --runner CMD  how to start a binary: "CMD NAME ARGS" (e.g. .device/run.sh on the GPU machine);
+#                   default: build/release/bin/NAME
+#     --quick       fewer frames and runs (lavapipe at 4K takes about a second a frame)
+#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake
+# The rows and their exact arguments are fixed here, so a rerun measures the same thing (fixed seeds and
+# poses: tests/reference/poses.txt, the generated scenes).
+set -uo pipefail
+out=${1:?usage: collect.sh OUT [--quick] [--runner CMD] [--skip LIST]}
+shift
+runner="" quick=0 skip=""
+while (($#)); do
+  case $1 in
+    --quick) quick=1 ;;
+    --runner) runner=$2; shift ;;
+    --skip) skip=$2; shift ;;
+    *) echo "collect.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+  shift
+done
+root=$(cd "$(dirname "$0")/../.." && pwd)
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+bin() {  # bin NAME ARGS...
+  if [[ -n $runner ]]; then "$runner" "$@"; else "$root/build/release/bin/$1" "${@:2}"; fi
+}
+skipped() { [[ ",$skip," == *",$1,"* ]]; }
+# row ID NAME ARGS...: runs one command, its output to $out/ID.txt; a failure is recorded, not fatal.
+row() {
+  local id=$1; shift
+  local t0=$SECONDS
+  local shown="$*"
+  shown=${shown//$root\//}  # paths relative to the repository, as a reader re-runs them
+  { echo "\$ $shown"; bin "$@" 2>&1; echo "# exit $? after $((SECONDS - t0)) s"; } >"$out/$id.txt"
+  echo "collect: $id ($((SECONDS - t0)) s)" >&2
+}
+
+if ((quick)); then runs=5 warm=2 frames=5 cmpframes=5; else runs=50 warm=10 frames=100 cmpframes=50; fi
+assets=${RTR_ASSET_DIR:-$root/build/release/assets}
+temple=$assets/temple.rtrscene
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+{
+  echo "date: $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo "host: $(uname -srm)"
+  echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//') ($(nproc) threads)"
+  command -v nvidia-smi >/dev/null && echo "gpu: $(nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader)"
+  echo "commit: $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  echo "quick: $quick"
+} >"$out/meta.txt"
+# The Vulkan device and driver, as the renderer sees them.
+bin rtr-view "$temple" --headless --size 64x64 2>&1 | grep -m1 ' on ' | sed 's/^/vulkan: /' >>"$out/meta.txt"
+
+if ! skipped gpu; then
+  row gpu-passes rtr-bench-gpu --runs $runs --warmup $warm
+fi
+# Whole frame per pass: PBR + mosaic (both post paths), plain textured (mode 13) baseline.
+frame_rows() {  # frame_rows TAG SCENE SIZES...
+  local tag=$1 scene=$2; shift 2
+  for size in "$@"; do
+    row "frame-$tag-$size-pbr" rtr-view "$scene" --headless --size "$size" --bench $frames
+    row "frame-$tag-$size-pbr-graphics" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic graphics
+    row "frame-$tag-$size-textured" rtr-view "$scene" --headless --size "$size" --bench $frames --mode 13
+  done
+}
+if ! skipped frame; then
+  frame_rows default "$temple" 1920x1080 3840x2160
+fi
+if ! skipped big; then  # the Sun-Temple-size version of the default scene
+  bin scenegen --out "$work/big" --scale 100 >/dev/null 2>&1 &&
+    bin rtr-bake "$work/big/temple.obj.zst" "$work/big/temple.rtrscene" --view 0,2.2,-2.5,0,-3 >"$out/bake-big.txt" 2>&1 &&
+    frame_rows big "$work/big/temple.rtrscene" 1920x1080 3840x2160
+fi
+if ! skipped compare; then  # GPU raster vs CPU trace, same view and shading model, with the image error
+  row frame-compare rtr-frame-compare --size 1920x1080 --frames $cmpframes
+fi
+if ! skipped trace; then  # tracer vs Embree: 1M-triangle sphere, then the Sun-Temple-size scene
+  row trace-sphere-1t bench-trace --threads 1
+  row trace-sphere-all bench-trace --threads "$(nproc)"
+  if bin scenegen --out "$work/plain" --scale 100 --plain >/dev/null 2>&1; then
+    row trace-temple-1t bench-trace --threads 1 --scene "$work/plain/temple.obj"
+    row trace-temple-all bench-trace --threads "$(nproc)" --scene "$work/plain/temple.obj"
+  fi
+fi
+if ! skipped bake; then  # ours vs tinyobjloader on the 175 MB temple (scale 300)
+  if bin scenegen --out "$work/bake" --scale 300 --plain >/dev/null 2>&1 &&
+     bin scenegen --out "$work/bake" --scale 300 >/dev/null 2>&1; then
+    RTR_BENCH_OBJ="$work/bake/temple.obj" row bake bench_bake --benchmark_min_time=$((quick ? 1 : 3))
+  fi
+fi
+echo "collect: done -> $out" >&2

@@ -1,0 +1,481 @@
+#!/usr/bin/python3
+"""Writes docs/BENCHMARKS.md and its plots from the raw outputs that tools/report/collect.sh kept.
+
+    tools/report/render.py [DATA_DIR [DOC]]    (defaults: docs/bench/data, docs/BENCHMARKS.md)
+
+DATA_DIR holds one folder per machine (e.g. h200/, lavapipe-vm/), each with meta.txt and one <row>.txt per
+command. Every number in the report comes from those files; a row that a machine did not produce is
+reported as missing with the reason (the command failed, or was not run there).
+"""
+import math
+import os
+import re
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+# ---------------------------------------------------------------- reading the raw outputs
+
+def md_tables(text):
+    """Every markdown table in text: a list of (header, rows), cells stripped."""
+    out, lines, i = [], text.splitlines(), 0
+    while i < len(lines):
+        if lines[i].startswith("|") and i + 1 < len(lines) and re.match(r"^\|[-:| ]+\|\s*$", lines[i + 1]):
+            header = [c.strip() for c in lines[i].strip().strip("|").split("|")]
+            rows, i = [], i + 2
+            while i < len(lines) and lines[i].startswith("|"):
+                rows.append([c.strip() for c in lines[i].strip().strip("|").split("|")])
+                i += 1
+            out.append((header, rows))
+        else:
+            i += 1
+    return out
+
+
+def num(cell):
+    """The first number in a cell ('0.37×' -> 0.37, '192 (0.189 %)' -> 192), or None."""
+    m = re.search(r"-?\d+(?:\.\d+)?(?:e-?\d+)?", cell or "")
+    return float(m.group(0)) if m else None
+
+
+def col(header, *names):
+    """Index of the first column whose name contains one of names (case-insensitive), or None."""
+    for n in names:
+        for i, h in enumerate(header):
+            if n.lower() in h.lower():
+                return i
+    return None
+
+
+class Machine:
+    def __init__(self, folder):
+        self.folder, self.label = folder, os.path.basename(folder)
+        self.meta = {}
+        with open(os.path.join(folder, "meta.txt")) as f:
+            for line in f:
+                k, _, v = line.partition(":")
+                self.meta[k.strip()] = v.strip()
+
+    def raw(self, row):
+        p = os.path.join(self.folder, row + ".txt")
+        return open(p).read() if os.path.exists(p) else None
+
+    def command(self, row):
+        t = self.raw(row)
+        return t.splitlines()[0].lstrip("$ ") if t else None
+
+    def failed(self, row):
+        t = self.raw(row)
+        if t is None:
+            return "not run on this machine"
+        m = re.search(r"# exit (\d+)", t)
+        return None if m and m.group(1) == "0" else "the command failed: see " + self.rel(row)
+
+    def rel(self, row):
+        return os.path.relpath(os.path.join(self.folder, row + ".txt"), os.path.join(ROOT, "docs"))
+
+    @property
+    def device(self):
+        m = re.search(r" on (.+?): \d+ meshes", self.meta.get("vulkan", ""))
+        return m.group(1) if m else "unknown Vulkan device"
+
+    def caption(self):
+        gpu = self.meta.get("gpu")
+        return (f"{self.label}: {self.device}" + (f" ({gpu})" if gpu else "") +
+                f"; CPU {self.meta.get('cpu', '?')}; {self.meta.get('date', '?')}; commit {self.meta.get('commit', '?')}")
+
+
+# ---------------------------------------------------------------- the sections
+
+class Report:
+    def __init__(self, machines, plots_dir):
+        self.m, self.plots, self.out, self.goals = machines, plots_dir, [], []
+        os.makedirs(plots_dir, exist_ok=True)
+
+    def w(self, s=""):
+        self.out.append(s)
+
+    def plot(self, fig, name, caption):
+        path = os.path.join(self.plots, name)
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        self.w(f"![{caption}](bench/plots/{name})")
+        self.w()
+
+    def source(self, m, row):
+        cmd = m.command(row)
+        if cmd:
+            self.w(f"<sub>{m.label}: `{cmd}` — raw output `{m.rel(row)}`</sub>")
+            self.w()
+
+    def missing(self, what, m, row):
+        self.w(f"- {what} on **{m.label}**: not measured — {m.failed(row)}.")
+
+    # 1. ray–triangle routines: speed against miss rate
+    def routines(self):
+        self.w("## Ray–triangle tests: speed against misses on a closed mesh")
+        self.w()
+        self.w("Each routine alone (scalar, 1 thread) on the same triangles, and its misses for rays shot from "
+               "inside a closed sphere (every ray must hit: a miss is a crack). `bench-trace`.")
+        self.w()
+        fig, ax = plt.subplots(figsize=(6, 3.6))
+        any_point = False
+        for m in self.m:
+            t = m.raw("trace-sphere-1t")
+            if not t or m.failed("trace-sphere-1t"):
+                self.missing("ray–triangle routines", m, "trace-sphere-1t")
+                continue
+            for header, rows in md_tables(t):
+                if col(header, "routine") == 0 and col(header, "misses") is not None:
+                    ci, cm = col(header, "tests/s"), col(header, "misses")
+                    self.w(f"**{m.label}**")
+                    self.w()
+                    self.w("| routine | M tests/s | closed-sphere misses |")
+                    self.w("|---|---:|---|")
+                    for r in rows:
+                        self.w(f"| {r[0]} | {r[ci]} | {r[cm]} |")
+                        pct = re.search(r"\(([\d.]+) %\)", r[cm])
+                        x, y = num(r[ci]), float(pct.group(1)) if pct else None
+                        if x is not None and y is not None:
+                            ax.scatter(x, y, label=f"{r[0]} ({m.label})")
+                            ax.annotate(r[0], (x, y), fontsize=8, xytext=(4, 4), textcoords="offset points")
+                            any_point = True
+                    self.w()
+                    self.source(m, "trace-sphere-1t")
+        if any_point:
+            ax.set_xlabel("speed: M ray–triangle tests/s (1 thread)")
+            ax.set_ylabel("error: % of rays that miss a closed mesh")
+            ax.set_title("Ray–triangle routines: speed vs misses", fontsize=10)
+            ax.grid(alpha=0.3)
+            self.plot(fig, "routines.png", "ray-triangle routines: speed vs miss rate")
+        else:
+            plt.close(fig)
+
+    # 2. CPU tracer vs Embree
+    def tracer(self):
+        self.w("## CPU ray tracer against Embree 3 (same meshes, same rays, one run)")
+        self.w()
+        self.w("Watertight test; Embree 3.13.5 `rtcIntersect1`/`rtcOccluded1`, build quality high. "
+               "Rays: primary through the pixel centres of a 1024² image, shadow (any hit) to a point light from "
+               "the primary hits, mirror rays reflected there.")
+        self.w()
+        bars = []  # (label, ratio)
+        for m in self.m:
+            for scene, name in (("sphere", "1M-triangle UV sphere"), ("temple", "generated temple, Sun-Temple size")):
+                for th in ("1t", "all"):
+                    row = f"trace-{scene}-{th}"
+                    t = m.raw(row)
+                    if not t or m.failed(row):
+                        self.missing(f"tracer vs Embree, {name}, {th}", m, row)
+                        continue
+                    build = re.search(r"BVH build: (.+)", t)
+                    agree = re.findall(r"agreement with Embree[^\n]*", t)
+                    for header, rows in md_tables(t):
+                        if col(header, "rays") == 0 and col(header, "Embree") is not None:
+                            cr = col(header, "ours /")
+                            self.w(f"**{m.label}, {name}**" + (f" — BVH build: {build.group(1)}" if build else ""))
+                            self.w()
+                            self.w("| " + " | ".join(header) + " |")
+                            self.w("|" + "---|" * len(header))
+                            for r in rows:
+                                self.w("| " + " | ".join(r) + " |")
+                                if cr is not None and num(r[cr]) is not None:
+                                    bars.append((f"{scene} {r[0].split()[0]} {r[1]}t\n{m.label}", num(r[cr])))
+                            self.w()
+                            for a in agree:
+                                self.w(f"- {a}")
+                            self.w()
+                            self.source(m, row)
+        if bars:
+            fig, ax = plt.subplots(figsize=(max(6, 0.55 * len(bars)), 3.8))
+            ax.bar(range(len(bars)), [b[1] for b in bars], color=["tab:green" if b[1] >= 1 else "tab:red" for b in bars])
+            ax.axhline(1.0, color="k", lw=0.8)
+            ax.set_xticks(range(len(bars)), [b[0] for b in bars], rotation=90, fontsize=7)
+            ax.set_ylabel("ours / Embree (Mrays/s)")
+            ax.set_title("CPU tracer throughput relative to Embree (≥ 1 is the goal)", fontsize=10)
+            self.plot(fig, "tracer_vs_embree.png", "tracer vs Embree throughput ratio")
+            worst = min(b[1] for b in bars)
+            self.goals.append(("CPU tracer ≥ 1.0× Embree (watertight), every row", f"lowest ratio {worst:.2f}×",
+                               worst >= 1.0))
+
+    # 3. and 4. GPU passes: mips and mosaic
+    def gpu_passes(self):
+        rows_by_machine = {}
+        for m in self.m:
+            t = m.raw("gpu-passes")
+            if t and not m.failed("gpu-passes"):
+                for header, rows in md_tables(t):
+                    if col(header, "pass") == 0:
+                        rows_by_machine[m.label] = (header, rows, m)
+        self.w("## Mipmaps: blit chain against compute, GPU time against error")
+        self.w()
+        self.w("64 textures per submission (all chains of a set in one batch), GPU time by timestamp queries. "
+               "Error: against a float64 linear-light box filter (`src/core/mip_reference.hpp`), in 8-bit steps "
+               "(LSB), over every texel of every level of the set's first texture.")
+        self.w()
+        fig, ax = plt.subplots(figsize=(6.5, 3.8))
+        plotted = False
+        for m in self.m:
+            if m.label not in rows_by_machine:
+                self.missing("mips", m, "gpu-passes")
+                continue
+            header, rows, _ = rows_by_machine[m.label]
+            mips = [r for r in rows if r[0] == "mips"]
+            self.w(f"**{m.label}**")
+            self.w()
+            self.w("| " + " | ".join(header[1:]) + " |")
+            self.w("|" + "---|" * (len(header) - 1))
+            for r in mips:
+                self.w("| " + " | ".join(r[1:]) + " |")
+            self.w()
+            self.source(m, "gpu-passes")
+            cmed, cerr = col(header, "median"), col(header, "max err")
+            for r in mips:
+                if cerr is not None and num(r[cerr]) is not None:
+                    ax.scatter(num(r[cmed]), num(r[cerr]), marker="o" if "1024" in r[1] else "s")
+                    ax.annotate(f"{r[2]}, {'POT' if '1024' in r[1] else 'NPOT'}, {m.label}", (num(r[cmed]), num(r[cerr])),
+                                fontsize=7, xytext=(4, 3), textcoords="offset points")
+                    plotted = True
+            if m.label.startswith("h200"):
+                for size in ("1024x1024", "1000x600"):
+                    by = {r[2]: num(r[cmed]) for r in mips if size in r[1]}
+                    blit = by.get("blit")
+                    comp = min((v for k, v in by.items() if k != "blit" and v is not None), default=None)
+                    if blit and comp:
+                        goal = 0.1 if size == "1024x1024" else 1.0
+                        self.goals.append((f"compute mips ≤ {goal}× blit, 64 × {size} sRGB (H200)",
+                                           f"{comp:.3f} vs {blit:.3f} ms = {comp / blit:.3f}×", comp / blit <= goal))
+        if plotted:
+            ax.set_xscale("log")
+            ax.set_xlabel("speed: GPU ms per set of 64 chains (log)")
+            ax.set_ylabel("error: max |chain − float64 reference| (LSB)")
+            ax.set_title("Mip chains: time vs error", fontsize=10)
+            ax.grid(alpha=0.3)
+            self.plot(fig, "mips.png", "mip chains: GPU time vs max error")
+        else:
+            plt.close(fig)
+            self.w("- The error columns were not in these runs' output.")
+            self.w()
+
+        self.w("## Mosaic 5×3: graphics full-screen triangle against compute")
+        self.w()
+        self.w("RGBA16F input, RGBA8 output with explicit sRGB encode. `identical` compares the two paths' "
+               "outputs byte for byte in the same run (also a test: `tests/render/mosaic_test.cpp`).")
+        self.w()
+        fig, ax = plt.subplots(figsize=(6, 3.4))
+        bars = []
+        for m in self.m:
+            if m.label not in rows_by_machine:
+                self.missing("mosaic", m, "gpu-passes")
+                continue
+            header, rows, _ = rows_by_machine[m.label]
+            mos = [r for r in rows if r[0].startswith("mosaic")]
+            self.w(f"**{m.label}**")
+            self.w()
+            self.w("| " + " | ".join(header) + " |")
+            self.w("|" + "---|" * len(header))
+            for r in mos:
+                self.w("| " + " | ".join(r) + " |")
+            self.w()
+            self.source(m, "gpu-passes")
+            cmed = col(header, "median")
+            by = {(r[1], r[2]): num(r[cmed]) for r in mos}
+            for (size, mode), v in sorted(by.items()):
+                if mode in ("compute", "graphics"):
+                    bars.append((f"{mode}\n{size}\n{m.label}", v))
+            if m.label.startswith("h200") and by.get(("3840x2160", "compute")) and by.get(("3840x2160", "graphics")):
+                c, g = by[("3840x2160", "compute")], by[("3840x2160", "graphics")]
+                self.goals.append(("mosaic compute ≤ 0.05× graphics at 4K (H200)", f"{c:.3f} vs {g:.3f} ms = {c / g:.3f}×",
+                                   c / g <= 0.05))
+                self.goals.append(("mosaic compute ≤ 0.04 ms at 4K (H200)", f"{c:.3f} ms", c <= 0.04))
+        if bars:
+            ax.bar(range(len(bars)), [b[1] for b in bars], color="tab:blue")
+            ax.set_yscale("log")
+            ax.set_xticks(range(len(bars)), [b[0] for b in bars], fontsize=6)
+            ax.set_ylabel("GPU ms (median, log)")
+            ax.set_title("Mosaic: compute vs graphics (error: 0, bit-identical)", fontsize=10)
+            self.plot(fig, "mosaic.png", "mosaic GPU time, compute vs graphics")
+        else:
+            plt.close(fig)
+
+    # 5. whole frame per pass
+    def frames(self):
+        self.w("## Whole frame per pass (`rtr-view --headless --bench`)")
+        self.w()
+        self.w("PBR = the brief's Beckmann/Cook-Torrance shading with the alpha-masked pipeline and the compute "
+               "mosaic (graphics mosaic in its own row); plain textured = mode 13 (unlit base colour, same "
+               "geometry, same textures, same post pass). Median GPU ms per pass over the frames.")
+        self.w()
+        for m in self.m:
+            rows = sorted(r[:-4] for r in os.listdir(m.folder) if r.startswith("frame-") and r != "frame-compare.txt")
+            if not rows:
+                self.missing("frame timings", m, "frame-default-1920x1080-pbr")
+                continue
+            self.w(f"**{m.label}**")
+            self.w()
+            passes, table = [], []
+            for row in rows:
+                t = m.raw(row)
+                _, scene, size, *variant = row.split("-")
+                vals = {}
+                for header, rs in md_tables(t or ""):
+                    if col(header, "pass") == 0:
+                        cm = col(header, "median")
+                        for r in rs:
+                            vals[r[0]] = num(r[cm])
+                            if r[0] not in passes and r[0] != "total":
+                                passes.append(r[0])
+                table.append((scene, size, "-".join(variant), vals, m.failed(row)))
+            names = {"pbr": "PBR + mosaic compute", "pbr-graphics": "PBR + mosaic graphics",
+                     "textured": "plain textured (mode 13)", "pbr-forward": "PBR forward + mosaic compute",
+                     "pbr-visibility": "PBR visibility + mosaic compute"}
+            scenes = {"default": "default (11k triangles)", "big": "Sun-Temple size (1M triangles)"}
+            self.w("| scene | size | frame | " + " | ".join(passes) + " | total |")
+            self.w("|---|---|---|" + "---:|" * (len(passes) + 1))
+            for scene, size, variant, vals, fail in table:
+                cells = [f"{vals[p]:.3f}" if p in vals else "–" for p in passes + ["total"]]
+                self.w(f"| {scenes.get(scene, scene)} | {size} | {names.get(variant, variant)} | " + " | ".join(cells) +
+                       " |" + (f" {fail}" if fail else ""))
+            self.w()
+            self.source(m, rows[0])
+            if m.label.startswith("h200"):
+                for scene in ("default", "big"):
+                    tot = {(s, v): vals.get("total") for s_, s, v, vals, _ in [(x[0], x[1], x[2], x[3], 0) for x in table]
+                           if s_ == scene}
+                    pbr, tex = tot.get(("3840x2160", "pbr")), tot.get(("3840x2160", "textured"))
+                    if pbr and tex:
+                        self.goals.append((f"whole frame ≤ 1.1× plain textured at 4K, {scene} scene (H200)",
+                                           f"{pbr:.3f} vs {tex:.3f} ms = {pbr / tex:.2f}×", pbr / tex <= 1.1))
+
+    # 6. GPU raster vs CPU trace
+    def frame_compare(self):
+        self.w("## Whole frame: GPU raster time against CPU trace time, with the error between them")
+        self.w()
+        self.w("`rtr-frame-compare`: every case of `tests/reference/poses.txt` at 1920×1080, the same shading "
+               "model on both sides (PBR, no shadows, no reflections). Error: 8-bit sRGB steps, GPU against the "
+               "CPU reference; failing = beyond 3 steps even against the 3×3 neighbours (docs/reference-tests.md).")
+        self.w()
+        fig, ax = plt.subplots(figsize=(6.5, 3.8))
+        plotted = False
+        for m in self.m:
+            t = m.raw("frame-compare")
+            if not t or m.failed("frame-compare"):
+                self.missing("raster vs trace", m, "frame-compare")
+                continue
+            for header, rows in md_tables(t):
+                self.w(f"**{m.label}**")
+                self.w()
+                self.w("| " + " | ".join(header) + " |")
+                self.w("|" + "---|" * len(header))
+                for r in rows:
+                    self.w("| " + " | ".join(r) + " |")
+                self.w()
+                self.source(m, "frame-compare")
+                cg, cc, ce = col(header, "GPU frame"), col(header, "CPU trace ms"), col(header, "mean error")
+                for r in rows:
+                    g, c, e = num(r[cg]), num(r[cc]), num(r[ce])
+                    ax.plot([c, g], [0, e], color="0.7", lw=0.8)
+                    ax.scatter([g], [e], color="tab:red", s=12)
+                    ax.scatter([c], [0], color="tab:blue", s=12)
+                    ax.annotate(r[0], (g, e), fontsize=6, xytext=(3, 3), textcoords="offset points")
+                    plotted = True
+        if plotted:
+            ax.set_xscale("log")
+            ax.set_xlabel("speed: ms per 1920×1080 frame (red: GPU raster, blue: CPU trace; log)")
+            ax.set_ylabel("error: mean |GPU − CPU| (8-bit steps)")
+            ax.set_title("Raster vs ray trace: time vs error", fontsize=10)
+            ax.grid(alpha=0.3)
+            self.plot(fig, "raster_vs_trace.png", "GPU raster vs CPU trace time and error")
+        else:
+            plt.close(fig)
+
+    # 7. bake
+    def bake(self):
+        self.w("## Bake: ours against a tinyobjloader baseline")
+        self.w()
+        self.w("`bench_bake` (Google Benchmark) on the generated temple at `--scale 300` (175 MB OBJ, 1.54 M "
+               "vertices after welding): end to end, OBJ text to `.rtrscene` on disk. MB/s = OBJ bytes per second "
+               "of wall time.")
+        self.w()
+        bars = []
+        for m in self.m:
+            t = m.raw("bake")
+            if not t or m.failed("bake"):
+                self.missing("bake", m, "bake")
+                continue
+            self.w(f"**{m.label}**")
+            self.w()
+            self.w("| benchmark | wall ms | MB/s | other counters |")
+            self.w("|---|---:|---:|---|")
+            res = {}
+            for line in t.splitlines():
+                mm = re.match(r"^(BM_\w+)\S*\s+([\d.]+) ms\s+([\d.]+) ms\s+\d+\s*(.*)$", line)
+                if not mm:
+                    continue
+                counters = dict(re.findall(r"(\S+)=(\S+)", mm.group(4)))
+                mbs = counters.pop("MB/s", "–")
+                res[mm.group(1)] = num(mbs)
+                self.w(f"| {mm.group(1)} | {mm.group(2)} | {mbs} | " + ", ".join(f"{k} {v}" for k, v in counters.items()) + " |")
+                bars.append((f"{mm.group(1).replace('BM_', '')}\n{m.label}", num(mbs)))
+            self.w()
+            self.source(m, "bake")
+            ours, base = res.get("BM_OursBake"), res.get("BM_BaselineBake")
+            if ours and base and not self.goals_has("bake"):
+                self.goals.append((f"bake ≥ 100 MB/s and ≥ 2× tinyobjloader ({m.label})",
+                                   f"{ours:.0f} MB/s, {ours / base:.2f}×", ours >= 100 and ours / base >= 2))
+        if bars:
+            fig, ax = plt.subplots(figsize=(6, 3.2))
+            ax.bar(range(len(bars)), [b[1] or 0 for b in bars], color="tab:purple")
+            ax.set_xticks(range(len(bars)), [b[0] for b in bars], fontsize=7)
+            ax.set_ylabel("MB/s of OBJ text (wall)")
+            ax.set_title("Bake throughput", fontsize=10)
+            self.plot(fig, "bake.png", "bake throughput")
+
+    def goals_has(self, word):
+        return any(word in g[0] for g in self.goals)
+
+
+def main():
+    data = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "docs/bench/data")
+    doc = sys.argv[2] if len(sys.argv) > 2 else os.path.join(ROOT, "docs/BENCHMARKS.md")
+    folders = sorted(os.path.join(data, d) for d in os.listdir(data) if os.path.exists(os.path.join(data, d, "meta.txt")))
+    if not folders:
+        sys.exit(f"render.py: {data}: no machine folders (each needs a meta.txt from tools/report/collect.sh)")
+    machines = [Machine(f) for f in folders]
+    rep = Report(machines, os.path.join(os.path.dirname(doc), "bench/plots"))
+    rep.routines()
+    rep.tracer()
+    rep.gpu_passes()
+    rep.frames()
+    rep.frame_compare()
+    rep.bake()
+
+    head = ["# Benchmark report: speed beside error", "",
+            "Generated by `tools/report.sh` (`tools/report/collect.sh` runs every command on a machine and keeps "
+            "its raw output in `docs/bench/data/<machine>/`; `tools/report/render.py` writes this page and the "
+            "plots from those files). Do not edit by hand: every number below is in a raw file, with the exact "
+            "command on its first line. GPU times are timestamp queries (median over the stated frames or "
+            "submissions after warm-up).", "", "## Machines", ""]
+    for m in machines:
+        head.append(f"- **{m.label}**: {m.caption()}" + (" (quick run: fewer frames)" if m.meta.get("quick") == "1" else ""))
+    head += ["", "## Goals against the anchors (`../shared/ANCHORS.md`)", "", "| goal | measured | met? |", "|---|---|---|"]
+    for g, v, ok in rep.goals:
+        head.append(f"| {g} | {v} | {'yes' if ok else '**no**'} |")
+    head.append("")
+    notes = os.path.join(data, "NOTES.md")  # hand-written context that the numbers need, kept with the data
+    if os.path.exists(notes):
+        head += [open(notes).read().rstrip(), ""]
+    with open(doc, "w") as f:
+        f.write("\n".join(head + rep.out).rstrip() + "\n")
+    print(f"render.py: wrote {doc} and {rep.plots}/*.png from {len(machines)} machine(s)")
+
+
+if __name__ == "__main__":
+    main()
