@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
       const CasePair p = renderPair(ctx, rs, poses.at(name), View::Shaded,
                                     {.width = w, .height = h, .threads = threads, .benchFrames = frames});
       const CompareResult r = compareEdgeTolerant(p.gpu, p.cpu, lim.threshold);
-      std::printf("| %s | %ux%u | %.3f | %.1f | %.0f× | %.2f | %.2f | %.0f | %.3f |\n", name.c_str(), w, h,
+      std::printf("| %s | %ux%u | %.3f | %.1f | %.0f× | %.2f | %.3f | %.0f | %.3f |\n", name.c_str(), w, h,
                   p.gpuMs, p.cpuMs, p.cpuMs / p.gpuMs, double(p.cpuRays) / (p.cpuMs * 1e3), r.meanAbsError,
                   r.maxAbsError, 100.0 * r.failingFraction);
       std::fflush(stdout);

@@ -24,6 +24,7 @@ struct Row {
   std::string pass, size, mode;
   double minMs = 0, medianMs = 0;
   int runs = 0;
+  std::string error = "–";  // the error side: against a reference, or against the other path
 };
 
 // Times `record` (between two timestamps) over warmup + runs submissions.
@@ -125,6 +126,22 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
   });
   render::MosaicPass pass(ctx);
   std::vector<Row> rows;
+  // The output of each path, read back after its timed runs: compute and graphics must be identical.
+  vk::Buffer readback(ctx, texels, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+  auto readOutput = [&] {
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+      VkBufferImageCopy c{};
+      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      c.imageExtent = {extent.width, extent.height, 1};
+      vkCmdCopyImageToBuffer(cb, output.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(), 1, &c);
+      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                        VK_ACCESS_2_HOST_READ_BIT);
+    });
+    readback.invalidate();
+    const auto* p = static_cast<const uint8_t*>(readback.mapped());
+    return std::vector<uint8_t>(p, p + texels);
+  };
+  std::vector<uint8_t> computeBytes;
   const std::string size = std::to_string(extent.width) + "x" + std::to_string(extent.height);
   for (render::MosaicMode mode : {render::MosaicMode::Compute, render::MosaicMode::Graphics, render::MosaicMode::Off}) {
     Row r = measure(ctx, warmup, runs, [](VkCommandBuffer) {}, [&](VkCommandBuffer cb, std::vector<render::MipViews>&) {
@@ -134,6 +151,19 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
     r.pass = "mosaic 5x3";
     r.size = size;
     r.mode = render::toString(mode);
+    const std::vector<uint8_t> bytes = readOutput();
+    if (mode == render::MosaicMode::Compute) {
+      computeBytes = bytes;
+      r.error = "reference for graphics";
+    } else if (mode == render::MosaicMode::Graphics) {
+      const auto diff = std::mismatch(bytes.begin(), bytes.end(), computeBytes.begin());
+      const size_t at = size_t(diff.first - bytes.begin()) / 4;
+      r.error = diff.first == bytes.end() ? "bit-identical to compute (" + std::to_string(texels) + " bytes)"
+                                          : "DIFFERS from compute at pixel (" + std::to_string(at % extent.width) +
+                                                ", " + std::to_string(at / extent.width) + ")";
+    } else {
+      r.error = "plain copy (no mosaic)";
+    }
     rows.push_back(r);
     std::fprintf(stderr, "  mosaic %s %s: median %.3f ms\n", size.c_str(), r.mode.c_str(), r.medianMs);
   }
@@ -167,10 +197,10 @@ int main(int argc, char** argv) {
       add(benchMosaic(ctx, {3840, 2160}, warmup, runs));
     }
     std::printf("Device: %s (%s)\n\n", ctx.deviceName().c_str(), ctx.driverInfo().c_str());
-    std::printf("| pass | size | mode | min ms | median ms | runs |\n|---|---|---|---:|---:|---:|\n");
+    std::printf("| pass | size | mode | min ms | median ms | runs | error |\n|---|---|---|---:|---:|---:|---|\n");
     for (const Row& r : rows)
-      std::printf("| %s | %s | %s | %.3f | %.3f | %d |\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs,
-                  r.medianMs, r.runs);
+      std::printf("| %s | %s | %s | %.3f | %.3f | %d | %s |\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs,
+                  r.medianMs, r.runs, r.error.c_str());
     std::printf("\n");
     for (const Row& r : rows)
       std::printf("csv,%s,%s,%s,%.4f,%.4f,%d\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs, r.medianMs, r.runs);

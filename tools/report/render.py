@@ -236,11 +236,13 @@ class Report:
                 self.w("| " + " | ".join(r[1:]) + " |")
             self.w()
             self.source(m, "gpu-passes")
-            cmed, cerr = col(header, "median"), col(header, "max err")
+            cmed, cerr = col(header, "median"), col(header, "error")
             for r in mips:
-                if cerr is not None and num(r[cerr]) is not None:
-                    ax.scatter(num(r[cmed]), num(r[cerr]), marker="o" if "1024" in r[1] else "s")
-                    ax.annotate(f"{r[2]}, {'POT' if '1024' in r[1] else 'NPOT'}, {m.label}", (num(r[cmed]), num(r[cerr])),
+                e = re.search(r"max ([\d.]+)", r[cerr]) if cerr is not None else None
+                if e:
+                    x, y = num(r[cmed]), float(e.group(1))
+                    ax.scatter(x, y, marker="o" if "1024" in r[1] else "s")
+                    ax.annotate(f"{r[2]}, {'POT' if '1024' in r[1] else 'NPOT'}, {m.label}", (x, y),
                                 fontsize=7, xytext=(4, 3), textcoords="offset points")
                     plotted = True
             if m.label.startswith("h200"):
