@@ -12,28 +12,10 @@ layout(set = 0, binding = 2) writeonly uniform image2D dstLevels[MIP_MAX_LEVELS_
 layout(set = 0, binding = 3, std430) writeonly buffer DstScratch { vec4 dstTexels[]; };
 layout(push_constant) uniform Push { MipPush pc; };
 
-// Experiment: 0 = hardware sRGB decode through the image's own view, 1 = shared LUT, 2 = pow (UNORM view).
-layout(constant_id = 0) const int kDecode = 0;
-shared float srgbDecodeLut[256];
-void initDecode() {
-  if (kDecode == 1) {
-    srgbDecodeLut[gl_LocalInvocationIndex] = srgbToLinear(float(gl_LocalInvocationIndex) / 255.0);
-    barrier();
-  }
-}
-vec4 decodeSrc(vec4 v) {
-  if (kDecode == 0 || pc.srgb == 0) return v;
-  if (kDecode == 1) {
-    const ivec4 b = ivec4(v * 255.0 + 0.5);
-    return vec4(srgbDecodeLut[b.r], srgbDecodeLut[b.g], srgbDecodeLut[b.b], v.a);
-  }
-  return decode8(v, true);
-}
-
 // A texel of the dispatch's source level as linear colour.
 vec4 loadSource(ivec2 q) {
   if (pc.fromScratch != 0) return srcTexels[q.y * pc.srcWidth + q.x];
-  return decodeSrc(texelFetch(srcImage, q, 0));
+  return texelFetch(srcImage, q, 0);
 }
 
 // Level j (1-based) of the dispatch; constant indices only (dynamic indexing of storage image arrays is

@@ -30,7 +30,6 @@ vec4 loadLevel(int j, ivec2 q, ivec2 srcLo, int srcStride) {
 // spills them to local memory.
 void main() {
   const int L = pc.levels;
-  initDecode();
   ivec2 size[MIP_MAX_LEVELS_PER_DISPATCH + 1];
   size[0] = ivec2(pc.srcWidth, pc.srcHeight);
   [[unroll]] for (int j = 1; j <= MIP_MAX_LEVELS_PER_DISPATCH; ++j) size[j] = mipNext(size[j - 1]);

@@ -40,7 +40,6 @@ void put(int j, ivec2 p, ivec2 size, vec4 v) {
 }
 
 void main() {
-  initDecode();
   ivec2 size[MIP_MAX_LEVELS_PER_DISPATCH + 1];
   size[0] = ivec2(pc.srcWidth, pc.srcHeight);
   [[unroll]] for (int j = 1; j <= MIP_MAX_LEVELS_PER_DISPATCH; ++j) size[j] = mipNext(size[j - 1]);

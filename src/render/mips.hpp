@@ -38,7 +38,7 @@ struct MipDispatch {
   bool even = false;
   VkExtent2D groups{1, 1};
 };
-std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, bool evenShader = true);
+std::vector<MipDispatch> planMipDispatches(VkExtent2D extent);
 
 // What a recorded generation uses; keep it until the command buffer has completed.
 struct MipViews {
@@ -65,7 +65,6 @@ class MipGenerator {
   void recordBlit(VkCommandBuffer cb, const vk::Image& image) const;
   const vk::Context& ctx_;
   vk::Pipeline even_, general_;
-  int decode_ = 0;  // experiment
 };
 
 }  // namespace rtr::render
