@@ -151,8 +151,7 @@ MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* con
     const vk::Image* image;
     uint32_t base;
     std::vector<MipDispatch> plan;
-    std::vector<VkDeviceSize> region;  // per dispatch: offset, size
-    std::vector<VkDeviceSize> regionSize;
+    std::vector<VkDeviceSize> region, regionSize;  // per dispatch: where its last level's float copy goes
   };
   const VkDeviceSize align = std::max<VkDeviceSize>(16, ctx_.properties().limits.minStorageBufferOffsetAlignment);
   VkDeviceSize scratchSize = 0;
