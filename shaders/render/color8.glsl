@@ -1,11 +1,8 @@
-// 8-bit colour helpers shared by the mip and post shaders: exact sRGB transfer functions and a
+// 8-bit colour helpers shared by the mip and post shaders: the exact sRGB encode and a
 // rounding that makes the stored byte independent of the hardware's float -> UNORM rounding.
 #ifndef RTR_RENDER_COLOR8_GLSL
 #define RTR_RENDER_COLOR8_GLSL
 
-float srgbToLinear(float c) {
-  return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
 float linearToSrgb(float c) {
   return c <= 0.0031308 ? c * 12.92 : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
 }
@@ -21,11 +18,6 @@ vec4 encode8(vec4 linear, bool srgb) {
   vec4 c = clamp(linear, 0.0, 1.0);
   if (srgb) c = vec4(linearToSrgb(c.r), linearToSrgb(c.g), linearToSrgb(c.b), c.a);
   return quantize8(c);
-}
-
-vec4 decode8(vec4 stored, bool srgb) {
-  if (!srgb) return stored;
-  return vec4(srgbToLinear(stored.r), srgbToLinear(stored.g), srgbToLinear(stored.b), stored.a);
 }
 
 #endif

@@ -1,9 +1,9 @@
 #version 460
-// Multi-level mip generation: each workgroup owns ONE texel of the last level this dispatch writes
-// and computes, level by level in shared memory, every texel of the intermediate levels that this
-// texel's box covers (up to 64x64 source texels -> 6 levels). Each texel is also written to the image
-// by exactly one workgroup: the one whose last-level texel contains the texel's top-left corner.
-// Intermediate levels stay in float (no 8-bit rounding) until the next dispatch re-reads the last one.
+// Multi-level mip generation for any sizes (odd ones included): each workgroup owns ONE texel of the
+// last level this dispatch writes and computes, level by level in shared memory, every texel of the
+// intermediate levels that this texel's box covers (up to 64x64 source texels -> 6 levels). Each texel
+// is also written to the image by exactly one workgroup: the one whose last-level texel contains the
+// texel's top-left corner. Levels that halve exactly take mips_even.comp instead (much faster).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
 #extension GL_EXT_control_flow_attributes : require
@@ -13,29 +13,13 @@
 
 layout(local_size_x = MIP_GROUP_SIZE) in;
 
-layout(set = 0, binding = 0) uniform texture2D srcLevel;  // UNORM view of the source level
-layout(set = 0, binding = 1) writeonly uniform image2D dstLevels[MIP_MAX_LEVELS_PER_DISPATCH];
-layout(push_constant) uniform Push { MipPush pc; };
-
 shared vec4 tileOdd[MIP_CAP_ODD * MIP_CAP_ODD];     // outputs 1, 3, 5 of this dispatch
 shared vec4 tileEven[MIP_CAP_EVEN * MIP_CAP_EVEN];  // outputs 2, 4
 
-// Constant indices only: dynamic indexing of storage image arrays is an optional feature.
-void storeLevel(int j, ivec2 p, vec4 v) {
-  switch (j) {
-    case 1: imageStore(dstLevels[0], p, v); break;
-    case 2: imageStore(dstLevels[1], p, v); break;
-    case 3: imageStore(dstLevels[2], p, v); break;
-    case 4: imageStore(dstLevels[3], p, v); break;
-    case 5: imageStore(dstLevels[4], p, v); break;
-    case 6: imageStore(dstLevels[5], p, v); break;
-  }
-}
-
 // A level-(j-1) texel as linear colour: level 0 of the dispatch from the image, the others from the
 // tile that holds level j-1 (j is a constant once the level loop is unrolled).
-vec4 loadSource(int j, ivec2 q, ivec2 srcLo, int srcStride, bool srgb) {
-  if (j == 1) return decodeLut(texelFetch(srcLevel, q, 0), srgb);
+vec4 loadLevel(int j, ivec2 q, ivec2 srcLo, int srcStride) {
+  if (j == 1) return loadSource(q);
   const int i = (q.y - srcLo.y) * srcStride + (q.x - srcLo.x);
   return (j % 2 == 0) ? tileOdd[i] : tileEven[i];
 }
@@ -46,8 +30,6 @@ vec4 loadSource(int j, ivec2 q, ivec2 srcLo, int srcStride, bool srgb) {
 // spills them to local memory.
 void main() {
   const int L = pc.levels;
-  const bool srgb = pc.srgb != 0;
-  initSrgbDecodeLut();
   ivec2 size[MIP_MAX_LEVELS_PER_DISPATCH + 1];
   size[0] = ivec2(pc.srcWidth, pc.srcHeight);
   [[unroll]] for (int j = 1; j <= MIP_MAX_LEVELS_PER_DISPATCH; ++j) size[j] = mipNext(size[j - 1]);
@@ -85,8 +67,8 @@ void main() {
       vec4 sum;
       if (halves) {
         const ivec2 q = 2 * p;
-        const vec4 r0 = 0.5 * loadSource(j, q, srcLo, srcStride, srgb) + 0.5 * loadSource(j, q + ivec2(1, 0), srcLo, srcStride, srgb);
-        const vec4 r1 = 0.5 * loadSource(j, q + ivec2(0, 1), srcLo, srcStride, srgb) + 0.5 * loadSource(j, q + ivec2(1, 1), srcLo, srcStride, srgb);
+        const vec4 r0 = 0.5 * loadLevel(j, q, srcLo, srcStride) + 0.5 * loadLevel(j, q + ivec2(1, 0), srcLo, srcStride);
+        const vec4 r1 = 0.5 * loadLevel(j, q + ivec2(0, 1), srcLo, srcStride) + 0.5 * loadLevel(j, q + ivec2(1, 1), srcLo, srcStride);
         sum = 0.5 * r0 + 0.5 * r1;
       } else {
         const MipTaps tx = mipTaps(p.x, size[j - 1].x, size[j].x);
@@ -97,7 +79,7 @@ void main() {
           vec4 r = vec4(0.0);
           [[unroll]] for (int a = 0; a < 3; ++a) {
             if (a >= tx.count) break;
-            r += tx.w[a] * loadSource(j, ivec2(tx.first + a, ty.first + b), srcLo, srcStride, srgb);
+            r += tx.w[a] * loadLevel(j, ivec2(tx.first + a, ty.first + b), srcLo, srcStride);
           }
           sum += ty.w[b] * r;
         }
@@ -106,7 +88,10 @@ void main() {
         const int i = t;  // (p - lo[j]) in row-major order of the [lo, hi) range
         if (j % 2 == 1) tileOdd[i] = sum; else tileEven[i] = sum;
       }
-      if (all(greaterThanEqual(p, ownLo)) && all(lessThan(p, ownHi))) storeLevel(j, p, encode8(sum, srgb));
+      if (all(greaterThanEqual(p, ownLo)) && all(lessThan(p, ownHi))) {
+        storeLevel(j, p, sum);
+        if (j == L) storeLastLevel(p, size[j], sum);
+      }
     }
     if (j < L) barrier();  // level j complete in shared memory before level j + 1 reads it
   }

@@ -1,4 +1,4 @@
-// Push constants and limits of the mip shaders (shaders/render/mips.comp, mip_level.comp), shared by
+// Push constants and limits of the mip shaders (shaders/render/mips.comp, mips_even.comp), shared by
 // GLSL and C++ (src/render/mips.cpp). Plain ints only, so the std430 push block is the C++ layout.
 #ifndef RTR_SHADERS_SHARED_MIPS_H
 #define RTR_SHADERS_SHARED_MIPS_H
@@ -7,21 +7,21 @@
 namespace rtr::shader {
 #endif
 
-#define MIP_MAX_LEVELS_PER_DISPATCH 6  // levels one mips.comp dispatch writes (64x64 -> 1x1)
-#define MIP_GROUP_SIZE 256             // threads of a mips.comp workgroup
-#define MIP_LEVEL_GROUP 16             // mip_level.comp: 16x16 threads, one destination texel each
-// Side of the shared-memory tiles holding a dispatch's odd (1st, 3rd, 5th) and even output levels.
-// 64x64 source texels give 32x32; the margin takes the extra texels of odd sizes (the host plan
+#define MIP_MAX_LEVELS_PER_DISPATCH 6  // levels one dispatch writes (64x64 -> 1x1)
+#define MIP_GROUP_SIZE 256             // threads of a workgroup (both shaders)
+#define MIP_EVEN_TILE 64               // mips_even.comp: source texels per workgroup and axis
+// mips.comp: side of the shared-memory tiles holding a dispatch's odd (1st, 3rd, 5th) and even output
+// levels. 64x64 source texels give 32x32; the margin takes the extra texels of odd sizes (the host plan
 // checks every workgroup's footprint against these and writes fewer levels per dispatch when needed).
 #define MIP_CAP_ODD 36
 #define MIP_CAP_EVEN 20
 
 struct MipPush {
-  int srcWidth;   // size of the source level of this dispatch
+  int srcWidth;     // size of the source level of this dispatch
   int srcHeight;
-  int levels;     // levels written (1 .. MIP_MAX_LEVELS_PER_DISPATCH)
-  int srgb;       // 1: decode sRGB on read and encode on write (R, G, B; alpha stays linear)
-  int fromScratch;  // mip_level.comp: 1 reads the source level's float copy instead of its 8-bit texels
+  int levels;       // levels written (1 .. MIP_MAX_LEVELS_PER_DISPATCH)
+  int srgb;         // 1: sRGB-encode R, G, B on write (alpha stays linear)
+  int fromScratch;  // 1: the source level is the float copy the previous dispatch left (not level 0)
 };
 
 #ifdef __cplusplus

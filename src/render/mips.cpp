@@ -44,7 +44,6 @@ bool axisFits(uint32_t size0, uint32_t levels) {
 const char* toString(MipMode mode) {
   switch (mode) {
     case MipMode::Blit: return "blit";
-    case MipMode::ComputePerLevel: return "compute-per-level";
     case MipMode::Compute: return "compute";
   }
   return "?";
@@ -71,23 +70,27 @@ vk::ImageDesc textureDesc(VkExtent2D extent, VkFormat format, const char* name) 
   return d;
 }
 
-std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, MipMode mode) {
+std::vector<MipDispatch> planMipDispatches(VkExtent2D extent) {
   std::vector<MipDispatch> plan;
-  if (mode == MipMode::Blit) return plan;
   const uint32_t total = mipLevelCount(extent);
+  auto halves = [](uint32_t n) { return n % 2 == 0 || n == 1; };
   for (uint32_t s = 0; s + 1 < total;) {
     MipDispatch d;
     d.srcLevel = s;
-    d.levels = mode == MipMode::Compute ? std::min<uint32_t>(MIP_MAX_LEVELS_PER_DISPATCH, total - 1 - s) : 1;
-    while (d.levels > 1 && !(axisFits(levelSize(extent.width, s), d.levels) &&
-                             axisFits(levelSize(extent.height, s), d.levels)))
-      --d.levels;
-    // One output level gains nothing from shared memory: the per-level shader does it with full groups.
-    d.multiLevel = d.levels > 1;
-    const VkExtent2D last{levelSize(extent.width, s + d.levels), levelSize(extent.height, s + d.levels)};
-    d.groups = d.multiLevel ? last
-                            : VkExtent2D{(last.width + MIP_LEVEL_GROUP - 1) / MIP_LEVEL_GROUP,
-                                         (last.height + MIP_LEVEL_GROUP - 1) / MIP_LEVEL_GROUP};
+    const VkExtent2D src{levelSize(extent.width, s), levelSize(extent.height, s)};
+    uint32_t even = 0;
+    while (even < MIP_MAX_LEVELS_PER_DISPATCH && s + even + 1 < total &&
+           halves(levelSize(extent.width, s + even)) && halves(levelSize(extent.height, s + even)))
+      ++even;
+    d.even = even > 0;
+    if (d.even) {
+      d.levels = even;
+      d.groups = {(src.width + MIP_EVEN_TILE - 1) / MIP_EVEN_TILE, (src.height + MIP_EVEN_TILE - 1) / MIP_EVEN_TILE};
+    } else {
+      d.levels = std::min<uint32_t>(MIP_MAX_LEVELS_PER_DISPATCH, total - 1 - s);
+      while (d.levels > 1 && !(axisFits(src.width, d.levels) && axisFits(src.height, d.levels))) --d.levels;
+      d.groups = {levelSize(extent.width, s + d.levels), levelSize(extent.height, s + d.levels)};
+    }
     plan.push_back(d);
     s += d.levels;
   }
@@ -96,8 +99,8 @@ std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, MipMode mode) {
 
 MipGenerator::MipGenerator(const vk::Context& ctx) : ctx_(ctx) {
   vk::LayoutOptions push{.pushDescriptorSets = {0}};
-  multi_ = vk::makeComputePipeline(ctx, vk::loadShader("mips.comp"), push);
-  perLevel_ = vk::makeComputePipeline(ctx, vk::loadShader("mip_level.comp"), push);
+  even_ = vk::makeComputePipeline(ctx, vk::loadShader("mips_even.comp"), push);
+  general_ = vk::makeComputePipeline(ctx, vk::loadShader("mips.comp"), push);
 }
 
 void MipGenerator::recordBlit(VkCommandBuffer cb, const vk::Image& image) const {
@@ -143,97 +146,81 @@ MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* con
   }
   const VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 
-  // Per image: its views (from `base` in views.sampled / views.storage), plan and scratch regions.
+  // Per image: its storage views (from `base`), plan, and the scratch offset of each dispatch's last level.
   struct Job {
     const vk::Image* image;
     uint32_t base;
     std::vector<MipDispatch> plan;
-    int srgb;
-    VkBuffer scratch = VK_NULL_HANDLE;
-    VkDeviceSize region[2] = {16, 16};  // [even, odd] level sizes; never empty
+    std::vector<VkDeviceSize> region, regionSize;  // per dispatch: where its last level's float copy goes
   };
+  const VkDeviceSize align = std::max<VkDeviceSize>(16, ctx_.properties().limits.minStorageBufferOffsetAlignment);
+  VkDeviceSize scratchSize = 0;
   std::vector<Job> jobs;
   std::vector<vk::ImageBarrier> start, done;
   size_t steps = 0;
   for (const vk::Image* image : images) {
     const uint32_t n = image->mipLevels();
     const VkImage img = image->handle();
-    Job job{image, uint32_t(views.sampled.size()), planMipDispatches(image->extent(), mode), isSrgb(image->format()) ? 1 : 0};
-    const VkFormat viewFormat = unormOf(image->format());
-    for (uint32_t i = 0; i < n; ++i) {
-      views.sampled.push_back(image->createView(viewFormat, i, 1, VK_IMAGE_USAGE_SAMPLED_BIT));
-      if (i > 0) views.storage.push_back(image->createView(viewFormat, i, 1, VK_IMAGE_USAGE_STORAGE_BIT));
-      else views.storage.emplace_back();
+    const VkExtent2D e = image->extent();
+    Job job{image, uint32_t(views.storage.size()), planMipDispatches(e), {}, {}};
+    const VkFormat unorm = unormOf(image->format());
+    // Level 0 through a view of the image's own format: the texture unit decodes sRGB (exactly enough:
+    // measured within 1 LSB on lavapipe and the H200, and cheaper than a table or pow in the shader).
+    views.source.push_back(image->createView(image->format(), 0, 1, VK_IMAGE_USAGE_SAMPLED_BIT));
+    for (uint32_t i = 1; i < n; ++i) views.storage.push_back(image->createView(unorm, i, 1, VK_IMAGE_USAGE_STORAGE_BIT));
+    for (const MipDispatch& d : job.plan) {
+      const uint32_t last = d.srcLevel + d.levels;
+      job.region.push_back(scratchSize);
+      job.regionSize.push_back(VkDeviceSize(levelSize(e.width, last)) * levelSize(e.height, last) * 16);
+      scratchSize += (job.regionSize.back() + align - 1) / align * align;
     }
-    // Level 0 is only read: straight to its final layout. The others are written (and re-read) in GENERAL.
+    // Level 0 is only read: straight to its final layout. The others are written in GENERAL.
     start.push_back({img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                      VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, readers, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, 1});
     if (n > 1) {
       start.push_back({img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
-                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
-                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1});
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, 1, n - 1});
       done.push_back({img, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, readers, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 1, n - 1});
     }
-    // Per level dispatches: level k's float copy goes to region k % 2 (odd levels: the size of level 1,
-    // even: level 2).
-    if (std::any_of(job.plan.begin(), job.plan.end(), [](const MipDispatch& d) { return !d.multiLevel; })) {
-      const VkExtent2D e = image->extent();
-      job.region[1] = VkDeviceSize(levelSize(e.width, 1)) * levelSize(e.height, 1) * 16;
-      if (n > 2) job.region[0] = VkDeviceSize(levelSize(e.width, 2)) * levelSize(e.height, 2) * 16;
-      const VkDeviceSize align = std::max<VkDeviceSize>(256, ctx_.properties().limits.minStorageBufferOffsetAlignment);
-      job.region[1] = (job.region[1] + align - 1) / align * align;
-      views.scratch.emplace_back(ctx_, job.region[1] + job.region[0], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                 vk::MemoryUse::Device, "mip scratch");
-      job.scratch = views.scratch.back().handle();
-    }
     steps = std::max(steps, job.plan.size());
     jobs.push_back(std::move(job));
   }
+  if (scratchSize > 0)
+    views.scratch = vk::Buffer(ctx_, scratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device, "mip scratch");
   if (!start.empty()) vk::barrier(cb, start);
 
   for (size_t k = 0; k < steps; ++k) {
-    // Step k - 1's last levels (or their float copies) are step k's sources; the scratch regions are
-    // also rewritten every other level (WAR and WAW). One barrier for the whole batch.
+    // Step k - 1's float copies are step k's sources. One barrier for the whole batch.
     if (k > 0)
       vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     const vk::Pipeline* bound = nullptr;
-    for (const Job& job : jobs) {
+    for (size_t j = 0; j < jobs.size(); ++j) {
+      const Job& job = jobs[j];
       if (k >= job.plan.size()) continue;
       const MipDispatch& d = job.plan[k];
-      const MipDispatch* prev = k > 0 ? &job.plan[k - 1] : nullptr;
       const VkExtent2D extent = job.image->extent();
-      const vk::Pipeline& p = d.multiLevel ? multi_ : perLevel_;
+      const vk::Pipeline& p = d.even ? even_ : general_;
       if (bound != &p) {
         p.bind(cb);
         bound = &p;
       }
-      auto storage = [&](uint32_t level) { return views.storage[job.base + level].get(); };
       vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
-      w.image(0, views.sampled[job.base + d.srcLevel],
-              d.srcLevel == 0 ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_GENERAL);
-      if (d.multiLevel) {
-        // Unused slots repeat the last level written, so every descriptor is valid and no extra level is touched.
-        std::vector<VkDescriptorImageInfo> outs;
-        for (uint32_t l = 1; l <= MIP_MAX_LEVELS_PER_DISPATCH; ++l)
-          outs.push_back({VK_NULL_HANDLE, storage(d.srcLevel + std::min(l, d.levels)), VK_IMAGE_LAYOUT_GENERAL});
-        w.images(1, outs);
-      } else {
-        auto scratchRegion = [&](uint32_t level, uint32_t binding) {
-          w.buffer(binding, job.scratch, level % 2 ? 0 : job.region[1], job.region[level % 2]);
-        };
-        w.image(1, storage(d.srcLevel + 1), VK_IMAGE_LAYOUT_GENERAL);
-        scratchRegion(d.srcLevel, 2);  // not read by the first dispatch, but must be valid
-        scratchRegion(d.srcLevel + 1, 3);
-      }
+      w.image(0, views.source[j], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      const size_t src = k > 0 ? k - 1 : k;  // the first dispatch reads no scratch, but the binding must be valid
+      w.buffer(1, views.scratch.handle(), job.region[src], job.regionSize[src]);
+      // Unused slots repeat the last level written, so every descriptor is valid and no extra level is touched.
+      std::vector<VkDescriptorImageInfo> outs;
+      for (uint32_t l = 1; l <= MIP_MAX_LEVELS_PER_DISPATCH; ++l)
+        outs.push_back({VK_NULL_HANDLE, views.storage[job.base + d.srcLevel + std::min(l, d.levels) - 1], VK_IMAGE_LAYOUT_GENERAL});
+      w.images(2, outs);
+      w.buffer(3, views.scratch.handle(), job.region[k], job.regionSize[k]);
       w.push(cb, p);
       const shader::MipPush push{int(levelSize(extent.width, d.srcLevel)), int(levelSize(extent.height, d.srcLevel)),
-                                 int(d.levels), job.srgb, prev && !prev->multiLevel ? 1 : 0};
+                                 int(d.levels), isSrgb(job.image->format()) ? 1 : 0, k > 0 ? 1 : 0};
       p.push(cb, push);
       vkCmdDispatch(cb, d.groups.width, d.groups.height, 1);
     }

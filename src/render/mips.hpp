@@ -1,9 +1,9 @@
 #pragma once
-// Mip-chain generation for 2D textures, three ways: the vkCmdBlitImage chain (baseline), one compute
-// dispatch per level, and (default) a multi-level compute pass that writes up to 6 levels per dispatch
-// through shared memory. The compute paths filter in linear light with the box rule of
-// src/core/mip_reference.hpp (exact fractional coverage for odd sizes), each level from the previous one
-// (MipSource::PreviousLevel), and are within 1 LSB of that float64 reference. See docs/post-and-mips.md.
+// Mip-chain generation for 2D textures, two ways: the vkCmdBlitImage chain (baseline) and (default) a
+// compute pass that writes up to 6 levels per dispatch, keeping the intermediate levels in float. It
+// filters in linear light with the box rule of src/core/mip_reference.hpp (exact fractional coverage
+// for odd sizes), each level from the previous one (MipSource::PreviousLevel), within 1 LSB of that
+// float64 reference. See docs/post-and-mips.md.
 //
 // Layout contract of MipGenerator::record (for every image of a batch):
 //   on entry  level 0 is in TRANSFER_DST_OPTIMAL (its upload recorded earlier), other levels UNDEFINED;
@@ -20,7 +20,7 @@
 
 namespace rtr::render {
 
-enum class MipMode { Blit, ComputePerLevel, Compute };
+enum class MipMode { Blit, Compute };
 const char* toString(MipMode mode);
 
 uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1
@@ -31,31 +31,30 @@ uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1
 // drops storage usage.
 vk::ImageDesc textureDesc(VkExtent2D extent, VkFormat format, const char* name = nullptr);
 
-// The dispatches of a compute mode: source level, levels written, and whether it is a multi-level one.
+// The compute dispatches of one image: source level, levels written, and the shader: `even` when every
+// level written halves exactly (mips_even.comp), else the general one for odd sizes (mips.comp).
 struct MipDispatch {
   uint32_t srcLevel = 0, levels = 1;
-  bool multiLevel = false;
+  bool even = false;
   VkExtent2D groups{1, 1};
 };
-std::vector<MipDispatch> planMipDispatches(VkExtent2D extent, MipMode mode);
+std::vector<MipDispatch> planMipDispatches(VkExtent2D extent);
 
-// Views (and, per level mode, float scratch buffers) a recorded generation uses; keep them until the
-// command buffer has completed. For a batch, the images' levels follow each other in batch order
-// (image 0's levels 0..n0-1, then image 1's, ...); for one image, index = level.
+// What a recorded generation uses; keep it until the command buffer has completed.
 struct MipViews {
-  std::vector<vk::ImageView> sampled;  // per level, UNORM-equivalent format, sampled usage
-  std::vector<vk::ImageView> storage;  // per level, UNORM-equivalent format, storage usage (none at level 0)
-  std::vector<vk::Buffer> scratch;     // ComputePerLevel: per image, float copies of odd and even levels
+  std::vector<vk::ImageView> source;   // per image: level 0, sampled
+  std::vector<vk::ImageView> storage;  // per image, levels 1..: UNORM-equivalent format, storage usage
+  vk::Buffer scratch;                  // float copies of every dispatch's last level, for the next dispatch
 };
 
 class MipGenerator {
  public:
-  explicit MipGenerator(const vk::Context& ctx);  // once per context: builds the two compute pipelines
+  explicit MipGenerator(const vk::Context& ctx);  // once per context: builds the compute pipelines
 
   // Records the generation of levels 1.. of every image from its level 0 (see the layout contract above).
   // Batched: step k of every image's dispatch plan is recorded for all images, then ONE global barrier,
   // then step k + 1, so independent images' dispatches overlap on the GPU and a batch of textures costs
-  // as many barriers as its longest plan has steps (2 for 1024² and 1000x600), not that many per image.
+  // as many barriers as its longest plan has steps (2 for 1024², 3 for 1000x600), not that many per image.
   // Images may differ in size and format. Blit mode records each image's blit chain in turn.
   [[nodiscard]] MipViews record(VkCommandBuffer cb, std::span<const vk::Image* const> images,
                                 MipMode mode = MipMode::Compute) const;
@@ -65,7 +64,7 @@ class MipGenerator {
  private:
   void recordBlit(VkCommandBuffer cb, const vk::Image& image) const;
   const vk::Context& ctx_;
-  vk::Pipeline multi_, perLevel_;
+  vk::Pipeline even_, general_;
 };
 
 }  // namespace rtr::render

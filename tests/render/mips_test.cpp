@@ -128,8 +128,11 @@ MaxDiff compare(const std::vector<std::vector<uint8_t>>& gpu, const MipChain& re
   return m;
 }
 
-const VkExtent2D kSizes[] = {{1, 1},  {1, 37},   {37, 1},   {64, 64},  {63, 63},
-                             {65, 65}, {256, 256}, {255, 129}, {200, 120}, {257, 5}};
+// 1 x 64: one axis copies while the other halves; 4 x 64, 256 x 2: an axis reaches 1 inside a dispatch;
+// 200 x 120 and 384 x 40: exact halvings first, then odd sizes; 33 x 256: odd first, then exact
+// halvings; 257 x 5: many 1D odd reductions.
+const VkExtent2D kSizes[] = {{1, 1},     {1, 37},    {37, 1},    {1, 64},    {4, 64},   {256, 2},  {64, 64}, {63, 63},
+                             {65, 65},   {256, 256}, {255, 129}, {200, 120}, {384, 40}, {33, 256}, {257, 5}};
 const VkFormat kFormats[] = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_R8_UNORM};
 
 std::string label(VkExtent2D e, VkFormat f, MipMode m) {
@@ -152,8 +155,7 @@ void expectWithinOneLsb(MipsTest& t, MipMode mode) {
       }
 }
 
-TEST_F(MipsTest, MultiLevelComputeWithinOneLsbOfReference) { expectWithinOneLsb(*this, MipMode::Compute); }
-TEST_F(MipsTest, PerLevelComputeWithinOneLsbOfReference) { expectWithinOneLsb(*this, MipMode::ComputePerLevel); }
+TEST_F(MipsTest, ComputeWithinOneLsbOfReference) { expectWithinOneLsb(*this, MipMode::Compute); }
 
 // One record call for images of different sizes, formats and plan lengths (one barrier per step for
 // all of them): each image's chain is as good as alone.
@@ -162,7 +164,8 @@ TEST_F(MipsTest, BatchedImagesWithinOneLsbOfReference) {
       {{256, 256}, VK_FORMAT_R8G8B8A8_SRGB}, {{1, 1}, VK_FORMAT_R8G8B8A8_UNORM}, {{255, 129}, VK_FORMAT_R8G8B8A8_SRGB},
       {{257, 5}, VK_FORMAT_R8_UNORM},        {{64, 64}, VK_FORMAT_R8G8B8A8_UNORM}, {{1000, 600}, VK_FORMAT_R8G8B8A8_SRGB},
       {{37, 1}, VK_FORMAT_R8G8B8A8_SRGB}};
-  for (MipMode mode : {MipMode::Compute, MipMode::ComputePerLevel}) {
+  {
+    const MipMode mode = MipMode::Compute;
     std::vector<TexelData> srcs;
     std::vector<VkFormat> formats;
     uint32_t seed = 500;
@@ -194,26 +197,46 @@ TEST_F(MipsTest, BlitChainDifferenceIsReported) {
       std::printf("max |blit - reference| %s: %d LSB%s%s\n", name.c_str(), d.value, d.value ? " at " : "", d.where.c_str());
       const bool pot = (e.width & (e.width - 1)) == 0 && (e.height & (e.height - 1)) == 0;
       // A wrong level or a broken readback is off by ~100; drivers round their blits differently.
-      if (pot) EXPECT_LE(d.value, 8) << name << ", worst at " << d.where;
+      if (pot) {
+        EXPECT_LE(d.value, 8) << name << ", worst at " << d.where;
+      }
     }
 }
 
-TEST(MipPlan, MultiLevelDispatchesWriteSixLevelsForPowerOfTwo) {
-  const auto plan = render::planMipDispatches({1024, 1024}, MipMode::Compute);
-  ASSERT_EQ(plan.size(), 2u);
-  EXPECT_EQ(plan[0].levels, 6u);
-  EXPECT_EQ(plan[0].groups.width, 16u);
-  EXPECT_EQ(plan[1].srcLevel, 6u);
-  EXPECT_EQ(plan[1].levels, 4u);
-  const auto npot = render::planMipDispatches({1000, 600}, MipMode::Compute);
+// Dispatches follow each other level by level and write the whole chain.
+void expectContiguousPlan(VkExtent2D e, const std::vector<render::MipDispatch>& plan) {
   uint32_t written = 0;
-  for (const auto& d : npot) {
-    EXPECT_EQ(d.srcLevel, written);
+  for (const auto& d : plan) {
+    EXPECT_EQ(d.srcLevel, written) << e.width << "x" << e.height;
+    EXPECT_GE(d.levels, 1u);
+    EXPECT_LE(d.levels, 6u);
     written += d.levels;
   }
-  EXPECT_EQ(written, render::mipLevelCount({1000, 600}) - 1);
+  EXPECT_EQ(written + 1, render::mipLevelCount(e)) << e.width << "x" << e.height;
+}
+
+TEST(MipPlan, ExactHalvingsTakeTheEvenShaderSixLevelsAtATime) {
+  const auto plan = render::planMipDispatches({1024, 1024});
+  ASSERT_EQ(plan.size(), 2u);
+  EXPECT_TRUE(plan[0].even && plan[1].even);
+  EXPECT_EQ(plan[0].levels, 6u);
+  EXPECT_EQ(plan[0].groups.width, 16u);  // 64 x 64 source texels per workgroup
+  EXPECT_EQ(plan[1].srcLevel, 6u);
+  EXPECT_EQ(plan[1].levels, 4u);
+  EXPECT_EQ(plan[1].groups.width, 1u);
+  // 1000 x 600 halves exactly three times (125 x 75), then the general shader takes the odd sizes.
+  const auto npot = render::planMipDispatches({1000, 600});
+  ASSERT_GE(npot.size(), 2u);
+  EXPECT_TRUE(npot[0].even);
+  EXPECT_EQ(npot[0].levels, 3u);
+  EXPECT_EQ(npot[0].groups.width, 16u);
+  EXPECT_EQ(npot[0].groups.height, 10u);
+  EXPECT_FALSE(npot[1].even);
   EXPECT_LE(npot.size(), 3u);
-  EXPECT_EQ(render::planMipDispatches({1000, 600}, MipMode::ComputePerLevel).size(), written);
+  for (VkExtent2D e : kSizes) expectContiguousPlan(e, render::planMipDispatches(e));
+  expectContiguousPlan({1000, 600}, npot);
+  expectContiguousPlan({1, 4096}, render::planMipDispatches({1, 4096}));
+  EXPECT_TRUE(render::planMipDispatches({1, 64})[0].even);  // an axis of size 1 copies: still exact
 }
 
 TEST(MipPlan, TextureDescHasTheFullChain) {

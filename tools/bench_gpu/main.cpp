@@ -1,5 +1,6 @@
-// rtr-bench-gpu: times mip generation (64 textures, three modes) and the mosaic post-process (compute,
-// graphics, off) with GPU timestamps; min / median over --runs submissions after --warmup ones.
+// rtr-bench-gpu: times mip generation (64 textures, blit and compute) and the mosaic post-process
+// (compute, graphics, off) with GPU timestamps; min / median over --runs submissions after --warmup ones.
+// Mips also report the largest difference, in LSB, of any texel of any texture from the float64 reference.
 // Prints a Markdown table and "csv," lines. Headless: no window, no validation unless RTR_VALIDATION=1.
 #include <algorithm>
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 #include <glm/gtc/packing.hpp>
 
+#include "core/mip_reference.hpp"
 #include "render/mips.hpp"
 #include "render/post.hpp"
 #include "vk/commands.hpp"
@@ -24,6 +26,7 @@ struct Row {
   std::string pass, size, mode;
   double minMs = 0, medianMs = 0;
   int runs = 0;
+  int maxLsb = -1;  // mips: largest |GPU - reference| over every texel of levels >= 1; -1: not checked
   std::string error = "–";  // the error side: against a reference, or against the other path
 };
 
@@ -88,7 +91,63 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
   };
   std::vector<Row> rows;
   const std::string size = std::to_string(count) + " x " + std::to_string(extent.width) + "x" + std::to_string(extent.height) + " sRGB";
-  for (render::MipMode mode : {render::MipMode::Blit, render::MipMode::ComputePerLevel, render::MipMode::Compute}) {
+  // Every texture's levels 1.. back to the host after a mode's last run, against the float64 reference.
+  const TexelData level0{extent.width, extent.height, 4,
+                         {static_cast<const uint8_t*>(upload.mapped()), static_cast<const uint8_t*>(upload.mapped()) + bytes}};
+  const MipChain ref = buildMipReference(level0, TexelEncoding::Srgb, MipSource::PreviousLevel);
+  std::vector<std::vector<uint8_t>> want;
+  std::vector<VkDeviceSize> offsets;
+  VkDeviceSize perTexture = 0;
+  for (uint32_t l = 1; l < ref.levels.size(); ++l) {
+    want.push_back(quantizeMipLevel(ref, l));
+    offsets.push_back(perTexture);
+    perTexture += (want.back().size() + 15) & ~VkDeviceSize(15);
+  }
+  vk::Buffer readback(ctx, perTexture * count, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+  auto maxError = [&] {
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+      std::vector<vk::ImageBarrier> toCopy, back;
+      for (auto& t : textures) {
+        toCopy.push_back({t.handle(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
+                          VK_ACCESS_2_TRANSFER_READ_BIT});
+        back.push_back({t.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
+                        VK_ACCESS_2_NONE});
+      }
+      vk::barrier(cb, toCopy);
+      for (size_t i = 0; i < textures.size(); ++i) {
+        std::vector<VkBufferImageCopy> copies;
+        for (uint32_t l = 1; l < ref.levels.size(); ++l) {
+          VkBufferImageCopy c{};
+          c.bufferOffset = i * perTexture + offsets[l - 1];
+          c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, 1};
+          c.imageExtent = {ref.levels[l].width, ref.levels[l].height, 1};
+          copies.push_back(c);
+        }
+        vkCmdCopyImageToBuffer(cb, textures[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(),
+                               uint32_t(copies.size()), copies.data());
+      }
+      vk::barrier(cb, back);
+      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                        VK_ACCESS_2_HOST_READ_BIT);
+    });
+    readback.invalidate();
+    int worst = 0;
+    double sum = 0, count = 0;
+    for (size_t i = 0; i < textures.size(); ++i)
+      for (size_t l = 0; l < want.size(); ++l) {
+        const uint8_t* got = static_cast<const uint8_t*>(readback.mapped()) + i * perTexture + offsets[l];
+        for (size_t b = 0; b < want[l].size(); ++b) {
+          const int e = std::abs(int(got[b]) - int(want[l][b]));
+          worst = std::max(worst, e);
+          sum += e;
+        }
+        count += double(want[l].size());
+      }
+    return std::pair{worst, sum / count};
+  };
+  for (render::MipMode mode : {render::MipMode::Blit, render::MipMode::Compute}) {
     Row r = measure(ctx, warmup, runs, prepare, [&](VkCommandBuffer cb, std::vector<render::MipViews>& keep) {
       if (batched) keep.push_back(gen.record(cb, batch, mode));
       else for (auto& t : textures) keep.push_back(gen.record(cb, t, mode));
@@ -96,8 +155,13 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
     r.pass = "mips";
     r.size = size;
     r.mode = std::string(render::toString(mode)) + (batched ? "" : " (per texture)");
+    const auto [worst, mean] = maxError();
+    r.maxLsb = worst;
+    char err[96];
+    std::snprintf(err, sizeof err, "max %d, mean %.4f LSB vs the float64 reference (every texel)", worst, mean);
+    r.error = err;
     rows.push_back(r);
-    std::fprintf(stderr, "  %s %s: median %.3f ms\n", size.c_str(), r.mode.c_str(), r.medianMs);
+    std::fprintf(stderr, "  %s %s: median %.3f ms, max error %d LSB\n", size.c_str(), r.mode.c_str(), r.medianMs, r.maxLsb);
   }
   return rows;
 }
@@ -203,7 +267,8 @@ int main(int argc, char** argv) {
                   r.medianMs, r.runs, r.error.c_str());
     std::printf("\n");
     for (const Row& r : rows)
-      std::printf("csv,%s,%s,%s,%.4f,%.4f,%d\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs, r.medianMs, r.runs);
+      std::printf("csv,%s,%s,%s,%.4f,%.4f,%d,%d\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs, r.medianMs,
+                  r.runs, r.maxLsb);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rtr-bench-gpu: %s\n", e.what());
     return 1;

@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
                "8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic off/compute/graphics, [ ] LOD bias,\n"
                "C print camera pose, F1 or H timing overlay, R ray-trace the view on the CPU (again: hide),\n"
                "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, Esc quit."};
-  std::string camera, size = "1280x720", mips = "compute-per-level", mosaic = "compute", light;
+  std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light;
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
   app.add_option("--size", size, "image size WxH")->capture_default_str();
@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
   app.add_option("--mode", o.settings.mode, "view mode 1-12 (1 shaded)")->check(CLI::Range(1, VIEW_COUNT))->capture_default_str();
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(CLI::PositiveNumber);
   app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay) to this PNG");
-  app.add_option("--mips", mips, "mip generation: compute-per-level (fastest measured) | compute (multi-level per dispatch) | blit")->capture_default_str();
+  app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit")->capture_default_str();
   app.add_option("--mosaic", mosaic, "post process: off | compute | graphics")->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias");
   app.add_option("--light", light, "light position x,y,z");
@@ -118,11 +118,10 @@ int main(int argc, char** argv) {
       o.settings.lightPos = p.position;
     }
     const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
-                                                          {"compute-per-level", render::MipMode::ComputePerLevel},
                                                           {"blit", render::MipMode::Blit}};
     const std::map<std::string, render::MosaicMode> mosaicModes{
         {"off", render::MosaicMode::Off}, {"compute", render::MosaicMode::Compute}, {"graphics", render::MosaicMode::Graphics}};
-    if (!mipModes.count(mips)) throw Error("--mips '" + mips + "': expected compute, compute-per-level or blit");
+    if (!mipModes.count(mips)) throw Error("--mips '" + mips + "': expected compute or blit");
     if (!mosaicModes.count(mosaic)) throw Error("--mosaic '" + mosaic + "': expected off, compute or graphics");
     o.mips = mipModes.at(mips);
     o.settings.mosaic = mosaicModes.at(mosaic);

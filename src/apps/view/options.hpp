@@ -16,7 +16,7 @@ struct ViewOptions {
   std::optional<CameraPose> camera;
   Lens lens;
   render::RenderSettings settings;
-  render::MipMode mips = render::MipMode::ComputePerLevel;  // fastest measured (H200 and lavapipe)
+  render::MipMode mips = render::MipMode::Compute;
   int frames = 1;                  // frames to render before the screenshot
   std::string screenshot;          // PNG path; empty: none
   int bench = 0;                   // frames to time after warm-up; 0: no benchmark
