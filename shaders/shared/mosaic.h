@@ -10,7 +10,7 @@ using glm::ivec2;
 using glm::min;
 #endif
 
-#define MOSAIC_GROUP 16  // mosaic.comp: 16x16 threads, one output pixel each
+#define MOSAIC_GROUP 64  // mosaic.comp: 64 threads, one block each, in one block row
 
 struct MosaicPush {
   ivec2 block;  // block size in pixels; 5x3 by default, 1x1 is a plain copy (MosaicMode::Off)

@@ -81,7 +81,8 @@ void MosaicPass::record(VkCommandBuffer cb, VkImageView input, VkImage output, V
         .image(1, outputView, VK_IMAGE_LAYOUT_GENERAL)
         .push(cb, c);
     c.push(cb, push);
-    vkCmdDispatch(cb, (extent.width + MOSAIC_GROUP - 1) / MOSAIC_GROUP, (extent.height + MOSAIC_GROUP - 1) / MOSAIC_GROUP, 1);
+    const uint32_t blocksX = (extent.width + block.width - 1) / block.width;
+    vkCmdDispatch(cb, (blocksX + MOSAIC_GROUP - 1) / MOSAIC_GROUP, (extent.height + block.height - 1) / block.height, 1);
   }
   // Presentation is ordered by the submit's signal semaphore: only the layout change is needed then.
   const bool present = outputFinalLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
