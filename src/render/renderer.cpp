@@ -204,7 +204,8 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, uint32_t frame) {
   w.push(cb, c);
   c.push(cb, shader::VisShadePush{primitiveBits_});
   if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade_.textures.get(1));
-  vkCmdDispatch(cb, (extent_.width + VIS_GROUP_X - 1) / VIS_GROUP_X, (extent_.height + VIS_GROUP_Y - 1) / VIS_GROUP_Y, 1);
+  const auto& group = c.layout.interface().stages.at(0).localSize;  // one thread per pixel
+  vkCmdDispatch(cb, (extent_.width + group[0] - 1) / group[0], (extent_.height + group[1] - 1) / group[1], 1);
 }
 
 void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose, const Lens& lens,
