@@ -36,6 +36,11 @@ struct FrameUniforms {
   vec4 lightColor;    // rgb colour x intensity; w: 1 = inverse-square falloff, 0 = none
   vec4 ambient;       // rgb constant ambient illumination
   vec4 params;        // x: view mode, y: mip LOD bias, z: near, w: far
+  // Visibility path: a (not normalised) world-space direction of the ray through pixel coordinate
+  // (x, y) is rayDir + x rayDx + y rayDy (pixel centres at .5); rays start at cameraPos.
+  vec4 rayDir;
+  vec4 rayDx;
+  vec4 rayDy;
 };
 
 // Material factors (storage buffer, std430). Texture indices index the scene's texture array;
@@ -51,7 +56,27 @@ struct GpuMaterial {
 // Per-draw push constants.
 struct DrawPush {
   uint material;
+  uint idBase;        // visibility pass: draw index << VisShadePush.primitiveBits
 };
+
+// One draw of the scene, for the visibility path's shading pass (storage buffer, std430, 16 bytes).
+struct GpuDraw {
+  uint material;
+  uint firstIndex;    // in the index buffer of its type
+  uint vertexOffset;
+  uint flags;         // DRAW_*
+};
+#define DRAW_INDEX16 1u   // 16-bit indices (two per 32-bit word)
+#define DRAW_TEXTURED 2u  // has texcoords: sample the material's textures
+
+// Visibility target (R32_UINT): draw index << primitiveBits | gl_PrimitiveID; VIS_EMPTY where nothing
+// was drawn. The renderer gives the draw index just enough bits that no id equals VIS_EMPTY.
+#define VIS_EMPTY 0xFFFFFFFFu
+struct VisShadePush {
+  uint primitiveBits;
+};
+#define VIS_GROUP_X 8     // shading pass workgroup
+#define VIS_GROUP_Y 8
 
 #define NO_TEXTURE 0xFFFFFFFFu
 

@@ -10,7 +10,9 @@ using glm::ivec2;
 using glm::min;
 #endif
 
-#define MOSAIC_GROUP 16  // mosaic.comp: 16x16 threads, one output pixel each
+// mosaic.comp workgroup: one thread per block, MOSAIC_GROUP_X blocks wide, MOSAIC_GROUP_Y block rows
+#define MOSAIC_GROUP_X 64
+#define MOSAIC_GROUP_Y 4
 
 struct MosaicPush {
   ivec2 block;  // block size in pixels; 5x3 by default, 1x1 is a plain copy (MosaicMode::Off)

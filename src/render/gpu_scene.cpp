@@ -80,6 +80,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
   std::vector<glm::vec2> texcoords;
   std::vector<uint16_t> idx16;
   std::vector<uint32_t> idx32;
+  std::vector<shader::GpuDraw> drawInfo;
   for (const Mesh& m : scene.meshes) {
     if (m.indices.empty()) continue;
     const Material& mat = scene.materials.at(m.material);
@@ -109,6 +110,9 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     DrawKind kind = !textured                                      ? DrawKind::Untextured
                     : masked || (mat.flags & kMaterialDoubleSided) ? DrawKind::AlphaMasked
                                                                    : DrawKind::Opaque;
+    d.id = uint32_t(drawInfo.size());
+    drawInfo.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
+                        (d.indexType == VK_INDEX_TYPE_UINT16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});
     draws_[size_t(kind)].push_back(d);
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
@@ -137,13 +141,17 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     dst = vk::Buffer(ctx, size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, name);
     return append(staging, data, size);
   };
-  const size_t oPos = makeBuffer(positions_, positions.data(), positions.size() * 12, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "positions");
-  const size_t oNrm = makeBuffer(normals_, normals.data(), normals.size() * 12, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "normals");
-  const size_t oUv = makeBuffer(texcoords_, texcoords.data(), texcoords.size() * 8, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "texcoords");
-  const size_t oI16 = makeBuffer(indices16_, idx16.data(), idx16.size() * 2, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "indices16");
-  const size_t oI32 = makeBuffer(indices32_, idx32.data(), idx32.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "indices32");
+  constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  const size_t oPos = makeBuffer(positions_, positions.data(), positions.size() * 12, kVertex, "positions");
+  const size_t oNrm = makeBuffer(normals_, normals.data(), normals.size() * 12, kVertex, "normals");
+  const size_t oUv = makeBuffer(texcoords_, texcoords.data(), texcoords.size() * 8, kVertex, "texcoords");
+  const size_t oI16 = makeBuffer(indices16_, idx16.data(), idx16.size() * 2, kIndex, "indices16");
+  const size_t oI32 = makeBuffer(indices32_, idx32.data(), idx32.size() * 4, kIndex, "indices32");
   const size_t oMat = makeBuffer(materials_, materials.data(), materials.size() * sizeof(shader::GpuMaterial),
                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "materials");
+  const size_t oDraw = makeBuffer(drawInfo_, drawInfo.data(), drawInfo.size() * sizeof(shader::GpuDraw),
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "draws");
   std::vector<size_t> texOffsets;
   for (size_t i = 0; i < used.size(); ++i) {
     const Texture& t = scene.textures[used[i]];
@@ -173,9 +181,10 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     copy(indices16_, oI16);
     copy(indices32_, oI32);
     copy(materials_, oMat);
+    copy(drawInfo_, oDraw);
     vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT |
-                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_2_INDEX_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     std::vector<vk::ImageBarrier> toDst;
     for (auto& img : textures_)

@@ -1,6 +1,6 @@
 #pragma once
-// A scene on the GPU: vertex streams, index buffers (16-bit where a mesh allows), the material buffer
-// and the textures that some drawn material uses (decoded on several threads, uploaded through one
+// A scene on the GPU: vertex streams, index buffers (16-bit where a mesh allows; both also readable as
+// storage buffers by the visibility path's shading pass), the material and draw buffers and the textures that some drawn material uses (decoded on several threads, uploaded through one
 // staging buffer, mips generated on the GPU). Nothing the scene does not use is created.
 #include <array>
 #include <vector>
@@ -25,6 +25,7 @@ struct DrawItem {
   uint32_t firstIndex = 0;   // in the index buffer of its type
   int32_t vertexOffset = 0;
   VkIndexType indexType = VK_INDEX_TYPE_UINT32;
+  uint32_t id = 0;           // index of its GpuDraw in drawInfo() (visibility path)
 };
 
 struct GpuSceneStats {
@@ -44,6 +45,7 @@ class GpuScene {
   VkBuffer indices16() const { return indices16_.handle(); }
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }
+  VkBuffer drawInfo() const { return drawInfo_.handle(); }  // GpuDraw per draw, for shading in compute
   uint32_t textureCount() const { return uint32_t(textures_.size()); }
   std::vector<VkDescriptorImageInfo> textureDescriptors() const;
   const Bounds& bounds() const { return bounds_; }
@@ -51,7 +53,7 @@ class GpuScene {
 
  private:
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
-  vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_;
+  vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_;
   std::vector<vk::Image> textures_;
   vk::Sampler sampler_;
   Bounds bounds_;

@@ -81,7 +81,11 @@ void MosaicPass::record(VkCommandBuffer cb, VkImageView input, VkImage output, V
         .image(1, outputView, VK_IMAGE_LAYOUT_GENERAL)
         .push(cb, c);
     c.push(cb, push);
-    vkCmdDispatch(cb, (extent.width + MOSAIC_GROUP - 1) / MOSAIC_GROUP, (extent.height + MOSAIC_GROUP - 1) / MOSAIC_GROUP, 1);
+    // One thread per block; the workgroup's shape is the shader's (reflected) local size.
+    const auto& group = c.layout.interface().stages.at(0).localSize;
+    const uint32_t blocksX = (extent.width + block.width - 1) / block.width;
+    const uint32_t blocksY = (extent.height + block.height - 1) / block.height;
+    vkCmdDispatch(cb, (blocksX + group[0] - 1) / group[0], (blocksY + group[1] - 1) / group[1], 1);
   }
   // Presentation is ordered by the submit's signal semaphore: only the layout change is needed then.
   const bool present = outputFinalLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;

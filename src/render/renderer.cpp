@@ -1,5 +1,6 @@
 #include "render/renderer.hpp"
 
+#include <bit>
 #include <cstdio>
 #include <cstring>
 
@@ -17,10 +18,25 @@ constexpr StageFiles kStages[kDrawKindCount] = {
     {"scene.vert", "pbr_alpha.frag", "debug_alpha.frag"},
 };
 
-// Who last used the intermediate images: the post pass reads colour in compute or fragment shaders.
+// Foliage (the alpha-masked, two-sided kind) is not culled.
+VkCullModeFlags cullMode(DrawKind kind) { return kind == DrawKind::AlphaMasked ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT; }
+
+// The visibility pass draws untextured meshes with the opaque pipeline: both need positions only.
+DrawKind visPipelineKind(DrawKind kind) { return kind == DrawKind::Untextured ? DrawKind::Opaque : kind; }
+
+bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding) {
+  for (const vk::ReflectedBinding& b : layout.interface().bindings)
+    if (b.set == set && b.binding == binding) return true;
+  return false;
+}
+
+// Who last used the intermediate images: the post pass reads colour in compute or fragment shaders, the
+// shading pass reads the visibility image in compute.
 constexpr VkPipelineStageFlags2 kPostReadStages = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
 
 }  // namespace
+
+const char* toString(ShadingPath path) { return path == ShadingPath::Forward ? "forward" : "visibility"; }
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
@@ -29,82 +45,176 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
                            "frame uniforms");
     timers_.emplace_back(ctx, 4);
   }
-  rebuildPipelines();
+  VkPhysicalDeviceFeatures features{};
+  vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
+  // Draw index in the high bits (just enough that no id is VIS_EMPTY), primitive index in the rest.
+  uint32_t draws = 0, maxTriangles = 0;
+  for (size_t k = 0; k < kDrawKindCount; ++k)
+    for (const DrawItem& d : scene.draws(DrawKind(k))) ++draws, maxTriangles = std::max(maxTriangles, d.indexCount / 3);
+  primitiveBits_ = 32 - uint32_t(std::bit_width(draws));
+  canUseVisibility_ = features.geometryShader && draws > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
 }
 
-Renderer::ScenePipelines Renderer::makePipeline(DrawKind kind, bool debug) const {
-  const StageFiles& f = kStages[size_t(kind)];
+ShadingPath Renderer::pathFor(const RenderSettings& s) const {
+  return s.shading == ShadingPath::Visibility && s.mode == VIEW_SHADED && canUseVisibility_ ? ShadingPath::Visibility
+                                                                                           : ShadingPath::Forward;
+}
+
+Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* frag, VkFormat colorFormat,
+                                                VkCullModeFlags cull) const {
   vk::GraphicsDesc d;
-  d.modules = {vk::loadShader(f.vert), vk::loadShader(debug ? f.debug : f.shaded)};
-  d.cullMode = kind == DrawKind::AlphaMasked ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;  // foliage is two-sided
-  d.colorFormats = {kColorFormat};
+  d.modules = {vk::loadShader(vert), vk::loadShader(frag)};
+  d.cullMode = cull;
+  d.colorFormats = {colorFormat};
   d.depthFormat = kDepthFormat;
   vk::LayoutOptions options;
-  if (kind != DrawKind::Untextured) options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
+  options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
   ScenePipelines p;
   p.pipeline.emplace(vk::makeGraphicsPipeline(ctx_, d, options));
   const vk::PipelineLayout& layout = p.pipeline->layout;
   p.sets = vk::DescriptorSets(ctx_, layout, framesInFlight_);
   auto textures = scene_.textureDescriptors();
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
+    if (layout.setCount() == 0) break;
     vk::DescriptorWriter w(ctx_, layout, 0, p.sets.get(0, frame));
-    w.buffer(0, uniforms_[frame].handle()).buffer(1, scene_.materials()).commit();
+    w.buffer(0, uniforms_[frame].handle());
+    if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
+    w.commit();
     if (layout.setCount() > 1 && !textures.empty())
       vk::DescriptorWriter(ctx_, layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
   }
   return p;
 }
 
-void Renderer::rebuildPipelines() {
-  // Build all first, swap after: a failure leaves the running pipelines untouched.
-  std::array<ScenePipelines, kDrawKindCount> shaded, debug;
+Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
+  KindPipelines out;
   for (size_t k = 0; k < kDrawKindCount; ++k) {
-    if (!scene_.hasDraws(DrawKind(k))) continue;  // only pipelines the scene needs
-    shaded[k] = makePipeline(DrawKind(k), false);
-    debug[k] = makePipeline(DrawKind(k), true);
+    const DrawKind kind = DrawKind(k);
+    if (set == kVisibility) {
+      if (kind == DrawKind::Untextured) continue;
+      const bool needed = kind == DrawKind::Opaque ? scene_.hasDraws(DrawKind::Opaque) || scene_.hasDraws(DrawKind::Untextured)
+                                                   : scene_.hasDraws(kind);
+      if (!needed) continue;  // only pipelines the scene needs
+      const bool alpha = kind == DrawKind::AlphaMasked;
+      out[k] = makePipeline(alpha ? "vis_alpha.vert" : "vis.vert", alpha ? "vis_alpha.frag" : "vis.frag", kVisFormat,
+                            cullMode(kind));
+    } else if (scene_.hasDraws(kind)) {
+      const StageFiles& f = kStages[k];
+      out[k] = makePipeline(f.vert, set == kDebug ? f.debug : f.shaded, kColorFormat, cullMode(kind));
+    }
   }
-  vkDeviceWaitIdle(ctx_.device());
-  shaded_ = std::move(shaded);
-  debug_ = std::move(debug);
+  return out;
 }
 
-void Renderer::createTargets(VkExtent2D extent) {
-  vkDeviceWaitIdle(ctx_.device());
-  color_ = vk::Image(ctx_, {extent, kColorFormat, 1,
-                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                            0, 0, "scene colour"});
-  depth_ = vk::Image(ctx_, {extent, kDepthFormat, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0, 0, "scene depth"});
-  extent_ = extent;
+Renderer::VisShade Renderer::makeShade() const {
+  const bool textured = scene_.texcoords() != VK_NULL_HANDLE;
+  vk::LayoutOptions options{.pushDescriptorSets = {0}};
+  options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
+  VisShade v;
+  v.pipeline.emplace(
+      vk::makeComputePipeline(ctx_, vk::loadShader(textured ? "vis_shade.comp" : "vis_shade_untextured.comp"), options));
+  if (v.pipeline->layout.setCount() > 1) {
+    v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
+    auto textures = scene_.textureDescriptors();
+    if (!textures.empty()) vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
+  }
+  return v;
 }
 
-void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, bool debug) {
-  auto& pipelines = debug ? debug_ : shaded_;
+void Renderer::ensurePipelines(PipelineSet set) {
+  if (pipelines_[set]) return;
+  pipelines_[set] = makePipelines(set);
+  if (set == kVisibility) shade_ = makeShade();
+}
+
+void Renderer::rebuildPipelines() {
+  // Build all that exist first, swap after: a failure leaves the running pipelines untouched.
+  std::array<std::optional<KindPipelines>, kPipelineSetCount> fresh;
+  VisShade shade;
+  for (int set = 0; set < kPipelineSetCount; ++set)
+    if (pipelines_[set]) fresh[set] = makePipelines(PipelineSet(set));
+  if (pipelines_[kVisibility]) shade = makeShade();
+  vkDeviceWaitIdle(ctx_.device());
+  pipelines_ = std::move(fresh);
+  shade_ = std::move(shade);
+}
+
+void Renderer::createTargets(VkExtent2D extent, bool visibility) {
+  vkDeviceWaitIdle(ctx_.device());
+  if (extent.width != extent_.width || extent.height != extent_.height) {
+    color_ = vk::Image(ctx_, {extent, kColorFormat, 1,
+                              VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                  VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                              0, 0, "scene colour"});
+    depth_ = vk::Image(ctx_, {extent, kDepthFormat, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0, 0, "scene depth"});
+    vis_ = {};
+    extent_ = extent;
+  }
+  if (visibility && !vis_.handle())
+    vis_ = vk::Image(ctx_, {extent, kVisFormat, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, 0, 0,
+                            "visibility"});
+}
+
+void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
+  KindPipelines& pipelines = *pipelines_[set];
+  const bool vis = set == kVisibility;
   // Opaque geometry first, alpha-masked last (brief 1.6).
   for (DrawKind kind : {DrawKind::Opaque, DrawKind::Untextured, DrawKind::AlphaMasked}) {
-    ScenePipelines& p = pipelines[size_t(kind)];
-    if (!p.pipeline) continue;
+    ScenePipelines& p = pipelines[size_t(vis ? visPipelineKind(kind) : kind)];
+    if (!p.pipeline || !scene_.hasDraws(kind)) continue;
     const vk::Pipeline& pl = *p.pipeline;
     pl.bind(cb);
-    for (uint32_t set = 0; set < pl.layout.setCount(); ++set) pl.bindSet(cb, set, p.sets.get(set, frame));
-    VkBuffer streams[3] = {scene_.positions(), scene_.normals(), scene_.texcoords()};
-    VkDeviceSize offsets[3] = {0, 0, 0};
-    vkCmdBindVertexBuffers(cb, 0, kind == DrawKind::Untextured ? 2 : 3, streams, offsets);
+    for (uint32_t s = 0; s < pl.layout.setCount(); ++s) pl.bindSet(cb, s, p.sets.get(s, frame));
+    // Streams in the order of the vertex shader's input locations.
+    const VkBuffer forward[3] = {scene_.positions(), scene_.normals(), scene_.texcoords()};
+    const VkBuffer visStreams[2] = {scene_.positions(), scene_.texcoords()};
+    const VkDeviceSize offsets[3] = {0, 0, 0};
+    if (vis) vkCmdBindVertexBuffers(cb, 0, kind == DrawKind::AlphaMasked ? 2 : 1, visStreams, offsets);
+    else vkCmdBindVertexBuffers(cb, 0, kind == DrawKind::Untextured ? 2 : 3, forward, offsets);
     VkIndexType bound = VK_INDEX_TYPE_MAX_ENUM;
     for (const DrawItem& d : scene_.draws(kind)) {
       if (d.indexType != bound) {
         vkCmdBindIndexBuffer(cb, d.indexType == VK_INDEX_TYPE_UINT16 ? scene_.indices16() : scene_.indices32(), 0, d.indexType);
         bound = d.indexType;
       }
-      shader::DrawPush push{d.material};
+      shader::DrawPush push{d.material, vis ? d.id << primitiveBits_ : 0u};
       pl.push(cb, push);
       vkCmdDrawIndexed(cb, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
     }
   }
 }
 
+void Renderer::shadeVisibility(VkCommandBuffer cb, uint32_t frame) {
+  const vk::Pipeline& c = *shade_.pipeline;
+  c.bind(cb);
+  // A scene may lack one index width: any storage buffer fills that binding (no draw reads it).
+  const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
+  const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
+  vk::DescriptorWriter w(ctx_, c.layout, 0, VK_NULL_HANDLE);
+  w.buffer(0, uniforms_[frame].handle())
+      .buffer(1, scene_.materials())
+      .buffer(2, scene_.drawInfo())
+      .buffer(3, scene_.positions())
+      .buffer(4, scene_.normals())
+      .buffer(5, i32)
+      .buffer(6, i16)
+      .image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
+      .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
+  if (hasBinding(c.layout, 0, 9)) w.buffer(9, scene_.texcoords());
+  w.push(cb, c);
+  c.push(cb, shader::VisShadePush{primitiveBits_});
+  if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade_.textures.get(1));
+  const auto& group = c.layout.interface().stages.at(0).localSize;  // one thread per pixel
+  vkCmdDispatch(cb, (extent_.width + group[0] - 1) / group[0], (extent_.height + group[1] - 1) / group[1], 1);
+}
+
 void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose, const Lens& lens,
                       const RenderSettings& s, const RenderTarget& target) {
-  if (target.extent.width != extent_.width || target.extent.height != extent_.height) createTargets(target.extent);
+  const bool visibility = pathFor(s) == ShadingPath::Visibility;
+  const PipelineSet set = visibility ? kVisibility : s.mode == VIEW_SHADED ? kShaded : kDebug;
+  if (target.extent.width != extent_.width || target.extent.height != extent_.height || (visibility && !vis_.handle()))
+    createTargets(target.extent, visibility);
+  ensurePipelines(set);
   const float aspect = float(target.extent.width) / float(target.extent.height);
 
   shader::FrameUniforms u{};
@@ -115,15 +225,29 @@ void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose
   u.lightColor = glm::vec4(s.lightColor, s.inverseSquareFalloff ? 1.0f : 0.0f);
   u.ambient = glm::vec4(s.ambient, 0.0f);
   u.params = glm::vec4(float(s.mode), s.lodBias, lens.zNear, lens.zFar);
+  {
+    // Pixel rays from the inverse projection: h = M^-1 (ndc, 0.5, 1) is linear in the pixel, and
+    // h.xyz - h.w cameraPos = h.w (point - cameraPos) points along the pixel's ray (scaled).
+    const glm::dmat4 inv = glm::inverse(glm::dmat4(u.viewProj));
+    const glm::dvec3 cam(pose.position);
+    auto ray = [&](double x, double y) {
+      const glm::dvec4 h = inv * glm::dvec4(2.0 * x / target.extent.width - 1.0, 2.0 * y / target.extent.height - 1.0, 0.5, 1.0);
+      return glm::dvec3(h) - h.w * cam;
+    };
+    u.rayDir = glm::vec4(glm::vec3(ray(0, 0)), 0.0f);
+    u.rayDx = glm::vec4(glm::vec3(ray(1, 0) - ray(0, 0)), 0.0f);
+    u.rayDy = glm::vec4(glm::vec3(ray(0, 1) - ray(0, 0)), 0.0f);
+  }
   std::memcpy(uniforms_[frame].mapped(), &u, sizeof u);
   uniforms_[frame].flush();
 
   vk::GpuTimer& timer = timers_[frame];
   timer.reset(cb);
   timer.begin(cb);
-  // The previous frame's post pass may still read the colour image: wait for it (write-after-read),
-  // and for the previous depth writes; old contents are discarded.
-  vk::barrier(cb, {{color_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+  // The previous frame's post pass (or shading pass) may still read the image this pass writes: wait
+  // for it (write-after-read), and for the previous depth writes; old contents are discarded.
+  const vk::Image& target0 = visibility ? vis_ : color_;
+  vk::barrier(cb, {{target0.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                     kPostReadStages, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_NONE,
                     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
                    {depth_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -132,11 +256,12 @@ void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose
                     0, 1, VK_IMAGE_ASPECT_DEPTH_BIT}});
 
   VkRenderingAttachmentInfo colorAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-  colorAtt.imageView = color_.view();
+  colorAtt.imageView = target0.view();
   colorAtt.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   colorAtt.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
   colorAtt.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-  colorAtt.clearValue.color = {{0.0f, 0.0f, 0.0f, 1.0f}};
+  if (visibility) colorAtt.clearValue.color.uint32[0] = VIS_EMPTY;
+  else colorAtt.clearValue.color = {{0.0f, 0.0f, 0.0f, 1.0f}};
   VkRenderingAttachmentInfo depthAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   depthAtt.imageView = depth_.view();
   depthAtt.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
@@ -154,13 +279,26 @@ void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose
   VkRect2D sc{{0, 0}, target.extent};
   vkCmdSetViewport(cb, 0, 1, &vp);
   vkCmdSetScissor(cb, 0, 1, &sc);
-  drawScene(cb, frame, s.mode != VIEW_SHADED);
+  drawScene(cb, frame, set);
   vkCmdEndRendering(cb);
-  timer.mark(cb, "scene");
+  timer.mark(cb, visibility ? "visibility" : "scene");
 
-  vk::barrier(cb, {{color_.handle(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                    VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, kPostReadStages,
-                    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
+  if (visibility) {
+    // Ids to the shading pass; the colour image's previous readers (last frame's post pass) first.
+    vk::barrier(cb, {{vis_.handle(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT},
+                     {color_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, kPostReadStages,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
+    shadeVisibility(cb, frame);
+    timer.mark(cb, "shade");
+  }
+  vk::barrier(cb, {{color_.handle(), visibility ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                    visibility ? VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                    kPostReadStages,
+                    visibility ? VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT : VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
   post_.record(cb, color_.view(), target.image, target.view, target.format, target.extent, s.mosaic, target.finalLayout);
   timer.mark(cb, "post");
 }

@@ -16,8 +16,15 @@
 
 namespace rtr::render {
 
+// How the shaded view (mode 1) is made: forward (BRDF in the scene pass's fragment shaders) or a
+// visibility buffer (triangle ids rasterised, BRDF in a compute pass; docs/design.md). Debug views
+// are always forward.
+enum class ShadingPath { Forward, Visibility };
+const char* toString(ShadingPath path);
+
 struct RenderSettings {
   int mode = VIEW_SHADED;         // VIEW_* from frame.h
+  ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   float lodBias = 0.0f;
   MosaicMode mosaic = MosaicMode::Compute;
   glm::vec3 lightPos{-0.2972f, 7.3100f, -11.9532f};  // the brief's standard light
@@ -38,6 +45,7 @@ class Renderer {
  public:
   static constexpr VkFormat kColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
   static constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+  static constexpr VkFormat kVisFormat = VK_FORMAT_R32_UINT;  // draw index, primitive index (frame.h)
 
   Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight);
 
@@ -50,24 +58,40 @@ class Renderer {
   const vk::Image& sceneColor() const { return color_; }
   // Rebuilds the scene pipelines from the shader folder (hot reload); on error keeps the old ones.
   void rebuildPipelines();
+  // The path a frame with these settings takes: Visibility needs the geometryShader feature
+  // (gl_PrimitiveID), a shaded view and ids that fit 32 bits; otherwise Forward.
+  ShadingPath pathFor(const RenderSettings& settings) const;
 
  private:
   struct ScenePipelines {
     std::optional<vk::Pipeline> pipeline;
     vk::DescriptorSets sets;
   };
-  void createTargets(VkExtent2D extent);
-  ScenePipelines makePipeline(DrawKind kind, bool debug) const;
-  void drawScene(VkCommandBuffer cb, uint32_t frame, bool debug);
+  using KindPipelines = std::array<ScenePipelines, kDrawKindCount>;
+  enum PipelineSet { kShaded, kDebug, kVisibility, kPipelineSetCount };  // built on first use
+  struct VisShade {
+    std::optional<vk::Pipeline> pipeline;
+    vk::DescriptorSets textures;  // set 1; set 0 is pushed per frame
+  };
+  void createTargets(VkExtent2D extent, bool visibility);
+  ScenePipelines makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull) const;
+  KindPipelines makePipelines(PipelineSet set) const;
+  VisShade makeShade() const;
+  void ensurePipelines(PipelineSet set);
+  void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set);
+  void shadeVisibility(VkCommandBuffer cb, uint32_t frame);
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
   uint32_t framesInFlight_;
   std::vector<vk::Buffer> uniforms_;  // FrameUniforms, one per frame in flight
-  std::array<ScenePipelines, kDrawKindCount> shaded_, debug_;
+  std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
+  VisShade shade_;
+  bool canUseVisibility_ = false;
+  uint32_t primitiveBits_ = 0;  // low bits of a visibility id: the primitive index
   MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;
-  vk::Image color_, depth_;
+  vk::Image color_, depth_, vis_;  // vis_ only once the visibility path ran
   VkExtent2D extent_{0, 0};
 };
 

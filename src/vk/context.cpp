@@ -181,6 +181,10 @@ Context::Context(const ContextOptions& options) {
     f12.scalarBlockLayout = VK_TRUE;
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
     f2.features.shaderStorageImageWriteWithoutFormat = VK_TRUE;
+    // gl_PrimitiveID in fragment shaders (the renderer's visibility path) needs it; optional.
+    VkPhysicalDeviceFeatures supported{};
+    vkGetPhysicalDeviceFeatures(physical_, &supported);
+    f2.features.geometryShader = supported.geometryShader;
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

@@ -1,4 +1,4 @@
-// The reference comparison has teeth: the GPU side is rendered with fragment shaders compiled at run time
+// The reference comparison has teeth: the GPU side is rendered with shaders compiled at run time
 // against an edited copy of shaders/shared/brdf.h (the shared header itself is untouched; the CPU tracer
 // keeps the real BRDF), and the comparison must fail. A control compiles the unedited copy the same way
 // and must pass, so a failure is the edit's doing, not the run-time compile path's.
@@ -36,8 +36,8 @@ std::string readAll(const std::filesystem::path& f) {
   return s.str();
 }
 
-// A shader folder: every compiled shader of the build, with the scene's PBR fragment shaders recompiled
-// against brdf.h with `edit` applied.
+// A shader folder: every compiled shader of the build, with the shaded view's shaders (forward and
+// visibility path) recompiled against brdf.h with `edit` applied.
 std::filesystem::path shaderFolderWith(const Edit& edit) {
   const std::filesystem::path src = std::filesystem::path(RTR_SOURCE_DIR) / "shaders";
   const std::filesystem::path dir = outDir() / "work" / (std::string("shaders_") + edit.name);
@@ -53,12 +53,14 @@ std::filesystem::path shaderFolderWith(const Edit& edit) {
     brdf.replace(at, std::string(edit.from).size(), edit.to);
   }
   std::ofstream(inc / "brdf.h", std::ios::binary) << brdf;
-  // pbr_frag.glsl includes "brdf.h": not found next to it (shaders/), so the edited copy comes first.
-  for (const char* frag : {"pbr.frag", "pbr_untextured.frag", "pbr_alpha.frag"}) {
-    const vk::SpirvModule m = vk::compileGlsl(src / frag, {inc, src, src / "shared"});
-    std::ofstream out(dir / (std::string(frag) + ".spv"), std::ios::binary | std::ios::trunc);
+  // The shaded view's shaders of both paths (forward fragment, visibility compute) include "brdf.h":
+  // not found next to them (shaders/), so the edited copy comes first.
+  for (const char* shader :
+       {"pbr.frag", "pbr_untextured.frag", "pbr_alpha.frag", "vis_shade.comp", "vis_shade_untextured.comp"}) {
+    const vk::SpirvModule m = vk::compileGlsl(src / shader, {inc, src, src / "shared"});
+    std::ofstream out(dir / (std::string(shader) + ".spv"), std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(m.code.data()), std::streamsize(m.code.size() * sizeof(uint32_t)));
-    if (!out) throw Error("cannot write " + (dir / frag).string() + ".spv");
+    if (!out) throw Error("cannot write " + (dir / shader).string() + ".spv");
   }
   return dir;
 }

@@ -76,15 +76,16 @@ CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const Pose
   if (shaderDir) setenv("RTR_SHADER_DIR", shaderDir->c_str(), 1);
   std::optional<render::GpuScene> gpuScene;
   std::optional<render::HeadlessRenderer> renderer;
-  try {
+  render::HeadlessFrame f;
+  try {  // the renderer loads a path's shaders on its first frame: keep the folder set until then
     gpuScene.emplace(ctx, rs.scene, render::MipMode::Compute);
     renderer.emplace(ctx, *gpuScene, VkExtent2D{o.width, o.height});
+    f = renderer->render(pe.pose, lens, s, 1, true);
   } catch (...) {
     if (shaderDir) env ? setenv("RTR_SHADER_DIR", previous.c_str(), 1) : unsetenv("RTR_SHADER_DIR");
     throw;
   }
   if (shaderDir) env ? setenv("RTR_SHADER_DIR", previous.c_str(), 1) : unsetenv("RTR_SHADER_DIR");
-  render::HeadlessFrame f = renderer->render(pe.pose, lens, s, 1, true);
   CasePair pair{toSrgb8(f.sceneColor), std::move(f.image), toSrgb8(cpu)};
   if (o.benchFrames > 0) {
     renderer->bench(pe.pose, lens, s, 10);  // warm-up

@@ -53,16 +53,20 @@ TEST_F(VulkanTest, AlphaMaskedQuadDiscardsAndLightsBothFaces) {
     s.ambient = glm::vec3(0.0f);  // lit only by the light: an unlit face would be black
     Lens lens;
     lens.fovYDeg = 60.0f;
-    for (bool back : {false, true}) {
-      CameraPose pose{{0, 0, back ? -2.5f : 2.5f}, back ? 180.0f : 0.0f, 0.0f};
-      s.lightPos = pose.position;
-      render::HeadlessFrame f = r.render(pose, lens, s);
-      // Seen from the back, the texture's opaque half (u > 0.5, world x > 0) appears on the image's left.
-      const uint32_t opaqueX = back ? 22 : 42, clearX = back ? 42 : 22;
-      const uint8_t* lit = f.image.at(opaqueX, 32);
-      const uint8_t* hole = f.image.at(clearX, 32);
-      EXPECT_GT(lit[0], 60) << (back ? "back" : "front") << " face not lit";
-      EXPECT_EQ(hole[0] + hole[1] + hole[2], 0) << (back ? "back" : "front") << ": alpha < 0.5 texel was drawn";
+    for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility}) {
+      s.shading = path;
+      for (bool back : {false, true}) {
+        SCOPED_TRACE(testing::Message() << render::toString(path) << (back ? " back" : " front"));
+        CameraPose pose{{0, 0, back ? -2.5f : 2.5f}, back ? 180.0f : 0.0f, 0.0f};
+        s.lightPos = pose.position;
+        render::HeadlessFrame f = r.render(pose, lens, s);
+        // Seen from the back, the texture's opaque half (u > 0.5, world x > 0) appears on the image's left.
+        const uint32_t opaqueX = back ? 22 : 42, clearX = back ? 42 : 22;
+        const uint8_t* lit = f.image.at(opaqueX, 32);
+        const uint8_t* hole = f.image.at(clearX, 32);
+        EXPECT_GT(lit[0], 60) << "face not lit";
+        EXPECT_EQ(hole[0] + hole[1] + hole[2], 0) << "alpha < 0.5 texel was drawn";
+      }
     }
   }
   std::filesystem::remove_all(dir);

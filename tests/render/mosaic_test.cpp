@@ -110,10 +110,11 @@ class MosaicTest : public VulkanTest {
   vk::Image input;
 };
 
+// 701x41 spans several workgroups in both directions, with partial tiles and blocks.
 TEST_F(MosaicTest, ComputeAndGraphicsAreBitIdenticalAndFollowTheRule) {
   render::MosaicPass pass(*ctx);
   uint32_t seed = 7;
-  for (VkExtent2D e : {VkExtent2D{64, 48}, {67, 50}, {5, 3}, {1, 1}, {4, 2}, {13, 1}}) {
+  for (VkExtent2D e : {VkExtent2D{64, 48}, {67, 50}, {5, 3}, {1, 1}, {4, 2}, {13, 1}, {701, 41}}) {
     SCOPED_TRACE(testing::Message() << e.width << "x" << e.height);
     makeInput(e, seed++);
     const auto compute = run(pass, MosaicMode::Compute);

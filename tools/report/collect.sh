@@ -60,11 +60,13 @@ bin rtr-view "$temple" --headless --size 64x64 2>&1 | grep -m1 ' on ' | sed 's/^
 if ! skipped gpu; then
   row gpu-passes rtr-bench-gpu --runs $runs --warmup $warm
 fi
-# Whole frame per pass: PBR + mosaic (both post paths), plain textured (mode 13) baseline.
+# Whole frame per pass: PBR (visibility path, the default; forward) + mosaic (both post paths), and the
+# plain textured (mode 13) baseline.
 frame_rows() {  # frame_rows TAG SCENE SIZES...
   local tag=$1 scene=$2; shift 2
   for size in "$@"; do
     row "frame-$tag-$size-pbr" rtr-view "$scene" --headless --size "$size" --bench $frames
+    row "frame-$tag-$size-pbr-forward" rtr-view "$scene" --headless --size "$size" --bench $frames --shading-path forward
     row "frame-$tag-$size-pbr-graphics" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic graphics
     row "frame-$tag-$size-textured" rtr-view "$scene" --headless --size "$size" --bench $frames --mode 13
   done

@@ -311,9 +311,10 @@ class Report:
     def frames(self):
         self.w("## Whole frame per pass (`rtr-view --headless --bench`)")
         self.w()
-        self.w("PBR = the brief's Beckmann/Cook-Torrance shading with the alpha-masked pipeline and the compute "
-               "mosaic (graphics mosaic in its own row); plain textured = mode 13 (unlit base colour, same "
-               "geometry, same textures, same post pass). Median GPU ms per pass over the frames.")
+        self.w("PBR = the brief's Beckmann/Cook-Torrance shading with alpha masking and the mosaic, on the "
+               "visibility path (ids rasterised, shading in compute; the default) or the forward path "
+               "(`--shading-path forward`); plain textured = mode 13 (unlit base colour, forward, same geometry, "
+               "same textures, same post pass). Median GPU ms per pass over the frames.")
         self.w()
         for m in self.m:
             rows = sorted(r[:-4] for r in os.listdir(m.folder) if r.startswith("frame-") and r != "frame-compare.txt")
@@ -335,9 +336,9 @@ class Report:
                             if r[0] not in passes and r[0] != "total":
                                 passes.append(r[0])
                 table.append((scene, size, "-".join(variant), vals, m.failed(row)))
-            names = {"pbr": "PBR + mosaic compute", "pbr-graphics": "PBR + mosaic graphics",
-                     "textured": "plain textured (mode 13)", "pbr-forward": "PBR forward + mosaic compute",
-                     "pbr-visibility": "PBR visibility + mosaic compute"}
+            names = {"pbr": "PBR, visibility path (default) + mosaic compute",
+                     "pbr-forward": "PBR, forward path + mosaic compute",
+                     "pbr-graphics": "PBR, visibility path + mosaic graphics", "textured": "plain textured (mode 13)"}
             scenes = {"default": "default (11k triangles)", "big": "Sun-Temple size (1M triangles)"}
             self.w("| scene | size | frame | " + " | ".join(passes) + " | total |")
             self.w("|---|---|---|" + "---:|" * (len(passes) + 1))

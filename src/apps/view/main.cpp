@@ -89,6 +89,7 @@ int main(int argc, char** argv) {
                "C print camera pose, F1 or H timing overlay, R ray-trace the view on the CPU (again: hide),\n"
                "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, Esc quit."};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light;
+  std::string shadingPath = render::toString(o.settings.shading);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
   app.add_option("--size", size, "image size WxH")->capture_default_str();
@@ -99,6 +100,8 @@ int main(int argc, char** argv) {
   app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay) to this PNG");
   app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit")->capture_default_str();
   app.add_option("--mosaic", mosaic, "post process: off | compute | graphics")->capture_default_str();
+  app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward")
+      ->check(CLI::IsMember({"visibility", "forward"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias");
   app.add_option("--light", light, "light position x,y,z");
   app.add_flag("--falloff", o.settings.inverseSquareFalloff, "inverse-square light falloff");
@@ -125,6 +128,7 @@ int main(int argc, char** argv) {
     if (!mosaicModes.count(mosaic)) throw Error("--mosaic '" + mosaic + "': expected off, compute or graphics");
     o.mips = mipModes.at(mips);
     o.settings.mosaic = mosaicModes.at(mosaic);
+    o.settings.shading = shadingPath == "forward" ? render::ShadingPath::Forward : render::ShadingPath::Visibility;
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rtr-view: %s\n", e.what());

@@ -1,0 +1,24 @@
+// Visibility pass fragment stage: stores which triangle is visible (draw index and gl_PrimitiveID, which
+// needs the geometryShader feature, in one uint); the compute pass vis_shade.glsl shades it. Alpha-masked materials
+// discard here exactly like pbr_frag.glsl (same texture, same implicit LOD and bias).
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_nonuniform_qualifier : require
+#include "frame.h"
+
+layout(push_constant) uniform Push { DrawPush draw; };
+layout(location = 0) out uint outId;
+
+#if ALPHA_MASK
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 1, std430) readonly buffer Materials { GpuMaterial materials[]; };
+layout(set = 1, binding = 0) uniform sampler2D textures[];
+layout(location = 0) in vec2 inTexcoord;
+#endif
+
+void main() {
+#if ALPHA_MASK
+  uint t = materials[draw.material].textures.w;  // uniform per draw
+  if (t != NO_TEXTURE && texture(textures[t], inTexcoord, frame.params.y).a < 0.5) discard;
+#endif
+  outId = draw.idBase | uint(gl_PrimitiveID);
+}

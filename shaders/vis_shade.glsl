@@ -1,0 +1,108 @@
+// Visibility path, shading in compute (ShadingPath::Visibility, mode 1): one thread per pixel reads the
+// visible triangle's ids, rebuilds the triangle from the index and vertex buffers, intersects the pixel's
+// ray with it for perspective-correct barycentrics, and shades with the same brdf.h as pbr_frag.glsl.
+// Texture LOD: the texcoord differences to the quad neighbour, like the rasteriser's fine derivatives
+// (docs/shading.md, "Visibility path").
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_nonuniform_qualifier : require
+#extension GL_EXT_samplerless_texture_functions : require
+#include "frame.h"
+#include "brdf.h"
+
+layout(local_size_x = VIS_GROUP_X, local_size_y = VIS_GROUP_Y) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 1, std430) readonly buffer Materials { GpuMaterial materials[]; };
+layout(set = 0, binding = 2, std430) readonly buffer Draws { GpuDraw draws[]; };
+layout(set = 0, binding = 3, std430) readonly buffer Positions { float positions[]; };
+layout(set = 0, binding = 4, std430) readonly buffer Normals { float normals[]; };
+layout(set = 0, binding = 5, std430) readonly buffer Indices32 { uint indices32[]; };
+layout(set = 0, binding = 6, std430) readonly buffer Indices16 { uint indices16[]; };  // two per word
+layout(set = 0, binding = 7) uniform utexture2D visibility;
+layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D sceneColor;
+#if HAS_TEXCOORDS
+layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
+layout(set = 1, binding = 0) uniform sampler2D textures[];
+#endif
+layout(push_constant) uniform Push { VisShadePush pc; };
+
+const float kMaxRadiance = 60000.0;  // as pbr_frag.glsl: stay below the half-float maximum
+
+vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
+vec3 normal(uint i) { return vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]); }
+
+uint vertexIndex(GpuDraw d, uint i) {
+  if ((d.flags & DRAW_INDEX16) == 0u) return indices32[d.firstIndex + i];
+  uint k = d.firstIndex + i;
+  return (indices16[k >> 1] >> ((k & 1u) * 16u)) & 0xFFFFu;  // little-endian halves
+}
+
+// Barycentrics (of vertices 0, 1, 2) where the ray o + t dir meets the triangle's plane. With
+// s = o - p0: u = dir.(e2 x s) / det, v = dir.(s x e1) / det, det = -dir.(e1 x e2); any scale of dir
+// gives the same result. The guard keeps a ray parallel to the plane finite.
+vec3 barycentrics(vec3 dir, vec3 a, vec3 b, vec3 n) {
+  float det = -dot(dir, n);
+  float inv = 1.0 / (abs(det) > 1e-30 ? det : 1e-30);
+  vec2 uv = clamp(vec2(dot(dir, a), dot(dir, b)) * inv, -1e4, 1e4);
+  return vec3(1.0 - uv.x - uv.y, uv);
+}
+
+#if HAS_TEXCOORDS
+vec4 sampleOr(uint index, vec2 uv, vec2 gx, vec2 gy, vec4 fallback) {
+  return index == NO_TEXTURE ? fallback : textureGrad(textures[nonuniformEXT(index)], uv, gx, gy);
+}
+#endif
+
+void main() {
+  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(p, imageSize(sceneColor)))) return;
+  const uint packed = texelFetch(visibility, p, 0).x;
+  if (packed == VIS_EMPTY) {
+    imageStore(sceneColor, p, vec4(0.0, 0.0, 0.0, 1.0));  // the forward pass's clear colour
+    return;
+  }
+  const GpuDraw d = draws[packed >> pc.primitiveBits];
+  const uint first = 3u * (packed & ((1u << pc.primitiveBits) - 1u));  // primitiveBits < 32
+  const uvec3 tri = uvec3(vertexIndex(d, first), vertexIndex(d, first + 1u), vertexIndex(d, first + 2u)) + d.vertexOffset;
+  const vec3 p0 = position(tri.x), p1 = position(tri.y), p2 = position(tri.z);
+  const vec3 e1 = p1 - p0, e2 = p2 - p0, s = frame.cameraPos.xyz - p0;
+  const vec3 n = cross(e1, e2), a = cross(e2, s), b = cross(s, e1);
+
+  const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
+  const vec3 w = clamp(barycentrics(dir, a, b, n), 0.0, 1.0);  // the rasteriser covered this pixel centre
+  const vec3 worldPos = p0 * w.x + p1 * w.y + p2 * w.z;
+  // Two-sided materials light their back faces with the flipped normal (front: counter-clockwise seen
+  // from the camera, as the forward pipelines' VK_FRONT_FACE_COUNTER_CLOCKWISE).
+  vec3 nrm = normal(tri.x) * w.x + normal(tri.y) * w.y + normal(tri.z) * w.z;
+  if (dot(n, s) < 0.0) nrm = -nrm;
+
+  const GpuMaterial m = materials[d.material];
+  vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
+  float roughness = m.roughMetal.x, metalness = m.roughMetal.y;
+#if HAS_TEXCOORDS
+  if ((d.flags & DRAW_TEXTURED) != 0u) {
+    const vec2 t0 = texcoords[tri.x], t1 = texcoords[tri.y], t2 = texcoords[tri.z];
+    const vec2 uv = t0 * w.x + t1 * w.y + t2 * w.z;
+    // Differences to the other pixel of the 2x2 quad in x and in y (what fine dFdx/dFdy give), scaled
+    // by 2^bias: textureGrad has no bias argument, and the LOD is log2 of the gradient's length.
+    const vec2 side = vec2(1 - 2 * (p & 1));
+    const vec3 wx = barycentrics(dir + side.x * frame.rayDx.xyz, a, b, n);
+    const vec3 wy = barycentrics(dir + side.y * frame.rayDy.xyz, a, b, n);
+    const float scale = exp2(frame.params.y);
+    const vec2 gx = (t0 * wx.x + t1 * wx.y + t2 * wx.z - uv) * (side.x * scale);
+    const vec2 gy = (t0 * wy.x + t1 * wy.y + t2 * wy.z - uv) * (side.y * scale);
+    baseColor *= sampleOr(m.textures.x, uv, gx, gy, vec4(1.0)).rgb;
+    roughness *= sampleOr(m.textures.y, uv, gx, gy, vec4(1.0)).r;
+    metalness *= sampleOr(m.textures.z, uv, gx, gy, vec4(1.0)).r;
+    emissive *= sampleOr(m.textures2.x, uv, gx, gy, vec4(1.0)).rgb;
+  }
+#endif
+
+  const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
+  const vec3 toLight = frame.lightPos.xyz - worldPos;
+  const float dist2 = max(dot(toLight, toLight), 1e-12);
+  const vec3 l = toLight * inversesqrt(dist2);
+  const vec3 lightColor = frame.lightColor.rgb * (frame.lightColor.w > 0.5 ? 1.0 / dist2 : 1.0);
+  const vec3 c = shadePbr(nrm, v, l, lightColor, frame.ambient.rgb, baseColor, roughness, metalness, emissive);
+  imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
+}
