@@ -9,6 +9,11 @@
 #include <limits>
 #include <memory>
 #include <thread>
+#include <vector>
+#include <cstdlib>
+#include <new>
+
+#include <sys/mman.h>
 
 #include <glm/common.hpp>
 
@@ -189,6 +194,23 @@ struct BvhBuilder {
     return Bvh::kLeafBit | ((np - 1) << 28) | first;
   }
 
+  // Writes the subtree at `ref` (a node or a leaf) into bvh's arrays in depth-first order; returns its
+  // new reference.
+  uint32_t relayout(uint32_t ref, Bvh& bvh, uint32_t& nextNode, uint32_t& nextPack) const {
+    if (ref & Bvh::kLeafBit) {
+      const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+      for (uint32_t p = 0; p < np; ++p) bvh.packs_[nextPack + p] = packs[first + p];
+      nextPack += np;
+      return (ref & ~0x0FFFFFFFu) | (nextPack - np);
+    }
+    Node n = nodes[ref];
+    const uint32_t index = nextNode++;
+    for (int k = 0; k < int(kWidth); ++k)
+      if (n.box[0][0][k] <= n.box[1][0][k]) n.child[k] = relayout(n.child[k], bvh, nextNode, nextPack);  // not empty
+    bvh.nodes_[index] = n;
+    return index;
+  }
+
   uint32_t build(const Range& r) {
     uint32_t d = maxDepth.load();
     while (r.depth > d && !maxDepth.compare_exchange_weak(d, r.depth)) {}
@@ -262,13 +284,36 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   b.packs.reset(new TriPack[n + 1]);
   b.spawnBudget = int(threads) * 2 - 1;
   root_ = b.build(BvhBuilder::boundsOf(b.refs, 0, n, 0));
-  nodes_.assign(b.nodes.get(), b.nodes.get() + b.nodeCount.load());
-  packs_.assign(b.packs.get(), b.packs.get() + b.packCount.load());
+  // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
+  nodes_ = HugeArray<Node>(b.nodeCount.load());
+  packs_ = HugeArray<TriPack>(b.packCount.load());
+  uint32_t nextNode = 0, nextPack = 0;
+  root_ = b.relayout(root_, *this, nextNode, nextPack);
   stats_.nodes = uint32_t(nodes_.size());
   stats_.packs = uint32_t(packs_.size());
   stats_.maxDepth = b.maxDepth.load();
   stats_.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
+
+template <class T>
+HugeArray<T>::HugeArray(size_t n) : n_(n) {
+  constexpr size_t kHuge = size_t(2) << 20;
+  size_t bytes = std::max<size_t>(n, 1) * sizeof(T);
+  const size_t align = bytes >= kHuge ? kHuge : alignof(T);
+  bytes = (bytes + align - 1) / align * align;
+  void* p = std::aligned_alloc(align, bytes);
+  if (!p) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+  if (align == kHuge) madvise(p, bytes, MADV_HUGEPAGE);  // a hint: without THP it is plain pages
+#endif
+  p_.reset(static_cast<T*>(p));
+}
+
+template <class T>
+void HugeArray<T>::Free::operator()(T* p) const { std::free(p); }
+
+template class HugeArray<Node>;
+template class HugeArray<TriPack>;
 
 namespace sse {
 bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
@@ -282,7 +327,7 @@ bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
 namespace {
 bool cpuHasAvx2() {
   __builtin_cpu_init();  // may run before libgcc's own initialiser (static initialisation order)
-  return __builtin_cpu_supports("avx2");
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }
 std::atomic<bool> useAvx2{cpuHasAvx2()};
 }  // namespace

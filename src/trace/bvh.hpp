@@ -3,9 +3,10 @@
 // heuristic and stored flat for traversal: each node holds its eight children's boxes in SoA form so
 // one AVX2 box test (or two SSE ones) covers them, and leaves hold triangles in packs of eight laid out
 // for an 8-wide watertight test. See docs/tracer.md.
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
-#include <vector>
 
 #include "trace/intersect.hpp"
 #include "trace/ray.hpp"
@@ -25,6 +26,23 @@ struct alignas(64) Node {
 struct BvhStats {
   uint32_t nodes = 0, packs = 0, triangles = 0, maxDepth = 0;
   double buildSeconds = 0.0;
+};
+
+// A fixed-size array in memory the kernel is asked to back with 2 MB pages (transparent huge pages):
+// traversal jumps all over tens of MB, and 4 KB pages would miss the TLB on most node visits.
+template <class T>
+class HugeArray {
+ public:
+  HugeArray() = default;
+  explicit HugeArray(size_t n);
+  T* data() const { return p_.get(); }
+  size_t size() const { return n_; }
+  T& operator[](size_t i) const { return p_[i]; }
+
+ private:
+  struct Free { void operator()(T* p) const; };
+  std::unique_ptr<T[], Free> p_;
+  size_t n_ = 0;
 };
 
 // The instruction set the traversal runs with: AVX2 where the CPU has it, else SSE4.2 (same results).
@@ -63,8 +81,8 @@ class Bvh {
 
  private:
   static constexpr uint32_t kEmpty = 0xFFFFFFFFu;
-  std::vector<Node> nodes_;
-  std::vector<TriPack> packs_;
+  HugeArray<Node> nodes_;
+  HugeArray<TriPack> packs_;
   uint32_t root_ = kEmpty;
   BvhStats stats_;
   friend struct BvhBuilder;

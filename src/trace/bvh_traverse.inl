@@ -34,6 +34,7 @@ inline F eq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
 inline F neq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NEQ_UQ)}; }
 inline unsigned bits(F a) { return unsigned(_mm256_movemask_ps(a.v)); }
 inline void store(float* p, F a) { _mm256_store_ps(p, a.v); }
+inline F fmsub(F a, F b, F c) { return {_mm256_fmsub_ps(a.v, b.v, c.v)}; }  // a·b − c, rounded once
 // The top bits of eight 32-bit integers.
 inline unsigned topBits(const uint32_t* p) {
   return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(p)))));
@@ -66,10 +67,6 @@ inline unsigned topBits(const uint32_t* p) {
 }
 #endif
 
-// 1 + 2·gamma(4): the far slab distance scaled by it (the scale folded into the reciprocal, one more
-// rounding) stays at or beyond every rounded near distance of a box the ray really meets (Ize 2013), so
-// the BVH keeps the watertight triangle test watertight.
-constexpr float kFarScale = 1.0f + 2.0f * (4.0f * 0x1p-24f) / (1.0f - 4.0f * 0x1p-24f);
 constexpr int kStackSize = 640;  // 7 entries per level, binary depth ≤ 48 + 32 (bvh.cpp)
 
 inline Triangle laneTriangle(const TriPack& p, int lane) {
@@ -88,15 +85,35 @@ inline int ctz(unsigned m) { return __builtin_ctz(m); }
 template <bool AnyHit>
 bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
   static_assert(sizeof(Triangle) == 9 * sizeof(float));
-  const WatertightRay wr(ray);
   const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
   const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-  F org[3], rdir[3], rdirFar[3];
+  const float rcp[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
+  // Slab distances, conservative under rounding so that the BVH keeps the watertight test watertight:
+  // a box the ray really meets is never culled. A zero direction component gives an infinite
+  // reciprocal and, on the slab's plane, NaN: the min/max below are ordered so that NaN is ignored.
   int nearOff[3], farOff[3];
+#if RTR_BVH_AVX2
+  // One FMA per slab: t = box·r − o·r. The near distance uses r shrunk by 8 ulps and o·r pushed up by
+  // 4 ulps, the far one r grown and o·r pushed down: enough to cover every rounding (of 1/d, of o·r, of
+  // the FMA), so a near distance never ends up past the true one, nor a far one short of it.
+  F rNear[3], qNear[3], rFar[3], qFar[3];
   for (int a = 0; a < 3; ++a) {
-    // A zero component gives an infinite reciprocal and, on the slab's plane, 0·inf = NaN: the min/max
-    // below are ordered so that a NaN slab distance is ignored.
-    const float inv = 1.0f / d[a];
+    const float r = rcp[a];
+    const float rn = r * (1.0f - 0x1p-21f), rf = r * (1.0f + 0x1p-21f);
+    const float qn0 = o[a] * rn, qf0 = o[a] * rf;
+    const float qnf = qn0 + (__builtin_fabsf(qn0) * 0x1p-22f + 0x1p-100f);
+    const float qff = qf0 - (__builtin_fabsf(qf0) * 0x1p-22f + 0x1p-100f);
+    rNear[a] = set1(rn); qNear[a] = set1(qnf); rFar[a] = set1(rf); qFar[a] = set1(qff);
+    const int nearSide = r < 0.0f ? 1 : 0;
+    nearOff[a] = (nearSide * 3 + a) * 8;
+    farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+  }
+#else
+  // (box − o)·r, the far one scaled by 1 + 2·gamma(4) (Ize 2013; the scale folded into r, one more rounding).
+  constexpr float kFarScale = 1.0f + 2.0f * (4.0f * 0x1p-24f) / (1.0f - 4.0f * 0x1p-24f);
+  F org[3], rdir[3], rdirFar[3];
+  for (int a = 0; a < 3; ++a) {
+    const float inv = rcp[a];
     org[a] = set1(o[a]);
     rdir[a] = set1(inv);
     rdirFar[a] = set1(inv * kFarScale);
@@ -104,10 +121,17 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
     nearOff[a] = (nearSide * 3 + a) * 8;
     farOff[a] = ((1 - nearSide) * 3 + a) * 8;
   }
+#endif
   // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
-  const int kx = wr.kx, ky = wr.ky, kz = wr.kz;
+  // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
+  // must shear identically), inline here and sharing the reciprocal with the slab test.
+  const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[1]), __builtin_fabsf(d[2])};
+  const int kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+  int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
+  if (d[kz] < 0.0f) { const int t = kx; kx = ky; ky = t; }
+  const float szs = rcp[kz];
   const F ox = set1(o[kx]), oy = set1(o[ky]), oz = set1(o[kz]);
-  const F sx = set1(wr.sx), sy = set1(wr.sy), sz = set1(wr.sz);
+  const F sx = set1(d[kx] * szs), sy = set1(d[ky] * szs), sz = set1(szs);
   const F zero = set1(0.0f), signBit = set1(-0.0f);
 
   // Stack entries: the entry distance's bits above the node reference, so one integer compare sorts.
@@ -122,40 +146,57 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
     while (!(ref & Bvh::kLeafBit)) {
       const Node& n = bvh.nodes[ref];
       const float* b = &n.box[0][0][0];
+#if RTR_BVH_AVX2
+      const F tx0 = fmsub(load(b + nearOff[0]), rNear[0], qNear[0]);
+      const F ty0 = fmsub(load(b + nearOff[1]), rNear[1], qNear[1]);
+      const F tz0 = fmsub(load(b + nearOff[2]), rNear[2], qNear[2]);
+      const F tx1 = fmsub(load(b + farOff[0]), rFar[0], qFar[0]);
+      const F ty1 = fmsub(load(b + farOff[1]), rFar[1], qFar[1]);
+      const F tz1 = fmsub(load(b + farOff[2]), rFar[2], qFar[2]);
+#else
       const F tx0 = (load(b + nearOff[0]) - org[0]) * rdir[0];
       const F ty0 = (load(b + nearOff[1]) - org[1]) * rdir[1];
       const F tz0 = (load(b + nearOff[2]) - org[2]) * rdir[2];
       const F tx1 = (load(b + farOff[0]) - org[0]) * rdirFar[0];
       const F ty1 = (load(b + farOff[1]) - org[1]) * rdirFar[1];
       const F tz1 = (load(b + farOff[2]) - org[2]) * rdirFar[2];
+#endif
       const F tNear = vmax(tz0, vmax(ty0, vmax(tx0, zero)));
       const F tFar = vmin(tz1, vmin(ty1, vmin(tx1, tHitV)));
       unsigned mask = bits(le(tNear, tFar));
       if (mask == 0) goto pop;
-      if constexpr (AnyHit) {
-        ref = n.child[ctz(mask)];
-        for (mask &= mask - 1; mask; mask &= mask - 1) stack[sp++] = n.child[ctz(mask)];
-        continue;
-      } else {
-        const int c0 = ctz(mask);
-        mask &= mask - 1;
-        if (mask == 0) { ref = n.child[c0]; continue; }
-        alignas(32) float dist[8];
-        store(dist, tNear);
-        // Two or more: push them sorted, nearest on top, then take the top.
-        uint64_t* run = stack + sp;
-        int k = 0;
-        for (mask |= 1u << c0; mask; mask &= mask - 1) {
-          const int c = ctz(mask);
-          const uint64_t key = uint64_t(floatBits(dist[c])) << 32 | n.child[c];
-          int j = k++;
-          while (j > 0 && run[j - 1] < key) { run[j] = run[j - 1]; --j; }
-          run[j] = key;
-        }
-        sp += k - 1;
-        ref = uint32_t(run[k - 1]);
+      const int c0 = ctz(mask);
+      mask &= mask - 1;
+      if (mask == 0) { ref = n.child[c0]; continue; }
+      // Two or more children: the one visited next is the smallest key, the others go on the stack.
+      // Closest hit goes nearest first, so that a hit culls the rest. Any hit goes farthest first: a
+      // shadow ray leaves a surface, and the boxes around its origin hold that surface and its
+      // neighbours, which rarely block it (measured: docs/bench/trace.md).
+      alignas(32) float dist[8];
+      store(dist, tNear);
+      auto key = [&](int c) {
+        const uint32_t d32 = floatBits(dist[c]);
+        return uint64_t(AnyHit ? ~d32 : d32) << 32 | n.child[c];
+      };
+      const int c1 = ctz(mask);
+      mask &= mask - 1;
+      if (mask == 0) {  // two, the common case
+        const uint64_t k0 = key(c0), k1 = key(c1);
+        stack[sp++] = k0 < k1 ? k1 : k0;
+        ref = uint32_t(k0 < k1 ? k0 : k1);
         continue;
       }
+      // Three or more: insertion sort onto the stack, smallest key on top.
+      uint64_t* run = stack + sp;
+      int k = 0;
+      for (mask |= 1u << c0 | 1u << c1; mask; mask &= mask - 1) {
+        const uint64_t kc = key(ctz(mask));
+        int j = k++;
+        while (j > 0 && run[j - 1] < kc) { run[j] = run[j - 1]; --j; }
+        run[j] = kc;
+      }
+      sp += k - 1;
+      ref = uint32_t(run[k - 1]);
     }
     {
       const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
@@ -213,7 +254,7 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
         }
         for (; edge; edge &= edge - 1) {
           const int lane = ctz(edge);
-          WatertightRay r = wr;
+          WatertightRay r(ray);
           r.tMax = tHit;
           float b1, b2;
           const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);

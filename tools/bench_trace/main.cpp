@@ -120,12 +120,13 @@ std::vector<Triangle> trianglesOf(const Scene& s) {
 }
 
 void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, unsigned threads, int res,
-                bool sphere) {
-  std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max\n\n", label, tris.size(), res, res, threads);
+                bool sphere, bool quick) {
+  std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
+              res, threads, Bvh::isa() == BvhIsa::Avx2 ? "AVX2" : "SSE4.2");
   const auto t0 = Clock::now();
   const Bvh bvh(tris, {}, threads);
   const double ourBuild = seconds(t0);
-  const Embree em(tris, threads);
+  const Embree em(std::getenv("OURS_ONLY") ? std::vector<Triangle>{} : tris, threads);
   std::printf("BVH build: ours %.3f s (%u nodes, %u packs, depth %u); Embree (quality high) %.3f s\n\n", ourBuild,
               bvh.stats().nodes, bvh.stats().packs, bvh.stats().maxDepth, em.buildSeconds);
 
@@ -160,6 +161,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
               100.0 * double(nHit) / double(primary.size()), shadow.size(), mirror.size());
 
   // Agreement on primary and mirror rays.
+  if (!std::getenv("OURS_ONLY"))
   for (auto* set : {&primary, &mirror}) {
     size_t disagree = 0, otherTriangle = 0, farOff = 0;
     double maxRel = 0, maxRelSame = 0;
@@ -193,17 +195,18 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
       const double ours = timed(rays.size(), th, 3, [&](size_t i) {
         return s.any ? uint32_t(bvh.occluded(rays[i])) : bvh.closest(rays[i]).prim;
       });
-      const double theirs = timed(rays.size(), th, 3, [&](size_t i) {
+      const double theirs = std::getenv("OURS_ONLY") ? 1.0 : timed(rays.size(), th, 3, [&](size_t i) {
         return s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
       });
       std::printf("| %s | %u | %.2f | %.2f | %.2f× |\n", s.name, th, rays.size() / ours * 1e-6, rays.size() / theirs * 1e-6,
                   theirs / ours);
     }
   }
+  if (quick) return;
   std::printf("\nPrimary rays through our BVH with the other routines (1 thread):\n\n| routine | Mrays/s |\n|---|---|\n");
   for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::MollerTrumbore, IntersectMethod::HalfPlane}) {
     const double t = timed(primary.size(), 1, 2, [&](size_t i) { return bvh.closest(primary[i], m).prim; });
-    std::printf("| %s | %.2f |\n", m == IntersectMethod::Watertight ? "watertight (4-wide SSE)" : m == IntersectMethod::HalfPlane ? "half-plane (scalar)" : "Möller–Trumbore (scalar)",
+    std::printf("| %s | %.2f |\n", m == IntersectMethod::Watertight ? "watertight (8-wide)" : m == IntersectMethod::HalfPlane ? "half-plane (scalar)" : "Möller–Trumbore (scalar)",
                 primary.size() / t * 1e-6);
   }
 }
@@ -262,25 +265,30 @@ int main(int argc, char** argv) {
   int res = 1024;
   uint32_t rings = 707;
   std::vector<std::string> scenes;
+  bool quick = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
     else if (a == "--res" && i + 1 < argc) res = std::atoi(argv[++i]);
     else if (a == "--rings" && i + 1 < argc) rings = uint32_t(std::atoi(argv[++i]));
     else if (a == "--scene" && i + 1 < argc) scenes.push_back(argv[++i]);
-    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]...\n"); return 2; }
+    else if (a == "--quick") quick = true;
+    else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
+    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--sse]\n"
+                              "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
+                              "  --sse: our traversal with SSE4.2 even where AVX2 is available\n"); return 2; }
   }
   if (threads == 0 || res <= 0 || rings < 2) { std::fprintf(stderr, "bench-trace: bad argument\n"); return 2; }
-  benchRoutines();
+  if (!quick) benchRoutines();
   const Mesh sphere = uvSphere({0, 0, 0}, 1.0f, rings, rings + 1);
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
     tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
-  benchScene("UV sphere", tris, sphere.bounds, threads, res, true);
+  benchScene("UV sphere", tris, sphere.bounds, threads, res, true, quick);
   for (const std::string& f : scenes) {
     try {
       const Scene s = loadScene(f);
-      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false);
+      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false, quick);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "bench-trace: %s\n", e.what());
       return 1;
