@@ -224,10 +224,11 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
         const F bx = (load(pk.v[1][kx]) - ox) - sx * Bz, by = (load(pk.v[1][ky]) - oy) - sy * Bz;
         const F cx = (load(pk.v[2][kx]) - ox) - sx * Cz, cy = (load(pk.v[2][ky]) - oy) - sy * Cz;
         const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
-        const F inside = (ge(U, zero) & ge(V, zero) & ge(W, zero)) | (le(U, zero) & le(V, zero) & le(W, zero));
+        // Inside: U, V, W of one sign. Lanes with a zero go to the edge path; a NaN lane that passes
+        // here fails the t test below (as in the scalar routine, where it fails here).
         // Exactly on an edge in float: the scalar routine decides in double.
         unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W, zero));
-        unsigned m = bits(inside) & ~edge;
+        unsigned m = ~bits((U ^ V) | (V ^ W)) & 0xFFu & ~edge;
         if ((m | edge) == 0) continue;
         const F det = U + V + W;
         const F T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
