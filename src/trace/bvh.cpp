@@ -2,16 +2,15 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <future>
 #include <limits>
 #include <memory>
+#include <new>
 #include <thread>
 #include <vector>
-#include <cstdlib>
-#include <new>
 
 #include <sys/mman.h>
 
