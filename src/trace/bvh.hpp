@@ -1,42 +1,63 @@
 #pragma once
-// A 4-wide bounding volume hierarchy over triangles, built top-down with a binned surface area
-// heuristic and stored flat for traversal: each node holds its four children's boxes in SoA form so
-// one SSE box test covers them, and leaves hold triangles in packs of four laid out for a 4-wide
-// watertight test. See docs/tracer.md.
+// An 8-wide bounding volume hierarchy over triangles, built top-down with a binned surface area
+// heuristic and stored flat for traversal: each node holds its eight children's boxes in SoA form so
+// one AVX2 box test (or two SSE ones) covers them, and leaves hold triangles in packs of eight laid out
+// for an 8-wide watertight test. See docs/tracer.md.
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
-#include <vector>
 
 #include "trace/intersect.hpp"
 #include "trace/ray.hpp"
 
 namespace rtr::trace {
 
-struct alignas(16) TriPack {
-  float v[3][3][4];        // [vertex][axis][lane]; a short pack repeats its last triangle
-  uint32_t prim[4];        // triangle index per lane
-  uint32_t occluderMask;   // lanes that cast shadows (light geometry does not)
-  uint32_t pad[3];
+struct alignas(64) TriPack {
+  float v[3][3][8];  // [vertex][axis][lane]; a short pack repeats its last triangle
+  uint32_t prim[8];  // triangle index per lane; the top bit set: the lane casts no shadow (a light)
 };
 
-struct alignas(64) Node4 {
-  float box[2][3][4];  // [min, max][axis][child]; an empty slot has min = +inf, max = -inf
-  uint32_t child[4];   // inner node index, or leaf: kLeafBit | (packs - 1) << 28 | first pack
+struct alignas(64) Node {
+  float box[2][3][8];  // [min, max][axis][child]; an empty slot has min = +inf, max = -inf
+  uint32_t child[8];   // inner node index, or leaf: kLeafBit | (packs - 1) << 28 | first pack
 };
 
 struct BvhStats {
   uint32_t nodes = 0, packs = 0, triangles = 0, maxDepth = 0;
   double buildSeconds = 0.0;
-  double sahCost = 0.0;
 };
+
+// A fixed-size array in memory the kernel is asked to back with 2 MB pages (transparent huge pages):
+// traversal jumps all over tens of MB, and 4 KB pages would miss the TLB on most node visits.
+template <class T>
+class HugeArray {
+ public:
+  HugeArray() = default;
+  explicit HugeArray(size_t n);
+  T* data() const { return p_.get(); }
+  size_t size() const { return n_; }
+  T& operator[](size_t i) const { return p_[i]; }
+
+ private:
+  struct Free { void operator()(T* p) const; };
+  std::unique_ptr<T[], Free> p_;
+  size_t n_ = 0;
+};
+
+// The instruction set the traversal runs with: AVX2 where the CPU has it, else SSE4.2 (same results).
+enum class BvhIsa { Sse, Avx2 };
 
 class Bvh {
  public:
   static constexpr uint32_t kLeafBit = 0x80000000u;
-  static constexpr uint32_t kMaxLeafTriangles = 8;
+  static constexpr uint32_t kNoShadowBit = 0x80000000u;
+  static constexpr uint32_t kMaxLeafTriangles = 16;
+  static constexpr uint32_t kMaxTriangles = 0x7FFFFFFFu;
 
   Bvh() = default;
-  // castsShadow: one flag per triangle (empty = all cast). threads: 0 = all cores.
+  // castsShadow: one flag per triangle (empty = all cast). threads: 0 = all cores. Throws rtr::Error
+  // for more than kMaxTriangles triangles.
   Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShadow = {}, unsigned threads = 0);
 
   // Closest hit in (0, ray.tMax), front to back.
@@ -47,13 +68,21 @@ class Bvh {
   const BvhStats& stats() const { return stats_; }
   bool empty() const { return root_ == kEmpty; }
 
+  // For tests and benchmarks: pick the ISA (AVX2 only where supported); returns the one in use.
+  static BvhIsa setIsa(BvhIsa isa);
+  static BvhIsa isa();
+
+  // What a traversal needs; the per-ISA traversals live in bvh_traverse.inl.
+  struct View {
+    const Node* nodes;
+    const TriPack* packs;
+    uint32_t root;
+  };
+
  private:
   static constexpr uint32_t kEmpty = 0xFFFFFFFFu;
-  template <bool AnyHit>
-  bool traverse(const Ray& ray, IntersectMethod method, Hit& hit) const;
-
-  std::vector<Node4> nodes_;
-  std::vector<TriPack> packs_;
+  HugeArray<Node> nodes_;
+  HugeArray<TriPack> packs_;
   uint32_t root_ = kEmpty;
   BvhStats stats_;
   friend struct BvhBuilder;

@@ -50,9 +50,10 @@ WatertightRay::WatertightRay(const Ray& r) : origin(r.origin), tMax(r.tMax) {
   kx = (kz + 1) % 3;
   ky = (kx + 1) % 3;
   if (r.direction[kz] < 0.0f) std::swap(kx, ky);  // keep the winding, so the sign of det means facing
-  sx = r.direction[kx] / r.direction[kz];
-  sy = r.direction[ky] / r.direction[kz];
+  // One division; the BVH traversal (bvh_traverse.inl) repeats exactly these operations.
   sz = 1.0f / r.direction[kz];
+  sx = r.direction[kx] * sz;
+  sy = r.direction[ky] * sz;
 }
 
 float intersectWatertight(const WatertightRay& r, const Triangle& tri, float& b1, float& b2) {

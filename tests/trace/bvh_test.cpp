@@ -30,7 +30,10 @@ TEST(Bvh, MatchesBruteForceOnATriangleSoup) {
   const Bvh bvh(tris, casts, 2);
   EXPECT_GT(bvh.stats().nodes, 10u);
   EXPECT_EQ(bvh.stats().triangles, tris.size());
+  // Both traversal ISAs (where the CPU has AVX2; else SSE twice), every routine.
+  for (BvhIsa isa : {BvhIsa::Avx2, BvhIsa::Sse})
   for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::HalfPlane, IntersectMethod::MollerTrumbore}) {
+    Bvh::setIsa(isa);
     int hits = 0;
     for (int i = 0; i < 3000; ++i) {
       Ray r{{u(rng) * 12, u(rng) * 12, u(rng) * 12}, {u(rng), u(rng), u(rng)}};
@@ -48,6 +51,7 @@ TEST(Bvh, MatchesBruteForceOnATriangleSoup) {
     }
     EXPECT_GT(hits, 300);
   }
+  Bvh::setIsa(BvhIsa::Avx2);
 }
 
 TEST(Bvh, ShadowRaysIgnoreNonCasters) {

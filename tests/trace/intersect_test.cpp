@@ -66,11 +66,9 @@ TEST(Intersect, RoutinesAgreeOnAPlainHit) {
 
 // A closed sphere hit from inside: every ray must hit. Watertight: exactly one triangle per ray, for
 // random rays, rays aimed exactly at vertices and rays aimed along shared edges.
-TEST(Intersect, ClosedSphereFromInsideIsWatertight) {
-  std::mt19937 rng(1234);
+// Far from the origin, the BVH's slab test works with large coordinates and small differences.
+void expectClosedSphereWatertight(std::mt19937& rng, float radius, glm::vec3 centre) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  const float radius = 0.5f + 10.0f * (u(rng) + 1.0f);
-  const glm::vec3 centre{u(rng) * 3.0f, u(rng) * 3.0f, u(rng) * 3.0f};
   const Mesh sphere = uvSphere(centre, radius, 16, 16);
   const std::vector<Triangle> tris = trianglesOf(sphere);
   const Bvh bvh(tris);
@@ -93,10 +91,14 @@ TEST(Intersect, ClosedSphereFromInsideIsWatertight) {
       }
     }
   for (IntersectMethod m : kMethods) {
-    // Every ray through the BVH; every triangle (to count double hits) for the aimed rays and 10k random.
-    size_t misses = 0, doubles = 0, tested = 0, bvhMisses = 0;
+    // Every ray through the BVH, with each traversal ISA (the same answers); every triangle (to count
+    // double hits) for the aimed rays and 10k random.
+    size_t misses = 0, doubles = 0, tested = 0, bvhMisses = 0, sseMisses = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
       bvhMisses += !bvh.closest(rays[i], m).hit();
+      Bvh::setIsa(BvhIsa::Sse);
+      sseMisses += !bvh.closest(rays[i], m).hit();
+      Bvh::setIsa(BvhIsa::Avx2);
       if (i >= 10000 && i < 100000) continue;
       const int n = hitCount(m, rays[i], tris);
       ++tested;
@@ -110,8 +112,21 @@ TEST(Intersect, ClosedSphereFromInsideIsWatertight) {
       EXPECT_EQ(misses, 0u);
       EXPECT_EQ(doubles, 0u);
       EXPECT_EQ(bvhMisses, 0u);
+      EXPECT_EQ(sseMisses, 0u);
     }
   }
+}
+
+TEST(Intersect, ClosedSphereFromInsideIsWatertight) {
+  std::mt19937 rng(1234);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  const float radius = 0.5f + 10.0f * (u(rng) + 1.0f);
+  expectClosedSphereWatertight(rng, radius, {u(rng) * 3.0f, u(rng) * 3.0f, u(rng) * 3.0f});
+}
+
+TEST(Intersect, ClosedSphereFarFromTheOriginIsWatertight) {
+  std::mt19937 rng(99);
+  expectClosedSphereWatertight(rng, 0.75f, {3000.0f, -2000.0f, 1000.0f});
 }
 
 // A unit quad split along y = x, hit exactly on (near) the diagonal from above at several angles.

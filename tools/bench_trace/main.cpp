@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <random>
 #include <string>
 #include <thread>
@@ -18,6 +19,7 @@
 #include <xmmintrin.h>
 
 #include <glm/trigonometric.hpp>
+#include <glm/vec3.hpp>
 
 #include "core/camera.hpp"
 #include "scene/load.hpp"
@@ -34,7 +36,10 @@ namespace {
 double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
 
 // Runs f(i) for i in [0, n) over `threads` threads in blocks of 256; returns the best of `reps` wall times.
-double timed(size_t n, unsigned threads, int reps, const std::function<void(size_t)>& f) {
+// Each thread sums f's results privately: one shared sink written per ray would bounce its cache line
+// between the cores and cap both tracers at the same rate.
+double timed(size_t n, unsigned threads, int reps, const std::function<uint32_t(size_t)>& f) {
+  static std::atomic<uint32_t> sink{0};
   double best = 1e30;
   for (int r = 0; r < reps; ++r) {
     std::atomic<size_t> next{0};
@@ -42,8 +47,10 @@ double timed(size_t n, unsigned threads, int reps, const std::function<void(size
     auto work = [&] {
       _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
       _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+      uint32_t acc = 0;
       for (size_t b; (b = next.fetch_add(256)) < n;)
-        for (size_t i = b; i < std::min(n, b + 256); ++i) f(i);
+        for (size_t i = b; i < std::min(n, b + 256); ++i) acc += f(i);
+      sink.fetch_add(acc, std::memory_order_relaxed);
     };
     std::vector<std::thread> pool;
     for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
@@ -114,9 +121,67 @@ std::vector<Triangle> trianglesOf(const Scene& s) {
   return t;
 }
 
+
+// Why a hit/miss disagreement happens: the triangle that one side hit, the watertight test's edge
+// functions for it (in float, as the scalar routine computes them), the edge the ray passes nearest and
+// whether another triangle shares that edge (same vertex positions). Counted by kind in `kinds`.
+// Whether the ray meets the triangle (edges included) in front of its origin, all in double precision.
+bool meetsInDouble(const Ray& r, const Triangle& t) {
+  const WatertightRay w(r);
+  const glm::dvec3 o(r.origin), d(r.direction);
+  const double sx = d[w.kx] / d[w.kz], sy = d[w.ky] / d[w.kz];
+  double x[3], y[3], z[3];
+  const glm::vec3 v[3] = {t.v0, t.v1, t.v2};
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec3 a = glm::dvec3(v[i]) - o;
+    x[i] = a[w.kx] - sx * a[w.kz]; y[i] = a[w.ky] - sy * a[w.kz]; z[i] = a[w.kz] / d[w.kz];
+  }
+  const double e0 = x[2] * y[1] - y[2] * x[1], e1 = x[0] * y[2] - y[0] * x[2], e2 = x[1] * y[0] - y[1] * x[0];
+  const double det = e0 + e1 + e2;
+  if (det == 0.0 || !((e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0))) return false;
+  return (e0 * z[0] + e1 * z[1] + e2 * z[2]) / det > 0.0;
+}
+
+void explain(const Ray& r, const Hit& ours, const Hit& theirs, const std::vector<Triangle>& tris, bool print,
+             std::map<std::string, size_t>& kinds) {
+  const Hit& h = ours.hit() ? ours : theirs;
+  const Triangle& t = tris[h.prim];
+  const WatertightRay w(r);
+  const glm::vec3 A = t.v0 - r.origin, B = t.v1 - r.origin, C = t.v2 - r.origin;
+  const float ax = A[w.kx] - w.sx * A[w.kz], ay = A[w.ky] - w.sy * A[w.kz];
+  const float bx = B[w.kx] - w.sx * B[w.kz], by = B[w.ky] - w.sy * B[w.kz];
+  const float cx = C[w.kx] - w.sx * C[w.kz], cy = C[w.ky] - w.sy * C[w.kz];
+  const float e[3] = {cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax};  // opposite v0, v1, v2
+  const glm::vec3 v[3] = {t.v0, t.v1, t.v2};
+  const float sum = std::fabs(e[0]) + std::fabs(e[1]) + std::fabs(e[2]);
+  int k = 0;
+  for (int i = 1; i < 3; ++i) if (std::fabs(e[i]) < std::fabs(e[k])) k = i;
+  const float rel = std::fabs(e[k]) / sum;  // 0: exactly on the edge in float
+  const glm::vec3 p = v[(k + 1) % 3], q = v[(k + 2) % 3];
+  int neighbours = 0;
+  bool meets = meetsInDouble(r, t);
+  for (uint32_t i = 0; i < tris.size(); ++i) {
+    if (i == h.prim) continue;
+    int shared = 0;
+    for (const glm::vec3& c : {tris[i].v0, tris[i].v1, tris[i].v2}) shared += c == p || c == q;
+    if (shared < 2) continue;
+    ++neighbours;
+    meets = meets || meetsInDouble(r, tris[i]);
+  }
+  std::string kind = ours.hit() ? "only ours hits" : "only Embree hits";
+  kind += rel == 0.0f ? ", exactly on an edge" : rel < 1e-5f ? ", within 1e-5 of an edge" : ", away from edges";
+  if (rel < 1e-5f) kind += neighbours ? " another triangle shares" : " of an open mesh (no other triangle shares it)";
+  kind += meets ? "; in double precision the ray meets it or a triangle across that edge"
+                : "; in double precision the ray meets neither it nor a triangle across that edge";
+  ++kinds[kind];
+  if (print)
+    std::printf("    triangle %u, t %.9g, edge functions %.3g %.3g %.3g: %s\n", h.prim, h.t, e[0], e[1], e[2], kind.c_str());
+}
+
 void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, unsigned threads, int res,
-                bool sphere) {
-  std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max\n\n", label, tris.size(), res, res, threads);
+                bool sphere, bool quick, bool explainAll) {
+  std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
+              res, threads, Bvh::isa() == BvhIsa::Avx2 ? "AVX2" : "SSE4.2");
   const auto t0 = Clock::now();
   const Bvh bvh(tris, {}, threads);
   const double ourBuild = seconds(t0);
@@ -158,15 +223,17 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   for (auto* set : {&primary, &mirror}) {
     size_t disagree = 0, otherTriangle = 0, farOff = 0;
     double maxRel = 0, maxRelSame = 0;
+    std::map<std::string, size_t> kinds;
     for (const Ray& r : *set) {
       const Hit a = bvh.closest(r), b = em.closest(r);
-      if (a.hit() != b.hit()) { ++disagree; continue; }
+      if (a.hit() != b.hit()) { explain(r, a, b, tris, explainAll, kinds); ++disagree; continue; }
       if (!a.hit()) continue;
       const double rel = std::fabs(double(a.t) - double(b.t)) / std::max(1e-30, double(b.t));
       maxRel = std::max(maxRel, rel);
       farOff += rel > 1e-4;
       if (a.prim != b.prim) ++otherTriangle; else maxRelSame = std::max(maxRelSame, rel);
     }
+    for (const auto& [kind, n] : kinds) std::printf("  (%zu: %s)\n", n, kind.c_str());
     std::printf("  (%zu rays hit another triangle than Embree's; %zu differ in t by more than 1e-4 relative; "
                 "same triangle: largest relative t difference %.3g)\n", otherTriangle, farOff, maxRelSame);
     size_t shadowDisagree = 0;
@@ -181,25 +248,25 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   std::printf("|---|---|---|---|---|\n");
   std::vector<unsigned> counts{1};
   if (threads > 1) counts.push_back(threads);
-  volatile uint32_t sink = 0;
   for (unsigned th : counts) {
     struct Set { const char* name; const std::vector<Ray>* rays; bool any; };
     for (const Set& s : {Set{"primary", &primary, false}, Set{"shadow (any hit)", &shadow, true}, Set{"mirror", &mirror, false}}) {
       const auto& rays = *s.rays;
       const double ours = timed(rays.size(), th, 3, [&](size_t i) {
-        sink = s.any ? uint32_t(bvh.occluded(rays[i])) : bvh.closest(rays[i]).prim;
+        return s.any ? uint32_t(bvh.occluded(rays[i])) : bvh.closest(rays[i]).prim;
       });
       const double theirs = timed(rays.size(), th, 3, [&](size_t i) {
-        sink = s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
+        return s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
       });
       std::printf("| %s | %u | %.2f | %.2f | %.2f× |\n", s.name, th, rays.size() / ours * 1e-6, rays.size() / theirs * 1e-6,
                   theirs / ours);
     }
   }
+  if (quick) return;
   std::printf("\nPrimary rays through our BVH with the other routines (1 thread):\n\n| routine | Mrays/s |\n|---|---|\n");
   for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::MollerTrumbore, IntersectMethod::HalfPlane}) {
-    const double t = timed(primary.size(), 1, 2, [&](size_t i) { sink = bvh.closest(primary[i], m).prim; });
-    std::printf("| %s | %.2f |\n", m == IntersectMethod::Watertight ? "watertight (4-wide SSE)" : m == IntersectMethod::HalfPlane ? "half-plane (scalar)" : "Möller–Trumbore (scalar)",
+    const double t = timed(primary.size(), 1, 2, [&](size_t i) { return bvh.closest(primary[i], m).prim; });
+    std::printf("| %s | %.2f |\n", m == IntersectMethod::Watertight ? "watertight (8-wide)" : m == IntersectMethod::HalfPlane ? "half-plane (scalar)" : "Möller–Trumbore (scalar)",
                 primary.size() / t * 1e-6);
   }
 }
@@ -258,25 +325,32 @@ int main(int argc, char** argv) {
   int res = 1024;
   uint32_t rings = 707;
   std::vector<std::string> scenes;
+  bool quick = false, explainAll = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
     else if (a == "--res" && i + 1 < argc) res = std::atoi(argv[++i]);
     else if (a == "--rings" && i + 1 < argc) rings = uint32_t(std::atoi(argv[++i]));
     else if (a == "--scene" && i + 1 < argc) scenes.push_back(argv[++i]);
-    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]...\n"); return 2; }
+    else if (a == "--quick") quick = true;
+    else if (a == "--explain") explainAll = true;
+    else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
+    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--sse] [--explain]\n"
+                              "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
+                              "  --sse: our traversal with SSE4.2 even where AVX2 is available\n"
+                              "  --explain: one line per hit/miss disagreement with Embree\n"); return 2; }
   }
   if (threads == 0 || res <= 0 || rings < 2) { std::fprintf(stderr, "bench-trace: bad argument\n"); return 2; }
-  benchRoutines();
+  if (!quick) benchRoutines();
   const Mesh sphere = uvSphere({0, 0, 0}, 1.0f, rings, rings + 1);
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
     tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
-  benchScene("UV sphere", tris, sphere.bounds, threads, res, true);
+  benchScene("UV sphere", tris, sphere.bounds, threads, res, true, quick, explainAll);
   for (const std::string& f : scenes) {
     try {
       const Scene s = loadScene(f);
-      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false);
+      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false, quick, explainAll);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "bench-trace: %s\n", e.what());
       return 1;

@@ -1,0 +1,289 @@
+// BVH traversal, compiled once per instruction set: bvh_sse.cpp and bvh_avx2.cpp include this with
+// RTR_BVH_ISA naming the namespace (sse, avx2) and RTR_BVH_AVX2 set for the 8-wide registers.
+// Everything here is inline and inside that namespace, and uses no glm or std function templates: an
+// out-of-line copy compiled for AVX2 must never be what the SSE build links to.
+#include <immintrin.h>
+
+#include <cstring>
+
+#include "trace/bvh.hpp"
+
+namespace rtr::trace::RTR_BVH_ISA {
+namespace {
+
+// Eight floats: one AVX register, or two SSE ones with the same per-lane results.
+#if RTR_BVH_AVX2
+struct F { __m256 v; };
+inline F load(const float* p) { return {_mm256_load_ps(p)}; }
+inline F set1(float x) { return {_mm256_set1_ps(x)}; }
+inline F operator+(F a, F b) { return {_mm256_add_ps(a.v, b.v)}; }
+inline F operator-(F a, F b) { return {_mm256_sub_ps(a.v, b.v)}; }
+inline F operator*(F a, F b) { return {_mm256_mul_ps(a.v, b.v)}; }
+inline F operator/(F a, F b) { return {_mm256_div_ps(a.v, b.v)}; }
+inline F operator&(F a, F b) { return {_mm256_and_ps(a.v, b.v)}; }
+inline F operator|(F a, F b) { return {_mm256_or_ps(a.v, b.v)}; }
+inline F operator^(F a, F b) { return {_mm256_xor_ps(a.v, b.v)}; }
+// min/max return the second operand when either is NaN, as the SSE instructions do.
+inline F vmin(F a, F b) { return {_mm256_min_ps(a.v, b.v)}; }
+inline F vmax(F a, F b) { return {_mm256_max_ps(a.v, b.v)}; }
+inline F lt(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
+inline F le(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)}; }
+inline F gt(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
+inline F ge(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GE_OQ)}; }
+inline F eq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
+inline F neq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NEQ_UQ)}; }
+inline unsigned bits(F a) { return unsigned(_mm256_movemask_ps(a.v)); }
+inline void store(float* p, F a) { _mm256_store_ps(p, a.v); }
+inline F fmsub(F a, F b, F c) { return {_mm256_fmsub_ps(a.v, b.v, c.v)}; }  // a·b − c, rounded once
+// The top bits of eight 32-bit integers.
+inline unsigned topBits(const uint32_t* p) {
+  return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(p)))));
+}
+#else
+struct F { __m128 a, b; };
+inline F load(const float* p) { return {_mm_load_ps(p), _mm_load_ps(p + 4)}; }
+inline F set1(float x) { return {_mm_set1_ps(x), _mm_set1_ps(x)}; }
+inline F operator+(F x, F y) { return {_mm_add_ps(x.a, y.a), _mm_add_ps(x.b, y.b)}; }
+inline F operator-(F x, F y) { return {_mm_sub_ps(x.a, y.a), _mm_sub_ps(x.b, y.b)}; }
+inline F operator*(F x, F y) { return {_mm_mul_ps(x.a, y.a), _mm_mul_ps(x.b, y.b)}; }
+inline F operator/(F x, F y) { return {_mm_div_ps(x.a, y.a), _mm_div_ps(x.b, y.b)}; }
+inline F operator&(F x, F y) { return {_mm_and_ps(x.a, y.a), _mm_and_ps(x.b, y.b)}; }
+inline F operator|(F x, F y) { return {_mm_or_ps(x.a, y.a), _mm_or_ps(x.b, y.b)}; }
+inline F operator^(F x, F y) { return {_mm_xor_ps(x.a, y.a), _mm_xor_ps(x.b, y.b)}; }
+inline F vmin(F x, F y) { return {_mm_min_ps(x.a, y.a), _mm_min_ps(x.b, y.b)}; }
+inline F vmax(F x, F y) { return {_mm_max_ps(x.a, y.a), _mm_max_ps(x.b, y.b)}; }
+inline F lt(F x, F y) { return {_mm_cmplt_ps(x.a, y.a), _mm_cmplt_ps(x.b, y.b)}; }
+inline F le(F x, F y) { return {_mm_cmple_ps(x.a, y.a), _mm_cmple_ps(x.b, y.b)}; }
+inline F gt(F x, F y) { return {_mm_cmpgt_ps(x.a, y.a), _mm_cmpgt_ps(x.b, y.b)}; }
+inline F ge(F x, F y) { return {_mm_cmpge_ps(x.a, y.a), _mm_cmpge_ps(x.b, y.b)}; }
+inline F eq(F x, F y) { return {_mm_cmpeq_ps(x.a, y.a), _mm_cmpeq_ps(x.b, y.b)}; }
+inline F neq(F x, F y) { return {_mm_cmpneq_ps(x.a, y.a), _mm_cmpneq_ps(x.b, y.b)}; }
+inline unsigned bits(F x) { return unsigned(_mm_movemask_ps(x.a)) | unsigned(_mm_movemask_ps(x.b)) << 4; }
+inline void store(float* p, F x) { _mm_store_ps(p, x.a); _mm_store_ps(p + 4, x.b); }
+inline unsigned topBits(const uint32_t* p) {
+  const __m128i* q = reinterpret_cast<const __m128i*>(p);
+  return unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(q)))) |
+         unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(q + 1)))) << 4;
+}
+#endif
+
+constexpr int kStackSize = 640;  // 7 entries per level, binary depth ≤ 48 + 32 (bvh.cpp)
+
+inline Triangle laneTriangle(const TriPack& p, int lane) {
+  float f[9];
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) f[k * 3 + a] = p.v[k][a][lane];
+  Triangle t;
+  std::memcpy(static_cast<void*>(&t), f, sizeof f);
+  return t;
+}
+
+inline uint32_t floatBits(float x) { return __builtin_bit_cast(uint32_t, x); }
+inline float bitsFloat(uint32_t x) { return __builtin_bit_cast(float, x); }
+inline int ctz(unsigned m) { return __builtin_ctz(m); }
+
+template <bool AnyHit>
+bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
+  static_assert(sizeof(Triangle) == 9 * sizeof(float));
+  const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+  const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+  const float rcp[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
+  // Slab distances, conservative under rounding so that the BVH keeps the watertight test watertight:
+  // a box the ray really meets is never culled. A zero direction component gives an infinite
+  // reciprocal and, on the slab's plane, NaN: the min/max below are ordered so that NaN is ignored.
+  int nearOff[3], farOff[3];
+#if RTR_BVH_AVX2
+  // One FMA per slab: t = box·r − o·r. The near distance uses r shrunk by 8 ulps and o·r pushed up by
+  // 4 ulps, the far one r grown and o·r pushed down: enough to cover every rounding (of 1/d, of o·r, of
+  // the FMA), so a near distance never ends up past the true one, nor a far one short of it.
+  F rNear[3], qNear[3], rFar[3], qFar[3];
+  for (int a = 0; a < 3; ++a) {
+    const float r = rcp[a];
+    const float rn = r * (1.0f - 0x1p-21f), rf = r * (1.0f + 0x1p-21f);
+    const float qn0 = o[a] * rn, qf0 = o[a] * rf;
+    const float qnf = qn0 + (__builtin_fabsf(qn0) * 0x1p-22f + 0x1p-100f);
+    const float qff = qf0 - (__builtin_fabsf(qf0) * 0x1p-22f + 0x1p-100f);
+    rNear[a] = set1(rn); qNear[a] = set1(qnf); rFar[a] = set1(rf); qFar[a] = set1(qff);
+    const int nearSide = r < 0.0f ? 1 : 0;
+    nearOff[a] = (nearSide * 3 + a) * 8;
+    farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+  }
+#else
+  // (box − o)·r, the far one scaled by 1 + 2·gamma(4) (Ize 2013; the scale folded into r, one more rounding).
+  constexpr float kFarScale = 1.0f + 2.0f * (4.0f * 0x1p-24f) / (1.0f - 4.0f * 0x1p-24f);
+  F org[3], rdir[3], rdirFar[3];
+  for (int a = 0; a < 3; ++a) {
+    const float inv = rcp[a];
+    org[a] = set1(o[a]);
+    rdir[a] = set1(inv);
+    rdirFar[a] = set1(inv * kFarScale);
+    const int nearSide = inv < 0.0f ? 1 : 0;
+    nearOff[a] = (nearSide * 3 + a) * 8;
+    farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+  }
+#endif
+  // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
+  // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
+  // must shear identically), inline here and sharing the reciprocal with the slab test.
+  const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[1]), __builtin_fabsf(d[2])};
+  const int kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+  int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
+  if (d[kz] < 0.0f) { const int t = kx; kx = ky; ky = t; }
+  const float szs = rcp[kz];
+  const F ox = set1(o[kx]), oy = set1(o[ky]), oz = set1(o[kz]);
+  const F sx = set1(d[kx] * szs), sy = set1(d[ky] * szs), sz = set1(szs);
+  const F zero = set1(0.0f), signBit = set1(-0.0f);
+
+  // Stack entries: the entry distance's bits above the node reference, so one integer compare sorts.
+  uint64_t stack[kStackSize];
+  int sp = 0;
+  uint32_t ref = bvh.root;
+  float tHit = ray.tMax;
+  bool found = false;
+
+  for (;;) {
+    const F tHitV = set1(tHit);
+    while (!(ref & Bvh::kLeafBit)) {
+      const Node& n = bvh.nodes[ref];
+      const float* b = &n.box[0][0][0];
+#if RTR_BVH_AVX2
+      const F tx0 = fmsub(load(b + nearOff[0]), rNear[0], qNear[0]);
+      const F ty0 = fmsub(load(b + nearOff[1]), rNear[1], qNear[1]);
+      const F tz0 = fmsub(load(b + nearOff[2]), rNear[2], qNear[2]);
+      const F tx1 = fmsub(load(b + farOff[0]), rFar[0], qFar[0]);
+      const F ty1 = fmsub(load(b + farOff[1]), rFar[1], qFar[1]);
+      const F tz1 = fmsub(load(b + farOff[2]), rFar[2], qFar[2]);
+#else
+      const F tx0 = (load(b + nearOff[0]) - org[0]) * rdir[0];
+      const F ty0 = (load(b + nearOff[1]) - org[1]) * rdir[1];
+      const F tz0 = (load(b + nearOff[2]) - org[2]) * rdir[2];
+      const F tx1 = (load(b + farOff[0]) - org[0]) * rdirFar[0];
+      const F ty1 = (load(b + farOff[1]) - org[1]) * rdirFar[1];
+      const F tz1 = (load(b + farOff[2]) - org[2]) * rdirFar[2];
+#endif
+      const F tNear = vmax(tz0, vmax(ty0, vmax(tx0, zero)));
+      const F tFar = vmin(tz1, vmin(ty1, vmin(tx1, tHitV)));
+      unsigned mask = bits(le(tNear, tFar));
+      if (mask == 0) goto pop;
+      const int c0 = ctz(mask);
+      mask &= mask - 1;
+      if (mask == 0) { ref = n.child[c0]; continue; }
+      // Two or more children: the one visited next is the smallest key, the others go on the stack.
+      // Closest hit goes nearest first, so that a hit culls the rest. Any hit goes farthest first: a
+      // shadow ray leaves a surface, and the boxes around its origin hold that surface and its
+      // neighbours, which rarely block it (measured: docs/bench/trace.md).
+      alignas(32) float dist[8];
+      store(dist, tNear);
+      auto key = [&](int c) {
+        const uint32_t d32 = floatBits(dist[c]);
+        return uint64_t(AnyHit ? ~d32 : d32) << 32 | n.child[c];
+      };
+      const int c1 = ctz(mask);
+      mask &= mask - 1;
+      if (mask == 0) {  // two, the common case
+        const uint64_t k0 = key(c0), k1 = key(c1);
+        stack[sp++] = k0 < k1 ? k1 : k0;
+        ref = uint32_t(k0 < k1 ? k0 : k1);
+        continue;
+      }
+      // Three or more: insertion sort onto the stack, smallest key on top.
+      uint64_t* run = stack + sp;
+      int k = 0;
+      for (mask |= 1u << c0 | 1u << c1; mask; mask &= mask - 1) {
+        const uint64_t kc = key(ctz(mask));
+        int j = k++;
+        while (j > 0 && run[j - 1] < kc) { run[j] = run[j - 1]; --j; }
+        run[j] = kc;
+      }
+      sp += k - 1;
+      ref = uint32_t(run[k - 1]);
+    }
+    {
+      const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+      for (uint32_t p = first; p < first + np; ++p) {
+        const TriPack& pk = bvh.packs[p];
+        if (method != IntersectMethod::Watertight) {
+          for (int lane = 0; lane < 8; ++lane) {
+            const uint32_t prim = pk.prim[lane];
+            if (AnyHit && (prim & Bvh::kNoShadowBit)) continue;
+            Ray r = ray;
+            r.tMax = tHit;
+            float b1, b2;
+            const float t = intersect(method, r, laneTriangle(pk, lane), b1, b2);
+            if (t > 0.0f) {
+              if constexpr (AnyHit) return true;
+              tHit = t; hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit}; found = true;
+            }
+          }
+          continue;
+        }
+        // The 8-wide watertight test: the same float operations in the same order as the scalar one
+        // (no FMA), so both agree bit for bit.
+        const F Az = load(pk.v[0][kz]) - oz, Bz = load(pk.v[1][kz]) - oz, Cz = load(pk.v[2][kz]) - oz;
+        const F ax = (load(pk.v[0][kx]) - ox) - sx * Az, ay = (load(pk.v[0][ky]) - oy) - sy * Az;
+        const F bx = (load(pk.v[1][kx]) - ox) - sx * Bz, by = (load(pk.v[1][ky]) - oy) - sy * Bz;
+        const F cx = (load(pk.v[2][kx]) - ox) - sx * Cz, cy = (load(pk.v[2][ky]) - oy) - sy * Cz;
+        const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
+        // Inside: U, V, W of one sign. Lanes with a zero go to the edge path; a NaN lane that passes
+        // here fails the t test below (as in the scalar routine, where it fails here).
+        // Exactly on an edge in float: the scalar routine decides in double.
+        unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W, zero));
+        unsigned m = ~bits((U ^ V) | (V ^ W)) & 0xFFu & ~edge;
+        if ((m | edge) == 0) continue;
+        const F det = U + V + W;
+        const F T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
+        const F detSign = det & signBit;
+        const F Ts = T ^ detSign;
+        m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tHitV * (det ^ detSign)));
+        if constexpr (AnyHit) {
+          const unsigned casters = ~topBits(pk.prim);
+          if (m & casters) return true;
+          edge &= casters;
+        } else if (m) {
+          const F inv = set1(1.0f) / det;
+          alignas(32) float tv[8], iv[8], vv[8], wv[8];
+          store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W);
+          for (; m; m &= m - 1) {
+            const int lane = ctz(m);
+            const float t = tv[lane];
+            if (t > 0.0f && t < tHit) {
+              tHit = t;
+              hit = {t, vv[lane] * iv[lane], wv[lane] * iv[lane], pk.prim[lane] & ~Bvh::kNoShadowBit};
+              found = true;
+            }
+          }
+        }
+        for (; edge; edge &= edge - 1) {
+          const int lane = ctz(edge);
+          WatertightRay r(ray);
+          r.tMax = tHit;
+          float b1, b2;
+          const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
+          if (t > 0.0f) {
+            if constexpr (AnyHit) return true;
+            tHit = t; hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit}; found = true;
+          }
+        }
+      }
+    }
+  pop:
+    for (;;) {
+      if (sp == 0) return found;
+      const uint64_t e = stack[--sp];
+      if (!AnyHit && bitsFloat(uint32_t(e >> 32)) > tHit) continue;
+      ref = uint32_t(e);
+      break;
+    }
+  }
+}
+
+}  // namespace
+
+bool closest(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
+  return traverse<false>(bvh, ray, method, hit);
+}
+bool occluded(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& scratch) {
+  return traverse<true>(bvh, ray, method, scratch);
+}
+
+}  // namespace rtr::trace::RTR_BVH_ISA
