@@ -82,13 +82,10 @@ fi
 if ! skipped compare; then  # GPU raster vs CPU trace, same view and shading model, with the image error
   row frame-compare rtr-frame-compare --size 1920x1080 --frames $cmpframes
 fi
-if ! skipped trace; then  # tracer vs Embree: 1M-triangle sphere, then the Sun-Temple-size scene
-  row trace-sphere-1t bench-trace --threads 1
-  row trace-sphere-all bench-trace --threads "$(nproc)"
-  if bin scenegen --out "$work/plain" --scale 100 --plain >/dev/null 2>&1; then
-    row trace-temple-1t bench-trace --threads 1 --scene "$work/plain/temple.obj"
-    row trace-temple-all bench-trace --threads "$(nproc)" --scene "$work/plain/temple.obj"
-  fi
+if ! skipped trace; then  # tracer vs Embree on the 1M-triangle sphere and the Sun-Temple-size scene,
+  # 1 thread and every core, plus the ray-triangle routines alone (one run of bench-trace does all)
+  bin scenegen --out "$work/plain" --scale 100 --plain >/dev/null 2>&1 &&
+    row trace bench-trace --threads "$(nproc)" --scene "$work/plain/temple.obj"
 fi
 if ! skipped bake; then  # ours vs tinyobjloader on the 175 MB temple (scale 300)
   if bin scenegen --out "$work/bake" --scale 300 --plain >/dev/null 2>&1 &&
