@@ -28,22 +28,17 @@ HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens,
     vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
       renderer_.record(cb, 0, pose, lens, settings, target);
       if (!last) return;
-      VkBufferImageCopy region{};
-      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      region.imageExtent = {extent_.width, extent_.height, 1};
-      vkCmdCopyImageToBuffer(cb, target_.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.handle(), 1, &region);
+      vk::copyImageToHost(cb, target_.handle(), extent_, readback_.handle());
       if (readSceneColor) {
         const VkImage color = renderer_.sceneColor().handle();
         vk::barrier(cb, {{color, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                           VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_READ_BIT}});
-        vkCmdCopyImageToBuffer(cb, color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorReadback_.handle(), 1, &region);
+        vk::copyImageToHost(cb, color, extent_, colorReadback_.handle());
         vk::barrier(cb, {{color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                           VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
                           VK_ACCESS_2_NONE}});
       }
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
     });
   }
   HeadlessFrame out;

@@ -51,22 +51,8 @@ void MosaicPass::record(VkCommandBuffer cb, VkImageView input, VkImage output, V
                     VK_ACCESS_2_NONE, write, 0, 1}});
   if (raster) {
     const vk::Pipeline& p = graphics(outputFormat);
-    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    color.imageView = outputView;
-    color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-    color.loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;  // the triangle covers every pixel
-    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, extent};
-    ri.layerCount = 1;
-    ri.colorAttachmentCount = 1;
-    ri.pColorAttachments = &color;
-    vkCmdBeginRendering(cb, &ri);
+    vk::beginColorRendering(cb, outputView, extent, VK_ATTACHMENT_LOAD_OP_DONT_CARE);  // the triangle covers all
     p.bind(cb);
-    const VkViewport vp{0, 0, float(extent.width), float(extent.height), 0, 1};
-    const VkRect2D sc{{0, 0}, extent};
-    vkCmdSetViewport(cb, 0, 1, &vp);
-    vkCmdSetScissor(cb, 0, 1, &sc);
     vk::DescriptorWriter(ctx_, p.layout, 0, VK_NULL_HANDLE)
         .image(0, input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
         .push(cb, p);

@@ -275,10 +275,7 @@ void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose
   ri.pColorAttachments = &colorAtt;
   ri.pDepthAttachment = &depthAtt;
   vkCmdBeginRendering(cb, &ri);
-  VkViewport vp{0, 0, float(target.extent.width), float(target.extent.height), 0.0f, 1.0f};
-  VkRect2D sc{{0, 0}, target.extent};
-  vkCmdSetViewport(cb, 0, 1, &vp);
-  vkCmdSetScissor(cb, 0, 1, &sc);
+  vk::setFullViewport(cb, target.extent);
   drawScene(cb, frame, set);
   vkCmdEndRendering(cb);
   timer.mark(cb, visibility ? "visibility" : "scene");

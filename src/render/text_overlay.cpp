@@ -19,8 +19,8 @@ constexpr float kMargin = 4.0f;        // font units of backdrop around the text
 
 TextOverlay::TextOverlay(const vk::Context& ctx, uint32_t framesInFlight) : ctx_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i)
-    rects_.emplace_back(ctx, kCapacity * sizeof(shader::TextRect), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                        vk::MemoryUse::Upload, "text overlay");
+    frames_.push_back({vk::Buffer(ctx, kCapacity * sizeof(shader::TextRect), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                  vk::MemoryUse::Upload, "text overlay")});
 }
 
 uint32_t TextOverlay::layout(const std::string& text, float scale, void* out, uint32_t capacity) {
@@ -29,7 +29,8 @@ uint32_t TextOverlay::layout(const std::string& text, float scale, void* out, ui
   // stb_easy_font writes 4 vertices of 16 bytes (x, y, z, rgba8) per quad, axis-aligned.
   std::vector<char> text0(text.begin(), text.end());
   text0.push_back('\0');
-  std::vector<float> verts(size_t(capacity - 1) * 16);
+  // stb_easy_font draws a printable ASCII glyph with at most 11 segments (quads): room for 12 per character.
+  std::vector<float> verts(std::min<size_t>(capacity - 1, 12 * text.size()) * 16);
   unsigned char white[4] = {255, 255, 255, 255};
   const int quads = stb_easy_font_print(kMargin, kMargin, text0.data(), white, verts.data(),
                                         int(verts.size() * sizeof(float)));
@@ -57,31 +58,23 @@ const vk::Pipeline& TextOverlay::pipeline(VkFormat format) {
 void TextOverlay::record(VkCommandBuffer cb, uint32_t frame, const std::string& text, VkImage image,
                          VkImageView view, VkFormat format, VkExtent2D extent, VkImageLayout layout,
                          VkImageLayout finalLayout, float scale) {
-  const vk::Buffer& buf = rects_.at(frame);
-  const uint32_t count = TextOverlay::layout(text, scale, buf.mapped(), kCapacity);
-  buf.flush();
+  FrameText& ft = frames_.at(frame);
+  if (ft.text != text || ft.scale != scale) {  // not in use: this frame slot's fence has signalled
+    ft.count = TextOverlay::layout(text, scale, ft.rects.mapped(), kCapacity);
+    ft.rects.flush();
+    ft.text = text;
+    ft.scale = scale;
+  }
+  const vk::Buffer& buf = ft.rects;
+  const uint32_t count = ft.count;
   // Everything before wrote the image (post pass, copies): wait for all of it, keep its contents.
   vk::barrier(cb, {{image, layout, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                     VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, 0, 1}});
   if (count > 0) {
     const vk::Pipeline& p = pipeline(format);
-    VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    color.imageView = view;
-    color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-    color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, extent};
-    ri.layerCount = 1;
-    ri.colorAttachmentCount = 1;
-    ri.pColorAttachments = &color;
-    vkCmdBeginRendering(cb, &ri);
+    vk::beginColorRendering(cb, view, extent, VK_ATTACHMENT_LOAD_OP_LOAD);  // text over the frame
     p.bind(cb);
-    const VkViewport vp{0, 0, float(extent.width), float(extent.height), 0, 1};
-    const VkRect2D sc{{0, 0}, extent};
-    vkCmdSetViewport(cb, 0, 1, &vp);
-    vkCmdSetScissor(cb, 0, 1, &sc);
     vk::DescriptorWriter(ctx_, p.layout, 0, VK_NULL_HANDLE).buffer(0, buf.handle()).push(cb, p);
     p.push(cb, shader::TextPush{{2.0f / float(extent.width), 2.0f / float(extent.height)}});
     vkCmdDraw(cb, count * 6, 1, 0, 0);

@@ -29,7 +29,13 @@ class TextOverlay {
  private:
   const vk::Pipeline& pipeline(VkFormat format);
   const vk::Context& ctx_;
-  std::vector<vk::Buffer> rects_;
+  struct FrameText {
+    vk::Buffer rects;
+    std::string text;  // what `rects` holds: laid out again only when the text changes
+    float scale = 0;
+    uint32_t count = 0;
+  };
+  std::vector<FrameText> frames_;
   std::map<VkFormat, vk::Pipeline> pipelines_;
 };
 

@@ -108,4 +108,35 @@ std::vector<std::pair<std::string, double>> GpuTimer::results() const {
   return out;
 }
 
+void copyImageToHost(VkCommandBuffer cb, VkImage image, VkExtent2D extent, VkBuffer buffer) {
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {extent.width, extent.height, 1};
+  vkCmdCopyImageToBuffer(cb, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
+  memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                VK_ACCESS_2_HOST_READ_BIT);
+}
+
+void setFullViewport(VkCommandBuffer cb, VkExtent2D extent) {
+  const VkViewport vp{0, 0, float(extent.width), float(extent.height), 0.0f, 1.0f};
+  const VkRect2D sc{{0, 0}, extent};
+  vkCmdSetViewport(cb, 0, 1, &vp);
+  vkCmdSetScissor(cb, 0, 1, &sc);
+}
+
+void beginColorRendering(VkCommandBuffer cb, VkImageView view, VkExtent2D extent, VkAttachmentLoadOp loadOp) {
+  VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  color.imageView = view;
+  color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  color.loadOp = loadOp;
+  color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+  VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  ri.renderArea = {{0, 0}, extent};
+  ri.layerCount = 1;
+  ri.colorAttachmentCount = 1;
+  ri.pColorAttachments = &color;
+  vkCmdBeginRendering(cb, &ri);
+  setFullViewport(cb, extent);
+}
+
 }  // namespace rtr::vk

@@ -28,6 +28,15 @@ void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images);
 void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
                    VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
 
+// Read-back: copies level 0 of a colour image (in TRANSFER_SRC_OPTIMAL) tightly packed into `buffer` and
+// makes the copy visible to the host once the submission's fence has signalled.
+void copyImageToHost(VkCommandBuffer cb, VkImage image, VkExtent2D extent, VkBuffer buffer);
+
+// Viewport and scissor covering all of `extent`.
+void setFullViewport(VkCommandBuffer cb, VkExtent2D extent);
+// Dynamic rendering into one colour attachment (no depth) covering `extent`, viewport and scissor set.
+void beginColorRendering(VkCommandBuffer cb, VkImageView view, VkExtent2D extent, VkAttachmentLoadOp loadOp);
+
 // Timestamps around named passes. Usage per frame: reset(cb); begin(cb); ...pass...; mark(cb, "pass"); ...
 // then, once the frame's fence has signalled, results() gives each pass's time in milliseconds.
 class GpuTimer {

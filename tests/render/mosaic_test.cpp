@@ -68,12 +68,7 @@ class MosaicTest : public VulkanTest {
     vk::Buffer readback(*ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
       pass.record(cb, input.view(), out.handle(), out.view(), format, extent, mode, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-      VkBufferImageCopy c{};
-      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      c.imageExtent = {extent.width, extent.height, 1};
-      vkCmdCopyImageToBuffer(cb, out.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(), 1, &c);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
+      vk::copyImageToHost(cb, out.handle(), extent, readback.handle());
     });
     readback.invalidate();
     const uint8_t* p = static_cast<const uint8_t*>(readback.mapped());

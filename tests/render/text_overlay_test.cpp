@@ -61,12 +61,7 @@ TEST_F(TextOverlayTest, DrawsTextOverTheFrameAndKeepsTheRest) {
     vkCmdClearColorImage(cb, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &grey, 1, &range);
     overlay.record(cb, 1, text, img.handle(), img.view(), format, e, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                    VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-    VkBufferImageCopy c{};
-    c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    c.imageExtent = {e.width, e.height, 1};
-    vkCmdCopyImageToBuffer(cb, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(), 1, &c);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                      VK_ACCESS_2_HOST_READ_BIT);
+    vk::copyImageToHost(cb, img.handle(), e, readback.handle());
   });
   readback.invalidate();
   const uint8_t* px = static_cast<const uint8_t*>(readback.mapped());

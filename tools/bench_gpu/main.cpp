@@ -193,14 +193,7 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
   // The output of each path, read back after its timed runs: compute and graphics must be identical.
   vk::Buffer readback(ctx, texels, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
   auto readOutput = [&] {
-    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-      VkBufferImageCopy c{};
-      c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      c.imageExtent = {extent.width, extent.height, 1};
-      vkCmdCopyImageToBuffer(cb, output.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(), 1, &c);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
-    });
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) { vk::copyImageToHost(cb, output.handle(), extent, readback.handle()); });
     readback.invalidate();
     const auto* p = static_cast<const uint8_t*>(readback.mapped());
     return std::vector<uint8_t>(p, p + texels);

@@ -101,6 +101,14 @@ class Report:
     def w(self, s=""):
         self.out.append(s)
 
+    def table(self, header, rows):
+        """A parsed table written back as Markdown, followed by a blank line."""
+        self.w("| " + " | ".join(header) + " |")
+        self.w("|" + "---|" * len(header))
+        for r in rows:
+            self.w("| " + " | ".join(r) + " |")
+        self.w()
+
     def plot(self, fig, name, caption):
         path = os.path.join(self.plots, name)
         fig.tight_layout()
@@ -198,13 +206,10 @@ class Report:
                     if build:
                         self.w(f"BVH build: {build.group(1)}")
                         self.w()
-                    self.w("| " + " | ".join(header) + " |")
-                    self.w("|" + "---|" * len(header))
+                    self.table(header, rows)
                     for r in rows:
-                        self.w("| " + " | ".join(r) + " |")
                         if cr is not None and num(r[cr]) is not None:
                             bars.append((f"{short} {r[0].split()[0]} {r[1]}t\n{m.label}", num(r[cr]), m.label))
-                    self.w()
                     for a in agree:
                         self.w(f"- {a}")
                     self.w()
@@ -247,11 +252,7 @@ class Report:
             mips = [r for r in rows if r[0] == "mips"]
             self.w(f"**{m.label}**")
             self.w()
-            self.w("| " + " | ".join(header[1:]) + " |")
-            self.w("|" + "---|" * (len(header) - 1))
-            for r in mips:
-                self.w("| " + " | ".join(r[1:]) + " |")
-            self.w()
+            self.table(header[1:], [r[1:] for r in mips])
             self.source(m, "gpu-passes")
             cmed, cerr = col(header, "median"), col(header, "error")
             for r in mips:
@@ -298,11 +299,7 @@ class Report:
             mos = [r for r in rows if r[0].startswith("mosaic")]
             self.w(f"**{m.label}**")
             self.w()
-            self.w("| " + " | ".join(header) + " |")
-            self.w("|" + "---|" * len(header))
-            for r in mos:
-                self.w("| " + " | ".join(r) + " |")
-            self.w()
+            self.table(header, mos)
             self.source(m, "gpu-passes")
             cmed = col(header, "median")
             by = {(r[1], r[2]): num(r[cmed]) for r in mos}
@@ -392,11 +389,7 @@ class Report:
             for header, rows in md_tables(t):
                 self.w(f"**{m.label}**")
                 self.w()
-                self.w("| " + " | ".join(header) + " |")
-                self.w("|" + "---|" * len(header))
-                for r in rows:
-                    self.w("| " + " | ".join(r) + " |")
-                self.w()
+                self.table(header, rows)
                 self.source(m, "frame-compare")
                 cg, cc, ce = col(header, "GPU frame"), col(header, "CPU trace ms"), col(header, "mean error")
                 for r in rows:

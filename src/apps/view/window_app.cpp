@@ -303,14 +303,9 @@ int runWindowed(const ViewOptions& o) {
                             VK_ACCESS_2_TRANSFER_READ_BIT}});
       }
       if (readBack) {
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {e.width, e.height, 1};
-        vkCmdCopyImageToBuffer(f.cb, target.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, shot.handle(), 1, &region);
+        vk::copyImageToHost(f.cb, target.image, e, shot.handle());
         vk::barrier(f.cb, {{target.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_ACCESS_2_NONE}});
-        vk::memoryBarrier(f.cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                          VK_ACCESS_2_HOST_READ_BIT);
       }
       // The overlay comes last, after any read-back copy: screenshots never contain it.
       if (app.overlay && !readBack)
