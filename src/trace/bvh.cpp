@@ -314,36 +314,61 @@ void HugeArray<T>::Free::operator()(T* p) const { std::free(p); }
 template class HugeArray<Node>;
 template class HugeArray<TriPack>;
 
-namespace sse {
-bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
-bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
-}  // namespace sse
-namespace avx2 {
-bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
-bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
-}  // namespace avx2
+#define RTR_DECLARE_TRAVERSAL(ns)                                 \
+  namespace ns {                                                  \
+  bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);  \
+  bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&); \
+  }
+RTR_DECLARE_TRAVERSAL(sse)
+RTR_DECLARE_TRAVERSAL(avx2)
+RTR_DECLARE_TRAVERSAL(avx512)
+#undef RTR_DECLARE_TRAVERSAL
 
 namespace {
-bool cpuHasAvx2() {
+bool cpuHas(BvhIsa isa) {
   __builtin_cpu_init();  // may run before libgcc's own initialiser (static initialisation order)
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  switch (isa) {
+    case BvhIsa::Sse: return true;
+    case BvhIsa::Avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case BvhIsa::Avx512:
+      return cpuHas(BvhIsa::Avx2) && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+  }
+  return false;
 }
-std::atomic<bool> useAvx2{cpuHasAvx2()};
+BvhIsa best(BvhIsa wanted) {
+  for (BvhIsa isa : {BvhIsa::Avx512, BvhIsa::Avx2})
+    if (int(isa) <= int(wanted) && cpuHas(isa)) return isa;
+  return BvhIsa::Sse;
+}
+std::atomic<BvhIsa> currentIsa{best(BvhIsa::Avx512)};
 }  // namespace
 
 BvhIsa Bvh::setIsa(BvhIsa isa) {
-  useAvx2 = isa == BvhIsa::Avx2 && cpuHasAvx2();
-  return Bvh::isa();
+  currentIsa = best(isa);
+  return currentIsa;
 }
 
-BvhIsa Bvh::isa() { return useAvx2.load(std::memory_order_relaxed) ? BvhIsa::Avx2 : BvhIsa::Sse; }
+BvhIsa Bvh::isa() { return currentIsa.load(std::memory_order_relaxed); }
+
+const char* Bvh::isaName(BvhIsa isa) {
+  switch (isa) {
+    case BvhIsa::Sse: return "SSE4.2";
+    case BvhIsa::Avx2: return "AVX2";
+    case BvhIsa::Avx512: return "AVX-512VL";
+  }
+  return "?";
+}
 
 Hit Bvh::closest(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return h;
   const View v{nodes_.data(), packs_.data(), root_};
-  if (useAvx2.load(std::memory_order_relaxed)) avx2::closest(v, ray, method, h);
-  else sse::closest(v, ray, method, h);
+  switch (currentIsa.load(std::memory_order_relaxed)) {
+    case BvhIsa::Avx512: avx512::closest(v, ray, method, h); break;
+    case BvhIsa::Avx2: avx2::closest(v, ray, method, h); break;
+    case BvhIsa::Sse: sse::closest(v, ray, method, h); break;
+  }
   return h;
 }
 
@@ -351,7 +376,12 @@ bool Bvh::occluded(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return false;
   const View v{nodes_.data(), packs_.data(), root_};
-  return useAvx2.load(std::memory_order_relaxed) ? avx2::occluded(v, ray, method, h) : sse::occluded(v, ray, method, h);
+  switch (currentIsa.load(std::memory_order_relaxed)) {
+    case BvhIsa::Avx512: return avx512::occluded(v, ray, method, h);
+    case BvhIsa::Avx2: return avx2::occluded(v, ray, method, h);
+    case BvhIsa::Sse: break;
+  }
+  return sse::occluded(v, ray, method, h);
 }
 
 }  // namespace rtr::trace

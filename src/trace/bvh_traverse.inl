@@ -1,9 +1,10 @@
-// BVH traversal, compiled once per instruction set: bvh_sse.cpp and bvh_avx2.cpp include this with
-// RTR_BVH_ISA naming the namespace (sse, avx2) and RTR_BVH_AVX2 set for the 8-wide registers.
+// BVH traversal, compiled once per instruction set: bvh_sse.cpp, bvh_avx2.cpp and bvh_avx512.cpp include
+// this with RTR_BVH_ISA naming the namespace (sse, avx2, avx512) and RTR_BVH_AVX2 set for 8-wide registers.
 // Everything here is inline and inside that namespace, and uses no glm or std function templates: an
 // out-of-line copy compiled for AVX2 must never be what the SSE build links to.
 #include <immintrin.h>
 
+#include <array>
 #include <cstring>
 
 #include "trace/bvh.hpp"
@@ -32,6 +33,7 @@ inline F gt(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
 inline F ge(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GE_OQ)}; }
 inline F eq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
 inline F neq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NEQ_UQ)}; }
+inline F ngt(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NGT_UQ)}; }  // true when unordered
 inline unsigned bits(F a) { return unsigned(_mm256_movemask_ps(a.v)); }
 inline void store(float* p, F a) { _mm256_store_ps(p, a.v); }
 inline F fmsub(F a, F b, F c) { return {_mm256_fmsub_ps(a.v, b.v, c.v)}; }  // a·b − c, rounded once
@@ -58,6 +60,7 @@ inline F gt(F x, F y) { return {_mm_cmpgt_ps(x.a, y.a), _mm_cmpgt_ps(x.b, y.b)};
 inline F ge(F x, F y) { return {_mm_cmpge_ps(x.a, y.a), _mm_cmpge_ps(x.b, y.b)}; }
 inline F eq(F x, F y) { return {_mm_cmpeq_ps(x.a, y.a), _mm_cmpeq_ps(x.b, y.b)}; }
 inline F neq(F x, F y) { return {_mm_cmpneq_ps(x.a, y.a), _mm_cmpneq_ps(x.b, y.b)}; }
+inline F ngt(F x, F y) { return {_mm_cmpngt_ps(x.a, y.a), _mm_cmpngt_ps(x.b, y.b)}; }
 inline unsigned bits(F x) { return unsigned(_mm_movemask_ps(x.a)) | unsigned(_mm_movemask_ps(x.b)) << 4; }
 inline void store(float* p, F x) { _mm_store_ps(p, x.a); _mm_store_ps(p + 4, x.b); }
 inline unsigned topBits(const uint32_t* p) {
@@ -67,6 +70,7 @@ inline unsigned topBits(const uint32_t* p) {
 }
 #endif
 
+constexpr float kInf = __builtin_inff();
 constexpr int kStackSize = 640;  // 7 entries per level, binary depth ≤ 48 + 32 (bvh.cpp)
 
 inline Triangle laneTriangle(const TriPack& p, int lane) {
@@ -82,15 +86,26 @@ inline uint32_t floatBits(float x) { return __builtin_bit_cast(uint32_t, x); }
 inline float bitsFloat(uint32_t x) { return __builtin_bit_cast(float, x); }
 inline int ctz(unsigned m) { return __builtin_ctz(m); }
 
-template <bool AnyHit>
+// Parallel: bit a set when the ray runs parallel to axis a (a zero direction component), see below.
+template <bool AnyHit, unsigned Parallel>
 bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
   static_assert(sizeof(Triangle) == 9 * sizeof(float));
   const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
   const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
   const float rcp[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
   // Slab distances, conservative under rounding so that the BVH keeps the watertight test watertight:
-  // a box the ray really meets is never culled. A zero direction component gives an infinite
-  // reciprocal and, on the slab's plane, NaN: the min/max below are ordered so that NaN is ignored.
+  // a box the ray really meets is never culled. A NaN distance (an overflow) never culls either: the
+  // test below is "not tNear > tFar". An axis the ray runs parallel to (orthographic views, axis-aligned
+  // rays) has no slab distances (they would be infinite or NaN and cull nothing: every box across the
+  // view visited, ~300× slower); its test is exact instead, lo ≤ o ≤ hi.
+  constexpr int kSlabs = 3 - __builtin_popcount(Parallel);
+  constexpr auto slabAxes = [] {
+    std::array<int, 3> axes{};
+    for (int a = 0, i = 0; a < 3; ++a)
+      if (!(Parallel >> a & 1)) axes[i++] = a;
+    return axes;
+  }();
+  const F oAxis[3] = {set1(o[0]), set1(o[1]), set1(o[2])};
   int nearOff[3], farOff[3];
 #if RTR_BVH_AVX2
   // One FMA per slab: t = box·r − o·r. The near distance uses r shrunk by 8 ulps and o·r pushed up by
@@ -146,24 +161,33 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
     while (!(ref & Bvh::kLeafBit)) {
       const Node& n = bvh.nodes[ref];
       const float* b = &n.box[0][0][0];
+      F tn[3], tf[3];
+      for (int i = 0; i < kSlabs; ++i) {
+        const int a = slabAxes[i];
 #if RTR_BVH_AVX2
-      const F tx0 = fmsub(load(b + nearOff[0]), rNear[0], qNear[0]);
-      const F ty0 = fmsub(load(b + nearOff[1]), rNear[1], qNear[1]);
-      const F tz0 = fmsub(load(b + nearOff[2]), rNear[2], qNear[2]);
-      const F tx1 = fmsub(load(b + farOff[0]), rFar[0], qFar[0]);
-      const F ty1 = fmsub(load(b + farOff[1]), rFar[1], qFar[1]);
-      const F tz1 = fmsub(load(b + farOff[2]), rFar[2], qFar[2]);
+        tn[i] = fmsub(load(b + nearOff[a]), rNear[a], qNear[a]);
+        tf[i] = fmsub(load(b + farOff[a]), rFar[a], qFar[a]);
 #else
-      const F tx0 = (load(b + nearOff[0]) - org[0]) * rdir[0];
-      const F ty0 = (load(b + nearOff[1]) - org[1]) * rdir[1];
-      const F tz0 = (load(b + nearOff[2]) - org[2]) * rdir[2];
-      const F tx1 = (load(b + farOff[0]) - org[0]) * rdirFar[0];
-      const F ty1 = (load(b + farOff[1]) - org[1]) * rdirFar[1];
-      const F tz1 = (load(b + farOff[2]) - org[2]) * rdirFar[2];
+        tn[i] = (load(b + nearOff[a]) - org[a]) * rdir[a];
+        tf[i] = (load(b + farOff[a]) - org[a]) * rdirFar[a];
 #endif
-      const F tNear = vmax(tz0, vmax(ty0, vmax(tx0, zero)));
-      const F tFar = vmin(tz1, vmin(ty1, vmin(tx1, tHitV)));
-      unsigned mask = bits(le(tNear, tFar));
+      }
+      // At most two levels of min/max, not a chain: this is the loop's critical path.
+      F tNear = zero, tFar = tHitV;
+      if constexpr (kSlabs == 3) {
+        tNear = vmax(vmax(tn[0], tn[1]), vmax(tn[2], zero));
+        tFar = vmin(vmin(tf[0], tf[1]), vmin(tf[2], tHitV));
+      } else if constexpr (kSlabs == 2) {
+        tNear = vmax(vmax(tn[0], tn[1]), zero);
+        tFar = vmin(vmin(tf[0], tf[1]), tHitV);
+      } else if constexpr (kSlabs == 1) {
+        tNear = vmax(tn[0], zero);
+        tFar = vmin(tf[0], tHitV);
+      }
+      F hitBox = ngt(tNear, tFar);
+      for (int a = 0; a < 3; ++a)
+        if (Parallel >> a & 1) hitBox = hitBox & le(load(b + a * 8), oAxis[a]) & ge(load(b + 24 + a * 8), oAxis[a]);
+      unsigned mask = bits(hitBox);
       if (mask == 0) goto pop;
       const int c0 = ctz(mask);
       mask &= mask - 1;
@@ -279,11 +303,27 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
 
 }  // namespace
 
+// One traversal per set of axes the ray runs parallel to; a zero direction meets nothing.
+template <bool AnyHit>
+bool dispatch(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
+  const glm::vec3& d = ray.direction;
+  switch (unsigned(d.x == 0.0f) | unsigned(d.y == 0.0f) << 1 | unsigned(d.z == 0.0f) << 2) {
+    case 0: return traverse<AnyHit, 0>(bvh, ray, method, hit);
+    case 1: return traverse<AnyHit, 1>(bvh, ray, method, hit);
+    case 2: return traverse<AnyHit, 2>(bvh, ray, method, hit);
+    case 3: return traverse<AnyHit, 3>(bvh, ray, method, hit);
+    case 4: return traverse<AnyHit, 4>(bvh, ray, method, hit);
+    case 5: return traverse<AnyHit, 5>(bvh, ray, method, hit);
+    case 6: return traverse<AnyHit, 6>(bvh, ray, method, hit);
+    default: return false;
+  }
+}
+
 bool closest(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
-  return traverse<false>(bvh, ray, method, hit);
+  return dispatch<false>(bvh, ray, method, hit);
 }
 bool occluded(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& scratch) {
-  return traverse<true>(bvh, ray, method, scratch);
+  return dispatch<true>(bvh, ray, method, scratch);
 }
 
 }  // namespace rtr::trace::RTR_BVH_ISA

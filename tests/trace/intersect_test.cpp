@@ -93,12 +93,14 @@ void expectClosedSphereWatertight(std::mt19937& rng, float radius, glm::vec3 cen
   for (IntersectMethod m : kMethods) {
     // Every ray through the BVH, with each traversal ISA (the same answers); every triangle (to count
     // double hits) for the aimed rays and 10k random.
-    size_t misses = 0, doubles = 0, tested = 0, bvhMisses = 0, sseMisses = 0;
+    size_t misses = 0, doubles = 0, tested = 0, bvhMisses = 0, sseMisses = 0, avx2Misses = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
       bvhMisses += !bvh.closest(rays[i], m).hit();
       Bvh::setIsa(BvhIsa::Sse);
       sseMisses += !bvh.closest(rays[i], m).hit();
       Bvh::setIsa(BvhIsa::Avx2);
+      avx2Misses += !bvh.closest(rays[i], m).hit();
+      Bvh::setIsa(BvhIsa::Avx512);
       if (i >= 10000 && i < 100000) continue;
       const int n = hitCount(m, rays[i], tris);
       ++tested;
@@ -113,6 +115,7 @@ void expectClosedSphereWatertight(std::mt19937& rng, float radius, glm::vec3 cen
       EXPECT_EQ(doubles, 0u);
       EXPECT_EQ(bvhMisses, 0u);
       EXPECT_EQ(sseMisses, 0u);
+      EXPECT_EQ(avx2Misses, 0u);
     }
   }
 }

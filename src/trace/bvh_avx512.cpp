@@ -1,0 +1,5 @@
+// The BVH traversal with AVX-512VL: the AVX2 code, compiled with 32 vector registers (this file alone is
+// compiled for them; bvh.cpp picks it at run time).
+#define RTR_BVH_ISA avx512
+#define RTR_BVH_AVX2 1
+#include "trace/bvh_traverse.inl"
