@@ -4,7 +4,6 @@
 // out-of-line copy compiled for AVX2 must never be what the SSE build links to.
 #include <immintrin.h>
 
-#include <array>
 #include <cstring>
 
 #include "trace/bvh.hpp"
@@ -88,6 +87,16 @@ inline uint32_t floatBits(float x) { return __builtin_bit_cast(uint32_t, x); }
 inline float bitsFloat(uint32_t x) { return __builtin_bit_cast(float, x); }
 inline int ctz(unsigned m) { return __builtin_ctz(m); }
 
+// The axes that get slab distances: those the ray is not parallel to (a plain struct, not std::array:
+// see the top of this file).
+struct SlabAxes { int axis[3]; };
+constexpr SlabAxes slabAxesOf(unsigned parallel) {
+  SlabAxes s{};
+  for (int a = 0, i = 0; a < 3; ++a)
+    if (!(parallel >> a & 1)) s.axis[i++] = a;
+  return s;
+}
+
 // Parallel: bit a set when the ray runs parallel to axis a (a zero direction component), see below.
 template <bool AnyHit, unsigned Parallel>
 bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
@@ -101,12 +110,7 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
   // rays) has no slab distances (they would be infinite or NaN and cull nothing: every box across the
   // view visited, ~300× slower); its test is exact instead, lo ≤ o ≤ hi.
   constexpr int kSlabs = 3 - __builtin_popcount(Parallel);
-  constexpr auto slabAxes = [] {
-    std::array<int, 3> axes{};
-    for (int a = 0, i = 0; a < 3; ++a)
-      if (!(Parallel >> a & 1)) axes[i++] = a;
-    return axes;
-  }();
+  constexpr SlabAxes slabs = slabAxesOf(Parallel);
   const F oAxis[3] = {set1(o[0]), set1(o[1]), set1(o[2])};
   int nearOff[3], farOff[3];
 #if RTR_BVH_AVX2
@@ -168,7 +172,7 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
       const float* b = &n.box[0][0][0];
       F tn[3], tf[3];
       for (int i = 0; i < kSlabs; ++i) {
-        const int a = slabAxes[i];
+        const int a = slabs.axis[i];
 #if RTR_BVH_AVX2
         tn[i] = fmsub(load(b + nearOff[a]), rNear[a], qNear[a]);
         tf[i] = fmsub(load(b + farOff[a]), rFar[a], qFar[a]);
