@@ -55,7 +55,7 @@ trap 'rm -rf "$work"' EXIT
   echo "quick: $quick"
 } >"$out/meta.txt"
 # The Vulkan device and driver, as the renderer sees them.
-bin rtr-view "$temple" --headless --size 64x64 2>&1 | grep -m1 ' on ' | sed 's/^/vulkan: /' >>"$out/meta.txt"
+bin rtr-view "$temple" --headless --size 64x64 --screenshot "$work/meta.png" 2>&1 | grep -m1 ' on ' | sed 's/^/vulkan: /' >>"$out/meta.txt"
 
 if ! skipped gpu; then
   row gpu-passes rtr-bench-gpu --runs $runs --warmup $warm
