@@ -33,6 +33,10 @@ inline F ge(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GE_OQ)}; }
 inline F eq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
 inline F neq(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NEQ_UQ)}; }
 inline F ngt(F a, F b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NGT_UQ)}; }  // true when unordered
+// Max and min of the floats' bit patterns as signed integers (one cycle, not four, on Intel): the same as
+// the float max/min when one operand is ≥ +0, see the box test.
+inline F imax(F a, F b) { return {_mm256_castsi256_ps(_mm256_max_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))}; }
+inline F imin(F a, F b) { return {_mm256_castsi256_ps(_mm256_min_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))}; }
 inline unsigned bits(F a) { return unsigned(_mm256_movemask_ps(a.v)); }
 template <int Lane>
 inline F lane(__m128 v) { return {_mm256_broadcastss_ps(_mm_shuffle_ps(v, v, _MM_SHUFFLE(Lane, Lane, Lane, Lane)))}; }
@@ -62,6 +66,10 @@ inline F ge(F x, F y) { return {_mm_cmpge_ps(x.a, y.a), _mm_cmpge_ps(x.b, y.b)};
 inline F eq(F x, F y) { return {_mm_cmpeq_ps(x.a, y.a), _mm_cmpeq_ps(x.b, y.b)}; }
 inline F neq(F x, F y) { return {_mm_cmpneq_ps(x.a, y.a), _mm_cmpneq_ps(x.b, y.b)}; }
 inline F ngt(F x, F y) { return {_mm_cmpngt_ps(x.a, y.a), _mm_cmpngt_ps(x.b, y.b)}; }
+inline __m128 imax4(__m128 a, __m128 b) { return _mm_castsi128_ps(_mm_max_epi32(_mm_castps_si128(a), _mm_castps_si128(b))); }
+inline __m128 imin4(__m128 a, __m128 b) { return _mm_castsi128_ps(_mm_min_epi32(_mm_castps_si128(a), _mm_castps_si128(b))); }
+inline F imax(F x, F y) { return {imax4(x.a, y.a), imax4(x.b, y.b)}; }
+inline F imin(F x, F y) { return {imin4(x.a, y.a), imin4(x.b, y.b)}; }
 inline unsigned bits(F x) { return unsigned(_mm_movemask_ps(x.a)) | unsigned(_mm_movemask_ps(x.b)) << 4; }
 inline void store(float* p, F x) { _mm_store_ps(p, x.a); _mm_store_ps(p + 4, x.b); }
 inline unsigned topBits(const uint32_t* p) {
@@ -181,17 +189,21 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
         tf[i] = (load(b + farOff[a]) - org[a]) * rdirFar[a];
 #endif
       }
-      // At most two levels of min/max, not a chain: this is the loop's critical path.
+      // At most two levels of min/max, not a chain: this is the loop's critical path. Integer max/min of
+      // the bit patterns: with +0 among the near distances, a negative one (sign bit set: a negative
+      // integer) never wins, and non-negative floats order as their bits do, so tNear is exact; a far
+      // distance below zero makes tFar negative (maybe not the most negative, but the box is culled
+      // either way), else tFar is exact. A NaN either drops out or reaches the compare, which visits.
       F tNear = zero, tFar = tHitV;
       if constexpr (kSlabs == 3) {
-        tNear = vmax(vmax(tn[0], tn[1]), vmax(tn[2], zero));
-        tFar = vmin(vmin(tf[0], tf[1]), vmin(tf[2], tHitV));
+        tNear = imax(imax(tn[0], tn[1]), imax(tn[2], zero));
+        tFar = imin(imin(tf[0], tf[1]), imin(tf[2], tHitV));
       } else if constexpr (kSlabs == 2) {
-        tNear = vmax(vmax(tn[0], tn[1]), zero);
-        tFar = vmin(vmin(tf[0], tf[1]), tHitV);
+        tNear = imax(imax(tn[0], tn[1]), zero);
+        tFar = imin(imin(tf[0], tf[1]), tHitV);
       } else if constexpr (kSlabs == 1) {
-        tNear = vmax(tn[0], zero);
-        tFar = vmin(tf[0], tHitV);
+        tNear = imax(tn[0], zero);
+        tFar = imin(tf[0], tHitV);
       }
       F hitBox = ngt(tNear, tFar);
       for (int a = 0; a < 3; ++a)
