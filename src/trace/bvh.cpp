@@ -325,6 +325,16 @@ RTR_DECLARE_TRAVERSAL(avx512)
 #undef RTR_DECLARE_TRAVERSAL
 
 namespace {
+// The traversals by BvhIsa.
+struct Traversal {
+  bool (*closest)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
+  bool (*occluded)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
+};
+constexpr Traversal kTraversals[] = {{sse::closest, sse::occluded}, {avx2::closest, avx2::occluded},
+                                     {avx512::closest, avx512::occluded}};
+}  // namespace
+
+namespace {
 bool cpuHas(BvhIsa isa) {
   __builtin_cpu_init();  // may run before libgcc's own initialiser (static initialisation order)
   switch (isa) {
@@ -363,25 +373,14 @@ const char* Bvh::isaName(BvhIsa isa) {
 Hit Bvh::closest(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return h;
-  const View v{nodes_.data(), packs_.data(), root_};
-  switch (currentIsa.load(std::memory_order_relaxed)) {
-    case BvhIsa::Avx512: avx512::closest(v, ray, method, h); break;
-    case BvhIsa::Avx2: avx2::closest(v, ray, method, h); break;
-    case BvhIsa::Sse: sse::closest(v, ray, method, h); break;
-  }
+  kTraversals[int(isa())].closest({nodes_.data(), packs_.data(), root_}, ray, method, h);
   return h;
 }
 
 bool Bvh::occluded(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return false;
-  const View v{nodes_.data(), packs_.data(), root_};
-  switch (currentIsa.load(std::memory_order_relaxed)) {
-    case BvhIsa::Avx512: return avx512::occluded(v, ray, method, h);
-    case BvhIsa::Avx2: return avx2::occluded(v, ray, method, h);
-    case BvhIsa::Sse: break;
-  }
-  return sse::occluded(v, ray, method, h);
+  return kTraversals[int(isa())].occluded({nodes_.data(), packs_.data(), root_}, ray, method, h);
 }
 
 }  // namespace rtr::trace

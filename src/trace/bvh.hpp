@@ -53,7 +53,7 @@ class Bvh {
  public:
   static constexpr uint32_t kLeafBit = 0x80000000u;
   static constexpr uint32_t kNoShadowBit = 0x80000000u;
-    static constexpr uint32_t kMaxLeafTriangles = 16;
+  static constexpr uint32_t kMaxLeafTriangles = 16;
   static constexpr uint32_t kMaxTriangles = 0x7FFFFFFFu;
 
   Bvh() = default;

@@ -66,10 +66,6 @@ inline F ge(F x, F y) { return {_mm_cmpge_ps(x.a, y.a), _mm_cmpge_ps(x.b, y.b)};
 inline F eq(F x, F y) { return {_mm_cmpeq_ps(x.a, y.a), _mm_cmpeq_ps(x.b, y.b)}; }
 inline F neq(F x, F y) { return {_mm_cmpneq_ps(x.a, y.a), _mm_cmpneq_ps(x.b, y.b)}; }
 inline F ngt(F x, F y) { return {_mm_cmpngt_ps(x.a, y.a), _mm_cmpngt_ps(x.b, y.b)}; }
-inline __m128 imax4(__m128 a, __m128 b) { return _mm_castsi128_ps(_mm_max_epi32(_mm_castps_si128(a), _mm_castps_si128(b))); }
-inline __m128 imin4(__m128 a, __m128 b) { return _mm_castsi128_ps(_mm_min_epi32(_mm_castps_si128(a), _mm_castps_si128(b))); }
-inline F imax(F x, F y) { return {imax4(x.a, y.a), imax4(x.b, y.b)}; }
-inline F imin(F x, F y) { return {imin4(x.a, y.a), imin4(x.b, y.b)}; }
 inline unsigned bits(F x) { return unsigned(_mm_movemask_ps(x.a)) | unsigned(_mm_movemask_ps(x.b)) << 4; }
 inline void store(float* p, F x) { _mm_store_ps(p, x.a); _mm_store_ps(p + 4, x.b); }
 inline unsigned topBits(const uint32_t* p) {
@@ -219,7 +215,7 @@ bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit&
       }
       F hitBox = ngt(tNear, tFar);
       for (int a = 0; a < 3; ++a)
-        if (Parallel >> a & 1) hitBox = hitBox & le(load(b + a * 8), oAxis[a]) & ge(load(b + 24 + a * 8), oAxis[a]);
+        if (Parallel >> a & 1) hitBox = hitBox & le(load(n.box[0][a]), oAxis[a]) & ge(load(n.box[1][a]), oAxis[a]);
       unsigned mask = bits(hitBox);
       if (mask == 0) goto pop;
       const int c0 = ctz(mask);

@@ -194,23 +194,22 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   CameraPose pose = frameBounds(bounds, lens, 1.0f);
   // The unit sphere just inscribed in the square image (about 78 % of rays hit, as in ANCHORS.md).
   if (sphere) pose.position = {0.0f, 0.0f, 1.01f / std::sin(glm::radians(lens.fovYDeg * 0.5f))};
-  std::vector<Ray> primary(size_t(res) * res);
-  for (int y = 0; y < res; ++y)
-    for (int x = 0; x < res; ++x) {
-      const CameraRay cr = cameraRay(pose, lens, 1.0f, pixelToNdc(x + 0.5f, y + 0.5f, res, res));
-      primary[size_t(y) * res + x] = {cr.origin, cr.direction};
-    }
+  auto cameraRays = [&](const Lens& l) {
+    std::vector<Ray> rays(size_t(res) * res);
+    for (int y = 0; y < res; ++y)
+      for (int x = 0; x < res; ++x) {
+        const CameraRay cr = cameraRay(pose, l, 1.0f, pixelToNdc(x + 0.5f, y + 0.5f, res, res));
+        rays[size_t(y) * res + x] = {cr.origin, cr.direction};
+      }
+    return rays;
+  };
+  std::vector<Ray> primary = cameraRays(lens);
   // The same view, orthographic: every ray runs parallel to two axes (the case that once made our
   // traversal visit every box across the view).
   Lens orthoLens = lens;
   orthoLens.orthographic = true;
   orthoLens.orthoHalfHeight = sphere ? 1.01f : 0.55f * std::max(bounds.extent().x, bounds.extent().y);
-  std::vector<Ray> ortho(size_t(res) * res);
-  for (int y = 0; y < res; ++y)
-    for (int x = 0; x < res; ++x) {
-      const CameraRay cr = cameraRay(pose, orthoLens, 1.0f, pixelToNdc(x + 0.5f, y + 0.5f, res, res));
-      ortho[size_t(y) * res + x] = {cr.origin, cr.direction};
-    }
+  std::vector<Ray> ortho = cameraRays(orthoLens);
   // Secondary rays from Embree's... no: from our hits (the same rays go to both).
   std::vector<Hit> hits(primary.size());
   for (size_t i = 0; i < primary.size(); ++i) hits[i] = bvh.closest(primary[i]);
