@@ -95,7 +95,10 @@ int run(int argc, char** argv) {
   if (tty) std::fprintf(stderr, "\r\033[K");
   savePng(outPath, toSrgb8(image));
   if (!quiet) {
-    const uint64_t rays = st.primaryRays + st.shadowRays + st.reflectionRays;
+    if (s.shading == Shading::Pbr)
+      std::fprintf(stderr, "rtr-trace: %zu textures decoded and mip-mapped in %.3f s; %llu rays continued past cut-out texels\n",
+                   tracer.textures().count(), tracer.textures().loadSeconds(), (unsigned long long)st.alphaRays);
+    const uint64_t rays = st.primaryRays + st.shadowRays + st.reflectionRays + st.alphaRays;
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
                  "(%llu primary, %llu shadow, %llu mirror), %.2f Mrays/s; pose %s -> %s\n",
