@@ -232,6 +232,9 @@ Tracer::Frame Tracer::makeFrame(const TraceSettings& s) const {
   const float h = float(std::max(1u, s.height));
   if (s.lens.orthographic) f.camera = {2.0f * s.lens.orthoHalfHeight / h * glm::length(glm::vec3(f.toScene[0])), 0.0f};
   else f.camera = {0.0f, std::atan(2.0f * std::tan(glm::radians(s.lens.fovYDeg) * 0.5f) / h)};
+  // A cone 2^bias times as wide: every LOD goes up by the bias.
+  f.camera.width *= std::exp2(s.lodBias);
+  f.camera.spread *= std::exp2(s.lodBias);
   return f;
 }
 

@@ -50,6 +50,7 @@ struct TraceSettings {
   uint32_t tileSize = 32;
   int areaLightSamples = 1;        // shadow rays per area light: 1 aims at its centre (hard shadows)
   PbrLight pbrLight;
+  float lodBias = 0.0f;            // pbr: added to every texture's level of detail, as the GPU's bias
   glm::vec3 background{0.0f};
 };
 

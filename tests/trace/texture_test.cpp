@@ -140,6 +140,9 @@ TEST(TracerTextures, RayConeLodFollowsDistancePixelSizeAndProjection) {
   EXPECT_NEAR(whiteAt(0.5f), 0.5f + 0.5f * grey, 1e-4f);
   EXPECT_NEAR(whiteAt(1.0f), grey, 1e-4f);
   EXPECT_NEAR(whiteAt(20.0f), grey, 1e-5f);  // far beyond the 1×1 level: clamped to it
+  ts.lodBias = 1.0f;                          // the GPU's LOD bias: one level up
+  EXPECT_NEAR(whiteAt(-0.5f), 0.5f + 0.5f * grey, 1e-4f);
+  ts.lodBias = 0.0f;
   float previous = 2.0f;
   for (float lod = -1.0f; lod <= 1.5f; lod += 0.125f) {
     const float v = whiteAt(lod);

@@ -56,6 +56,7 @@ int run(int argc, char** argv) {
   app.add_option("--light", light, "pbr: point light position x,y,z (default: the GPU renderer's)");
   app.add_option("--light-color", lightColor, "pbr: light colour r,g,b");
   app.add_option("--ambient", s.pbrLight.ambient, "pbr: ambient")->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
+  app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")->capture_default_str()->check(CLI::Range(-16.0f, 16.0f));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
     app.parse(argc, argv);
