@@ -35,8 +35,10 @@ MipTexture::MipTexture(const TexelData& image, bool srgb) : channels_(image.chan
     throw Error("texture: " + std::to_string(channels_) + " channels; the tracer samples 1 or 4");
   const MipChain chain = buildMipReference(image, srgb ? TexelEncoding::Srgb : TexelEncoding::Unorm,
                                            MipSource::PreviousLevel);
-  for (uint32_t k = 0; k < chain.levels.size(); ++k)
-    levels_.push_back({chain.levels[k].width, chain.levels[k].height, k == 0 ? image.texels : quantizeMipLevel(chain, k)});
+  for (uint32_t k = 0; k < chain.levels.size(); ++k) {
+    const MipLevel& l = chain.levels[k];
+    levels_.push_back({l.width, l.height, k == 0 ? image.texels : quantizeMipLevel(chain, k)});
+  }
   halfLog2Area_ = 0.5f * std::log2(float(width()) * float(height()));
 }
 

@@ -72,7 +72,9 @@ Ray rayAt(glm::vec2 uv, float depth, float dist) {
 float srgb(uint8_t b) { return float(decodeTexel(b, 0, TexelEncoding::Srgb)); }
 
 // A 4×4 texture of distinct colours.
-Texel pattern(uint32_t x, uint32_t y) { return {uint8_t(40 + 60 * x), uint8_t(200 - 50 * y), uint8_t(17 * (x + 4 * y)), 255}; }
+Texel pattern(uint32_t x, uint32_t y) {
+  return {uint8_t(40 + 60 * x), uint8_t(200 - 50 * y), uint8_t(17 * (x + 4 * y)), 255};
+}
 
 void expectNear(glm::vec3 a, glm::vec3 b, float tol, const std::string& what) {
   EXPECT_NEAR(a.x, b.x, tol) << what;

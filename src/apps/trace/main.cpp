@@ -56,7 +56,8 @@ int run(int argc, char** argv) {
   app.add_option("--light", light, "pbr: point light position x,y,z (default: the GPU renderer's)");
   app.add_option("--light-color", lightColor, "pbr: light colour r,g,b");
   app.add_option("--ambient", s.pbrLight.ambient, "pbr: ambient")->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
-  app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")->capture_default_str()->check(CLI::Range(-16.0f, 16.0f));
+  app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
+      ->capture_default_str()->check(CLI::Range(-16.0f, 16.0f));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
     app.parse(argc, argv);
@@ -97,8 +98,9 @@ int run(int argc, char** argv) {
   savePng(outPath, toSrgb8(image));
   if (!quiet) {
     if (s.shading == Shading::Pbr)
-      std::fprintf(stderr, "rtr-trace: %zu textures decoded and mip-mapped in %.3f s; %llu rays continued past cut-out texels\n",
-                   tracer.textures().count(), tracer.textures().loadSeconds(), (unsigned long long)st.alphaRays);
+      std::fprintf(stderr, "rtr-trace: %zu textures decoded and mip-mapped in %.3f s; %llu rays continued past "
+                   "cut-out texels\n", tracer.textures().count(), tracer.textures().loadSeconds(),
+                   (unsigned long long)st.alphaRays);
     const uint64_t rays = st.primaryRays + st.shadowRays + st.reflectionRays + st.alphaRays;
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
