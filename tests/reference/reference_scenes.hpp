@@ -1,6 +1,6 @@
 #pragma once
-// Scenes, poses and lights of the GPU-vs-CPU reference tests: the generated default scene (untextured
-// copy), the ray tracer's course scenes, and synthetic hard views built in code.
+// Scenes, poses and lights of the GPU-vs-CPU reference tests: the generated default scene (an untextured
+// copy, and as baked), the ray tracer's course scenes, and synthetic hard views built in code.
 #include <filesystem>
 #include <map>
 #include <string>
