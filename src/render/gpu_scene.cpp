@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
-#include <future>
-#include <thread>
 
 #include "core/image.hpp"
+#include "scene/textures.hpp"
 #include "vk/check.hpp"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
@@ -17,15 +16,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-// Texture slots the renderer samples (the normal map is not part of the brief's shading model).
-constexpr TextureSlot kSampledSlots[] = {TextureSlot::BaseColor, TextureSlot::Roughness, TextureSlot::Metalness,
-                                         TextureSlot::AlphaMask, TextureSlot::Emissive};
-
 VkFormat textureFormat(const Texture& t) {
-  if (t.channels == 1) return VK_FORMAT_R8_UNORM;
-  return t.srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+  if (decodeChannels(t) == 1) return VK_FORMAT_R8_UNORM;
+  return decodeSrgb(t) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
 }
-int decodeChannels(const Texture& t) { return t.channels == 1 ? 1 : 4; }
 
 // Appends `bytes` to a staging byte vector at an offset aligned for copies, returning the offset.
 size_t append(std::vector<uint8_t>& staging, const void* bytes, size_t size) {
@@ -41,37 +35,14 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
   const auto t0 = Clock::now();
   bounds_ = scene.bounds();
 
-  // Which textures are sampled: only slots of materials drawn by meshes that have texcoords.
+  // Which textures are sampled (scene/textures.hpp), decoded on all cores.
+  const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
   std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
-  std::vector<uint32_t> used;  // scene texture indices, in GPU array order
-  bool anyTexcoords = false;
-  for (const Mesh& m : scene.meshes) {
-    if (m.texcoords.empty() || m.indices.empty()) continue;
-    anyTexcoords = true;
-    for (TextureSlot slot : kSampledSlots) {
-      uint32_t t = scene.materials.at(m.material).texture(slot);
-      if (t != kNoTexture && gpuIndex.at(t) == NO_TEXTURE) {
-        gpuIndex[t] = uint32_t(used.size());
-        used.push_back(t);
-      }
-    }
-  }
-
-  // Decode on all cores; each texture is independent.
+  for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
+  const bool anyTexcoords = std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                                        [](const Mesh& m) { return !m.texcoords.empty() && !m.indices.empty(); });
   std::vector<TexelData> texels(used.size());
-  {
-    std::atomic<size_t> next{0};
-    std::vector<std::future<void>> workers;
-    const unsigned n = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(used.size())));
-    for (unsigned w = 0; w < n; ++w)
-      workers.push_back(std::async(std::launch::async, [&] {
-        for (size_t i; (i = next++) < used.size();) {
-          const Texture& t = scene.textures[used[i]];
-          texels[i] = loadImage(t.path.is_absolute() ? t.path : scene.baseDir / t.path, decodeChannels(t));
-        }
-      }));
-    for (auto& w : workers) w.get();  // rethrows the first decode error
-  }
+  decodeTextures(scene, used, [&](size_t i, TexelData&& t) { texels[i] = std::move(t); });
   stats_.decodeMs = msSince(t0);
   const auto t1 = Clock::now();
 

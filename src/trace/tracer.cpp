@@ -10,10 +10,12 @@
 #include <xmmintrin.h>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
 
 #include "core/error.hpp"
+#include "scene/textures.hpp"
 #include "trace/shade.hpp"
 #include "trace/spawn.hpp"
 
@@ -21,10 +23,27 @@ namespace rtr::trace {
 
 glm::mat4 modelview(const CameraPose& pose, const glm::mat4& model) { return viewMatrix(pose) * model; }
 
+namespace {
+
+// The rest of `seg` beyond its hit h at sp: the same line from just past the surface (spawn.hpp's offset,
+// so it cannot find that surface again), up to the same end point.
+Ray beyond(const Ray& seg, const Hit& h, const SurfacePoint& sp) {
+  return spawnRay(sp.position, sp.geomNormal, seg.direction, seg.tMax - h.t);
+}
+
+// A ray cone's width on the surface in texture-coordinate units: stretched by 1/|cos| of the incidence.
+float uvWidth(const SurfacePoint& sp, const Ray& r, float coneWidth) {
+  return sp.uvScale * coneWidth / std::abs(glm::dot(sp.geomNormal, glm::normalize(r.direction)));
+}
+
+}  // namespace
+
 Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
   for (uint32_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     const bool light = m.material < scene.materials.size() && isLightMaterial(scene.materials[m.material]);
+    meshAlphaTested_.push_back(m.material < scene.materials.size() && alphaTested(m, scene.materials[m.material]));
+    anyAlphaTested_ = anyAlphaTested_ || meshAlphaTested_.back();
     for (uint32_t t = 0; t < m.triangleCount(); ++t) {
       const uint32_t* idx = &m.indices[size_t(t) * 3];
       if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size())
@@ -78,8 +97,11 @@ SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
     const float nl = glm::length(n);
     if (nl > 0.0f && std::isfinite(nl)) ns = n / nl;
   }
-  if (m.texcoords.size() == m.positions.size())
-    sp.uv = b0 * m.texcoords[idx[0]] + h.b1 * m.texcoords[idx[1]] + h.b2 * m.texcoords[idx[2]];
+  if (m.texcoords.size() == m.positions.size()) {
+    const glm::vec2 t0 = m.texcoords[idx[0]], e1 = m.texcoords[idx[1]] - t0, e2 = m.texcoords[idx[2]] - t0;
+    sp.uv = t0 + h.b1 * e1 + h.b2 * e2;
+    if (len > 0.0f) sp.uvScale = std::sqrt(std::abs(e1.x * e2.y - e1.y * e2.x) / len);  // both doubled areas
+  }
   // Two-sided: face the normals towards where the ray came from.
   if (glm::dot(ng, r.direction) > 0.0f) ng = -ng;
   if (glm::dot(ns, ng) < 0.0f) ns = -ns;
@@ -91,20 +113,55 @@ SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
   return sp;
 }
 
-glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, const Frame& f, Counters& c) const {
+bool Tracer::cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const {
+  return f.tex && meshAlphaTested_[sp.mesh] && f.tex->alpha(*sp.material, sp.uv, uvWidth(sp, r, coneWidth)) < 0.5f;
+}
+
+Tracer::Visible Tracer::closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c) const {
+  Visible v{r, closestTriangle(r, f.s->intersect), {}, cone.width};
+  for (int layer = 0; v.hit.hit(); ++layer) {
+    v.sp = surface(v.ray, v.hit);
+    if (f.tex) v.coneWidth = cone.width + cone.spread * glm::distance(r.origin, v.sp.position);
+    if (layer == kMaxAlphaLayers || !cutOut(v.sp, v.ray, v.coneWidth, f)) break;
+    v.ray = beyond(v.ray, v.hit, v.sp);
+    v.hit = closestTriangle(v.ray, f.s->intersect);
+    ++c.alpha;
+  }
+  return v;
+}
+
+// The any-hit query, except in pbr scenes with alpha-tested materials: there a cut-out texel must not
+// block, so closest hits are taken one after another, past cut-outs and past the lights' own geometry.
+bool Tracer::shadowed(const Ray& r, const Frame& f, Counters& c) const {
+  ++c.shadow;
+  if (!f.tex || !anyAlphaTested_) return occluded(r, f.s->intersect);
+  Ray seg = r;
+  for (int layer = 0;; ++layer) {
+    const Hit h = closestTriangle(seg, f.s->intersect);
+    if (!h.hit()) return false;
+    const SurfacePoint sp = surface(seg, h);
+    // A point light casts a sharp shadow: the mask at full resolution (a cone of width 0).
+    if (layer == kMaxAlphaLayers || (castsShadow_[h.prim] && !cutOut(sp, seg, 0.0f, f))) return true;
+    seg = beyond(seg, h, sp);
+    ++c.alpha;
+  }
+}
+
+glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c) const {
   const TraceSettings& s = *f.s;
   const Material& mat = *sp.material;
   const glm::vec3 v = -glm::normalize(r.direction);
   if (s.shading == Shading::Pbr) {
+    const bool textured = f.tex && !scene_.meshes[sp.mesh].texcoords.empty();
+    const SurfaceInputs in = textured ? f.tex->fetch(mat, sp.uv, uvWidth(sp, r, coneWidth)) : materialFactors(mat);
     const glm::vec3 toLight = f.pbrLightPos - sp.position;
     const glm::vec3 l = glm::normalize(toLight);
     glm::vec3 lightColor = s.pbrLight.color;
-    if (s.shadows && glm::dot(sp.geomNormal, l) > 0.0f) {
-      ++c.shadow;
-      if (occluded(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), s.intersect)) lightColor = glm::vec3(0.0f);
-    }
-    return shadePbr(sp.normal, v, l, lightColor, glm::vec3(s.pbrLight.ambient), mat.baseColor, mat.roughness,
-                    mat.metalness, mat.emissive);
+    if (s.shadows && glm::dot(sp.geomNormal, l) > 0.0f &&
+        shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c))
+      lightColor = glm::vec3(0.0f);
+    return shadePbr(sp.normal, v, l, lightColor, glm::vec3(s.pbrLight.ambient), in.baseColor, in.roughness,
+                    in.metalness, in.emissive);
   }
   // A light's own surface shows its emission only (it does not light itself).
   if (isLightMaterial(mat)) return mat.ke;
@@ -125,8 +182,7 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, const Frame& f, Co
       if (d == glm::vec3(0.0f)) continue;
       if (s.shadows) {
         if (glm::dot(sp.geomNormal, l) <= 0.0f) continue;  // light behind the surface itself
-        ++c.shadow;
-        if (occluded(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), s.intersect)) continue;
+        if (shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c)) continue;
       }
       direct += d;
     }
@@ -135,18 +191,19 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, const Frame& f, Co
   return color;
 }
 
-glm::vec3 Tracer::shade(const Ray& r, int bounces, const Frame& f, Counters& c) const {
+glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c) const {
   const TraceSettings& s = *f.s;
-  const Hit h = closestTriangle(r, s.intersect);
   if (s.shading == Shading::Depth) {
+    const Hit h = closestTriangle(r, s.intersect);
     if (!h.hit()) return glm::vec3(1.0f);
     const float depth = h.t * glm::dot(r.direction, f.depthAxis) / f.depthFar;
     return glm::vec3(std::clamp(depth, 0.0f, 1.0f));
   }
-  if (!h.hit()) return s.background;
-  const SurfacePoint sp = surface(r, h);
+  const Visible vis = closestVisible(r, cone, f, c);
+  if (!vis.hit.hit()) return s.background;
+  const SurfacePoint& sp = vis.sp;
   if (s.shading == Shading::Normals) return glm::abs(sp.normal);  // the brief's "interpolation" view
-  const glm::vec3 col = local(r, sp, f, c);
+  const glm::vec3 col = local(vis.ray, sp, vis.coneWidth, f, c);
   const float m = std::clamp(sp.material->mirror, 0.0f, 1.0f);
   if (m <= 0.0f || bounces <= 0) return col;  // out of bounces: the surface's own colour
   // Task 7: reflect about the shading normal (the geometric one if that would dive under the surface).
@@ -154,7 +211,9 @@ glm::vec3 Tracer::shade(const Ray& r, int bounces, const Frame& f, Counters& c) 
   glm::vec3 d = r.direction - 2.0f * glm::dot(r.direction, n) * n;
   if (glm::dot(d, sp.geomNormal) <= 0.0f) n = sp.geomNormal;
   ++c.reflection;
-  const glm::vec3 reflected = shade(reflectRay(r, n, sp.position, sp.geomNormal), bounces - 1, f, c);
+  // A flat mirror keeps the cone's spread; it goes on from the width it has reached (RTG ch. 20).
+  const glm::vec3 reflected =
+      shade(reflectRay(vis.ray, n, sp.position, sp.geomNormal), {vis.coneWidth, cone.spread}, bounces - 1, f, c);
   return (1.0f - m) * col + m * reflected;  // convex mix: no energy lost or added
 }
 
@@ -167,12 +226,28 @@ Tracer::Frame Tracer::makeFrame(const TraceSettings& s) const {
   const glm::vec3 fwd = basis(pose).forward;
   f.depthAxis = glm::transpose(glm::mat3(s.model)) * fwd;
   f.depthFar = resolveLens(s).zFar;
+  f.tex = s.shading == Shading::Pbr ? &textures() : nullptr;
+  // A perspective pixel subtends atan(2·tan(fov/2) / H) (RTG ch. 20); an orthographic one is a beam of
+  // constant width 2·h / H (taken into scene units through the model's scale).
+  const float h = float(std::max(1u, s.height));
+  if (s.lens.orthographic) f.camera = {2.0f * s.lens.orthoHalfHeight / h * glm::length(glm::vec3(f.toScene[0])), 0.0f};
+  else f.camera = {0.0f, std::atan(2.0f * std::tan(glm::radians(s.lens.fovYDeg) * 0.5f) / h)};
+  // A cone 2^bias times as wide: every LOD goes up by the bias.
+  f.camera.width *= std::exp2(s.lodBias);
+  f.camera.spread *= std::exp2(s.lodBias);
   return f;
 }
 
 glm::vec3 Tracer::traceAndShade(const Ray& r, int bounces, const TraceSettings& s) const {
   Counters c;
-  return shade(r, bounces, makeFrame(s), c);
+  const Frame f = makeFrame(s);
+  return shade(r, f.camera, bounces, f, c);
+}
+
+const SceneTextures& Tracer::textures() const {
+  std::lock_guard lock(texturesMutex_);
+  if (!textures_) textures_ = std::make_unique<const SceneTextures>(scene_);
+  return *textures_;
 }
 
 namespace {
@@ -211,12 +286,12 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
     throw Error("image size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " is out of range");
   if (s.bounces < 0 || s.bounces > 64) throw Error("bounces must be in 0..64, got " + std::to_string(s.bounces));
   if (s.shading == Shading::Pbr && !pbrAvailable()) shadePbr({}, {}, {}, {}, {}, {}, 0, 0, {});  // throws
+  const Frame frame = makeFrame(s);  // loads the textures on the first pbr render: not part of its time
   const auto start = std::chrono::steady_clock::now();
   out.width = s.width;
   out.height = s.height;
   out.pixels.assign(size_t(s.width) * s.height, glm::vec4(s.background, 1.0f));
 
-  const Frame frame = makeFrame(s);
   const CameraPose pose = resolvePose(s);
   const float aspect = float(s.width) / float(s.height);
   const uint32_t ts = std::max(4u, s.tileSize);
@@ -245,7 +320,7 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
               cameraRay(pose, s.lens, aspect, pixelToNdc(float(x) + 0.5f, float(y) + 0.5f, s.width, s.height));
           const Ray r{glm::vec3(frame.toScene * glm::vec4(cr.origin, 1.0f)),
                       glm::vec3(frame.toScene * glm::vec4(cr.direction, 0.0f))};
-          glm::vec3 col = shade(r, s.bounces, frame, c);
+          glm::vec3 col = shade(r, frame.camera, s.bounces, frame, c);
           // Debug views hold their value as displayed: encode so that sRGB output shows it unchanged.
           if (debugView) col = {srgbToLinear(col.x), srgbToLinear(col.y), srgbToLinear(col.z)};
           out.at(x, y) = glm::vec4(col, 1.0f);
@@ -259,6 +334,7 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
     stats.primaryRays += primary;
     stats.shadowRays += c.shadow;
     stats.reflectionRays += c.reflection;
+    stats.alphaRays += c.alpha;
   };
   unsigned n = s.threads ? s.threads : std::max(1u, std::thread::hardware_concurrency());
   n = std::min(n, stats.tilesTotal);

@@ -5,6 +5,8 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -18,10 +20,13 @@
 #include "trace/intersect.hpp"
 #include "trace/lights.hpp"
 #include "trace/ray.hpp"
+#include "trace/textures.hpp"
 
 namespace rtr::trace {
 
 constexpr int N_BOUNCES = 5;  // the brief's default recursion depth for mirrors
+// Cut-out texels (alpha < 0.5) a ray passes through at most; the surface after them counts as opaque.
+constexpr int kMaxAlphaLayers = 32;
 
 enum class Shading { Phong, Pbr, Normals, Depth };
 
@@ -45,6 +50,7 @@ struct TraceSettings {
   uint32_t tileSize = 32;
   int areaLightSamples = 1;        // shadow rays per area light: 1 aims at its centre (hard shadows)
   PbrLight pbrLight;
+  float lodBias = 0.0f;            // pbr: added to every texture's level of detail, as the GPU's bias
   glm::vec3 background{0.0f};
 };
 
@@ -55,6 +61,7 @@ using TileCallback = std::function<void(const TileRect&)>;
 struct RenderStats {
   double seconds = 0.0;
   uint64_t primaryRays = 0, shadowRays = 0, reflectionRays = 0;
+  uint64_t alphaRays = 0;  // rays continued beyond a cut-out texel (pbr with alpha-tested materials)
   uint32_t tilesDone = 0, tilesTotal = 0;
   bool cancelled = false;
 };
@@ -65,6 +72,7 @@ struct SurfacePoint {
   glm::vec3 geomNormal;  // unit, facing the incoming ray
   glm::vec3 normal;      // interpolated shading normal, unit, same side as geomNormal
   glm::vec2 uv{0.0f};
+  float uvScale = 0.0f;  // √(uv area / area) of the triangle: texture-coordinate units per scene unit
   const Material* material = nullptr;
   uint32_t mesh = 0;
 };
@@ -94,8 +102,13 @@ class Tracer {
   Hit closestTriangle(const Ray& r, IntersectMethod m = IntersectMethod::Watertight) const;
   bool occluded(const Ray& r, IntersectMethod m = IntersectMethod::Watertight) const;
   SurfacePoint surface(const Ray& r, const Hit& h) const;
-  // Task 7's TraceAndShadeWithRay: colour seen along r with `bounces` mirror bounces left.
+  // Task 7's TraceAndShadeWithRay: colour seen along r with `bounces` mirror bounces left. Textures are
+  // filtered for the ray cone of one pixel of `s` starting at r's origin.
   glm::vec3 traceAndShade(const Ray& r, int bounces, const TraceSettings& s) const;
+
+  // The textures pbr shading samples, loaded on the first call (the first pbr render); no other shading
+  // loads any. Thread-safe. Throws rtr::Error naming a texture file that is missing or undecodable.
+  const SceneTextures& textures() const;
 
   const std::vector<Light>& lights() const { return lights_; }
   const std::vector<Triangle>& triangles() const { return tris_; }
@@ -104,7 +117,10 @@ class Tracer {
   const Scene& scene() const { return scene_; }
 
  private:
-  struct Counters { uint64_t shadow = 0, reflection = 0; };
+  struct Counters { uint64_t shadow = 0, reflection = 0, alpha = 0; };
+  // A ray cone (Akenine-Möller et al., Ray Tracing Gems ch. 20) for texture LOD: width at the ray's
+  // origin, growing by `spread` (radians) per unit of distance.
+  struct Cone { float width = 0.0f, spread = 0.0f; };
   // Per-render constants in scene space.
   struct Frame {
     const TraceSettings* s;
@@ -112,18 +128,34 @@ class Tracer {
     glm::vec3 pbrLightPos;  // pbr light in scene space
     glm::vec3 depthAxis;    // t · dot(d, depthAxis) = distance along the camera's forward axis
     float depthFar;
+    const SceneTextures* tex = nullptr;  // pbr only
+    Cone camera;                         // a primary ray's cone
+  };
+  // A hit with its surface and the cone's width there; `ray` is the segment it was found on.
+  struct Visible {
+    Ray ray;
+    Hit hit;
+    SurfacePoint sp;
+    float coneWidth = 0.0f;
   };
   Frame makeFrame(const TraceSettings& s) const;
-  glm::vec3 shade(const Ray& r, int bounces, const Frame& f, Counters& c) const;
-  glm::vec3 local(const Ray& r, const SurfacePoint& sp, const Frame& f, Counters& c) const;
+  glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c) const;
+  glm::vec3 local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c) const;
+  bool cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const;
+  Visible closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c) const;
+  bool shadowed(const Ray& r, const Frame& f, Counters& c) const;
 
   const Scene& scene_;
   std::vector<Triangle> tris_;
   std::vector<uint32_t> triMesh_, triLocal_;  // triangle → mesh, triangle index within the mesh
   std::vector<uint8_t> castsShadow_;
+  std::vector<uint8_t> meshAlphaTested_;  // per mesh: scene/textures.hpp's alphaTested
+  bool anyAlphaTested_ = false;
   std::vector<Light> lights_;
   Bvh bvh_;
   bool useBvh_ = false;
+  mutable std::mutex texturesMutex_;
+  mutable std::unique_ptr<const SceneTextures> textures_;
 };
 
 }  // namespace rtr::trace

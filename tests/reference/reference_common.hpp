@@ -28,6 +28,9 @@ struct Limits {
   double maxFailingFraction;  // of all pixels
 };
 Limits limits(View v);
+// A case's limits: limits(v), except the textured temple's shaded view, which is looser because the GPU's
+// derivative LOD and the tracer's ray-cone LOD differ by a fraction of a level (docs/reference-tests.md).
+Limits limits(const std::string& caseName, View v);
 
 struct CasePair {
   ImageRGBA8 gpu;           // toSrgb8(the GPU's linear intermediate image)

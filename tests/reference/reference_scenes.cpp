@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <glm/geometric.hpp>
@@ -85,7 +86,7 @@ Material material(const std::string& name, glm::vec3 base, float roughness, floa
 
 // Two-sided on the GPU needs the alpha-masked pipeline (the only one that does not cull back faces): give
 // the material an all-opaque alpha mask (every fragment kept) and its meshes texture coordinates. The
-// tracer samples no textures and draws both sides of every triangle, so it sees the same surface.
+// tracer keeps every texel of that mask and draws both sides of every triangle, so it sees the same surface.
 void twoSidedOnGpu(Scene& s, uint32_t material, const std::filesystem::path& workDir) {
   std::filesystem::create_directories(workDir);
   const std::filesystem::path mask = workDir / "opaque_mask.png";
@@ -109,6 +110,9 @@ ReferenceScene loadFile(const std::filesystem::path& file) {
   r.scene = loadScene(file);
   return r;
 }
+
+// The fire cards: one-sided quads (the GPU culls their backs, the tracer draws them).
+bool isFireCard(const Mesh& m) { return m.name.rfind("fire_", 0) == 0; }
 
 }  // namespace
 
@@ -162,7 +166,7 @@ Scene untexturedTemple(const Scene& temple, int* removed) {
   // Cards: one-sided quads (the GPU culls their backs, the tracer draws them) whose shape is the alpha mask.
   auto isCard = [&](const Mesh& m) {
     const Material* mat = m.material < s.materials.size() ? &s.materials[m.material] : nullptr;
-    return (mat && (mat->flags & kMaterialDoubleSided)) || m.name.rfind("fire_", 0) == 0;
+    return (mat && (mat->flags & kMaterialDoubleSided)) || isFireCard(m);
   };
   const size_t before = s.meshes.size();
   std::erase_if(s.meshes, isCard);
@@ -170,12 +174,27 @@ Scene untexturedTemple(const Scene& temple, int* removed) {
   return s;
 }
 
+Scene texturedTemple(const Scene& temple, const std::filesystem::path& workDir) {
+  Scene s = temple;
+  std::set<uint32_t> fire;
+  for (const Mesh& m : s.meshes)
+    if (isFireCard(m)) fire.insert(m.material);
+  for (uint32_t material : fire) twoSidedOnGpu(s, material, workDir);
+  return s;
+}
+
 ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir) {
   const std::filesystem::path rt = sourceDir() / "assets-src/rt";
+  // The default light (the brief's standard light above the statue) for the temple.
   if (name == "temple_nave" || name == "temple_aisle") {
     ReferenceScene r;
     r.scene = untexturedTemple(loadScene(assetDir() / "temple.rtrscene"));
-    return r;  // the default light (the brief's standard light above the statue)
+    return r;
+  }
+  if (name == "temple_nave_textured" || name == "temple_aisle_textured") {
+    ReferenceScene r;
+    r.scene = texturedTemple(loadScene(assetDir() / "temple.rtrscene"), workDir);
+    return r;
   }
   if (name == "cornell_box") {
     ReferenceScene r = loadFile(rt / "cornell_box.obj");

@@ -1,6 +1,6 @@
 #pragma once
-// Scenes, poses and lights of the GPU-vs-CPU reference tests: the generated default scene (untextured
-// copy), the ray tracer's course scenes, and synthetic hard views built in code.
+// Scenes, poses and lights of the GPU-vs-CPU reference tests: the generated default scene (an untextured
+// copy, and as baked), the ray tracer's course scenes, and synthetic hard views built in code.
 #include <filesystem>
 #include <map>
 #include <string>
@@ -35,9 +35,12 @@ struct ReferenceScene {
 // back-face quad's alpha-mask texture). Throws rtr::Error for an unknown name.
 ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir);
 
-// The default scene as the CPU PBR mode sees it: every texture slot cleared (the tracer samples no
-// textures), and the meshes that only make sense with an alpha mask or would need two-sided drawing
+// The default scene without textures: every texture slot cleared (both sides then use the material
+// factors), and the meshes that only make sense with an alpha mask or would need two-sided drawing
 // (foliage and ivy cards, the fire cards) removed. Returns how many meshes were removed in `removed`.
 Scene untexturedTemple(const Scene& temple, int* removed = nullptr);
+// The default scene as it is, textures and all, except that the one-sided fire cards are made two-sided
+// on the GPU (the tracer draws both sides of everything; see docs "Culling"). `workDir` as for makeScene.
+Scene texturedTemple(const Scene& temple, const std::filesystem::path& workDir);
 
 }  // namespace rtr::reftest

@@ -56,6 +56,8 @@ int run(int argc, char** argv) {
   app.add_option("--light", light, "pbr: point light position x,y,z (default: the GPU renderer's)");
   app.add_option("--light-color", lightColor, "pbr: light colour r,g,b");
   app.add_option("--ambient", s.pbrLight.ambient, "pbr: ambient")->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
+  app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
+      ->capture_default_str()->check(CLI::Range(-16.0f, 16.0f));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
   try {
     app.parse(argc, argv);
@@ -95,7 +97,11 @@ int run(int argc, char** argv) {
   if (tty) std::fprintf(stderr, "\r\033[K");
   savePng(outPath, toSrgb8(image));
   if (!quiet) {
-    const uint64_t rays = st.primaryRays + st.shadowRays + st.reflectionRays;
+    if (s.shading == Shading::Pbr)
+      std::fprintf(stderr, "rtr-trace: %zu textures decoded and mip-mapped in %.3f s; %llu rays continued past "
+                   "cut-out texels\n", tracer.textures().count(), tracer.textures().loadSeconds(),
+                   (unsigned long long)st.alphaRays);
+    const uint64_t rays = st.primaryRays + st.shadowRays + st.reflectionRays + st.alphaRays;
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
                  "(%llu primary, %llu shadow, %llu mirror), %.2f Mrays/s; pose %s -> %s\n",

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <exception>
+#include <string>
 
 #include "core/compare.hpp"
 
@@ -28,8 +30,16 @@ void TraceOverlay::start(const trace::TraceSettings& settings, std::optional<Ima
   visible_ = true;
   worker_ = std::thread([this, settings, raster = std::move(raster)] {
     std::lock_guard lock(mutex_);
-    const trace::RenderStats st =
-        tracer_->render(settings, image_, [this](const trace::TileRect&) { ++tilesDone_; dirty_ = true; }, &cancel_);
+    trace::RenderStats st;
+    try {  // a texture file gone since the GPU loaded it: say so instead of ending the viewer
+      st = tracer_->render(settings, image_, [this](const trace::TileRect&) { ++tilesDone_; dirty_ = true; }, &cancel_);
+    } catch (const std::exception& e) {
+      errorText_ = std::string("ray trace failed: ") + e.what();
+      errorMap_ = toSrgb8(image_);  // shown in place of an error map: same size as the overlay
+      showError_ = true;
+      dirty_ = true;
+      return;
+    }
     if (raster && !st.cancelled) {
       const CompareResult r = compareEdgeTolerant(*raster, toSrgb8(image_), kErrorThreshold);
       errorMap_ = r.errorMap;
@@ -39,7 +49,6 @@ void TraceOverlay::start(const trace::TraceSettings& settings, std::optional<Ima
                     "%.2f%% of pixels > %d steps beyond 3x3 edge tolerance (red); trace %.2f s",
                     r.meanAbsError, r.maxAbsError, 100.0 * r.failingFraction, kErrorThreshold, st.seconds);
       errorText_ = text;
-      if (!tracer_->scene().textures.empty()) errorText_ += "\nthe tracer samples no textures: textured surfaces differ";
       showError_ = true;
     }
     dirty_ = true;

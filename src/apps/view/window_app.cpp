@@ -258,6 +258,7 @@ int runWindowed(const ViewOptions& o) {
         ts.shadows = app.traceShadows;
         ts.bounces = app.traceReflections ? trace::N_BOUNCES : 0;
         ts.pbrLight = {app.settings.lightPos, app.settings.lightColor, app.settings.ambient.x};
+        ts.lodBias = app.settings.lodBias;
         return ts;
       };
       if (app.traceRequested) {  // R: trace this view; R again while shown hides it

@@ -1,0 +1,39 @@
+#pragma once
+// Which of a scene's textures the renderers sample, and their decoding: shared by the GPU renderer
+// (render/gpu_scene.cpp) and the CPU ray tracer's PBR mode (trace/textures.cpp), so both read the same
+// files into the same texels. No GPU here.
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "core/image.hpp"
+#include "scene/scene.hpp"
+
+namespace rtr {
+
+// Texture slots the renderers sample (the normal map is not part of the brief's shading model).
+constexpr TextureSlot kSampledSlots[] = {TextureSlot::BaseColor, TextureSlot::Roughness, TextureSlot::Metalness,
+                                         TextureSlot::AlphaMask, TextureSlot::Emissive};
+
+// Scene texture indices sampled by some slot of a material drawn by a mesh that has texcoords (a mesh
+// without texcoords samples nothing), each once, in order of first use.
+std::vector<uint32_t> sampledTextures(const Scene& scene);
+
+// Channels a texture is decoded to: 1 for single-channel data (R8), otherwise 4 (RGBA8).
+int decodeChannels(const Texture& t);
+// Whether its colour channels are sRGB-encoded (decoded to linear on read): sRGB four-channel textures.
+bool decodeSrgb(const Texture& t);
+
+// Decodes scene.textures[which[i]] for every i on all cores and hands the texels to use(i, texels) on the
+// thread that decoded them (so per-texture work after decoding runs in parallel too). Throws rtr::Error
+// naming the file of a texture that is missing or cannot be decoded.
+void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
+                    const std::function<void(size_t, TexelData&&)>& use);
+
+// Whether a mesh's fragments are alpha-tested (discarded where the mask's alpha < 0.5), as on the GPU: it
+// has texcoords and an alpha-mask texture, and its material is alpha-masked or double-sided (the GPU's
+// alpha-tested pipeline).
+bool alphaTested(const Mesh& mesh, const Material& material);
+
+}  // namespace rtr

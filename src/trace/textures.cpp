@@ -1,0 +1,119 @@
+#include "trace/textures.hpp"
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include <glm/common.hpp>
+
+#include "core/error.hpp"
+#include "core/mip_reference.hpp"
+#include "scene/textures.hpp"
+
+namespace rtr::trace {
+namespace {
+
+// Byte -> linear value, the decoding of mip_reference.hpp (which the GPU's formats follow) as a table.
+using Table = std::array<float, 256>;
+Table decodeTable(TexelEncoding e) {
+  Table t;
+  for (uint32_t b = 0; b < 256; ++b) t[b] = float(decodeTexel(uint8_t(b), 0, e));
+  return t;
+}
+const Table kUnorm = decodeTable(TexelEncoding::Unorm);
+const Table kSrgb = decodeTable(TexelEncoding::Srgb);
+
+// REPEAT for texel index i in [-1, n]: the neighbours of a bilinear footprint.
+uint32_t wrap(int i, uint32_t n) { return i < 0 ? n - 1 : uint32_t(i) >= n ? 0u : uint32_t(i); }
+
+}  // namespace
+
+MipTexture::MipTexture(const TexelData& image, bool srgb) : channels_(image.channels), srgb_(srgb) {
+  if (channels_ != 1 && channels_ != 4)
+    throw Error("texture: " + std::to_string(channels_) + " channels; the tracer samples 1 or 4");
+  const MipChain chain = buildMipReference(image, srgb ? TexelEncoding::Srgb : TexelEncoding::Unorm,
+                                           MipSource::PreviousLevel);
+  for (uint32_t k = 0; k < chain.levels.size(); ++k) {
+    const MipLevel& l = chain.levels[k];
+    levels_.push_back({l.width, l.height, k == 0 ? image.texels : quantizeMipLevel(chain, k)});
+  }
+  halfLog2Area_ = 0.5f * std::log2(float(width()) * float(height()));
+}
+
+glm::vec4 MipTexture::bilinear(const Level& l, glm::vec2 uv) const {
+  // Texel centres sit at half-integers; REPEAT makes the image periodic, so wrap uv into [0, 1] first.
+  const float x = (uv.x - std::floor(uv.x)) * float(l.width) - 0.5f;
+  const float y = (uv.y - std::floor(uv.y)) * float(l.height) - 0.5f;
+  const float fx = std::floor(x), fy = std::floor(y);
+  const uint32_t x0 = wrap(int(fx), l.width), x1 = wrap(int(fx) + 1, l.width);
+  const uint32_t y0 = wrap(int(fy), l.height), y1 = wrap(int(fy) + 1, l.height);
+  const Table& colour = srgb_ ? kSrgb : kUnorm;
+  auto texel = [&](uint32_t tx, uint32_t ty) {
+    const uint8_t* p = &l.texels[(size_t(ty) * l.width + tx) * channels_];
+    if (channels_ == 1) return glm::vec4(kUnorm[p[0]], 0.0f, 0.0f, 1.0f);
+    return glm::vec4(colour[p[0]], colour[p[1]], colour[p[2]], kUnorm[p[3]]);  // alpha is never sRGB
+  };
+  const float ax = x - fx, ay = y - fy;
+  return glm::mix(glm::mix(texel(x0, y0), texel(x1, y0), ax), glm::mix(texel(x0, y1), texel(x1, y1), ax), ay);
+}
+
+glm::vec4 MipTexture::sample(glm::vec2 uv, float lod) const {
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
+  lod = lod > 0.0f ? std::min(lod, float(levels_.size() - 1)) : 0.0f;  // NaN reads level 0
+  const uint32_t l0 = uint32_t(lod);
+  const float f = lod - float(l0);
+  const glm::vec4 a = bilinear(levels_[l0], uv);
+  return f > 0.0f ? glm::mix(a, bilinear(levels_[l0 + 1], uv), f) : a;
+}
+
+float MipTexture::lod(float uvWidth) const { return std::log2(uvWidth) + halfLog2Area_; }
+
+SurfaceInputs materialFactors(const Material& m) {
+  return {m.baseColor, m.roughness, m.metalness, m.emissive, 1.0f};
+}
+
+SceneTextures::SceneTextures(const Scene& scene) : index_(scene.textures.size(), kNoTexture) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<uint32_t> used = sampledTextures(scene);
+  std::vector<std::optional<MipTexture>> built(used.size());
+  decodeTextures(scene, used, [&](size_t i, TexelData&& t) {
+    try {
+      built[i].emplace(t, decodeSrgb(scene.textures[used[i]]));
+    } catch (const Error& e) {
+      throw Error(scene.textures[used[i]].path.string() + ": " + e.what());
+    }
+  });
+  for (size_t i = 0; i < used.size(); ++i) {
+    index_[used[i]] = uint32_t(i);
+    textures_.push_back(std::move(*built[i]));
+  }
+  seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+const MipTexture* SceneTextures::texture(const Material& m, TextureSlot slot) const {
+  const uint32_t t = m.texture(slot);
+  return t < index_.size() && index_[t] != kNoTexture ? &textures_[index_[t]] : nullptr;
+}
+
+SurfaceInputs SceneTextures::fetch(const Material& m, glm::vec2 uv, float uvWidth) const {
+  auto sample = [&](TextureSlot slot) {
+    const MipTexture* t = texture(m, slot);
+    return t ? t->sample(uv, t->lod(uvWidth)) : glm::vec4(1.0f);
+  };
+  SurfaceInputs s = materialFactors(m);
+  s.baseColor *= glm::vec3(sample(TextureSlot::BaseColor));
+  s.roughness *= sample(TextureSlot::Roughness).r;
+  s.metalness *= sample(TextureSlot::Metalness).r;
+  s.alpha = sample(TextureSlot::AlphaMask).a;
+  s.emissive *= glm::vec3(sample(TextureSlot::Emissive));
+  return s;
+}
+
+float SceneTextures::alpha(const Material& m, glm::vec2 uv, float uvWidth) const {
+  const MipTexture* t = texture(m, TextureSlot::AlphaMask);
+  return t ? t->sample(uv, t->lod(uvWidth)).a : 1.0f;
+}
+
+}  // namespace rtr::trace

@@ -1,0 +1,78 @@
+#pragma once
+// Textures of the tracer's PBR mode, sampled as the GPU renderer samples them (render/gpu_scene.cpp):
+// the same files and texels (scene/textures.hpp), the same mip chain, trilinear filtering with REPEAT
+// addressing and no anisotropy. Only the level of detail is chosen differently (ray cones, not screen
+// derivatives; trace/tracer.cpp).
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "core/image.hpp"
+#include "scene/scene.hpp"
+
+namespace rtr::trace {
+
+// One texture as the GPU holds it: every level from the float64 box-filter reference of the GPU's mip
+// chain (core/mip_reference.hpp, each level from the previous one as the compute chain does) rounded to
+// 8 bits like the GPU's image, and decoded to linear on read (sRGB before filtering, as Vulkan does).
+class MipTexture {
+ public:
+  MipTexture(const TexelData& image, bool srgb);  // throws rtr::Error for an empty or malformed image
+
+  // Trilinear sample at uv (REPEAT) at level of detail `lod` (clamped to the chain; NaN reads level 0).
+  // A one-channel texture reads (r, 0, 0, 1), as R8_UNORM does.
+  glm::vec4 sample(glm::vec2 uv, float lod) const;
+  // The level of detail of a footprint `uvWidth` wide in texture coordinates: log2(uvWidth · √(w·h)).
+  float lod(float uvWidth) const;
+
+  uint32_t width() const { return levels_[0].width; }
+  uint32_t height() const { return levels_[0].height; }
+  uint32_t levels() const { return uint32_t(levels_.size()); }
+
+ private:
+  struct Level {
+    uint32_t width, height;
+    std::vector<uint8_t> texels;
+  };
+  glm::vec4 bilinear(const Level& level, glm::vec2 uv) const;
+
+  std::vector<Level> levels_;
+  uint32_t channels_;
+  bool srgb_;
+  float halfLog2Area_;  // 0.5·log2(width·height)
+};
+
+// What a surface point's material gives the BRDF: shaders/material.glsl's Surface.
+struct SurfaceInputs {
+  glm::vec3 baseColor;
+  float roughness, metalness;
+  glm::vec3 emissive;
+  float alpha;
+};
+SurfaceInputs materialFactors(const Material& m);  // factors only (a mesh without texcoords)
+
+// The textures a scene's PBR shading samples (only those scene/textures.hpp's sampledTextures lists),
+// decoded and mip-mapped on all cores. Throws rtr::Error naming a file that is missing or undecodable.
+class SceneTextures {
+ public:
+  explicit SceneTextures(const Scene& scene);
+
+  // material.glsl's fetchSurface: factors × textures at uv. uvWidth: the ray cone's width at the hit in
+  // texture-coordinate units (the level of detail follows from it and each texture's size).
+  SurfaceInputs fetch(const Material& m, glm::vec2 uv, float uvWidth) const;
+  float alpha(const Material& m, glm::vec2 uv, float uvWidth) const;  // the alpha-mask texture's alpha
+
+  size_t count() const { return textures_.size(); }
+  double loadSeconds() const { return seconds_; }  // decoding and mip building, wall time
+
+ private:
+  const MipTexture* texture(const Material& m, TextureSlot slot) const;
+  std::vector<uint32_t> index_;  // scene texture -> textures_ index (kNoTexture: not sampled)
+  std::vector<MipTexture> textures_;
+  double seconds_ = 0;
+};
+
+}  // namespace rtr::trace
