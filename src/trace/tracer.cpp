@@ -264,6 +264,7 @@ Bounds transformed(const Bounds& b, const glm::mat4& m) {
 
 CameraPose Tracer::resolvePose(const TraceSettings& s) const {
   if (s.pose) return *s.pose;
+  if (scene_.defaultView) return *scene_.defaultView;  // the view the scene was baked with, as rtr-view starts
   const float aspect = float(std::max(1u, s.width)) / float(std::max(1u, s.height));
   return frameBounds(transformed(scene_.bounds(), s.model), s.lens, aspect);
 }

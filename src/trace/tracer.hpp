@@ -39,7 +39,7 @@ struct PbrLight {
 
 struct TraceSettings {
   uint32_t width = 1280, height = 720;
-  std::optional<CameraPose> pose;  // none: frameBounds(scene bounds), the viewer's default view
+  std::optional<CameraPose> pose;  // none: the scene's stored view, else frameBounds(scene bounds), as the viewer
   Lens lens{};                     // the viewer's defaults (60° vertical fov); --fov 80 is the course's
   glm::mat4 model{1.0f};           // Task 1 model transform (a similarity); modelview = view × model
   Shading shading = Shading::Phong;

@@ -280,6 +280,30 @@ TEST(Tracer, CameraRaysAndModelTransform) {
   EXPECT_EQ(modelview(*ts.pose, ts.model), viewMatrix(*ts.pose));
 }
 
+// Without a pose the tracer starts where rtr-view does: the scene's stored view, else the bounds framed.
+TEST(Tracer, DefaultPoseIsTheViewersStartPose) {
+  Scene s = mirrorScene(0.0f);
+  TraceSettings ts;
+  ts.width = 64;
+  ts.height = 32;
+  const CameraPose framed = frameBounds(s.bounds(), ts.lens, 2.0f);
+  {
+    const Tracer t(s);
+    const CameraPose p = t.resolvePose(ts);
+    EXPECT_EQ(p.position, framed.position);
+    EXPECT_EQ(p.yawDeg, framed.yawDeg);
+    EXPECT_EQ(p.pitchDeg, framed.pitchDeg);
+  }
+  s.defaultView = CameraPose{{1.0f, 2.0f, 3.0f}, 40.0f, -15.0f};
+  const Tracer t(s);
+  const CameraPose p = t.resolvePose(ts);
+  EXPECT_EQ(p.position, s.defaultView->position);
+  EXPECT_EQ(p.yawDeg, 40.0f);
+  EXPECT_EQ(p.pitchDeg, -15.0f);
+  ts.pose = CameraPose{{0, 0, 9}, 0, 0};  // --camera wins over both
+  EXPECT_EQ(t.resolvePose(ts).position, glm::vec3(0, 0, 9));
+}
+
 TEST(Tracer, DebugViewsAndTinyScenes) {
   Scene s;
   const uint32_t m = addMaterial(s, phong(glm::vec3(0.5f)));

@@ -38,7 +38,7 @@ int run(int argc, char** argv) {
   app.add_option("scene", scenePath, "scene file (.obj, .obj.zst, .comp5892mesh, .rtrscene)")->required();
   app.add_option("-o,--output", outPath, "output PNG (sRGB)")->required();
   app.add_option("--size", size, "image size WxH")->capture_default_str();
-  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default frames the scene looking down -z");
+  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else framing the scene looking down -z");
   app.add_option("--fov", fov, "vertical field of view in degrees (the viewer's default; the course uses 80)")
       ->capture_default_str()->check(CLI::Range(1.0f, 179.0f));
   app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, FORMATS.md §2)");
