@@ -76,11 +76,10 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     }
     const bool textured = !m.texcoords.empty();
     // Two-sided materials go to the alpha-tested pipeline, which does not cull (with no mask texture
-    // the alpha is 1 and nothing is discarded).
-    const bool masked = (mat.flags & kMaterialAlphaMasked) && mat.texture(TextureSlot::AlphaMask) != kNoTexture;
-    DrawKind kind = !textured                                      ? DrawKind::Untextured
-                    : masked || (mat.flags & kMaterialDoubleSided) ? DrawKind::AlphaMasked
-                                                                   : DrawKind::Opaque;
+    // the alpha is 1 and nothing is discarded). alphaTested is the same rule the tracer cuts out by.
+    DrawKind kind = !textured                                                  ? DrawKind::Untextured
+                    : alphaTested(m, mat) || (mat.flags & kMaterialDoubleSided) ? DrawKind::AlphaMasked
+                                                                               : DrawKind::Opaque;
     d.id = uint32_t(drawInfo.size());
     drawInfo.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
                         (d.indexType == VK_INDEX_TYPE_UINT16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});

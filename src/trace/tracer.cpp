@@ -119,8 +119,10 @@ bool Tracer::cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const
 
 Tracer::Visible Tracer::closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c) const {
   Visible v{r, closestTriangle(r, f.s->intersect), {}, cone.width};
+  v.t = v.hit.t;
   for (int layer = 0; v.hit.hit(); ++layer) {
     v.sp = surface(v.ray, v.hit);
+    if (layer > 0) v.t = glm::dot(v.sp.position - r.origin, r.direction) / glm::dot(r.direction, r.direction);
     if (f.tex) v.coneWidth = cone.width + cone.spread * glm::distance(r.origin, v.sp.position);
     if (layer == kMaxAlphaLayers || !cutOut(v.sp, v.ray, v.coneWidth, f)) break;
     v.ray = beyond(v.ray, v.hit, v.sp);
@@ -130,7 +132,7 @@ Tracer::Visible Tracer::closestVisible(const Ray& r, const Cone& cone, const Fra
   return v;
 }
 
-// The any-hit query, except in pbr scenes with alpha-tested materials: there a cut-out texel must not
+// The any-hit query, except in scenes with alpha-tested materials: there a cut-out texel must not
 // block, so closest hits are taken one after another, past cut-outs and past the lights' own geometry.
 bool Tracer::shadowed(const Ray& r, const Frame& f, Counters& c) const {
   ++c.shadow;
@@ -193,13 +195,11 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
 
 glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c) const {
   const TraceSettings& s = *f.s;
-  if (s.shading == Shading::Depth) {
-    const Hit h = closestTriangle(r, s.intersect);
-    if (!h.hit()) return glm::vec3(1.0f);
-    const float depth = h.t * glm::dot(r.direction, f.depthAxis) / f.depthFar;
-    return glm::vec3(std::clamp(depth, 0.0f, 1.0f));
-  }
   const Visible vis = closestVisible(r, cone, f, c);
+  if (s.shading == Shading::Depth) {
+    if (!vis.hit.hit()) return glm::vec3(1.0f);
+    return glm::vec3(std::clamp(vis.t * glm::dot(r.direction, f.depthAxis) / f.depthFar, 0.0f, 1.0f));
+  }
   if (!vis.hit.hit()) return s.background;
   const SurfacePoint& sp = vis.sp;
   if (s.shading == Shading::Normals) return glm::abs(sp.normal);  // the brief's "interpolation" view
@@ -226,7 +226,8 @@ Tracer::Frame Tracer::makeFrame(const TraceSettings& s) const {
   const glm::vec3 fwd = basis(pose).forward;
   f.depthAxis = glm::transpose(glm::mat3(s.model)) * fwd;
   f.depthFar = resolveLens(s).zFar;
-  f.tex = s.shading == Shading::Pbr ? &textures() : nullptr;
+  // Pbr samples the textures; every view needs the alpha masks, which decide what is visible.
+  f.tex = s.shading == Shading::Pbr || anyAlphaTested_ ? &textures() : nullptr;
   // A perspective pixel subtends atan(2·tan(fov/2) / H) (RTG ch. 20); an orthographic one is a beam of
   // constant width 2·h / H (taken into scene units through the model's scale).
   const float h = float(std::max(1u, s.height));

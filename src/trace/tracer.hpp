@@ -131,12 +131,14 @@ class Tracer {
     const SceneTextures* tex = nullptr;  // pbr only
     Cone camera;                         // a primary ray's cone
   };
-  // A hit with its surface and the cone's width there; `ray` is the segment it was found on.
+  // A hit with its surface and the cone's width there; `ray` is the segment it was found on, t the hit's
+  // parameter along the first ray (past cut-outs, of the hit point projected onto it).
   struct Visible {
     Ray ray;
     Hit hit;
     SurfacePoint sp;
     float coneWidth = 0.0f;
+    float t = 0.0f;
   };
   Frame makeFrame(const TraceSettings& s) const;
   glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c) const;
