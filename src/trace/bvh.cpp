@@ -318,6 +318,8 @@ template class HugeArray<TriPack>;
   namespace ns {                                                  \
   bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);  \
   bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&); \
+  unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
+  unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
   }
 RTR_DECLARE_TRAVERSAL(sse)
 RTR_DECLARE_TRAVERSAL(avx2)
@@ -329,9 +331,12 @@ namespace {
 struct Traversal {
   bool (*closest)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
   bool (*occluded)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
+  unsigned (*closestPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
+  unsigned (*occludedPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
 };
-constexpr Traversal kTraversals[] = {{sse::closest, sse::occluded}, {avx2::closest, avx2::occluded},
-                                     {avx512::closest, avx512::occluded}};
+#define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair}
+constexpr Traversal kTraversals[] = {RTR_TRAVERSAL(sse), RTR_TRAVERSAL(avx2), RTR_TRAVERSAL(avx512)};
+#undef RTR_TRAVERSAL
 }  // namespace
 
 namespace {
@@ -381,6 +386,19 @@ bool Bvh::occluded(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return false;
   return kTraversals[int(isa())].occluded({nodes_.data(), packs_.data(), root_}, ray, method, h);
+}
+
+std::array<Hit, 2> Bvh::closestPair(const std::array<Ray, 2>& rays, IntersectMethod method) const {
+  std::array<Hit, 2> h;
+  if (root_ != kEmpty) kTraversals[int(isa())].closestPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
+  return h;
+}
+
+std::array<bool, 2> Bvh::occludedPair(const std::array<Ray, 2>& rays, IntersectMethod method) const {
+  std::array<Hit, 2> h;
+  if (root_ == kEmpty) return {false, false};
+  const unsigned m = kTraversals[int(isa())].occludedPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
+  return {(m & 1) != 0, (m & 2) != 0};
 }
 
 }  // namespace rtr::trace

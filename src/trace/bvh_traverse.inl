@@ -112,239 +112,347 @@ constexpr SlabAxes slabAxesOf(unsigned parallel) {
   return s;
 }
 
+
+#define RTR_INLINE inline __attribute__((always_inline))
+
+// One ray's walk through the BVH, front to back, as a state machine: run() walks it to the end; step()
+// does one node or one leaf, so that two walks can be interleaved on one thread (traversePair below).
 // Parallel: bit a set when the ray runs parallel to axis a (a zero direction component), see below.
 template <bool AnyHit, unsigned Parallel>
-bool traverse(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
+struct Walker {
   static_assert(sizeof(Triangle) == 9 * sizeof(float));
-  const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
-  const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-  const float rcp[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
-  // Slab distances, conservative under rounding so that the BVH keeps the watertight test watertight:
-  // a box the ray really meets is never culled. A NaN distance (an overflow) never culls either: the
-  // test below is "not tNear > tFar". An axis the ray runs parallel to (orthographic views, axis-aligned
-  // rays) has no slab distances (they would be infinite or NaN and cull nothing: every box across the
-  // view visited, ~300× slower); its test is exact instead, lo ≤ o ≤ hi.
-  constexpr int kSlabs = 3 - __builtin_popcount(Parallel);
-  constexpr SlabAxes slabs = slabAxesOf(Parallel);
-  const F oAxis[3] = {set1(o[0]), set1(o[1]), set1(o[2])};
+  static constexpr int kSlabs = 3 - __builtin_popcount(Parallel);
+  static constexpr SlabAxes kSlabAxes = slabAxesOf(Parallel);
+
+  const Bvh::View& bvh;
+  const Ray& ray;
+  const IntersectMethod method;
+  Hit& hit;
+  F oAxis[3];
   int nearOff[3], farOff[3];
 #if RTR_BVH_AVX2
-  // One FMA per slab: t = box·r − o·r. The near distance uses r shrunk by 8 ulps and o·r pushed up by
-  // 4 ulps, the far one r grown and o·r pushed down: enough to cover every rounding (of 1/d, of o·r, of
-  // the FMA), so a near distance never ends up past the true one, nor a far one short of it.
-  // All three axes at once in one SSE register (the same operations per lane as one axis alone): the
-  // per-ray set-up is a good part of a ray's time (measured with rays that miss the root).
-  const __m128 r4 = _mm_setr_ps(rcp[0], rcp[1], rcp[2], 1.0f), o4 = _mm_setr_ps(o[0], o[1], o[2], 0.0f);
-  const __m128 rn4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f - 0x1p-21f)), rf4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f + 0x1p-21f));
-  const __m128 qn0 = _mm_mul_ps(o4, rn4), qf0 = _mm_mul_ps(o4, rf4), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
-  const __m128 qn4 = _mm_add_ps(qn0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qn0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
-  const __m128 qf4 = _mm_sub_ps(qf0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qf0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
-  const F rNear[3] = {lane<0>(rn4), lane<1>(rn4), lane<2>(rn4)}, qNear[3] = {lane<0>(qn4), lane<1>(qn4), lane<2>(qn4)};
-  const F rFar[3] = {lane<0>(rf4), lane<1>(rf4), lane<2>(rf4)}, qFar[3] = {lane<0>(qf4), lane<1>(qf4), lane<2>(qf4)};
-  const unsigned negative = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r4, _mm_setzero_ps())));
-  for (int a = 0; a < 3; ++a) {
-    const int nearSide = negative >> a & 1;
-    nearOff[a] = (nearSide * 3 + a) * 8;
-    farOff[a] = ((1 - nearSide) * 3 + a) * 8;
-  }
+  F rNear[3], qNear[3], rFar[3], qFar[3];
 #else
-  // (box − o)·r, the far one scaled by 1 + 2·gamma(4) (Ize 2013; the scale folded into r, one more rounding).
-  constexpr float kFarScale = 1.0f + 2.0f * (4.0f * 0x1p-24f) / (1.0f - 4.0f * 0x1p-24f);
   F org[3], rdir[3], rdirFar[3];
-  for (int a = 0; a < 3; ++a) {
-    const float inv = rcp[a];
-    org[a] = set1(o[a]);
-    rdir[a] = set1(inv);
-    rdirFar[a] = set1(inv * kFarScale);
-    const int nearSide = inv < 0.0f ? 1 : 0;
-    nearOff[a] = (nearSide * 3 + a) * 8;
-    farOff[a] = ((1 - nearSide) * 3 + a) * 8;
-  }
 #endif
-  // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
-  // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
-  // must shear identically), inline here and sharing the reciprocal with the slab test.
-  const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[1]), __builtin_fabsf(d[2])};
-  const int kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
-  int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
-  if (d[kz] < 0.0f) { const int t = kx; kx = ky; ky = t; }
-  const float szs = rcp[kz];
-  const F ox = set1(o[kx]), oy = set1(o[ky]), oz = set1(o[kz]);
-  const F sx = set1(d[kx] * szs), sy = set1(d[ky] * szs), sz = set1(szs);
-  const F zero = set1(0.0f), signBit = set1(-0.0f);
-
-  // Stack entries: the entry distance's bits above the node reference, so one integer compare sorts.
-  uint64_t stack[kStackSize];
+  int kx, ky, kz;
+  F ox, oy, oz, sx, sy, sz;
+  // The stack (kStackSize entries) is the caller's, passed to each call: as an array member it would keep
+  // the compiler from holding this struct's fields in registers, as a pointer member it takes a register
+  // (either measured 4-5 % slower). An entry: the entry distance's bits above the node reference, so one
+  // integer compare sorts.
   int sp = 0;
-  uint32_t ref = bvh.root;
-  float tHit = ray.tMax;
+  uint32_t ref;
+  float tHit;
   bool found = false;
 
-  for (;;) {
-    const F tHitV = set1(tHit);
-    while (!(ref & Bvh::kLeafBit)) {
-      const Node& n = bvh.nodes[ref];
-      const float* b = &n.box[0][0][0];
-      F tn[3], tf[3];
-      for (int i = 0; i < kSlabs; ++i) {
-        const int a = slabs.axis[i];
+  RTR_INLINE Walker(const Bvh::View& view, const Ray& r, IntersectMethod m, Hit& h)
+      : bvh(view), ray(r), method(m), hit(h), ref(view.root), tHit(r.tMax) {
+    const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+    const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+    const float rcp[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
+    // Slab distances, conservative under rounding so that the BVH keeps the watertight test watertight:
+    // a box the ray really meets is never culled. A NaN distance (an overflow) never culls either: the
+    // test below is "not tNear > tFar". An axis the ray runs parallel to (orthographic views, axis-aligned
+    // rays) has no slab distances (they would be infinite or NaN and cull nothing: every box across the
+    // view visited, ~300× slower); its test is exact instead, lo ≤ o ≤ hi.
+    for (int a = 0; a < 3; ++a) oAxis[a] = set1(o[a]);
 #if RTR_BVH_AVX2
-        tn[i] = fmsub(load(b + nearOff[a]), rNear[a], qNear[a]);
-        tf[i] = fmsub(load(b + farOff[a]), rFar[a], qFar[a]);
-#else
-        tn[i] = (load(b + nearOff[a]) - org[a]) * rdir[a];
-        tf[i] = (load(b + farOff[a]) - org[a]) * rdirFar[a];
-#endif
-      }
-      // At most two levels of min/max, not a chain: this is the loop's critical path. As floats, a NaN
-      // operand drops out or reaches the compare, which visits. As integers (slabMax): with +0 among the
-      // near distances a negative one (sign bit set: a negative integer) never wins, and non-negative
-      // floats order as their bits do, so tNear is exact; a far distance below zero makes tFar negative
-      // (maybe not the most negative, but the box is culled either way), else tFar is exact; a positive
-      // NaN wins a max and the compare visits, a negative one drops out of a max or makes tFar NaN.
-      F tNear = zero, tFar = tHitV;
-      if constexpr (kSlabs == 3) {
-        tNear = slabMax(slabMax(tn[0], tn[1]), slabMax(tn[2], zero));
-        tFar = slabMin(slabMin(tf[0], tf[1]), slabMin(tf[2], tHitV));
-      } else if constexpr (kSlabs == 2) {
-        tNear = slabMax(slabMax(tn[0], tn[1]), zero);
-        tFar = slabMin(slabMin(tf[0], tf[1]), tHitV);
-      } else if constexpr (kSlabs == 1) {
-        tNear = slabMax(tn[0], zero);
-        tFar = slabMin(tf[0], tHitV);
-      }
-      F hitBox = ngt(tNear, tFar);
-      for (int a = 0; a < 3; ++a)
-        if (Parallel >> a & 1) hitBox = hitBox & le(load(n.box[0][a]), oAxis[a]) & ge(load(n.box[1][a]), oAxis[a]);
-      unsigned mask = bits(hitBox);
-      if (mask == 0) goto pop;
-      const int c0 = ctz(mask);
-      mask &= mask - 1;
-      if (mask == 0) { ref = n.child[c0]; continue; }
-      // Two or more children: the one visited next is the smallest key, the others go on the stack.
-      // Closest hit goes nearest first, so that a hit culls the rest. Any hit goes farthest first: a
-      // shadow ray leaves a surface, and the boxes around its origin hold that surface and its
-      // neighbours, which rarely block it (measured: docs/bench/trace.md).
-      alignas(32) float dist[8];
-      store(dist, tNear);
-      auto key = [&](int c) {
-        const uint32_t d32 = floatBits(dist[c]);
-        return uint64_t(AnyHit ? ~d32 : d32) << 32 | n.child[c];
-      };
-      const int c1 = ctz(mask);
-      mask &= mask - 1;
-      if (mask == 0) {  // two, the common case
-        const uint64_t k0 = key(c0), k1 = key(c1);
-        stack[sp++] = k0 < k1 ? k1 : k0;
-        ref = uint32_t(k0 < k1 ? k0 : k1);
-        continue;
-      }
-      // Three or more: insertion sort onto the stack, smallest key on top.
-      uint64_t* run = stack + sp;
-      int k = 0;
-      for (mask |= 1u << c0 | 1u << c1; mask; mask &= mask - 1) {
-        const uint64_t kc = key(ctz(mask));
-        int j = k++;
-        while (j > 0 && run[j - 1] < kc) { run[j] = run[j - 1]; --j; }
-        run[j] = kc;
-      }
-      sp += k - 1;
-      ref = uint32_t(run[k - 1]);
+    // One FMA per slab: t = box·r − o·r. The near distance uses r shrunk by 8 ulps and o·r pushed up by
+    // 4 ulps, the far one r grown and o·r pushed down: enough to cover every rounding (of 1/d, of o·r, of
+    // the FMA), so a near distance never ends up past the true one, nor a far one short of it.
+    // All three axes at once in one SSE register (the same operations per lane as one axis alone): the
+    // per-ray set-up is a good part of a ray's time (measured with rays that miss the root).
+    const __m128 r4 = _mm_setr_ps(rcp[0], rcp[1], rcp[2], 1.0f), o4 = _mm_setr_ps(o[0], o[1], o[2], 0.0f);
+    const __m128 rn4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f - 0x1p-21f)), rf4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f + 0x1p-21f));
+    const __m128 qn0 = _mm_mul_ps(o4, rn4), qf0 = _mm_mul_ps(o4, rf4), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+    const __m128 qn4 = _mm_add_ps(qn0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qn0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
+    const __m128 qf4 = _mm_sub_ps(qf0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qf0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
+    rNear[0] = lane<0>(rn4); rNear[1] = lane<1>(rn4); rNear[2] = lane<2>(rn4);
+    qNear[0] = lane<0>(qn4); qNear[1] = lane<1>(qn4); qNear[2] = lane<2>(qn4);
+    rFar[0] = lane<0>(rf4); rFar[1] = lane<1>(rf4); rFar[2] = lane<2>(rf4);
+    qFar[0] = lane<0>(qf4); qFar[1] = lane<1>(qf4); qFar[2] = lane<2>(qf4);
+    const unsigned negative = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r4, _mm_setzero_ps())));
+    for (int a = 0; a < 3; ++a) {
+      const int nearSide = negative >> a & 1;
+      nearOff[a] = (nearSide * 3 + a) * 8;
+      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
     }
-    {
-      const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
-      for (uint32_t p = first; p < first + np; ++p) {
-        const TriPack& pk = bvh.packs[p];
-        if (method != IntersectMethod::Watertight) {
-          for (int lane = 0; lane < 8; ++lane) {
-            const uint32_t prim = pk.prim[lane];
-            if (AnyHit && (prim & Bvh::kNoShadowBit)) continue;
-            Ray r = ray;
-            r.tMax = tHit;
-            float b1, b2;
-            const float t = intersect(method, r, laneTriangle(pk, lane), b1, b2);
-            if (t > 0.0f) {
-              if constexpr (AnyHit) return true;
-              tHit = t; hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit}; found = true;
-            }
-          }
-          continue;
-        }
-        // The 8-wide watertight test: the same float operations in the same order as the scalar one
-        // (no FMA), so both agree bit for bit.
-        const F Az = load(pk.v[0][kz]) - oz, Bz = load(pk.v[1][kz]) - oz, Cz = load(pk.v[2][kz]) - oz;
-        const F ax = (load(pk.v[0][kx]) - ox) - sx * Az, ay = (load(pk.v[0][ky]) - oy) - sy * Az;
-        const F bx = (load(pk.v[1][kx]) - ox) - sx * Bz, by = (load(pk.v[1][ky]) - oy) - sy * Bz;
-        const F cx = (load(pk.v[2][kx]) - ox) - sx * Cz, cy = (load(pk.v[2][ky]) - oy) - sy * Cz;
-        const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
-        // Inside: U, V, W of one sign. Lanes with a zero go to the edge path; a NaN lane that passes
-        // here fails the t test below (as in the scalar routine, where it fails here).
-        // Exactly on an edge in float: the scalar routine decides in double.
-        unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W, zero));
-        unsigned m = ~bits((U ^ V) | (V ^ W)) & 0xFFu & ~edge;
-        if ((m | edge) == 0) continue;
-        const F det = U + V + W;
-        const F T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
-        const F detSign = det & signBit;
-        const F Ts = T ^ detSign;
-        m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tHitV * (det ^ detSign)));
-        if constexpr (AnyHit) {
-          const unsigned casters = ~topBits(pk.prim);
-          if (m & casters) return true;
-          edge &= casters;
-        } else if (m) {
-          const F inv = set1(1.0f) / det;
-          alignas(32) float tv[8], iv[8], vv[8], wv[8];
-          store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W);
-          for (; m; m &= m - 1) {
-            const int lane = ctz(m);
-            const float t = tv[lane];
-            if (t > 0.0f && t < tHit) {
-              tHit = t;
-              hit = {t, vv[lane] * iv[lane], wv[lane] * iv[lane], pk.prim[lane] & ~Bvh::kNoShadowBit};
-              found = true;
-            }
-          }
-        }
-        for (; edge; edge &= edge - 1) {
-          const int lane = ctz(edge);
-          WatertightRay r(ray);
+#else
+    // (box − o)·r, the far one scaled by 1 + 2·gamma(4) (Ize 2013; the scale folded into r, one more rounding).
+    constexpr float kFarScale = 1.0f + 2.0f * (4.0f * 0x1p-24f) / (1.0f - 4.0f * 0x1p-24f);
+    for (int a = 0; a < 3; ++a) {
+      const float inv = rcp[a];
+      org[a] = set1(o[a]);
+      rdir[a] = set1(inv);
+      rdirFar[a] = set1(inv * kFarScale);
+      const int nearSide = inv < 0.0f ? 1 : 0;
+      nearOff[a] = (nearSide * 3 + a) * 8;
+      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+    }
+#endif
+    // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
+    // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
+    // must shear identically), inline here and sharing the reciprocal with the slab test.
+    const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[1]), __builtin_fabsf(d[2])};
+    kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0f) { const int t = kx; kx = ky; ky = t; }
+    const float szs = rcp[kz];
+    ox = set1(o[kx]); oy = set1(o[ky]); oz = set1(o[kz]);
+    sx = set1(d[kx] * szs); sy = set1(d[ky] * szs); sz = set1(szs);
+  }
+
+  // Tests the inner node `ref`'s children: false when it meets none; else `ref` is the child to visit
+  // next and the others are on the stack.
+  RTR_INLINE bool visitNode(uint64_t* stack, F tHitV) {
+    const Node& n = bvh.nodes[ref];
+    const float* b = &n.box[0][0][0];
+    const F zero = set1(0.0f);
+    F tn[3], tf[3];
+    for (int i = 0; i < kSlabs; ++i) {
+      const int a = kSlabAxes.axis[i];
+#if RTR_BVH_AVX2
+      tn[i] = fmsub(load(b + nearOff[a]), rNear[a], qNear[a]);
+      tf[i] = fmsub(load(b + farOff[a]), rFar[a], qFar[a]);
+#else
+      tn[i] = (load(b + nearOff[a]) - org[a]) * rdir[a];
+      tf[i] = (load(b + farOff[a]) - org[a]) * rdirFar[a];
+#endif
+    }
+    // At most two levels of min/max, not a chain: this is the loop's critical path. As floats, a NaN
+    // operand drops out or reaches the compare, which visits. As integers (slabMax): with +0 among the
+    // near distances a negative one (sign bit set: a negative integer) never wins, and non-negative
+    // floats order as their bits do, so tNear is exact; a far distance below zero makes tFar negative
+    // (maybe not the most negative, but the box is culled either way), else tFar is exact; a positive
+    // NaN wins a max and the compare visits, a negative one drops out of a max or makes tFar NaN.
+    F tNear = zero, tFar = tHitV;
+    if constexpr (kSlabs == 3) {
+      tNear = slabMax(slabMax(tn[0], tn[1]), slabMax(tn[2], zero));
+      tFar = slabMin(slabMin(tf[0], tf[1]), slabMin(tf[2], tHitV));
+    } else if constexpr (kSlabs == 2) {
+      tNear = slabMax(slabMax(tn[0], tn[1]), zero);
+      tFar = slabMin(slabMin(tf[0], tf[1]), tHitV);
+    } else if constexpr (kSlabs == 1) {
+      tNear = slabMax(tn[0], zero);
+      tFar = slabMin(tf[0], tHitV);
+    }
+    F hitBox = ngt(tNear, tFar);
+    for (int a = 0; a < 3; ++a)
+      if (Parallel >> a & 1) hitBox = hitBox & le(load(n.box[0][a]), oAxis[a]) & ge(load(n.box[1][a]), oAxis[a]);
+    unsigned mask = bits(hitBox);
+    if (mask == 0) return false;
+    const int c0 = ctz(mask);
+    mask &= mask - 1;
+    if (mask == 0) { ref = n.child[c0]; return true; }
+    // Two or more children: the one visited next is the smallest key, the others go on the stack.
+    // Closest hit goes nearest first, so that a hit culls the rest. Any hit goes farthest first: a
+    // shadow ray leaves a surface, and the boxes around its origin hold that surface and its
+    // neighbours, which rarely block it (measured: docs/bench/trace.md).
+    alignas(32) float dist[8];
+    store(dist, tNear);
+    auto key = [&](int c) {
+      const uint32_t d32 = floatBits(dist[c]);
+      return uint64_t(AnyHit ? ~d32 : d32) << 32 | n.child[c];
+    };
+    const int c1 = ctz(mask);
+    mask &= mask - 1;
+    if (mask == 0) {  // two, the common case
+      const uint64_t k0 = key(c0), k1 = key(c1);
+      stack[sp++] = k0 < k1 ? k1 : k0;
+      ref = uint32_t(k0 < k1 ? k0 : k1);
+      return true;
+    }
+    // Three or more: insertion sort onto the stack, smallest key on top.
+    uint64_t* run = stack + sp;
+    int k = 0;
+    for (mask |= 1u << c0 | 1u << c1; mask; mask &= mask - 1) {
+      const uint64_t kc = key(ctz(mask));
+      int j = k++;
+      while (j > 0 && run[j - 1] < kc) { run[j] = run[j - 1]; --j; }
+      run[j] = kc;
+    }
+    sp += k - 1;
+    ref = uint32_t(run[k - 1]);
+    return true;
+  }
+
+  // Tests the leaf `ref`'s triangles, keeping the closest in tHit/hit; true when an any-hit query has
+  // found its hit (the walk is over).
+  RTR_INLINE bool testLeaf(F tHitV) {
+    const F zero = set1(0.0f), signBit = set1(-0.0f);
+    const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+    for (uint32_t p = first; p < first + np; ++p) {
+      const TriPack& pk = bvh.packs[p];
+      if (method != IntersectMethod::Watertight) {
+        for (int lane = 0; lane < 8; ++lane) {
+          const uint32_t prim = pk.prim[lane];
+          if (AnyHit && (prim & Bvh::kNoShadowBit)) continue;
+          Ray r = ray;
           r.tMax = tHit;
           float b1, b2;
-          const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
+          const float t = intersect(method, r, laneTriangle(pk, lane), b1, b2);
           if (t > 0.0f) {
             if constexpr (AnyHit) return true;
-            tHit = t; hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit}; found = true;
+            tHit = t; hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit}; found = true;
+          }
+        }
+        continue;
+      }
+      // The 8-wide watertight test: the same float operations in the same order as the scalar one
+      // (no FMA), so both agree bit for bit.
+      const F Az = load(pk.v[0][kz]) - oz, Bz = load(pk.v[1][kz]) - oz, Cz = load(pk.v[2][kz]) - oz;
+      const F ax = (load(pk.v[0][kx]) - ox) - sx * Az, ay = (load(pk.v[0][ky]) - oy) - sy * Az;
+      const F bx = (load(pk.v[1][kx]) - ox) - sx * Bz, by = (load(pk.v[1][ky]) - oy) - sy * Bz;
+      const F cx = (load(pk.v[2][kx]) - ox) - sx * Cz, cy = (load(pk.v[2][ky]) - oy) - sy * Cz;
+      const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
+      // Inside: U, V, W of one sign. Lanes with a zero go to the edge path; a NaN lane that passes
+      // here fails the t test below (as in the scalar routine, where it fails here).
+      // Exactly on an edge in float: the scalar routine decides in double.
+      unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W, zero));
+      unsigned m = ~bits((U ^ V) | (V ^ W)) & 0xFFu & ~edge;
+      if ((m | edge) == 0) continue;
+      const F det = U + V + W;
+      const F T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
+      const F detSign = det & signBit;
+      const F Ts = T ^ detSign;
+      m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tHitV * (det ^ detSign)));
+      if constexpr (AnyHit) {
+        const unsigned casters = ~topBits(pk.prim);
+        if (m & casters) return true;
+        edge &= casters;
+      } else if (m) {
+        const F inv = set1(1.0f) / det;
+        alignas(32) float tv[8], iv[8], vv[8], wv[8];
+        store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W);
+        for (; m; m &= m - 1) {
+          const int lane = ctz(m);
+          const float t = tv[lane];
+          if (t > 0.0f && t < tHit) {
+            tHit = t;
+            hit = {t, vv[lane] * iv[lane], wv[lane] * iv[lane], pk.prim[lane] & ~Bvh::kNoShadowBit};
+            found = true;
           }
         }
       }
+      for (; edge; edge &= edge - 1) {
+        const int lane = ctz(edge);
+        WatertightRay r(ray);
+        r.tMax = tHit;
+        float b1, b2;
+        const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
+        if (t > 0.0f) {
+          if constexpr (AnyHit) return true;
+          tHit = t; hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit}; found = true;
+        }
+      }
     }
-  pop:
-    for (;;) {
-      if (sp == 0) return found;
+    return false;
+  }
+
+  // Takes the next entry off the stack into `ref`, skipping those beyond the closest hit; false when
+  // none is left.
+  RTR_INLINE bool pop(const uint64_t* stack) {
+    while (sp > 0) {
       const uint64_t e = stack[--sp];
       if (!AnyHit && bitsFloat(uint32_t(e >> 32)) > tHit) continue;
       ref = uint32_t(e);
-      break;
+      return true;
+    }
+    return false;
+  }
+
+  // Walks on from `ref` to the end; returns whether the ray hit.
+  RTR_INLINE bool run(uint64_t* stack) {
+    for (;;) {
+      const F tHitV = set1(tHit);
+      while (!(ref & Bvh::kLeafBit))
+        if (!visitNode(stack, tHitV)) goto next;
+      if (AnyHit && testLeaf(tHitV)) return found = true;
+      if (!AnyHit) testLeaf(tHitV);
+    next:
+      if (!pop(stack)) return found;
     }
   }
-}
+
+  // One node or one leaf; false when the walk is over (the result is in `found`).
+  RTR_INLINE bool step(uint64_t* stack) {
+    const F tHitV = set1(tHit);
+    if (!(ref & Bvh::kLeafBit)) {
+      if (visitNode(stack, tHitV)) return true;
+    } else if (testLeaf(tHitV)) {
+      found = true;
+      return false;
+    }
+    return pop(stack);
+  }
+};
 
 }  // namespace
 
 // One traversal per set of axes the ray runs parallel to; a zero direction meets nothing.
+// The axes a ray runs parallel to (zero direction components) as bits; 7 (no direction) meets nothing.
+inline unsigned parallelAxes(const Ray& r) {
+  const glm::vec3& d = r.direction;
+  return unsigned(d.x == 0.0f) | unsigned(d.y == 0.0f) << 1 | unsigned(d.z == 0.0f) << 2;
+}
+
+template <bool AnyHit, unsigned Parallel>
+bool walk(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
+  uint64_t stack[kStackSize];
+  return Walker<AnyHit, Parallel>(bvh, ray, method, hit).run(stack);
+}
+
+// Two rays, one node or leaf of each in turn: while one waits for memory or recovers from a mispredicted
+// branch, the other's independent work fills the core (docs/bench/trace.md, round 5). Each gets exactly
+// the result it gets alone.
+template <bool AnyHit, unsigned Parallel>
+unsigned walkPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod method, Hit* hits) {
+  uint64_t stackA[kStackSize], stackB[kStackSize];
+  Walker<AnyHit, Parallel> a(bvh, rays[0], method, hits[0]), b(bvh, rays[1], method, hits[1]);
+  bool moreA = true, moreB = true;
+  while (moreA && moreB) {
+    moreA = a.step(stackA);
+    moreB = b.step(stackB);
+  }
+  if (moreA) a.run(stackA);
+  if (moreB) b.run(stackB);
+  return unsigned(a.found) | unsigned(b.found) << 1;
+}
+
+// One traversal per set of axes the ray runs parallel to.
 template <bool AnyHit>
 bool dispatch(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
-  const glm::vec3& d = ray.direction;
-  switch (unsigned(d.x == 0.0f) | unsigned(d.y == 0.0f) << 1 | unsigned(d.z == 0.0f) << 2) {
-    case 0: return traverse<AnyHit, 0>(bvh, ray, method, hit);
-    case 1: return traverse<AnyHit, 1>(bvh, ray, method, hit);
-    case 2: return traverse<AnyHit, 2>(bvh, ray, method, hit);
-    case 3: return traverse<AnyHit, 3>(bvh, ray, method, hit);
-    case 4: return traverse<AnyHit, 4>(bvh, ray, method, hit);
-    case 5: return traverse<AnyHit, 5>(bvh, ray, method, hit);
-    case 6: return traverse<AnyHit, 6>(bvh, ray, method, hit);
+  switch (parallelAxes(ray)) {
+    case 0: return walk<AnyHit, 0>(bvh, ray, method, hit);
+    case 1: return walk<AnyHit, 1>(bvh, ray, method, hit);
+    case 2: return walk<AnyHit, 2>(bvh, ray, method, hit);
+    case 3: return walk<AnyHit, 3>(bvh, ray, method, hit);
+    case 4: return walk<AnyHit, 4>(bvh, ray, method, hit);
+    case 5: return walk<AnyHit, 5>(bvh, ray, method, hit);
+    case 6: return walk<AnyHit, 6>(bvh, ray, method, hit);
     default: return false;
+  }
+}
+
+// Pairs whose rays run parallel to the same axes (all of a view's rays, orthographic or not) walk
+// together; others one at a time.
+template <bool AnyHit>
+unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod method, Hit* hits) {
+  const unsigned p = parallelAxes(rays[0]);
+  switch (p == parallelAxes(rays[1]) ? p : 8u) {
+    case 0: return walkPair<AnyHit, 0>(bvh, rays, method, hits);
+    case 1: return walkPair<AnyHit, 1>(bvh, rays, method, hits);
+    case 2: return walkPair<AnyHit, 2>(bvh, rays, method, hits);
+    case 3: return walkPair<AnyHit, 3>(bvh, rays, method, hits);
+    case 4: return walkPair<AnyHit, 4>(bvh, rays, method, hits);
+    case 5: return walkPair<AnyHit, 5>(bvh, rays, method, hits);
+    case 6: return walkPair<AnyHit, 6>(bvh, rays, method, hits);
+    case 7: return 0;
+    default:
+      return unsigned(dispatch<AnyHit>(bvh, rays[0], method, hits[0])) |
+             unsigned(dispatch<AnyHit>(bvh, rays[1], method, hits[1])) << 1;
   }
 }
 
@@ -353,6 +461,12 @@ bool closest(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& 
 }
 bool occluded(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& scratch) {
   return dispatch<true>(bvh, ray, method, scratch);
+}
+unsigned closestPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod method, Hit* hits) {
+  return dispatchPair<false>(bvh, rays, method, hits);
+}
+unsigned occludedPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod method, Hit* scratch) {
+  return dispatchPair<true>(bvh, rays, method, scratch);
 }
 
 }  // namespace rtr::trace::RTR_BVH_ISA

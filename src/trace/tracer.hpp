@@ -141,10 +141,13 @@ class Tracer {
     float t = 0.0f;
   };
   Frame makeFrame(const TraceSettings& s) const;
-  glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c) const;
+  // `first`: r's closest hit when the caller has traced it already (the render loop traces primary rays
+  // in pairs), else null.
+  glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
+                  const Hit* first = nullptr) const;
   glm::vec3 local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c) const;
   bool cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const;
-  Visible closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c) const;
+  Visible closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c, const Hit* first) const;
   bool shadowed(const Ray& r, const Frame& f, Counters& c) const;
 
   const Scene& scene_;

@@ -58,6 +58,58 @@ TEST(Bvh, MatchesBruteForceOnATriangleSoup) {
   Bvh::setIsa(BvhIsa::Avx512);
 }
 
+// Two rays walked together give each exactly what it gets alone: rays in general directions, rays
+// parallel to the same axis (walked together too) or to different ones, a zero direction, short tMax,
+// pairs where one ray ends long before the other (one misses the scene), and each routine and ISA.
+TEST(Bvh, PairsGiveExactlyTheResultsOfSingleRays) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Triangle> tris;
+  std::vector<uint8_t> casts;
+  for (int i = 0; i < 4000; ++i) {
+    const glm::vec3 c{u(rng) * 10, u(rng) * 10, u(rng) * 10};
+    tris.push_back({c, c + glm::vec3{u(rng), u(rng), u(rng)}, c + glm::vec3{u(rng), u(rng), u(rng)}});
+    casts.push_back(i % 5 != 0);
+  }
+  const Bvh bvh(tris, casts, 2);
+  auto randomRay = [&](int i) {
+    Ray r{{u(rng) * 12, u(rng) * 12, u(rng) * 12}, {u(rng), u(rng), u(rng)}};
+    if (i % 5 == 1) r.direction.y = 0.0f;
+    if (i % 5 == 2) r.direction.x = r.direction.z = 0.0f;
+    if (i % 7 == 3) r.tMax = 4.0f;
+    if (i % 11 == 4) r.origin = {40.0f, 40.0f, 40.0f};  // misses the root: ends at once
+    if (i % 29 == 5) r.direction = glm::vec3(0.0f);
+    return r;
+  };
+  for (BvhIsa isa : {BvhIsa::Avx512, BvhIsa::Avx2, BvhIsa::Sse})
+    for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::HalfPlane, IntersectMethod::MollerTrumbore}) {
+      Bvh::setIsa(isa);
+      int hits = 0, occluded = 0;
+      for (int i = 0; i < 4000; ++i) {
+        const std::array<Ray, 2> rays{randomRay(i), randomRay(i / 2)};
+        const std::array<Hit, 2> pair = bvh.closestPair(rays, m);
+        const std::array<bool, 2> occ = bvh.occludedPair(rays, m);
+        for (int k = 0; k < 2; ++k) {
+          const Hit one = bvh.closest(rays[k], m);
+          ASSERT_EQ(pair[k].prim, one.prim) << Bvh::isaName(isa) << " pair " << i << " ray " << k;
+          EXPECT_EQ(pair[k].t, one.t) << i;
+          EXPECT_EQ(pair[k].b1, one.b1) << i;
+          EXPECT_EQ(pair[k].b2, one.b2) << i;
+          ASSERT_EQ(occ[k], bvh.occluded(rays[k], m)) << Bvh::isaName(isa) << " pair " << i << " ray " << k;
+          hits += one.hit();
+          occluded += occ[k];
+        }
+      }
+      EXPECT_GT(hits, 1000);
+      EXPECT_GT(occluded, 1000);
+      EXPECT_LT(occluded, hits);  // non-casters: some hits cast no shadow
+    }
+  Bvh::setIsa(BvhIsa::Avx512);
+  const Bvh empty(std::vector<Triangle>{});
+  EXPECT_FALSE(empty.closestPair({Ray{}, Ray{}})[1].hit());
+  EXPECT_FALSE(empty.occludedPair({Ray{}, Ray{}})[0]);
+}
+
 // Orthographic views and axis-aligned rays: direction components exactly zero, and origins exactly on
 // box planes (the rays pass through vertices, whose coordinates bound the boxes). The parallel axes are
 // tested exactly (lo ≤ o ≤ hi); any box culled wrongly shows up as a difference from brute force, and
