@@ -115,19 +115,30 @@ constexpr SlabAxes slabAxesOf(unsigned parallel) {
 
 #define RTR_INLINE inline __attribute__((always_inline))
 
-// One ray's walk through the BVH, front to back, as a state machine: run() walks it to the end; step()
-// does one node or one leaf, so that two walks can be interleaved on one thread (traversePair below).
-// Parallel: bit a set when the ray runs parallel to axis a (a zero direction component), see below.
+// Where a walk is: the stack's fill, the node or leaf to visit next, the closest hit so far. The stack
+// itself (kStackSize entries) is passed beside it: as a member it kept the compiler from holding these
+// in registers (measured 5-10 % slower). An entry: the entry distance's bits above the node reference,
+// so one integer compare sorts.
+struct Cursor {
+  int sp;
+  uint32_t ref;
+  float tHit;
+  bool found;
+};
+
+// One ray's walk through the BVH, front to back: the per-ray constants and the steps of the walk.
+// run() walks to the end; step() does one node or one leaf, so that two walks can be interleaved on one
+// thread (walkPair below). Parallel: bit a set when the ray runs parallel to axis a (a zero direction
+// component), see below.
 template <bool AnyHit, unsigned Parallel>
 struct Walker {
   static_assert(sizeof(Triangle) == 9 * sizeof(float));
   static constexpr int kSlabs = 3 - __builtin_popcount(Parallel);
   static constexpr SlabAxes kSlabAxes = slabAxesOf(Parallel);
 
-  const Bvh::View& bvh;
+  const Bvh::View bvh;  // a copy: through a reference, the node array's address was reloaded after every pop
   const Ray& ray;
   const IntersectMethod method;
-  Hit& hit;
   F oAxis[3];
   int nearOff[3], farOff[3];
 #if RTR_BVH_AVX2
@@ -137,17 +148,8 @@ struct Walker {
 #endif
   int kx, ky, kz;
   F ox, oy, oz, sx, sy, sz;
-  // The stack (kStackSize entries) is the caller's, passed to each call: as an array member it would keep
-  // the compiler from holding this struct's fields in registers, as a pointer member it takes a register
-  // (either measured 4-5 % slower). An entry: the entry distance's bits above the node reference, so one
-  // integer compare sorts.
-  int sp = 0;
-  uint32_t ref;
-  float tHit;
-  bool found = false;
 
-  RTR_INLINE Walker(const Bvh::View& view, const Ray& r, IntersectMethod m, Hit& h)
-      : bvh(view), ray(r), method(m), hit(h), ref(view.root), tHit(r.tMax) {
+  RTR_INLINE Walker(const Bvh::View& view, const Ray& r, IntersectMethod m) : bvh(view), ray(r), method(m) {
     const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
     const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
     const float rcp[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
@@ -204,10 +206,10 @@ struct Walker {
     sx = set1(d[kx] * szs); sy = set1(d[ky] * szs); sz = set1(szs);
   }
 
-  // Tests the inner node `ref`'s children: false when it meets none; else `ref` is the child to visit
+  // Tests the inner node at.ref's children: false when it meets none; else at.ref is the child to visit
   // next and the others are on the stack.
-  RTR_INLINE bool visitNode(uint64_t* stack, F tHitV) {
-    const Node& n = bvh.nodes[ref];
+  RTR_INLINE bool visitNode(uint64_t* stack, Cursor& at, F tHitV) const {
+    const Node& n = bvh.nodes[at.ref];
     const float* b = &n.box[0][0][0];
     const F zero = set1(0.0f);
     F tn[3], tf[3];
@@ -245,7 +247,7 @@ struct Walker {
     if (mask == 0) return false;
     const int c0 = ctz(mask);
     mask &= mask - 1;
-    if (mask == 0) { ref = n.child[c0]; return true; }
+    if (mask == 0) { at.ref = n.child[c0]; return true; }
     // Two or more children: the one visited next is the smallest key, the others go on the stack.
     // Closest hit goes nearest first, so that a hit culls the rest. Any hit goes farthest first: a
     // shadow ray leaves a surface, and the boxes around its origin hold that surface and its
@@ -260,12 +262,12 @@ struct Walker {
     mask &= mask - 1;
     if (mask == 0) {  // two, the common case
       const uint64_t k0 = key(c0), k1 = key(c1);
-      stack[sp++] = k0 < k1 ? k1 : k0;
-      ref = uint32_t(k0 < k1 ? k0 : k1);
+      stack[at.sp++] = k0 < k1 ? k1 : k0;
+      at.ref = uint32_t(k0 < k1 ? k0 : k1);
       return true;
     }
     // Three or more: insertion sort onto the stack, smallest key on top.
-    uint64_t* run = stack + sp;
+    uint64_t* run = stack + at.sp;
     int k = 0;
     for (mask |= 1u << c0 | 1u << c1; mask; mask &= mask - 1) {
       const uint64_t kc = key(ctz(mask));
@@ -273,16 +275,16 @@ struct Walker {
       while (j > 0 && run[j - 1] < kc) { run[j] = run[j - 1]; --j; }
       run[j] = kc;
     }
-    sp += k - 1;
-    ref = uint32_t(run[k - 1]);
+    at.sp += k - 1;
+    at.ref = uint32_t(run[k - 1]);
     return true;
   }
 
-  // Tests the leaf `ref`'s triangles, keeping the closest in tHit/hit; true when an any-hit query has
-  // found its hit (the walk is over).
-  RTR_INLINE bool testLeaf(F tHitV) {
+  // Tests the leaf at.ref's triangles, keeping the closest in at.tHit and hit; true when an any-hit query
+  // has found its hit (the walk is over).
+  RTR_INLINE bool testLeaf(Cursor& at, Hit& hit, F tHitV) const {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
-    const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+    const uint32_t first = at.ref & 0x0FFFFFFFu, np = ((at.ref >> 28) & 7u) + 1;
     for (uint32_t p = first; p < first + np; ++p) {
       const TriPack& pk = bvh.packs[p];
       if (method != IntersectMethod::Watertight) {
@@ -290,12 +292,12 @@ struct Walker {
           const uint32_t prim = pk.prim[lane];
           if (AnyHit && (prim & Bvh::kNoShadowBit)) continue;
           Ray r = ray;
-          r.tMax = tHit;
+          r.tMax = at.tHit;
           float b1, b2;
           const float t = intersect(method, r, laneTriangle(pk, lane), b1, b2);
           if (t > 0.0f) {
             if constexpr (AnyHit) return true;
-            tHit = t; hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit}; found = true;
+            at.tHit = t; hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit}; at.found = true;
           }
         }
         continue;
@@ -329,69 +331,68 @@ struct Walker {
         for (; m; m &= m - 1) {
           const int lane = ctz(m);
           const float t = tv[lane];
-          if (t > 0.0f && t < tHit) {
-            tHit = t;
+          if (t > 0.0f && t < at.tHit) {
+            at.tHit = t;
             hit = {t, vv[lane] * iv[lane], wv[lane] * iv[lane], pk.prim[lane] & ~Bvh::kNoShadowBit};
-            found = true;
+            at.found = true;
           }
         }
       }
       for (; edge; edge &= edge - 1) {
         const int lane = ctz(edge);
         WatertightRay r(ray);
-        r.tMax = tHit;
+        r.tMax = at.tHit;
         float b1, b2;
         const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
         if (t > 0.0f) {
           if constexpr (AnyHit) return true;
-          tHit = t; hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit}; found = true;
+          at.tHit = t; hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit}; at.found = true;
         }
       }
     }
     return false;
   }
 
-  // Takes the next entry off the stack into `ref`, skipping those beyond the closest hit; false when
+  // Takes the next entry off the stack into at.ref, skipping those beyond the closest hit; false when
   // none is left.
-  RTR_INLINE bool pop(const uint64_t* stack) {
-    while (sp > 0) {
-      const uint64_t e = stack[--sp];
-      if (!AnyHit && bitsFloat(uint32_t(e >> 32)) > tHit) continue;
-      ref = uint32_t(e);
+  RTR_INLINE static bool pop(const uint64_t* stack, Cursor& at) {
+    while (at.sp > 0) {
+      const uint64_t e = stack[--at.sp];
+      if (!AnyHit && bitsFloat(uint32_t(e >> 32)) > at.tHit) continue;
+      at.ref = uint32_t(e);
       return true;
     }
     return false;
   }
 
-  // Walks on from `ref` to the end; returns whether the ray hit.
-  RTR_INLINE bool run(uint64_t* stack) {
+  // Walks on from at.ref to the end; returns whether the ray hit.
+  RTR_INLINE bool run(uint64_t* stack, Cursor& at, Hit& hit) const {
     for (;;) {
-      const F tHitV = set1(tHit);
-      while (!(ref & Bvh::kLeafBit))
-        if (!visitNode(stack, tHitV)) goto next;
-      if (AnyHit && testLeaf(tHitV)) return found = true;
-      if (!AnyHit) testLeaf(tHitV);
+      const F tHitV = set1(at.tHit);
+      while (!(at.ref & Bvh::kLeafBit))
+        if (!visitNode(stack, at, tHitV)) goto next;
+      if (AnyHit && testLeaf(at, hit, tHitV)) return at.found = true;
+      if (!AnyHit) testLeaf(at, hit, tHitV);
     next:
-      if (!pop(stack)) return found;
+      if (!pop(stack, at)) return at.found;
     }
   }
 
-  // One node or one leaf; false when the walk is over (the result is in `found`).
-  RTR_INLINE bool step(uint64_t* stack) {
-    const F tHitV = set1(tHit);
-    if (!(ref & Bvh::kLeafBit)) {
-      if (visitNode(stack, tHitV)) return true;
-    } else if (testLeaf(tHitV)) {
-      found = true;
+  // One node or one leaf; false when the walk is over (the result is in at.found).
+  RTR_INLINE bool step(uint64_t* stack, Cursor& at, Hit& hit) const {
+    const F tHitV = set1(at.tHit);
+    if (!(at.ref & Bvh::kLeafBit)) {
+      if (visitNode(stack, at, tHitV)) return true;
+    } else if (testLeaf(at, hit, tHitV)) {
+      at.found = true;
       return false;
     }
-    return pop(stack);
+    return pop(stack, at);
   }
 };
 
 }  // namespace
 
-// One traversal per set of axes the ray runs parallel to; a zero direction meets nothing.
 // The axes a ray runs parallel to (zero direction components) as bits; 7 (no direction) meets nothing.
 inline unsigned parallelAxes(const Ray& r) {
   const glm::vec3& d = r.direction;
@@ -401,7 +402,8 @@ inline unsigned parallelAxes(const Ray& r) {
 template <bool AnyHit, unsigned Parallel>
 bool walk(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit) {
   uint64_t stack[kStackSize];
-  return Walker<AnyHit, Parallel>(bvh, ray, method, hit).run(stack);
+  Cursor at{0, bvh.root, ray.tMax, false};
+  return Walker<AnyHit, Parallel>(bvh, ray, method).run(stack, at, hit);
 }
 
 // Two rays, one node or leaf of each in turn: while one waits for memory or recovers from a mispredicted
@@ -410,15 +412,16 @@ bool walk(const Bvh::View& bvh, const Ray& ray, IntersectMethod method, Hit& hit
 template <bool AnyHit, unsigned Parallel>
 unsigned walkPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod method, Hit* hits) {
   uint64_t stackA[kStackSize], stackB[kStackSize];
-  Walker<AnyHit, Parallel> a(bvh, rays[0], method, hits[0]), b(bvh, rays[1], method, hits[1]);
+  const Walker<AnyHit, Parallel> a(bvh, rays[0], method), b(bvh, rays[1], method);
+  Cursor atA{0, bvh.root, rays[0].tMax, false}, atB{0, bvh.root, rays[1].tMax, false};
   bool moreA = true, moreB = true;
   while (moreA && moreB) {
-    moreA = a.step(stackA);
-    moreB = b.step(stackB);
+    moreA = a.step(stackA, atA, hits[0]);
+    moreB = b.step(stackB, atB, hits[1]);
   }
-  if (moreA) a.run(stackA);
-  if (moreB) b.run(stackB);
-  return unsigned(a.found) | unsigned(b.found) << 1;
+  if (moreA) a.run(stackA, atA, hits[0]);
+  if (moreB) b.run(stackB, atB, hits[1]);
+  return unsigned(atA.found) | unsigned(atB.found) << 1;
 }
 
 // One traversal per set of axes the ray runs parallel to.
