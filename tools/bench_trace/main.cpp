@@ -102,19 +102,22 @@ struct Embree {
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) h = {rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.primID};
     return h;
   }
-  // Packets of eight rays (rtcIntersect8/Occluded8, Embree's SIMD packet traversal), rays [first, first + n).
+  // Packets of eight rays (rtcIntersect8/Occluded8, Embree's SIMD packet traversal): the n ≤ 8 rays at r.
   bool packets() const { return rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0; }
-  uint32_t closest8(const Ray* r, int n) const {
-    alignas(32) int valid[8];
-    alignas(32) RTCRayHit8 rh;
+  static void fill8(const Ray* r, int n, int (&valid)[8], RTCRay8& ray) {
     for (int k = 0; k < 8; ++k) {
       const Ray& q = r[k < n ? k : 0];
       valid[k] = k < n ? -1 : 0;
-      rh.ray.org_x[k] = q.origin.x; rh.ray.org_y[k] = q.origin.y; rh.ray.org_z[k] = q.origin.z;
-      rh.ray.dir_x[k] = q.direction.x; rh.ray.dir_y[k] = q.direction.y; rh.ray.dir_z[k] = q.direction.z;
-      rh.ray.tnear[k] = 0.0f; rh.ray.tfar[k] = q.tMax; rh.ray.mask[k] = ~0u; rh.ray.time[k] = 0.0f;
-      rh.ray.flags[k] = 0; rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      ray.org_x[k] = q.origin.x; ray.org_y[k] = q.origin.y; ray.org_z[k] = q.origin.z;
+      ray.dir_x[k] = q.direction.x; ray.dir_y[k] = q.direction.y; ray.dir_z[k] = q.direction.z;
+      ray.tnear[k] = 0.0f; ray.tfar[k] = q.tMax; ray.mask[k] = ~0u; ray.time[k] = 0.0f; ray.flags[k] = 0;
     }
+  }
+  uint32_t closest8(const Ray* r, int n) const {
+    alignas(32) int valid[8];
+    alignas(32) RTCRayHit8 rh;
+    fill8(r, n, valid, rh.ray);
+    for (int k = 0; k < 8; ++k) rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     rtcIntersect8(valid, scene, &ctx, &rh);
@@ -125,13 +128,7 @@ struct Embree {
   uint32_t occluded8(const Ray* r, int n) const {
     alignas(32) int valid[8];
     alignas(32) RTCRay8 ray;
-    for (int k = 0; k < 8; ++k) {
-      const Ray& q = r[k < n ? k : 0];
-      valid[k] = k < n ? -1 : 0;
-      ray.org_x[k] = q.origin.x; ray.org_y[k] = q.origin.y; ray.org_z[k] = q.origin.z;
-      ray.dir_x[k] = q.direction.x; ray.dir_y[k] = q.direction.y; ray.dir_z[k] = q.direction.z;
-      ray.tnear[k] = 0.0f; ray.tfar[k] = q.tMax; ray.mask[k] = ~0u; ray.time[k] = 0.0f; ray.flags[k] = 0;
-    }
+    fill8(r, n, valid, ray);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     rtcOccluded8(valid, scene, &ctx, &ray);
