@@ -100,6 +100,7 @@ BakeReport bake(const BakeOptions& opt) {
   if (::access(outDir.c_str(), W_OK) != 0)
     throw fileError(opt.output.string(), "", "output folder '" + outDir.string() + "' is not writable");
   if (opt.view && course && opt.warn) opt.warn("the .comp5892mesh format has no default view; --view ignored");
+  if (!opt.lights.empty() && course && opt.warn) opt.warn("the .comp5892mesh format stores no lights; --light ignored");
   const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
 
   // 1. Parse and weld.
@@ -112,6 +113,7 @@ BakeReport bake(const BakeOptions& opt) {
   rep.parseSeconds = rep.obj.parseSeconds;
   rep.weldSeconds = rep.obj.weldSeconds;
   if (opt.view) scene.defaultView = opt.view;
+  if (!opt.lights.empty()) scene.lights = opt.lights;
 
   // 2. Textures: plan, check every source decodes and no destination would be overwritten, then copy.
   auto t0 = Clock::now();

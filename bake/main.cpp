@@ -1,4 +1,4 @@
-// rtr-bake INPUT OUTPUT [--force] [--view x,y,z,yaw,pitch]: OBJ (plain or zstd) + MTL to .rtrscene / .comp5892mesh.
+// rtr-bake INPUT OUTPUT [--force] [--view x,y,z,yaw,pitch] [--light x,y,z]: OBJ (plain or zstd) + MTL to .rtrscene / .comp5892mesh.
 #include <unistd.h>
 
 #include <cstdio>
@@ -12,11 +12,13 @@
 int main(int argc, char** argv) {
   CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh"};
   rtr::BakeOptions opt;
-  std::string input, output, view;
+  std::string input, output, view, light, lightColor;
   app.add_option("INPUT", input, "OBJ file")->required();
   app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh)")->required();
   app.add_flag("--force", opt.force, "overwrite an existing output and textures");
   app.add_option("--view", view, "default camera pose x,y,z,yaw,pitch (degrees)");
+  app.add_option("--light", light, "store a point light at x,y,z with the scene (.rtrscene); it replaces the scene's own");
+  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)");
   CLI11_PARSE(app, argc, argv);
 
@@ -31,6 +33,12 @@ int main(int argc, char** argv) {
     };
   try {
     if (!view.empty()) opt.view = rtr::parsePose(view);
+    if (!light.empty()) {
+      rtr::Light l;
+      l.position = rtr::parseVec3(light, "--light");
+      if (!lightColor.empty()) l.color = rtr::parseVec3(lightColor, "--light-color");
+      opt.lights = {l};
+    }
     const rtr::BakeReport r = rtr::bake(opt);
     if (tty) std::fprintf(stderr, "\r%40s\r", "");
     const auto& o = r.obj;

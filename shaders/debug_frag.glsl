@@ -28,7 +28,8 @@ void main() {
   int mode = int(frame.params.x);
   vec3 n = brdfSafeNormal(shadingNormal());
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
-  vec3 l = normalize(frame.lightPos.xyz - inWorldPos);
+  // The first light (a scene without lights: the view direction, as a headlight).
+  vec3 l = frame.lightCount.x > 0u ? normalize(frame.lights[0].position.xyz - inWorldPos) : v;
   float viewDepth = -(frame.view * vec4(inWorldPos, 1.0)).z;  // distance along the view axis
   float far = frame.params.w;
   vec3 c = vec3(0.0);

@@ -1,4 +1,4 @@
-// The shaded view (mode 1): the brief's Beckmann / Cook-Torrance model for one point light, per fragment,
+// The shaded view (mode 1): the brief's Beckmann / Cook-Torrance model summed over the frame's lights, per fragment,
 // in world space. The BRDF itself lives in brdf.h, shared with the CPU reference.
 #include "material.glsl"
 #include "brdf.h"
@@ -15,11 +15,12 @@ void main() {
   if (s.alpha < 0.5) discard;
 #endif
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
-  vec3 toLight = frame.lightPos.xyz - inWorldPos;
-  float dist2 = max(dot(toLight, toLight), 1e-12);
-  vec3 l = toLight * inversesqrt(dist2);
-  vec3 lightColor = frame.lightColor.rgb * (frame.lightColor.w > 0.5 ? 1.0 / dist2 : 1.0);
-  vec3 c = shadePbr(shadingNormal(), v, l, lightColor, frame.ambient.rgb, s.baseColor, s.roughness, s.metalness,
-                    s.emissive);
+  vec3 n = shadingNormal();
+  vec3 c = frame.ambient.rgb * clamp(s.baseColor, vec3(0.0), vec3(1.0)) + s.emissive;
+  for (uint i = 0u; i < frame.lightCount.x; ++i) {
+    LightSample ls = lightSample(frame.lights[i].position.xyz, frame.lights[i].color.rgb,
+                                 frame.lights[i].position.w > 0.5, inWorldPos);
+    c += pbrDirect(n, v, ls.l, ls.radiance, s.baseColor, s.roughness, s.metalness);
+  }
   outColor = vec4(min(c, vec3(kMaxRadiance)), 1.0);
 }

@@ -99,10 +99,11 @@ void main() {
 #endif
 
   const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
-  const vec3 toLight = frame.lightPos.xyz - worldPos;
-  const float dist2 = max(dot(toLight, toLight), 1e-12);
-  const vec3 l = toLight * inversesqrt(dist2);
-  const vec3 lightColor = frame.lightColor.rgb * (frame.lightColor.w > 0.5 ? 1.0 / dist2 : 1.0);
-  const vec3 c = shadePbr(nrm, v, l, lightColor, frame.ambient.rgb, baseColor, roughness, metalness, emissive);
+  vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) + emissive;
+  for (uint i = 0u; i < frame.lightCount.x; ++i) {
+    const LightSample ls = lightSample(frame.lights[i].position.xyz, frame.lights[i].color.rgb,
+                                       frame.lights[i].position.w > 0.5, worldPos);
+    c += pbrDirect(nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
+  }
   imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
 }

@@ -124,14 +124,19 @@ RTR_FN BrdfTerms brdfTerms(vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughne
   return t;
 }
 
-// Outgoing radiance for one point light (brief eq. 1):
-// L = c_ambient c_mat + c_emit + (f_diffuse + f_spec) c_light (n.l)_+.
-RTR_FN vec3 shadePbr(vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 ambient, vec3 baseColor, float roughness,
-                     float metalness, vec3 emissive) {
+// What one light adds (brief eq. 1, its sum's term): (f_diffuse + f_spec) c_light (n.l)_+.
+RTR_FN vec3 pbrDirect(vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 baseColor, float roughness, float metalness) {
   BrdfTerms t = brdfTerms(n, v, l, baseColor, roughness, metalness);
   float nl = max(dot(brdfSafeNormal(n), l), 0.0f);
+  return (t.diffuse + t.specular) * lightColor * nl;
+}
+
+// Outgoing radiance for one point light (brief eq. 1):
+// L = c_ambient c_mat + c_emit + (f_diffuse + f_spec) c_light (n.l)_+. More lights add more pbrDirect terms.
+RTR_FN vec3 shadePbr(vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 ambient, vec3 baseColor, float roughness,
+                     float metalness, vec3 emissive) {
   vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
-  return ambient * c + emissive + (t.diffuse + t.specular) * lightColor * nl;
+  return ambient * c + emissive + pbrDirect(n, v, l, lightColor, baseColor, roughness, metalness);
 }
 
 #ifdef __cplusplus

@@ -3,6 +3,8 @@
 #ifndef RTR_SHADERS_SHARED_FRAME_H
 #define RTR_SHADERS_SHARED_FRAME_H
 
+#include "lights.h"
+
 #ifdef __cplusplus
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -32,8 +34,6 @@ struct FrameUniforms {
   mat4 viewProj;
   mat4 view;
   vec4 cameraPos;     // xyz world position
-  vec4 lightPos;      // xyz world position
-  vec4 lightColor;    // rgb colour x intensity; w: 1 = inverse-square falloff, 0 = none
   vec4 ambient;       // rgb constant ambient illumination
   vec4 params;        // x: view mode, y: mip LOD bias, z: near, w: far
   // Visibility path: a (not normalised) world-space direction of the ray through pixel coordinate
@@ -41,6 +41,8 @@ struct FrameUniforms {
   vec4 rayDir;
   vec4 rayDx;
   vec4 rayDy;
+  uvec4 lightCount;   // x: lights in use (<= MAX_LIGHTS); debug views use the first
+  GpuLight lights[MAX_LIGHTS];
 };
 
 // Material factors (storage buffer, std430). Texture indices index the scene's texture array;

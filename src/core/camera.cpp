@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -10,6 +11,38 @@
 #include "core/error.hpp"
 
 namespace rtr {
+
+namespace {
+
+// Comma-separated finite numbers; nullopt names the first bad field (1-based) in `bad`.
+std::optional<std::vector<float>> parseFloats(std::string_view text, size_t& bad) {
+  std::vector<float> v;
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t end = text.find(',', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string field(text.substr(start, end - start));
+    char* stop = nullptr;
+    float f = std::strtof(field.c_str(), &stop);
+    if (field.empty() || *stop != '\0' || !std::isfinite(f)) { bad = v.size() + 1; return std::nullopt; }
+    v.push_back(f);
+    start = end + 1;
+  }
+  return v;
+}
+
+}  // namespace
+
+glm::vec3 parseVec3(std::string_view text, const std::string& option, bool scalarAllowed) {
+  size_t bad = 0;
+  const auto v = parseFloats(text, bad);
+  const std::string expected = scalarAllowed ? "three numbers r,g,b or one" : "three numbers x,y,z";
+  if (!v) throw Error(option + " '" + std::string(text) + "': field " + std::to_string(bad) +
+                      " is not a finite number; expected " + expected);
+  if (v->size() == 1 && scalarAllowed) return glm::vec3((*v)[0]);
+  if (v->size() != 3) throw Error(option + " '" + std::string(text) + "': expected " + expected);
+  return {(*v)[0], (*v)[1], (*v)[2]};
+}
 
 CameraPose parsePose(std::string_view text) {
   std::vector<float> v;
@@ -83,14 +116,22 @@ CameraRay cameraRay(const CameraPose& pose, const Lens& lens, float aspect, glm:
   return {pose.position, glm::normalize(d)};
 }
 
-CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect) {
+CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect, Framing framing) {
   if (bounds.empty()) return {};
   const glm::vec3 c = bounds.center(), e = bounds.extent() * 0.5f;
-  // Fit the front face (x,y extent) into the view, then step back past the near half of the depth.
   const float tanY = std::tan(glm::radians(lens.fovYDeg) * 0.5f);
   const float tanX = tanY * std::max(aspect, 1e-3f);
-  const float dist = std::max(e.y / tanY, e.x / tanX) * 1.05f + e.z;
-  return {{c.x, c.y, c.z + std::max(dist, 1e-3f)}, 0.0f, 0.0f};
+  if (framing == Framing::Front) {
+    // Fit the front face (x,y extent) into the view, then step back past the near half of the depth.
+    const float dist = std::max(e.y / tanY, e.x / tanX) * 1.05f + e.z;
+    return {{c.x, c.y, c.z + std::max(dist, 1e-3f)}, 0.0f, 0.0f};
+  }
+  // The bounding sphere inside the narrower half-angle of the view, seen from 35° right of +z, 25° up.
+  CameraPose p{{}, 35.0f, -25.0f};
+  const float r = std::max(glm::length(e), 1e-3f);
+  const float halfAngle = std::atan(std::min(tanX, tanY));
+  p.position = c - basis(p).forward * (r / std::sin(halfAngle) * 1.02f);
+  return p;
 }
 
 Lens fitDepthRange(Lens lens, const Bounds& bounds, const CameraPose& pose) {

@@ -29,6 +29,9 @@ struct Lens {
 // "x,y,z,yaw,pitch" (yaw and pitch in degrees). Throws rtr::Error saying what is wrong.
 CameraPose parsePose(std::string_view text);
 std::string formatPose(const CameraPose& pose);  // round-trips through parsePose
+// "x,y,z" (or one value for all three when `scalarAllowed`) for the option named `option` (say "--light");
+// finite numbers only. Throws rtr::Error naming the option.
+glm::vec3 parseVec3(std::string_view text, const std::string& option, bool scalarAllowed = false);
 
 struct CameraBasis { glm::vec3 forward, right, up; };
 CameraBasis basis(const CameraPose& pose);
@@ -42,8 +45,12 @@ struct CameraRay { glm::vec3 origin, direction; };
 CameraRay cameraRay(const CameraPose& pose, const Lens& lens, float aspect, glm::vec2 ndc);
 glm::vec2 pixelToNdc(float px, float py, uint32_t width, uint32_t height);  // px,py: pixel centre coords
 
-// A view down -z that frames the whole of `bounds` (the course scenes' convention).
-CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect);
+// How a pose frames a scene: Front looks down -z at the bounds' front face (the course's staged scenes,
+// authored to be seen that way); ThreeQuarter looks down at the bounds from the front right and above,
+// so that a bare model reads as a solid.
+enum class Framing { Front, ThreeQuarter };
+// A pose that frames the whole of `bounds`.
+CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect, Framing framing = Framing::Front);
 // Near and far planes that keep `bounds` inside the depth range from `pose`.
 Lens fitDepthRange(Lens lens, const Bounds& bounds, const CameraPose& pose);
 

@@ -1,5 +1,6 @@
 #include "render/renderer.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstdio>
 #include <cstring>
@@ -221,9 +222,14 @@ void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose
   u.view = viewMatrix(pose);
   u.viewProj = projectionMatrix(lens, aspect) * u.view;
   u.cameraPos = glm::vec4(pose.position, 1.0f);
-  u.lightPos = glm::vec4(s.lightPos, 1.0f);
-  u.lightColor = glm::vec4(s.lightColor, s.inverseSquareFalloff ? 1.0f : 0.0f);
-  u.ambient = glm::vec4(s.ambient, 0.0f);
+  u.ambient = glm::vec4(s.lights.ambient, 0.0f);
+  static_assert(MAX_LIGHTS == kMaxLights);
+  u.lightCount.x = uint32_t(std::min(s.lights.lights.size(), kMaxLights));
+  for (uint32_t i = 0; i < u.lightCount.x; ++i) {
+    const Light& l = s.lights.lights[i];
+    const glm::vec3 p = l.kind == Light::Kind::Headlight ? pose.position : l.position;
+    u.lights[i] = {glm::vec4(p, l.falloff ? 1.0f : 0.0f), glm::vec4(l.color, 0.0f)};
+  }
   u.params = glm::vec4(float(s.mode), s.lodBias, lens.zNear, lens.zFar);
   {
     // Pixel rays from the inverse projection: h = M^-1 (ndc, 0.5, 1) is linear in the pixel, and

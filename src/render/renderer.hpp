@@ -11,6 +11,7 @@
 #include "frame.h"
 #include "render/gpu_scene.hpp"
 #include "render/post.hpp"
+#include "scene/lights.hpp"
 #include "vk/commands.hpp"
 #include "vk/pipeline.hpp"
 
@@ -27,10 +28,9 @@ struct RenderSettings {
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   float lodBias = 0.0f;
   MosaicMode mosaic = MosaicMode::Compute;
-  glm::vec3 lightPos{-0.2972f, 7.3100f, -11.9532f};  // the brief's standard light
-  glm::vec3 lightColor{1.0f};
-  bool inverseSquareFalloff = false;
-  glm::vec3 ambient{0.02f};
+  // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;
+  // the apps resolve them once from the scene and the command line (scene/lights.hpp).
+  LightRig lights{{briefLight()}, glm::vec3(0.02f), {}};
 };
 
 struct RenderTarget {

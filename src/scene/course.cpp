@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "scene/binio.hpp"
+#include "scene/lights.hpp"
 #include "scene/text.hpp"
 
 namespace rtr {
@@ -165,6 +166,8 @@ Scene decodeCourseMesh(std::span<const uint8_t> bytes, const std::string& file) 
   }
   scene.materials = std::move(raw.materials);
   scene.meshes = std::move(raw.meshes);
+  // The format stores no lights; the course's Vulkan viewer lights every such scene with its standard light.
+  scene.lights = {briefLight()};
   return scene;
 }
 

@@ -14,6 +14,7 @@ constexpr size_t kAlign = 16;
 constexpr uint32_t kMaxString = 32768;
 
 constexpr uint32_t kHasView = 1u << 0;  // header flags
+constexpr uint32_t kLightFalloff = 1u << 0;  // light flags
 constexpr uint32_t kHasNormals = 1u << 0, kHasTexcoords = 1u << 1, kIndex16 = 1u << 2;  // mesh flags
 constexpr uint32_t kKnownMaterialFlags = kMaterialAlphaMasked | kMaterialDoubleSided | kMaterialLight;
 
@@ -31,7 +32,8 @@ std::string readString(ByteReader& r, const char* what) {
   const uint32_t n = r.u32(what);
   if (n >= kMaxString) r.failAt(at, std::string(what) + " length " + std::to_string(n) + " is not below 32768");
   std::string_view s = r.view(n, what);
-  if (s.find('\0') != std::string_view::npos || !text::validUtf8(s)) r.failAt(at + 4, std::string(what) + " is not valid UTF-8 text");
+  // Names are bytes, as the OBJ/MTL files they come from (Latin-1 names exist); only NUL is refused.
+  if (s.find('\0') != std::string_view::npos) r.failAt(at + 4, std::string(what) + " contains a NUL byte");
   r.align(4, what);
   return std::string(s);
 }
@@ -59,7 +61,7 @@ std::string encodeRtrScene(const Scene& scene) {
   w.u32(uint32_t(scene.textures.size()));
   w.u32(uint32_t(scene.materials.size()));
   w.u32(uint32_t(scene.meshes.size()));
-  w.u32(0);
+  w.u32(uint32_t(scene.lights.size()));
   w.pod(uint64_t(0));  // payload size, patched below
   w.pod(uint64_t(0));  // checksum, patched below
   const CameraPose view = scene.defaultView.value_or(CameraPose{});
@@ -68,6 +70,11 @@ std::string encodeRtrScene(const Scene& scene) {
   w.f32(view.pitchDeg);
   w.pad(kAlign);
 
+  for (const Light& l : scene.lights) {  // 80 bytes each
+    w.u32(uint32_t(l.kind));
+    w.u32(l.falloff ? kLightFalloff : 0);
+    for (const glm::vec3& v : {l.position, l.color, l.corner, l.edge1, l.edge2, l.normal}) writeVec(w, v);
+  }
   for (const Texture& t : scene.textures) {
     w.u8(t.srgb ? 1 : 0);
     w.u8(t.channels);
@@ -132,12 +139,13 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file) {
   r.raw(magic, 8, "the header");
   if (std::memcmp(magic, kMagic, 8) != 0) r.failAt(0, "not an .rtrscene file (magic mismatch)");
   const uint32_t version = r.u32("the header");
-  if (version != kRtrSceneVersion)
+  if (version != 1 && version != kRtrSceneVersion)
     r.failAt(8, "unsupported version " + std::to_string(version) + " (this build reads " + std::to_string(kRtrSceneVersion) + ")");
   const uint32_t flags = r.u32("the header");
   if (flags & ~uint32_t(kHasView)) r.failAt(12, "unknown header flags");
   const uint32_t texCount = r.u32("the header"), matCount = r.u32("the header"), meshCount = r.u32("the header");
-  r.u32("the header");
+  const uint32_t lightCount = r.u32("the header");
+  if (version == 1 && lightCount != 0) r.failAt(28, "reserved field is not 0");
   const uint64_t payload = r.pod<uint64_t>("the header");
   const uint64_t sum = r.pod<uint64_t>("the header");
   Scene scene;
@@ -153,9 +161,21 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file) {
   if (checksum64(bytes.subspan(kHeaderSize)) != sum) r.failAt(40, "checksum mismatch: the payload is corrupt");
 
   // Each record has a minimum size; a count that cannot fit is refused before anything is allocated.
+  if (uint64_t(lightCount) * 80 > r.remaining()) r.failAt(28, "light count " + std::to_string(lightCount) + " cannot fit in the file");
   if (uint64_t(texCount) * 8 > r.remaining()) r.failAt(16, "texture count " + std::to_string(texCount) + " cannot fit in the file");
   if (uint64_t(matCount) * 128 > r.remaining()) r.failAt(20, "material count " + std::to_string(matCount) + " cannot fit in the file");
   if (uint64_t(meshCount) * 64 > r.remaining()) r.failAt(24, "mesh count " + std::to_string(meshCount) + " cannot fit in the file");
+
+  scene.lights.resize(lightCount);
+  for (Light& l : scene.lights) {
+    const size_t at = r.pos();
+    const uint32_t kind = r.u32("a light record"), lflags = r.u32("a light record");
+    if (kind > uint32_t(Light::Kind::Headlight)) r.failAt(at, "unknown light kind " + std::to_string(kind));
+    if (lflags & ~kLightFalloff) r.failAt(at + 4, "unknown light flags");
+    l.kind = Light::Kind(kind);
+    l.falloff = (lflags & kLightFalloff) != 0;
+    for (glm::vec3* v : {&l.position, &l.color, &l.corner, &l.edge1, &l.edge2, &l.normal}) *v = readVec(r, "a light");
+  }
 
   scene.textures.resize(texCount);
   for (Texture& t : scene.textures) {

@@ -9,7 +9,7 @@
 
 namespace rtr {
 
-constexpr uint32_t kRtrSceneVersion = 1;
+constexpr uint32_t kRtrSceneVersion = 2;  // 2 added lights; version 1 files still load
 
 std::string encodeRtrScene(const Scene& scene);
 // Validates everything (sizes, counts, strings, indices, texture ids, finite values, checksum).

@@ -65,12 +65,29 @@ struct Mesh {
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
 };
 
+// A light in scene space. Point lights and the ray tracer's area lights (FORMATS.md §2); a headlight sits
+// at the camera, wherever it is (the default light of a scene that has none: scene/lights.hpp).
+struct Light {
+  enum class Kind : uint32_t { Point, Area, Headlight };
+  Kind kind = Kind::Point;
+  glm::vec3 position{0.0f};  // point light position, or the area light's centre
+  glm::vec3 color{1.0f};     // colour x intensity
+  bool falloff = false;      // inverse-square falloff with distance
+  glm::vec3 corner{0.0f}, edge1{0.0f}, edge2{0.0f};  // area light: corner + s·edge1 + t·edge2
+  glm::vec3 normal{0.0f};    // area light: normal of its first face
+  // Where to aim shadow ray `i` of `n` (n = 1: the centre; otherwise a stratified grid on the quad).
+  glm::vec3 samplePoint(int i, int n) const;
+};
+
 struct Scene {
   std::filesystem::path baseDir;  // folder the texture paths are relative to
   std::vector<Texture> textures;
   std::vector<Material> materials;
   std::vector<Mesh> meshes;
   std::optional<CameraPose> defaultView;
+  // Lights stored with the scene (.rtrscene, the course format's standard light). Empty: the scene's
+  // lights are its `*light*` geometry (scene/lights.hpp).
+  std::vector<Light> lights;
 
   Bounds bounds() const {
     Bounds b;

@@ -4,10 +4,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "core/error.hpp"
-
 #include "brdf.h"  // shaders/shared: the GPU renderer's BRDF, compiled here as C++
-#define RTR_HAVE_BRDF 1
 
 namespace rtr::trace {
 
@@ -22,18 +19,9 @@ glm::vec3 blinnPhongDirect(const Material& m, const glm::vec3& n, const glm::vec
 
 glm::vec3 blinnPhongAmbient(const Material& m, const glm::vec3& lightColor) { return m.ka * lightColor; }
 
-bool pbrAvailable() { return RTR_HAVE_BRDF != 0; }
-
-glm::vec3 shadePbr(const glm::vec3& n, const glm::vec3& v, const glm::vec3& l, const glm::vec3& lightColor,
-                   const glm::vec3& ambient, const glm::vec3& baseColor, float roughness, float metalness,
-                   const glm::vec3& emissive) {
-#if RTR_HAVE_BRDF
-  return rtr::shader::shadePbr(n, v, l, lightColor, ambient, baseColor, roughness, metalness, emissive);
-#else
-  (void)n; (void)v; (void)l; (void)lightColor; (void)ambient; (void)baseColor; (void)roughness;
-  (void)metalness; (void)emissive;
-  throw Error("--shading pbr: this build has no shaders/shared/brdf.h (the shared BRDF)");
-#endif
+glm::vec3 pbrDirect(const glm::vec3& n, const glm::vec3& v, const glm::vec3& l, const glm::vec3& lightColor,
+                    const glm::vec3& baseColor, float roughness, float metalness) {
+  return shader::pbrDirect(n, v, l, lightColor, baseColor, roughness, metalness);
 }
 
 }  // namespace rtr::trace

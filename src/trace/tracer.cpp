@@ -55,7 +55,6 @@ Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
       castsShadow_.push_back(light ? 0 : 1);  // shadow rays pass through the lights' own geometry
     }
   }
-  lights_ = extractLights(scene);
   useBvh_ = tris_.size() >= kBruteForceMax;
   if (useBvh_) bvh_ = Bvh(tris_, castsShadow_, buildThreads);
 }
@@ -155,37 +154,31 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
   const TraceSettings& s = *f.s;
   const Material& mat = *sp.material;
   const glm::vec3 v = -glm::normalize(r.direction);
-  if (s.shading == Shading::Pbr) {
+  const bool pbr = s.shading == Shading::Pbr;
+  // A light's own surface shows its emission only (it does not light itself), in the course's model.
+  if (!pbr && isLightMaterial(mat)) return mat.ke;
+  SurfaceInputs in{};
+  if (pbr) {
     const bool textured = f.tex && !scene_.meshes[sp.mesh].texcoords.empty();
-    const SurfaceInputs in = textured ? f.tex->fetch(mat, sp.uv, uvWidth(sp, r, coneWidth)) : materialFactors(mat);
-    const glm::vec3 toLight = f.pbrLightPos - sp.position;
-    const glm::vec3 l = glm::normalize(toLight);
-    glm::vec3 lightColor = s.pbrLight.color;
-    if (s.shadows && glm::dot(sp.geomNormal, l) > 0.0f &&
-        shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c))
-      lightColor = glm::vec3(0.0f);
-    return shadePbr(sp.normal, v, l, lightColor, glm::vec3(s.pbrLight.ambient), in.baseColor, in.roughness,
-                    in.metalness, in.emissive);
+    in = textured ? f.tex->fetch(mat, sp.uv, uvWidth(sp, r, coneWidth)) : materialFactors(mat);
   }
-  // A light's own surface shows its emission only (it does not light itself).
-  if (isLightMaterial(mat)) return mat.ke;
-  // Blinn-Phong over every light; in shadow a light gives only its ambient.
-  glm::vec3 color = mat.ke;
+  // Ambient and emission, then every light's direct term averaged over its shadow samples; with shadows
+  // on, a sample behind the surface itself or blocked gives nothing (Phong keeps its ambient Ka x Lc).
+  glm::vec3 color = pbr ? f.ambient * glm::clamp(in.baseColor, 0.0f, 1.0f) + in.emissive : mat.ke;
   const int n = std::max(1, s.areaLightSamples);
-  for (const Light& light : lights_) {
-    color += blinnPhongAmbient(mat, light.color);
-    const int samples = light.area ? n : 1;
+  for (const Light& light : f.lights) {
+    if (!pbr) color += blinnPhongAmbient(mat, light.color);
+    const int samples = light.kind == Light::Kind::Area ? n : 1;
     glm::vec3 direct(0.0f);
     for (int i = 0; i < samples; ++i) {
-      const glm::vec3 target = light.samplePoint(i, samples);
-      const glm::vec3 toLight = target - sp.position;
-      const float dist = glm::length(toLight);
-      if (!(dist > 0.0f)) continue;
-      const glm::vec3 l = toLight / dist;
-      const glm::vec3 d = blinnPhongDirect(mat, sp.normal, v, l, light.color);
+      const glm::vec3 toLight = light.samplePoint(i, samples) - sp.position;
+      if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
+      const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
+      const glm::vec3 d = pbr ? pbrDirect(sp.normal, v, ls.l, ls.radiance, in.baseColor, in.roughness, in.metalness)
+                              : blinnPhongDirect(mat, sp.normal, v, ls.l, ls.radiance);
       if (d == glm::vec3(0.0f)) continue;
       if (s.shadows) {
-        if (glm::dot(sp.geomNormal, l) <= 0.0f) continue;  // light behind the surface itself
+        if (glm::dot(sp.geomNormal, ls.l) <= 0.0f) continue;
         if (shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c)) continue;
       }
       direct += d;
@@ -224,8 +217,12 @@ Tracer::Frame Tracer::makeFrame(const TraceSettings& s) const {
   Frame f;
   f.s = &s;
   f.toScene = glm::inverse(s.model);
-  f.pbrLightPos = glm::vec3(f.toScene * glm::vec4(s.pbrLight.position, 1.0f));
   const CameraPose pose = resolvePose(s);
+  const LightRig rig = s.lights ? *s.lights : resolveLights(scene_);
+  f.ambient = rig.ambient;
+  f.lights = rig.lights;
+  for (Light& l : f.lights)
+    if (l.kind == Light::Kind::Headlight) l.position = glm::vec3(f.toScene * glm::vec4(pose.position, 1.0f));
   const glm::vec3 fwd = basis(pose).forward;
   f.depthAxis = glm::transpose(glm::mat3(s.model)) * fwd;
   f.depthFar = resolveLens(s).zFar;
@@ -270,7 +267,7 @@ CameraPose Tracer::resolvePose(const TraceSettings& s) const {
   if (s.pose) return *s.pose;
   if (scene_.defaultView) return *scene_.defaultView;  // the view the scene was baked with, as rtr-view starts
   const float aspect = float(std::max(1u, s.width)) / float(std::max(1u, s.height));
-  return frameBounds(transformed(scene_.bounds(), s.model), s.lens, aspect);
+  return frameBounds(transformed(scene_.bounds(), s.model), s.lens, aspect, framingFor(scene_));
 }
 
 Lens Tracer::resolveLens(const TraceSettings& s) const {
@@ -290,7 +287,6 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
   if (s.width == 0 || s.height == 0 || s.width > 32768 || s.height > 32768)
     throw Error("image size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " is out of range");
   if (s.bounces < 0 || s.bounces > 64) throw Error("bounces must be in 0..64, got " + std::to_string(s.bounces));
-  if (s.shading == Shading::Pbr && !pbrAvailable()) shadePbr({}, {}, {}, {}, {}, {}, 0, 0, {});  // throws
   const Frame frame = makeFrame(s);  // loads the textures on the first pbr render: not part of its time
   const auto start = std::chrono::steady_clock::now();
   out.width = s.width;

@@ -1,7 +1,7 @@
 #pragma once
 // The CPU ray tracer: built once per scene, then renders images of it tile by tile over N threads.
-// Shading follows the brief's Part 1 (Blinn-Phong with the scene's geometry lights, shadow rays, impulse
-// mirrors up to N_BOUNCES), or the GPU renderer's PBR BRDF, or debug views (normals, depth).
+// Shading follows the brief's Part 1 (Blinn-Phong with the scene's lights, shadow rays, impulse mirrors
+// up to N_BOUNCES), or the GPU renderer's PBR BRDF over the same lights, or debug views (normals, depth).
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -15,10 +15,10 @@
 
 #include "core/camera.hpp"
 #include "core/image.hpp"
+#include "scene/lights.hpp"
 #include "scene/scene.hpp"
 #include "trace/bvh.hpp"
 #include "trace/intersect.hpp"
-#include "trace/lights.hpp"
 #include "trace/ray.hpp"
 #include "trace/textures.hpp"
 
@@ -30,16 +30,9 @@ constexpr int kMaxAlphaLayers = 32;
 
 enum class Shading { Phong, Pbr, Normals, Depth };
 
-// The GPU renderer's light, for --shading pbr (world space).
-struct PbrLight {
-  glm::vec3 position{-0.2972f, 7.3100f, -11.9532f};
-  glm::vec3 color{1.0f};
-  float ambient = 0.02f;
-};
-
 struct TraceSettings {
   uint32_t width = 1280, height = 720;
-  std::optional<CameraPose> pose;  // none: the scene's stored view, else frameBounds(scene bounds), as the viewer
+  std::optional<CameraPose> pose;  // none: the scene's stored view, else frameBounds(.., framingFor(scene)), as the viewer
   Lens lens{};                     // the viewer's defaults (60° vertical fov); --fov 80 is the course's
   glm::mat4 model{1.0f};           // Task 1 model transform (a similarity); modelview = view × model
   Shading shading = Shading::Phong;
@@ -49,7 +42,9 @@ struct TraceSettings {
   unsigned threads = 0;            // 0: every core
   uint32_t tileSize = 32;
   int areaLightSamples = 1;        // shadow rays per area light: 1 aims at its centre (hard shadows)
-  PbrLight pbrLight;
+  // The lights, in scene space, and pbr's ambient colour; none: resolveLights(scene) (scene/lights.hpp).
+  // Phong's ambient is Ka x each light's colour, as the course's.
+  std::optional<LightRig> lights;
   float lodBias = 0.0f;            // pbr: added to every texture's level of detail, as the GPU's bias
   glm::vec3 background{0.0f};
 };
@@ -110,7 +105,6 @@ class Tracer {
   // loads any. Thread-safe. Throws rtr::Error naming a texture file that is missing or undecodable.
   const SceneTextures& textures() const;
 
-  const std::vector<Light>& lights() const { return lights_; }
   const std::vector<Triangle>& triangles() const { return tris_; }
   bool usesBvh() const { return useBvh_; }
   const Bvh& bvh() const { return bvh_; }
@@ -125,7 +119,8 @@ class Tracer {
   struct Frame {
     const TraceSettings* s;
     glm::mat4 toScene;      // inverse of the model transform
-    glm::vec3 pbrLightPos;  // pbr light in scene space
+    std::vector<Light> lights;  // in scene space; a headlight placed at the camera
+    glm::vec3 ambient{0.0f};    // pbr
     glm::vec3 depthAxis;    // t · dot(d, depthAxis) = distance along the camera's forward axis
     float depthFar;
     const SceneTextures* tex = nullptr;  // pbr only
@@ -156,7 +151,6 @@ class Tracer {
   std::vector<uint8_t> castsShadow_;
   std::vector<uint8_t> meshAlphaTested_;  // per mesh: scene/textures.hpp's alphaTested
   bool anyAlphaTested_ = false;
-  std::vector<Light> lights_;
   Bvh bvh_;
   bool useBvh_ = false;
   mutable std::mutex texturesMutex_;

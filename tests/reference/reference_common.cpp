@@ -58,7 +58,7 @@ CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const Pose
   ts.shadows = false;  // the GPU renderer has no shadows
   ts.bounces = 0;      // nor reflections
   ts.threads = o.threads;
-  ts.pbrLight = rs.light;
+  ts.lights = rs.lights;
   const trace::Tracer tracer(rs.scene, o.threads);
   ImageF cpu;
   const trace::RenderStats stats = tracer.render(ts, cpu);
@@ -69,10 +69,7 @@ CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const Pose
   render::RenderSettings s;
   s.mode = view == View::Shaded ? VIEW_SHADED : view == View::Normals ? VIEW_NORMAL : VIEW_LINEAR_DEPTH;
   s.mosaic = render::MosaicMode::Off;
-  s.lightPos = rs.light.position;
-  s.lightColor = rs.light.color;
-  s.inverseSquareFalloff = false;  // the tracer's PBR light has no falloff
-  s.ambient = glm::vec3(rs.light.ambient);
+  s.lights = rs.lights;
   const Lens lens = tracer.resolveLens(ts);  // the tracer's near/far: depth / far means the same on both sides
 
   std::string previous;

@@ -105,10 +105,27 @@ void twoSidedOnGpu(Scene& s, uint32_t material, const std::filesystem::path& wor
     if (mesh.material == material && mesh.texcoords.empty()) mesh.texcoords.assign(mesh.positions.size(), glm::vec2(0.0f));
 }
 
-ReferenceScene loadFile(const std::filesystem::path& file) {
+// A scene lit by its own lights (scene/lights.hpp), as the tools light it; `falloff` as --falloff.
+ReferenceScene ownLights(Scene scene, bool falloff = false) {
   ReferenceScene r;
-  r.scene = loadScene(file);
+  r.scene = std::move(scene);
+  LightOptions o;
+  o.falloff = falloff;
+  r.lights = resolveLights(r.scene, o);
   return r;
+}
+
+// Point lights at (position, colour) pairs, ambient 0.02.
+LightRig pointLights(std::initializer_list<std::pair<glm::vec3, glm::vec3>> lights, bool falloff = false) {
+  LightRig rig;
+  for (const auto& [p, c] : lights) {
+    Light l;
+    l.position = p;
+    l.color = c;
+    l.falloff = falloff;
+    rig.lights.push_back(l);
+  }
+  return rig;
 }
 
 // The fire cards: one-sided quads (the GPU culls their backs, the tracer draws them).
@@ -185,33 +202,25 @@ Scene texturedTemple(const Scene& temple, const std::filesystem::path& workDir) 
 
 ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir) {
   const std::filesystem::path rt = sourceDir() / "assets-src/rt";
-  // The default light (the brief's standard light above the statue) for the temple.
-  if (name == "temple_nave" || name == "temple_aisle") {
-    ReferenceScene r;
-    r.scene = untexturedTemple(loadScene(assetDir() / "temple.rtrscene"));
-    return r;
-  }
-  if (name == "temple_nave_textured" || name == "temple_aisle_textured") {
-    ReferenceScene r;
-    r.scene = texturedTemple(loadScene(assetDir() / "temple.rtrscene"), workDir);
-    return r;
-  }
-  if (name == "cornell_box") {
-    ReferenceScene r = loadFile(rt / "cornell_box.obj");
-    r.light.position = {0.3f, 0.8f, -1.8f};  // inside the box, near the ceiling, towards the front
-    r.light.color = glm::vec3(1.5f);
-    return r;
-  }
-  if (name == "cube_backplane") {
-    ReferenceScene r = loadFile(rt / "cube_backplane.obj");
+  // The temple's stored light (the brief's standard light above the statue); the course scenes' own lights:
+  // the GPU sees an area light as a point at its centre, as the tracer with one shadow sample does.
+  if (name == "temple_nave" || name == "temple_aisle")
+    return ownLights(untexturedTemple(loadScene(assetDir() / "temple.rtrscene")));
+  if (name == "temple_nave_textured" || name == "temple_aisle_textured")
+    return ownLights(texturedTemple(loadScene(assetDir() / "temple.rtrscene"), workDir));
+  if (name == "cornell_box") return ownLights(loadScene(rt / "cornell_box.obj"));
+  if (name == "cube_backplane" || name == "cube_backplane_falloff") {
+    Scene s = loadScene(rt / "cube_backplane.obj");
     // The three emissive quads face the backplane (-z): the camera sees their backs, which the tracer draws
     // and the GPU culls. Compare the same surfaces: make them two-sided on the GPU (docs: "Culling").
     int lights = 0;
-    for (uint32_t i = 0; i < r.scene.materials.size(); ++i)
-      if (r.scene.materials[i].name.rfind("light_", 0) == 0) twoSidedOnGpu(r.scene, i, workDir), ++lights;
+    for (uint32_t i = 0; i < s.materials.size(); ++i)
+      if (s.materials[i].name.rfind("light_", 0) == 0) twoSidedOnGpu(s, i, workDir), ++lights;
     if (lights != 3) throw Error("cube_backplane: expected 3 light_* materials, found " + std::to_string(lights));
-    r.light.position = {-2.0f, 3.0f, 6.0f};
-    r.light.color = glm::vec3(1.2f);
+    ReferenceScene r = ownLights(std::move(s), name.ends_with("_falloff"));
+    if (r.lights.lights.size() != 3) throw Error("cube_backplane: expected 3 lights");
+    if (name.ends_with("_falloff"))  // the quads are 3-4 units from what they light: keep the image bright
+      for (Light& l : r.lights.lights) l.color *= 12.0f;
     return r;
   }
   ReferenceScene r;
@@ -219,27 +228,41 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
   if (name == "grazing_floor") {
     s.materials.push_back(material("floor", {0.5f, 0.5f, 0.55f}, 0.4f, 0.0f));
     s.meshes.push_back(grid("floor", 0, {-200, 0, 200}, {400, 0, 0}, {0, 0, -400}, 16, 16, false));
-    r.light = {{0.0f, 3.0f, -60.0f}, glm::vec3(1.0f), 0.02f};  // ahead of the camera: forward grazing specular
+    r.lights = pointLights({{{0.0f, 3.0f, -60.0f}, glm::vec3(1.0f)}});  // ahead of the camera: forward grazing specular
     return r;
   }
   if (name == "metal_sphere") {
     s.materials.push_back(material("copper", {0.95f, 0.64f, 0.54f}, 0.3f, 1.0f));
     s.meshes.push_back(sphere("sphere", 0, {0, 0, -3}, 1.0f, 96, 48));
-    r.light = {{2.0f, 3.0f, 1.0f}, glm::vec3(2.0f), 0.02f};
+    r.lights = pointLights({{{2.0f, 3.0f, 1.0f}, glm::vec3(2.0f)}});
+    return r;
+  }
+  if (name == "two_lights" || name == "two_lights_falloff") {
+    // A dielectric and a metal sphere on a floor, a warm key light and a cool fill from the other side.
+    s.materials.push_back(material("floor", {0.6f, 0.6f, 0.6f}, 0.6f, 0.0f));
+    s.materials.push_back(material("plastic", {0.2f, 0.4f, 0.8f}, 0.35f, 0.0f));
+    s.materials.push_back(material("gold", {1.0f, 0.78f, 0.34f}, 0.25f, 1.0f));
+    s.meshes.push_back(grid("floor", 0, {-4, -1, 0}, {8, 0, 0}, {0, 0, -8}, 8, 8, false));
+    s.meshes.push_back(sphere("plastic", 1, {-1.1f, 0, -4}, 1.0f, 64, 32));
+    s.meshes.push_back(sphere("gold", 2, {1.1f, 0, -4}, 1.0f, 64, 32));
+    const bool falloff = name.ends_with("_falloff");
+    const float k = falloff ? 20.0f : 1.0f;  // about the squared distance to the spheres
+    r.lights = pointLights({{{3.0f, 3.0f, -1.0f}, k * glm::vec3(1.2f, 1.0f, 0.8f)},
+                            {{-3.5f, 1.5f, -2.0f}, k * glm::vec3(0.3f, 0.4f, 0.6f)}}, falloff);
     return r;
   }
   if (name == "rough0_patch") {
     s.materials.push_back(material("polished", {0.45f, 0.5f, 0.6f}, 0.0f, 0.0f));
     s.meshes.push_back(grid("patch", 0, {-1, 0, -3}, {2, 0, 0}, {0, 0, -2}, 4, 4, false));
     // Light at the mirror image of the camera about the patch centre (0, 0, -4): h = n there.
-    r.light = {{0.0f, 1.5f, -8.0f}, glm::vec3(4.0f), 0.02f};
+    r.lights = pointLights({{{0.0f, 1.5f, -8.0f}, glm::vec3(4.0f)}});
     return r;
   }
   if (name == "backface_quad") {
     s.materials.push_back(material("quad.DoubleSided", {0.2f, 0.6f, 0.3f}, 0.5f, 0.0f));
     s.meshes.push_back(grid("quad", 0, {-1, -1, -3}, {2, 0, 0}, {0, 2, 0}, 2, 2, true));  // faces +z
     twoSidedOnGpu(s, 0, workDir);
-    r.light = {{1.0f, 2.0f, -7.0f}, glm::vec3(1.5f), 0.02f};  // on the camera's (back) side
+    r.lights = pointLights({{{1.0f, 2.0f, -7.0f}, glm::vec3(1.5f)}});  // on the camera's (back) side
     return r;
   }
   throw Error("no reference scene named '" + name + "'");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/camera.hpp"
+#include "scene/lights.hpp"
 #include "scene/scene.hpp"
 #include "trace/tracer.hpp"
 
@@ -28,7 +29,7 @@ std::map<std::string, PoseEntry> loadPoses(const std::filesystem::path& file);
 
 struct ReferenceScene {
   Scene scene;
-  trace::PbrLight light;  // used for both renderers (GPU: lightPos/lightColor/ambient, no falloff)
+  LightRig lights;  // both renderers light the scene with exactly these
 };
 
 // Builds the scene of a case by name (the names in poses.txt). `workDir` receives generated files (the

@@ -50,7 +50,7 @@ TEST_F(VulkanTest, AlphaMaskedQuadDiscardsAndLightsBothFaces) {
     render::HeadlessRenderer r(*ctx, gpu, {64, 64});
     render::RenderSettings s;
     s.mosaic = render::MosaicMode::Off;
-    s.ambient = glm::vec3(0.0f);  // lit only by the light: an unlit face would be black
+    s.lights.ambient = glm::vec3(0.0f);  // lit only by the light: an unlit face would be black
     Lens lens;
     lens.fovYDeg = 60.0f;
     for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility}) {
@@ -58,7 +58,8 @@ TEST_F(VulkanTest, AlphaMaskedQuadDiscardsAndLightsBothFaces) {
       for (bool back : {false, true}) {
         SCOPED_TRACE(testing::Message() << render::toString(path) << (back ? " back" : " front"));
         CameraPose pose{{0, 0, back ? -2.5f : 2.5f}, back ? 180.0f : 0.0f, 0.0f};
-        s.lightPos = pose.position;
+        s.lights.lights = {Light{}};
+        s.lights.lights[0].position = pose.position;
         render::HeadlessFrame f = r.render(pose, lens, s);
         // Seen from the back, the texture's opaque half (u > 0.5, world x > 0) appears on the image's left.
         const uint32_t opaqueX = back ? 22 : 42, clearX = back ? 42 : 22;

@@ -52,7 +52,7 @@ TraceSettings baseColourView() {
   ts.shading = Shading::Pbr;
   ts.shadows = false;
   ts.bounces = 0;
-  ts.pbrLight = {{0, 0, 10}, glm::vec3(0.0f), 1.0f};
+  ts.lights = LightRig{{}, glm::vec3(1.0f), {}};  // no light, ambient 1
   ts.height = 32768;  // a tiny pixel: level 0 unless a test says otherwise
   return ts;
 }
@@ -252,7 +252,9 @@ TEST(TracerTextures, CutOutTexelsCastNoShadow) {
   const Scene s = maskedPair();
   const Tracer t(s);
   TraceSettings ts = baseColourView();
-  ts.pbrLight = {{0, 0, 10}, glm::vec3(1.0f), 0.1f};
+  Light light;
+  light.position = {0, 0, 10};
+  ts.lights = LightRig{{light}, glm::vec3(0.1f), {}};
   ts.shadows = true;
   // Floor points seen from between the quads; their shadow rays to the light cross the masked quad at
   // 12/14 of their distance from the axis.

@@ -68,15 +68,15 @@ TEST(Tracer, LightsComeFromGeometry) {
   const uint32_t l2 = addMaterial(s, named);
   addMesh(s, quad({-1, 3, -1}, {2, 0, 0}, {0, 0, 2}, l));       // two triangles: area light
   addMesh(s, box({1, 1, 1}, {2, 3, 4}, l2));                     // twelve: point light at the centroid
-  const Tracer t(s);
-  ASSERT_EQ(t.lights().size(), 2u);
-  EXPECT_TRUE(t.lights()[0].area);
-  EXPECT_EQ(t.lights()[0].color, glm::vec3(1, 0.5f, 0.25f));
-  EXPECT_NEAR(glm::distance(t.lights()[0].position, glm::vec3(0, 3, 0)), 0.0f, 1e-6f);
-  EXPECT_NEAR(std::abs(t.lights()[0].normal.y), 1.0f, 1e-6f);
-  EXPECT_NEAR(glm::length(glm::cross(t.lights()[0].edge1, t.lights()[0].edge2)), 4.0f, 1e-5f);
-  EXPECT_FALSE(t.lights()[1].area);
-  EXPECT_NEAR(glm::distance(t.lights()[1].position, glm::vec3(1.5f, 2, 2.5f)), 0.0f, 1e-5f);
+  const std::vector<Light> lights = resolveLights(s).lights;
+  ASSERT_EQ(lights.size(), 2u);
+  EXPECT_EQ(lights[0].kind, Light::Kind::Area);
+  EXPECT_EQ(lights[0].color, glm::vec3(1, 0.5f, 0.25f));
+  EXPECT_NEAR(glm::distance(lights[0].position, glm::vec3(0, 3, 0)), 0.0f, 1e-6f);
+  EXPECT_NEAR(std::abs(lights[0].normal.y), 1.0f, 1e-6f);
+  EXPECT_NEAR(glm::length(glm::cross(lights[0].edge1, lights[0].edge2)), 4.0f, 1e-5f);
+  EXPECT_EQ(lights[1].kind, Light::Kind::Point);
+  EXPECT_NEAR(glm::distance(lights[1].position, glm::vec3(1.5f, 2, 2.5f)), 0.0f, 1e-5f);
 }
 
 TEST(Tracer, ShadowGivesAmbientAndEmissiveOnly) {
@@ -139,7 +139,7 @@ TEST(Tracer, NoSelfIntersectionOrAcneAtAnyScale) {
       const Hit h = t.closestTriangle(primary);
       ASSERT_TRUE(h.hit()) << "scale " << k.size << " ray " << i;
       const SurfacePoint sp = t.surface(primary, h);
-      const Ray shadow = spawnRay(sp.position, sp.geomNormal, t.lights()[0].position - sp.position, 1.0f);
+      const Ray shadow = spawnRay(sp.position, sp.geomNormal, resolveLights(t.scene()).lights[0].position - sp.position, 1.0f);
       EXPECT_FALSE(t.occluded(shadow)) << "scale " << k.size;
       const Ray mirror = reflectRay(primary, sp.geomNormal, sp.position, sp.geomNormal);
       const Hit again = t.closestTriangle(mirror);

@@ -1,4 +1,5 @@
 // rtr-trace: ray-trace a scene file into a PNG (brief Part 1; issue 6).
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -18,20 +19,11 @@ namespace {
 using namespace rtr;
 using namespace rtr::trace;
 
-glm::vec3 parseVec3(const std::string& text, const char* what) {
-  float v[3];
-  char tail;
-  if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v[0], &v[1], &v[2], &tail) != 3)
-    throw Error(std::string(what) + " '" + text + "': expected three numbers x,y,z");
-  for (float f : v)
-    if (!std::isfinite(f)) throw Error(std::string(what) + " '" + text + "': not finite");
-  return {v[0], v[1], v[2]};
-}
-
 int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "phong", shadows = "on",
-                                  intersectName = "watertight", light, lightColor;
+                                  intersectName = "watertight", light, lightColor, ambient = "0.02";
+  LightOptions lightOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
   bool ortho = false, quiet = false;
@@ -53,9 +45,12 @@ int run(int argc, char** argv) {
       ->capture_default_str()->check(CLI::IsMember({"halfplane", "watertight", "moller"}));
   app.add_option("--area-samples", s.areaLightSamples, "shadow rays per area light (1: its centre)")
       ->capture_default_str()->check(CLI::Range(1, 1024));
-  app.add_option("--light", light, "pbr: point light position x,y,z (default: the GPU renderer's)");
-  app.add_option("--light-color", lightColor, "pbr: light colour r,g,b");
-  app.add_option("--ambient", s.pbrLight.ambient, "pbr: ambient")->capture_default_str()->check(CLI::Range(0.0f, 100.0f));
+  app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
+  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
+  app.add_flag("--falloff", lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
+  app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str();
+  app.add_flag("!--no-default-light", lightOptions.defaultLight,
+               "a scene without lights gets no headlight (the brief's strict behaviour)");
   app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
       ->capture_default_str()->check(CLI::Range(-16.0f, 16.0f));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
@@ -81,10 +76,13 @@ int run(int argc, char** argv) {
   s.shadows = shadows == "on";
   s.intersect = intersectName == "halfplane" ? IntersectMethod::HalfPlane
               : intersectName == "moller" ? IntersectMethod::MollerTrumbore : IntersectMethod::Watertight;
-  if (!light.empty()) s.pbrLight.position = parseVec3(light, "--light");
-  if (!lightColor.empty()) s.pbrLight.color = parseVec3(lightColor, "--light-color");
+  if (!light.empty()) lightOptions.position = parseVec3(light, "--light");
+  if (!lightColor.empty()) lightOptions.color = parseVec3(lightColor, "--light-color");
+  lightOptions.ambient = parseVec3(ambient, "--ambient", true);
 
   const Scene scene = loadScene(scenePath);
+  s.lights = resolveLights(scene, lightOptions);
+  if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   const Tracer tracer(scene, s.threads);
   const bool tty = !quiet && isatty(STDERR_FILENO);
   ImageF image;
@@ -95,6 +93,9 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "\rrtr-trace: tracing %3u%%", unsigned(100.0 * done / ((w + s.tileSize - 1) / s.tileSize * ((h + s.tileSize - 1) / s.tileSize))));
   });
   if (tty) std::fprintf(stderr, "\r\033[K");
+  if (s.lights->lights.empty() && s.shading != Shading::Normals && s.shading != Shading::Depth &&
+      std::all_of(image.pixels.begin(), image.pixels.end(), [](const glm::vec4& p) { return glm::vec3(p) == glm::vec3(0.0f); }))
+    std::fprintf(stderr, "rtr-trace: warning: the image is all black (no lights: --no-default-light)\n");
   savePng(outPath, toSrgb8(image));
   if (!quiet) {
     if (s.shading == Shading::Pbr)
@@ -105,7 +106,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
                  "(%llu primary, %llu shadow, %llu mirror), %.2f Mrays/s; pose %s -> %s\n",
-                 tracer.triangles().size(), tracer.lights().size(), tracer.usesBvh() ? "BVH8" : "no BVH",
+                 tracer.triangles().size(), s.lights->lights.size(), tracer.usesBvh() ? "BVH8" : "no BVH",
                  tracer.usesBvh() ? tracer.bvh().stats().buildSeconds : 0.0, w, h, st.seconds,
                  (unsigned long long)rays, (unsigned long long)st.primaryRays, (unsigned long long)st.shadowRays,
                  (unsigned long long)st.reflectionRays, double(rays) / st.seconds * 1e-6,

@@ -14,13 +14,26 @@
 
 namespace rtr::view {
 
-CameraPose startPose(const ViewOptions& o, const std::optional<CameraPose>& sceneView, const Bounds& bounds) {
+CameraPose startPose(const ViewOptions& o, const Scene& scene) {
   if (o.camera) return *o.camera;
-  if (sceneView) return *sceneView;
-  return frameBounds(bounds, o.lens, float(o.width) / float(o.height));
+  if (scene.defaultView) return *scene.defaultView;
+  return frameBounds(scene.bounds(), o.lens, float(o.width) / float(o.height), framingFor(scene));
+}
+
+render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
+  render::RenderSettings s = o.settings;
+  s.lights = resolveLights(scene, o.lightOptions);
+  if (!s.lights.note.empty()) std::fprintf(stderr, "rtr-view: note: %s\n", s.lights.note.c_str());
+  return s;
 }
 
 namespace {
+
+bool allBlack(const ImageRGBA8& img) {
+  for (size_t i = 0; i < img.pixels.size(); i += 4)
+    if (img.pixels[i] | img.pixels[i + 1] | img.pixels[i + 2]) return false;
+  return true;
+}
 
 void printBench(const std::vector<std::vector<std::pair<std::string, double>>>& frames, const std::string& device) {
   std::map<std::string, std::vector<double>> perPass;
@@ -60,15 +73,18 @@ int runHeadless(const ViewOptions& o) {
                "decode %.0f ms, upload %.0f ms, mips %.3f ms GPU\n",
                o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16,
                st.triangles, st.textures, st.decodeMs, st.uploadMs, st.mipGpuMs);
-  const CameraPose pose = startPose(o, scene.defaultView, scene.bounds());
+  const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(o.lens, scene.bounds(), pose);
+  const render::RenderSettings settings = sceneSettings(o, scene);
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
   if (o.bench > 0) {
-    renderer.bench(pose, lens, o.settings, 10);  // warm-up
-    printBench(renderer.bench(pose, lens, o.settings, o.bench), ctx.deviceName());
+    renderer.bench(pose, lens, settings, 10);  // warm-up
+    printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
   }
   if (!o.screenshot.empty() || o.bench == 0) {
-    render::HeadlessFrame frame = renderer.render(pose, lens, o.settings, std::max(1, o.frames));
+    render::HeadlessFrame frame = renderer.render(pose, lens, settings, std::max(1, o.frames));
+    if (settings.lights.lights.empty() && allBlack(frame.image))
+      std::fprintf(stderr, "rtr-view: warning: the image is all black (no lights: --no-default-light)\n");
     const std::string out = o.screenshot.empty() ? "rtr-view.png" : o.screenshot;
     savePng(out, frame.image);
     for (const auto& [name, ms] : frame.gpuTimes) std::fprintf(stderr, "  %s: %.3f ms GPU\n", name.c_str(), ms);
@@ -88,14 +104,15 @@ int main(int argc, char** argv) {
                "8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic off/compute/graphics, [ ] LOD bias,\n"
                "C print camera pose, F1 or H timing overlay, R ray-trace the view on the CPU (again: hide),\n"
                "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, Esc quit."};
-  std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light;
+  std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light, lightColor,
+              ambient = "0.02";
   std::string shadingPath = render::toString(o.settings.shading);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
   app.add_option("--size", size, "image size WxH")->capture_default_str();
   app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)");
   app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str();
-  app.add_option("--mode", o.settings.mode, "view mode 1-12 (1 shaded)")->check(CLI::Range(1, VIEW_COUNT))->capture_default_str();
+  app.add_option("--mode", o.settings.mode, "view mode 1-13 (1 shaded)")->check(CLI::Range(1, VIEW_COUNT))->capture_default_str();
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(CLI::PositiveNumber);
   app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay) to this PNG");
   app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit")->capture_default_str();
@@ -103,8 +120,12 @@ int main(int argc, char** argv) {
   app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward")
       ->check(CLI::IsMember({"visibility", "forward"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias");
-  app.add_option("--light", light, "light position x,y,z");
-  app.add_flag("--falloff", o.settings.inverseSquareFalloff, "inverse-square light falloff");
+  app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
+  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
+  app.add_flag("--falloff", o.lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
+  app.add_option("--ambient", ambient, "ambient colour r,g,b (or one grey value)")->capture_default_str();
+  app.add_flag("!--no-default-light", o.lightOptions.defaultLight,
+               "a scene without lights gets no headlight (only ambient and emission light it)");
   app.add_option("--bench", o.bench, "time N frames after 10 warm-up frames; print per-pass GPU min/median");
   app.add_flag("--watch", o.watch, "recompile edited shaders at run time (windowed)");
   app.add_option("--device", o.device, "Vulkan device index or name substring (default: discrete GPU first)");
@@ -116,10 +137,9 @@ int main(int argc, char** argv) {
         o.width > 16384 || o.height > 16384)
       throw Error("--size '" + size + "': expected WxH, e.g. 1920x1080");
     if (!camera.empty()) o.camera = parsePose(camera);
-    if (!light.empty()) {
-      CameraPose p = parsePose(light + ",0,0");
-      o.settings.lightPos = p.position;
-    }
+    if (!light.empty()) o.lightOptions.position = parseVec3(light, "--light");
+    if (!lightColor.empty()) o.lightOptions.color = parseVec3(lightColor, "--light-color");
+    o.lightOptions.ambient = parseVec3(ambient, "--ambient", true);
     const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
                                                           {"blit", render::MipMode::Blit}};
     const std::map<std::string, render::MosaicMode> mosaicModes{

@@ -6,6 +6,7 @@
 #include "core/camera.hpp"
 #include "render/mips.hpp"
 #include "render/renderer.hpp"
+#include "scene/lights.hpp"
 
 namespace rtr::view {
 
@@ -15,7 +16,8 @@ struct ViewOptions {
   uint32_t width = 1280, height = 720;
   std::optional<CameraPose> camera;
   Lens lens;
-  render::RenderSettings settings;
+  render::RenderSettings settings;  // settings.lights: resolved from lightOptions once the scene is loaded
+  LightOptions lightOptions;
   render::MipMode mips = render::MipMode::Compute;
   int frames = 1;                  // frames to render before the screenshot
   std::string screenshot;          // PNG path; empty: none
@@ -25,8 +27,11 @@ struct ViewOptions {
   bool validation = false;
 };
 
-// The start pose: --camera, else the scene's own view, else a view down -z framing the bounds.
-CameraPose startPose(const ViewOptions& o, const std::optional<CameraPose>& sceneView, const Bounds& bounds);
+// The start pose: --camera, else the scene's own view, else framing the scene (framingFor), as rtr-trace.
+CameraPose startPose(const ViewOptions& o, const Scene& scene);
+// The render settings for `scene`: o.settings with the scene's lights (scene/lights.hpp), the choice
+// said once on stderr when it is not simply the scene's own lights.
+render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene);
 
 int runHeadless(const ViewOptions& o);
 int runWindowed(const ViewOptions& o);

@@ -30,7 +30,7 @@ struct App {
   render::RenderSettings settings;
   bool overlay = false, resized = false;
   // Ray tracer (FORMATS.md §2's toggles, on keys that do not clash with the view modes).
-  bool traceRequested = false, errorMapRequested = false;
+  bool traceRequested = false, errorMapRequested = false, reframeRequested = false;
   trace::Shading traceShading = trace::Shading::Phong;
   bool traceShadows = true, traceReflections = true, traceOrtho = false;
 };
@@ -60,6 +60,7 @@ void onKey(GLFWwindow* w, int key, int, int action, int) {
   else if (key == GLFW_KEY_M) app.settings.mosaic = render::MosaicMode((int(app.settings.mosaic) + 1) % 3);
   else if (key == GLFW_KEY_LEFT_BRACKET) app.settings.lodBias -= 0.5f;
   else if (key == GLFW_KEY_RIGHT_BRACKET) app.settings.lodBias += 0.5f;
+  else if (key == GLFW_KEY_F) app.reframeRequested = true;
   else if (key == GLFW_KEY_C) std::printf("--camera %s\n", formatPose(app.camera.pose()).c_str()), std::fflush(stdout);
   else if (key == GLFW_KEY_F1 || key == GLFW_KEY_H) app.overlay = !app.overlay;
   else if (key == GLFW_KEY_R) app.traceRequested = true;
@@ -108,7 +109,7 @@ ImageRGBA8 readSwapchainImage(const vk::Buffer& buf, VkFormat format, VkExtent2D
 const char* const kKeyHelp =
     "W/S/A/D/E/Q move, Shift/Ctrl faster/slower, right mouse: mouse-look\n"
     "1-7 views, 8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic\n"
-    "[ ] LOD bias, C print pose, F1/H this overlay, Esc quit\n"
+    "[ ] LOD bias, F frame the scene, C print pose, F1/H this overlay, Esc quit\n"
     "R ray-trace (T shading, Y shadows, U reflections, O ortho)\n"
     "X error map: raster vs CPU trace of the same model";
 
@@ -118,8 +119,8 @@ int runWindowed(const ViewOptions& o) {
   GlfwSession glfw;
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   App app;
-  app.settings = o.settings;
   Scene scene = loadScene(o.scene);
+  app.settings = sceneSettings(o, scene);
 
   uint32_t extCount = 0;
   const char** exts = glfwGetRequiredInstanceExtensions(&extCount);
@@ -148,7 +149,7 @@ int runWindowed(const ViewOptions& o) {
   CameraSpeeds speeds;
   // Cross the scene in about 5 s with Shift held.
   if (!bounds.empty()) speeds.base = glm::length(bounds.extent()) / (5.0f * speeds.fastFactor);
-  app.camera = CameraController(startPose(o, scene.defaultView, bounds), speeds);
+  app.camera = CameraController(startPose(o, scene), speeds);
   // Course scenes light themselves with "*light*" geometry (Blinn-Phong); others use the renderer's light.
   const bool geometryLights = std::any_of(scene.materials.begin(), scene.materials.end(),
                                           [](const Material& m) { return m.flags & kMaterialLight; });
@@ -238,6 +239,11 @@ int runWindowed(const ViewOptions& o) {
         }
       }
 
+      if (app.reframeRequested) {  // F: the whole scene in view, as a scene without a stored view starts
+        app.reframeRequested = false;
+        const VkExtent2D e = swapchain.extent();
+        app.camera.setPose(frameBounds(bounds, o.lens, float(e.width) / float(std::max(1u, e.height)), framingFor(scene)));
+      }
       Frame& f = frames[frameNumber % kFramesInFlight];
       VkFence fence = f.fence;
       VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
@@ -257,7 +263,7 @@ int runWindowed(const ViewOptions& o) {
         ts.shading = app.traceShading;
         ts.shadows = app.traceShadows;
         ts.bounces = app.traceReflections ? trace::N_BOUNCES : 0;
-        ts.pbrLight = {app.settings.lightPos, app.settings.lightColor, app.settings.ambient.x};
+        ts.lights = app.settings.lights;
         ts.lodBias = app.settings.lodBias;
         return ts;
       };

@@ -1,17 +1,24 @@
-#include "trace/lights.hpp"
+#include "scene/lights.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
 
-namespace rtr::trace {
+namespace rtr {
+
+Light briefLight() {
+  Light l;
+  l.position = {-0.2972f, 7.3100f, -11.9532f};
+  return l;
+}
 
 bool isLightMaterial(const Material& m) {
   return (m.flags & kMaterialLight) != 0 || m.name.find("light") != std::string::npos;
 }
 
 glm::vec3 Light::samplePoint(int i, int n) const {
-  if (!area || n <= 1) return position;
+  if (kind != Kind::Area || n <= 1) return position;
   const int side = std::max(1, int(std::lround(std::sqrt(double(n)))));
   const float s = (float(i % side) + 0.5f) / float(side), t = (float((i / side) % side) + 0.5f) / float(side);
   return corner + s * edge1 + t * edge2;
@@ -23,7 +30,7 @@ Light areaLight(const Mesh& m, glm::vec3 color) {
   const uint32_t* f0 = &m.indices[0];
   const uint32_t* f1 = &m.indices[3];
   Light l;
-  l.area = true;
+  l.kind = Light::Kind::Area;
   l.color = color;
   const glm::vec3 a = m.positions[f0[0]], b = m.positions[f0[1]], c = m.positions[f0[2]];
   l.normal = glm::cross(b - a, c - a);
@@ -49,7 +56,7 @@ Light areaLight(const Mesh& m, glm::vec3 color) {
 
 }  // namespace
 
-std::vector<Light> extractLights(const Scene& scene) {
+std::vector<Light> lightsFromGeometry(const Scene& scene) {
   std::vector<Light> lights;
   for (const Mesh& m : scene.meshes) {
     if (m.material >= scene.materials.size() || m.positions.empty()) continue;
@@ -69,4 +76,35 @@ std::vector<Light> extractLights(const Scene& scene) {
   return lights;
 }
 
-}  // namespace rtr::trace
+bool hasOwnLights(const Scene& scene) { return !scene.lights.empty() || !lightsFromGeometry(scene).empty(); }
+
+LightRig resolveLights(const Scene& scene, const LightOptions& o) {
+  LightRig rig;
+  rig.ambient = o.ambient;
+  if (o.position) {
+    Light l;
+    l.position = *o.position;
+    l.color = o.color;
+    rig.lights = {l};
+    rig.note = "lit by --light";
+  } else {
+    rig.lights = scene.lights.empty() ? lightsFromGeometry(scene) : scene.lights;
+  }
+  if (rig.lights.size() > kMaxLights) {
+    rig.note = "the scene has " + std::to_string(rig.lights.size()) + " lights; the first " +
+               std::to_string(kMaxLights) + " are used";
+    rig.lights.resize(kMaxLights);
+  }
+  for (Light& l : rig.lights) l.falloff = l.falloff || o.falloff;
+  if (rig.lights.empty() && o.defaultLight) {
+    Light h;
+    h.kind = Light::Kind::Headlight;
+    rig.lights = {h};
+    rig.note = "the scene has no lights: lit by a headlight at the camera (--no-default-light: none)";
+  } else if (rig.lights.empty()) {
+    rig.note = "the scene has no lights and --no-default-light is set: only ambient and emission light it";
+  }
+  return rig;
+}
+
+}  // namespace rtr

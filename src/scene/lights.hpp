@@ -1,0 +1,49 @@
+#pragma once
+// Which lights light a scene, one rule for every tool (docs/lights.md):
+// 1. --light on the command line replaces the scene's lights with one point light;
+// 2. else the lights stored with the scene (.rtrscene; the course format's standard light);
+// 3. else its light geometry (FORMATS.md §2): every object whose material name contains "light" lights
+//    the scene with its Ke; two triangles make an area light (a parallelogram), anything else a point
+//    light at the centroid of its vertices;
+// 4. else, unless switched off, a headlight at the camera, announced once.
+// At most kMaxLights are kept (the GPU's frame uniforms hold that many); the rest are dropped with a note.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "scene/scene.hpp"
+
+namespace rtr {
+
+constexpr size_t kMaxLights = 8;  // MAX_LIGHTS in shaders/shared/lights.h
+
+// The brief's standard light of the Vulkan part (FORMATS.md §1).
+Light briefLight();
+
+bool isLightMaterial(const Material& m);  // flag set, or "light" in the name
+std::vector<Light> lightsFromGeometry(const Scene& scene);
+
+struct LightOptions {
+  std::optional<glm::vec3> position;  // --light x,y,z: one point light instead of the scene's
+  glm::vec3 color{1.0f};              // --light-color, for that light
+  bool falloff = false;               // --falloff: inverse-square falloff on every light but a headlight
+  bool defaultLight = true;           // false: --no-default-light (the brief's strict behaviour)
+  glm::vec3 ambient{0.02f};           // --ambient r,g,b: constant ambient colour
+};
+
+struct LightRig {
+  std::vector<Light> lights;
+  glm::vec3 ambient{0.02f};
+  std::string note;  // what was chosen when it is not simply the scene's own lights (print it once)
+};
+
+LightRig resolveLights(const Scene& scene, const LightOptions& options = {});
+// Whether the scene brings lights of its own (stored or as geometry).
+bool hasOwnLights(const Scene& scene);
+// A staged scene (it brings its own lights, like the course's Cornell box) is seen from the front, down
+// -z, as the course shows it; a bare model from a raised three-quarter view.
+inline Framing framingFor(const Scene& scene) { return hasOwnLights(scene) ? Framing::Front : Framing::ThreeQuarter; }
+
+}  // namespace rtr
