@@ -1,6 +1,9 @@
 #include "core/camera.hpp"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.hpp"
@@ -74,6 +77,53 @@ TEST(Camera, FrameBoundsSeesEveryCorner) {
     EXPECT_GE(clip.z / clip.w, 0.0f);
     EXPECT_LE(clip.z / clip.w, 1.0f);
   }
+}
+
+// A bare model's three-quarter view: from the front right and above, every corner in view, far from the
+// origin too.
+TEST(Camera, ThreeQuarterFramingSeesEveryCornerFromAbove) {
+  for (const glm::vec3 offset : {glm::vec3(0.0f), glm::vec3(1e4f, -3e3f, 2e4f)}) {
+    Bounds b;
+    b.extend(offset + glm::vec3(-3, -1, -8));
+    b.extend(offset + glm::vec3(5, 4, -2));
+    for (float aspect : {0.5f, 1.0f, 2.0f}) {
+      Lens lens;
+      const CameraPose pose = frameBounds(b, lens, aspect, Framing::ThreeQuarter);
+      const glm::vec3 c = b.center();
+      EXPECT_GT(pose.position.x, c.x);
+      EXPECT_GT(pose.position.y, b.max.y);
+      EXPECT_GT(pose.position.z, b.max.z);
+      // It looks at the centre.
+      const glm::vec3 toCentre = glm::normalize(c - pose.position);
+      EXPECT_GT(glm::dot(toCentre, basis(pose).forward), 0.9999f);
+      lens = fitDepthRange(lens, b, pose);
+      const glm::mat4 vp = projectionMatrix(lens, aspect) * viewMatrix(pose);
+      float widest = 0.0f;
+      for (int i = 0; i < 8; ++i) {
+        const glm::vec3 k{i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z};
+        const glm::vec4 clip = vp * glm::vec4(k, 1.0f);
+        ASSERT_GT(clip.w, 0.0f);
+        EXPECT_LE(std::abs(clip.x / clip.w), 1.0f) << aspect;
+        EXPECT_LE(std::abs(clip.y / clip.w), 1.0f) << aspect;
+        widest = std::max({widest, std::abs(clip.x / clip.w), std::abs(clip.y / clip.w)});
+      }
+      EXPECT_GT(widest, 0.4f) << "the model fills a fair part of the view";
+    }
+  }
+}
+
+TEST(Camera, ParseVec3NamesTheOption) {
+  EXPECT_EQ(parseVec3("1,-2.5,3", "--light"), glm::vec3(1, -2.5f, 3));
+  EXPECT_EQ(parseVec3("0.25", "--ambient", true), glm::vec3(0.25f));
+  for (const char* bad : {"", "1,2", "1,2,3,4", "1,nan,3", "1,inf,3", "a,b,c", "1,,3"}) {
+    try {
+      parseVec3(bad, "--light");
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("--light"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(parseVec3("0.25", "--light"), Error);  // one value only where allowed
 }
 
 }  // namespace

@@ -237,7 +237,7 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
     r.lights = pointLights({{{2.0f, 3.0f, 1.0f}, glm::vec3(2.0f)}});
     return r;
   }
-  if (name == "two_lights" || name == "two_lights_falloff") {
+  if (name == "two_lights" || name == "two_lights_falloff" || name == "headlight") {
     // A dielectric and a metal sphere on a floor, a warm key light and a cool fill from the other side.
     s.materials.push_back(material("floor", {0.6f, 0.6f, 0.6f}, 0.6f, 0.0f));
     s.materials.push_back(material("plastic", {0.2f, 0.4f, 0.8f}, 0.35f, 0.0f));
@@ -245,6 +245,7 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
     s.meshes.push_back(grid("floor", 0, {-4, -1, 0}, {8, 0, 0}, {0, 0, -8}, 8, 8, false));
     s.meshes.push_back(sphere("plastic", 1, {-1.1f, 0, -4}, 1.0f, 64, 32));
     s.meshes.push_back(sphere("gold", 2, {1.1f, 0, -4}, 1.0f, 64, 32));
+    if (name == "headlight") return ownLights(std::move(s));  // no lights of its own: the default headlight
     const bool falloff = name.ends_with("_falloff");
     const float k = falloff ? 20.0f : 1.0f;  // about the squared distance to the spheres
     r.lights = pointLights({{{3.0f, 3.0f, -1.0f}, k * glm::vec3(1.2f, 1.0f, 0.8f)},

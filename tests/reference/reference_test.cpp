@@ -18,7 +18,7 @@ namespace {
 const char* const kCases[] = {"temple_nave",   "temple_aisle",  "cornell_box",   "cube_backplane",
                               "grazing_floor", "metal_sphere",  "rough0_patch",  "backface_quad",
                               "temple_nave_textured", "temple_aisle_textured", "cube_backplane_falloff",
-                              "two_lights", "two_lights_falloff"};
+                              "two_lights", "two_lights_falloff", "headlight"};
 
 struct Param {
   std::string name;

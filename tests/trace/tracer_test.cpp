@@ -79,6 +79,53 @@ TEST(Tracer, LightsComeFromGeometry) {
   EXPECT_NEAR(glm::distance(lights[1].position, glm::vec3(1.5f, 2, 2.5f)), 0.0f, 1e-5f);
 }
 
+// Falloff divides a light's direct term by the squared distance, in both shading models; ambient stays.
+TEST(Tracer, FalloffDividesByTheSquaredDistance) {
+  Scene s = litPlane({0, 0, 0}, 4.0f, 4);
+  const Tracer t(s);
+  for (Shading shading : {Shading::Phong, Shading::Pbr}) {
+    TraceSettings ts;
+    ts.shading = shading;
+    LightRig rig = resolveLights(s);
+    ASSERT_EQ(rig.lights.size(), 1u);
+    rig.ambient = glm::vec3(0.0f);
+    const glm::vec3 lightPos = rig.lights[0].position;
+    const Ray down{{lightPos.x, lightPos.y, 0.5f}, {0, 0, -1}};  // the plane point right below the light
+    ts.lights = rig;
+    const glm::vec3 plain = t.traceAndShade(down, 0, ts);
+    rig.lights[0].falloff = true;
+    ts.lights = rig;
+    const glm::vec3 fell = t.traceAndShade(down, 0, ts);
+    const float ambient = shading == Shading::Phong ? s.materials[0].ka.x : 0.0f;  // Ka x Lc, no falloff
+    const float d2 = lightPos.z * lightPos.z;
+    EXPECT_NEAR(fell.x - ambient, (plain.x - ambient) / d2, 1e-5f) << int(shading);
+    EXPECT_GT(plain.x - ambient, 0.1f);
+  }
+}
+
+// A scene without lights is lit from the camera by default; with the default light off only ambient stays.
+TEST(Tracer, HeadlightSitsAtTheCamera) {
+  Scene s;
+  const uint32_t mat = addMaterial(s, phong(glm::vec3(0.7f)));
+  addMesh(s, quad({-1, -1, -3}, {2, 0, 0}, {0, 2, 0}, mat));  // faces +z, towards the camera
+  const Tracer t(s);
+  TraceSettings ts;
+  ts.width = ts.height = 16;
+  ts.pose = CameraPose{{0.5f, 0, 2}, 0, 0};
+  ts.lights = resolveLights(s);
+  ImageF img;
+  t.render(ts, img);
+  // Lambert + Blinn-Phong with the light at the eye: the brightest pixel is the one that looks along n.
+  const glm::vec4 centre = img.pixels[8 * 16 + 8];
+  const float kdOnly = 0.7f * glm::dot(glm::normalize(glm::vec3(-0.5f, 0, -5)), glm::vec3(0, 0, -1));
+  EXPECT_GT(centre.x, s.materials[0].ka.x + 0.5f * kdOnly);
+  LightOptions off;
+  off.defaultLight = false;
+  ts.lights = resolveLights(s, off);
+  t.render(ts, img);
+  EXPECT_NEAR(img.pixels[8 * 16 + 8].x, 0.0f, 1e-6f);  // Phong's ambient is Ka x each light: none
+}
+
 TEST(Tracer, ShadowGivesAmbientAndEmissiveOnly) {
   Scene s = litPlane({0, 0, 0}, 4.0f, 4);
   const uint32_t mat = addMaterial(s, phong(glm::vec3(0.2f, 0.4f, 0.6f)));
