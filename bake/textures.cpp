@@ -12,6 +12,7 @@ TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool cou
   plan.scene.baseDir = in.baseDir;
   plan.scene.meshes = in.meshes;
   plan.scene.defaultView = in.defaultView;
+  plan.scene.lights = in.lights;
   std::unordered_map<std::string, uint32_t> ids;           // destination path -> new id
   std::unordered_map<std::string, std::string> sourceOf;   // destination path -> source, to catch clashes
   const std::string folder = sceneName + "-tex/";

@@ -86,6 +86,17 @@ TEST(ReferenceScenes, UntexturedTempleDropsOnlyCards) {
   EXPECT_GT(s.meshes.size(), 10u);
 }
 
+// The baked temple carries the brief's light (rtr-bake --light at build time), and both renderers use it.
+TEST(ReferenceScenes, TempleIsLitByTheBriefsStoredLight) {
+  for (const char* name : {"temple_nave", "temple_nave_textured"}) {
+    const ReferenceScene rs = makeScene(name, outDir() / "work");
+    ASSERT_EQ(rs.lights.lights.size(), 1u) << name;
+    EXPECT_EQ(rs.lights.lights[0].kind, Light::Kind::Point) << name;
+    EXPECT_EQ(rs.lights.lights[0].position, briefLight().position) << name;
+    EXPECT_TRUE(rs.lights.note.empty()) << rs.lights.note;
+  }
+}
+
 // The textured temple is the scene as baked (textures, cards), with only the fire cards made two-sided.
 TEST(ReferenceScenes, TexturedTempleKeepsTexturesAndCards) {
   const Scene temple = loadScene(std::filesystem::path(RTR_BINARY_DIR) / "assets/temple.rtrscene");

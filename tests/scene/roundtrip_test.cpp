@@ -57,9 +57,16 @@ TEST(RoundTrip, RtrSceneKeepsEverything) {
   const fs::path dir = tempDir("rt_rtrscene");
   BakeOptions o{fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst", dir / "temple.rtrscene"};
   o.view = want.defaultView;
+  Light light;
+  light.position = {1, 2, 3};
+  light.color = {0.5f, 0.25f, 2};
+  o.lights = {light};
   o.threads = 2;
   bake(o);
   const Scene got = loadScene(o.output);
+  ASSERT_EQ(got.lights.size(), 1u);  // --light is stored with the scene
+  EXPECT_EQ(got.lights[0].position, light.position);
+  EXPECT_EQ(got.lights[0].color, light.color);
   EXPECT_EQ(got.baseDir, dir);
   expectSameMeshes(want, got);
   for (size_t i = 0; i < want.meshes.size(); ++i) EXPECT_EQ(want.meshes[i].name, got.meshes[i].name);

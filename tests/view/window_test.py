@@ -200,6 +200,17 @@ def main():
         v_fast = check_move(["shift", "w"], 1.0, speed * 5)
         check(v_fast > 3 * v_walk, f"Shift is faster ({v_fast / v_walk:.2f}x W)")
 
+        # F frames the whole scene: one fixed pose, whatever the camera did before.
+        xdo("key", "f")
+        time.sleep(0.3)
+        framed = pose()
+        hold(["d"], 0.3)
+        moved = pose()
+        xdo("key", "f")
+        time.sleep(0.3)
+        again = pose()
+        check(moved != framed and again == framed, f"F frames the scene ({framed})")
+
         # Mouse-look: RMB on, motion turns the camera; RMB off, motion does not.
         p0 = pose()
         xdo("click", "3")
