@@ -25,9 +25,25 @@ const char* resultName(SpvReflectResult r) {
   return size_t(r) < std::size(names) ? names[r] : "unknown error";
 }
 
+// SPIRV-Reflect (Debian's build keeps its asserts) aborts on an instruction that runs past the end of
+// the module, so the instruction stream is walked first.
+void checkInstructionStream(const SpirvModule& s) {
+  const std::vector<uint32_t>& w = s.code;
+  if (w.size() < 5) throw fileError(s.name, "", "not SPIR-V: shorter than its 5-word header");
+  for (size_t i = 5; i < w.size();) {
+    const uint32_t words = w[i] >> 16;
+    if (words == 0 || words > w.size() - i)
+      throw fileError(s.name, "at word " + std::to_string(i),
+                      "not SPIR-V: an instruction of " + std::to_string(words) + " words in a module of " +
+                          std::to_string(w.size()));
+    i += words;
+  }
+}
+
 struct ReflectModule {
   SpvReflectShaderModule m{};
   ReflectModule(const SpirvModule& s) {
+    checkInstructionStream(s);
     SpvReflectResult r = spvReflectCreateShaderModule(s.code.size() * 4, s.code.data(), &m);
     if (r != SPV_REFLECT_RESULT_SUCCESS)
       throw Error(s.name + ": SPIRV-Reflect cannot read this module (" + resultName(r) + ", error " +
@@ -246,7 +262,9 @@ PipelineInterface reflectPipeline(const std::vector<SpirvModule>& modules) {
     if (m.entry_point_count == 0) throw Error(s.name + ": no entry point");
     std::vector<SpecConstant> specs;
     for (uint32_t i = 0; i < m.spec_constant_count; ++i) specs.push_back(specConstant(m.spec_constants[i]));
-    std::sort(specs.begin(), specs.end(), [](auto& a, auto& b) { return a.id < b.id; });
+    // SPIRV-Reflect may list one constant twice (glslang's local_size_x_id): one entry per id.
+    std::stable_sort(specs.begin(), specs.end(), [](auto& a, auto& b) { return a.id < b.id; });
+    specs.erase(std::unique(specs.begin(), specs.end(), [](auto& a, auto& b) { return a.id == b.id; }), specs.end());
 
     for (uint32_t e = 0; e < m.entry_point_count; ++e) {
       const SpvReflectEntryPoint& ep = m.entry_points[e];

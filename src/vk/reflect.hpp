@@ -68,13 +68,15 @@ struct SpecConstant {
   std::string name, type, defaultValue;  // type: bool, int, uint, float, ...; the default as written
 };
 
+constexpr uint32_t kSpecializedSize = UINT32_MAX;
+
 // One entry point. A module with several (as Slang writes them) gives one StageInterface for each, each
 // with the resources its own code uses.
 struct StageInterface {
   std::string module;
   VkShaderStageFlagBits stage{};
   std::string entryPoint;
-  std::array<uint32_t, 3> localSize{0, 0, 0};  // compute only
+  std::array<uint32_t, 3> localSize{0, 0, 0};  // compute only; kSpecializedSize: set by a spec constant
   std::vector<InterfaceVariable> inputs, outputs;  // built-ins left out
   std::vector<SpecConstant> specConstants;         // the module's, sorted by id
 };

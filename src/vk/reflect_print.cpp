@@ -106,11 +106,12 @@ const char* formatName(VkFormat f) {
 }
 
 std::string toText(const PipelineInterface& p) {
+  auto size = [](uint32_t n) { return n == kSpecializedSize ? std::string("spec") : std::to_string(n); };
   std::ostringstream o;
   for (const auto& s : p.stages) {
     o << "stage " << stageNames(s.stage) << ": " << s.module << " entry '" << s.entryPoint << "'";
     if (s.stage == VK_SHADER_STAGE_COMPUTE_BIT)
-      o << " workgroup " << s.localSize[0] << "x" << s.localSize[1] << "x" << s.localSize[2];
+      o << " workgroup " << size(s.localSize[0]) << "x" << size(s.localSize[1]) << "x" << size(s.localSize[2]);
     o << "\n";
     for (const auto& v : s.inputs) o << "  in  location " << v.location << " " << formatName(v.format) << " " << v.name << "\n";
     for (const auto& v : s.outputs) o << "  out location " << v.location << " " << formatName(v.format) << " " << v.name << "\n";
@@ -135,6 +136,7 @@ std::string toText(const PipelineInterface& p) {
 }
 
 std::string toJson(const PipelineInterface& p) {
+  auto size = [](uint32_t n) { return n == kSpecializedSize ? std::string("null") : std::to_string(n); };
   std::ostringstream o;
   o << "{\"stages\":[";
   for (size_t i = 0; i < p.stages.size(); ++i) {
@@ -142,7 +144,7 @@ std::string toJson(const PipelineInterface& p) {
     o << (i ? "," : "") << "{\"module\":" << jsonString(s.module) << ",\"stage\":" << jsonString(stageNames(s.stage))
       << ",\"entryPoint\":" << jsonString(s.entryPoint);
     if (s.stage == VK_SHADER_STAGE_COMPUTE_BIT)
-      o << ",\"workgroupSize\":[" << s.localSize[0] << "," << s.localSize[1] << "," << s.localSize[2] << "]";
+      o << ",\"workgroupSize\":[" << size(s.localSize[0]) << "," << size(s.localSize[1]) << "," << size(s.localSize[2]) << "]";
     o << ",\"inputs\":";
     jsonVars(o, s.inputs);
     o << ",\"outputs\":";
