@@ -11,7 +11,9 @@
 
 #include "core/error.hpp"
 #include "vk/glsl.hpp"
+#include "vk/pipeline.hpp"
 #include "vk/reflect.hpp"
+#include "vk_fixture.hpp"
 
 namespace rtr {
 namespace {
@@ -169,6 +171,19 @@ TEST(ReflectModern, EachEntryPointOfAModuleIsAStageWithItsOwnResources) {
   EXPECT_EQ(findBinding(p, 0, 1).blockSize, 32u);
   ASSERT_EQ(p.pushConstants.size(), 1u);
   EXPECT_EQ(p.pushConstants[0].stages, VkShaderStageFlags(VK_SHADER_STAGE_FRAGMENT_BIT));
+}
+
+using test::VulkanTest;
+
+// The renderer pairs module i with stage i; a module with two entry points is refused, not mismatched.
+TEST_F(VulkanTest, GraphicsPipelineRefusesAModuleWithTwoEntryPoints) {
+  std::ifstream in(kData / "two_entry_points.spvasm");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  vk::GraphicsDesc d;
+  d.modules.push_back({"two_entry_points.spv", {}});
+  ASSERT_TRUE(spvtools::SpirvTools(SPV_ENV_VULKAN_1_3).Assemble(text, &d.modules[0].code));
+  d.colorFormats = {VK_FORMAT_R8G8B8A8_UNORM};
+  EXPECT_THROW(vk::makeGraphicsPipeline(*ctx, d), Error);
 }
 
 // A module cut inside an instruction is an error naming the place (SPIRV-Reflect itself aborts on it).
