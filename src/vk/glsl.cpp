@@ -51,19 +51,28 @@ class Includer : public glslang::TShader::Includer {
   std::vector<std::filesystem::path> dirs_;
 };
 
+// glslangValidator's file extensions.
+EShLanguage stageOf(const std::filesystem::path& file) {
+  static const std::pair<const char*, EShLanguage> stages[] = {
+      {".vert", EShLangVertex}, {".tesc", EShLangTessControl}, {".tese", EShLangTessEvaluation},
+      {".geom", EShLangGeometry}, {".frag", EShLangFragment}, {".comp", EShLangCompute},
+      {".rgen", EShLangRayGen}, {".rint", EShLangIntersect}, {".rahit", EShLangAnyHit},
+      {".rchit", EShLangClosestHit}, {".rmiss", EShLangMiss}, {".rcall", EShLangCallable},
+      {".task", EShLangTask}, {".mesh", EShLangMesh}};
+  for (auto [ext, stage] : stages)
+    if (file.extension() == ext) return stage;
+  return EShLangCount;
+}
+
 }  // namespace
 
-bool isGlslPath(const std::filesystem::path& file) {
-  auto e = file.extension();
-  return e == ".vert" || e == ".frag" || e == ".comp";
-}
+bool isGlslPath(const std::filesystem::path& file) { return stageOf(file) != EShLangCount; }
 
 SpirvModule compileGlsl(const std::filesystem::path& file, const std::vector<std::filesystem::path>& includeDirs) {
   static std::once_flag init;
   std::call_once(init, [] { glslang::InitializeProcess(); });  // process-wide; finalised at exit by the OS
-  const auto ext = file.extension();
-  EShLanguage stage = ext == ".vert" ? EShLangVertex : ext == ".frag" ? EShLangFragment : ext == ".comp" ? EShLangCompute : EShLangCount;
-  if (stage == EShLangCount) throw fileError(file.string(), "", "unknown shader stage: use .vert, .frag or .comp");
+  const EShLanguage stage = stageOf(file);
+  if (stage == EShLangCount) throw fileError(file.string(), "", "unknown shader stage: use .vert, .frag, .comp, .rgen, .rchit, ...");
   const std::string source = readText(file);
   const std::string name = file.string();
   const char* text = source.c_str();

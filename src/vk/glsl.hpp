@@ -8,8 +8,8 @@
 
 namespace rtr::vk {
 
-// The stage comes from the extension (.vert, .frag, .comp). A compile error is an rtr::Error whose
-// message carries glslang's "file:line: message" lines.
+// The stage comes from the extension, as for glslangValidator (.vert, .frag, .comp, .rgen, .rchit, .mesh,
+// ...). A compile error is an rtr::Error whose message carries glslang's "file:line: message" lines.
 SpirvModule compileGlsl(const std::filesystem::path& file, const std::vector<std::filesystem::path>& includeDirs = {});
 bool isGlslPath(const std::filesystem::path& file);
 

@@ -161,6 +161,8 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   p.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
   p.layout = PipelineLayout(ctx, reflectPipeline(d.modules), options);
   const PipelineInterface& iface = p.layout.interface();
+  // Stage i is module i's only entry point; a module with several would shift them.
+  if (iface.stages.size() != d.modules.size()) throw Error("graphics pipeline: a module with several entry points");
 
   std::vector<ShaderModuleHandle> modules;
   std::vector<VkPipelineShaderStageCreateInfo> stages;

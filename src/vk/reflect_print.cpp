@@ -18,7 +18,12 @@ std::string jsonString(const std::string& s) {
 
 void textMembers(std::ostringstream& o, const std::vector<BlockMember>& ms, int indent) {
   for (const auto& m : ms) {
-    o << std::string(indent, ' ') << "+" << m.offset << " " << m.name << " (" << m.size << " bytes)\n";
+    o << std::string(indent, ' ') << "+" << m.offset << " " << m.name << " (" << m.size << " bytes)";
+    if (!m.pointee.empty()) {
+      o << " -> " << m.pointee;  // size 0: SPIRV-Reflect did not lay the block out (arrays of 2+ dimensions)
+      if (m.pointeeSize) o << " (" << m.pointeeSize << " bytes" << (m.members.empty() ? ", members listed above)" : ")");
+    }
+    o << "\n";
     textMembers(o, m.members, indent + 2);
   }
 }
@@ -28,6 +33,7 @@ void jsonMembers(std::ostringstream& o, const std::vector<BlockMember>& ms) {
   for (size_t i = 0; i < ms.size(); ++i) {
     o << (i ? "," : "") << "{\"name\":" << jsonString(ms[i].name) << ",\"offset\":" << ms[i].offset
       << ",\"size\":" << ms[i].size;
+    if (!ms[i].pointee.empty()) o << ",\"pointee\":" << jsonString(ms[i].pointee) << ",\"pointeeSize\":" << ms[i].pointeeSize;
     if (!ms[i].members.empty()) { o << ",\"members\":"; jsonMembers(o, ms[i].members); }
     o << "}";
   }
@@ -53,6 +59,14 @@ std::string stageNames(VkShaderStageFlags s) {
   add(VK_SHADER_STAGE_GEOMETRY_BIT, "geometry");
   add(VK_SHADER_STAGE_FRAGMENT_BIT, "fragment");
   add(VK_SHADER_STAGE_COMPUTE_BIT, "compute");
+  add(VK_SHADER_STAGE_TASK_BIT_EXT, "task");
+  add(VK_SHADER_STAGE_MESH_BIT_EXT, "mesh");
+  add(VK_SHADER_STAGE_RAYGEN_BIT_KHR, "raygen");
+  add(VK_SHADER_STAGE_ANY_HIT_BIT_KHR, "any-hit");
+  add(VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR, "closest-hit");
+  add(VK_SHADER_STAGE_MISS_BIT_KHR, "miss");
+  add(VK_SHADER_STAGE_INTERSECTION_BIT_KHR, "intersection");
+  add(VK_SHADER_STAGE_CALLABLE_BIT_KHR, "callable");
   return out.empty() ? "none" : out;
 }
 
@@ -67,6 +81,7 @@ const char* descriptorTypeName(VkDescriptorType t) {
     case VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER: return "uniform-buffer";
     case VK_DESCRIPTOR_TYPE_STORAGE_BUFFER: return "storage-buffer";
     case VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT: return "input-attachment";
+    case VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR: return "acceleration-structure";
     default: return "other";
   }
 }
@@ -91,18 +106,23 @@ const char* formatName(VkFormat f) {
 }
 
 std::string toText(const PipelineInterface& p) {
+  auto size = [](uint32_t n) { return n == kSpecializedSize ? std::string("spec") : std::to_string(n); };
   std::ostringstream o;
   for (const auto& s : p.stages) {
     o << "stage " << stageNames(s.stage) << ": " << s.module << " entry '" << s.entryPoint << "'";
     if (s.stage == VK_SHADER_STAGE_COMPUTE_BIT)
-      o << " workgroup " << s.localSize[0] << "x" << s.localSize[1] << "x" << s.localSize[2];
+      o << " workgroup " << size(s.localSize[0]) << "x" << size(s.localSize[1]) << "x" << size(s.localSize[2]);
     o << "\n";
     for (const auto& v : s.inputs) o << "  in  location " << v.location << " " << formatName(v.format) << " " << v.name << "\n";
     for (const auto& v : s.outputs) o << "  out location " << v.location << " " << formatName(v.format) << " " << v.name << "\n";
+    for (const auto& c : s.specConstants)
+      o << "  specialization constant " << c.id << " " << c.type << " " << c.name << " = " << c.defaultValue << "\n";
   }
   for (const auto& b : p.bindings) {
     o << "set " << b.set << " binding " << b.binding << ": " << descriptorTypeName(b.type);
     if (b.count != 1) o << "[" << (b.count ? std::to_string(b.count) : std::string()) << "]";
+    if (b.imageFormat != VK_FORMAT_UNDEFINED) o << " " << imageFormatName(b.imageFormat);
+    if (b.type == VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT) o << " input_attachment_index " << b.inputAttachmentIndex;
     o << " " << b.name << " (" << stageNames(b.stages) << ")";
     if (b.blockSize) o << " " << b.blockSize << " bytes";
     o << "\n";
@@ -116,6 +136,7 @@ std::string toText(const PipelineInterface& p) {
 }
 
 std::string toJson(const PipelineInterface& p) {
+  auto size = [](uint32_t n) { return n == kSpecializedSize ? std::string("null") : std::to_string(n); };
   std::ostringstream o;
   o << "{\"stages\":[";
   for (size_t i = 0; i < p.stages.size(); ++i) {
@@ -123,11 +144,20 @@ std::string toJson(const PipelineInterface& p) {
     o << (i ? "," : "") << "{\"module\":" << jsonString(s.module) << ",\"stage\":" << jsonString(stageNames(s.stage))
       << ",\"entryPoint\":" << jsonString(s.entryPoint);
     if (s.stage == VK_SHADER_STAGE_COMPUTE_BIT)
-      o << ",\"workgroupSize\":[" << s.localSize[0] << "," << s.localSize[1] << "," << s.localSize[2] << "]";
+      o << ",\"workgroupSize\":[" << size(s.localSize[0]) << "," << size(s.localSize[1]) << "," << size(s.localSize[2]) << "]";
     o << ",\"inputs\":";
     jsonVars(o, s.inputs);
     o << ",\"outputs\":";
     jsonVars(o, s.outputs);
+    if (!s.specConstants.empty()) {
+      o << ",\"specConstants\":[";
+      for (size_t j = 0; j < s.specConstants.size(); ++j) {
+        const auto& c = s.specConstants[j];
+        o << (j ? "," : "") << "{\"id\":" << c.id << ",\"name\":" << jsonString(c.name) << ",\"type\":"
+          << jsonString(c.type) << ",\"default\":" << jsonString(c.defaultValue) << "}";
+      }
+      o << "]";
+    }
     o << "}";
   }
   o << "],\"descriptorSets\":[";
@@ -137,6 +167,8 @@ std::string toJson(const PipelineInterface& p) {
       << jsonString(descriptorTypeName(b.type)) << ",\"count\":" << b.count << ",\"runtimeArray\":"
       << (b.count == 0 ? "true" : "false") << ",\"name\":" << jsonString(b.name) << ",\"stages\":"
       << jsonString(stageNames(b.stages));
+    if (b.imageFormat != VK_FORMAT_UNDEFINED) o << ",\"imageFormat\":" << jsonString(imageFormatName(b.imageFormat));
+    if (b.type == VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT) o << ",\"inputAttachmentIndex\":" << b.inputAttachmentIndex;
     if (b.blockSize) { o << ",\"blockSize\":" << b.blockSize << ",\"members\":"; jsonMembers(o, b.members); }
     o << "}";
   }

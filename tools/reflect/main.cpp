@@ -11,18 +11,24 @@
 int main(int argc, char** argv) {
   CLI::App app{
       "rtr-reflect: print the interface of the shaders that form one pipeline, merged across stages.\n"
-      "Inputs are SPIR-V (.spv) or GLSL (.vert/.frag/.comp, compiled with glslang for Vulkan 1.3).\n"
-      "Prints entry points and stages, compute workgroup sizes, descriptor sets (binding, type, count,\n"
-      "name, stages), push-constant ranges, block members with offsets and sizes, vertex inputs and\n"
-      "fragment outputs. The descriptor set layouts and push-constant ranges shown are exactly those\n"
-      "the renderer creates. Exit status 1 on invalid SPIR-V, a GLSL error or a cross-stage conflict."};
+      "Inputs are SPIR-V (.spv) or GLSL (compiled with glslang for Vulkan 1.3; the extension names the\n"
+      "stage: .vert .frag .comp .rgen .rchit ...). A module may hold several entry points.\n"
+      "Prints entry points and stages, compute workgroup sizes, specialization constants, descriptor\n"
+      "sets (binding, type, count, image format, name, stages), push-constant ranges, block members with\n"
+      "offsets and sizes (buffer references name the block they point to), vertex inputs and fragment\n"
+      "outputs. The descriptor set layouts and push-constant ranges shown are exactly those the renderer\n"
+      "creates. SPIR-V that spirv-val rejects is a warning (newer compilers write what Debian's validator\n"
+      "does not know yet), an error with --strict. Exit status 1 on SPIR-V that cannot be reflected, a\n"
+      "GLSL error, a cross-stage conflict, or with --strict a module spirv-val rejects."};
   std::vector<std::string> files;
   std::vector<std::string> includes;
-  bool json = false, noValidate = false;
+  bool json = false, noValidate = false, strict = false;
   app.add_option("shaders", files, "SPIR-V or GLSL files of one pipeline")->required()->check(CLI::ExistingFile);
   app.add_flag("--json", json, "machine-readable JSON output");
-  app.add_option("-I,--include", includes, "include folder for GLSL inputs (repeatable)");
+  // One folder per -I: without allow_extra_args(false) "-I a x.vert" would take x.vert as a folder too.
+  app.add_option("-I,--include", includes, "include folder for GLSL inputs (repeatable)")->allow_extra_args(false);
   app.add_flag("--no-validate", noValidate, "skip spirv-val style validation of SPIR-V inputs");
+  app.add_flag("--strict", strict, "a module spirv-val rejects is an error (exit 1), not a warning");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -30,7 +36,13 @@ int main(int argc, char** argv) {
     std::vector<rtr::vk::SpirvModule> modules;
     for (const auto& f : files) {
       modules.push_back(rtr::vk::isGlslPath(f) ? rtr::vk::compileGlsl(f, dirs) : rtr::vk::readSpirv(f));
-      if (!noValidate) rtr::vk::validateSpirv(modules.back());
+      if (noValidate) continue;
+      try {
+        rtr::vk::validateSpirv(modules.back());
+      } catch (const rtr::Error& e) {
+        if (strict) throw;
+        std::fprintf(stderr, "rtr-reflect: warning: %s\n  (reflecting it anyway; --strict makes this an error)\n", e.what());
+      }
     }
     const auto iface = rtr::vk::reflectPipeline(modules);
     std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
