@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "scene/binio.hpp"
-#include "scene/text.hpp"
 
 namespace rtr {
 namespace {
@@ -31,7 +30,8 @@ std::string readString(ByteReader& r, const char* what) {
   const uint32_t n = r.u32(what);
   if (n >= kMaxString) r.failAt(at, std::string(what) + " length " + std::to_string(n) + " is not below 32768");
   std::string_view s = r.view(n, what);
-  if (s.find('\0') != std::string_view::npos || !text::validUtf8(s)) r.failAt(at + 4, std::string(what) + " is not valid UTF-8 text");
+  // Names are bytes in the encoding of the OBJ they came from; only NUL is refused.
+  if (s.find('\0') != std::string_view::npos) r.failAt(at + 4, std::string(what) + " contains a NUL byte");
   r.align(4, what);
   return std::string(s);
 }
