@@ -5,7 +5,6 @@
 
 #include "scene/binio.hpp"
 #include "scene/lights.hpp"
-#include "scene/text.hpp"
 
 namespace rtr {
 namespace {
@@ -77,7 +76,6 @@ Scene decodeCourseMesh(std::span<const uint8_t> bytes, const std::string& file) 
     if (s.back() != '\0') r.failAt(at + 4 + n - 1, "texture path not NUL-terminated");
     s.remove_suffix(1);
     if (s.find('\0') != std::string_view::npos) r.failAt(at + 4, "texture path contains NUL");
-    if (!text::validUtf8(s)) r.failAt(at + 4, "texture path is not valid UTF-8");
     t.path = std::filesystem::path(std::string(s));
     const size_t csAt = r.pos();
     const uint8_t cs = r.u8("a texture colour space");

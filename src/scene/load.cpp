@@ -7,10 +7,16 @@
 
 namespace rtr {
 
-Scene loadScene(const std::filesystem::path& file) {
+Scene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
   const std::string n = file.filename().string();
   auto ends = [&](std::string_view s) { return n.size() >= s.size() && n.compare(n.size() - s.size(), s.size(), s) == 0; };
-  if (ends(".obj") || ends(".obj.zst") || ends(".obj-zstd")) return loadObj(file);
+  if (ends(".obj") || ends(".obj.zst") || ends(".obj-zstd")) {
+    ObjOptions o;
+    static_cast<LoadOptions&>(o) = options;
+    return loadObj(file, o);
+  }
+  if (options.mtl)
+    throw fileError(file.string(), "", "an MTL file ('" + options.mtl->string() + "') can only be given with an OBJ scene");
   if (ends(".comp5892mesh")) return loadCourseMesh(file);
   if (ends(".rtrscene")) return loadRtrScene(file);
   throw fileError(file.string(), "", "unknown scene format (expected .obj, .obj.zst, .obj-zstd, .comp5892mesh, .rtrscene)");

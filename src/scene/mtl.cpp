@@ -1,6 +1,7 @@
 #include "scene/mtl.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.hpp"
 #include "scene/text.hpp"
@@ -27,6 +28,8 @@ SlotFormat slotFormat(TextureSlot slot) {
   }
 }
 
+float roughnessFromNs(float ns) { return std::pow(2.0f / (std::max(ns, 0.0f) + 2.0f), 0.25f); }
+
 namespace {
 
 struct MtlParser {
@@ -35,6 +38,7 @@ struct MtlParser {
   size_t line = 0;
   std::vector<MtlMaterial> out;
   std::vector<std::string> warnedKeys;
+  std::vector<uint8_t> givenPr, givenNs;  // per material: whether the MTL set Pr / Ns
 
   Error error(const std::string& what) const { return fileError(file, std::to_string(line), what); }
 
@@ -88,8 +92,7 @@ struct MtlParser {
       rest = text::trim(rest);
     }
     if (rest.empty()) throw error("'" + std::string(key) + "' names no file");
-    if (rest.size() >= 32768) throw error("texture file name too long");
-    if (!text::validUtf8(rest)) throw error("texture file name is not valid UTF-8");
+    if (rest.size() >= 32768) throw error("texture file name too long");  // names are bytes, any encoding
     std::string name(rest);
     std::replace(name.begin(), name.end(), '\\', '/');  // files exported on Windows
     return name;
@@ -100,10 +103,11 @@ struct MtlParser {
     std::string_view key = text::nextToken(rest);
     if (key.empty() || key[0] == '#') return;
     if (key == "newmtl") {
-      std::string_view name = text::trim(rest);
-      if (name.empty()) throw error("'newmtl' without a name");
+      std::string_view name = text::trim(rest);  // bytes in any encoding
+      if (name.empty() && warn) warn(file + ":" + std::to_string(line) + ": 'newmtl' without a name (usable as 'usemtl' with no name)");
       if (name.size() >= 32768) throw error("material name too long");
-      if (!text::validUtf8(name)) throw error("material name is not valid UTF-8");
+      givenPr.push_back(0);
+      givenNs.push_back(0);
       MtlMaterial m;
       m.material.name = std::string(name);
       m.material.flags = flagsFromName(name);
@@ -117,19 +121,20 @@ struct MtlParser {
     else if (key == "Ka") mat().ka = colour(key, rest);
     else if (key == "Ks") mat().ks = colour(key, rest);
     else if (key == "Ke") { glm::vec3 c = colour(key, rest); mat().ke = c; mat().emissive = c; }
-    else if (key == "Ns") mat().ns = scalar(key, rest);
-    else if (key == "Pr") mat().roughness = scalar(key, rest);
+    else if (key == "Ns") { mat().ns = scalar(key, rest); givenNs.back() = 1; }
+    else if (key == "Pr") { mat().roughness = scalar(key, rest); givenPr.back() = 1; }
     else if (key == "Pm") mat().metalness = scalar(key, rest);
     else if (key == "N_mirr") mat().mirror = scalar(key, rest);
     else if (key == "N_ior") mat().ior = scalar(key, rest);
-    else if (key == "N_transp") mat().transparency = scalar(key, rest);
+    else if (key == "N_transp" || key == "Tr") mat().transparency = scalar(key, rest);
+    else if (key == "d") mat().transparency = 1.0f - scalar(key, rest);  // dissolve: 1 is opaque
     else if (key == "map_Kd") slot(TextureSlot::BaseColor) = mapFile(key, rest);
     else if (key == "map_Pr") slot(TextureSlot::Roughness) = mapFile(key, rest);
     else if (key == "map_Pm") slot(TextureSlot::Metalness) = mapFile(key, rest);
     else if (key == "map_d") { slot(TextureSlot::AlphaMask) = mapFile(key, rest); mat().flags |= kMaterialAlphaMasked; }
     else if (key == "norm") slot(TextureSlot::NormalMap) = mapFile(key, rest);
     else if (key == "map_Ke") slot(TextureSlot::Emissive) = mapFile(key, rest);
-    else if (key == "Ni" || key == "d" || key == "Tr" || key == "Tf" || key == "illum" || key == "map_Ka" ||
+    else if (key == "Ni" || key == "Tf" || key == "illum" || key == "map_Ka" ||
              key == "map_Ks" || key == "map_Ns" || key == "map_bump" || key == "bump" || key == "map_Bump") {
       current(key);  // known to the wider MTL world; not used by our scenes
     } else {
@@ -152,7 +157,16 @@ std::vector<MtlMaterial> parseMtl(std::string_view src, const std::string& file,
     std::string_view l = src.substr(0, nl);
     src.remove_prefix(nl == std::string_view::npos ? src.size() : nl + 1);
     ++p.line;
+    if (p.line == 1 && l.substr(0, 3) == "\xEF\xBB\xBF") l.remove_prefix(3);  // UTF-8 byte order mark
     p.onLine(l);
+  }
+  // Classic MTL onto the PBR model (docs/obj-mtl.md).
+  for (size_t i = 0; i < p.out.size(); ++i) {
+    Material& m = p.out[i].material;
+    if (!p.givenPr[i] && p.givenNs[i]) m.roughness = roughnessFromNs(m.ns);
+    // Exporters often write Kd 0 0 0 beside a map_Kd; viewers then show the texture, not black.
+    if (m.baseColor == glm::vec3(0.0f) && !p.out[i].maps[uint32_t(TextureSlot::BaseColor)].empty())
+      m.baseColor = glm::vec3(1.0f);
   }
   return std::move(p.out);
 }

@@ -22,6 +22,10 @@ uint32_t flagsFromName(std::string_view name);
 std::vector<MtlMaterial> parseMtl(std::string_view text, const std::string& file,
                                   const std::function<void(const std::string&)>& warn);
 
+// The PBR roughness for a classic MTL's Ns when it gives no Pr: the shared BRDF's Beckmann alpha (the
+// roughness squared) becomes sqrt(2 / (Ns + 2)), the usual Phong-exponent-to-Beckmann match.
+float roughnessFromNs(float ns);
+
 // The slot conventions of the course format (FORMATS.md §1): colour space and channel count.
 struct SlotFormat { bool srgb; uint8_t channels; };
 SlotFormat slotFormat(TextureSlot slot);

@@ -1,11 +1,14 @@
 #include "scene/obj.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <thread>
 #include <unordered_map>
@@ -13,6 +16,7 @@
 #include "core/error.hpp"
 #include "scene/mtl.hpp"
 #include "scene/text.hpp"
+#include "scene/triangulate.hpp"
 #include "scene/weld.hpp"
 
 namespace rtr {
@@ -24,6 +28,8 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 constexpr size_t kChunk = size_t(4) << 20;
 constexpr size_t kMaxLine = size_t(64) << 20;
 constexpr size_t kMaxName = 32767;
+constexpr size_t kShownWarnings = 10;
+constexpr size_t kSniffBytes = 8192;  // how much of the start is checked for being text, as git does
 
 struct MeshBuild {
   std::string name;
@@ -33,10 +39,16 @@ struct MeshBuild {
 
 class ObjParser {
 public:
-  ObjParser(const std::string& name, const MtlReader& readMtl, const ObjOptions& options, ObjStats& stats)
-      : name_(name), readMtl_(readMtl), opt_(options), stats_(stats) {}
+  ObjParser(const std::string& name, const MtlReader& readMtl, const ObjOptions& options, ObjStats& stats,
+            const std::string& besideMtl)
+      : name_(name), readMtl_(readMtl), opt_(options), stats_(stats), besideMtl_(besideMtl) {}
 
   void run(ByteSource& src) {
+    if (opt_.mtl) {
+      const std::string given = opt_.mtl->string();
+      if (!loadMtl(given, given)) throw fileError(given, "", "MTL file given for '" + name_ + "' does not exist");
+      mtlSeen_ = true;
+    }
     // Small inputs (tests, fuzzing) get a small buffer; it grows for long lines.
     std::vector<char> buf(std::min<uint64_t>(kChunk, std::max<uint64_t>(65536, src.fileSize())));
     size_t have = 0;
@@ -46,6 +58,7 @@ public:
         buf.resize(buf.size() * 2);
       }
       const size_t got = src.read(buf.data() + have, buf.size() - have);
+      if (stats_.textBytes < kSniffBytes) sniff(std::string_view(buf.data() + have, got), stats_.textBytes);
       stats_.textBytes += got;
       have += got;
       size_t start = 0;
@@ -74,17 +87,38 @@ public:
 
 private:
   Error error(const std::string& what) const { return fileError(name_, std::to_string(line_), what); }
-  void warn(const std::string& what) {
-    ++stats_.warnings;
-    const std::string msg = name_ + ":" + std::to_string(line_) + ": " + what;
+  void warn(const std::string& what) { warnRaw(name_ + ":" + std::to_string(line_) + ": " + what); }
+  // Every warning is counted; the first few are passed on, finish() reports the total.
+  void warnRaw(const std::string& msg) {
+    if (++stats_.warnings > kShownWarnings) return;
     if (opt_.warn) opt_.warn(msg);
     else std::cerr << "warning: " << msg << "\n";
   }
+  void note(const std::string& msg) {
+    if (opt_.note) opt_.note(msg);
+    else std::cerr << "note: " << msg << "\n";
+  }
 
+  // Text OBJ is ASCII or any 8-bit encoding; UTF-16 and binary data would otherwise parse as nothing.
+  void sniff(std::string_view data, uint64_t offset) {
+    if (offset == 0 && data.size() >= 2 &&
+        ((data[0] == '\xFE' && data[1] == '\xFF') || (data[0] == '\xFF' && data[1] == '\xFE')))
+      throw fileError(name_, "", "UTF-16 text (byte order mark); an OBJ file must be ASCII or UTF-8");
+    for (size_t i = 0; i < data.size() && offset + i < kSniffBytes; ++i) {
+      const unsigned char c = static_cast<unsigned char>(data[i]);
+      if (c < 0x20 && c != '\n' && !text::isSpace(char(c)) && c != 0x1A) {  // 0x1A: DOS end-of-file mark
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", c);
+        throw fileError(name_, "at byte " + std::to_string(offset + i),
+                        std::string("control byte ") + hex + ": binary data, not a text OBJ file");
+      }
+    }
+  }
+
+  // Names are bytes in whatever encoding the exporter used; only their length is limited.
   std::string checkedName(std::string_view what, std::string_view s) {
     s = text::trim(s);
     if (s.size() > kMaxName) throw error(std::string(what) + " longer than " + std::to_string(kMaxName) + " bytes");
-    if (!text::validUtf8(s)) throw error(std::string(what) + " is not valid UTF-8");
     return std::string(s);
   }
 
@@ -107,6 +141,7 @@ private:
   }
 
   void onLine(std::string_view l) {
+    if (line_ == 1 && l.substr(0, 3) == "\xEF\xBB\xBF") l.remove_prefix(3);  // UTF-8 byte order mark
     size_t i = 0;
     while (i < l.size() && text::isSpace(l[i])) ++i;
     if (i == l.size()) return;
@@ -129,6 +164,11 @@ private:
       object_ = it->second;
       mesh_ = kAbsent;
     } else if (key == "usemtl") {
+      if (!mtlSeen_ && !besideMtl_.empty()) {  // no mtllib: the course's NAME.mtl convention
+        mtlSeen_ = true;
+        if (loadMtl(besideMtl_, mtlLabel(besideMtl_)))
+          note(name_ + ": no 'mtllib' line; using '" + mtlLabel(besideMtl_) + "' beside it");
+      }
       material_ = materialId(checkedName("material name", rest), true);
       if (!groupsSeen_) {  // no o/g lines: each usemtl run is an object (the ray tracer's lights)
         object_ = uint32_t(objectNames_.size());
@@ -136,9 +176,19 @@ private:
       }
       mesh_ = kAbsent;
     } else if (key == "mtllib") {
-      loadMtl(checkedName("mtllib file name", rest));
-    } else if (key == "s" || key == "l" || key == "p" || key == "cstype" || key == "vp") {
-      // smoothing groups, lines and points carry nothing for triangle meshes
+      const std::string file = checkedName("mtllib file name", rest);
+      if (file.empty()) throw error("'mtllib' names no file");
+      if (opt_.mtl) {
+        if (!mtllibIgnored_) note(name_ + ":" + std::to_string(line_) + ": 'mtllib " + file + "' ignored; using '" + opt_.mtl->string() + "' as given");
+        mtllibIgnored_ = true;
+      } else if (!loadMtl(file, mtlLabel(file))) {
+        warn("material library '" + mtlLabel(file) + "' named by 'mtllib' does not exist; its materials get default values");
+      }
+      mtlSeen_ = true;
+    } else if (key == "l" || key == "p") {
+      ++pointsAndLines_;  // nothing to draw for triangle meshes; one note at the end
+    } else if (key == "s" || key == "cstype" || key == "vp") {
+      // smoothing groups and free-form data carry nothing for triangle meshes
     } else if (std::find(unknown_.begin(), unknown_.end(), key) == unknown_.end()) {
       unknown_.emplace_back(key.substr(0, 64));
       warn("unknown OBJ keyword '" + std::string(key.substr(0, 64)) + "' ignored");
@@ -157,26 +207,29 @@ private:
     return uint32_t(materials_.size() - 1);
   }
 
-  void loadMtl(const std::string& file) {
-    if (file.empty()) throw error("'mtllib' names no file");
-    if (std::find(mtlFiles_.begin(), mtlFiles_.end(), file) != mtlFiles_.end()) return;
+  // An MTL's path for messages: beside the OBJ (given MTLs are named as given).
+  std::string mtlLabel(const std::string& file) const {
+    return (std::filesystem::path(name_).parent_path() / file).string();
+  }
+
+  // Reads the MTL `file` (as the reader knows it) once; false when it does not exist.
+  bool loadMtl(const std::string& file, const std::string& label) {
+    if (std::find(mtlFiles_.begin(), mtlFiles_.end(), file) != mtlFiles_.end()) return true;
     mtlFiles_.push_back(file);
-    const std::string textMtl = readMtl_(file);
-    auto ws = [this](const std::string& w) {
-      ++stats_.warnings;
-      if (opt_.warn) opt_.warn(w);
-      else std::cerr << "warning: " << w << "\n";
-    };
-    for (MtlMaterial& m : parseMtl(textMtl, file, ws)) {
+    const std::optional<std::string> textMtl = readMtl_(file);
+    if (!textMtl) return false;
+    auto ws = [this](const std::string& w) { warnRaw(w); };
+    for (MtlMaterial& m : parseMtl(*textMtl, label, ws)) {
       auto it = materialIds_.find(m.material.name);
       if (it == materialIds_.end()) {
         materialIds_.emplace(m.material.name, uint32_t(materials_.size()));
         materials_.push_back(std::move(m));
       } else {
-        ws(file + ": material '" + m.material.name + "' defined again; the later definition wins");
+        ws(label + ": material '" + m.material.name + "' defined again; the later definition wins");
         materials_[it->second] = std::move(m);
       }
     }
+    return true;
   }
 
   // Parses one signed index; returns false at the end of the token.
@@ -237,7 +290,16 @@ private:
     }
     if (mesh_ == kAbsent) mesh_ = currentMesh();
     auto& corners = builds_[mesh_].corners;
-    for (size_t k = 1; k + 1 < poly_.size(); ++k) corners.insert(corners.end(), {poly_[0], poly_[k], poly_[k + 1]});
+    if (poly_.size() == 3) {
+      corners.insert(corners.end(), poly_.begin(), poly_.end());
+      return;
+    }
+    polyPos_.clear();
+    for (const Corner& c : poly_) polyPos_.push_back(positions_[c.p]);
+    tris_.clear();
+    if (!triangulatePolygon(polyPos_, tris_))
+      warn("polygon of " + std::to_string(poly_.size()) + " corners crosses itself; part of it fan-triangulated");
+    for (const auto& t : tris_) corners.insert(corners.end(), {poly_[t[0]], poly_[t[1]], poly_[t[2]]});
   }
 
   uint32_t currentMesh() {
@@ -261,6 +323,8 @@ private:
   std::vector<glm::vec3> positions_, normals_;
   std::vector<glm::vec2> texcoords_;
   std::vector<Corner> poly_;
+  std::vector<glm::vec3> polyPos_;
+  std::vector<std::array<uint32_t, 3>> tris_;
   std::vector<MeshBuild> builds_;
   std::unordered_map<uint64_t, uint32_t> meshIds_;
   std::vector<std::string> objectNames_;
@@ -268,8 +332,10 @@ private:
   std::vector<MtlMaterial> materials_;
   std::unordered_map<std::string, uint32_t> materialIds_;
   std::vector<std::string> mtlFiles_, unknown_;
+  std::string besideMtl_;
   uint32_t object_ = kAbsent, material_ = kAbsent, mesh_ = kAbsent;
-  bool groupsSeen_ = false;
+  bool groupsSeen_ = false, mtlSeen_ = false, mtllibIgnored_ = false;
+  size_t pointsAndLines_ = 0;
 };
 
 Scene ObjParser::finish() {
@@ -324,6 +390,17 @@ Scene ObjParser::finish() {
     meshes[i].material = builds_[i].material;
     scene.meshes.push_back(std::move(meshes[i]));
   }
+
+  const std::string skipped = std::to_string(pointsAndLines_) + " point/line element(s)";
+  if (pointsAndLines_ && !scene.meshes.empty()) note(name_ + ": " + skipped + " skipped; only faces are drawn");
+  if (stats_.warnings > kShownWarnings && opt_.warn)
+    opt_.warn(name_ + ": " + std::to_string(stats_.warnings) + " warnings, first " + std::to_string(kShownWarnings) + " shown");
+  else if (stats_.warnings > kShownWarnings)
+    std::cerr << "warning: " << name_ << ": " << stats_.warnings << " warnings, first " << kShownWarnings << " shown\n";
+  if (scene.meshes.empty())
+    throw fileError(name_, "", stats_.faces ? "all " + std::to_string(stats_.faces) + " faces are degenerate; nothing to draw"
+                               : pointsAndLines_ ? "no faces, only " + skipped + "; nothing to draw"
+                                                 : "no faces; nothing to draw (is it an OBJ file?)");
   return scene;
 }
 
@@ -339,11 +416,11 @@ std::string readWholeFile(const std::filesystem::path& file, const std::string& 
 }  // namespace
 
 Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& readMtl, const ObjOptions& options,
-               ObjStats* stats) {
+               ObjStats* stats, const std::string& besideMtl) {
   ObjStats local;
   ObjStats& st = stats ? *stats : local;
   st.fileBytes = source.fileSize();
-  ObjParser parser(name, readMtl, options, st);
+  ObjParser parser(name, readMtl, options, st, besideMtl);
   auto t0 = Clock::now();
   parser.run(source);
   st.parseSeconds = since(t0);
@@ -356,14 +433,22 @@ Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& rea
 Scene loadObj(const std::filesystem::path& file, const ObjOptions& options, ObjStats* stats) {
   auto src = openSource(file);
   const std::filesystem::path dir = file.parent_path();
-  MtlReader readMtl = [&](const std::string& mtl) {
-    const std::filesystem::path p = dir / mtl;
+  MtlReader readMtl = [&](const std::string& mtl) -> std::optional<std::string> {
+    const std::filesystem::path p = options.mtl && mtl == options.mtl->string() ? *options.mtl : dir / mtl;
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(p, ec))
-      throw fileError(file.string(), "", "material library '" + p.string() + "' named by 'mtllib' does not exist");
+    if (!std::filesystem::exists(p, ec)) return std::nullopt;
     return readWholeFile(p, "material library");
   };
-  Scene scene = parseObj(*src, file.string(), readMtl, options, stats);
+  // NAME.mtl for NAME.obj, NAME.obj.zst and NAME.obj-zstd.
+  std::string stem = file.filename().string();
+  for (std::string_view ext : {".obj.zst", ".obj-zstd", ".obj"})
+    if (stem.size() > ext.size() && stem.compare(stem.size() - ext.size(), ext.size(), ext) == 0) {
+      stem.resize(stem.size() - ext.size());
+      break;
+    }
+  std::error_code ec;
+  const std::string beside = std::filesystem::is_regular_file(dir / (stem + ".mtl"), ec) ? stem + ".mtl" : "";
+  Scene scene = parseObj(*src, file.string(), readMtl, options, stats, beside);
   scene.baseDir = dir;
   return scene;
 }

@@ -1,20 +1,22 @@
 #pragma once
-// OBJ + MTL to rtr::Scene: streaming parse (plain or zstd), fan triangulation, one mesh per
-// (object/group x material), vertex welding within 1e-5, area-weighted normals where missing.
+// OBJ + MTL to rtr::Scene: streaming parse (plain or zstd), polygons triangulated (convex: fan; concave:
+// ear clipping), one mesh per (object/group x material), vertex welding within 1e-5, area-weighted
+// normals where missing. docs/obj-mtl.md says what is read, what is lenient and what is refused.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
+#include "scene/load.hpp"
 #include "scene/scene.hpp"
 #include "scene/stream.hpp"
 
 namespace rtr {
 
-struct ObjOptions {
-  // Non-fatal findings (unknown keys, unknown materials); default prints "warning: ..." to stderr.
-  std::function<void(const std::string&)> warn;
+// LoadOptions (mtl, warn, note) plus what only the OBJ reader takes.
+struct ObjOptions : LoadOptions {
   // Called now and then while reading with (bytes consumed from the file, file size).
   std::function<void(uint64_t, uint64_t)> progress;
   unsigned threads = 0;  // welding workers; 0 = hardware concurrency
@@ -29,18 +31,21 @@ struct ObjStats {
   size_t degenerateSkipped = 0;   // triangles with repeated corners or zero area
   size_t verticesBeforeWeld = 0;  // triangle corners (the soup)
   size_t verticesAfterWeld = 0;
-  size_t warnings = 0;
+  size_t warnings = 0;            // all of them, also those not passed on to the sink
   double parseSeconds = 0, weldSeconds = 0;
 };
 
-// Reads `file` (.obj, .obj.zst, .obj-zstd) and the MTL files it names from beside it.
+// Reads `file` (.obj, .obj.zst, .obj-zstd) and its MTL: options.mtl when given (an error when absent),
+// else the files named by `mtllib` beside it (a warning when absent), else NAME.mtl beside it if present.
 // Throws rtr::Error naming the file and line (or byte offset for zstd faults).
 Scene loadObj(const std::filesystem::path& file, const ObjOptions& options = {}, ObjStats* stats = nullptr);
 
-// The same parser over any byte source. `readMtl(name)` returns the text of the MTL named by an
-// `mtllib` line (throwing rtr::Error when it cannot); `name` labels errors. Used by tests and fuzzing.
-using MtlReader = std::function<std::string(const std::string& mtlName)>;
+// The same parser over any byte source; `name` labels errors. `readMtl(name)` returns the text of an MTL:
+// one named by an `mtllib` line, `options.mtl` (as given), or `besideMtl`; std::nullopt when it does not
+// exist (throwing rtr::Error when it cannot be read). `besideMtl` (may be empty) is read at the first
+// `usemtl` when no `mtllib` came before. Used by loadObj, tests and fuzzing.
+using MtlReader = std::function<std::optional<std::string>(const std::string& mtlName)>;
 Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& readMtl,
-               const ObjOptions& options = {}, ObjStats* stats = nullptr);
+               const ObjOptions& options = {}, ObjStats* stats = nullptr, const std::string& besideMtl = {});
 
 }  // namespace rtr

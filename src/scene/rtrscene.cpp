@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "scene/binio.hpp"
-#include "scene/text.hpp"
 
 namespace rtr {
 namespace {

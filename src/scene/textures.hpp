@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/image.hpp"
@@ -25,11 +26,17 @@ int decodeChannels(const Texture& t);
 // Whether its colour channels are sRGB-encoded (decoded to linear on read): sRGB four-channel textures.
 bool decodeSrgb(const Texture& t);
 
+// The texels shown for a texture that is missing or cannot be decoded: a 64x64 magenta/black checker of
+// 8-texel cells (one channel: 255/0), so the fault is visible in every renderer.
+TexelData fallbackTexels(int channels);
+
 // Decodes scene.textures[which[i]] for every i on all cores and hands the texels to use(i, texels) on the
-// thread that decoded them (so per-texture work after decoding runs in parallel too). Throws rtr::Error
-// naming the file of a texture that is missing or cannot be decoded.
+// thread that decoded them (so per-texture work after decoding runs in parallel too). A texture that is
+// missing or cannot be decoded gets fallbackTexels() and one message naming its file to `warn` (default:
+// "warning: ..." on stderr; calls are serialised).
 void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
-                    const std::function<void(size_t, TexelData&&)>& use);
+                    const std::function<void(size_t, TexelData&&)>& use,
+                    const std::function<void(const std::string&)>& warn = {});
 
 // Whether a mesh's fragments are alpha-tested (discarded where the mask's alpha < 0.5), as on the GPU: it
 // has texcoords and an alpha-mask texture, and its material is alpha-masked or double-sided (the GPU's

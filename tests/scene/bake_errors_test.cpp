@@ -65,9 +65,15 @@ TEST_F(Fixture, TextureThatIsNotAPng) {
   EXPECT_EQ(filesIn(out), 0u);
 }
 
-TEST_F(Fixture, MissingMtl) {
+TEST_F(Fixture, MissingMtlIsAWarning) {
   fs::remove(dir / "s.mtl");
-  EXPECT_THAT(bakeError(out / "s.rtrscene"), HasSubstr("s.mtl' named by 'mtllib' does not exist"));
+  std::vector<std::string> warnings;
+  rtr::BakeOptions o{dir / "s.obj", out / "s.rtrscene"};
+  o.warn = [&](const std::string& w) { warnings.push_back(w); };
+  rtr::bake(o);
+  ASSERT_FALSE(warnings.empty());
+  EXPECT_THAT(warnings[0], HasSubstr("s.mtl' named by 'mtllib' does not exist"));
+  EXPECT_TRUE(fs::is_regular_file(out / "s.rtrscene"));
 }
 
 TEST_F(Fixture, OutputFolderMissingOrNotWritable) {

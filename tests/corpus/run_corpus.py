@@ -1,0 +1,155 @@
+#!/usr/bin/env python3
+"""Runs every .obj of Debian's assimp-testmodels through rtr-bake, rtr-view and rtr-trace.
+
+Each tool must render the model or refuse it with a message naming the file; none may crash (signal)
+or hang (timeout). Rendered images must not be all black, and models whose MTL has a map_Kd must show
+texture-like colour variety. Exit 0: all good, 1: a failure, 77: the corpus is not installed (CTest skip).
+Usage: run_corpus.py BIN_DIR [--table] [--timeout S] [--keep DIR]
+"""
+import os, re, struct, subprocess, sys, tempfile, zlib
+
+CORPUS = ["/usr/share/assimp/models/OBJ", "/usr/share/assimp/models/invalid"]
+SIZE = "160x120"
+
+
+def read_png(path):
+    """RGBA8 pixels of a non-interlaced 8-bit PNG (what stb writes) as (width, height, bytes)."""
+    data = open(path, "rb").read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError(path + ": not a PNG")
+    pos, idat, w = 8, b"", 0
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+        if kind == b"IHDR":
+            w, h, depth, ctype, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            if depth != 8 or interlace:
+                raise ValueError(path + ": only 8-bit non-interlaced PNG is read here")
+            bpp = {6: 4, 2: 3, 0: 1, 4: 2}[ctype]
+        elif kind == b"IDAT":
+            idat += body
+    raw, stride = zlib.decompress(idat), w * bpp
+    out, prev = bytearray(), bytearray(stride)
+    for y in range(h):
+        f, row = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = row[i - bpp] if i >= bpp else 0
+            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
+            if f == 1: row[i] = (row[i] + a) & 255
+            elif f == 2: row[i] = (row[i] + b) & 255
+            elif f == 3: row[i] = (row[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                row[i] = (row[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        out += row
+        prev = row
+    rgb = bytearray()
+    for i in range(0, len(out), bpp):
+        px = out[i:i + bpp]
+        rgb += px[:3] if bpp >= 3 else bytes([px[0]] * 3)
+    return w, h, bytes(rgb)
+
+
+def image_stats(path):
+    """(brightest channel value, number of distinct coloured (not grey) 4-bit-per-channel colours)."""
+    _, _, rgb = read_png(path)
+    brightest, colours = 0, set()
+    for i in range(0, len(rgb), 3):
+        r, g, b = rgb[i], rgb[i + 1], rgb[i + 2]
+        brightest = max(brightest, r, g, b)
+        if max(r, g, b) - min(r, g, b) > 8:
+            colours.add((r >> 4, g >> 4, b >> 4))
+    return brightest, len(colours)
+
+
+def textured(obj):
+    """Whether an MTL of the model (named by mtllib, or NAME.mtl beside it) has a map_Kd."""
+    folder, libs = os.path.dirname(obj), []
+    with open(obj, "rb") as f:
+        for line in f:
+            m = re.match(rb"\s*mtllib\s+(.+?)\s*$", line)
+            if m: libs.append(m.group(1).decode("latin-1"))
+    if not libs: libs = [os.path.splitext(os.path.basename(obj))[0] + ".mtl"]
+    for lib in libs:
+        p = os.path.join(folder, lib)
+        if os.path.isfile(p) and re.search(rb"^\s*map_Kd\s", open(p, "rb").read(), re.M):
+            return True
+    return False
+
+
+def run(cmd, obj, timeout):
+    """'ok', 'refused', or a failure ('CRASH ...', 'HANG', 'UNNAMED ...') with the message's first line."""
+    try:
+        p = subprocess.run(cmd, capture_output=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return "HANG", ""
+    err = p.stderr.decode("utf-8", "replace")
+    if p.returncode < 0 or p.returncode >= 128:
+        return "CRASH (signal %d)" % (-p.returncode if p.returncode < 0 else p.returncode - 128), err
+    if p.returncode != 0:
+        lines = [l for l in err.splitlines() if "error" in l]
+        msg = lines[-1] if lines else err.strip().splitlines()[-1] if err.strip() else ""
+        return ("refused" if obj in msg else "UNNAMED refusal"), msg
+    return "ok", err
+
+
+def main():
+    args = sys.argv[1:]
+    if not args:
+        print(__doc__)
+        return 2
+    bindir, table = args[0], "--table" in args
+    timeout = float(args[args.index("--timeout") + 1]) if "--timeout" in args else 120.0
+    objs = sorted(os.path.join(d, f) for d in CORPUS if os.path.isdir(d) for f in os.listdir(d) if f.endswith(".obj"))
+    if not objs:
+        print("corpus not installed (Debian package assimp-testmodels): skipped")
+        return 77
+    keep = args[args.index("--keep") + 1] if "--keep" in args else None
+    tmp = keep or tempfile.mkdtemp(prefix="rtr_corpus_")
+    os.makedirs(tmp, exist_ok=True)
+    bake, view, trace = (os.path.join(bindir, t) for t in ("rtr-bake", "rtr-view", "rtr-trace"))
+    failures, rows = [], []
+    for obj in objs:
+        name = os.path.splitext(os.path.basename(obj))[0]
+        out = os.path.join(tmp, name)
+        os.makedirs(out, exist_ok=True)
+        cells, notes = [], []
+        r1 = run([bake, obj, os.path.join(out, name + ".rtrscene"), "--force"], obj, timeout)
+        r2 = run([bake, obj, os.path.join(out, name + ".comp5892mesh"), "--force"], obj, timeout)
+        cells.append(r1[0] if r1[0] == r2[0] else r1[0] + "/" + r2[0])
+        for tool, cmd, png in (
+                ("view", [view, "--headless", "--size", SIZE, "--screenshot", os.path.join(out, "view.png"), obj], "view.png"),
+                ("trace", [trace, "-q", "--size", SIZE, obj, "-o", os.path.join(out, "trace.png")], "trace.png")):
+            outcome, msg = run(cmd, obj, timeout)
+            if outcome == "ok":
+                brightest, colours = image_stats(os.path.join(out, png))
+                if brightest < 16:
+                    outcome = "BLACK image"
+                elif textured(obj) and colours < 24:
+                    outcome = "NO TEXTURE (%d colours)" % colours
+                else:
+                    outcome = "ok (max %d, %d colours)" % (brightest, colours)
+            cells.append(outcome)
+            if outcome.startswith("refused"): notes.append(msg.split(": error: ")[-1])
+        if r1[0] == "refused": notes.insert(0, r1[1].split(": error: ")[-1])
+        for c in cells:
+            if c.split(" ")[0].isupper() or c.startswith(("CRASH", "HANG", "UNNAMED", "BLACK", "NO ")):
+                failures.append("%s: %s" % (obj, c))
+        note = notes[0].replace(obj, "FILE") if notes else ""
+        rows.append((os.path.relpath(obj, "/usr/share/assimp/models"), cells, note))
+    if table:
+        print("| file | bake | view | trace | note |\n|---|---|---|---|---|")
+        for f, c, n in rows:
+            print("| %s | %s | %s | %s | %s |" % (f, c[0], c[1], c[2], n.replace("|", "\\|")))
+    else:
+        for f, c, n in rows:
+            print("%-40s bake %-10s view %-28s trace %-28s %s" % (f, c[0], c[1], c[2], n))
+    for f in failures:
+        print("FAIL", f)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
