@@ -107,6 +107,7 @@ BakeReport bake(const BakeOptions& opt) {
   ObjOptions oo;
   oo.warn = opt.warn;
   oo.threads = threads;
+  oo.mtl = opt.mtl;
   if (opt.progress)
     oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
   Scene scene = loadObj(opt.input, oo, &rep.obj);

@@ -17,6 +17,7 @@ struct BakeOptions {
   std::filesystem::path input, output;
   bool force = false;                     // overwrite an existing output and texture files
   std::optional<CameraPose> view;         // stored as the default view (.rtrscene only)
+  std::optional<std::filesystem::path> mtl;  // the OBJ's MTL instead of its mtllib lines (LoadOptions::mtl)
   std::vector<Light> lights;              // stored with the scene (.rtrscene only); empty: none stored
   std::function<void(const std::string&)> warn;
   std::function<void(const char* phase, double fraction)> progress;

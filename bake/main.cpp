@@ -12,9 +12,10 @@
 int main(int argc, char** argv) {
   CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh"};
   rtr::BakeOptions opt;
-  std::string input, output, view, light, lightColor;
+  std::string input, output, view, light, lightColor, mtl;
   app.add_option("INPUT", input, "OBJ file")->required();
   app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh)")->required();
+  app.add_option("--mtl", mtl, "take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--force", opt.force, "overwrite an existing output and textures");
   app.add_option("--view", view, "default camera pose x,y,z,yaw,pitch (degrees)");
   app.add_option("--light", light, "store a point light at x,y,z with the scene (.rtrscene); it replaces the scene's own");
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
     };
   try {
     if (!view.empty()) opt.view = rtr::parsePose(view);
+    if (!mtl.empty()) opt.mtl = mtl;
     if (!light.empty()) {
       rtr::Light l;
       l.position = rtr::parseVec3(light, "--light");

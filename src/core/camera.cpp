@@ -116,21 +116,24 @@ CameraRay cameraRay(const CameraPose& pose, const Lens& lens, float aspect, glm:
   return {pose.position, glm::normalize(d)};
 }
 
-CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect, Framing framing) {
+CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect) {
   if (bounds.empty()) return {};
   const glm::vec3 c = bounds.center(), e = bounds.extent() * 0.5f;
+  // Fit the front face (x,y extent) into the view, then step back past the near half of the depth.
   const float tanY = std::tan(glm::radians(lens.fovYDeg) * 0.5f);
   const float tanX = tanY * std::max(aspect, 1e-3f);
-  if (framing == Framing::Front) {
-    // Fit the front face (x,y extent) into the view, then step back past the near half of the depth.
-    const float dist = std::max(e.y / tanY, e.x / tanX) * 1.05f + e.z;
-    return {{c.x, c.y, c.z + std::max(dist, 1e-3f)}, 0.0f, 0.0f};
-  }
-  // The bounding sphere inside the narrower half-angle of the view, seen from 35° right of +z, 25° up.
-  CameraPose p{{}, 35.0f, -25.0f};
-  const float r = std::max(glm::length(e), 1e-3f);
-  const float halfAngle = std::atan(std::min(tanX, tanY));
-  p.position = c - basis(p).forward * (r / std::sin(halfAngle) * 1.02f);
+  const float dist = std::max(e.y / tanY, e.x / tanX) * 1.05f + e.z;
+  return {{c.x, c.y, c.z + std::max(dist, 1e-3f)}, 0.0f, 0.0f};
+}
+
+CameraPose orbitFrame(const Bounds& bounds, const Lens& lens, float aspect, float yawDeg, float pitchDeg) {
+  if (bounds.empty()) return {};
+  const glm::vec3 c = bounds.center();
+  const float tanY = std::tan(glm::radians(lens.fovYDeg) * 0.5f);
+  const float tanX = tanY * std::max(aspect, 1e-3f);
+  const float r = std::max(glm::length(bounds.extent()) * 0.5f, 1e-3f);
+  CameraPose p{{}, yawDeg, pitchDeg};
+  p.position = c - basis(p).forward * (r / std::sin(std::atan(std::min(tanX, tanY))) * 1.02f);
   return p;
 }
 

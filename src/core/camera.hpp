@@ -45,12 +45,10 @@ struct CameraRay { glm::vec3 origin, direction; };
 CameraRay cameraRay(const CameraPose& pose, const Lens& lens, float aspect, glm::vec2 ndc);
 glm::vec2 pixelToNdc(float px, float py, uint32_t width, uint32_t height);  // px,py: pixel centre coords
 
-// How a pose frames a scene: Front looks down -z at the bounds' front face (the course's staged scenes,
-// authored to be seen that way); ThreeQuarter looks down at the bounds from the front right and above,
-// so that a bare model reads as a solid.
-enum class Framing { Front, ThreeQuarter };
-// A pose that frames the whole of `bounds`.
-CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect, Framing framing = Framing::Front);
+// A view down -z that frames the whole of `bounds` (the course's staged scenes are authored to be seen so).
+CameraPose frameBounds(const Bounds& bounds, const Lens& lens, float aspect);
+// A view of the bounds' centre with this yaw and pitch, the bounding sphere inside the view.
+CameraPose orbitFrame(const Bounds& bounds, const Lens& lens, float aspect, float yawDeg, float pitchDeg);
 // Near and far planes that keep `bounds` inside the depth range from `pose`.
 Lens fitDepthRange(Lens lens, const Bounds& bounds, const CameraPose& pose);
 

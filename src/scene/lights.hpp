@@ -42,8 +42,5 @@ struct LightRig {
 LightRig resolveLights(const Scene& scene, const LightOptions& options = {});
 // Whether the scene brings lights of its own (stored or as geometry).
 bool hasOwnLights(const Scene& scene);
-// A staged scene (it brings its own lights, like the course's Cornell box) is seen from the front, down
-// -z, as the course shows it; a bare model from a raised three-quarter view.
-inline Framing framingFor(const Scene& scene) { return hasOwnLights(scene) ? Framing::Front : Framing::ThreeQuarter; }
 
 }  // namespace rtr

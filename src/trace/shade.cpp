@@ -8,13 +8,13 @@
 
 namespace rtr::trace {
 
-glm::vec3 blinnPhongDirect(const Material& m, const glm::vec3& n, const glm::vec3& v, const glm::vec3& l,
+glm::vec3 blinnPhongDirect(const Material& m, const glm::vec3& kd, const glm::vec3& n, const glm::vec3& v, const glm::vec3& l,
                            const glm::vec3& lightColor) {
   const float nl = glm::dot(n, l);
   if (!(nl > 0.0f)) return glm::vec3(0.0f);
   const glm::vec3 h = glm::normalize(l + v);
   const float nh = std::max(glm::dot(n, h), 0.0f);
-  return lightColor * (m.kd * nl + m.ks * std::pow(nh, m.ns));
+  return lightColor * (kd * nl + m.ks * std::pow(nh, m.ns));
 }
 
 glm::vec3 blinnPhongAmbient(const Material& m, const glm::vec3& lightColor) { return m.ka * lightColor; }

@@ -7,10 +7,11 @@
 
 namespace rtr::trace {
 
-// Diffuse and specular of one light at one point (no ambient, no emission), Blinn-Phong with Kd, Ks, Ns:
+// Diffuse and specular of one light at one point (no ambient, no emission), Blinn-Phong with kd (Kd, or Kd
+// times the base-colour texture of a model from elsewhere), Ks, Ns:
 // Lc ⊙ (Kd·max(n·l, 0) + Ks·max(n·h, 0)^Ns), the specular only where n·l > 0. n, v, l: unit vectors.
 // Lc is the radiance arriving (lightSample: the course's lights have no falloff unless asked).
-glm::vec3 blinnPhongDirect(const Material& m, const glm::vec3& n, const glm::vec3& v, const glm::vec3& l,
+glm::vec3 blinnPhongDirect(const Material& m, const glm::vec3& kd, const glm::vec3& n, const glm::vec3& v, const glm::vec3& l,
                            const glm::vec3& lightColor);
 // Ambient of one light: Ka ⊙ Lc. It is all a light gives to a point in its shadow (with Ke).
 glm::vec3 blinnPhongAmbient(const Material& m, const glm::vec3& lightColor);

@@ -16,6 +16,7 @@
 #include <glm/matrix.hpp>
 
 #include "core/error.hpp"
+#include "scene/framing.hpp"
 #include "scene/textures.hpp"
 #include "trace/shade.hpp"
 #include "trace/spawn.hpp"
@@ -45,6 +46,8 @@ Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
     const bool light = m.material < scene.materials.size() && isLightMaterial(scene.materials[m.material]);
     meshAlphaTested_.push_back(m.material < scene.materials.size() && alphaTested(m, scene.materials[m.material]));
     anyAlphaTested_ = anyAlphaTested_ || meshAlphaTested_.back();
+    anyBaseTextured_ = anyBaseTextured_ || (m.material < scene.materials.size() && !m.texcoords.empty() &&
+                                            scene.materials[m.material].texture(TextureSlot::BaseColor) != kNoTexture);
     for (uint32_t t = 0; t < m.triangleCount(); ++t) {
       const uint32_t* idx = &m.indices[size_t(t) * 3];
       if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size())
@@ -157,11 +160,11 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
   const bool pbr = s.shading == Shading::Pbr;
   // A light's own surface shows its emission only (it does not light itself), in the course's model.
   if (!pbr && isLightMaterial(mat)) return mat.ke;
-  SurfaceInputs in{};
-  if (pbr) {
-    const bool textured = f.tex && !scene_.meshes[sp.mesh].texcoords.empty();
-    in = textured ? f.tex->fetch(mat, sp.uv, uvWidth(sp, r, coneWidth)) : materialFactors(mat);
-  }
+  // Phong takes Kd from the base colour (Kd x map_Kd) where a model textures it.
+  const bool baseTextured = mat.texture(TextureSlot::BaseColor) != kNoTexture;
+  const bool textured = f.tex && !scene_.meshes[sp.mesh].texcoords.empty() && (pbr || baseTextured);
+  const SurfaceInputs in = textured ? f.tex->fetch(mat, sp.uv, uvWidth(sp, r, coneWidth)) : materialFactors(mat);
+  const glm::vec3 kd = textured && baseTextured ? in.baseColor : mat.kd;
   // Ambient and emission, then every light's direct term averaged over its shadow samples; with shadows
   // on, a sample behind the surface itself or blocked gives nothing (Phong keeps its ambient Ka x Lc).
   glm::vec3 color = pbr ? f.ambient * glm::clamp(in.baseColor, 0.0f, 1.0f) + in.emissive : mat.ke;
@@ -175,7 +178,7 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
       if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
       const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
       const glm::vec3 d = pbr ? pbrDirect(sp.normal, v, ls.l, ls.radiance, in.baseColor, in.roughness, in.metalness)
-                              : blinnPhongDirect(mat, sp.normal, v, ls.l, ls.radiance);
+                              : blinnPhongDirect(mat, kd, sp.normal, v, ls.l, ls.radiance);
       if (d == glm::vec3(0.0f)) continue;
       if (s.shadows) {
         if (glm::dot(sp.geomNormal, ls.l) <= 0.0f) continue;
@@ -226,8 +229,9 @@ Tracer::Frame Tracer::makeFrame(const TraceSettings& s) const {
   const glm::vec3 fwd = basis(pose).forward;
   f.depthAxis = glm::transpose(glm::mat3(s.model)) * fwd;
   f.depthFar = resolveLens(s).zFar;
-  // Pbr samples the textures; every view needs the alpha masks, which decide what is visible.
-  f.tex = s.shading == Shading::Pbr || anyAlphaTested_ ? &textures() : nullptr;
+  // Pbr samples the textures, Phong the base colour; every view needs the alpha masks (visibility).
+  const bool shaded = s.shading == Shading::Pbr || (s.shading == Shading::Phong && anyBaseTextured_);
+  f.tex = shaded || anyAlphaTested_ ? &textures() : nullptr;
   // A perspective pixel subtends atan(2·tan(fov/2) / H) (RTG ch. 20); an orthographic one is a beam of
   // constant width 2·h / H (taken into scene units through the model's scale).
   const float h = float(std::max(1u, s.height));
@@ -267,7 +271,7 @@ CameraPose Tracer::resolvePose(const TraceSettings& s) const {
   if (s.pose) return *s.pose;
   if (scene_.defaultView) return *scene_.defaultView;  // the view the scene was baked with, as rtr-view starts
   const float aspect = float(std::max(1u, s.width)) / float(std::max(1u, s.height));
-  return frameBounds(transformed(scene_.bounds(), s.model), s.lens, aspect, framingFor(scene_));
+  return framingPose(scene_, s.lens, aspect, s.model);
 }
 
 Lens Tracer::resolveLens(const TraceSettings& s) const {

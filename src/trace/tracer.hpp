@@ -32,7 +32,7 @@ enum class Shading { Phong, Pbr, Normals, Depth };
 
 struct TraceSettings {
   uint32_t width = 1280, height = 720;
-  std::optional<CameraPose> pose;  // none: the scene's stored view, else frameBounds(.., framingFor(scene)), as the viewer
+  std::optional<CameraPose> pose;  // none: the scene's stored view, else framingPose(scene), as the viewer
   Lens lens{};                     // the viewer's defaults (60° vertical fov); --fov 80 is the course's
   glm::mat4 model{1.0f};           // Task 1 model transform (a similarity); modelview = view × model
   Shading shading = Shading::Phong;
@@ -151,6 +151,7 @@ class Tracer {
   std::vector<uint8_t> castsShadow_;
   std::vector<uint8_t> meshAlphaTested_;  // per mesh: scene/textures.hpp's alphaTested
   bool anyAlphaTested_ = false;
+  bool anyBaseTextured_ = false;  // a mesh with texcoords whose material has a base colour texture
   Bvh bvh_;
   bool useBvh_ = false;
   mutable std::mutex texturesMutex_;

@@ -88,7 +88,7 @@ TEST(Camera, ThreeQuarterFramingSeesEveryCornerFromAbove) {
     b.extend(offset + glm::vec3(5, 4, -2));
     for (float aspect : {0.5f, 1.0f, 2.0f}) {
       Lens lens;
-      const CameraPose pose = frameBounds(b, lens, aspect, Framing::ThreeQuarter);
+      const CameraPose pose = orbitFrame(b, lens, aspect, 35.0f, -25.0f);
       const glm::vec3 c = b.center();
       EXPECT_GT(pose.position.x, c.x);
       EXPECT_GT(pose.position.y, b.max.y);

@@ -9,7 +9,7 @@ Usage: run_corpus.py BIN_DIR [--table] [--timeout S] [--keep DIR]
 import os, re, struct, subprocess, sys, tempfile, zlib
 
 CORPUS = ["/usr/share/assimp/models/OBJ", "/usr/share/assimp/models/invalid"]
-SIZE = "160x120"
+SIZE = "320x240"
 
 
 def read_png(path):
@@ -120,8 +120,11 @@ def main():
         r2 = run([bake, obj, os.path.join(out, name + ".comp5892mesh"), "--force"], obj, timeout)
         cells.append(r1[0] if r1[0] == r2[0] else r1[0] + "/" + r2[0])
         for tool, cmd, png in (
-                ("view", [view, "--headless", "--size", SIZE, "--screenshot", os.path.join(out, "view.png"), obj], "view.png"),
-                ("trace", [trace, "-q", "--size", SIZE, obj, "-o", os.path.join(out, "trace.png")], "trace.png")):
+                ("view", [view, "--headless", "--mosaic", "off", "--size", SIZE, "--screenshot", os.path.join(out, "view.png"), obj], "view.png"),
+                # Textured models in the tracer's pbr mode, the viewer's model: its default Blinn-Phong (the
+                # course's) samples map_Kd too, but Ka + Kd of these MTLs saturate it to near white.
+                ("trace", [trace, "-q", "--size", SIZE, obj, "-o", os.path.join(out, "trace.png")] +
+                 (["--shading", "pbr"] if textured(obj) else []), "trace.png")):
             outcome, msg = run(cmd, obj, timeout)
             if outcome == "ok":
                 brightest, colours = image_stats(os.path.join(out, png))

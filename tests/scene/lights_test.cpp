@@ -50,7 +50,6 @@ TEST(Lights, GeometryLightsWhenNothingElse) {
   EXPECT_FALSE(rig.lights[0].falloff);
   EXPECT_TRUE(rig.note.empty()) << rig.note;
   EXPECT_TRUE(hasOwnLights(litScene()));
-  EXPECT_EQ(framingFor(litScene()), Framing::Front);
 }
 
 TEST(Lights, StoredLightsWinOverGeometryAndCommandLineWinsOverBoth) {
@@ -80,7 +79,6 @@ TEST(Lights, StoredLightsWinOverGeometryAndCommandLineWinsOverBoth) {
 TEST(Lights, ABareSceneGetsAHeadlightAndSaysSo) {
   const Scene s = bareScene();
   EXPECT_FALSE(hasOwnLights(s));
-  EXPECT_EQ(framingFor(s), Framing::ThreeQuarter);
   LightOptions o;
   o.falloff = true;  // never on the headlight: it would light a model by its distance from the camera
   LightRig rig = resolveLights(s, o);

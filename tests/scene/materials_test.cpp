@@ -53,7 +53,9 @@ void expectCovers(const std::vector<glm::vec3>& poly, const Tris& tris, bool pla
     const glm::vec3 tn = glm::cross(b - a, c - a);
     EXPECT_GT(glm::dot(tn, n), 0.0f) << "triangle " << t[0] << "," << t[1] << "," << t[2] << " flipped or flat";
     sum += tn;
-    if (planeZ) EXPECT_NE(winding(poly, (a + b + c) / 3.0f), 0) << "triangle " << t[0] << "," << t[1] << "," << t[2] << " outside";
+    if (planeZ) {
+      EXPECT_NE(winding(poly, (a + b + c) / 3.0f), 0) << "triangle " << t[0] << "," << t[1] << "," << t[2] << " outside";
+    }
   }
   EXPECT_NEAR(glm::length(sum - n), 0.0f, 1e-4f * glm::length(n));
 }

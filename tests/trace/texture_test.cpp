@@ -283,27 +283,37 @@ TEST(TracerTextures, AlphaLayersAreBounded) {
   expectNear(c, {0, 1, 0}, 0.0f, "layer after the last allowed cut-out");
 }
 
-TEST(TracerTextures, BadFilesAreErrorsNamingThemAndOnlyPbrLoadsTextures) {
+// A texture that is missing or does not decode is shown as the shared magenta/black checker, in pbr and
+// in Phong (Kd x map_Kd), never as a silent white or an abort; the other views do not need it.
+TEST(TracerTextures, BadFilesShowTheCheckerInPbrAndPhong) {
   const auto garbage = tempDir() / "garbage.png";
   std::ofstream(garbage) << "not a png";
   for (const std::filesystem::path& file : {std::filesystem::path("/nonexistent/missing_base.png"), garbage}) {
     Scene s;
     s.textures.push_back({file, true, 4});
-    addMesh(s, facingQuad(2, addMaterial(s, pbr(glm::vec3(1), 0))));
+    Material m = pbr(glm::vec3(1), 0);
+    m.kd = glm::vec3(1);
+    m.ka = m.ks = glm::vec3(0.0f);  // Phong: diffuse only, so a pixel is Kd x texture x n.l
+    addMesh(s, facingQuad(2, addMaterial(s, m)));
     const Tracer t(s);
     TraceSettings ts = baseColourView();
     ts.width = ts.height = 8;
     ImageF img;
-    for (Shading other : {Shading::Phong, Shading::Normals, Shading::Depth}) {
+    for (Shading other : {Shading::Normals, Shading::Depth}) {
       ts.shading = other;
       EXPECT_NO_THROW(t.render(ts, img));
     }
-    ts.shading = Shading::Pbr;
-    try {
+    for (Shading shaded : {Shading::Pbr, Shading::Phong}) {
+      ts.shading = shaded;
+      if (shaded == Shading::Phong) ts.lights = resolveLights(s);  // a headlight: Kd lights up
       t.render(ts, img);
-      ADD_FAILURE() << "no error for " << file;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(file.filename().string()), std::string::npos) << e.what();
+      int magenta = 0, green = 0;
+      for (const glm::vec4& p : img.pixels) {
+        magenta += p.r > 0.2f && p.b > 0.2f && p.g < 0.05f;
+        green += p.g > 0.05f;
+      }
+      EXPECT_GT(magenta, 0) << file << " shading " << int(shaded);
+      EXPECT_EQ(green, 0) << file << " shading " << int(shaded) << ": an untextured white surface";
     }
   }
 }

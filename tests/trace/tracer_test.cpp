@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "scene/load.hpp"
 #include "trace/procedural.hpp"
 #include "core/error.hpp"
 #include "trace/spawn.hpp"
@@ -124,6 +125,36 @@ TEST(Tracer, HeadlightSitsAtTheCamera) {
   ts.lights = resolveLights(s, off);
   t.render(ts, img);
   EXPECT_NEAR(img.pixels[8 * 16 + 8].x, 0.0f, 1e-6f);  // Phong's ambient is Ka x each light: none
+}
+
+// A course scene as the course ships it (no mtllib; NAME.mtl beside the OBJ; a "light" material): lit by
+// its own ceiling light from the default pose, with shadows that darken and never brighten.
+TEST(Tracer, CourseSceneTracesLitWithShadows) {
+  const Scene s = loadScene(std::filesystem::path(RTR_SOURCE_DIR) / "assets-src/rt/cornell_box.obj");
+  const LightRig rig = resolveLights(s);
+  ASSERT_EQ(rig.lights.size(), 1u);
+  EXPECT_EQ(rig.lights[0].kind, Light::Kind::Area);
+  EXPECT_GT(rig.lights[0].color.x, 0.0f) << "the light's Ke came from cornell_box.mtl";
+  EXPECT_TRUE(rig.note.empty()) << rig.note;
+  const Tracer t(s);
+  TraceSettings ts;
+  ts.width = 64;
+  ts.height = 48;
+  ts.lens.fovYDeg = 80.0f;
+  ImageF on, off;
+  t.render(ts, on);
+  ts.shadows = false;
+  t.render(ts, off);
+  double mean = 0.0;
+  int darker = 0;
+  for (size_t i = 0; i < on.pixels.size(); ++i) {
+    mean += on.pixels[i].x + on.pixels[i].y + on.pixels[i].z;
+    EXPECT_LE(on.pixels[i].x, off.pixels[i].x + 1e-6f) << "a shadow brightened pixel " << i;
+    darker += on.pixels[i].x < off.pixels[i].x - 0.02f;
+  }
+  mean /= 3.0 * double(on.pixels.size());
+  EXPECT_GT(mean, 0.1) << "lit, not black";
+  EXPECT_GT(darker, 20) << "the blocks cast shadows";
 }
 
 TEST(Tracer, ShadowGivesAmbientAndEmissiveOnly) {

@@ -22,12 +22,14 @@ using namespace rtr::trace;
 int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "phong", shadows = "on",
-                                  intersectName = "watertight", light, lightColor, ambient = "0.02";
+                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath;
   LightOptions lightOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
   bool ortho = false, quiet = false;
   app.add_option("scene", scenePath, "scene file (.obj, .obj.zst, .comp5892mesh, .rtrscene)")->required();
+  app.add_option("mtl,--mtl", mtlPath, "OBJ: its MTL, as the course runs `program NAME.obj NAME.mtl` (default: the "
+                 "OBJ's mtllib, else NAME.mtl beside it)");
   app.add_option("-o,--output", outPath, "output PNG (sRGB)")->required();
   app.add_option("--size", size, "image size WxH")->capture_default_str();
   app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else framing the scene looking down -z");
@@ -80,7 +82,9 @@ int run(int argc, char** argv) {
   if (!lightColor.empty()) lightOptions.color = parseVec3(lightColor, "--light-color");
   lightOptions.ambient = parseVec3(ambient, "--ambient", true);
 
-  const Scene scene = loadScene(scenePath);
+  LoadOptions load;
+  if (!mtlPath.empty()) load.mtl = mtlPath;
+  const Scene scene = loadScene(scenePath, load);
   s.lights = resolveLights(scene, lightOptions);
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   const Tracer tracer(scene, s.threads);

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "options.hpp"
 #include "render/headless.hpp"
+#include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "vk/context.hpp"
 
@@ -17,7 +18,7 @@ namespace rtr::view {
 CameraPose startPose(const ViewOptions& o, const Scene& scene) {
   if (o.camera) return *o.camera;
   if (scene.defaultView) return *scene.defaultView;
-  return frameBounds(scene.bounds(), o.lens, float(o.width) / float(o.height), framingFor(scene));
+  return framingPose(scene, o.lens, float(o.width) / float(o.height));
 }
 
 render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
@@ -66,7 +67,7 @@ int runHeadless(const ViewOptions& o) {
   if (o.validation) co.validation = true;
   if (!o.device.empty()) co.device = o.device;
   vk::Context ctx(co);
-  Scene scene = loadScene(o.scene);
+  Scene scene = loadScene(o.scene, o.load);
   render::GpuScene gpuScene(ctx, scene, o.mips);
   const auto& st = gpuScene.stats();
   std::fprintf(stderr, "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
@@ -105,9 +106,10 @@ int main(int argc, char** argv) {
                "C print camera pose, F1 or H timing overlay, R ray-trace the view on the CPU (again: hide),\n"
                "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, Esc quit."};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light, lightColor,
-              ambient = "0.02";
+              ambient = "0.02", mtl;
   std::string shadingPath = render::toString(o.settings.shading);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
+  app.add_option("--mtl", mtl, "OBJ: take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
   app.add_option("--size", size, "image size WxH")->capture_default_str();
   app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)");
@@ -137,6 +139,7 @@ int main(int argc, char** argv) {
         o.width > 16384 || o.height > 16384)
       throw Error("--size '" + size + "': expected WxH, e.g. 1920x1080");
     if (!camera.empty()) o.camera = parsePose(camera);
+    if (!mtl.empty()) o.load.mtl = mtl;
     if (!light.empty()) o.lightOptions.position = parseVec3(light, "--light");
     if (!lightColor.empty()) o.lightOptions.color = parseVec3(lightColor, "--light-color");
     o.lightOptions.ambient = parseVec3(ambient, "--ambient", true);

@@ -7,11 +7,13 @@
 #include "render/mips.hpp"
 #include "render/renderer.hpp"
 #include "scene/lights.hpp"
+#include "scene/load.hpp"
 
 namespace rtr::view {
 
 struct ViewOptions {
   std::string scene;
+  LoadOptions load;                // --mtl
   bool headless = false;
   uint32_t width = 1280, height = 720;
   std::optional<CameraPose> camera;
@@ -27,7 +29,7 @@ struct ViewOptions {
   bool validation = false;
 };
 
-// The start pose: --camera, else the scene's own view, else framing the scene (framingFor), as rtr-trace.
+// The start pose: --camera, else the scene's own view, else framing the scene (framingPose), as rtr-trace.
 CameraPose startPose(const ViewOptions& o, const Scene& scene);
 // The render settings for `scene`: o.settings with the scene's lights (scene/lights.hpp), the choice
 // said once on stderr when it is not simply the scene's own lights.

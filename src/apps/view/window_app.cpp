@@ -15,6 +15,7 @@
 #include "core/image.hpp"
 #include "options.hpp"
 #include "render/text_overlay.hpp"
+#include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
@@ -119,7 +120,7 @@ int runWindowed(const ViewOptions& o) {
   GlfwSession glfw;
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   App app;
-  Scene scene = loadScene(o.scene);
+  Scene scene = loadScene(o.scene, o.load);
   app.settings = sceneSettings(o, scene);
 
   uint32_t extCount = 0;
@@ -242,7 +243,7 @@ int runWindowed(const ViewOptions& o) {
       if (app.reframeRequested) {  // F: the whole scene in view, as a scene without a stored view starts
         app.reframeRequested = false;
         const VkExtent2D e = swapchain.extent();
-        app.camera.setPose(frameBounds(bounds, o.lens, float(e.width) / float(std::max(1u, e.height)), framingFor(scene)));
+        app.camera.setPose(framingPose(scene, o.lens, float(e.width) / float(std::max(1u, e.height))));
       }
       Frame& f = frames[frameNumber % kFramesInFlight];
       VkFence fence = f.fence;

@@ -1,0 +1,21 @@
+#pragma once
+// The pose that frames a scene when no pose is given, the same for rtr-view and rtr-trace.
+#include <glm/mat4x4.hpp>
+
+#include "core/camera.hpp"
+#include "scene/scene.hpp"
+
+namespace rtr {
+
+// A staged scene (it brings its own lights, like the course's Cornell box) is seen from the front, down
+// -z, as the course shows its scenes. A bare model is seen from above at a three-quarter angle (35° to
+// the right, 25° down) so a solid reads as a solid, unless another of the eight three-quarter views
+// (four sides, above and below) sees clearly more of its front faces: the renderer culls back faces, and
+// a single sheet seen from behind or edge-on would show nothing. `model` places the scene in the world
+// (the tracer's Task 1 transform; a similarity).
+CameraPose framingPose(const Scene& scene, const Lens& lens, float aspect, const glm::mat4& model = glm::mat4(1.0f));
+
+// Front-facing area of the scene's triangles projected on the plane facing `toViewer` (scene space).
+double frontArea(const Scene& scene, const glm::vec3& toViewer);
+
+}  // namespace rtr

@@ -1,0 +1,80 @@
+// The pose that frames a scene when none is given (scene/framing.hpp).
+#include "scene/framing.hpp"
+
+#include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+
+namespace rtr {
+namespace {
+
+Mesh triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material = 0) {
+  Mesh m;
+  m.material = material;
+  m.positions = {a, b, c};
+  m.indices = {0, 1, 2};
+  for (const glm::vec3& p : m.positions) m.bounds.extend(p);
+  return m;
+}
+
+// A closed unit cube, faces counter-clockwise seen from outside.
+Mesh cube() {
+  Mesh m;
+  for (int i = 0; i < 8; ++i) m.positions.push_back({float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1)});
+  m.indices = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
+  for (const glm::vec3& p : m.positions) m.bounds.extend(p);
+  return m;
+}
+
+Scene sceneOf(Mesh m, std::string material = "grey") {
+  Scene s;
+  Material mat;
+  mat.name = std::move(material);
+  s.materials.push_back(mat);
+  s.meshes.push_back(std::move(m));
+  return s;
+}
+
+glm::vec3 toViewer(const CameraPose& p) { return -basis(p).forward; }
+
+TEST(Framing, AClosedModelGetsTheRaisedThreeQuarterView) {
+  const Scene s = sceneOf(cube());
+  const CameraPose p = framingPose(s, Lens{}, 1.5f);
+  EXPECT_EQ(p.yawDeg, 35.0f);
+  EXPECT_EQ(p.pitchDeg, -25.0f);
+  EXPECT_GT(glm::dot(glm::normalize(s.bounds().center() - p.position), basis(p).forward), 0.9999f);
+  EXPECT_GT(frontArea(s, toViewer(p)), 0.0);
+}
+
+TEST(Framing, AStagedSceneIsSeenFromTheFront) {
+  Scene s = sceneOf(cube(), "ceiling_light");  // a light of its own
+  const CameraPose p = framingPose(s, Lens{}, 1.5f);
+  const CameraPose front = frameBounds(s.bounds(), Lens{}, 1.5f);
+  EXPECT_EQ(p.position, front.position);
+  EXPECT_EQ(p.yawDeg, 0.0f);
+  EXPECT_EQ(p.pitchDeg, 0.0f);
+}
+
+// One-sided sheets are seen from their front: a triangle facing back-left, and one facing down.
+TEST(Framing, ASheetIsSeenFromItsFront) {
+  const Scene backLeft = sceneOf(triangle({0, 0, 0}, {0, 1, 0}, {1, 0, 1}));  // normal (1, 0, -1)
+  ASSERT_EQ(frontArea(backLeft, toViewer(CameraPose{{}, 35.0f, -25.0f})), 0.0) << "the preferred view sees its back";
+  CameraPose p = framingPose(backLeft, Lens{}, 1.0f);
+  EXPECT_GT(frontArea(backLeft, toViewer(p)), 0.0) << p.yawDeg << " " << p.pitchDeg;
+  const Scene down = sceneOf(triangle({0, 0, 0}, {1, 0, 0}, {0, 0, 1}));  // normal -y: only seen from below
+  p = framingPose(down, Lens{}, 1.0f);
+  EXPECT_EQ(p.pitchDeg, 25.0f);
+  EXPECT_GT(frontArea(down, toViewer(p)), 0.0);
+}
+
+TEST(Framing, TwoSidedFacesCountFromBothSides) {
+  const Mesh t = triangle({0, 0, 0}, {1, 0, 0}, {0, 0, 1});
+  EXPECT_EQ(frontArea(sceneOf(t), {0, 1, 0}), 0.0);
+  EXPECT_NEAR(frontArea(sceneOf(t), {0, -1, 0}), 0.5, 1e-6);
+  Scene two = sceneOf(t, "leaves.DoubleSided");
+  two.materials[0].flags = kMaterialDoubleSided;
+  EXPECT_NEAR(frontArea(two, {0, 1, 0}), 0.5, 1e-6);
+  EXPECT_NEAR(frontArea(two, {0, -1, 0}), 0.5, 1e-6);
+}
+
+}  // namespace
+}  // namespace rtr
