@@ -7,18 +7,19 @@
 #include <CLI/CLI.hpp>
 
 #include "bake.hpp"
+#include "core/cli.hpp"
 #include "core/error.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh"};
+  CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh", "rtr-bake"};
   rtr::BakeOptions opt;
   std::string input, output, view;
   app.add_option("INPUT", input, "OBJ file")->required();
-  app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh)")->required();
+  app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh); a missing folder is created")->required();
   app.add_flag("--force", opt.force, "overwrite an existing output and textures");
   app.add_option("--view", view, "default camera pose x,y,z,yaw,pitch (degrees)");
-  app.add_option("--threads", opt.threads, "worker threads (0: all cores)");
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
+  if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   opt.input = input;
   opt.output = output;
@@ -30,7 +31,7 @@ int main(int argc, char** argv) {
       std::fflush(stderr);
     };
   try {
-    if (!view.empty()) opt.view = rtr::parsePose(view);
+    if (!view.empty()) opt.view = rtr::cli::parsePose("--view", view);
     const rtr::BakeReport r = rtr::bake(opt);
     if (tty) std::fprintf(stderr, "\r%40s\r", "");
     const auto& o = r.obj;
@@ -47,7 +48,6 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");
-    std::cerr << "rtr-bake: error: " << e.what() << "\n";
-    return 1;
+    return rtr::cli::fail("rtr-bake", e);
   }
 }
