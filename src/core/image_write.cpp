@@ -14,6 +14,9 @@
 #include <mutex>
 #include <thread>
 
+#include <sched.h>
+#include <unistd.h>
+
 #include <stb_image_write.h>
 #include <tinyexr.h>
 
@@ -42,9 +45,11 @@ private:
     const auto start = steady_clock::now();
     std::unique_lock l(m_);
     if (cv_.wait_for(l, seconds(1), [&] { return done_; })) return;
-    do std::fprintf(stderr, "\rwriting %s: %3.0f%%", name.c_str(), fraction.load() * 100.0);
+    const bool tty = ::isatty(STDERR_FILENO);  // a log gets one line, not a percentage every 250 ms
+    if (!tty) std::fprintf(stderr, "writing %s ...\n", name.c_str());
+    do if (tty) std::fprintf(stderr, "\rwriting %s: %3.0f%%", name.c_str(), fraction.load() * 100.0);
     while (!cv_.wait_for(l, milliseconds(250), [&] { return done_; }));
-    std::fprintf(stderr, "\rwriting %s: done in %.1f s\n", name.c_str(),
+    std::fprintf(stderr, "%swriting %s: done in %.1f s\n", tty ? "\r" : "", name.c_str(),
                  duration<double>(steady_clock::now() - start).count());
   }
   std::thread watcher_;
@@ -52,6 +57,13 @@ private:
   std::condition_variable cv_;
   bool done_ = false;
 };
+
+// The cores this process may run on (a cpuset or taskset may allow fewer than the machine has).
+unsigned usableCores() {
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0) return unsigned(std::max(1, CPU_COUNT(&set)));
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 void put32(std::string& s, uint32_t v) {
   const char b[4] = {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
@@ -76,7 +88,7 @@ void chunk(AtomicFile& f, const char type[4], const void* data, size_t size) {
 // independent pieces of one zlib stream (each ends on a sync flush; their Adler-32s are combined).
 void writePng(AtomicFile& f, const ImageRGBA8& img, ProgressLine& progress) {
   const size_t row = size_t(img.width) * 4, h = img.height;
-  const unsigned threads = std::max(1u, std::min(std::thread::hardware_concurrency(), 16u));
+  const unsigned threads = std::min(usableCores(), 16u);
   const size_t strips = std::min<size_t>(h, threads * 4);
   std::vector<std::string> out(strips);
   std::vector<uLong> adler(strips);
