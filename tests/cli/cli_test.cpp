@@ -264,10 +264,24 @@ TEST_F(Cli, KilledBakeLeavesTheOldFileAndTheNextRunNoTemporary) {
   ASSERT_TRUE(oldBytes != newBytes);
   std::mt19937 rng(12345);
   std::uniform_real_distribution<double> when(0.0, bakeSeconds * 1.2);
-  int killed = 0;
+  // A file other than the output and its texture folder: a temporary being written.
+  auto writing = [&] {
+    std::error_code ec;
+    for (const fs::path& d : {out.parent_path(), out.parent_path() / "t-tex"})
+      for (auto it = fs::directory_iterator(d, ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+        if (it->path().filename().string().find("tmp") != std::string::npos) return true;
+    return false;
+  };
+  int killed = 0, killedWriting = 0;
   for (int i = 0; i < 12; ++i) {
     Process p = start("rtr-bake", b);
-    std::this_thread::sleep_for(std::chrono::duration<double>(when(rng)));
+    if (i % 2) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(when(rng)));
+    } else {  // the moment a temporary exists, so that some kills surely land mid-write
+      const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+      while (!writing() && std::chrono::steady_clock::now() < giveUp) {}
+      killedWriting += writing();
+    }
     p.kill(SIGKILL);
     const Result r = p.wait(30);
     killed += r.exitCode == -1;
@@ -276,6 +290,7 @@ TEST_F(Cli, KilledBakeLeavesTheOldFileAndTheNextRunNoTemporary) {
     if (now == newBytes) std::ofstream(out, std::ios::binary) << oldBytes;  // start again from the old file
   }
   EXPECT_GT(killed, 0);
+  EXPECT_GT(killedWriting, 0);
   ASSERT_EQ(run("rtr-bake", b).exitCode, 0);
   EXPECT_TRUE(readAll(out) == newBytes);
   EXPECT_EQ(namesIn(out.parent_path()), (std::vector<std::string>{"t-tex", "t.rtrscene"}));
