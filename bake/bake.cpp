@@ -34,19 +34,6 @@ struct CreatedFiles {
   }
 };
 
-void copyFileAtomic(const std::filesystem::path& src, const std::filesystem::path& dst) {
-  std::filesystem::path tmp = dst;
-  tmp += ".tmp";
-  std::error_code ec;
-  std::filesystem::copy_file(src, tmp, std::filesystem::copy_options::overwrite_existing, ec);
-  if (ec) throw fileError(dst.string(), "", "cannot copy texture from '" + src.string() + "': " + ec.message());
-  std::filesystem::rename(tmp, dst, ec);
-  if (ec) {
-    std::filesystem::remove(tmp);
-    throw fileError(dst.string(), "", "cannot rename temporary texture: " + ec.message());
-  }
-}
-
 // Decodes every source texture with the channel count of its slot, on a few threads.
 void verifyTextures(const TexturePlan& plan, unsigned threads) {
   std::atomic<size_t> next{0};
@@ -75,10 +62,20 @@ void verifyTextures(const TexturePlan& plan, unsigned threads) {
     if (!e.empty()) throw Error(e);
 }
 
-void writeFallback(const std::filesystem::path& file, const std::string& name) {
+void writeFallback(const std::filesystem::path& file, const std::string& name, Replace replace) {
   ImageRGBA8 img{1, 1, {255, 255, 255, 255}};
   if (name == kFallbackEmissive) img.pixels = {0, 0, 0, 255};
-  savePng(file, img);
+  saveImage(file, img, {replace});
+}
+
+// Creates `dir` and any missing parents, recording each folder it made.
+void createFolders(const std::filesystem::path& dir, CreatedFiles& created) {
+  std::error_code ec;
+  if (dir.empty() || std::filesystem::is_directory(dir, ec)) return;
+  createFolders(dir.parent_path(), created);
+  if (std::filesystem::create_directory(dir, ec)) created.files.push_back(dir);
+  else if (!std::filesystem::is_directory(dir))  // another bake may have made it meanwhile: fine
+    throw fileError(dir.string(), "", "cannot create folder: " + (ec ? ec.message() : "a file of that name exists"));
 }
 
 }  // namespace
@@ -89,14 +86,15 @@ BakeReport bake(const BakeOptions& opt) {
   const std::string out = opt.output.filename().string();
   const bool course = endsWith(out, ".comp5892mesh");
   if (!course && !endsWith(out, ".rtrscene"))
-    throw fileError(opt.output.string(), "", "unknown output format (expected .rtrscene or .comp5892mesh)");
+    throw UsageError(opt.output.string() + ": unknown output format (expected .rtrscene or .comp5892mesh)");
   std::error_code ec;
+  const Replace replace = opt.force ? Replace::Yes : Replace::No;
   if (std::filesystem::exists(opt.output, ec) && !opt.force)
-    throw fileError(opt.output.string(), "", "output exists; use --force to overwrite it");
+    throw OutputExists(opt.output.string() + ": output exists; use --force to overwrite it");
   std::filesystem::path outDir = opt.output.parent_path();
   if (outDir.empty()) outDir = ".";
-  if (!std::filesystem::is_directory(outDir, ec))
-    throw fileError(opt.output.string(), "", "output folder '" + outDir.string() + "' does not exist");
+  CreatedFiles created;  // removed again if the bake fails
+  createFolders(outDir, created);
   if (::access(outDir.c_str(), W_OK) != 0)
     throw fileError(opt.output.string(), "", "output folder '" + outDir.string() + "' is not writable");
   if (opt.view && course && opt.warn) opt.warn("the .comp5892mesh format has no default view; --view ignored");
@@ -128,33 +126,31 @@ BakeReport bake(const BakeOptions& opt) {
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
     const auto dst = outDir / plan.scene.textures[i].path;
     if (std::filesystem::exists(dst, ec) && !opt.force)
-      throw fileError(dst.string(), "", "texture exists; refusing to overwrite it without --force");
+      throw OutputExists(dst.string() + ": texture exists; refusing to overwrite it without --force");
   }
-  CreatedFiles created;
-  if (!plan.scene.textures.empty() && !std::filesystem::is_directory(texDir, ec)) {
-    if (!std::filesystem::create_directory(texDir, ec))
-      throw fileError(texDir.string(), "", "cannot create texture folder: " + ec.message());
-    created.files.push_back(texDir);
-  }
+  if (!plan.scene.textures.empty()) createFolders(texDir, created);
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
+    // Without --force a texture is only ever created, never replaced (FORMATS.md §1): AtomicFile's
+    // link-based commit lets exactly one of two concurrent bakes create it; the other stops here.
     const auto dst = outDir / plan.scene.textures[i].path;
     const bool existed = std::filesystem::exists(dst, ec);
     if (plan.sources[i].empty()) {
-      writeFallback(dst, dst.filename().string());
+      writeFallback(dst, dst.filename().string(), replace);
       ++rep.fallbackTextures;
     } else {
-      copyFileAtomic(plan.sources[i], dst);
+      copyFileAtomic(plan.sources[i], dst, replace);
     }
     if (!existed) created.files.push_back(dst);
     if (opt.progress) opt.progress("copying textures", double(i + 1) / double(plan.scene.textures.size()));
   }
   rep.textureSeconds = since(t0);
 
-  // 3. Encode and write (temporary file, then rename).
+  // 3. Encode and write (a temporary of our own, then rename; without --force, link, so that an output
+  // another run made meanwhile is kept).
   t0 = Clock::now();
   if (opt.progress) opt.progress("writing", 0.0);
   const std::string bytes = course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene);
-  writeFileAtomic(opt.output, bytes);
+  writeFileAtomic(opt.output, bytes, replace);
   created.keep = true;
   rep.writeSeconds = since(t0);
   rep.outputBytes = bytes.size();

@@ -7,21 +7,22 @@
 #include <CLI/CLI.hpp>
 
 #include "bake.hpp"
+#include "core/cli.hpp"
 #include "core/error.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh"};
+  CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh", "rtr-bake"};
   rtr::BakeOptions opt;
   std::string input, output, view, light, lightColor, mtl;
   app.add_option("INPUT", input, "OBJ file")->required();
-  app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh)")->required();
+  app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh); a missing folder is created")->required();
   app.add_option("--mtl", mtl, "take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--force", opt.force, "overwrite an existing output and textures");
   app.add_option("--view", view, "default camera pose x,y,z,yaw,pitch (degrees)");
   app.add_option("--light", light, "store a point light at x,y,z with the scene (.rtrscene); it replaces the scene's own");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
-  app.add_option("--threads", opt.threads, "worker threads (0: all cores)");
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
+  if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   opt.input = input;
   opt.output = output;
@@ -33,12 +34,12 @@ int main(int argc, char** argv) {
       std::fflush(stderr);
     };
   try {
-    if (!view.empty()) opt.view = rtr::parsePose(view);
+    if (!view.empty()) opt.view = rtr::cli::parsePose("--view", view);
     if (!mtl.empty()) opt.mtl = mtl;
     if (!light.empty()) {
       rtr::Light l;
-      l.position = rtr::parseVec3(light, "--light");
-      if (!lightColor.empty()) l.color = rtr::parseVec3(lightColor, "--light-color");
+      l.position = rtr::cli::parseVec3("--light", light);
+      if (!lightColor.empty()) l.color = rtr::cli::parseVec3("--light-color", lightColor);
       opt.lights = {l};
     }
     const rtr::BakeReport r = rtr::bake(opt);
@@ -57,7 +58,6 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");
-    std::cerr << "rtr-bake: error: " << e.what() << "\n";
-    return 1;
+    return rtr::cli::fail("rtr-bake", e);
   }
 }

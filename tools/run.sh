@@ -8,4 +8,4 @@ cmake --preset release >/dev/null
 cmake --build --preset release -j "$(nproc)" --target rtr-view rtr_shaders assets
 mkdir -p out
 exec build/release/bin/rtr-view build/release/assets/temple.rtrscene --headless --size 1920x1080 \
-  --screenshot out/temple.png "$@"
+  --screenshot out/temple.png --force "$@"

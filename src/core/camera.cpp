@@ -3,7 +3,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -11,38 +10,6 @@
 #include "core/error.hpp"
 
 namespace rtr {
-
-namespace {
-
-// Comma-separated finite numbers; nullopt names the first bad field (1-based) in `bad`.
-std::optional<std::vector<float>> parseFloats(std::string_view text, size_t& bad) {
-  std::vector<float> v;
-  size_t start = 0;
-  while (start <= text.size()) {
-    size_t end = text.find(',', start);
-    if (end == std::string_view::npos) end = text.size();
-    std::string field(text.substr(start, end - start));
-    char* stop = nullptr;
-    float f = std::strtof(field.c_str(), &stop);
-    if (field.empty() || *stop != '\0' || !std::isfinite(f)) { bad = v.size() + 1; return std::nullopt; }
-    v.push_back(f);
-    start = end + 1;
-  }
-  return v;
-}
-
-}  // namespace
-
-glm::vec3 parseVec3(std::string_view text, const std::string& option, bool scalarAllowed) {
-  size_t bad = 0;
-  const auto v = parseFloats(text, bad);
-  const std::string expected = scalarAllowed ? "three numbers r,g,b or one" : "three numbers x,y,z";
-  if (!v) throw Error(option + " '" + std::string(text) + "': field " + std::to_string(bad) +
-                      " is not a finite number; expected " + expected);
-  if (v->size() == 1 && scalarAllowed) return glm::vec3((*v)[0]);
-  if (v->size() != 3) throw Error(option + " '" + std::string(text) + "': expected " + expected);
-  return {(*v)[0], (*v)[1], (*v)[2]};
-}
 
 CameraPose parsePose(std::string_view text) {
   std::vector<float> v;

@@ -29,9 +29,6 @@ struct Lens {
 // "x,y,z,yaw,pitch" (yaw and pitch in degrees). Throws rtr::Error saying what is wrong.
 CameraPose parsePose(std::string_view text);
 std::string formatPose(const CameraPose& pose);  // round-trips through parsePose
-// "x,y,z" (or one value for all three when `scalarAllowed`) for the option named `option` (say "--light");
-// finite numbers only. Throws rtr::Error naming the option.
-glm::vec3 parseVec3(std::string_view text, const std::string& option, bool scalarAllowed = false);
 
 struct CameraBasis { glm::vec3 forward, right, up; };
 CameraBasis basis(const CameraPose& pose);

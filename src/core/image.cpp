@@ -1,7 +1,6 @@
 #include "core/image.hpp"
 
 #include <cmath>
-#include <system_error>
 
 #include "core/error.hpp"
 
@@ -21,16 +20,6 @@ TexelData loadImage(const std::filesystem::path& file, int channels) {
   out.texels.assign(data, data + size_t(w) * h * channels);
   stbi_image_free(data);
   return out;
-}
-
-void savePng(const std::filesystem::path& file, const ImageRGBA8& image) {
-  auto tmp = file;
-  tmp += ".tmp";
-  if (!stbi_write_png(tmp.c_str(), int(image.width), int(image.height), 4, image.pixels.data(), int(image.width) * 4))
-    throw fileError(file.string(), "", "cannot write PNG (is the folder writable?)");
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) throw fileError(file.string(), "", "cannot rename temporary PNG: " + ec.message());
 }
 
 float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }

@@ -1,10 +1,13 @@
 #pragma once
-// CPU images: 8-bit RGBA for files, float RGBA for linear-light work. PNG I/O through stb.
+// CPU images: 8-bit RGBA for files, float RGBA for linear-light work. Reading through stb; writing PNG,
+// JPEG, Radiance HDR and OpenEXR, always atomically (core/atomic_file.hpp).
 #include <cstdint>
 #include <filesystem>
 #include <vector>
 
 #include <glm/vec4.hpp>
+
+#include "core/atomic_file.hpp"
 
 namespace rtr {
 
@@ -29,7 +32,21 @@ struct TexelData {
 };
 
 TexelData loadImage(const std::filesystem::path& file, int channels);  // throws rtr::Error naming the file
-void savePng(const std::filesystem::path& file, const ImageRGBA8& image);  // atomic: temp file + rename
+void savePng(const std::filesystem::path& file, const ImageRGBA8& image);  // PNG whatever the name says
+
+// Output format by extension; anything else is a UsageError that lists these.
+enum class ImageFormat { Png, Jpg, Exr, Hdr };
+inline constexpr const char* kImageExtensions = ".png, .jpg (or .jpeg), .exr, .hdr";
+ImageFormat imageFormatFor(const std::filesystem::path& file);
+
+struct ImageWriteOptions {
+  Replace replace = Replace::Yes;  // No: an existing file is kept (OutputExists)
+  bool progress = false;           // a line on stderr once a write has taken a second
+};
+// 8-bit images are sRGB-encoded: .exr and .hdr get them decoded to linear floats.
+void saveImage(const std::filesystem::path& file, const ImageRGBA8& image, const ImageWriteOptions& options = {});
+// Linear light: written as-is to .exr (32-bit float) and .hdr; .png and .jpg get toSrgb8's encoding.
+void saveImage(const std::filesystem::path& file, const ImageF& linear, const ImageWriteOptions& options = {});
 
 float srgbToLinear(float c);
 float linearToSrgb(float c);

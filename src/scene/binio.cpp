@@ -24,29 +24,6 @@ std::vector<uint8_t> readFileBytes(const std::filesystem::path& file) {
   return out;
 }
 
-void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes) {
-  std::filesystem::path tmp = file;
-  tmp += ".tmp";
-  {
-    std::unique_ptr<std::FILE, FileCloser> f(std::fopen(tmp.c_str(), "wb"));
-    if (!f) throw fileError(file.string(), "", std::string("cannot create output: ") + std::strerror(errno));
-    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f.get()) == bytes.size();
-    ok = std::fflush(f.get()) == 0 && ok;
-    if (!ok) {
-      int err = errno;
-      f.reset();
-      std::filesystem::remove(tmp);
-      throw fileError(file.string(), "", std::string("cannot write output: ") + std::strerror(err));
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp);
-    throw fileError(file.string(), "", "cannot rename temporary output: " + ec.message());
-  }
-}
-
 uint64_t checksum64(std::span<const uint8_t> data) {
   uint64_t h = 0x243F6A8885A308D3ull ^ data.size();
   size_t i = 0;

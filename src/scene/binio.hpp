@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/atomic_file.hpp"  // writeFileAtomic: every baked file is written through it
 #include "core/error.hpp"
 
 namespace rtr {
@@ -97,8 +98,6 @@ private:
 
 // Whole file into memory; throws rtr::Error naming the file.
 std::vector<uint8_t> readFileBytes(const std::filesystem::path& file);
-// Writes to "<file>.tmp" beside it, then renames, so a failure never leaves a partial `file`.
-void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes);
 // 64-bit checksum over bytes (word-wise multiply-xorshift; detects corruption, not tampering).
 uint64_t checksum64(std::span<const uint8_t> data);
 

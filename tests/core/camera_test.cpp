@@ -112,19 +112,5 @@ TEST(Camera, ThreeQuarterFramingSeesEveryCornerFromAbove) {
   }
 }
 
-TEST(Camera, ParseVec3NamesTheOption) {
-  EXPECT_EQ(parseVec3("1,-2.5,3", "--light"), glm::vec3(1, -2.5f, 3));
-  EXPECT_EQ(parseVec3("0.25", "--ambient", true), glm::vec3(0.25f));
-  for (const char* bad : {"", "1,2", "1,2,3,4", "1,nan,3", "1,inf,3", "a,b,c", "1,,3"}) {
-    try {
-      parseVec3(bad, "--light");
-      ADD_FAILURE() << "accepted '" << bad << "'";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("--light"), std::string::npos) << e.what();
-    }
-  }
-  EXPECT_THROW(parseVec3("0.25", "--light"), Error);  // one value only where allowed
-}
-
 }  // namespace
 }  // namespace rtr

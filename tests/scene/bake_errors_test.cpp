@@ -76,8 +76,18 @@ TEST_F(Fixture, MissingMtlIsAWarning) {
   EXPECT_TRUE(fs::is_regular_file(out / "s.rtrscene"));
 }
 
-TEST_F(Fixture, OutputFolderMissingOrNotWritable) {
-  EXPECT_THAT(bakeError(dir / "nowhere/s.rtrscene"), HasSubstr("does not exist"));
+TEST_F(Fixture, MissingOutputFolderIsCreatedAndRemovedAgainIfTheBakeFails) {
+  EXPECT_EQ(bakeError(dir / "new/deeper/s.rtrscene"), "(no error)");
+  EXPECT_TRUE(fs::is_regular_file(dir / "new/deeper/s.rtrscene"));
+  EXPECT_TRUE(fs::is_regular_file(dir / "new/deeper/s-tex/tex.png"));
+  fs::remove(dir / "tex.png");
+  EXPECT_THAT(bakeError(dir / "other/deeper/s.rtrscene"), HasSubstr("does not exist"));
+  EXPECT_FALSE(fs::exists(dir / "other"));
+  write("plain", "a file where a folder should be");
+  EXPECT_THAT(bakeError(dir / "plain/s.rtrscene"), HasSubstr("cannot create folder"));
+}
+
+TEST_F(Fixture, OutputFolderNotWritable) {
   // /proc refuses new files even to root, so this holds whoever runs the test.
   EXPECT_THAT(bakeError("/proc/s.rtrscene"), HasSubstr("/proc"));
   if (::geteuid() != 0) {

@@ -1,4 +1,4 @@
-// rtr-trace: ray-trace a scene file into a PNG (brief Part 1; issue 6).
+// rtr-trace: ray-trace a scene file into an image (brief Part 1; issue 6).
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/camera.hpp"
+#include "core/cli.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "scene/load.hpp"
@@ -20,33 +21,34 @@ using namespace rtr;
 using namespace rtr::trace;
 
 int run(int argc, char** argv) {
-  CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)"};
+  CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)", "rtr-trace"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "phong", shadows = "on",
                                   intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath;
   LightOptions lightOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
-  bool ortho = false, quiet = false;
+  bool ortho = false, quiet = false, force = false;
   app.add_option("scene", scenePath, "scene file (.obj, .obj.zst, .comp5892mesh, .rtrscene)")->required();
   app.add_option("mtl,--mtl", mtlPath, "OBJ: its MTL, as the course runs `program NAME.obj NAME.mtl` (default: the "
                  "OBJ's mtllib, else NAME.mtl beside it)");
-  app.add_option("-o,--output", outPath, "output PNG (sRGB)")->required();
+  app.add_option("-o,--output", outPath, "output image: .png or .jpg (sRGB), .exr or .hdr (linear radiance)")->required();
+  app.add_flag("--force", force, "overwrite an existing output");
   app.add_option("--size", size, "image size WxH")->capture_default_str();
-  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else framing the scene looking down -z");
+  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else one that frames the scene (docs/lights.md)");
   app.add_option("--fov", fov, "vertical field of view in degrees (the viewer's default; the course uses 80)")
-      ->capture_default_str()->check(CLI::Range(1.0f, 179.0f));
+      ->capture_default_str()->check(cli::number(0, 180, true));
   app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, FORMATS.md §2)");
-  app.add_option("--ortho-height", orthoHeight, "half height of the orthographic volume")->check(CLI::PositiveNumber);
+  app.add_option("--ortho-height", orthoHeight, "half height of the orthographic volume")->check(cli::number(0, 1e30, true));
   app.add_option("--shading", shading, "phong | pbr | normals | depth")
       ->capture_default_str()->check(CLI::IsMember({"phong", "pbr", "normals", "depth"}));
   app.add_option("--shadows", shadows, "on | off")->capture_default_str()->check(CLI::IsMember({"on", "off"}));
   app.add_option("--bounces", s.bounces, "mirror bounces (N_BOUNCES); 0 turns reflections off")
-      ->capture_default_str()->check(CLI::Range(0, 64));
-  app.add_option("--threads", s.threads, "worker threads, 0 = every core")->capture_default_str()->check(CLI::Range(0, 1024));
+      ->capture_default_str()->check(cli::integer(0, 64));
+  app.add_option("--threads", s.threads, "worker threads, 0 = every core")->capture_default_str()->check(cli::integer(0, 1024));
   app.add_option("--intersect", intersectName, "halfplane | watertight | moller")
       ->capture_default_str()->check(CLI::IsMember({"halfplane", "watertight", "moller"}));
   app.add_option("--area-samples", s.areaLightSamples, "shadow rays per area light (1: its centre)")
-      ->capture_default_str()->check(CLI::Range(1, 1024));
+      ->capture_default_str()->check(cli::integer(1, 1024));
   app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
   app.add_flag("--falloff", lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
@@ -54,21 +56,15 @@ int run(int argc, char** argv) {
   app.add_flag("!--no-default-light", lightOptions.defaultLight,
                "a scene without lights gets no headlight (the brief's strict behaviour)");
   app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
-      ->capture_default_str()->check(CLI::Range(-16.0f, 16.0f));
+      ->capture_default_str()->check(cli::number(-16, 16));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
 
-  unsigned w = 0, h = 0;
-  char tail;
-  if (std::sscanf(size.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 32768 || h > 32768)
-    throw Error("--size '" + size + "': expected WxH with 1..32768 each, e.g. 1280x720");
+  const cli::Size size2 = cli::parseSize("--size", size);
+  const uint32_t w = size2.width, h = size2.height;
   s.width = w;
   s.height = h;
-  if (!camera.empty()) s.pose = parsePose(camera);
+  if (!camera.empty()) s.pose = cli::parsePose("--camera", camera);
   s.lens.fovYDeg = fov;
   s.lens.orthographic = ortho;
   const float aspect = float(w) / float(h);
@@ -78,9 +74,10 @@ int run(int argc, char** argv) {
   s.shadows = shadows == "on";
   s.intersect = intersectName == "halfplane" ? IntersectMethod::HalfPlane
               : intersectName == "moller" ? IntersectMethod::MollerTrumbore : IntersectMethod::Watertight;
-  if (!light.empty()) lightOptions.position = parseVec3(light, "--light");
-  if (!lightColor.empty()) lightOptions.color = parseVec3(lightColor, "--light-color");
-  lightOptions.ambient = parseVec3(ambient, "--ambient", true);
+  if (!light.empty()) lightOptions.position = cli::parseVec3("--light", light);
+  if (!lightColor.empty()) lightOptions.color = cli::parseVec3("--light-color", lightColor);
+  lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
+  cli::checkImageOutput("-o", outPath, force);  // before tracing, not after
 
   LoadOptions load;
   if (!mtlPath.empty()) load.mtl = mtlPath;
@@ -100,7 +97,7 @@ int run(int argc, char** argv) {
   if (s.lights->lights.empty() && s.shading != Shading::Normals && s.shading != Shading::Depth &&
       std::all_of(image.pixels.begin(), image.pixels.end(), [](const glm::vec4& p) { return glm::vec3(p) == glm::vec3(0.0f); }))
     std::fprintf(stderr, "rtr-trace: warning: the image is all black (no lights: --no-default-light)\n");
-  savePng(outPath, toSrgb8(image));
+  saveImage(outPath, image, {force ? Replace::Yes : Replace::No, !quiet});
   if (!quiet) {
     if (s.shading == Shading::Pbr)
       std::fprintf(stderr, "rtr-trace: %zu textures decoded and mip-mapped in %.3f s; %llu rays continued past "
@@ -125,7 +122,6 @@ int main(int argc, char** argv) {
   try {
     return run(argc, argv);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rtr-trace: error: %s\n", e.what());
-    return 1;
+    return cli::fail("rtr-trace", e);
   }
 }

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/cli.hpp"
 #include "core/error.hpp"
 #include "options.hpp"
 #include "render/headless.hpp"
@@ -82,12 +83,12 @@ int runHeadless(const ViewOptions& o) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
   }
-  if (!o.screenshot.empty() || o.bench == 0) {
+  if (!o.screenshot.empty()) {
     render::HeadlessFrame frame = renderer.render(pose, lens, settings, std::max(1, o.frames));
     if (settings.lights.lights.empty() && allBlack(frame.image))
       std::fprintf(stderr, "rtr-view: warning: the image is all black (no lights: --no-default-light)\n");
-    const std::string out = o.screenshot.empty() ? "rtr-view.png" : o.screenshot;
-    savePng(out, frame.image);
+    const std::string& out = o.screenshot;
+    saveImage(out, frame.image, {o.force ? Replace::Yes : Replace::No, true});
     for (const auto& [name, ms] : frame.gpuTimes) std::fprintf(stderr, "  %s: %.3f ms GPU\n", name.c_str(), ms);
     std::printf("%s\n", std::filesystem::absolute(out).c_str());
   }
@@ -104,7 +105,9 @@ int main(int argc, char** argv) {
                "1-7 views (shaded, mip level, linear depth, depth derivatives, normal, view dir, light dir),\n"
                "8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic off/compute/graphics, [ ] LOD bias,\n"
                "C print camera pose, F1 or H timing overlay, R ray-trace the view on the CPU (again: hide),\n"
-               "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, Esc quit."};
+               "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, F frame the scene,\n"
+               "Esc quit.",
+               "rtr-view"};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light, lightColor,
               ambient = "0.02", mtl;
   std::string shadingPath = render::toString(o.settings.shading);
@@ -113,48 +116,53 @@ int main(int argc, char** argv) {
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
   app.add_option("--size", size, "image size WxH")->capture_default_str();
   app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)");
-  app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str();
+  app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str()
+      ->check(cli::number(0, 180, true));
   app.add_option("--mode", o.settings.mode, "view mode 1-13 (1 shaded)")->check(CLI::Range(1, VIEW_COUNT))->capture_default_str();
-  app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(CLI::PositiveNumber);
-  app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay) to this PNG");
+  app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(cli::integer(1, 100000));
+  app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay): .png, .jpg, .exr or .hdr");
+  app.add_flag("--force", o.force, "overwrite an existing screenshot");
   app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit")->capture_default_str();
   app.add_option("--mosaic", mosaic, "post process: off | compute | graphics")->capture_default_str();
   app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward")
       ->check(CLI::IsMember({"visibility", "forward"}))->capture_default_str();
-  app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias");
+  app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
   app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
   app.add_flag("--falloff", o.lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
   app.add_option("--ambient", ambient, "ambient colour r,g,b (or one grey value)")->capture_default_str();
   app.add_flag("!--no-default-light", o.lightOptions.defaultLight,
                "a scene without lights gets no headlight (only ambient and emission light it)");
-  app.add_option("--bench", o.bench, "time N frames after 10 warm-up frames; print per-pass GPU min/median");
+  app.add_option("--bench", o.bench, "time N frames after 10 warm-up frames; print per-pass GPU min/median")
+      ->check(cli::integer(0, 1000000));
   app.add_flag("--watch", o.watch, "recompile edited shaders at run time (windowed)");
   app.add_option("--device", o.device, "Vulkan device index or name substring (default: discrete GPU first)");
   app.add_flag("--validation", o.validation, "enable the Vulkan validation layer");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
 
   try {
-    if (std::sscanf(size.c_str(), "%ux%u", &o.width, &o.height) != 2 || o.width == 0 || o.height == 0 ||
-        o.width > 16384 || o.height > 16384)
-      throw Error("--size '" + size + "': expected WxH, e.g. 1920x1080");
-    if (!camera.empty()) o.camera = parsePose(camera);
+    const cli::Size sz = cli::parseSize("--size", size);
+    o.width = sz.width;
+    o.height = sz.height;
+    if (!camera.empty()) o.camera = cli::parsePose("--camera", camera);
     if (!mtl.empty()) o.load.mtl = mtl;
-    if (!light.empty()) o.lightOptions.position = parseVec3(light, "--light");
-    if (!lightColor.empty()) o.lightOptions.color = parseVec3(lightColor, "--light-color");
-    o.lightOptions.ambient = parseVec3(ambient, "--ambient", true);
+    if (!light.empty()) o.lightOptions.position = cli::parseVec3("--light", light);
+    if (!lightColor.empty()) o.lightOptions.color = cli::parseVec3("--light-color", lightColor);
+    o.lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
+    if (o.headless && o.screenshot.empty() && o.bench == 0)
+      throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
+    if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
     const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
                                                           {"blit", render::MipMode::Blit}};
     const std::map<std::string, render::MosaicMode> mosaicModes{
         {"off", render::MosaicMode::Off}, {"compute", render::MosaicMode::Compute}, {"graphics", render::MosaicMode::Graphics}};
-    if (!mipModes.count(mips)) throw Error("--mips '" + mips + "': expected compute or blit");
-    if (!mosaicModes.count(mosaic)) throw Error("--mosaic '" + mosaic + "': expected off, compute or graphics");
+    if (!mipModes.count(mips)) throw UsageError("--mips '" + mips + "': expected compute or blit");
+    if (!mosaicModes.count(mosaic)) throw UsageError("--mosaic '" + mosaic + "': expected off, compute or graphics");
     o.mips = mipModes.at(mips);
     o.settings.mosaic = mosaicModes.at(mosaic);
     o.settings.shading = shadingPath == "forward" ? render::ShadingPath::Forward : render::ShadingPath::Visibility;
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rtr-view: %s\n", e.what());
-    return 1;
+    return cli::fail("rtr-view", e);
   }
 }

@@ -22,7 +22,8 @@ struct ViewOptions {
   LightOptions lightOptions;
   render::MipMode mips = render::MipMode::Compute;
   int frames = 1;                  // frames to render before the screenshot
-  std::string screenshot;          // PNG path; empty: none
+  std::string screenshot;          // image path (.png, .jpg, .exr, .hdr); empty: none
+  bool force = false;              // overwrite an existing screenshot
   int bench = 0;                   // frames to time after warm-up; 0: no benchmark
   bool watch = false;              // hot-reload shaders
   std::string device;

@@ -354,7 +354,7 @@ int runWindowed(const ViewOptions& o) {
 
       if (readBack) VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
       if (takeShot) {
-        savePng(o.screenshot, readSwapchainImage(shot, swapchain.format(), e));
+        saveImage(o.screenshot, readSwapchainImage(shot, swapchain.format(), e), {o.force ? Replace::Yes : Replace::No, true});
         std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());
         glfwSetWindowShouldClose(window, GLFW_TRUE);
       }
