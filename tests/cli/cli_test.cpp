@@ -178,7 +178,7 @@ TEST_F(Cli, BadOptionValuesAreUsageErrorsNamingTheOption) {
 }
 
 TEST_F(Cli, VersionAndExitStatusInHelp) {
-  for (const std::string tool : {"rtr-view", "rtr-trace", "rtr-bake"}) {
+  for (const std::string tool : {"rtr-view", "rtr-trace", "rtr-bake", "rtr-reflect"}) {
     const Result v = run(tool, {"--version"});
     EXPECT_EQ(v.exitCode, 0) << tool << v.err;
     EXPECT_THAT(v.out, HasSubstr(tool + " 0.")) << tool;

@@ -247,7 +247,7 @@ TEST(ReflectModernTool, ModuleSpirvReflectRefusesIsAnErrorNamingTheFile) {
   int status = 0;
   std::string out = runTool(file, &status);
   EXPECT_NE(status, 0);
-  EXPECT_NE(out.find("rtr-reflect: broken.spv: SPIRV-Reflect cannot read"), std::string::npos) << out;
+  EXPECT_NE(out.find("rtr-reflect: error: broken.spv: SPIRV-Reflect cannot read"), std::string::npos) << out;
 }
 
 TEST(ReflectModernTool, EachIncludeOptionTakesOneFolder) {

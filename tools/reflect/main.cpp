@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/cli.hpp"
 #include "core/error.hpp"
 #include "vk/glsl.hpp"
 #include "vk/reflect.hpp"
@@ -19,7 +20,8 @@ int main(int argc, char** argv) {
       "outputs. The descriptor set layouts and push-constant ranges shown are exactly those the renderer\n"
       "creates. SPIR-V that spirv-val rejects is a warning (newer compilers write what Debian's validator\n"
       "does not know yet), an error with --strict. Exit status 1 on SPIR-V that cannot be reflected, a\n"
-      "GLSL error, a cross-stage conflict, or with --strict a module spirv-val rejects."};
+      "GLSL error, a cross-stage conflict, or with --strict a module spirv-val rejects.",
+      "rtr-reflect"};
   std::vector<std::string> files;
   std::vector<std::string> includes;
   bool json = false, noValidate = false, strict = false;
@@ -29,7 +31,7 @@ int main(int argc, char** argv) {
   app.add_option("-I,--include", includes, "include folder for GLSL inputs (repeatable)")->allow_extra_args(false);
   app.add_flag("--no-validate", noValidate, "skip spirv-val style validation of SPIR-V inputs");
   app.add_flag("--strict", strict, "a module spirv-val rejects is an error (exit 1), not a warning");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   try {
     std::vector<std::filesystem::path> dirs(includes.begin(), includes.end());
@@ -47,8 +49,7 @@ int main(int argc, char** argv) {
     const auto iface = rtr::vk::reflectPipeline(modules);
     std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
     return 0;
-  } catch (const rtr::Error& e) {
-    std::fprintf(stderr, "rtr-reflect: %s\n", e.what());
-    return 1;
+  } catch (const std::exception& e) {
+    return rtr::cli::fail("rtr-reflect", e);
   }
 }
