@@ -88,6 +88,48 @@ TEST_F(ImageWrite, FormatFollowsTheExtension) {
   EXPECT_FALSE(std::filesystem::exists(dir / "a.bmp"));
 }
 
+// JPEG decodes through libjpeg-turbo: a smooth image comes back close (lossy) in every channel count the
+// texture slots ask for, alpha opaque; truncated or broken files are errors naming the file, never a crash.
+TEST_F(ImageWrite, JpegDecodesInEveryChannelCount) {
+  ImageRGBA8 img{64, 48, std::vector<uint8_t>(64 * 48 * 4)};
+  for (uint32_t y = 0; y < 48; ++y)
+    for (uint32_t x = 0; x < 64; ++x) {
+      uint8_t* p = &img.pixels[(y * 64 + x) * 4];
+      p[0] = uint8_t(x * 4), p[1] = uint8_t(y * 5), p[2] = 128, p[3] = 7;
+    }
+  saveImage(dir / "g.jpg", img);
+  for (int channels : {1, 2, 3, 4}) {
+    const TexelData t = loadImage(dir / "g.jpg", channels);
+    ASSERT_EQ(t.width, 64u);
+    ASSERT_EQ(t.height, 48u);
+    ASSERT_EQ(t.texels.size(), size_t(64 * 48 * channels));
+    const uint8_t* p = &t.texels[(20 * 64 + 30) * channels];
+    if (channels >= 3) {
+      EXPECT_NEAR(p[0], 120, 6) << channels;
+      EXPECT_NEAR(p[1], 100, 6) << channels;
+      EXPECT_NEAR(p[2], 128, 6) << channels;
+    } else {
+      EXPECT_NEAR(p[0], 0.299 * 120 + 0.587 * 100 + 0.114 * 128, 6) << channels;  // luma
+    }
+    if (channels % 2 == 0) {
+      EXPECT_EQ(p[channels - 1], 255) << "alpha is opaque";
+    }
+  }
+  const std::string bytes = readAll(dir / "g.jpg");
+  std::ofstream(dir / "cut.jpg", std::ios::binary) << bytes.substr(0, 200);
+  std::string bad = bytes;
+  for (size_t i = 20; i < 400 && i < bad.size(); ++i) bad[i] = char(0xFF);  // tables overwritten
+  std::ofstream(dir / "bad.jpg", std::ios::binary) << bad;
+  for (const char* f : {"cut.jpg", "bad.jpg"}) {
+    try {
+      const TexelData t = loadImage(dir / f, 4);
+      EXPECT_EQ(t.texels.size(), size_t(t.width) * t.height * 4) << f;  // recovered: still consistent
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+    }
+  }
+}
+
 // The tracer's radiance goes to .exr as-is: values above 1 and exact floats survive.
 TEST_F(ImageWrite, ExrKeepsLinearFloats) {
   ImageF img{3, 2, {}};
