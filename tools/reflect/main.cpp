@@ -1,4 +1,7 @@
 // rtr-reflect: prints the interface of a pipeline's shaders, as the renderer derives its layouts from it.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <iostream>
 
@@ -8,6 +11,33 @@
 #include "core/error.hpp"
 #include "vk/glsl.hpp"
 #include "vk/reflect.hpp"
+
+namespace {
+
+int reflectAll(const std::vector<std::string>& files, const std::vector<std::string>& includes, bool json,
+               bool noValidate, bool strict) {
+  try {
+    std::vector<std::filesystem::path> dirs(includes.begin(), includes.end());
+    std::vector<rtr::vk::SpirvModule> modules;
+    for (const auto& f : files) {
+      modules.push_back(rtr::vk::isGlslPath(f) ? rtr::vk::compileGlsl(f, dirs) : rtr::vk::readSpirv(f));
+      if (noValidate) continue;
+      try {
+        rtr::vk::validateSpirv(modules.back());
+      } catch (const rtr::Error& e) {
+        if (strict) throw;
+        std::fprintf(stderr, "rtr-reflect: warning: %s\n  (reflecting it anyway; --strict makes this an error)\n", e.what());
+      }
+    }
+    const auto iface = rtr::vk::reflectPipeline(modules);
+    std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
+    return 0;
+  } catch (const std::exception& e) {
+    return rtr::cli::fail("rtr-reflect", e);
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -33,23 +63,23 @@ int main(int argc, char** argv) {
   app.add_flag("--strict", strict, "a module spirv-val rejects is an error (exit 1), not a warning");
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
-  try {
-    std::vector<std::filesystem::path> dirs(includes.begin(), includes.end());
-    std::vector<rtr::vk::SpirvModule> modules;
-    for (const auto& f : files) {
-      modules.push_back(rtr::vk::isGlslPath(f) ? rtr::vk::compileGlsl(f, dirs) : rtr::vk::readSpirv(f));
-      if (noValidate) continue;
-      try {
-        rtr::vk::validateSpirv(modules.back());
-      } catch (const rtr::Error& e) {
-        if (strict) throw;
-        std::fprintf(stderr, "rtr-reflect: warning: %s\n  (reflecting it anyway; --strict makes this an error)\n", e.what());
-      }
-    }
-    const auto iface = rtr::vk::reflectPipeline(modules);
-    std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
-    return 0;
-  } catch (const std::exception& e) {
-    return rtr::cli::fail("rtr-reflect", e);
+  // SPIRV-Reflect (third party) asserts or crashes on some modules, even ones spirv-val accepts (found
+  // by fuzzing, docs/fuzzing.md). The work runs in a child process so that the tool reports such a module
+  // instead of dying with it.
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int rc = reflectAll(files, includes, json, noValidate, strict);
+    std::cout.flush();
+    std::fflush(nullptr);
+    _exit(rc);
   }
+  int status = 0;
+  if (pid < 0 || waitpid(pid, &status, 0) != pid) return reflectAll(files, includes, json, noValidate, strict);
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  std::string names;
+  for (const auto& f : files) names += (names.empty() ? "" : ", ") + f;
+  std::fprintf(stderr, "rtr-reflect: error: %s: SPIRV-Reflect crashed reading it (signal %d); the module is "
+               "malformed in a way SPIRV-Reflect does not check\n", names.c_str(), WTERMSIG(status));
+  return 1;
 }
