@@ -23,6 +23,7 @@
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 namespace {
 
@@ -125,7 +126,8 @@ TEST_F(Cli, BadOptionValuesAreUsageErrorsNamingTheOption) {
   const std::vector<BadValue> table = {
       {"rtr-view", {c, "--headless", "--screenshot", png, "--size", "4294967297x1"}, "--size"},
       {"rtr-view", {c, "--headless", "--screenshot", png, "--size", "0x5"}, "--size"},
-      {"rtr-view", {c, "--headless", "--screenshot", png, "--size", "16385x4"}, "--size"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--size", "16385x4"}, "--size"},  // lavapipe: 16384
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--size", "32769x4"}, "--size"},
       {"rtr-view", {c, "--headless", "--screenshot", png, "--fov", "0"}, "--fov"},
       {"rtr-view", {c, "--headless", "--screenshot", png, "--fov", "nan"}, "--fov"},
       {"rtr-view", {c, "--headless", "--screenshot", png, "--fov", "180"}, "--fov"},
@@ -300,6 +302,30 @@ TEST_F(Cli, KilledBakeLeavesTheOldFileAndTheNextRunNoTemporary) {
   EXPECT_EQ(namesIn(out.parent_path()), (std::vector<std::string>{"t-tex", "t.rtrscene"}));
   for (const auto& e : fs::directory_iterator(out.parent_path() / "t-tex"))
     EXPECT_EQ(e.path().filename().string().find(".rtrtmp"), std::string::npos) << e.path();
+}
+
+// A scene without lights is never black in silence: both tools say they add a headlight, and with
+// --no-default-light an all-black image gets a warning (exit 0: the image is what was asked for).
+TEST_F(Cli, NoLightsIsNeverBlackInSilence) {
+  const fs::path obj = dir / "sheet.obj";
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";  // no MTL, no light
+  const std::string png = (dir / "t.png").string(), vpng = (dir / "v.png").string();
+  Result r = run("rtr-trace", {obj.string(), "-o", png, "--size", "32x24"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("headlight"));
+  EXPECT_THAT(r.err, Not(HasSubstr("all black")));
+  r = run("rtr-trace", {obj.string(), "-o", png, "--size", "32x24", "--force", "--no-default-light"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("all black"));
+  // The viewer's ambient alone would light it a little: without ambient it is black too.
+  r = run("rtr-view", {obj.string(), "--headless", "--screenshot", vpng, "--size", "32x24", "--no-default-light",
+                       "--ambient", "0"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("all black"));
+  r = run("rtr-view", {obj.string(), "--headless", "--screenshot", vpng, "--size", "32x24", "--force"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("headlight"));
+  EXPECT_THAT(r.err, Not(HasSubstr("all black")));
 }
 
 }  // namespace

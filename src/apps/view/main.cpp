@@ -22,6 +22,13 @@ CameraPose startPose(const ViewOptions& o, const Scene& scene) {
   return framingPose(scene, o.lens, float(o.width) / float(o.height));
 }
 
+void checkSizeFits(const ViewOptions& o, const vk::Context& ctx) {
+  const uint32_t max = ctx.properties().limits.maxImageDimension2D;
+  if (o.width > max || o.height > max)
+    throw UsageError("--size " + std::to_string(o.width) + "x" + std::to_string(o.height) + ": " + ctx.deviceName() +
+                     " makes images of at most " + std::to_string(max) + " pixels a side");
+}
+
 render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
   render::RenderSettings s = o.settings;
   s.lights = resolveLights(scene, o.lightOptions);
@@ -68,6 +75,7 @@ int runHeadless(const ViewOptions& o) {
   if (o.validation) co.validation = true;
   if (!o.device.empty()) co.device = o.device;
   vk::Context ctx(co);
+  checkSizeFits(o, ctx);
   Scene scene = loadScene(o.scene, o.load);
   render::GpuScene gpuScene(ctx, scene, o.mips);
   const auto& st = gpuScene.stats();
@@ -141,7 +149,7 @@ int main(int argc, char** argv) {
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
 
   try {
-    const cli::Size sz = cli::parseSize("--size", size);
+    const cli::Size sz = cli::parseSize("--size", size, view::kMaxSize);  // the device's own limit is checked once it is known
     o.width = sz.width;
     o.height = sz.height;
     if (!camera.empty()) o.camera = cli::parsePose("--camera", camera);

@@ -9,6 +9,10 @@
 #include "scene/lights.hpp"
 #include "scene/load.hpp"
 
+namespace rtr::vk {
+class Context;
+}
+
 namespace rtr::view {
 
 struct ViewOptions {
@@ -29,6 +33,10 @@ struct ViewOptions {
   std::string device;
   bool validation = false;
 };
+
+constexpr uint32_t kMaxSize = 32768;  // the largest image side any Vulkan device offers today
+// --size within the device's maxImageDimension2D; throws rtr::UsageError naming the limit.
+void checkSizeFits(const ViewOptions& o, const vk::Context& ctx);
 
 // The start pose: --camera, else the scene's own view, else framing the scene (framingPose), as rtr-trace.
 CameraPose startPose(const ViewOptions& o, const Scene& scene);

@@ -132,6 +132,7 @@ int runWindowed(const ViewOptions& o) {
   co.instanceExtensions.assign(exts, exts + extCount);
   co.presentation = true;
   vk::Context ctx(co);
+  checkSizeFits(o, ctx);
 
   GLFWwindow* window = glfwCreateWindow(int(o.width), int(o.height), "rtr-view", nullptr, nullptr);
   if (!window) throw Error("cannot create a window");
