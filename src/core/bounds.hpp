@@ -2,8 +2,9 @@
 #include <algorithm>
 #include <limits>
 
-#include <glm/vec3.hpp>
 #include <glm/common.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
 
 namespace rtr {
 
@@ -17,5 +18,16 @@ struct Bounds {
   glm::vec3 center() const { return (min + max) * 0.5f; }
   glm::vec3 extent() const { return max - min; }
 };
+
+// The box around `b`'s eight corners moved by `m`.
+inline Bounds transformed(const Bounds& b, const glm::mat4& m) {
+  if (b.empty()) return b;
+  Bounds out;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 p{i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z};
+    out.extend(glm::vec3(m * glm::vec4(p, 1.0f)));
+  }
+  return out;
+}
 
 }  // namespace rtr

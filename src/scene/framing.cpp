@@ -21,20 +21,6 @@ double frontArea(const Scene& scene, const glm::vec3& toViewer) {
   return 0.5 * area;
 }
 
-namespace {
-
-Bounds transformed(const Bounds& b, const glm::mat4& m) {
-  if (b.empty()) return b;
-  Bounds out;
-  for (int i = 0; i < 8; ++i) {
-    const glm::vec3 p{i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z};
-    out.extend(glm::vec3(m * glm::vec4(p, 1.0f)));
-  }
-  return out;
-}
-
-}  // namespace
-
 CameraPose framingPose(const Scene& scene, const Lens& lens, float aspect, const glm::mat4& model) {
   const Bounds bounds = transformed(scene.bounds(), model);
   if (hasOwnLights(scene)) return frameBounds(bounds, lens, aspect);

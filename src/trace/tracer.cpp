@@ -255,18 +255,6 @@ const SceneTextures& Tracer::textures() const {
   return *textures_;
 }
 
-namespace {
-Bounds transformed(const Bounds& b, const glm::mat4& m) {
-  if (b.empty()) return b;
-  Bounds out;
-  for (int i = 0; i < 8; ++i) {
-    const glm::vec3 p{i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z};
-    out.extend(glm::vec3(m * glm::vec4(p, 1.0f)));
-  }
-  return out;
-}
-}  // namespace
-
 CameraPose Tracer::resolvePose(const TraceSettings& s) const {
   if (s.pose) return *s.pose;
   if (scene_.defaultView) return *scene_.defaultView;  // the view the scene was baked with, as rtr-view starts
