@@ -19,6 +19,7 @@
 #include "scene/load.hpp"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
+#include "vk/frame_ring.hpp"
 #include "vk/swapchain.hpp"
 
 namespace rtr::view {
@@ -164,37 +165,13 @@ int runWindowed(const ViewOptions& o) {
     vk::Swapchain swapchain(ctx, surface, {o.width, o.height});
     render::Renderer renderer(ctx, gpuScene, kFramesInFlight);
 
-    struct Frame { vk::CommandPool pool; VkCommandBuffer cb; vk::Fence fence; vk::Semaphore acquired; };
-    std::vector<Frame> frames(kFramesInFlight);
-    for (Frame& f : frames) {
-      VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-      pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-      pi.queueFamilyIndex = ctx.queueFamily();
-      VkCommandPool pool;
-      VK_CHECK(vkCreateCommandPool(ctx.device(), &pi, nullptr, &pool));
-      f.pool = vk::CommandPool(ctx.device(), pool);
-      VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-      ai.commandPool = pool;
-      ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-      ai.commandBufferCount = 1;
-      VK_CHECK(vkAllocateCommandBuffers(ctx.device(), &ai, &f.cb));
-      VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-      fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-      VkFence fence;
-      VK_CHECK(vkCreateFence(ctx.device(), &fi, nullptr, &fence));
-      f.fence = vk::Fence(ctx.device(), fence);
-      VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-      VkSemaphore sem;
-      VK_CHECK(vkCreateSemaphore(ctx.device(), &si, nullptr, &sem));
-      f.acquired = vk::Semaphore(ctx.device(), sem);
-    }
+    vk::FrameRing ring(ctx, kFramesInFlight);
     vk::Buffer shot;  // screenshot readback
     TraceOverlay traced(scene);
     std::unique_ptr<ShaderWatcher> watcher;
     if (o.watch) watcher = std::make_unique<ShaderWatcher>(RTR_SHADER_SOURCE_DIR);
     std::string shaderError;
     double watchTimer = 0;
-    vk::Buffer traceStaging;
     render::TextOverlay text(ctx, kFramesInFlight);
     std::string overlayText;
 
@@ -245,14 +222,11 @@ int runWindowed(const ViewOptions& o) {
         const VkExtent2D e = swapchain.extent();
         app.camera.setPose(framingPose(scene, o.lens, float(e.width) / float(std::max(1u, e.height))));
       }
-      Frame& f = frames[frameNumber % kFramesInFlight];
-      VkFence fence = f.fence;
-      VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
+      vk::Frame& f = ring.begin();
       uint32_t imageIndex = 0;
       VkResult acq = vkAcquireNextImageKHR(ctx.device(), swapchain.handle(), UINT64_MAX, f.acquired, VK_NULL_HANDLE, &imageIndex);
       if (acq == VK_ERROR_OUT_OF_DATE_KHR) { app.resized = true; continue; }
       if (acq != VK_SUBOPTIMAL_KHR) VK_CHECK(acq);
-      VK_CHECK(vkResetFences(ctx.device(), 1, &fence));
 
       auto traceSettings = [&] {
         trace::TraceSettings ts;
@@ -294,18 +268,14 @@ int runWindowed(const ViewOptions& o) {
         frameSettings.mosaic = render::MosaicMode::Off;
       }
 
-      VK_CHECK(vkResetCommandBuffer(f.cb, 0));
-      VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-      bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-      VK_CHECK(vkBeginCommandBuffer(f.cb, &bi));
       const bool showTrace = traced.visible() && (swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT);
       const VkImageLayout finalLayout = readBack ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
       const render::RenderTarget target{swapchain.image(imageIndex), swapchain.view(imageIndex), swapchain.format(), e,
                                         showTrace ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : finalLayout};
       const Lens lens = fitDepthRange(o.lens, bounds, app.camera.pose());
-      renderer.record(f.cb, uint32_t(frameNumber % kFramesInFlight), app.camera.pose(), lens, frameSettings, target);
+      renderer.record(f.cb, f.index, app.camera.pose(), lens, frameSettings, target);
       if (showTrace) {  // the traced image over the raster one
-        traced.recordCopy(ctx, f.cb, target.image, swapchain.format(), e, traceStaging);
+        traced.recordCopy(f, target.image, swapchain.format(), e);
         vk::barrier(f.cb, {{target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, finalLayout, VK_PIPELINE_STAGE_2_COPY_BIT,
                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                             VK_ACCESS_2_TRANSFER_READ_BIT}});
@@ -317,28 +287,12 @@ int runWindowed(const ViewOptions& o) {
       }
       // The overlay comes last, after any read-back copy: screenshots never contain it.
       if (app.overlay && !readBack)
-        text.record(f.cb, uint32_t(frameNumber % kFramesInFlight), overlayText, target.image, target.view,
+        text.record(f.cb, f.index, overlayText, target.image, target.view,
                     swapchain.format(), e, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
                     e.width >= 1280 ? 2.0f : 1.0f);  // the pixel font scales by whole pixels only
-      VK_CHECK(vkEndCommandBuffer(f.cb));
-
-      VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-      wait.semaphore = f.acquired;
       // The post pass is the first to touch the swapchain image, in compute or as a colour attachment.
-      wait.stageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-      VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-      signal.semaphore = swapchain.renderDone(imageIndex);
-      signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-      VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-      cbi.commandBuffer = f.cb;
-      VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-      si.waitSemaphoreInfoCount = 1;
-      si.pWaitSemaphoreInfos = &wait;
-      si.commandBufferInfoCount = 1;
-      si.pCommandBufferInfos = &cbi;
-      si.signalSemaphoreInfoCount = 1;
-      si.pSignalSemaphoreInfos = &signal;
-      VK_CHECK(vkQueueSubmit2(ctx.queue(), 1, &si, fence));
+      ring.submit(f, f.acquired, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                  swapchain.renderDone(imageIndex));
 
       VkSemaphore done = swapchain.renderDone(imageIndex);
       VkSwapchainKHR sc = swapchain.handle();
@@ -352,7 +306,7 @@ int runWindowed(const ViewOptions& o) {
       if (pr == VK_ERROR_OUT_OF_DATE_KHR || pr == VK_SUBOPTIMAL_KHR) app.resized = true;
       else VK_CHECK(pr);
 
-      if (readBack) VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
+      if (readBack) ring.waitIdle();
       if (takeShot) {
         saveImage(o.screenshot, readSwapchainImage(shot, swapchain.format(), e), {o.force ? Replace::Yes : Replace::No, true});
         std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());
@@ -379,7 +333,7 @@ int runWindowed(const ViewOptions& o) {
         std::snprintf(buf, sizeof buf, "CPU frame %.2f ms", cpuFrameMs);
         lines.push_back(buf);
         std::string gpu = "GPU";
-        for (const auto& [name, ms] : renderer.gpuTimes(uint32_t(frameNumber % kFramesInFlight))) {
+        for (const auto& [name, ms] : renderer.gpuTimes((f.index + 1) % ring.size())) {
           std::snprintf(buf, sizeof buf, " | %s %.3f ms", name.c_str(), ms);
           gpu += buf;
         }
@@ -394,7 +348,7 @@ int runWindowed(const ViewOptions& o) {
         overlayText += kKeyHelp;
       }
     }
-    vkDeviceWaitIdle(ctx.device());
+    ring.waitIdle();
   }
   return 0;
 }
