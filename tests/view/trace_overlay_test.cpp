@@ -2,6 +2,8 @@
 // that frame was recorded, even when a later frame uploads a newer image before the earlier one ran.
 #include <gtest/gtest.h>
 
+#include "test_paths.hpp"
+
 #include "scene/load.hpp"
 #include "trace_overlay.hpp"
 #include "vk/commands.hpp"
@@ -16,7 +18,7 @@ constexpr uint32_t kW = 64, kH = 48;
 class TraceOverlayTest : public test::VulkanTest {};
 
 TEST_F(TraceOverlayTest, EachFrameInFlightShowsItsOwnUpload) {
-  const Scene scene = loadScene(std::filesystem::path(RTR_SOURCE_DIR) / "assets-src/rt/cornell_box.obj");
+  const Scene scene = loadScene(test::sourceDir() / "assets-src/rt/cornell_box.obj");
   view::TraceOverlay overlay(scene);
   constexpr uint32_t kFrames = 3;
   vk::FrameRing ring(*ctx, kFrames);
