@@ -9,7 +9,7 @@
 namespace rtr::render {
 
 HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent)
-    : ctx_(ctx), extent_(extent), renderer_(ctx, scene, 1) {
+    : ctx_(ctx), extent_(extent), renderer_(ctx, scene, 1), ring_(ctx, 1) {
   target_ = vk::Image(ctx, {extent, VK_FORMAT_R8G8B8A8_UNORM, 1,
                             VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                             0, 0, "headless target"});
@@ -17,16 +17,23 @@ HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene
   readback_ = vk::Buffer(ctx, pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "target readback");
 }
 
+void HeadlessRenderer::frame(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
+                             const std::function<void(VkCommandBuffer)>& after) {
+  FrameContext fc{ring_.begin(), pose, lens, settings, target()};
+  renderer_.frame(fc);
+  if (after) after(fc.frame.cb);
+  ring_.submit(fc.frame);
+  ring_.waitIdle();
+}
+
 HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
                                        int frames, bool readSceneColor) {
-  const RenderTarget target = this->target();
   const VkDeviceSize pixels = VkDeviceSize(extent_.width) * extent_.height;
   if (readSceneColor && !colorReadback_.handle())
     colorReadback_ = vk::Buffer(ctx_, pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "colour readback");
   for (int f = 0; f < frames; ++f) {
     const bool last = f + 1 == frames;
-    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
-      renderer_.record(cb, 0, pose, lens, settings, target);
+    frame(pose, lens, settings, [&](VkCommandBuffer cb) {
       if (!last) return;
       vk::copyImageToHost(cb, target_.handle(), extent_, readback_.handle());
       if (readSceneColor) {
@@ -58,10 +65,9 @@ HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens,
 
 std::vector<std::vector<std::pair<std::string, double>>> HeadlessRenderer::bench(const CameraPose& pose, const Lens& lens,
                                                                                  const RenderSettings& settings, int frames) {
-  const RenderTarget target = this->target();
   std::vector<std::vector<std::pair<std::string, double>>> out;
   for (int f = 0; f < frames; ++f) {
-    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) { renderer_.record(cb, 0, pose, lens, settings, target); });
+    frame(pose, lens, settings);
     out.push_back(renderer_.gpuTimes(0));
   }
   return out;

@@ -1,5 +1,6 @@
 #pragma once
 // Offscreen rendering with no window and no display: the frame goes to an image that is read back.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,10 +30,14 @@ class HeadlessRenderer {
   RenderTarget target() const {
     return {target_.handle(), target_.view(), target_.format(), extent_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
   }
+  // One frame through Renderer::frame, as the window app's; `after` records more into it. Waits for it.
+  void frame(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
+             const std::function<void(VkCommandBuffer)>& after = {});
 
   const vk::Context& ctx_;
   VkExtent2D extent_;
   Renderer renderer_;
+  vk::FrameRing ring_;  // one frame: each is waited for (a read-back, a timing)
   vk::Image target_;
   vk::Buffer readback_, colorReadback_;
 };

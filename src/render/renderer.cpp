@@ -209,8 +209,13 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, uint32_t frame) {
   vkCmdDispatch(cb, (extent_.width + group[0] - 1) / group[0], (extent_.height + group[1] - 1) / group[1], 1);
 }
 
-void Renderer::record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose, const Lens& lens,
-                      const RenderSettings& s, const RenderTarget& target) {
+void Renderer::frame(FrameContext& fc) {
+  VkCommandBuffer cb = fc.frame.cb;
+  const uint32_t frame = fc.frame.index;
+  const CameraPose& pose = fc.pose;
+  const Lens& lens = fc.lens;
+  const RenderSettings& s = fc.settings;
+  const RenderTarget& target = fc.target;
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
   const PipelineSet set = visibility ? kVisibility : s.mode == VIEW_SHADED ? kShaded : kDebug;
   if (target.extent.width != extent_.width || target.extent.height != extent_.height || (visibility && !vis_.handle()))

@@ -13,6 +13,7 @@
 #include "render/post.hpp"
 #include "scene/lights.hpp"
 #include "vk/commands.hpp"
+#include "vk/frame_ring.hpp"
 #include "vk/pipeline.hpp"
 
 namespace rtr::render {
@@ -41,6 +42,16 @@ struct RenderTarget {
   VkImageLayout finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
 };
 
+// What one frame needs: the frame in flight (its command buffer, still recording, and its index), the view,
+// and where the picture goes. The window app and the headless target both fill one per frame.
+struct FrameContext {
+  vk::Frame& frame;
+  CameraPose pose;
+  Lens lens;
+  RenderSettings settings;
+  RenderTarget target;
+};
+
 class Renderer {
  public:
   static constexpr VkFormat kColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
@@ -49,9 +60,8 @@ class Renderer {
 
   Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight);
 
-  // Records the whole frame; `frame` picks the per-frame-in-flight uniform buffer and timer.
-  void record(VkCommandBuffer cb, uint32_t frame, const CameraPose& pose, const Lens& lens,
-              const RenderSettings& settings, const RenderTarget& target);
+  // Records the whole frame into fc.frame's command buffer; its index picks the uniforms and timer.
+  void frame(FrameContext& fc);
   // Per-pass GPU times of the last completed use of `frame`, in ms.
   std::vector<std::pair<std::string, double>> gpuTimes(uint32_t frame) const { return timers_[frame].results(); }
   // The linear-light intermediate image of the last frame (SHADER_READ_ONLY_OPTIMAL after a frame).

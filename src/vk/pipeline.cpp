@@ -278,13 +278,9 @@ DescriptorSets::DescriptorSets(const Context& ctx, const PipelineLayout& layout,
 }
 
 DescriptorWriter::DescriptorWriter(const Context& ctx, const PipelineLayout& layout, uint32_t set, VkDescriptorSet ds)
-    : ctx_(ctx), layout_(layout), set_(set), ds_(ds) {
-  bufferInfos_.reserve(16);
-  imageInfos_.reserve(16);
-}
+    : ctx_(ctx), layout_(layout), set_(set), ds_(ds) {}
 
 DescriptorWriter& DescriptorWriter::buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset, VkDeviceSize range) {
-  if (bufferInfos_.size() == bufferInfos_.capacity()) throw Error("DescriptorWriter: too many buffer writes");
   bufferInfos_.push_back({buffer, offset, range});
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = ds_;
@@ -301,7 +297,6 @@ DescriptorWriter& DescriptorWriter::image(uint32_t binding, VkImageView view, Vk
 }
 
 DescriptorWriter& DescriptorWriter::images(uint32_t binding, const std::vector<VkDescriptorImageInfo>& infos) {
-  if (imageInfos_.size() == imageInfos_.capacity()) throw Error("DescriptorWriter: too many image writes");
   imageInfos_.push_back(infos);
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = ds_;
@@ -315,12 +310,18 @@ DescriptorWriter& DescriptorWriter::images(uint32_t binding, const std::vector<V
 
 void DescriptorWriter::push(VkCommandBuffer cb, const Pipeline& pipeline) {
   ctx_.pushDescriptorFn()(cb, pipeline.bindPoint, pipeline.layout.handle(), set_, uint32_t(writes_.size()), writes_.data());
+  clear();
+}
+
+void DescriptorWriter::clear() {
   writes_.clear();
+  bufferInfos_.clear();
+  imageInfos_.clear();
 }
 
 void DescriptorWriter::commit() {
   vkUpdateDescriptorSets(ctx_.device(), uint32_t(writes_.size()), writes_.data(), 0, nullptr);
-  writes_.clear();
+  clear();
 }
 
 }  // namespace rtr::vk

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <deque>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -119,8 +120,10 @@ class DescriptorWriter {
   const PipelineLayout& layout_;
   uint32_t set_;
   VkDescriptorSet ds_;
-  std::vector<std::vector<VkDescriptorImageInfo>> imageInfos_;
-  std::vector<VkDescriptorBufferInfo> bufferInfos_;
+  void clear();
+  // Deques: the writes point into them, and a deque keeps its elements in place as it grows.
+  std::deque<std::vector<VkDescriptorImageInfo>> imageInfos_;
+  std::deque<VkDescriptorBufferInfo> bufferInfos_;
   std::vector<VkWriteDescriptorSet> writes_;
 };
 

@@ -30,7 +30,36 @@ void Swapchain::recreate(VkExtent2D windowExtent) {
   vkDestroySwapchainKHR(ctx_.device(), old, nullptr);
 }
 
+std::optional<uint32_t> Swapchain::acquire(VkSemaphore acquired, VkExtent2D windowExtent) {
+  if (stale_ || windowExtent.width != windowExtent_.width || windowExtent.height != windowExtent_.height)
+    recreate(windowExtent);
+  uint32_t i = 0;
+  const VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, UINT64_MAX, acquired, VK_NULL_HANDLE, &i);
+  if (r == VK_ERROR_OUT_OF_DATE_KHR) {
+    recreate(windowExtent);
+    return std::nullopt;
+  }
+  if (r == VK_SUBOPTIMAL_KHR) stale_ = true;  // usable now; recreated before the next frame
+  else VK_CHECK(r);
+  return i;
+}
+
+void Swapchain::present(uint32_t i) {
+  VkSemaphore done = renderDone_[i];
+  VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+  pi.waitSemaphoreCount = 1;
+  pi.pWaitSemaphores = &done;
+  pi.swapchainCount = 1;
+  pi.pSwapchains = &swapchain_;
+  pi.pImageIndices = &i;
+  const VkResult r = vkQueuePresentKHR(ctx_.queue(), &pi);
+  if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) stale_ = true;
+  else VK_CHECK(r);
+}
+
 void Swapchain::create(VkExtent2D windowExtent, VkSwapchainKHR old) {
+  windowExtent_ = windowExtent;
+  stale_ = false;
   VkPhysicalDevice pd = ctx_.physicalDevice();
   VkBool32 presentable = VK_FALSE;
   VK_CHECK(vkGetPhysicalDeviceSurfaceSupportKHR(pd, ctx_.queueFamily(), surface_, &presentable));

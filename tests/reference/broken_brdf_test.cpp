@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_paths.hpp"
+
 #include "core/error.hpp"
 #include "reference_common.hpp"
 #include "vk/glsl.hpp"
@@ -39,7 +41,7 @@ std::string readAll(const std::filesystem::path& f) {
 // A shader folder: every compiled shader of the build, with the shaded view's shaders (forward and
 // visibility path) recompiled against brdf.h with `edit` applied.
 std::filesystem::path shaderFolderWith(const Edit& edit) {
-  const std::filesystem::path src = std::filesystem::path(RTR_SOURCE_DIR) / "shaders";
+  const std::filesystem::path src = test::sourceDir() / "shaders";
   const std::filesystem::path dir = outDir() / "work" / (std::string("shaders_") + edit.name);
   const std::filesystem::path inc = dir / "include";
   std::filesystem::create_directories(inc);

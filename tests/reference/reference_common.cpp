@@ -1,4 +1,5 @@
 #include "reference_common.hpp"
+#include "test_paths.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -40,7 +41,7 @@ Limits limits(const std::string& caseName, View v) {
 std::filesystem::path posesFile() { return sourceDir() / "tests/reference/poses.txt"; }
 
 std::filesystem::path outDir() {
-  const std::filesystem::path d = std::filesystem::path(RTR_BINARY_DIR) / "reference-out";
+  const std::filesystem::path d = test::binaryDir() / "reference-out";
   std::filesystem::create_directories(d);
   return d;
 }

@@ -1,4 +1,5 @@
 #include "reference_scenes.hpp"
+#include "test_paths.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -163,15 +164,9 @@ std::map<std::string, PoseEntry> loadPoses(const std::filesystem::path& file) {
   return out;
 }
 
-std::filesystem::path sourceDir() {
-  const char* env = std::getenv("RTR_SOURCE_DIR");
-  return env && *env ? std::filesystem::path(env) : std::filesystem::path(RTR_SOURCE_DIR);
-}
+std::filesystem::path sourceDir() { return test::sourceDir(); }
 
-std::filesystem::path assetDir() {
-  const char* env = std::getenv("RTR_ASSET_DIR");
-  return env && *env ? std::filesystem::path(env) : std::filesystem::path(RTR_BINARY_DIR) / "assets";
-}
+std::filesystem::path assetDir() { return test::assetDir(); }
 
 Scene untexturedTemple(const Scene& temple, int* removed) {
   Scene s = temple;

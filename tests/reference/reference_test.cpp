@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_paths.hpp"
+
 #include "core/compare.hpp"
 #include "reference_common.hpp"
 #include "vk_fixture.hpp"
@@ -76,7 +78,7 @@ TEST(ReferencePoses, FileAndCasesAgree) {
 
 // The untextured temple copy removes exactly the card meshes and keeps no texture reference.
 TEST(ReferenceScenes, UntexturedTempleDropsOnlyCards) {
-  const Scene temple = loadScene(std::filesystem::path(RTR_BINARY_DIR) / "assets/temple.rtrscene");
+  const Scene temple = loadScene(test::assetDir() / "temple.rtrscene");
   int removed = 0;
   const Scene s = untexturedTemple(temple, &removed);
   EXPECT_EQ(removed, 4) << "foliage, ivy, fire_L, fire_R expected; the generated scene changed?";
@@ -99,7 +101,7 @@ TEST(ReferenceScenes, TempleIsLitByTheBriefsStoredLight) {
 
 // The textured temple is the scene as baked (textures, cards), with only the fire cards made two-sided.
 TEST(ReferenceScenes, TexturedTempleKeepsTexturesAndCards) {
-  const Scene temple = loadScene(std::filesystem::path(RTR_BINARY_DIR) / "assets/temple.rtrscene");
+  const Scene temple = loadScene(test::assetDir() / "temple.rtrscene");
   const Scene s = texturedTemple(temple, outDir() / "work");
   EXPECT_EQ(s.meshes.size(), temple.meshes.size());
   EXPECT_EQ(s.textures.size(), temple.textures.size() + 1);  // the opaque mask of the fire cards

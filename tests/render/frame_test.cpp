@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_paths.hpp"
+
 #include "core/image.hpp"
 #include "render/headless.hpp"
 #include "scene/load.hpp"
@@ -21,7 +23,7 @@ class FrameTest : public test::VulkanTest {
  protected:
   void SetUp() override {
     VulkanTest::SetUp();
-    scene = loadScene(std::filesystem::path(RTR_BINARY_DIR) / "assets/temple.rtrscene");
+    scene = loadScene(test::assetDir() / "temple.rtrscene");
     gpu = std::make_unique<render::GpuScene>(*ctx, scene, render::MipMode::Compute);
     renderer = std::make_unique<HeadlessRenderer>(*ctx, *gpu, VkExtent2D{kW, kH});
     pose = scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, float(kW) / kH));

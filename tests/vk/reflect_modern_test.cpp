@@ -7,6 +7,8 @@
 #include <memory>
 
 #include <gtest/gtest.h>
+
+#include "test_paths.hpp"
 #include <spirv-tools/libspirv.hpp>
 
 #include "core/error.hpp"
@@ -18,7 +20,7 @@
 namespace rtr {
 namespace {
 
-const std::filesystem::path kData = std::filesystem::path(RTR_SOURCE_DIR) / "tests/vk/data/reflect";
+const std::filesystem::path kData = test::sourceDir() / "tests/vk/data/reflect";
 
 vk::SpirvModule compile(const std::string& name) { return vk::compileGlsl(kData / name); }
 
@@ -35,7 +37,7 @@ const vk::BlockMember& member(const std::vector<vk::BlockMember>& ms, const std:
 }
 
 std::string runTool(const std::string& args, int* status) {
-  const std::string cmd = std::string(RTR_BINARY_DIR) + "/bin/rtr-reflect " + args + " 2>&1";
+  const std::string cmd = test::toolPath("rtr-reflect") + " " + args + " 2>&1";
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
   std::string out;
   std::array<char, 4096> buf;
@@ -251,7 +253,7 @@ TEST(ReflectModernTool, ModuleSpirvReflectRefusesIsAnErrorNamingTheFile) {
 }
 
 TEST(ReflectModernTool, EachIncludeOptionTakesOneFolder) {
-  const std::string data = std::string(RTR_SOURCE_DIR) + "/tests/vk/data/";
+  const std::string data = test::sourceDir().string() + "/tests/vk/data/";
   int status = -1;
   std::string out = runTool("-I " + data + " -I " + kData.string() + " " + data + "push_a.vert " + data + "push_ok.frag", &status);
   EXPECT_EQ(status, 0) << out;

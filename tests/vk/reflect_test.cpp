@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_paths.hpp"
+
 #include "core/error.hpp"
 #include "vk/glsl.hpp"
 #include "vk/pipeline.hpp"
@@ -12,9 +14,9 @@
 namespace rtr {
 namespace {
 
-const std::filesystem::path kData = std::filesystem::path(RTR_SOURCE_DIR) / "tests/vk/data";
-const std::vector<std::filesystem::path> kIncludes = {std::filesystem::path(RTR_SOURCE_DIR) / "shaders",
-                                                      std::filesystem::path(RTR_SOURCE_DIR) / "shaders/shared"};
+const std::filesystem::path kData = test::sourceDir() / "tests/vk/data";
+const std::vector<std::filesystem::path> kIncludes = {test::sourceDir() / "shaders",
+                                                      test::sourceDir() / "shaders/shared"};
 
 std::string errorOf(const std::function<void()>& f) {
   try {

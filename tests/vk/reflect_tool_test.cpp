@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_paths.hpp"
+
 #include "render/renderer.hpp"
 #include "vk/pipeline.hpp"
 #include "vk_fixture.hpp"
@@ -13,7 +15,7 @@ namespace rtr {
 namespace {
 
 std::string runTool(const std::string& args, int* status) {
-  const std::string cmd = std::string(RTR_BINARY_DIR) + "/bin/rtr-reflect " + args + " 2>&1";
+  const std::string cmd = test::toolPath("rtr-reflect") + " " + args + " 2>&1";
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
   std::string out;
   std::array<char, 4096> buf;
@@ -44,11 +46,11 @@ TEST_F(VulkanTest, ReflectToolMatchesTheRenderersPipelines) {
 
 TEST(ReflectTool, ConflictAndBadInputExitNonZero) {
   int status = 0;
-  const std::string data = std::string(RTR_SOURCE_DIR) + "/tests/vk/data/";
+  const std::string data = test::sourceDir().string() + "/tests/vk/data/";
   std::string out = runTool(data + "conflict.vert " + data + "conflict.frag", &status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("set 0 binding 1"), std::string::npos) << out;
-  out = runTool(std::string(RTR_SOURCE_DIR) + "/README.md", &status);
+  out = runTool(test::sourceDir().string() + "/README.md", &status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("not SPIR-V"), std::string::npos) << out;
 }

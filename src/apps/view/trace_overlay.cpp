@@ -67,28 +67,26 @@ std::string TraceOverlay::status() const {
   return "ray traced " + std::to_string(tilesDone_.load()) + "/" + std::to_string(tilesTotal_.load()) + " tiles";
 }
 
-void TraceOverlay::recordCopy(const vk::Context& ctx, VkCommandBuffer cb, VkImage image, VkFormat format,
-                              VkExtent2D extent, vk::Buffer& staging) {
+ImageRGBA8 TraceOverlay::cpuImage() { return showError_ ? errorMap_ : toSrgb8(image_); }
+
+void TraceOverlay::recordCopy(vk::Frame& frame, VkImage image, VkFormat format, VkExtent2D extent) {
   const uint32_t w = std::min(extent.width, image_.width), h = std::min(extent.height, image_.height);
   if (w == 0 || h == 0) return;
-  const VkDeviceSize bytes = VkDeviceSize(image_.width) * image_.height * 4;
-  if (staging.size() != bytes) {
-    staging = vk::Buffer(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "trace overlay");
-    dirty_ = true;
-  }
-  if (dirty_.exchange(false)) {
+  if (dirty_.exchange(false) || shownFormat_ != format || shown_.width != image_.width || shown_.height != image_.height) {
     // Tiles still being written may show half done; the next refresh completes them.
-    ImageRGBA8 srgb = showError_ ? errorMap_ : toSrgb8(image_);
+    shown_ = cpuImage();
+    shownFormat_ = format;
     if (format == VK_FORMAT_B8G8R8A8_UNORM)
-      for (size_t i = 0; i < srgb.pixels.size(); i += 4) std::swap(srgb.pixels[i], srgb.pixels[i + 2]);
-    std::memcpy(staging.mapped(), srgb.pixels.data(), bytes);
-    staging.flush();
+      for (size_t i = 0; i < shown_.pixels.size(); i += 4) std::swap(shown_.pixels[i], shown_.pixels[i + 2]);
   }
+  const vk::UploadArena::Slice slice = frame.upload(shown_.pixels.size(), 16);
+  std::memcpy(slice.data, shown_.pixels.data(), shown_.pixels.size());
   VkBufferImageCopy region{};
-  region.bufferRowLength = image_.width;
+  region.bufferOffset = slice.offset;
+  region.bufferRowLength = shown_.width;
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {w, h, 1};
-  vkCmdCopyBufferToImage(cb, staging.handle(), image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  vkCmdCopyBufferToImage(frame.cb, slice.buffer, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
 }
 
 }  // namespace rtr::view

@@ -13,7 +13,7 @@
 
 #include "core/image.hpp"
 #include "trace/tracer.hpp"
-#include "vk/resources.hpp"
+#include "vk/frame_ring.hpp"
 
 namespace rtr::view {
 
@@ -31,9 +31,13 @@ class TraceOverlay {
   std::string status() const;
 
   // Records a copy of the traced image over `image` (in TRANSFER_DST_OPTIMAL, `format` BGRA or RGBA UNORM,
-  // holding sRGB-encoded bytes). Refreshes `staging` from the CPU image when tiles have finished.
-  void recordCopy(const vk::Context& ctx, VkCommandBuffer cb, VkImage image, VkFormat format, VkExtent2D extent,
-                  vk::Buffer& staging);
+  // holding sRGB-encoded bytes). The bytes go through the frame's upload arena: an earlier frame still in
+  // flight keeps reading its own copy while tiles finish.
+  void recordCopy(vk::Frame& frame, VkImage image, VkFormat format, VkExtent2D extent);
+  // Waits for the trace to finish (or be cancelled); then cpuImage() is final.
+  void wait() { if (worker_.joinable()) worker_.join(); }
+  // The image the overlay shows, as sRGB bytes (RGBA): the trace, or its error map.
+  ImageRGBA8 cpuImage();
 
  private:
   const Scene& scene_;
@@ -46,6 +50,8 @@ class TraceOverlay {
   ImageF image_;
   ImageRGBA8 errorMap_;
   std::string errorText_;
+  ImageRGBA8 shown_;  // cpuImage() in the target's byte order, refreshed when tiles have finished
+  VkFormat shownFormat_ = VK_FORMAT_UNDEFINED;
 };
 
 }  // namespace rtr::view

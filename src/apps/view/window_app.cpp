@@ -1,30 +1,25 @@
-// The windowed viewer: GLFW window and input, swapchain, frames in flight, and the renderer.
+// The windowed viewer: GLFW window, input and camera; the frames themselves are view_frames.cpp's.
 #include <algorithm>
 #include <chrono>
 #include <memory>
 #include <cstdio>
-#include <cstring>
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 
 #include "camera_controller.hpp"
 #include "shader_watch.hpp"
-#include "trace_overlay.hpp"
+#include "view_frames.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "options.hpp"
-#include "render/text_overlay.hpp"
 #include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
-#include "vk/swapchain.hpp"
 
 namespace rtr::view {
 namespace {
-
-constexpr uint32_t kFramesInFlight = 2;
 
 struct App {
   CameraController camera{{}, {}};
@@ -97,16 +92,6 @@ struct GlfwSession {
   ~GlfwSession() { glfwTerminate(); }
 };
 
-// A read-back presented-format image (BGRA or RGBA UNORM) as RGBA bytes.
-ImageRGBA8 readSwapchainImage(const vk::Buffer& buf, VkFormat format, VkExtent2D e) {
-  buf.invalidate();
-  ImageRGBA8 img{e.width, e.height, std::vector<uint8_t>(size_t(e.width) * e.height * 4)};
-  std::memcpy(img.pixels.data(), buf.mapped(), img.pixels.size());
-  if (format == VK_FORMAT_B8G8R8A8_UNORM)
-    for (size_t i = 0; i < img.pixels.size(); i += 4) std::swap(img.pixels[i], img.pixels[i + 2]);
-  return img;
-}
-
 const char* const kKeyHelp =
     "W/S/A/D/E/Q move, Shift/Ctrl faster/slower, right mouse: mouse-look\n"
     "1-7 views, 8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic\n"
@@ -162,41 +147,12 @@ int runWindowed(const ViewOptions& o) {
 
   render::GpuScene gpuScene(ctx, scene, o.mips);
   {
-    vk::Swapchain swapchain(ctx, surface, {o.width, o.height});
-    render::Renderer renderer(ctx, gpuScene, kFramesInFlight);
-
-    struct Frame { vk::CommandPool pool; VkCommandBuffer cb; vk::Fence fence; vk::Semaphore acquired; };
-    std::vector<Frame> frames(kFramesInFlight);
-    for (Frame& f : frames) {
-      VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-      pi.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-      pi.queueFamilyIndex = ctx.queueFamily();
-      VkCommandPool pool;
-      VK_CHECK(vkCreateCommandPool(ctx.device(), &pi, nullptr, &pool));
-      f.pool = vk::CommandPool(ctx.device(), pool);
-      VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-      ai.commandPool = pool;
-      ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-      ai.commandBufferCount = 1;
-      VK_CHECK(vkAllocateCommandBuffers(ctx.device(), &ai, &f.cb));
-      VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-      fi.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-      VkFence fence;
-      VK_CHECK(vkCreateFence(ctx.device(), &fi, nullptr, &fence));
-      f.fence = vk::Fence(ctx.device(), fence);
-      VkSemaphoreCreateInfo si{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-      VkSemaphore sem;
-      VK_CHECK(vkCreateSemaphore(ctx.device(), &si, nullptr, &sem));
-      f.acquired = vk::Semaphore(ctx.device(), sem);
-    }
-    vk::Buffer shot;  // screenshot readback
+    ViewFrames frames(ctx, surface, {o.width, o.height}, gpuScene);
     TraceOverlay traced(scene);
     std::unique_ptr<ShaderWatcher> watcher;
     if (o.watch) watcher = std::make_unique<ShaderWatcher>(RTR_SHADER_SOURCE_DIR);
     std::string shaderError;
     double watchTimer = 0;
-    vk::Buffer traceStaging;
-    render::TextOverlay text(ctx, kFramesInFlight);
     std::string overlayText;
 
     auto last = std::chrono::steady_clock::now();
@@ -213,10 +169,7 @@ int runWindowed(const ViewOptions& o) {
         last = std::chrono::steady_clock::now();
         continue;
       }
-      if (app.resized || swapchain.extent().width != uint32_t(fbw) || swapchain.extent().height != uint32_t(fbh)) {
-        swapchain.recreate({uint32_t(fbw), uint32_t(fbh)});
-        app.resized = false;
-      }
+      if (app.resized) frames.markStale(), app.resized = false;
       const auto now = std::chrono::steady_clock::now();
       const float dt = std::chrono::duration<float>(now - last).count();
       last = now;
@@ -228,7 +181,7 @@ int runWindowed(const ViewOptions& o) {
         std::string err;
         if (watcher->poll(err)) {
           try {
-            renderer.rebuildPipelines();
+            frames.renderer().rebuildPipelines();
             shaderError.clear();
             std::fprintf(stderr, "rtr-view: shaders reloaded\n");
           } catch (const std::exception& e) {
@@ -241,24 +194,15 @@ int runWindowed(const ViewOptions& o) {
         }
       }
 
+      const VkExtent2D e = frames.extent();
       if (app.reframeRequested) {  // F: the whole scene in view, as a scene without a stored view starts
         app.reframeRequested = false;
-        const VkExtent2D e = swapchain.extent();
         app.camera.setPose(framingPose(scene, o.lens, float(e.width) / float(std::max(1u, e.height))));
       }
-      Frame& f = frames[frameNumber % kFramesInFlight];
-      VkFence fence = f.fence;
-      VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
-      uint32_t imageIndex = 0;
-      VkResult acq = vkAcquireNextImageKHR(ctx.device(), swapchain.handle(), UINT64_MAX, f.acquired, VK_NULL_HANDLE, &imageIndex);
-      if (acq == VK_ERROR_OUT_OF_DATE_KHR) { app.resized = true; continue; }
-      if (acq != VK_SUBOPTIMAL_KHR) VK_CHECK(acq);
-      VK_CHECK(vkResetFences(ctx.device(), 1, &fence));
-
       auto traceSettings = [&] {
         trace::TraceSettings ts;
-        ts.width = swapchain.extent().width;
-        ts.height = swapchain.extent().height;
+        ts.width = e.width;
+        ts.height = e.height;
         ts.pose = app.camera.pose();
         ts.lens = fitDepthRange(o.lens, bounds, app.camera.pose());
         ts.lens.orthographic = app.traceOrtho;
@@ -274,88 +218,27 @@ int runWindowed(const ViewOptions& o) {
         if (traced.visible()) traced.stop();
         else traced.start(traceSettings());
       }
-      const bool canShot = swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
       // X: this frame is rendered shaded without mosaic and read back, then traced with the renderer's model
       // (PBR, no shadows, no reflections, perspective) and compared; X again while shown hides it.
       bool captureRaster = false;
       if (app.errorMapRequested) {
         app.errorMapRequested = false;
         if (traced.visible()) traced.stop();
-        else if (canShot) captureRaster = true;
+        else if (frames.canReadBack()) captureRaster = true;
         else std::fprintf(stderr, "rtr-view: this surface's images cannot be read back for the error map\n");
       }
       const bool takeShot = !o.screenshot.empty() && frameNumber + 1 == uint64_t(std::max(1, o.frames));
-      if (takeShot && !canShot) throw Error("this surface's images cannot be read back for --screenshot");
-      const bool readBack = takeShot || captureRaster;
-      const VkExtent2D e = swapchain.extent();
-      if (readBack) shot = vk::Buffer(ctx, VkDeviceSize(e.width) * e.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
-      render::RenderSettings frameSettings = app.settings;
+      if (takeShot && !frames.canReadBack()) throw Error("this surface's images cannot be read back for --screenshot");
+      ViewFrameInput in{app.camera.pose(), fitDepthRange(o.lens, bounds, app.camera.pose()), app.settings, &traced,
+                        app.overlay ? &overlayText : nullptr, takeShot || captureRaster};
       if (captureRaster) {
-        frameSettings.mode = VIEW_SHADED;
-        frameSettings.mosaic = render::MosaicMode::Off;
+        in.settings.mode = VIEW_SHADED;
+        in.settings.mosaic = render::MosaicMode::Off;
       }
-
-      VK_CHECK(vkResetCommandBuffer(f.cb, 0));
-      VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-      bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-      VK_CHECK(vkBeginCommandBuffer(f.cb, &bi));
-      const bool showTrace = traced.visible() && (swapchain.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT);
-      const VkImageLayout finalLayout = readBack ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
-      const render::RenderTarget target{swapchain.image(imageIndex), swapchain.view(imageIndex), swapchain.format(), e,
-                                        showTrace ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : finalLayout};
-      const Lens lens = fitDepthRange(o.lens, bounds, app.camera.pose());
-      renderer.record(f.cb, uint32_t(frameNumber % kFramesInFlight), app.camera.pose(), lens, frameSettings, target);
-      if (showTrace) {  // the traced image over the raster one
-        traced.recordCopy(ctx, f.cb, target.image, swapchain.format(), e, traceStaging);
-        vk::barrier(f.cb, {{target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, finalLayout, VK_PIPELINE_STAGE_2_COPY_BIT,
-                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                            VK_ACCESS_2_TRANSFER_READ_BIT}});
-      }
-      if (readBack) {
-        vk::copyImageToHost(f.cb, target.image, e, shot.handle());
-        vk::barrier(f.cb, {{target.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_ACCESS_2_NONE}});
-      }
-      // The overlay comes last, after any read-back copy: screenshots never contain it.
-      if (app.overlay && !readBack)
-        text.record(f.cb, uint32_t(frameNumber % kFramesInFlight), overlayText, target.image, target.view,
-                    swapchain.format(), e, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-                    e.width >= 1280 ? 2.0f : 1.0f);  // the pixel font scales by whole pixels only
-      VK_CHECK(vkEndCommandBuffer(f.cb));
-
-      VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-      wait.semaphore = f.acquired;
-      // The post pass is the first to touch the swapchain image, in compute or as a colour attachment.
-      wait.stageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-      VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-      signal.semaphore = swapchain.renderDone(imageIndex);
-      signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-      VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-      cbi.commandBuffer = f.cb;
-      VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-      si.waitSemaphoreInfoCount = 1;
-      si.pWaitSemaphoreInfos = &wait;
-      si.commandBufferInfoCount = 1;
-      si.pCommandBufferInfos = &cbi;
-      si.signalSemaphoreInfoCount = 1;
-      si.pSignalSemaphoreInfos = &signal;
-      VK_CHECK(vkQueueSubmit2(ctx.queue(), 1, &si, fence));
-
-      VkSemaphore done = swapchain.renderDone(imageIndex);
-      VkSwapchainKHR sc = swapchain.handle();
-      VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
-      pi.waitSemaphoreCount = 1;
-      pi.pWaitSemaphores = &done;
-      pi.swapchainCount = 1;
-      pi.pSwapchains = &sc;
-      pi.pImageIndices = &imageIndex;
-      VkResult pr = vkQueuePresentKHR(ctx.queue(), &pi);
-      if (pr == VK_ERROR_OUT_OF_DATE_KHR || pr == VK_SUBOPTIMAL_KHR) app.resized = true;
-      else VK_CHECK(pr);
-
-      if (readBack) VK_CHECK(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX));
+      ImageRGBA8 shot;
+      if (!frames.frame({uint32_t(fbw), uint32_t(fbh)}, in, &shot)) continue;  // swapchain out of date: next time
       if (takeShot) {
-        saveImage(o.screenshot, readSwapchainImage(shot, swapchain.format(), e), {o.force ? Replace::Yes : Replace::No, true});
+        saveImage(o.screenshot, shot, {o.force ? Replace::Yes : Replace::No, true});
         std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());
         glfwSetWindowShouldClose(window, GLFW_TRUE);
       }
@@ -365,7 +248,7 @@ int runWindowed(const ViewOptions& o) {
         ts.shadows = false;
         ts.bounces = 0;
         ts.lens.orthographic = false;
-        traced.start(ts, readSwapchainImage(shot, swapchain.format(), e));
+        traced.start(ts, std::move(shot));
       }
       ++frameNumber;
 
@@ -380,7 +263,7 @@ int runWindowed(const ViewOptions& o) {
         std::snprintf(buf, sizeof buf, "CPU frame %.2f ms", cpuFrameMs);
         lines.push_back(buf);
         std::string gpu = "GPU";
-        for (const auto& [name, ms] : renderer.gpuTimes(uint32_t(frameNumber % kFramesInFlight))) {
+        for (const auto& [name, ms] : frames.gpuTimes()) {
           std::snprintf(buf, sizeof buf, " | %s %.3f ms", name.c_str(), ms);
           gpu += buf;
         }
@@ -395,7 +278,6 @@ int runWindowed(const ViewOptions& o) {
         overlayText += kKeyHelp;
       }
     }
-    vkDeviceWaitIdle(ctx.device());
   }
   return 0;
 }

@@ -1,0 +1,65 @@
+#include "view_frames.hpp"
+
+#include <cstring>
+
+#include "vk/commands.hpp"
+
+namespace rtr::view {
+
+ViewFrames::ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent,
+                       const render::GpuScene& scene)
+    : ctx_(ctx),
+      swapchain_(ctx, surface, windowExtent),
+      renderer_(ctx, scene, kFramesInFlight),
+      text_(ctx, kFramesInFlight),
+      ring_(ctx, kFramesInFlight) {}
+
+bool ViewFrames::frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageRGBA8* shot) {
+  vk::Frame& f = ring_.begin();
+  const std::optional<uint32_t> acquired = swapchain_.acquire(f.acquired, windowExtent);
+  if (!acquired) return false;
+  const uint32_t imageIndex = *acquired;
+  lastIndex_ = f.index;
+  const VkExtent2D e = swapchain_.extent();
+  const VkFormat format = swapchain_.format();
+  const bool readBack = in.readBack && canReadBack();
+  if (readBack)
+    shot_ = vk::Buffer(ctx_, VkDeviceSize(e.width) * e.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+  const bool showTrace = in.trace && in.trace->visible() && (swapchain_.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  const VkImageLayout finalLayout = readBack ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+  render::FrameContext fc{f, in.pose, in.lens, in.settings,
+                          {swapchain_.image(imageIndex), swapchain_.view(imageIndex), format, e,
+                           showTrace ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : finalLayout}};
+  renderer_.frame(fc);
+  const VkImage image = fc.target.image;
+  if (showTrace) {  // the traced image over the raster one
+    in.trace->recordCopy(f, image, format, e);
+    vk::barrier(f.cb, {{image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, finalLayout, VK_PIPELINE_STAGE_2_COPY_BIT,
+                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_TRANSFER_READ_BIT}});
+  }
+  if (readBack) {
+    vk::copyImageToHost(f.cb, image, e, shot_.handle());
+    vk::barrier(f.cb, {{image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_ACCESS_2_NONE}});
+  }
+  // The overlay comes last, after any read-back copy: screenshots never contain it.
+  if (in.text && !readBack)
+    text_.record(f.cb, f.index, *in.text, image, fc.target.view, format, e, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                 VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, e.width >= 1280 ? 2.0f : 1.0f);  // whole-pixel font scales only
+  // The post pass is the first to touch the swapchain image, in compute or as a colour attachment.
+  ring_.submit(f, f.acquired, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+               swapchain_.renderDone(imageIndex));
+  swapchain_.present(imageIndex);
+  if (readBack) {
+    ring_.waitIdle();
+    if (!shot) return true;
+    shot_.invalidate();
+    *shot = {e.width, e.height, std::vector<uint8_t>(size_t(e.width) * e.height * 4)};
+    std::memcpy(shot->pixels.data(), shot_.mapped(), shot->pixels.size());
+    if (format == VK_FORMAT_B8G8R8A8_UNORM)
+      for (size_t i = 0; i < shot->pixels.size(); i += 4) std::swap(shot->pixels[i], shot->pixels[i + 2]);
+  }
+  return true;
+}
+
+}  // namespace rtr::view

@@ -1,0 +1,50 @@
+#pragma once
+// The viewer's frames on a window surface: swapchain, frames in flight, the renderer, and what the viewer
+// draws over its frame (the traced image, the text overlay). The window app gives it a view per frame.
+#include <optional>
+#include <string>
+
+#include "core/image.hpp"
+#include "render/renderer.hpp"
+#include "render/text_overlay.hpp"
+#include "trace_overlay.hpp"
+#include "vk/frame_ring.hpp"
+#include "vk/swapchain.hpp"
+
+namespace rtr::view {
+
+struct ViewFrameInput {
+  CameraPose pose;
+  Lens lens;
+  render::RenderSettings settings;
+  TraceOverlay* trace = nullptr;          // drawn over the frame while visible
+  const std::string* text = nullptr;      // the overlay's text; none: no overlay
+  bool readBack = false;                  // return the frame (before the text overlay is drawn)
+};
+
+class ViewFrames {
+ public:
+  static constexpr uint32_t kFramesInFlight = 2;
+  ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent, const render::GpuScene& scene);
+
+  // Renders and presents one frame. False: the swapchain was out of date, nothing was drawn. With
+  // in.readBack, waits for the frame and fills `shot` (RGBA bytes).
+  bool frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageRGBA8* shot = nullptr);
+  void markStale() { swapchain_.markStale(); }
+  VkExtent2D extent() const { return swapchain_.extent(); }
+  bool canReadBack() const { return swapchain_.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT; }
+  render::Renderer& renderer() { return renderer_; }
+  // Per-pass GPU times of the most recently completed frame.
+  std::vector<std::pair<std::string, double>> gpuTimes() const { return renderer_.gpuTimes((lastIndex_ + 1) % kFramesInFlight); }
+
+ private:
+  const vk::Context& ctx_;
+  vk::Swapchain swapchain_;
+  render::Renderer renderer_;
+  render::TextOverlay text_;
+  vk::Buffer shot_;
+  uint32_t lastIndex_ = 0;
+  vk::FrameRing ring_;  // last: destroyed first, waiting for the frames that use the members above
+};
+
+}  // namespace rtr::view

@@ -1,0 +1,32 @@
+#pragma once
+// Where the Vulkan tests find their files, with no path of the build machine needed at run time:
+// $RTR_BINARY_DIR, else the folder above the executable's bin/ (the build tree, or a bundle from
+// tools/bundle_device.sh); $RTR_SOURCE_DIR, else that folder's src/ (a bundle's copy of the test data),
+// else two folders above it (build/<preset> in the repository); $RTR_ASSET_DIR, else <binary dir>/assets.
+// Compiled shaders: vk::shaderDir() ($RTR_SHADER_DIR, else <exe>/../shaders).
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace rtr::test {
+
+inline std::filesystem::path envOr(const char* name, const std::filesystem::path& fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::filesystem::path(v) : fallback;
+}
+
+inline std::filesystem::path binaryDir() {
+  return envOr("RTR_BINARY_DIR", std::filesystem::canonical("/proc/self/exe").parent_path().parent_path());
+}
+
+inline std::filesystem::path sourceDir() {
+  const std::filesystem::path b = binaryDir();
+  return envOr("RTR_SOURCE_DIR", std::filesystem::exists(b / "src/tests") ? b / "src" : b.parent_path().parent_path());
+}
+
+inline std::filesystem::path assetDir() { return envOr("RTR_ASSET_DIR", binaryDir() / "assets"); }
+
+// A tool built beside the tests (rtr-reflect).
+inline std::string toolPath(const std::string& name) { return (binaryDir() / "bin" / name).string(); }
+
+}  // namespace rtr::test
