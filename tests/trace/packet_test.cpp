@@ -117,7 +117,8 @@ TEST(Packets, ClosedSphereFromInsideNeverMisses) {
 
 // Rays through the shared diagonal of split quads and through shared vertices, in packets along the
 // diagonal; and coplanar copies of one quad (exact ties of t, which the traversal order decides for a
-// single ray: the packet must give the same triangle).
+// single ray: the packet must give the same triangle; here both orders happen to agree, so the retry of
+// near-ties is guarded by RaysParallelToAxesAndFaces, whose rays through vertices fail without it).
 TEST(Packets, SharedEdgesVerticesAndExactTies) {
   std::vector<Triangle> tris;
   for (int i = 0; i < 40; ++i) {
