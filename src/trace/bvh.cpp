@@ -320,6 +320,8 @@ template class HugeArray<TriPack>;
   bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&); \
   unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
   unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
+  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*); \
+  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*); \
   }
 RTR_DECLARE_TRAVERSAL(sse)
 RTR_DECLARE_TRAVERSAL(avx2)
@@ -333,8 +335,10 @@ struct Traversal {
   bool (*occluded)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
   unsigned (*closestPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
   unsigned (*occludedPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
+  unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*);
+  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*);
 };
-#define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair}
+#define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket}
 constexpr Traversal kTraversals[] = {RTR_TRAVERSAL(sse), RTR_TRAVERSAL(avx2), RTR_TRAVERSAL(avx512)};
 #undef RTR_TRAVERSAL
 }  // namespace
@@ -399,6 +403,27 @@ std::array<bool, 2> Bvh::occludedPair(const std::array<Ray, 2>& rays, IntersectM
   if (root_ == kEmpty) return {false, false};
   const unsigned m = kTraversals[int(isa())].occludedPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
   return {(m & 1) != 0, (m & 2) != 0};
+}
+
+void Bvh::closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method) const {
+  for (int i = 0; i < n; ++i) hits[i] = Hit{};
+  if (root_ == kEmpty || n <= 0) return;
+  if (n == 1) { hits[0] = closest(rays[0], method); return; }
+  const Traversal& tr = kTraversals[int(isa())];
+  const View v{nodes_.data(), packs_.data(), root_};
+  // Rays with a near-tie between two candidates are traced again alone (bvh_packet.inl).
+  for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits); retry; retry &= retry - 1) {
+    const int i = __builtin_ctz(retry);
+    hits[i] = Hit{};
+    tr.closest(v, rays[i], method, hits[i]);
+  }
+}
+
+unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method) const {
+  if (root_ == kEmpty || n <= 0) return 0;
+  if (n == 1) return unsigned(occluded(rays[0], method));
+  Hit scratch[8];
+  return kTraversals[int(isa())].occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch);
 }
 
 }  // namespace rtr::trace

@@ -307,22 +307,22 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
       if (tile >= stats.tilesTotal) break;
       const TileRect rect{(tile % tilesX) * ts, (tile / tilesX) * ts, std::min(s.width, (tile % tilesX + 1) * ts),
                           std::min(s.height, (tile / tilesX + 1) * ts)};
-      // Primary rays go through the BVH two at a time (neighbouring pixels: Bvh::closestPair, the same
-      // hits as one at a time, up to ~30 % faster in the BVH), then each pixel is shaded on its own.
+      // Primary rays go through the BVH eight at a time (a packet of neighbouring pixels of a row:
+      // Bvh::closest8, the same hits as one at a time), then each pixel is shaded on its own.
       for (uint32_t y = rect.y0; y < rect.y1; ++y)
-        for (uint32_t x = rect.x0; x < rect.x1; x += 2) {
-          const uint32_t n = std::min(2u, rect.x1 - x);
-          std::array<Ray, 2> rays;
+        for (uint32_t x = rect.x0; x < rect.x1; x += 8) {
+          const uint32_t n = std::min(8u, rect.x1 - x);
+          std::array<Ray, 8> rays;
           for (uint32_t k = 0; k < n; ++k) {
             const CameraRay cr =
                 cameraRay(pose, s.lens, aspect, pixelToNdc(float(x + k) + 0.5f, float(y) + 0.5f, s.width, s.height));
             rays[k] = {glm::vec3(frame.toScene * glm::vec4(cr.origin, 1.0f)),
                        glm::vec3(frame.toScene * glm::vec4(cr.direction, 0.0f))};
           }
-          const bool paired = n == 2 && useBvh_;
-          const std::array<Hit, 2> first = paired ? bvh_.closestPair(rays, s.intersect) : std::array<Hit, 2>{};
+          std::array<Hit, 8> first;
+          if (useBvh_) bvh_.closest8(rays.data(), int(n), first.data(), s.intersect);
           for (uint32_t k = 0; k < n; ++k) {
-            glm::vec3 col = shade(rays[k], frame.camera, s.bounces, frame, c, paired ? &first[k] : nullptr);
+            glm::vec3 col = shade(rays[k], frame.camera, s.bounces, frame, c, useBvh_ ? &first[k] : nullptr);
             // Debug views hold their value as displayed: encode so that sRGB output shows it unchanged.
             if (debugView) col = {srgbToLinear(col.x), srgbToLinear(col.y), srgbToLinear(col.z)};
             out.at(x + k, y) = glm::vec4(col, 1.0f);

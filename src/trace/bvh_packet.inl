@@ -1,0 +1,303 @@
+// Packets of up to eight rays through the BVH (included by bvh_traverse.inl, inside its namespace; the
+// same rules: inline, no glm or std function templates). Lanes are rays here: a node's children are
+// tested one after another against all rays of the packet at once, each ray with exactly the slab
+// arithmetic of its single-ray walk. Leaves are tested ray by ray with the single-ray 8-wide triangle
+// test. A ray left alone in a subtree walks it as a single ray. See docs/tracer.md.
+//
+// Why the results equal the single-ray ones bit for bit:
+// * Any hit: a ray's tMax never changes, so each box and each triangle gets the same answer for a ray
+//   whatever the order; the packet visits for each ray exactly the boxes its single walk may visit.
+// * Closest hit: every triangle the ray meets with t in (0, tMax) (the single-ray test's own predicate,
+//   t computed by the same operations) is a candidate; boxes are culled only beyond the best candidate
+//   by a window of 2⁻⁹ relative. The best candidate is the single walk's answer unless another
+//   candidate lies within 2⁻¹⁰ of it (a tie, or a near-tie that traversal order or the test's rounding
+//   could decide either way): such rays are reported back and traced again as single rays.
+
+#define RTR_INLINE inline __attribute__((always_inline))
+
+#if RTR_BVH_AVX2
+inline F sel(F mask, F a, F b) { return {_mm256_blendv_ps(b.v, a.v, mask.v)}; }  // mask ? a : b
+inline float hmin(F a) {
+  const __m128 m = _mm_min_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
+  const __m128 m2 = _mm_min_ps(m, _mm_movehl_ps(m, m));
+  return _mm_cvtss_f32(_mm_min_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
+}
+#else
+inline F sel(F mask, F x, F y) { return {_mm_blendv_ps(y.a, x.a, mask.a), _mm_blendv_ps(y.b, x.b, mask.b)}; }
+inline float hmin(F x) {
+  const __m128 m = _mm_min_ps(x.a, x.b);
+  const __m128 m2 = _mm_min_ps(m, _mm_movehl_ps(m, m));
+  return _mm_cvtss_f32(_mm_min_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
+}
+#endif
+
+constexpr float kTieWindow = 0x1p-10f;
+
+struct PacketEntry {
+  F tNear;  // per ray; a ray whose entry is beyond its cull distance when popped drops out
+  uint32_t ref, mask;
+};
+
+template <bool AnyHit, unsigned Parallel>
+struct PacketWalker {
+  using W = Walker<AnyHit, Parallel>;
+  static constexpr int kSlabs = W::kSlabs;
+  static constexpr SlabAxes kSlabAxes = W::kSlabAxes;
+
+  const Bvh::View bvh;
+  const Ray* rays;
+  Hit* hits;
+  F oAxis[3], neg[3];
+#if RTR_BVH_AVX2
+  F rNear[3], qNear[3], rFar[3], qFar[3];
+#else
+  F org[3], rdir[3], rdirFar[3];
+#endif
+  alignas(32) float tMax[8], cull[8], best[8], second[8];
+  alignas(W) unsigned char walkers[8][sizeof(W)];  // each ray's single-ray walk, for leaves and lone rays
+
+  const W& walker(int i) const { return *reinterpret_cast<const W*>(walkers[i]); }
+
+  RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, Hit* h, IntersectMethod m)
+      : bvh(view), rays(r), hits(h) {
+    alignas(32) float o[3][8], d[3][8];
+    for (int i = 0; i < 8; ++i) {
+      const Ray& ray = r[i < n ? i : 0];
+      o[0][i] = ray.origin.x; o[1][i] = ray.origin.y; o[2][i] = ray.origin.z;
+      d[0][i] = ray.direction.x; d[1][i] = ray.direction.y; d[2][i] = ray.direction.z;
+      tMax[i] = cull[i] = ray.tMax;
+      best[i] = second[i] = kInf;
+      if (i < n) new (walkers[i]) W(view, ray, m);
+    }
+    // Per ray, the operations of Walker's constructor (there done three axes at a time, here eight
+    // rays at a time: the same per-lane results), so the boxes are culled exactly as for a single ray.
+    const F zero = set1(0.0f);
+#if RTR_BVH_AVX2
+    const F absMask = set1(bitsFloat(0x7FFFFFFFu));
+#endif
+    for (int a = 0; a < 3; ++a) {
+      oAxis[a] = load(o[a]);
+      const F rcp = set1(1.0f) / load(d[a]);
+      neg[a] = lt(rcp, zero);
+#if RTR_BVH_AVX2
+      rNear[a] = rcp * set1(1.0f - 0x1p-21f);
+      rFar[a] = rcp * set1(1.0f + 0x1p-21f);
+      const F qn0 = oAxis[a] * rNear[a], qf0 = oAxis[a] * rFar[a];
+      qNear[a] = qn0 + ((qn0 & absMask) * set1(0x1p-22f) + set1(0x1p-100f));
+      qFar[a] = qf0 - ((qf0 & absMask) * set1(0x1p-22f) + set1(0x1p-100f));
+#else
+      constexpr float kFarScale = 1.0f + 2.0f * (4.0f * 0x1p-24f) / (1.0f - 4.0f * 0x1p-24f);
+      org[a] = oAxis[a];
+      rdir[a] = rcp;
+      rdirFar[a] = rcp * set1(kFarScale);
+#endif
+    }
+  }
+
+  // The rays of `active` whose box test passes child c of node n, with their entry distances.
+  RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F tHitV, F& tNearOut) const {
+    const F zero = set1(0.0f);
+    F tn[3], tf[3];
+    for (int i = 0; i < kSlabs; ++i) {
+      const int a = kSlabAxes.axis[i];
+      const F lo = set1(n.box[0][a][c]), hi = set1(n.box[1][a][c]);
+      const F nearB = sel(neg[a], hi, lo), farB = sel(neg[a], lo, hi);
+#if RTR_BVH_AVX2
+      tn[i] = fmsub(nearB, rNear[a], qNear[a]);
+      tf[i] = fmsub(farB, rFar[a], qFar[a]);
+#else
+      tn[i] = (nearB - org[a]) * rdir[a];
+      tf[i] = (farB - org[a]) * rdirFar[a];
+#endif
+    }
+    F tNear = zero, tFar = tHitV;  // the same min/max tree as Walker::visitNode
+    if constexpr (kSlabs == 3) {
+      tNear = slabMax(slabMax(tn[0], tn[1]), slabMax(tn[2], zero));
+      tFar = slabMin(slabMin(tf[0], tf[1]), slabMin(tf[2], tHitV));
+    } else if constexpr (kSlabs == 2) {
+      tNear = slabMax(slabMax(tn[0], tn[1]), zero);
+      tFar = slabMin(slabMin(tf[0], tf[1]), tHitV);
+    } else if constexpr (kSlabs == 1) {
+      tNear = slabMax(tn[0], zero);
+      tFar = slabMin(tf[0], tHitV);
+    }
+    F hitBox = ngt(tNear, tFar);
+    for (int a = 0; a < 3; ++a)
+      if (Parallel >> a & 1) hitBox = hitBox & le(set1(n.box[0][a][c]), oAxis[a]) & ge(set1(n.box[1][a][c]), oAxis[a]);
+    tNearOut = tNear;
+    return bits(hitBox) & active;
+  }
+
+  // Tests node `ref`'s children against the packet: false when no ray meets any; else ref/active are
+  // the child to visit next and its rays, the other children are on the stack.
+  RTR_INLINE bool visitNode(PacketEntry* stack, int& sp, uint32_t& ref, unsigned& active) const {
+    const Node& n = bvh.nodes[ref];
+    const F tHitV = load(cull);
+    unsigned slots = bits(le(load(n.box[0][0]), load(n.box[1][0])));  // empty slots have lo > hi
+    F tn[8];
+    unsigned mk[8];
+    uint64_t keys[8];
+    int k = 0;
+    for (; slots; slots &= slots - 1) {
+      const int c = ctz(slots);
+      F tNear;
+      const unsigned m = testChild(n, c, active, tHitV, tNear);
+      if (!m) continue;
+      // Order children by the nearest entry among their rays (farthest first for any hit, as Walker).
+      alignas(32) float lanes[8];
+      store(lanes, tNear);
+      float mn = kInf;
+      for (unsigned b = m; b; b &= b - 1) mn = lanes[ctz(b)] < mn ? lanes[ctz(b)] : mn;
+      const uint32_t d32 = floatBits(mn);
+      const uint64_t key = uint64_t(AnyHit ? ~d32 : d32) << 32 | uint32_t(c);
+      tn[c] = tNear;
+      mk[c] = m;
+      int j = k++;
+      while (j > 0 && keys[j - 1] > key) { keys[j] = keys[j - 1]; --j; }
+      keys[j] = key;
+    }
+    if (k == 0) return false;
+    for (int j = k - 1; j > 0; --j) {
+      const int c = int(keys[j] & 7u);
+      stack[sp++] = {tn[c], n.child[c], mk[c]};
+    }
+    const int c0 = int(keys[0] & 7u);
+    ref = n.child[c0];
+    active = mk[c0];
+    return true;
+  }
+
+  // Closest hit: a candidate for ray i (see the top of this file).
+  RTR_INLINE void offer(int i, float t, float b1, float b2, uint32_t prim) {
+    if (t < best[i]) {
+      second[i] = best[i];
+      best[i] = t;
+      hits[i] = {t, b1, b2, prim & ~Bvh::kNoShadowBit};
+      const float c = t * (1.0f + 2.0f * kTieWindow);
+      cull[i] = c < tMax[i] ? c : tMax[i];
+    } else if (t < second[i]) {
+      second[i] = t;
+    }
+  }
+
+  // Closest hit: every candidate of ray i in leaf `ref`. Walker::testLeaf's operations, but against the
+  // ray's own tMax, not the closest hit so far (a lane padding a short pack repeats the one before).
+  RTR_INLINE void leafCandidates(int i, uint32_t ref) {
+    const W& w = walker(i);
+    const F zero = set1(0.0f), signBit = set1(-0.0f);
+    const F tLimit = set1(cull[i] < tMax[i] ? cull[i] : tMax[i]);
+    const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+    for (uint32_t p = first; p < first + np; ++p) {
+      const TriPack& pk = bvh.packs[p];
+      const F Az = load(pk.v[0][w.kz]) - w.oz, Bz = load(pk.v[1][w.kz]) - w.oz, Cz = load(pk.v[2][w.kz]) - w.oz;
+      const F ax = (load(pk.v[0][w.kx]) - w.ox) - w.sx * Az, ay = (load(pk.v[0][w.ky]) - w.oy) - w.sy * Az;
+      const F bx = (load(pk.v[1][w.kx]) - w.ox) - w.sx * Bz, by = (load(pk.v[1][w.ky]) - w.oy) - w.sy * Bz;
+      const F cx = (load(pk.v[2][w.kx]) - w.ox) - w.sx * Cz, cy = (load(pk.v[2][w.ky]) - w.oy) - w.sy * Cz;
+      const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W3 = bx * ay - by * ax;
+      unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W3, zero));
+      unsigned m = ~bits((U ^ V) | (V ^ W3)) & 0xFFu & ~edge;
+      unsigned pad = 0;
+      for (int lane = 1; lane < 8; ++lane) pad |= unsigned(pk.prim[lane] == pk.prim[lane - 1]) << lane;
+      m &= ~pad;
+      edge &= ~pad;
+      if ((m | edge) == 0) continue;
+      const F det = U + V + W3;
+      const F T = U * (w.sz * Az) + V * (w.sz * Bz) + W3 * (w.sz * Cz);
+      const F detSign = det & signBit;
+      const F Ts = T ^ detSign;
+      m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));
+      if (m) {
+        const F inv = set1(1.0f) / det;
+        alignas(32) float tv[8], iv[8], vv[8], wv[8];
+        store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W3);
+        for (; m; m &= m - 1) {
+          const int lane = ctz(m);
+          const float t = tv[lane];
+          if (t > 0.0f && t < tMax[i]) offer(i, t, vv[lane] * iv[lane], wv[lane] * iv[lane], pk.prim[lane]);
+        }
+      }
+      for (; edge; edge &= edge - 1) {
+        const int lane = ctz(edge);
+        WatertightRay r(rays[i]);
+        float b1, b2;
+        const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
+        if (t > 0.0f) offer(i, t, b1, b2, pk.prim[lane]);
+      }
+    }
+  }
+
+  // Ray i alone from node or leaf `ref` on: its single-ray walk; returns whether it is occluded (any hit).
+  RTR_INLINE bool alone(int i, uint32_t ref) {
+    const W& w = walker(i);
+    uint64_t stack[kStackSize];
+    if constexpr (AnyHit) {
+      Cursor at{0, ref, tMax[i], false};
+      Hit scratch;
+      return w.run(stack, at, scratch);
+    } else {
+      Cursor at{0, ref, cull[i], false};
+      for (;;) {
+        const F tHitV = set1(at.tHit);
+        while (!(at.ref & Bvh::kLeafBit))
+          if (!w.visitNode(stack, at, tHitV)) goto next;
+        leafCandidates(i, at.ref);
+        at.tHit = cull[i];
+      next:
+        if (!W::pop(stack, at)) return false;
+      }
+    }
+  }
+
+  // Walks the packet; any hit: returns the occluded rays; closest hit: the rays to trace again alone.
+  RTR_INLINE unsigned run(unsigned active) {
+    PacketEntry stack[kStackSize];
+    int sp = 0;
+    uint32_t ref = bvh.root;
+    unsigned done = 0;  // any hit: the rays already occluded
+    for (;;) {
+      for (;;) {
+        if ((active & (active - 1)) == 0) {  // one ray left: no packet to share the work with
+          const int i = ctz(active);
+          if (alone(i, ref)) done |= 1u << i;
+          break;
+        }
+        if (ref & Bvh::kLeafBit) {
+          for (unsigned b = active; b; b &= b - 1) {
+            const int i = ctz(b);
+            if constexpr (AnyHit) {
+              Cursor at{0, ref, tMax[i], false};
+              Hit scratch;
+              if (walker(i).testLeaf(at, scratch, set1(tMax[i]))) done |= 1u << i;
+            } else {
+              leafCandidates(i, ref);
+            }
+          }
+          break;
+        }
+        if (!visitNode(stack, sp, ref, active)) break;
+        if (AnyHit) active &= ~done;
+        if (!active) break;
+      }
+      for (;;) {
+        if (sp == 0) {
+          if constexpr (AnyHit) return done;
+          unsigned retry = 0;
+          for (int i = 0; i < 8; ++i)
+            if (best[i] < kInf && !(second[i] > best[i] * (1.0f + kTieWindow))) retry |= 1u << i;
+          return retry;
+        }
+        const PacketEntry& e = stack[--sp];
+        active = e.mask & bits(ngt(e.tNear, load(cull))) & ~done;
+        if (active) { ref = e.ref; break; }
+      }
+    }
+  }
+};
+
+template <bool AnyHit, unsigned Parallel>
+unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
+  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, hits, method);
+  return p.run((1u << n) - 1);
+}
+
+#undef RTR_INLINE
