@@ -36,16 +36,6 @@ const vk::BlockMember& member(const std::vector<vk::BlockMember>& ms, const std:
   throw Error("no member " + name);
 }
 
-std::string runTool(const std::string& args, int* status) {
-  const std::string cmd = test::toolPath("rtr-reflect") + " " + args + " 2>&1";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), pipe.get())) out.append(buf.data(), n);
-  *status = pclose(pipe.release());
-  return out;
-}
-
 std::filesystem::path writeModule(const std::string& name, const std::vector<uint32_t>& code) {
   auto dir = std::filesystem::temp_directory_path() / "rtr_reflect_modern_test";
   std::filesystem::create_directories(dir);
@@ -214,7 +204,7 @@ TEST(ReflectModern, ModuleCutInsideAnInstructionIsAnError) {
 
 TEST(ReflectModernTool, LinkedListPrintsAndExitsZero) {
   int status = -1;
-  std::string out = runTool((kData / "list.comp").string(), &status);
+  std::string out = test::runTool("rtr-reflect", (kData / "list.comp").string(), &status);
   EXPECT_EQ(status, 0) << out;
   EXPECT_NE(out.find("set 0 binding 0: storage-buffer roots (compute) 52 bytes"), std::string::npos) << out;
   EXPECT_NE(out.find("+16 next (8 bytes) -> Node"), std::string::npos) << out;
@@ -233,11 +223,11 @@ TEST(ReflectModernTool, ModuleNewerThanSpirvValIsAWarningUnlessStrict) {
     const std::string file = writeModule(name, code).string();
     EXPECT_THROW(vk::validateSpirv({name, code}), Error) << name << ": spirv-val accepts it, so the test proves nothing";
     int status = -1;
-    std::string out = runTool(file, &status);
+    std::string out = test::runTool("rtr-reflect", file, &status);
     EXPECT_EQ(status, 0) << out;
     EXPECT_NE(out.find("warning: " + std::string(name)), std::string::npos) << out;
     EXPECT_NE(out.find("acceleration-structure scene"), std::string::npos) << out;
-    out = runTool("--strict " + file, &status);
+    out = test::runTool("rtr-reflect", "--strict " + file, &status);
     EXPECT_NE(status, 0) << out;
     EXPECT_NE(out.find(name), std::string::npos) << out;
   }
@@ -247,7 +237,7 @@ TEST(ReflectModernTool, ModuleSpirvReflectRefusesIsAnErrorNamingTheFile) {
   // A header and nothing else: well formed as far as words go, but no module.
   const std::string file = writeModule("broken.spv", {0x07230203u, 0x00010600u, 0, 64, 0}).string();
   int status = 0;
-  std::string out = runTool(file, &status);
+  std::string out = test::runTool("rtr-reflect", file, &status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("rtr-reflect: error: broken.spv: SPIRV-Reflect cannot read"), std::string::npos) << out;
 }
@@ -255,7 +245,7 @@ TEST(ReflectModernTool, ModuleSpirvReflectRefusesIsAnErrorNamingTheFile) {
 TEST(ReflectModernTool, EachIncludeOptionTakesOneFolder) {
   const std::string data = test::sourceDir().string() + "/tests/vk/data/";
   int status = -1;
-  std::string out = runTool("-I " + data + " -I " + kData.string() + " " + data + "push_a.vert " + data + "push_ok.frag", &status);
+  std::string out = test::runTool("rtr-reflect", "-I " + data + " -I " + kData.string() + " " + data + "push_a.vert " + data + "push_ok.frag", &status);
   EXPECT_EQ(status, 0) << out;
   EXPECT_NE(out.find("stage vertex: push_a.vert"), std::string::npos) << out;
   EXPECT_NE(out.find("stage fragment: push_ok.frag"), std::string::npos) << out;

@@ -14,16 +14,6 @@
 namespace rtr {
 namespace {
 
-std::string runTool(const std::string& args, int* status) {
-  const std::string cmd = test::toolPath("rtr-reflect") + " " + args + " 2>&1";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), pipe.get())) out.append(buf.data(), n);
-  *status = pclose(pipe.release());
-  return out;
-}
-
 using test::VulkanTest;
 
 TEST_F(VulkanTest, ReflectToolMatchesTheRenderersPipelines) {
@@ -38,7 +28,7 @@ TEST_F(VulkanTest, ReflectToolMatchesTheRenderersPipelines) {
     o.runtimeArrayCounts[{1, 0}] = 3;
     vk::Pipeline p = vk::makeGraphicsPipeline(*ctx, d, o);
     int status = -1;
-    std::string json = runTool("--json " + dir + vert + ".spv " + dir + frag + ".spv", &status);
+    std::string json = test::runTool("rtr-reflect", "--json " + dir + vert + ".spv " + dir + frag + ".spv", &status);
     EXPECT_EQ(status, 0) << json;
     EXPECT_EQ(json, vk::toJson(p.layout.interface())) << vert << " + " << frag;
   }
@@ -47,10 +37,10 @@ TEST_F(VulkanTest, ReflectToolMatchesTheRenderersPipelines) {
 TEST(ReflectTool, ConflictAndBadInputExitNonZero) {
   int status = 0;
   const std::string data = test::sourceDir().string() + "/tests/vk/data/";
-  std::string out = runTool(data + "conflict.vert " + data + "conflict.frag", &status);
+  std::string out = test::runTool("rtr-reflect", data + "conflict.vert " + data + "conflict.frag", &status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("set 0 binding 1"), std::string::npos) << out;
-  out = runTool(test::sourceDir().string() + "/README.md", &status);
+  out = test::runTool("rtr-reflect", test::sourceDir().string() + "/README.md", &status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("not SPIR-V"), std::string::npos) << out;
 }

@@ -4,7 +4,10 @@
 // tools/bundle_device.sh); $RTR_SOURCE_DIR, else that folder's src/ (a bundle's copy of the test data),
 // else two folders above it (build/<preset> in the repository); $RTR_ASSET_DIR, else <binary dir>/assets.
 // Compiled shaders: vk::shaderDir() ($RTR_SHADER_DIR, else <exe>/../shaders).
+#include <array>
+#include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <filesystem>
 #include <string>
 
@@ -28,5 +31,16 @@ inline std::filesystem::path assetDir() { return envOr("RTR_ASSET_DIR", binaryDi
 
 // A tool built beside the tests (rtr-reflect).
 inline std::string toolPath(const std::string& name) { return (binaryDir() / "bin" / name).string(); }
+
+// Runs that tool with `args` (shell words); returns stdout and stderr together, the wait status in *status.
+inline std::string runTool(const std::string& name, const std::string& args, int* status) {
+  const std::string cmd = toolPath(name) + " " + args + " 2>&1";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), pipe.get())) out.append(buf.data(), n);
+  *status = pclose(pipe.release());
+  return out;
+}
 
 }  // namespace rtr::test
