@@ -52,7 +52,7 @@ public:
   }
   void raw(void* dst, size_t n, const char* what) {
     need(n, what);
-    std::memcpy(dst, d_.data() + pos_, n);
+    if (n) std::memcpy(dst, d_.data() + pos_, n);  // an empty vector's data() may be null: UB even for 0 bytes
     pos_ += n;
   }
   template <class T>

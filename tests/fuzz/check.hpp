@@ -1,0 +1,39 @@
+#pragma once
+// What every fuzz target checks besides "no crash, no sanitizer report": a loaded scene is safe to use,
+// and a refusal names the input (the project's rule for bad input).
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include "core/error.hpp"
+#include "scene/scene.hpp"
+
+namespace rtr::fuzz {
+
+// Aborts (a finding for libFuzzer) when `ok` is false, printing what broke.
+inline void require(bool ok, const char* what) {
+  if (!ok) {
+    std::fprintf(stderr, "fuzz invariant broken: %s\n", what);
+    std::abort();
+  }
+}
+
+inline void requireNamesFile(const rtr::Error& e, const char* file) {
+  require(std::strstr(e.what(), file) != nullptr, "the error message does not name the file");
+}
+
+// Everything the renderers and the tracer index without further checks.
+inline void checkScene(const Scene& s) {
+  for (const Material& m : s.materials)
+    for (uint32_t t : m.textures) require(t == kNoTexture || t < s.textures.size(), "texture id out of range");
+  for (const Texture& t : s.textures) require(t.channels >= 1 && t.channels <= 4, "texture channel count");
+  for (const Mesh& m : s.meshes) {
+    require(m.material < s.materials.size(), "material id out of range");
+    require(m.normals.size() == m.positions.size(), "normal count differs from position count");
+    require(m.texcoords.empty() || m.texcoords.size() == m.positions.size(), "texcoord count differs");
+    require(m.indices.size() % 3 == 0, "index count not a multiple of 3");
+    for (uint32_t i : m.indices) require(i < m.positions.size(), "vertex index out of range");
+  }
+}
+
+}  // namespace rtr::fuzz
