@@ -9,6 +9,6 @@ cmake --build --preset release -j "$(nproc)"
 export RTR_VALIDATION=1
 # The tests run headless; no display is needed. The windowed test starts its own Xvfb.
 ctest --preset release -j "$(nproc)" "$@"
-# A short libFuzzer run of the scene loaders and the OBJ/MTL parser (clang, ASan + UBSan);
-# RTR_FUZZ_SECONDS=0 skips it, tests/fuzz/run.sh 3600 is the long run.
+# A short libFuzzer run of every decoder (scenes, OBJ/MTL, textures, poses, SPIR-V; clang, ASan + UBSan,
+# docs/fuzzing.md) that first replays every crash input found so far. RTR_FUZZ_SECONDS=0 skips it.
 if [[ ${RTR_FUZZ_SECONDS:-15} -gt 0 ]]; then bash tests/fuzz/run.sh "${RTR_FUZZ_SECONDS:-15}"; fi

@@ -5,15 +5,22 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <unistd.h>
+
 #include "core/error.hpp"
 #include "scene/scene.hpp"
 
 namespace rtr::fuzz {
 
+// Set in a child process that a target forks (fuzz_spirv): a broken invariant then exits with status 3,
+// so the parent tells it from a third-party library's abort.
+inline bool exitOnBrokenInvariant = false;
+
 // Aborts (a finding for libFuzzer) when `ok` is false, printing what broke.
 inline void require(bool ok, const char* what) {
   if (!ok) {
     std::fprintf(stderr, "fuzz invariant broken: %s\n", what);
+    if (exitOnBrokenInvariant) _exit(3);
     std::abort();
   }
 }

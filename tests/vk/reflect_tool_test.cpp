@@ -1,5 +1,8 @@
 // rtr-reflect prints exactly the interface the renderer builds its pipeline layouts from.
+#include <sys/wait.h>
+
 #include <array>
+#include <filesystem>
 #include <cstdio>
 #include <memory>
 
@@ -43,6 +46,23 @@ TEST(ReflectTool, ConflictAndBadInputExitNonZero) {
   out = test::runTool("rtr-reflect", test::sourceDir().string() + "/README.md", &status);
   EXPECT_NE(status, 0);
   EXPECT_NE(out.find("not SPIR-V"), std::string::npos) << out;
+}
+
+// Modules that make SPIRV-Reflect assert or crash (found by fuzzing, most of them valid for spirv-val): the
+// tool reports each, naming the file, and exits 1; it never dies of a signal.
+TEST(ReflectTool, ModulesThatCrashSpirvReflectAreErrors) {
+  const auto dir = test::sourceDir() / "tests/fuzz/crashes/fuzz_spirv";
+  int seen = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    int status = 0;
+    const std::string out = test::runTool("rtr-reflect", e.path().string(), &status);
+    ASSERT_TRUE(WIFEXITED(status)) << e.path() << "\n" << out;
+    EXPECT_EQ(WEXITSTATUS(status), 1) << e.path() << "\n" << out;
+    EXPECT_NE(out.find("rtr-reflect: error: "), std::string::npos) << out;
+    EXPECT_NE(out.find(e.path().filename().string()), std::string::npos) << out;
+    ++seen;
+  }
+  EXPECT_GE(seen, 4);
 }
 
 }  // namespace
