@@ -31,10 +31,6 @@ bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding
   return false;
 }
 
-// Who last used the intermediate images: the post pass reads colour in compute or fragment shaders, the
-// shading pass reads the visibility image in compute.
-constexpr VkPipelineStageFlags2 kPostReadStages = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-
 }  // namespace
 
 const char* toString(ShadingPath path) { return path == ShadingPath::Forward ? "forward" : "visibility"; }
@@ -255,16 +251,11 @@ void Renderer::frame(FrameContext& fc) {
   vk::GpuTimer& timer = timers_[frame];
   timer.reset(cb);
   timer.begin(cb);
-  // The previous frame's post pass (or shading pass) may still read the image this pass writes: wait
-  // for it (write-after-read), and for the previous depth writes; old contents are discarded.
+  // Old contents are discarded; the tracker waits for the previous frame's readers (post or shading pass).
   const vk::Image& target0 = visibility ? vis_ : color_;
-  vk::barrier(cb, {{target0.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                    kPostReadStages, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_NONE,
-                    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
-                   {depth_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                    VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
-                    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                    0, 1, VK_IMAGE_ASPECT_DEPTH_BIT}});
+  vk::require(cb, {{target0.tracked(), vk::Use::ColorAttachment, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, true},
+                   {depth_.tracked(), vk::Use::DepthAttachment,
+                    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, true}});
 
   VkRenderingAttachmentInfo colorAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   colorAtt.imageView = target0.view();
@@ -292,22 +283,12 @@ void Renderer::frame(FrameContext& fc) {
   timer.mark(cb, visibility ? "visibility" : "scene");
 
   if (visibility) {
-    // Ids to the shading pass; the colour image's previous readers (last frame's post pass) first.
-    vk::barrier(cb, {{vis_.handle(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT},
-                     {color_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, kPostReadStages,
-                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
+    vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
+                     {color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
     shadeVisibility(cb, frame);
     timer.mark(cb, "shade");
   }
-  vk::barrier(cb, {{color_.handle(), visibility ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                    visibility ? VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                    kPostReadStages,
-                    visibility ? VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT : VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
-  post_.record(cb, color_.view(), target.image, target.view, target.format, target.extent, s.mosaic, target.finalLayout);
+  post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
   timer.mark(cb, "post");
 }
 
