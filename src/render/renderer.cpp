@@ -38,8 +38,6 @@ const char* toString(ShadingPath path) { return path == ShadingPath::Forward ? "
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    uniforms_.emplace_back(ctx, sizeof(shader::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::MemoryUse::Upload,
-                           "frame uniforms");
     timers_.emplace_back(ctx, 4);
   }
   VkPhysicalDeviceFeatures features{};
@@ -73,10 +71,8 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   auto textures = scene_.textureDescriptors();
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
     if (layout.setCount() == 0) break;
-    vk::DescriptorWriter w(ctx_, layout, 0, p.sets.get(0, frame));
-    w.buffer(0, uniforms_[frame].handle());
-    if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
-    w.commit();
+    // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
+    if (hasBinding(layout, 0, 1)) vk::DescriptorWriter(ctx_, layout, 0, p.sets.get(0, frame)).buffer(1, scene_.materials()).commit();
     if (layout.setCount() > 1 && !textures.empty())
       vk::DescriptorWriter(ctx_, layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
   }
@@ -155,6 +151,13 @@ void Renderer::createTargets(VkExtent2D extent, bool visibility) {
 void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
   KindPipelines& pipelines = *pipelines_[set];
   const bool vis = set == kVisibility;
+  // This frame index's sets are not in use (its previous frame's fence signalled): point them at this
+  // frame's uniforms, once each, before any is bound (kinds may share a pipeline).
+  for (ScenePipelines& p : pipelines)
+    if (p.pipeline && hasBinding(p.pipeline->layout, 0, 0))
+      vk::DescriptorWriter(ctx_, p.pipeline->layout, 0, p.sets.get(0, frame))
+          .buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms))
+          .commit();
   // Opaque geometry first, alpha-masked last (brief 1.6).
   for (DrawKind kind : {DrawKind::Opaque, DrawKind::Untextured, DrawKind::AlphaMasked}) {
     ScenePipelines& p = pipelines[size_t(vis ? visPipelineKind(kind) : kind)];
@@ -188,7 +191,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, uint32_t frame) {
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
   vk::DescriptorWriter w(ctx_, c.layout, 0, VK_NULL_HANDLE);
-  w.buffer(0, uniforms_[frame].handle())
+  w.buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms))
       .buffer(1, scene_.materials())
       .buffer(2, scene_.drawInfo())
       .buffer(3, scene_.positions())
@@ -245,8 +248,9 @@ void Renderer::frame(FrameContext& fc) {
     u.rayDx = glm::vec4(glm::vec3(ray(1, 0) - ray(0, 0)), 0.0f);
     u.rayDy = glm::vec4(glm::vec3(ray(0, 1) - ray(0, 0)), 0.0f);
   }
-  std::memcpy(uniforms_[frame].mapped(), &u, sizeof u);
-  uniforms_[frame].flush();
+  // Through the frame's arena: a frame still in flight keeps its own uniforms (the ring flushes the arena).
+  uniforms_ = fc.frame.upload(sizeof u, ctx_.properties().limits.minUniformBufferOffsetAlignment);
+  std::memcpy(uniforms_.data, &u, sizeof u);
 
   vk::GpuTimer& timer = timers_[frame];
   timer.reset(cb);

@@ -95,7 +95,7 @@ class Renderer {
   const vk::Context& ctx_;
   const GpuScene& scene_;
   uint32_t framesInFlight_;
-  std::vector<vk::Buffer> uniforms_;  // FrameUniforms, one per frame in flight
+  vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   VisShade shade_;
   bool canUseVisibility_ = false;
