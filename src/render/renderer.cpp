@@ -11,19 +11,26 @@
 namespace rtr::render {
 namespace {
 
-// Shader files of each scene pipeline: the vertex stage, the shaded fragment stage, the debug one.
-struct StageFiles { const char* vert; const char* shaded; const char* debug; };
-constexpr StageFiles kStages[kDrawKindCount] = {
-    {"scene.vert", "pbr.frag", "debug.frag"},
-    {"scene_untextured.vert", "pbr_untextured.frag", "debug_untextured.frag"},
-    {"scene.vert", "pbr_alpha.frag", "debug_alpha.frag"},
+// Every draw kind in one place: its shaders per pipeline set, its cull mode, and the vertex streams its
+// vertex shaders read (a prefix of {positions, normals, texcoords} forward, of {positions, texcoords} in
+// the visibility pass). Rows are in draw order: opaque geometry first, alpha-masked last (brief 1.6).
+struct KindInfo {
+  const char* vert;    // forward and debug sets
+  const char* shaded;  // fragment stage of the shaded (forward) set
+  const char* debug;   // fragment stage of the debug set
+  DrawKind visAs;      // whose visibility pipeline draws this kind (untextured: the opaque one, positions only)
+  const char* visVert;
+  const char* visFrag;
+  VkCullModeFlags cull;  // foliage (alpha-masked, two-sided) is not culled
+  uint32_t streams, visStreams;
 };
-
-// Foliage (the alpha-masked, two-sided kind) is not culled.
-VkCullModeFlags cullMode(DrawKind kind) { return kind == DrawKind::AlphaMasked ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT; }
-
-// The visibility pass draws untextured meshes with the opaque pipeline: both need positions only.
-DrawKind visPipelineKind(DrawKind kind) { return kind == DrawKind::Untextured ? DrawKind::Opaque : kind; }
+constexpr KindInfo kKinds[kDrawKindCount] = {
+    {"scene.vert", "pbr.frag", "debug.frag", DrawKind::Opaque, "vis.vert", "vis.frag", VK_CULL_MODE_BACK_BIT, 3, 1},
+    {"scene_untextured.vert", "pbr_untextured.frag", "debug_untextured.frag", DrawKind::Opaque, nullptr, nullptr,
+     VK_CULL_MODE_BACK_BIT, 2, 1},
+    {"scene.vert", "pbr_alpha.frag", "debug_alpha.frag", DrawKind::AlphaMasked, "vis_alpha.vert", "vis_alpha.frag",
+     VK_CULL_MODE_NONE, 3, 2},
+};
 
 bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding) {
   for (const vk::ReflectedBinding& b : layout.interface().bindings)
@@ -82,19 +89,15 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
 Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
   KindPipelines out;
   for (size_t k = 0; k < kDrawKindCount; ++k) {
-    const DrawKind kind = DrawKind(k);
-    if (set == kVisibility) {
-      if (kind == DrawKind::Untextured) continue;
-      const bool needed = kind == DrawKind::Opaque ? scene_.hasDraws(DrawKind::Opaque) || scene_.hasDraws(DrawKind::Untextured)
-                                                   : scene_.hasDraws(kind);
-      if (!needed) continue;  // only pipelines the scene needs
-      const bool alpha = kind == DrawKind::AlphaMasked;
-      out[k] = makePipeline(alpha ? "vis_alpha.vert" : "vis.vert", alpha ? "vis_alpha.frag" : "vis.frag", kVisFormat,
-                            cullMode(kind));
-    } else if (scene_.hasDraws(kind)) {
-      const StageFiles& f = kStages[k];
-      out[k] = makePipeline(f.vert, set == kDebug ? f.debug : f.shaded, kColorFormat, cullMode(kind));
+    const KindInfo& info = kKinds[k];
+    if (set != kVisibility) {
+      if (scene_.hasDraws(DrawKind(k)))  // only pipelines the scene needs
+        out[k] = makePipeline(info.vert, set == kDebug ? info.debug : info.shaded, kColorFormat, info.cull);
+      continue;
     }
+    bool needed = false;  // by any kind drawn with this one's visibility pipeline
+    for (size_t j = 0; j < kDrawKindCount; ++j) needed |= size_t(kKinds[j].visAs) == k && scene_.hasDraws(DrawKind(j));
+    if (needed) out[k] = makePipeline(info.visVert, info.visFrag, kVisFormat, info.cull);
   }
   return out;
 }
@@ -158,9 +161,10 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
       vk::DescriptorWriter(ctx_, p.pipeline->layout, 0, p.sets.get(0, frame))
           .buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms))
           .commit();
-  // Opaque geometry first, alpha-masked last (brief 1.6).
-  for (DrawKind kind : {DrawKind::Opaque, DrawKind::Untextured, DrawKind::AlphaMasked}) {
-    ScenePipelines& p = pipelines[size_t(vis ? visPipelineKind(kind) : kind)];
+  for (size_t k = 0; k < kDrawKindCount; ++k) {  // the table's order is the draw order
+    const DrawKind kind = DrawKind(k);
+    const KindInfo& info = kKinds[k];
+    ScenePipelines& p = pipelines[vis ? size_t(info.visAs) : k];
     if (!p.pipeline || !scene_.hasDraws(kind)) continue;
     const vk::Pipeline& pl = *p.pipeline;
     pl.bind(cb);
@@ -169,8 +173,8 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
     const VkBuffer forward[3] = {scene_.positions(), scene_.normals(), scene_.texcoords()};
     const VkBuffer visStreams[2] = {scene_.positions(), scene_.texcoords()};
     const VkDeviceSize offsets[3] = {0, 0, 0};
-    if (vis) vkCmdBindVertexBuffers(cb, 0, kind == DrawKind::AlphaMasked ? 2 : 1, visStreams, offsets);
-    else vkCmdBindVertexBuffers(cb, 0, kind == DrawKind::Untextured ? 2 : 3, forward, offsets);
+    if (vis) vkCmdBindVertexBuffers(cb, 0, kKinds[size_t(info.visAs)].visStreams, visStreams, offsets);
+    else vkCmdBindVertexBuffers(cb, 0, info.streams, forward, offsets);
     VkIndexType bound = VK_INDEX_TYPE_MAX_ENUM;
     for (const DrawItem& d : scene_.draws(kind)) {
       if (d.indexType != bound) {
@@ -184,7 +188,7 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
   }
 }
 
-void Renderer::shadeVisibility(VkCommandBuffer cb, uint32_t frame) {
+void Renderer::shadeVisibility(VkCommandBuffer cb) {
   const vk::Pipeline& c = *shade_.pipeline;
   c.bind(cb);
   // A scene may lack one index width: any storage buffer fills that binding (no draw reads it).
@@ -289,7 +293,7 @@ void Renderer::frame(FrameContext& fc) {
   if (visibility) {
     vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
                      {color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
-    shadeVisibility(cb, frame);
+    shadeVisibility(cb);
     timer.mark(cb, "shade");
   }
   post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);

@@ -90,7 +90,7 @@ class Renderer {
   VisShade makeShade() const;
   void ensurePipelines(PipelineSet set);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set);
-  void shadeVisibility(VkCommandBuffer cb, uint32_t frame);
+  void shadeVisibility(VkCommandBuffer cb);
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
