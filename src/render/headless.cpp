@@ -35,16 +35,12 @@ HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens,
     const bool last = f + 1 == frames;
     frame(pose, lens, settings, [&](VkCommandBuffer cb) {
       if (!last) return;
+      vk::require(cb, target_.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
       vk::copyImageToHost(cb, target_.handle(), extent_, readback_.handle());
       if (readSceneColor) {
-        const VkImage color = renderer_.sceneColor().handle();
-        vk::barrier(cb, {{color, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                          VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_READ_BIT}});
-        vk::copyImageToHost(cb, color, extent_, colorReadback_.handle());
-        vk::barrier(cb, {{color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                          VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
-                          VK_ACCESS_2_NONE}});
+        const vk::Image& color = renderer_.sceneColor();
+        vk::require(cb, color.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
+        vk::copyImageToHost(cb, color.handle(), extent_, colorReadback_.handle());
       }
     });
   }

@@ -28,7 +28,7 @@ class HeadlessRenderer {
 
  private:
   RenderTarget target() const {
-    return {target_.handle(), target_.view(), target_.format(), extent_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+    return {target_.tracked(), target_.view(), target_.format(), extent_};
   }
   // One frame through Renderer::frame, as the window app's; `after` records more into it. Waits for it.
   void frame(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,

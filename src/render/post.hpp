@@ -5,14 +5,9 @@
 // image or headless target). Compute (default) and graphics (full-screen triangle, dynamic rendering,
 // no subpasses) give bit-identical bytes; Off is a plain copy with the same encode, in compute.
 //
-// Contract of MosaicPass::record:
-//   input   in SHADER_READ_ONLY_OPTIMAL, its writes already made visible to compute (Compute, Off) or
-//           fragment (Graphics) shader reads by the caller (the barrier after the scene pass);
-//   output  previous contents discarded (UNDEFINED -> GENERAL or COLOR_ATTACHMENT_OPTIMAL, after all
-//           earlier commands, so it chains with an acquire semaphore waited at any stage); it needs
-//           STORAGE usage for Compute/Off and COLOR_ATTACHMENT usage for Graphics; left in
-//           `outputFinalLayout` (e.g. PRESENT_SRC_KHR or TRANSFER_SRC_OPTIMAL), writes made available to
-//           all later commands.
+// MosaicPass::record requires (vk/image_state.hpp) the input sampled in the stage that reads it and the
+// output written (previous contents discarded): STORAGE usage for Compute/Off, COLOR_ATTACHMENT usage for
+// Graphics. The output is left as written; the caller requires what comes next (copy, present).
 #include <map>
 
 #include <vulkan/vulkan.h>
@@ -31,8 +26,8 @@ class MosaicPass {
   void setBlock(VkExtent2D block);  // 5x3 by default
   VkExtent2D block() const { return block_; }
 
-  void record(VkCommandBuffer cb, VkImageView input, VkImage output, VkImageView outputView, VkFormat outputFormat,
-              VkExtent2D extent, MosaicMode mode, VkImageLayout outputFinalLayout);
+  void record(VkCommandBuffer cb, vk::TrackedImage input, VkImageView inputView, vk::TrackedImage output,
+              VkImageView outputView, VkFormat outputFormat, VkExtent2D extent, MosaicMode mode);
 
  private:
   const vk::Pipeline& graphics(VkFormat format);

@@ -11,29 +11,32 @@
 namespace rtr::render {
 namespace {
 
-// Shader files of each scene pipeline: the vertex stage, the shaded fragment stage, the debug one.
-struct StageFiles { const char* vert; const char* shaded; const char* debug; };
-constexpr StageFiles kStages[kDrawKindCount] = {
-    {"scene.vert", "pbr.frag", "debug.frag"},
-    {"scene_untextured.vert", "pbr_untextured.frag", "debug_untextured.frag"},
-    {"scene.vert", "pbr_alpha.frag", "debug_alpha.frag"},
+// Every draw kind in one place: its shaders per pipeline set, its cull mode, and the vertex streams its
+// vertex shaders read (a prefix of {positions, normals, texcoords} forward, of {positions, texcoords} in
+// the visibility pass). Rows are in draw order: opaque geometry first, alpha-masked last (brief 1.6).
+struct KindInfo {
+  const char* vert;    // forward and debug sets
+  const char* shaded;  // fragment stage of the shaded (forward) set
+  const char* debug;   // fragment stage of the debug set
+  DrawKind visAs;      // whose visibility pipeline draws this kind (untextured: the opaque one, positions only)
+  const char* visVert;
+  const char* visFrag;
+  VkCullModeFlags cull;  // foliage (alpha-masked, two-sided) is not culled
+  uint32_t streams, visStreams;
 };
-
-// Foliage (the alpha-masked, two-sided kind) is not culled.
-VkCullModeFlags cullMode(DrawKind kind) { return kind == DrawKind::AlphaMasked ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT; }
-
-// The visibility pass draws untextured meshes with the opaque pipeline: both need positions only.
-DrawKind visPipelineKind(DrawKind kind) { return kind == DrawKind::Untextured ? DrawKind::Opaque : kind; }
+constexpr KindInfo kKinds[kDrawKindCount] = {
+    {"scene.vert", "pbr.frag", "debug.frag", DrawKind::Opaque, "vis.vert", "vis.frag", VK_CULL_MODE_BACK_BIT, 3, 1},
+    {"scene_untextured.vert", "pbr_untextured.frag", "debug_untextured.frag", DrawKind::Opaque, nullptr, nullptr,
+     VK_CULL_MODE_BACK_BIT, 2, 1},
+    {"scene.vert", "pbr_alpha.frag", "debug_alpha.frag", DrawKind::AlphaMasked, "vis_alpha.vert", "vis_alpha.frag",
+     VK_CULL_MODE_NONE, 3, 2},
+};
 
 bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding) {
   for (const vk::ReflectedBinding& b : layout.interface().bindings)
     if (b.set == set && b.binding == binding) return true;
   return false;
 }
-
-// Who last used the intermediate images: the post pass reads colour in compute or fragment shaders, the
-// shading pass reads the visibility image in compute.
-constexpr VkPipelineStageFlags2 kPostReadStages = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
 
 }  // namespace
 
@@ -42,8 +45,6 @@ const char* toString(ShadingPath path) { return path == ShadingPath::Forward ? "
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    uniforms_.emplace_back(ctx, sizeof(shader::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::MemoryUse::Upload,
-                           "frame uniforms");
     timers_.emplace_back(ctx, 4);
   }
   VkPhysicalDeviceFeatures features{};
@@ -77,10 +78,8 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   auto textures = scene_.textureDescriptors();
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
     if (layout.setCount() == 0) break;
-    vk::DescriptorWriter w(ctx_, layout, 0, p.sets.get(0, frame));
-    w.buffer(0, uniforms_[frame].handle());
-    if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
-    w.commit();
+    // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
+    if (hasBinding(layout, 0, 1)) vk::DescriptorWriter(ctx_, layout, 0, p.sets.get(0, frame)).buffer(1, scene_.materials()).commit();
     if (layout.setCount() > 1 && !textures.empty())
       vk::DescriptorWriter(ctx_, layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
   }
@@ -90,19 +89,15 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
 Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
   KindPipelines out;
   for (size_t k = 0; k < kDrawKindCount; ++k) {
-    const DrawKind kind = DrawKind(k);
-    if (set == kVisibility) {
-      if (kind == DrawKind::Untextured) continue;
-      const bool needed = kind == DrawKind::Opaque ? scene_.hasDraws(DrawKind::Opaque) || scene_.hasDraws(DrawKind::Untextured)
-                                                   : scene_.hasDraws(kind);
-      if (!needed) continue;  // only pipelines the scene needs
-      const bool alpha = kind == DrawKind::AlphaMasked;
-      out[k] = makePipeline(alpha ? "vis_alpha.vert" : "vis.vert", alpha ? "vis_alpha.frag" : "vis.frag", kVisFormat,
-                            cullMode(kind));
-    } else if (scene_.hasDraws(kind)) {
-      const StageFiles& f = kStages[k];
-      out[k] = makePipeline(f.vert, set == kDebug ? f.debug : f.shaded, kColorFormat, cullMode(kind));
+    const KindInfo& info = kKinds[k];
+    if (set != kVisibility) {
+      if (scene_.hasDraws(DrawKind(k)))  // only pipelines the scene needs
+        out[k] = makePipeline(info.vert, set == kDebug ? info.debug : info.shaded, kColorFormat, info.cull);
+      continue;
     }
+    bool needed = false;  // by any kind drawn with this one's visibility pipeline
+    for (size_t j = 0; j < kDrawKindCount; ++j) needed |= size_t(kKinds[j].visAs) == k && scene_.hasDraws(DrawKind(j));
+    if (needed) out[k] = makePipeline(info.visVert, info.visFrag, kVisFormat, info.cull);
   }
   return out;
 }
@@ -159,9 +154,17 @@ void Renderer::createTargets(VkExtent2D extent, bool visibility) {
 void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
   KindPipelines& pipelines = *pipelines_[set];
   const bool vis = set == kVisibility;
-  // Opaque geometry first, alpha-masked last (brief 1.6).
-  for (DrawKind kind : {DrawKind::Opaque, DrawKind::Untextured, DrawKind::AlphaMasked}) {
-    ScenePipelines& p = pipelines[size_t(vis ? visPipelineKind(kind) : kind)];
+  // This frame index's sets are not in use (its previous frame's fence signalled): point them at this
+  // frame's uniforms, once each, before any is bound (kinds may share a pipeline).
+  for (ScenePipelines& p : pipelines)
+    if (p.pipeline && hasBinding(p.pipeline->layout, 0, 0))
+      vk::DescriptorWriter(ctx_, p.pipeline->layout, 0, p.sets.get(0, frame))
+          .buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms))
+          .commit();
+  for (size_t k = 0; k < kDrawKindCount; ++k) {  // the table's order is the draw order
+    const DrawKind kind = DrawKind(k);
+    const KindInfo& info = kKinds[k];
+    ScenePipelines& p = pipelines[vis ? size_t(info.visAs) : k];
     if (!p.pipeline || !scene_.hasDraws(kind)) continue;
     const vk::Pipeline& pl = *p.pipeline;
     pl.bind(cb);
@@ -170,8 +173,8 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
     const VkBuffer forward[3] = {scene_.positions(), scene_.normals(), scene_.texcoords()};
     const VkBuffer visStreams[2] = {scene_.positions(), scene_.texcoords()};
     const VkDeviceSize offsets[3] = {0, 0, 0};
-    if (vis) vkCmdBindVertexBuffers(cb, 0, kind == DrawKind::AlphaMasked ? 2 : 1, visStreams, offsets);
-    else vkCmdBindVertexBuffers(cb, 0, kind == DrawKind::Untextured ? 2 : 3, forward, offsets);
+    if (vis) vkCmdBindVertexBuffers(cb, 0, kKinds[size_t(info.visAs)].visStreams, visStreams, offsets);
+    else vkCmdBindVertexBuffers(cb, 0, info.streams, forward, offsets);
     VkIndexType bound = VK_INDEX_TYPE_MAX_ENUM;
     for (const DrawItem& d : scene_.draws(kind)) {
       if (d.indexType != bound) {
@@ -185,14 +188,14 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
   }
 }
 
-void Renderer::shadeVisibility(VkCommandBuffer cb, uint32_t frame) {
+void Renderer::shadeVisibility(VkCommandBuffer cb) {
   const vk::Pipeline& c = *shade_.pipeline;
   c.bind(cb);
   // A scene may lack one index width: any storage buffer fills that binding (no draw reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
   vk::DescriptorWriter w(ctx_, c.layout, 0, VK_NULL_HANDLE);
-  w.buffer(0, uniforms_[frame].handle())
+  w.buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms))
       .buffer(1, scene_.materials())
       .buffer(2, scene_.drawInfo())
       .buffer(3, scene_.positions())
@@ -249,22 +252,18 @@ void Renderer::frame(FrameContext& fc) {
     u.rayDx = glm::vec4(glm::vec3(ray(1, 0) - ray(0, 0)), 0.0f);
     u.rayDy = glm::vec4(glm::vec3(ray(0, 1) - ray(0, 0)), 0.0f);
   }
-  std::memcpy(uniforms_[frame].mapped(), &u, sizeof u);
-  uniforms_[frame].flush();
+  // Through the frame's arena: a frame still in flight keeps its own uniforms (the ring flushes the arena).
+  uniforms_ = fc.frame.upload(sizeof u, ctx_.properties().limits.minUniformBufferOffsetAlignment);
+  std::memcpy(uniforms_.data, &u, sizeof u);
 
   vk::GpuTimer& timer = timers_[frame];
   timer.reset(cb);
   timer.begin(cb);
-  // The previous frame's post pass (or shading pass) may still read the image this pass writes: wait
-  // for it (write-after-read), and for the previous depth writes; old contents are discarded.
+  // Old contents are discarded; the tracker waits for the previous frame's readers (post or shading pass).
   const vk::Image& target0 = visibility ? vis_ : color_;
-  vk::barrier(cb, {{target0.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                    kPostReadStages, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_NONE,
-                    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
-                   {depth_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                    VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
-                    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                    0, 1, VK_IMAGE_ASPECT_DEPTH_BIT}});
+  vk::require(cb, {{target0.tracked(), vk::Use::ColorAttachment, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, true},
+                   {depth_.tracked(), vk::Use::DepthAttachment,
+                    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, true}});
 
   VkRenderingAttachmentInfo colorAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   colorAtt.imageView = target0.view();
@@ -292,22 +291,12 @@ void Renderer::frame(FrameContext& fc) {
   timer.mark(cb, visibility ? "visibility" : "scene");
 
   if (visibility) {
-    // Ids to the shading pass; the colour image's previous readers (last frame's post pass) first.
-    vk::barrier(cb, {{vis_.handle(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT},
-                     {color_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, kPostReadStages,
-                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
-    shadeVisibility(cb, frame);
+    vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
+                     {color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
+    shadeVisibility(cb);
     timer.mark(cb, "shade");
   }
-  vk::barrier(cb, {{color_.handle(), visibility ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                    visibility ? VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                    kPostReadStages,
-                    visibility ? VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT : VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
-  post_.record(cb, color_.view(), target.image, target.view, target.format, target.extent, s.mosaic, target.finalLayout);
+  post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
   timer.mark(cb, "post");
 }
 

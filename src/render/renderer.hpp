@@ -34,12 +34,13 @@ struct RenderSettings {
   LightRig lights{{briefLight()}, glm::vec3(0.02f), {}};
 };
 
+// The frame leaves the target written by the post pass (its state tracked); the caller requires what
+// comes next (a copy, presentation).
 struct RenderTarget {
-  VkImage image = VK_NULL_HANDLE;
+  vk::TrackedImage image;
   VkImageView view = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;  // a UNORM format: the post pass encodes sRGB itself
   VkExtent2D extent{};
-  VkImageLayout finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
 };
 
 // What one frame needs: the frame in flight (its command buffer, still recording, and its index), the view,
@@ -64,7 +65,7 @@ class Renderer {
   void frame(FrameContext& fc);
   // Per-pass GPU times of the last completed use of `frame`, in ms.
   std::vector<std::pair<std::string, double>> gpuTimes(uint32_t frame) const { return timers_[frame].results(); }
-  // The linear-light intermediate image of the last frame (SHADER_READ_ONLY_OPTIMAL after a frame).
+  // The linear-light intermediate image of the last frame (its state tracked: require() before use).
   const vk::Image& sceneColor() const { return color_; }
   // Rebuilds the scene pipelines from the shader folder (hot reload); on error keeps the old ones.
   void rebuildPipelines();
@@ -89,12 +90,12 @@ class Renderer {
   VisShade makeShade() const;
   void ensurePipelines(PipelineSet set);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set);
-  void shadeVisibility(VkCommandBuffer cb, uint32_t frame);
+  void shadeVisibility(VkCommandBuffer cb);
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
   uint32_t framesInFlight_;
-  std::vector<vk::Buffer> uniforms_;  // FrameUniforms, one per frame in flight
+  vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   VisShade shade_;
   bool canUseVisibility_ = false;

@@ -1,6 +1,7 @@
 #include "render/text_overlay.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <vector>
 
 #include <stb_easy_font.h>
@@ -12,16 +13,9 @@
 namespace rtr::render {
 namespace {
 
-constexpr uint32_t kCapacity = 16384;  // rectangles per frame: about 2,500 characters
 constexpr float kMargin = 4.0f;        // font units of backdrop around the text
 
 }  // namespace
-
-TextOverlay::TextOverlay(const vk::Context& ctx, uint32_t framesInFlight) : ctx_(ctx) {
-  for (uint32_t i = 0; i < framesInFlight; ++i)
-    frames_.push_back({vk::Buffer(ctx, kCapacity * sizeof(shader::TextRect), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                  vk::MemoryUse::Upload, "text overlay")});
-}
 
 uint32_t TextOverlay::layout(const std::string& text, float scale, void* out, uint32_t capacity) {
   if (capacity < 2 || text.empty()) return 0;
@@ -55,36 +49,31 @@ const vk::Pipeline& TextOverlay::pipeline(VkFormat format) {
   return pipelines_.emplace(format, vk::makeGraphicsPipeline(ctx_, d, {.pushDescriptorSets = {0}})).first->second;
 }
 
-void TextOverlay::record(VkCommandBuffer cb, uint32_t frame, const std::string& text, VkImage image,
-                         VkImageView view, VkFormat format, VkExtent2D extent, VkImageLayout layout,
-                         VkImageLayout finalLayout, float scale) {
-  FrameText& ft = frames_.at(frame);
-  if (ft.text != text || ft.scale != scale) {  // not in use: this frame slot's fence has signalled
-    ft.count = TextOverlay::layout(text, scale, ft.rects.mapped(), kCapacity);
-    ft.rects.flush();
-    ft.text = text;
-    ft.scale = scale;
+void TextOverlay::record(vk::Frame& frame, const std::string& text, vk::TrackedImage image, VkImageView view,
+                         VkFormat format, VkExtent2D extent, float scale) {
+  if (text != text_ || scale != scale_ || rects_.empty()) {
+    rects_.resize(kCapacity * sizeof(shader::TextRect));
+    rects_.resize(TextOverlay::layout(text, scale, rects_.data(), kCapacity) * sizeof(shader::TextRect));
+    text_ = text;
+    scale_ = scale;
   }
-  const vk::Buffer& buf = ft.rects;
-  const uint32_t count = ft.count;
-  // Everything before wrote the image (post pass, copies): wait for all of it, keep its contents.
-  vk::barrier(cb, {{image, layout, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                    VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                    VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, 0, 1}});
-  if (count > 0) {
-    const vk::Pipeline& p = pipeline(format);
-    vk::beginColorRendering(cb, view, extent, VK_ATTACHMENT_LOAD_OP_LOAD);  // text over the frame
-    p.bind(cb);
-    vk::DescriptorWriter(ctx_, p.layout, 0, VK_NULL_HANDLE).buffer(0, buf.handle()).push(cb, p);
-    p.push(cb, shader::TextPush{{2.0f / float(extent.width), 2.0f / float(extent.height)}});
-    vkCmdDraw(cb, count * 6, 1, 0, 0);
-    vkCmdEndRendering(cb);
-  }
-  const bool present = finalLayout == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
-  vk::barrier(cb, {{image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, finalLayout,
-                    VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                    present ? VK_ACCESS_2_NONE : VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, 0, 1}});
+  const uint32_t count = uint32_t(rects_.size() / sizeof(shader::TextRect));
+  // Its contents are kept: the tracker waits for whatever wrote the image last (post pass, copies).
+  vk::require(frame.cb, image, vk::Use::ColorAttachment, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT);
+  if (count == 0) return;
+  // This frame's arena: an earlier frame still in flight keeps its own rectangles.
+  const vk::UploadArena::Slice slice =
+      frame.upload(rects_.size(), ctx_.properties().limits.minStorageBufferOffsetAlignment);
+  std::memcpy(slice.data, rects_.data(), rects_.size());
+  const vk::Pipeline& p = pipeline(format);
+  vk::beginColorRendering(frame.cb, view, extent, VK_ATTACHMENT_LOAD_OP_LOAD);  // text over the frame
+  p.bind(frame.cb);
+  vk::DescriptorWriter(ctx_, p.layout, 0, VK_NULL_HANDLE)
+      .buffer(0, slice.buffer, slice.offset, rects_.size())
+      .push(frame.cb, p);
+  p.push(frame.cb, shader::TextPush{{2.0f / float(extent.width), 2.0f / float(extent.height)}});
+  vkCmdDraw(frame.cb, count * 6, 1, 0, 0);
+  vkCmdEndRendering(frame.cb);
 }
 
 }  // namespace rtr::render

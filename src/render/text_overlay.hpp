@@ -8,6 +8,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "vk/frame_ring.hpp"
 #include "vk/pipeline.hpp"
 #include "vk/resources.hpp"
 
@@ -15,13 +16,15 @@ namespace rtr::render {
 
 class TextOverlay {
  public:
-  // One rectangle buffer per frame in flight; pipelines are made per target format on first use.
-  TextOverlay(const vk::Context& ctx, uint32_t framesInFlight);
+  // Pipelines are made per target format on first use.
+  explicit TextOverlay(const vk::Context& ctx) : ctx_(ctx) {}
 
-  // Draws `text` (lines separated by '\n') at the top-left of `image`, which is in `layout` and is left in
-  // `finalLayout`. Text beyond the buffer's capacity is cut off. `scale`: pixels per font unit.
-  void record(VkCommandBuffer cb, uint32_t frame, const std::string& text, VkImage image, VkImageView view,
-              VkFormat format, VkExtent2D extent, VkImageLayout layout, VkImageLayout finalLayout, float scale = 2.0f);
+  // Draws `text` (lines separated by '\n') at the top-left of `image` (required as a colour attachment,
+  // its contents kept; left so). The rectangles go through the frame's upload arena. Text beyond
+  // kCapacity rectangles is cut off. `scale`: pixels per font unit.
+  void record(vk::Frame& frame, const std::string& text, vk::TrackedImage image, VkImageView view, VkFormat format,
+              VkExtent2D extent, float scale = 2.0f);
+  static constexpr uint32_t kCapacity = 16384;  // rectangles per frame: about 2,500 characters
 
   // The rectangles `text` becomes (backdrop first): exposed for the test of the layout.
   static uint32_t layout(const std::string& text, float scale, void* rects, uint32_t capacity);
@@ -29,13 +32,10 @@ class TextOverlay {
  private:
   const vk::Pipeline& pipeline(VkFormat format);
   const vk::Context& ctx_;
-  struct FrameText {
-    vk::Buffer rects;
-    std::string text;  // what `rects` holds: laid out again only when the text changes
-    float scale = 0;
-    uint32_t count = 0;
-  };
-  std::vector<FrameText> frames_;
+  // The last layout, kept so that an unchanged text is only copied, not laid out again.
+  std::string text_;
+  float scale_ = 0;
+  std::vector<uint8_t> rects_;
   std::map<VkFormat, vk::Pipeline> pipelines_;
 };
 

@@ -1,6 +1,7 @@
 #include "vk/frame_ring.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <memory>
 
 #include "vk/check.hpp"
@@ -79,11 +80,17 @@ Frame& FrameRing::begin() {
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(f.cb, &bi));
+  // The second frame: the first finds every image fresh, the second shows the steady state.
+  if (f.number == 1 && barrierLogRequested()) beginBarrierLog();
   return f;
 }
 
 void FrameRing::submit(Frame& f, VkSemaphore wait, VkPipelineStageFlags2 waitStages, VkSemaphore signal) {
   VK_CHECK(vkEndCommandBuffer(f.cb));
+  if (f.number == 1 && barrierLogRequested()) {
+    std::fprintf(stderr, "barriers of frame 1:\n");
+    for (const std::string& line : endBarrierLog()) std::fprintf(stderr, "  %s\n", line.c_str());
+  }
   f.arena.flush();
   VkFence fence = f.fence;
   VK_CHECK(vkResetFences(ctx_.device(), 1, &fence));

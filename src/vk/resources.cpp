@@ -93,6 +93,7 @@ Image& Image::operator=(Image&& o) noexcept {
     allocation_ = std::exchange(o.allocation_, nullptr);
     desc_ = o.desc_;
     view_ = std::move(o.view_);
+    state_ = std::exchange(o.state_, {});
   }
   return *this;
 }

@@ -6,12 +6,16 @@
 
 #include <vulkan/vulkan.h>
 
+#include "vk/image_state.hpp"
+
 typedef struct VmaAllocation_T* VmaAllocation;
 typedef struct VmaAllocator_T* VmaAllocator;
 
 namespace rtr::vk {
 
 class Context;
+
+bool isDepthFormat(VkFormat f);
 
 // A device-owned Vulkan handle destroyed with `Destroy` when its owner goes.
 template <class T, void (*Destroy)(VkDevice, T, const VkAllocationCallbacks*)>
@@ -101,6 +105,11 @@ class Image {
   VkExtent2D extent() const { return desc_.extent; }
   uint32_t mipLevels() const { return desc_.mipLevels; }
   const ImageDesc& desc() const { return desc_; }
+  // The image with its tracked state (layout and last access; vk/image_state.hpp), for require().
+  TrackedImage tracked() const {
+    return {image_, &state_, desc_.name ? desc_.name : "image",
+            VkImageAspectFlags(isDepthFormat(desc_.format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT)};
+  }
 
   // A view of a mip range in another (compatible) format with a given usage, owned by the caller.
   ImageView createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage) const;
@@ -112,8 +121,7 @@ class Image {
   VmaAllocation allocation_ = nullptr;
   ImageDesc desc_{};
   ImageView view_;
+  mutable ImageState state_;  // changes as commands are recorded, not the image itself
 };
-
-bool isDepthFormat(VkFormat f);
 
 }  // namespace rtr::vk

@@ -1,4 +1,5 @@
 // Whole frames rendered headless on lavapipe, checked by properties the images must have.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -8,6 +9,7 @@
 
 #include "core/image.hpp"
 #include "render/headless.hpp"
+#include "vk/image_state.hpp"
 #include "scene/load.hpp"
 #include "vk_fixture.hpp"
 
@@ -138,6 +140,56 @@ TEST_F(FrameTest, EveryViewModeRendersWithoutValidationMessages) {
     for (uint8_t b : f.image.pixels) sum += b;
     EXPECT_GT(sum, 0u) << "mode " << mode << " rendered black";
   }
+}
+
+// The barriers of one steady-state frame (the frame before it read the target back, as this one does),
+// written down from what each pass does:
+//   the scene pass discards its colour (or id) target after the previous frame's reader, and the depth;
+//   [visibility] the ids go to the shading compute pass, which discards the colour image and writes it;
+//   the colour image is sampled by the post pass (compute, or fragment for the graphics mosaic), which
+//   discards the target after last frame's read-back copy; the target goes to the read-back copy.
+std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::MosaicMode mosaic) {
+  const bool vis = path == render::ShadingPath::Visibility, raster = mosaic == render::MosaicMode::Graphics;
+  const std::string postRead = raster ? "FRAGMENT_SHADER" : "COMPUTE_SHADER";
+  const std::string first = vis ? "visibility" : "scene colour";
+  const std::string firstReader = vis ? "COMPUTE_SHADER" : postRead;
+  std::vector<std::string> out = {
+      first + ": UNDEFINED -> COLOR_ATTACHMENT, " + firstReader + "/NONE -> COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE",
+      "scene depth: UNDEFINED -> DEPTH_ATTACHMENT, EARLY_FRAGMENT_TESTS|LATE_FRAGMENT_TESTS/DEPTH_STENCIL_ATTACHMENT_WRITE"
+      " -> EARLY_FRAGMENT_TESTS|LATE_FRAGMENT_TESTS/DEPTH_STENCIL_ATTACHMENT_WRITE"};
+  if (vis) {
+    out.push_back("visibility: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> "
+                  "COMPUTE_SHADER/SHADER_SAMPLED_READ");
+    out.push_back("scene colour: UNDEFINED -> GENERAL, " + postRead + "/NONE -> COMPUTE_SHADER/SHADER_STORAGE_WRITE");
+    out.push_back("scene colour: GENERAL -> SHADER_READ_ONLY, COMPUTE_SHADER/SHADER_STORAGE_WRITE -> " + postRead +
+                  "/SHADER_SAMPLED_READ");
+  } else {
+    out.push_back("scene colour: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> " +
+                  postRead + "/SHADER_SAMPLED_READ");
+  }
+  const std::string work = raster ? "COLOR_ATTACHMENT" : "GENERAL";
+  const std::string write = raster ? "COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE" : "COMPUTE_SHADER/SHADER_STORAGE_WRITE";
+  out.push_back("headless target: UNDEFINED -> " + work + ", COPY/NONE -> " + write);
+  out.push_back("headless target: " + work + " -> TRANSFER_SRC, " + write + " -> COPY/TRANSFER_READ");
+  return out;
+}
+
+TEST_F(FrameTest, OneFrameRecordsExactlyTheBarriersItNeeds) {
+  for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility})
+    for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics}) {
+      SCOPED_TRACE(std::string(render::toString(path)) + ", mosaic " + render::toString(mosaic));
+      RenderSettings s;
+      s.shading = path;
+      s.mosaic = mosaic;
+      renderer->render(pose, lens, s);  // the previous frame, read back like the next
+      vk::beginBarrierLog();
+      renderer->render(pose, lens, s);
+      const std::vector<std::string> got = vk::endBarrierLog();
+      const std::vector<std::string> want = steadyFrameBarriers(path, mosaic);
+      EXPECT_EQ(got.size(), want.size());
+      for (size_t i = 0; i < std::max(got.size(), want.size()); ++i)
+        EXPECT_EQ(i < got.size() ? got[i] : "(none)", i < want.size() ? want[i] : "(none)") << "barrier " << i;
+    }
 }
 
 }  // namespace

@@ -45,17 +45,11 @@ class MosaicTest : public VulkanTest {
     std::memcpy(upload.mapped(), halfs.data(), halfs.size() * 2);
     upload.flush();
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
-      vk::barrier(cb, {{input.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                        VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                        VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+      vk::require(cb, input.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT, true);
       VkBufferImageCopy c{};
       c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
       c.imageExtent = {e.width, e.height, 1};
       vkCmdCopyBufferToImage(cb, upload.handle(), input.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
-      vk::barrier(cb, {{input.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                        VK_PIPELINE_STAGE_2_COPY_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                        VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
     });
   }
 
@@ -67,7 +61,8 @@ class MosaicTest : public VulkanTest {
     const size_t bytes = size_t(extent.width) * extent.height * 4;
     vk::Buffer readback(*ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
-      pass.record(cb, input.view(), out.handle(), out.view(), format, extent, mode, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+      pass.record(cb, input.tracked(), input.view(), out.tracked(), out.view(), format, extent, mode);
+      vk::require(cb, out.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
       vk::copyImageToHost(cb, out.handle(), extent, readback.handle());
     });
     readback.invalidate();

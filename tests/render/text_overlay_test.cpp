@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "render/text_overlay.hpp"
+#include "vk/frame_ring.hpp"
 #include "text.h"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
@@ -50,19 +51,22 @@ TEST_F(TextOverlayTest, DrawsTextOverTheFrameAndKeepsTheRest) {
                                          VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, 0, "frame"});
   const size_t bytes = size_t(e.width) * e.height * 4;
   vk::Buffer readback(*ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
-  render::TextOverlay overlay(*ctx, 2);
+  render::TextOverlay overlay(*ctx);
+  vk::FrameRing ring(*ctx, 1);
   const std::string text = "scene 1.234 ms";
-  vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
-    vk::barrier(cb, {{img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_NONE,
-                      VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+  {
+    vk::Frame& f = ring.begin();
+    VkCommandBuffer cb = f.cb;
+    vk::require(cb, img.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_CLEAR_BIT, true);
     const VkClearColorValue grey{{0.5f, 0.5f, 0.5f, 1.0f}};
     const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     vkCmdClearColorImage(cb, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &grey, 1, &range);
-    overlay.record(cb, 1, text, img.handle(), img.view(), format, e, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    overlay.record(f, text, img.tracked(), img.view(), format, e);
+    vk::require(cb, img.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
     vk::copyImageToHost(cb, img.handle(), e, readback.handle());
-  });
+    ring.submit(f);
+    ring.waitIdle();
+  }
   readback.invalidate();
   const uint8_t* px = static_cast<const uint8_t*>(readback.mapped());
 

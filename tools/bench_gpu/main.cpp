@@ -178,15 +178,11 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
   for (size_t i = 0; i < texels; ++i) h[i] = glm::packHalf1x16(u(rng));
   upload.flush();
   vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-    vk::barrier(cb, {{input.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
-                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+    vk::require(cb, input.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT, true);
     VkBufferImageCopy c{};
     c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     c.imageExtent = {extent.width, extent.height, 1};
     vkCmdCopyBufferToImage(cb, upload.handle(), input.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &c);
-    vk::barrier(cb, {{input.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                      VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
   });
   render::MosaicPass pass(ctx);
   std::vector<Row> rows;
@@ -202,8 +198,8 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
   const std::string size = std::to_string(extent.width) + "x" + std::to_string(extent.height);
   for (render::MosaicMode mode : {render::MosaicMode::Compute, render::MosaicMode::Graphics, render::MosaicMode::Off}) {
     Row r = measure(ctx, warmup, runs, [](VkCommandBuffer) {}, [&](VkCommandBuffer cb, std::vector<render::MipViews>&) {
-      pass.record(cb, input.view(), output.handle(), output.view(), VK_FORMAT_R8G8B8A8_UNORM, extent, mode,
-                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+      pass.record(cb, input.tracked(), input.view(), output.tracked(), output.view(), VK_FORMAT_R8G8B8A8_UNORM, extent, mode);
+      vk::require(cb, output.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
     });
     r.pass = "mosaic 5x3";
     r.size = size;

@@ -11,7 +11,7 @@ ViewFrames::ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D 
     : ctx_(ctx),
       swapchain_(ctx, surface, windowExtent),
       renderer_(ctx, scene, kFramesInFlight),
-      text_(ctx, kFramesInFlight),
+      text_(ctx),
       ring_(ctx, kFramesInFlight) {}
 
 bool ViewFrames::frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageRGBA8* shot) {
@@ -26,29 +26,27 @@ bool ViewFrames::frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageR
   if (readBack)
     shot_ = vk::Buffer(ctx_, VkDeviceSize(e.width) * e.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
   const bool showTrace = in.trace && in.trace->visible() && (swapchain_.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT);
-  const VkImageLayout finalLayout = readBack ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
-  render::FrameContext fc{f, in.pose, in.lens, in.settings,
-                          {swapchain_.image(imageIndex), swapchain_.view(imageIndex), format, e,
-                           showTrace ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : finalLayout}};
+  // The post pass is the first to touch the swapchain image, in compute or as a colour attachment, after
+  // the acquire semaphore waited at those stages: its barrier chains to that wait.
+  constexpr VkPipelineStageFlags2 kAcquireWait =
+      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+  vk::ImageState acquiredState{VK_IMAGE_LAYOUT_UNDEFINED, kAcquireWait, VK_ACCESS_2_NONE, 0};
+  const vk::TrackedImage image{swapchain_.image(imageIndex), &acquiredState, "swapchain image"};
+  render::FrameContext fc{f, in.pose, in.lens, in.settings, {image, swapchain_.view(imageIndex), format, e}};
   renderer_.frame(fc);
-  const VkImage image = fc.target.image;
   if (showTrace) {  // the traced image over the raster one
-    in.trace->recordCopy(f, image, format, e);
-    vk::barrier(f.cb, {{image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, finalLayout, VK_PIPELINE_STAGE_2_COPY_BIT,
-                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_TRANSFER_READ_BIT}});
+    vk::require(f.cb, image, vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT);
+    in.trace->recordCopy(f, image.image, format, e);
   }
   if (readBack) {
-    vk::copyImageToHost(f.cb, image, e, shot_.handle());
-    vk::barrier(f.cb, {{image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_ACCESS_2_NONE}});
+    vk::require(f.cb, image, vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
+    vk::copyImageToHost(f.cb, image.image, e, shot_.handle());
   }
   // The overlay comes last, after any read-back copy: screenshots never contain it.
   if (in.text && !readBack)
-    text_.record(f.cb, f.index, *in.text, image, fc.target.view, format, e, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-                 VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, e.width >= 1280 ? 2.0f : 1.0f);  // whole-pixel font scales only
-  // The post pass is the first to touch the swapchain image, in compute or as a colour attachment.
-  ring_.submit(f, f.acquired, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-               swapchain_.renderDone(imageIndex));
+    text_.record(f, *in.text, image, fc.target.view, format, e, e.width >= 1280 ? 2.0f : 1.0f);  // whole-pixel font scales only
+  vk::require(f.cb, image, vk::Use::Present, VK_PIPELINE_STAGE_2_NONE);
+  ring_.submit(f, f.acquired, kAcquireWait, swapchain_.renderDone(imageIndex));
   swapchain_.present(imageIndex);
   if (readBack) {
     ring_.waitIdle();
