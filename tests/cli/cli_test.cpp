@@ -20,6 +20,7 @@
 
 #include "core/image.hpp"
 #include "scene/load.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
@@ -27,13 +28,13 @@ using ::testing::Not;
 
 namespace {
 
-const fs::path kSource = RTR_SOURCE_DIR;
+const fs::path kSource = rtr::test::sourceDir();
 const fs::path kCornell = kSource / "assets-src/rt/cornell_box.obj";
 const fs::path kTemple = kSource / "assets-src/temple/temple.obj.zst";
 
 fs::path bin(const std::string& tool) {
   const char* dir = std::getenv("RTR_CLI_BIN_DIR");
-  return fs::path(dir ? dir : RTR_BIN_DIR) / tool;
+  return dir ? fs::path(dir) / tool : fs::path(rtr::test::toolPath(tool));
 }
 
 std::string readAll(const fs::path& f) {

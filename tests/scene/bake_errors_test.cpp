@@ -9,6 +9,7 @@
 
 #include "bake.hpp"
 #include "core/error.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
@@ -23,7 +24,7 @@ struct Fixture : ::testing::Test {
     fs::create_directories(out);
     write("s.obj", "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
     write("s.mtl", "newmtl a\nmap_Kd tex.png\n");
-    fs::copy_file(fs::path(RTR_SOURCE_DIR) / "assets-src/temple/textures/gold_col.png", dir / "tex.png");
+    fs::copy_file(rtr::test::sourceDir() / "assets-src/temple/textures/gold_col.png", dir / "tex.png");
   }
   void TearDown() override { fs::remove_all(dir); }
   void write(const std::string& name, const std::string& text) { std::ofstream(dir / name, std::ios::binary) << text; }

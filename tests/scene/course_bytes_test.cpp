@@ -8,6 +8,7 @@
 
 #include "bake.hpp"
 #include "scene/load.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -38,7 +39,7 @@ fs::path tempDir(const char* tag) {
 TEST(CourseBytes, TempleBakeFollowsTheTable) {
   const fs::path dir = tempDir("course_bytes");
   rtr::BakeOptions o;
-  o.input = fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst";
+  o.input = rtr::test::sourceDir() / "assets-src/temple/temple.obj.zst";
   o.output = dir / "temple.comp5892mesh";
   o.threads = 2;
   rtr::bake(o);

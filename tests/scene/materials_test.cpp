@@ -17,6 +17,7 @@
 #include "scene/obj.hpp"
 #include "scene/textures.hpp"
 #include "scene/triangulate.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using namespace rtr;
@@ -193,7 +194,7 @@ TEST(TextureFallback, MissingAndBrokenTexturesDecodeToTheChecker) {
   const fs::path dir = fs::temp_directory_path() / ("rtr_tex_fallback_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::ofstream(dir / "junk.png") << "not an image";
-  fs::copy_file(fs::path(RTR_SOURCE_DIR) / "assets-src/temple/textures/gold_col.png", dir / "good.png",
+  fs::copy_file(rtr::test::sourceDir() / "assets-src/temple/textures/gold_col.png", dir / "good.png",
                 fs::copy_options::overwrite_existing);
   Scene s;
   s.baseDir = dir;

@@ -7,6 +7,7 @@
 #include "scene/course.hpp"
 #include "scene/load.hpp"
 #include "scene/rtrscene.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using namespace rtr;
@@ -45,7 +46,7 @@ void expectSameTextures(const Scene& a, const Scene& b) {
 
 // The temple as the baker sees it: parsed, with paths planned for an output named "temple".
 Scene planned(bool course) {
-  Scene s = loadScene(fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst");
+  Scene s = loadScene(rtr::test::sourceDir() / "assets-src/temple/temple.obj.zst");
   s.defaultView = CameraPose{{1, 2, 3}, 45, -10};
   return planTextures(s, "temple", course).scene;
 }
@@ -55,7 +56,7 @@ Scene planned(bool course) {
 TEST(RoundTrip, RtrSceneKeepsEverything) {
   const Scene want = planned(false);
   const fs::path dir = tempDir("rt_rtrscene");
-  BakeOptions o{fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst", dir / "temple.rtrscene"};
+  BakeOptions o{rtr::test::sourceDir() / "assets-src/temple/temple.obj.zst", dir / "temple.rtrscene"};
   o.view = want.defaultView;
   Light light;
   light.position = {1, 2, 3};
@@ -102,7 +103,7 @@ TEST(RoundTrip, RtrSceneKeepsEverything) {
 TEST(RoundTrip, CourseFormatKeepsMeshesAndTextureSlots) {
   const Scene want = planned(false);  // fallbacks read back as "no texture"
   const fs::path dir = tempDir("rt_course");
-  BakeOptions o{fs::path(RTR_SOURCE_DIR) / "assets-src/temple/temple.obj.zst", dir / "temple.comp5892mesh"};
+  BakeOptions o{rtr::test::sourceDir() / "assets-src/temple/temple.obj.zst", dir / "temple.comp5892mesh"};
   o.threads = 2;
   bake(o);
   const Scene got = loadScene(o.output);

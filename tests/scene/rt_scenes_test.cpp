@@ -4,12 +4,13 @@
 #include <glm/geometric.hpp>
 
 #include "scene/load.hpp"
+#include "test_paths.hpp"
 
 using namespace rtr;
 
 namespace {
 
-const std::filesystem::path kRt = std::filesystem::path(RTR_SOURCE_DIR) / "assets-src/rt";
+const std::filesystem::path kRt = rtr::test::sourceDir() / "assets-src/rt";
 
 glm::vec3 firstFaceNormal(const Mesh& m) {
   glm::vec3 a = m.positions[m.indices[0]], b = m.positions[m.indices[1]], c = m.positions[m.indices[2]];

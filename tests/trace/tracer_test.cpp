@@ -13,6 +13,7 @@
 #include "trace/procedural.hpp"
 #include "core/error.hpp"
 #include "trace/spawn.hpp"
+#include "test_paths.hpp"
 
 namespace rtr::trace {
 namespace {
@@ -130,7 +131,7 @@ TEST(Tracer, HeadlightSitsAtTheCamera) {
 // A course scene as the course ships it (no mtllib; NAME.mtl beside the OBJ; a "light" material): lit by
 // its own ceiling light from the default pose, with shadows that darken and never brighten.
 TEST(Tracer, CourseSceneTracesLitWithShadows) {
-  const Scene s = loadScene(std::filesystem::path(RTR_SOURCE_DIR) / "assets-src/rt/cornell_box.obj");
+  const Scene s = loadScene(rtr::test::sourceDir() / "assets-src/rt/cornell_box.obj");
   const LightRig rig = resolveLights(s);
   ASSERT_EQ(rig.lights.size(), 1u);
   EXPECT_EQ(rig.lights[0].kind, Light::Kind::Area);
