@@ -89,7 +89,7 @@ struct BvhBuilder {
   std::unique_ptr<Node[]> nodes;
   std::unique_ptr<TriPack[]> packs;
   std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
-  std::atomic<int> spawnBudget{0};
+  std::atomic<int> running{0};  // subtree threads at work
   uint32_t threads = 1;
   static constexpr uint32_t kParallelChunk = 64 * 1024;  // refs per thread below which binning stays serial
 
@@ -341,8 +341,19 @@ struct BvhBuilder {
     std::future<uint32_t> pending[kWidth];
     for (int k = 0; k < count; ++k) {
       if (c[k].leaf) { node.child[k] = makeLeaf(c[k].r); continue; }
-      if (c[k].r.size() > 20000 && spawnBudget.fetch_sub(1) > 0)
-        pending[k] = std::async(std::launch::async, [this, rr = c[k].r] { return build(rr); });
+      // A thread for a large subtree whenever there is room (up to 2 × threads at work, one thread: none):
+      // a fixed budget, spent near the root, left whole 100 K-triangle subtrees to one thread late on.
+      bool spawn = false;
+      if (c[k].r.size() > 20000 && threads > 1) {
+        spawn = running.fetch_add(1) < int(threads) * 2 - 1;
+        if (!spawn) running.fetch_sub(1);
+      }
+      if (spawn)
+        pending[k] = std::async(std::launch::async, [this, rr = c[k].r] {
+          const uint32_t i = build(rr);
+          running.fetch_sub(1);
+          return i;
+        });
       else
         node.child[k] = build(c[k].r);
     }
@@ -378,7 +389,6 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   if (n == 0) return;
   b.nodes.reset(new Node[n + 1]);
   b.packs.reset(new TriPack[n + 1]);
-  b.spawnBudget = int(threads) * 2 - 1;
   b.threads = threads;
   root_ = b.build(BvhBuilder::boundsOf(b.refs, 0, n, 0));
   // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
