@@ -390,7 +390,11 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   b.nodes.reset(new Node[n + 1]);
   b.packs.reset(new TriPack[n + 1]);
   b.threads = threads;
+  const auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
+  stats_.refSeconds = since(start);
+  const auto treeStart = std::chrono::steady_clock::now();
   root_ = b.build(BvhBuilder::boundsOf(b.refs, 0, n, 0));
+  stats_.treeSeconds = since(treeStart);
   // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
   nodes_ = HugeArray<Node>(b.nodeCount.load());
   packs_ = HugeArray<TriPack>(b.packCount.load());
@@ -400,7 +404,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   stats_.packs = uint32_t(packs_.size());
   stats_.maxDepth = b.maxDepth.load();
   stats_.sahCost = sahCost(nodes_.data(), root_);
-  stats_.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.buildSeconds = since(start);
 }
 
 template <class T>

@@ -27,6 +27,7 @@ struct alignas(64) Node {
 struct BvhStats {
   uint32_t nodes = 0, packs = 0, triangles = 0, maxDepth = 0;
   double buildSeconds = 0.0;
+  double refSeconds = 0.0, treeSeconds = 0.0;  // of it: the references, the tree (the rest: copy-out)
   double sahCost = 0.0;  // expected node and pack tests of a ray through the root box (bvh.cpp)
 };
 
