@@ -51,6 +51,33 @@ struct Range {
 
 uint32_t packsFor(uint32_t n) { return (n + kWidth - 1) / kWidth; }
 
+// The tree's SAH cost as the builder counts it: per node kNodeCost, per leaf its packs, each weighted by
+// its box's area relative to the root's (the expected work of a ray that meets the root box).
+double sahCost(const Node* nodes, uint32_t root) {
+  const auto area = [](const Node& n, int k) {
+    const double e[3] = {double(n.box[1][0][k]) - n.box[0][0][k], double(n.box[1][1][k]) - n.box[0][1][k],
+                         double(n.box[1][2][k]) - n.box[0][2][k]};
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+  };
+  if (root & Bvh::kLeafBit) return double(((root >> 28) & 7u) + 1);
+  double total = 0.0, rootArea = 0.0;
+  Box rootBox;
+  std::vector<uint32_t> stack{root};
+  while (!stack.empty()) {
+    const Node& n = nodes[stack.back()];
+    stack.pop_back();
+    for (int k = 0; k < int(kWidth); ++k) {
+      if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty slot
+      if (&n == &nodes[root]) rootBox.grow(Box{{n.box[0][0][k], n.box[0][1][k], n.box[0][2][k]}, {n.box[1][0][k], n.box[1][1][k], n.box[1][2][k]}});
+      const uint32_t c = n.child[k];
+      if (c & Bvh::kLeafBit) total += area(n, k) * double(((c >> 28) & 7u) + 1);
+      else { total += area(n, k) * kNodeCost; stack.push_back(c); }
+    }
+  }
+  rootArea = rootBox.halfArea();
+  return rootArea > 0.0 ? kNodeCost + total / rootArea : 0.0;
+}
+
 }  // namespace
 
 // Top-down build straight into 8-wide nodes: a node's range is split by binned SAH, and the child with
@@ -62,7 +89,9 @@ struct BvhBuilder {
   std::unique_ptr<Node[]> nodes;
   std::unique_ptr<TriPack[]> packs;
   std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
-  std::atomic<int> spawnBudget{0};
+  std::atomic<int> running{0};  // subtree threads at work
+  uint32_t threads = 1;
+  static constexpr uint32_t kParallelChunk = 64 * 1024;  // refs per thread below which binning stays serial
 
   struct Split {
     int axis = -1, bin = 0;
@@ -70,25 +99,53 @@ struct BvhBuilder {
     Range left, right;
   };
 
-  // Binned SAH over all three axes in one pass. Cost counts packs of eight, since a leaf's price is the
-  // number of 8-wide triangle tests it takes.
-  Split findSplit(const Range& r) const {
-    struct Bin { Box b, c; uint32_t n = 0; };
-    Bin bins[3][kBins];
-    const glm::vec3 ext = r.cbounds.hi - r.cbounds.lo;
-    glm::vec3 scale;
-    for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
-    for (uint32_t i = r.begin; i < r.end; ++i) {
-      const PrimRef& p = refs[i];
+  struct Bin { Box b, c; uint32_t n = 0; };
+  struct Bins {
+    Bin bin[3][kBins];
+    // Min, max and sums: exact and order-free, so the bins (and the split) do not depend on how the
+    // range was cut up between threads.
+    void merge(const Bins& o) {
+      for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < kBins; ++k) { bin[a][k].b.grow(o.bin[a][k].b); bin[a][k].c.grow(o.bin[a][k].c); bin[a][k].n += o.bin[a][k].n; }
+    }
+  };
+
+  // The bins of refs [begin, end).
+  Bins binRefs(uint32_t begin, uint32_t end, glm::vec3 lo, glm::vec3 scale) const {
+    Bins out;
+    const PrimRef* ref = refs.data();
+    for (uint32_t i = begin; i < end; ++i) {
+      const PrimRef& p = ref[i];
       const glm::vec3 c = p.centroid2();
       for (int a = 0; a < 3; ++a) {
-        const int k = std::clamp(int((c[a] - r.cbounds.lo[a]) * scale[a]), 0, kBins - 1);
-        Bin& bin = bins[a][k];
+        const int k = std::clamp(int((c[a] - lo[a]) * scale[a]), 0, kBins - 1);
+        Bin& bin = out.bin[a][k];
         bin.b.grow(p.box);
         bin.c.grow(c);
         ++bin.n;
       }
     }
+    return out;
+  }
+
+  // Binned SAH over all three axes in one pass. Cost counts packs of eight, since a leaf's price is the
+  // number of 8-wide triangle tests it takes. Ranges near the root are binned by all threads: there the
+  // build has no subtrees yet to run side by side.
+  Split findSplit(const Range& r) const {
+    Bins all;
+    const glm::vec3 ext = r.cbounds.hi - r.cbounds.lo;
+    glm::vec3 scale;
+    for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
+    const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
+    if (chunks > 1) {
+      std::vector<Bins> part(chunks);
+      const auto cut = [&](uint32_t c) { return r.begin + uint32_t(uint64_t(r.size()) * c / chunks); };
+      parallelFor(chunks, [&](uint32_t c) { part[c] = binRefs(cut(c), cut(c + 1), r.cbounds.lo, scale); });
+      for (const Bins& p : part) all.merge(p);
+    } else {
+      all = binRefs(r.begin, r.end, r.cbounds.lo, scale);
+    }
+    const auto& bins = all.bin;
     Split best;
     for (int a = 0; a < 3; ++a) {
       if (!(ext[a] > 0.0f)) continue;
@@ -128,13 +185,53 @@ struct BvhBuilder {
     return best;
   }
 
+  // Runs fn(c) for c in [0, chunks), chunk 0 on this thread.
+  template <class Fn>
+  static void parallelFor(uint32_t chunks, const Fn& fn) {
+    std::vector<std::future<void>> jobs;
+    for (uint32_t c = 1; c < chunks; ++c) jobs.push_back(std::async(std::launch::async, [&fn, c] { fn(c); }));
+    fn(0);
+    for (auto& j : jobs) j.get();
+  }
+
+  // Moves the refs of bins ≤ s.bin in front. The k-th misplaced ref from the front trades places with the
+  // k-th misplaced one from the back (Hoare's scheme, as std::partition does it), whether one thread or
+  // many do it: the tree does not depend on the thread count.
   void partition(const Split& s, const Range& r) {
     const int a = s.axis;
     const float lo = r.cbounds.lo[a];
     const float ext = r.cbounds.hi[a] - lo;
     const float scale = float(kBins) * 0.99999f / ext;
-    std::partition(refs.begin() + r.begin, refs.begin() + r.end, [&](const PrimRef& p) {
-      return std::clamp(int((p.centroid2()[a] - lo) * scale), 0, kBins - 1) <= s.bin;
+    const auto left = [&](const PrimRef& p) { return std::clamp(int((p.centroid2()[a] - lo) * scale), 0, kBins - 1) <= s.bin; };
+    const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
+    if (chunks <= 1) {
+      uint32_t i = r.begin, j = r.end;
+      for (;;) {
+        while (i < j && left(refs[i])) ++i;
+        while (i < j && !left(refs[j - 1])) --j;
+        if (i >= j) return;
+        std::swap(refs[i++], refs[--j]);
+      }
+    }
+    // In parallel: list the misplaced refs of each side in that order, then swap the k-th pairs.
+    const uint32_t mid = s.left.end;
+    std::vector<std::vector<uint32_t>> front(chunks), back(chunks);
+    const auto cut = [&](uint32_t b, uint32_t e, uint32_t c) { return b + uint32_t(uint64_t(e - b) * c / chunks); };
+    parallelFor(chunks, [&](uint32_t c) {
+      for (uint32_t i = cut(r.begin, mid, c); i < cut(r.begin, mid, c + 1); ++i)
+        if (!left(refs[i])) front[c].push_back(i);
+      // Back side from the end: chunk c covers the c-th stretch counted from r.end down.
+      for (uint32_t i = r.end - cut(0, r.end - mid, c); i > r.end - cut(0, r.end - mid, c + 1); --i)
+        if (left(refs[i - 1])) back[c].push_back(i - 1);
+    });
+    std::vector<uint32_t> f, b;
+    for (uint32_t c = 0; c < chunks; ++c) {
+      f.insert(f.end(), front[c].begin(), front[c].end());
+      b.insert(b.end(), back[c].begin(), back[c].end());
+    }
+    if (f.size() != b.size()) throw Error("BVH build: partition counts disagree with the bins");  // never: same arithmetic
+    parallelFor(chunks, [&](uint32_t c) {
+      for (size_t k = size_t(f.size()) * c / chunks; k < size_t(f.size()) * (c + 1) / chunks; ++k) std::swap(refs[f[k]], refs[b[k]]);
     });
   }
 
@@ -244,8 +341,19 @@ struct BvhBuilder {
     std::future<uint32_t> pending[kWidth];
     for (int k = 0; k < count; ++k) {
       if (c[k].leaf) { node.child[k] = makeLeaf(c[k].r); continue; }
-      if (c[k].r.size() > 20000 && spawnBudget.fetch_sub(1) > 0)
-        pending[k] = std::async(std::launch::async, [this, rr = c[k].r] { return build(rr); });
+      // A thread for a large subtree whenever there is room (up to 2 × threads at work, one thread: none):
+      // a fixed budget, spent near the root, left whole 100 K-triangle subtrees to one thread late on.
+      bool spawn = false;
+      if (c[k].r.size() > 20000 && threads > 1) {
+        spawn = running.fetch_add(1) < int(threads) * 2 - 1;
+        if (!spawn) running.fetch_sub(1);
+      }
+      if (spawn)
+        pending[k] = std::async(std::launch::async, [this, rr = c[k].r] {
+          const uint32_t i = build(rr);
+          running.fetch_sub(1);
+          return i;
+        });
       else
         node.child[k] = build(c[k].r);
     }
@@ -281,8 +389,12 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   if (n == 0) return;
   b.nodes.reset(new Node[n + 1]);
   b.packs.reset(new TriPack[n + 1]);
-  b.spawnBudget = int(threads) * 2 - 1;
+  b.threads = threads;
+  const auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
+  stats_.refSeconds = since(start);
+  const auto treeStart = std::chrono::steady_clock::now();
   root_ = b.build(BvhBuilder::boundsOf(b.refs, 0, n, 0));
+  stats_.treeSeconds = since(treeStart);
   // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
   nodes_ = HugeArray<Node>(b.nodeCount.load());
   packs_ = HugeArray<TriPack>(b.packCount.load());
@@ -291,7 +403,8 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   stats_.nodes = uint32_t(nodes_.size());
   stats_.packs = uint32_t(packs_.size());
   stats_.maxDepth = b.maxDepth.load();
-  stats_.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.sahCost = sahCost(nodes_.data(), root_);
+  stats_.buildSeconds = since(start);
 }
 
 template <class T>

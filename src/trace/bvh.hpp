@@ -27,6 +27,8 @@ struct alignas(64) Node {
 struct BvhStats {
   uint32_t nodes = 0, packs = 0, triangles = 0, maxDepth = 0;
   double buildSeconds = 0.0;
+  double refSeconds = 0.0, treeSeconds = 0.0;  // of it: the references, the tree (the rest: copy-out)
+  double sahCost = 0.0;  // expected node and pack tests of a ray through the root box (bvh.cpp)
 };
 
 // A fixed-size array in memory the kernel is asked to back with 2 MB pages (transparent huge pages):
@@ -96,6 +98,7 @@ class Bvh {
     const TriPack* packs;
     uint32_t root;
   };
+  View view() const { return {nodes_.data(), packs_.data(), root_}; }  // also for tests of the tree
 
  private:
   static constexpr uint32_t kEmpty = 0xFFFFFFFFu;

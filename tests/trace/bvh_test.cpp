@@ -1,6 +1,8 @@
 // The BVH against brute force: same closest hits, any-hit agrees, shadow flags respected.
 #include "trace/bvh.hpp"
 
+#include <algorithm>
+#include <cstring>
 #include <random>
 
 #include <glm/geometric.hpp>
@@ -183,6 +185,76 @@ TEST(Bvh, EmptyAndDegenerateInputs) {
   // Non-finite coordinates are left out rather than poisoning the boxes.
   std::vector<Triangle> bad{{{NAN, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{-1, -1, -1}, {1, -1, -1}, {0, 1, -1}}};
   EXPECT_EQ(Bvh(bad).closest({{0, 0, 0}, {0, 0, -1}}).prim, 1u);
+}
+
+// The parallel build (ranges near the root binned and partitioned by all threads, subtrees side by side)
+// makes the very tree one thread makes: nodes and packs bit for bit. And that tree is sound: child
+// boxes inside their parent's, each leaf's triangles inside its box, every triangle in exactly one leaf.
+TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
+  const Mesh sphere = uvSphere({0.5f, -0.25f, 2.0f}, 3.0f, 300, 600);  // big enough for parallel binning
+  std::vector<Triangle> tris;
+  for (size_t i = 0; i < sphere.indices.size(); i += 3)
+    tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]],
+                    sphere.positions[sphere.indices[i + 2]]});
+  tris.insert(tris.end(), 1000, Triangle{{-1, -1, -1}, {1, -1, -1}, {0, 1, -1}});  // one centroid: median splits
+  const Bvh one(tris, {}, 1), many(tris, {}, 8);
+  ASSERT_GT(tris.size(), 300000u);
+  ASSERT_EQ(one.stats().nodes, many.stats().nodes);
+  ASSERT_EQ(one.stats().packs, many.stats().packs);
+  EXPECT_EQ(one.stats().sahCost, many.stats().sahCost);
+  EXPECT_GT(one.stats().sahCost, 1.0);
+  const Bvh::View a = one.view(), b = many.view();
+  EXPECT_EQ(a.root, b.root);
+  for (uint32_t i = 0; i < one.stats().nodes; ++i)  // field by field: a Node has padding
+    ASSERT_TRUE(!std::memcmp(a.nodes[i].box, b.nodes[i].box, sizeof a.nodes[i].box) &&
+                !std::memcmp(a.nodes[i].child, b.nodes[i].child, sizeof a.nodes[i].child)) << "node " << i;
+  for (uint32_t i = 0; i < one.stats().packs; ++i)
+    ASSERT_TRUE(!std::memcmp(a.packs[i].v, b.packs[i].v, sizeof a.packs[i].v) &&
+                !std::memcmp(a.packs[i].prim, b.packs[i].prim, sizeof a.packs[i].prim)) << "pack " << i;
+
+  std::vector<int> seen(tris.size(), 0);
+  size_t leaves = 0;
+  std::vector<uint32_t> stack{b.root};
+  while (!stack.empty()) {
+    const Node& n = b.nodes[stack.back()];
+    stack.pop_back();
+    for (int k = 0; k < 8; ++k) {
+      if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty slot
+      const auto inside = [&](float x, int axis) { return n.box[0][axis][k] <= x && x <= n.box[1][axis][k]; };
+      const uint32_t c = n.child[k];
+      if (c & Bvh::kLeafBit) {
+        ++leaves;
+        const uint32_t first = c & 0x0FFFFFFFu, np = ((c >> 28) & 7u) + 1;
+        for (uint32_t p = first; p < first + np; ++p)
+          for (int lane = 0; lane < 8; ++lane) {
+            const TriPack& pk = b.packs[p];
+            for (int v = 0; v < 3; ++v)
+              for (int axis = 0; axis < 3; ++axis) ASSERT_TRUE(inside(pk.v[v][axis][lane], axis));
+            if (lane == 0 || pk.prim[lane] != pk.prim[lane - 1]) ++seen[pk.prim[lane]];  // a short pack repeats
+          }
+      } else {
+        const Node& child = b.nodes[c];
+        for (int j = 0; j < 8; ++j)
+          if (child.box[0][0][j] <= child.box[1][0][j])
+            for (int axis = 0; axis < 3; ++axis)
+              ASSERT_TRUE(inside(child.box[0][axis][j], axis) && inside(child.box[1][axis][j], axis));
+        stack.push_back(c);
+      }
+    }
+  }
+  EXPECT_GT(leaves, 1000u);
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), std::ptrdiff_t(tris.size()));
+
+  // And so the same answers: rays from inside the closed sphere all hit.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 2000; ++i) {
+    const Ray r{{0.5f, -0.25f, 2.0f}, {u(rng), u(rng), u(rng)}};
+    const Hit h1 = one.closest(r), h8 = many.closest(r);
+    ASSERT_TRUE(h8.hit()) << i;
+    EXPECT_EQ(h1.prim, h8.prim);
+    EXPECT_EQ(h1.t, h8.t);
+  }
 }
 
 }  // namespace

@@ -221,8 +221,17 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   const Bvh bvh(tris, {}, threads);
   const double ourBuild = seconds(t0);
   const Embree em(tris, threads);
-  std::printf("BVH build: ours %.3f s (%u nodes, %u packs, depth %u); Embree (quality high) %.3f s\n\n", ourBuild,
-              bvh.stats().nodes, bvh.stats().packs, bvh.stats().maxDepth, em.buildSeconds);
+  double oneThread = 0.0;
+  if (threads != 1) {  // the same tree on one thread (bvh.cpp): the parallel build's speed-up
+    const auto t1 = Clock::now();
+    const Bvh serial(tris, {}, 1);
+    oneThread = seconds(t1);
+  }
+  const BvhStats& st = bvh.stats();
+  std::printf("BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
+              "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
+              ourBuild, st.nodes, st.packs, st.maxDepth, st.sahCost, st.refSeconds, st.treeSeconds,
+              st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
 
   // Primary rays through pixel centres from the default framing pose (the viewer's and rtr-trace's).
   Lens lens;
