@@ -17,9 +17,10 @@ for b in rtr-view rtr-bench-gpu rtr-trace bench-trace rtr-bake scenegen rtr-fram
 done
 cp -r "$B/shaders" "$out/shaders"
 cp -r "$B/assets" "$out/assets"
-# What the tests read from the source tree (tests/vk/test_paths.hpp finds it in src/).
-mkdir -p "$out/src/tests/vk" "$out/src/assets-src"
+# What the tests read from the source tree (tests/test_paths.hpp finds it in src/).
+mkdir -p "$out/src/tests/vk" "$out/src/tests/fuzz/crashes" "$out/src/assets-src"
 cp -r tests/vk/data "$out/src/tests/vk/"
+cp -r tests/fuzz/crashes/fuzz_spirv "$out/src/tests/fuzz/crashes/"  # SPIR-V that SPIRV-Reflect crashes on
 cp -r tests/reference "$out/src/tests/"
 cp -r shaders "$out/src/"
 cp -r assets-src/rt "$out/src/assets-src/"
