@@ -10,11 +10,7 @@
 
 #include "core/error.hpp"
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#define STBI_FAILURE_USERMSG
-#include <stb_image.h>
-#include <stb_image_write.h>
+#include <stb_image.h>  // the implementation is compiled in stb.cpp
 
 namespace rtr {
 
