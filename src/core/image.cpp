@@ -68,7 +68,7 @@ TexelData loadImage(const std::filesystem::path& file, int channels) {
   if (!in) throw fileError(file.string(), "", "cannot open image");
   const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw fileError(file.string(), "", "read error");
-  if (bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF) {
+  if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8) {  // a JPEG start-of-image marker
     TexelData out;
     std::string error;
     if (!decodeJpeg(bytes, channels, out, error)) throw fileError(file.string(), "", "cannot decode JPEG: " + error);
