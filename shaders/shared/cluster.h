@@ -1,0 +1,35 @@
+// Clusters: the unit of GPU-driven culling and of the compute rasteriser. A cluster is up to
+// CLUSTER_MAX_TRIANGLES triangles of one draw, contiguous in that draw's index range, so a triangle's id
+// (draw, firstTriangle + local index) is the same gl_PrimitiveID the hardware path sees. Built at bake time
+// (meshoptimizer, stored in .rtrscene) or at load; the mesh's index buffer is reordered cluster by cluster.
+#ifndef RTR_SHADERS_SHARED_CLUSTER_H
+#define RTR_SHADERS_SHARED_CLUSTER_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace rtr::shader {
+using namespace glm;
+typedef uint32_t uint;
+#endif
+
+#define CLUSTER_MAX_VERTICES 64
+#define CLUSTER_MAX_TRIANGLES 124
+
+// Storage buffer, std430, 48 bytes. Bounds are in scene (world) space: the scene has no instancing.
+struct GpuCluster {
+  vec4 sphere;         // xyz centre, w radius
+  vec4 cone;           // xyz axis (unit), w cutoff: cull when dot(normalize(centre - eye), axis) >= w; w > 1 never culls
+  uint draw;           // index of its GpuDraw (drawInfo buffer)
+  uint firstTriangle;  // of the draw: the triangle's primitive id is firstTriangle + local index
+  uint triangleCount;  // 1..CLUSTER_MAX_TRIANGLES
+  uint flags;          // CLUSTER_* below
+};
+#define CLUSTER_ALPHA_MASKED 1u  // its material cuts out by texture alpha
+#define CLUSTER_DOUBLE_SIDED 2u  // never back-face culled (cone disabled)
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuCluster) == 48);
+}  // namespace rtr::shader
+#endif
+#endif
