@@ -19,7 +19,8 @@ typedef uint32_t uint;
 // Storage buffer, std430, 48 bytes. Bounds are in scene (world) space: the scene has no instancing.
 struct GpuCluster {
   vec4 sphere;         // xyz centre, w radius
-  vec4 cone;           // xyz axis (unit), w cutoff: cull when dot(normalize(centre - eye), axis) >= w; w > 1 never culls
+  vec4 cone;           // xyz axis (unit), w cutoff: back-facing when dot(c - eye, axis) >= w |c - eye| + radius
+                       // (c the sphere's centre; meshoptimizer's conservative test); w >= 1 never culls
   uint draw;           // index of its GpuDraw (drawInfo buffer)
   uint firstTriangle;  // of the draw: the triangle's primitive id is firstTriangle + local index
   uint triangleCount;  // 1..CLUSTER_MAX_TRIANGLES
