@@ -198,6 +198,14 @@ def main():
         settle()
         check(frame() != hidden, "the panel was on screen when the screenshot was taken")
 
+        # Mip generation from the panel: the scene's GPU objects are rebuilt with the blit path (cleanly: the
+        # validation layer is watching). The panel is still shown.
+        n_err = len(viewer.lines("err"))
+        click("blit")
+        viewer.wait_line("err", r"rtr-view: mips \(blit\) [0-9.]+ ms GPU", start=n_err)
+        wait_title("CPU")
+        check(viewer.proc.poll() is None, "the blit radio button rebuilds the scene's mips")
+
         # Orbit: a left-drag over the view turns the camera about the target (which stays on the view axis, at
         # the same distance); scroll moves it to the target; a middle-drag pans both.
         xdo("key", "F1")
@@ -262,9 +270,10 @@ def main():
         check(frame() == kept, "a bad drop keeps the scene on screen")
         xdo("key", "F1")
         check(rect("message")[3] > 0, "the panel shows the message")
-        tri = os.path.join(tmp.name, "tri.obj")
+        # A triangle far from the origin: F must frame it, whatever the pose.
+        tri, far = os.path.join(tmp.name, "tri.obj"), (1000.0, 500.0, -700.0)
         with open(tri, "w") as f:
-            f.write("v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n")
+            f.write("".join(f"v {far[0] + x} {far[1] + y} {far[2]}\n" for x, y in ((-1, -1), (1, -1), (0, 1))) + "f 1 2 3\n")
         n_err = len(viewer.lines("err"))
         drop(tri)
         viewer.wait_line("err", r"rtr-view: loaded .*tri\.obj", start=n_err)
@@ -272,6 +281,16 @@ def main():
         xdo("key", "F1")
         settle()
         check(frame() != kept, "a good drop replaces the scene")
+        xdo("key", "Home")  # the dropped scene's start pose; then somewhere else, then F
+        drag(1, -80, 30)
+        xdo("key", "f")
+        time.sleep(0.5)
+        (cf, _, _) = pose()
+        fwd = forward(cf)
+        to = [far[i] - cf[i] for i in range(3)]
+        dist = math.sqrt(sum(v * v for v in to))
+        cos = sum(a * b for a, b in zip(fwd, to)) / dist
+        check(cos > 0.999 and dist < 20, f"F frames the far triangle (distance {dist:.2f}, cos {cos:.5f})")
     except Fail as e:
         print("FAIL:", e, flush=True)
         return finish(viewer, xvfb, ok=False, t0=t0, xdo=None)
