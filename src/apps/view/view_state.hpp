@@ -22,7 +22,7 @@ struct ViewState {
   // One-shot requests, served by the render loop.
   bool traceRequested = false, errorMapRequested = false, reframeRequested = false, homeRequested = false;
   bool screenshotRequested = false, remipRequested = false;
-  std::vector<std::string> drops;  // files dropped on the window, loaded in order (the last one wins)
+  std::vector<std::string> drops;  // files dropped on the window (the last one is loaded)
   // Ray tracer (FORMATS.md §2's toggles, on keys that do not clash with the view modes).
   trace::Shading traceShading = trace::Shading::Phong;
   bool traceShadows = true, traceReflections = true, traceOrtho = false;

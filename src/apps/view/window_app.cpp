@@ -265,6 +265,8 @@ int runWindowed(const ViewOptions& opts) {
   std::string shaderError;
   double watchTimer = 0;
   std::future<std::string> shotSaved;  // the panel's screenshot, encoded off the render thread
+  std::future<Scene> loading;          // a dropped file, parsed off the render thread
+  std::string loadingPath;
   FrameHistory history;
 
   auto last = std::chrono::steady_clock::now();
@@ -282,13 +284,20 @@ int runWindowed(const ViewOptions& opts) {
       last = std::chrono::steady_clock::now();
       continue;
     }
-    // Dropped files: a failing load keeps the current scene and says why in the panel.
+    // Dropped files load on a worker thread while frames go on (the panel says so); the GPU scene is then
+    // rebuilt between frames. A failing load keeps the current scene and says why in the panel.
+    if (!loading.valid() && !app.drops.empty()) {
+      loadingPath = app.drops.back();  // several files at once: the last one
+      app.drops.clear();
+      app.message = "loading " + loadingPath + " ...", app.messageIsError = false;
+      loading = std::async(std::launch::async, [path = loadingPath] { return loadScene(path, {}); });
+    }
     std::unique_ptr<Scene> dropped;
-    for (const std::string& path : std::exchange(app.drops, {})) {
+    if (loading.valid() && loading.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
       try {
-        dropped = std::make_unique<Scene>(loadScene(path, {}));
-        scenePath = path;
-        app.message = "loaded " + path, app.messageIsError = false;
+        dropped = std::make_unique<Scene>(loading.get());
+        scenePath = loadingPath;
+        app.message = "loaded " + loadingPath, app.messageIsError = false;
       } catch (const std::exception& e) {
         app.message = std::string("cannot load: ") + e.what(), app.messageIsError = true;
       }
