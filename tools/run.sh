@@ -7,5 +7,5 @@ bash tools/setup.sh
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$(nproc)" --target rtr-view rtr_shaders assets
 mkdir -p out
-exec build/release/bin/rtr-view build/release/assets/temple.rtrscene --headless --size 1920x1080 \
+exec build/release/bin/rtr-view build/release/assets/temple.rtrscene --headless --size 1920x1080 --mosaic compute \
   --screenshot out/temple.png --force "$@"

@@ -207,7 +207,15 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   ds.depthWriteEnable = d.depthWrite;
   ds.depthCompareOp = d.depthCompare;
   std::vector<VkPipelineColorBlendAttachmentState> blends(d.colorFormats.size());
-  for (auto& b : blends) b.colorWriteMask = 0xF;
+  for (auto& b : blends) {
+    b.colorWriteMask = 0xF;
+    if (!d.alphaBlend) continue;
+    b.blendEnable = VK_TRUE;
+    b.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+    b.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    b.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+  }
   VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   cb.attachmentCount = uint32_t(blends.size());
   cb.pAttachments = blends.data();

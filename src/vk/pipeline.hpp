@@ -83,6 +83,7 @@ struct GraphicsDesc {
   VkCullModeFlags cullMode = VK_CULL_MODE_BACK_BIT;
   VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
   bool depthTest = true, depthWrite = true;
+  bool alphaBlend = false;  // colour = src.a * src + (1 - src.a) * dst (overlays such as the viewer's panel)
   VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
   std::vector<VkFormat> colorFormats;
   VkFormat depthFormat = VK_FORMAT_UNDEFINED;

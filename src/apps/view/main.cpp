@@ -112,11 +112,11 @@ int main(int argc, char** argv) {
                "Keys: W/S/A/D/E/Q move, Shift faster, Ctrl slower, right mouse button toggles mouse-look,\n"
                "1-7 views (shaded, mip level, linear depth, depth derivatives, normal, view dir, light dir),\n"
                "8/9/0 BRDF D/F/G, -/= diffuse/specular, M mosaic off/compute/graphics, [ ] LOD bias,\n"
-               "C print camera pose, F1 or H timing overlay, R ray-trace the view on the CPU (again: hide),\n"
+               "C print camera pose, F1 or H settings panel, Home start pose, R ray-trace the view on the CPU (again: hide),\n"
                "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, F frame the scene,\n"
                "Esc quit.",
                "rtr-view"};
-  std::string camera, size = "1280x720", mips = "compute", mosaic = "compute", light, lightColor,
+  std::string camera, size = "1280x720", mips = "compute", mosaic = "off", light, lightColor,
               ambient = "0.02", mtl;
   std::string shadingPath = render::toString(o.settings.shading);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
   app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay): .png, .jpg, .exr or .hdr");
   app.add_flag("--force", o.force, "overwrite an existing screenshot");
   app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit")->capture_default_str();
-  app.add_option("--mosaic", mosaic, "post process: off | compute | graphics")->capture_default_str();
+  app.add_option("--mosaic", mosaic, "post process: off (the scene plainly) | compute | graphics (the brief's captures: compute)")->capture_default_str();
   app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward")
       ->check(CLI::IsMember({"visibility", "forward"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
@@ -144,6 +144,7 @@ int main(int argc, char** argv) {
   app.add_option("--bench", o.bench, "time N frames after 10 warm-up frames; print per-pass GPU min/median")
       ->check(cli::integer(0, 1000000));
   app.add_flag("--watch", o.watch, "recompile edited shaders at run time (windowed)");
+  app.add_flag("--orbit", o.orbit, "start in orbit camera mode: left-drag turns about a target, scroll zooms, middle-drag pans (windowed)");
   app.add_option("--device", o.device, "Vulkan device index or name substring (default: discrete GPU first)");
   app.add_flag("--validation", o.validation, "enable the Vulkan validation layer");
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;

@@ -30,6 +30,7 @@ struct ViewOptions {
   bool force = false;              // overwrite an existing screenshot
   int bench = 0;                   // frames to time after warm-up; 0: no benchmark
   bool watch = false;              // hot-reload shaders
+  bool orbit = false;              // start in orbit camera mode (windowed)
   std::string device;
   bool validation = false;
 };

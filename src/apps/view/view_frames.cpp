@@ -11,7 +11,7 @@ ViewFrames::ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D 
     : ctx_(ctx),
       swapchain_(ctx, surface, windowExtent),
       renderer_(ctx, scene, kFramesInFlight),
-      text_(ctx),
+      panel_(ctx, kFramesInFlight),
       ring_(ctx, kFramesInFlight) {}
 
 bool ViewFrames::frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageRGBA8* shot) {
@@ -42,9 +42,9 @@ bool ViewFrames::frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageR
     vk::require(f.cb, image, vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
     vk::copyImageToHost(f.cb, image.image, e, shot_.handle());
   }
-  // The overlay comes last, after any read-back copy: screenshots never contain it.
-  if (in.text && !readBack)
-    text_.record(f, *in.text, image, fc.target.view, format, e, e.width >= 1280 ? 2.0f : 1.0f);  // whole-pixel font scales only
+  // The panel comes last, after any read-back copy: screenshots never contain it.
+  if (in.panel) panel_.record(f, *in.panel, image, fc.target.view, format, e);
+  else panel_.skip(f.index);
   vk::require(f.cb, image, vk::Use::Present, VK_PIPELINE_STAGE_2_NONE);
   ring_.submit(f, f.acquired, kAcquireWait, swapchain_.renderDone(imageIndex));
   swapchain_.present(imageIndex);
@@ -58,6 +58,18 @@ bool ViewFrames::frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageR
       for (size_t i = 0; i < shot->pixels.size(); i += 4) std::swap(shot->pixels[i], shot->pixels[i + 2]);
   }
   return true;
+}
+
+std::vector<std::pair<std::string, double>> ViewFrames::gpuTimes() const {
+  const uint32_t done = (lastIndex_ + 1) % kFramesInFlight;
+  auto times = renderer_.gpuTimes(done);
+  if (const auto ms = panel_.gpuMs(done)) times.push_back({"panel", *ms});
+  return times;
+}
+
+void ViewFrames::rebuildPipelines() {
+  renderer_.rebuildPipelines();
+  panel_.rebuildPipelines();
 }
 
 }  // namespace rtr::view
