@@ -28,6 +28,7 @@ class UploadArena {
   Slice alloc(VkDeviceSize bytes, VkDeviceSize align, std::vector<std::function<void()>>& deletions);
   void flush() const;  // before the frame is submitted
   void reset() { used_ = 0; }
+  VkDeviceSize used() const { return used_; }  // bytes handed out this frame
 
  private:
   const Context* ctx_ = nullptr;

@@ -67,7 +67,11 @@ Image::Image(const Context& ctx, const ImageDesc& desc) : device_(ctx.device()),
   ai.usage = VMA_MEMORY_USAGE_AUTO_PREFER_DEVICE;
   VK_CHECK(vmaCreateImage(allocator_, &ii, &ai, &image_, &allocation_, nullptr));
   if (desc.name) ctx.setName(uint64_t(image_), VK_OBJECT_TYPE_IMAGE, desc.name);
-  view_ = createView(desc.format, 0, desc.mipLevels, desc.viewUsage ? desc.viewUsage : desc.usage);
+  // A copy-only image has no view (Vulkan allows none for such usage).
+  constexpr VkImageUsageFlags kViewUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
+                                           VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+                                           VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+  if (desc.usage & kViewUsage) view_ = createView(desc.format, 0, desc.mipLevels, desc.viewUsage ? desc.viewUsage : desc.usage);
 }
 
 ImageView Image::createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage) const {

@@ -1,5 +1,7 @@
 // The tracer overlay's upload with frames in flight: each frame must show the CPU image as it was when
 // that frame was recorded, even when a later frame uploads a newer image before the earlier one ran.
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "test_paths.hpp"
@@ -8,6 +10,7 @@
 #include "trace_overlay.hpp"
 #include "vk/commands.hpp"
 #include "vk/frame_ring.hpp"
+#include "vk/image_state.hpp"
 #include "vk_fixture.hpp"
 
 namespace rtr {
@@ -19,7 +22,7 @@ class TraceOverlayTest : public test::VulkanTest {};
 
 TEST_F(TraceOverlayTest, EachFrameInFlightShowsItsOwnUpload) {
   const Scene scene = loadScene(test::sourceDir() / "assets-src/rt/cornell_box.obj");
-  view::TraceOverlay overlay(scene);
+  view::TraceOverlay overlay(*ctx, scene);
   constexpr uint32_t kFrames = 3;
   vk::FrameRing ring(*ctx, kFrames);
   struct Shown { vk::Image image; vk::Buffer readback; ImageRGBA8 expected; vk::Frame* frame; };
@@ -74,6 +77,41 @@ TEST_F(TraceOverlayTest, EachFrameInFlightShowsItsOwnUpload) {
         EXPECT_EQ(wrong, 0u) << "tile at " << tx << "," << ty;
       }
     }
+  }
+}
+
+// A finished trace is uploaded once: later frames copy it on the GPU and take no upload bytes, and still
+// show it whole.
+TEST_F(TraceOverlayTest, AFinishedTraceIsUploadedOnce) {
+  const Scene scene = loadScene(test::sourceDir() / "assets-src/rt/cornell_box.obj");
+  view::TraceOverlay overlay(*ctx, scene);
+  trace::TraceSettings ts;
+  ts.width = kW;
+  ts.height = kH;
+  overlay.start(ts);
+  overlay.wait();
+  const ImageRGBA8 expected = overlay.cpuImage();
+  vk::FrameRing ring(*ctx, 1);
+  for (int i = 0; i < 3; ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    vk::Image target(*ctx, {{kW, kH}, VK_FORMAT_R8G8B8A8_UNORM, 1,
+                            VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0, "target"});
+    vk::Buffer readback(*ctx, VkDeviceSize(kW) * kH * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+    vk::Frame& f = ring.begin();
+    vk::require(f.cb, target.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT, true);
+    overlay.recordCopy(f, target.handle(), VK_FORMAT_R8G8B8A8_UNORM, {kW, kH});
+    if (i == 0) {
+      EXPECT_GE(f.arena.used(), expected.pixels.size());
+    } else {
+      EXPECT_EQ(f.arena.used(), 0u) << "an unchanged trace was uploaded again";
+    }
+    vk::require(f.cb, target.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
+    vk::copyImageToHost(f.cb, target.handle(), {kW, kH}, readback.handle());
+    ring.submit(f);
+    ring.waitIdle();
+    readback.invalidate();
+    const auto* got = static_cast<const uint8_t*>(readback.mapped());
+    EXPECT_TRUE(std::equal(expected.pixels.begin(), expected.pixels.end(), got));
   }
 }
 

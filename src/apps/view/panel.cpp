@@ -156,7 +156,8 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::Text("BRDF term:");
     for (int m : {VIEW_BRDF_D, VIEW_BRDF_F, VIEW_BRDF_G, VIEW_DIFFUSE, VIEW_SPECULAR}) {
       ImGui::SameLine();
-      radio(m == VIEW_DIFFUSE ? "diff" : m == VIEW_SPECULAR ? "spec" : modeName(m) + 5, s.settings.mode, m);  // "BRDF D" -> "D"
+      radio(m == VIEW_BRDF_D ? "D" : m == VIEW_BRDF_F ? "F" : m == VIEW_BRDF_G ? "G" : m == VIEW_DIFFUSE ? "diff" : "spec",
+            s.settings.mode, m);
     }
     ImGui::Text("mosaic (M):");
     ImGui::SameLine();

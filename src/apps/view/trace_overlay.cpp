@@ -4,11 +4,13 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <memory>
 #include <string>
 
 #include "core/compare.hpp"
 
 #include "vk/context.hpp"
+#include "vk/image_state.hpp"
 
 namespace rtr::view {
 
@@ -72,21 +74,34 @@ ImageRGBA8 TraceOverlay::cpuImage() { return showError_ ? errorMap_ : toSrgb8(im
 void TraceOverlay::recordCopy(vk::Frame& frame, VkImage image, VkFormat format, VkExtent2D extent) {
   const uint32_t w = std::min(extent.width, image_.width), h = std::min(extent.height, image_.height);
   if (w == 0 || h == 0) return;
-  if (dirty_.exchange(false) || shownFormat_ != format || shown_.width != image_.width || shown_.height != image_.height) {
+  const VkExtent2D size{image_.width, image_.height};
+  const bool resized = !shown_.handle() || shown_.format() != format || shown_.extent().width != size.width ||
+                       shown_.extent().height != size.height;
+  if (dirty_.exchange(false) || resized) {
+    if (resized) {  // the old image may still be read by a frame in flight: free it with this one
+      frame.defer([old = std::make_shared<vk::Image>(std::move(shown_))] {});
+      shown_ = vk::Image(ctx_, {size, format, 1, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                0, 0, "traced image"});
+    }
     // Tiles still being written may show half done; the next refresh completes them.
-    shown_ = cpuImage();
-    shownFormat_ = format;
+    ImageRGBA8 bytes = cpuImage();
     if (format == VK_FORMAT_B8G8R8A8_UNORM)
-      for (size_t i = 0; i < shown_.pixels.size(); i += 4) std::swap(shown_.pixels[i], shown_.pixels[i + 2]);
+      for (size_t i = 0; i < bytes.pixels.size(); i += 4) std::swap(bytes.pixels[i], bytes.pixels[i + 2]);
+    const vk::UploadArena::Slice slice = frame.upload(bytes.pixels.size(), 16);
+    std::memcpy(slice.data, bytes.pixels.data(), bytes.pixels.size());
+    vk::require(frame.cb, shown_.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT, true);
+    VkBufferImageCopy region{};
+    region.bufferOffset = slice.offset;
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {size.width, size.height, 1};
+    vkCmdCopyBufferToImage(frame.cb, slice.buffer, shown_.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
   }
-  const vk::UploadArena::Slice slice = frame.upload(shown_.pixels.size(), 16);
-  std::memcpy(slice.data, shown_.pixels.data(), shown_.pixels.size());
-  VkBufferImageCopy region{};
-  region.bufferOffset = slice.offset;
-  region.bufferRowLength = shown_.width;
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.imageExtent = {w, h, 1};
-  vkCmdCopyBufferToImage(frame.cb, slice.buffer, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  vk::require(frame.cb, shown_.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
+  VkImageCopy region{};
+  region.srcSubresource = region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.extent = {w, h, 1};
+  vkCmdCopyImage(frame.cb, shown_.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image,
+                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
 }
 
 }  // namespace rtr::view

@@ -14,12 +14,13 @@
 #include "core/image.hpp"
 #include "trace/tracer.hpp"
 #include "vk/frame_ring.hpp"
+#include "vk/resources.hpp"
 
 namespace rtr::view {
 
 class TraceOverlay {
  public:
-  explicit TraceOverlay(const Scene& scene) : scene_(scene) {}
+  TraceOverlay(const vk::Context& ctx, const Scene& scene) : ctx_(ctx), scene_(scene) {}
   ~TraceOverlay() { stop(); }
 
   // Starts tracing `settings` (its size, pose and lens set by the caller); cancels a running trace. With
@@ -31,8 +32,10 @@ class TraceOverlay {
   std::string status() const;
 
   // Records a copy of the traced image over `image` (in TRANSFER_DST_OPTIMAL, `format` BGRA or RGBA UNORM,
-  // holding sRGB-encoded bytes). The bytes go through the frame's upload arena: an earlier frame still in
-  // flight keeps reading its own copy while tiles finish.
+  // holding sRGB-encoded bytes). The overlay keeps the image on the GPU: only when tiles have finished since
+  // the last frame do its bytes go through the frame's upload arena into it (a frame still in flight keeps
+  // its copy: frames record and submit in order, and the image's tracked state orders the rewrite after
+  // the earlier frame's read). A steady overlay costs one GPU-side image copy a frame.
   void recordCopy(vk::Frame& frame, VkImage image, VkFormat format, VkExtent2D extent);
   // Waits for the trace to finish (or be cancelled); then cpuImage() is final.
   void wait() { if (worker_.joinable()) worker_.join(); }
@@ -40,6 +43,7 @@ class TraceOverlay {
   ImageRGBA8 cpuImage();
 
  private:
+  const vk::Context& ctx_;
   const Scene& scene_;
   std::unique_ptr<trace::Tracer> tracer_;  // built on the first R: the BVH is only made when asked for
   std::thread worker_;
@@ -50,8 +54,7 @@ class TraceOverlay {
   ImageF image_;
   ImageRGBA8 errorMap_;
   std::string errorText_;
-  ImageRGBA8 shown_;  // cpuImage() in the target's byte order, refreshed when tiles have finished
-  VkFormat shownFormat_ = VK_FORMAT_UNDEFINED;
+  vk::Image shown_;  // cpuImage() in the target's format, refreshed when tiles have finished
 };
 
 }  // namespace rtr::view

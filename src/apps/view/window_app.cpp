@@ -186,7 +186,7 @@ struct Loaded {
   void build(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D extent, render::MipMode mips) {
     gpu = std::make_unique<render::GpuScene>(ctx, *scene, mips);
     frames = std::make_unique<ViewFrames>(ctx, surface, extent, *gpu);
-    traced = std::make_unique<TraceOverlay>(*scene);
+    traced = std::make_unique<TraceOverlay>(ctx, *scene);
   }
 };
 
