@@ -46,7 +46,8 @@ void ComputeRaster::resize(VkExtent2D extent) {
   extent_ = extent;
 }
 
-void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits) {
+void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits,
+                           vk::GpuTimer& timer) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
@@ -75,6 +76,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   bind(clear_);
   const uint32_t pixels = extent_.width * extent_.height;
   vkCmdDispatch(cb, (pixels + RASTER_CLEAR_GROUP - 1) / RASTER_CLEAR_GROUP, 1, 1);
+  timer.mark(cb, "clear");
   vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                     VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -85,6 +87,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     const uint32_t x = std::min(scene_.clusterCount(), maxX);
     vkCmdDispatch(cb, x, (scene_.clusterCount() + x - 1) / x, 1);
   }
+  timer.mark(cb, "raster");
   vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                     VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
                         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
@@ -99,6 +102,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   if (hardware_.layout.setCount() > 1) hardware_.bindSet(cb, 1, textures_.get(1));
   vkCmdDrawIndirect(cb, hwList_.handle(), 0, 1, sizeof(VkDrawIndirectCommand));
   vkCmdEndRendering(cb);
+  timer.mark(cb, "raster hw");
 }
 
 }  // namespace rtr::render

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "render/gpu_scene.hpp"
+#include "vk/commands.hpp"
 #include "vk/frame_ring.hpp"
 #include "vk/pipeline.hpp"
 
@@ -17,9 +18,9 @@ class ComputeRaster {
   ComputeRaster(const vk::Context& ctx, const GpuScene& scene);
 
   void resize(VkExtent2D extent);  // the caller has waited for the device to be idle
-  // Records the three passes; afterwards ids() is written (compute and fragment stages), for a compute
-  // reader after a barrier the caller makes (vis_shade reads it).
-  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits);
+  // Records the three passes, each timed ("clear", "raster", "raster hw"); afterwards ids() is written
+  // (compute and fragment stages), for a compute reader after a barrier the caller makes (vis_shade).
+  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
 
  private:

@@ -48,7 +48,7 @@ const char* toString(RasterPath path) {
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    timers_.emplace_back(ctx, 4);
+    timers_.emplace_back(ctx, 6);
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
@@ -293,8 +293,7 @@ void Renderer::frame(FrameContext& fc) {
   timer.reset(cb);
   timer.begin(cb);
   if (compute) {
-    raster_->record(cb, uniforms_, primitiveBits_);
-    timer.mark(cb, "raster");
+    raster_->record(cb, uniforms_, primitiveBits_, timer);
     vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
