@@ -24,6 +24,11 @@ layout(set = 0, binding = 7, std430) RASTER_LIST_ACCESS buffer HardwareList {
   uint vertexCount, instanceCount, firstVertex, firstInstance;
   uint hwTriangles[];
 };
+// Large triangles' tiles (raster.comp -> raster_large.comp): (triangle as in hwTriangles, tile index).
+layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
+  uint largeCount, largePad0, largePad1, largePad2;
+  uvec2 largeTiles[];
+};
 layout(push_constant) uniform Push { RasterPush pc; };
 
 vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }

@@ -1,6 +1,8 @@
 #include "render/raster.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <string>
 
 #include "raster.h"
 #include "vk/commands.hpp"
@@ -18,7 +20,10 @@ bool ComputeRaster::supported(const vk::Context& ctx) {
 ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene) : ctx_(ctx), scene_(scene) {
   const vk::LayoutOptions push{.pushDescriptorSets = {0}};
   clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
-  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), push);
+  uint32_t sharedArea = RASTER_SHARED_AREA;
+  if (const char* env = std::getenv("RTR_RASTER_SHARED_AREA")) sharedArea = uint32_t(std::stoul(env));
+  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), push, {{0, sharedArea}});
+  large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), push, {{0, sharedArea}});
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader("raster_hw.vert"), vk::loadShader("raster_hw.frag")};
   d.cullMode = VK_CULL_MODE_NONE;  // the fragment stage culls by the cluster's flags
@@ -36,6 +41,8 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene) : ct
   hwList_ = vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryUse::Device,
                        "raster hand-off");
+  largeList_ = vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                          vk::MemoryUse::Device, "raster tiles");
 }
 
 void ComputeRaster::resize(VkExtent2D extent) {
@@ -58,7 +65,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     for (const vk::ReflectedBinding& b : p.layout.interface().bindings) {
       if (b.set != 0) continue;
       const VkBuffer buffers[] = {uniforms.buffer, scene_.clusters(), scene_.drawInfo(), scene_.positions(),
-                                  i32, i16, vis_.handle(), hwList_.handle(), scene_.materials(), uv};
+                                  i32, i16, vis_.handle(), hwList_.handle(), scene_.materials(), uv,
+                                  largeList_.handle()};
       if (b.binding == 0) w.buffer(0, uniforms.buffer, uniforms.offset, sizeof(shader::FrameUniforms));
       else w.buffer(b.binding, buffers[b.binding]);
     }
@@ -86,8 +94,14 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     const uint32_t maxX = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0], 65535u);
     const uint32_t x = std::min(scene_.clusterCount(), maxX);
     vkCmdDispatch(cb, x, (scene_.clusterCount() + x - 1) / x, 1);
+    timer.mark(cb, "raster");
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    bind(large_);
+    vkCmdDispatch(cb, RASTER_LARGE_GROUPS, 1, 1);
+    timer.mark(cb, "raster large");
   }
-  timer.mark(cb, "raster");
   vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                     VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
                         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,

@@ -48,7 +48,7 @@ const char* toString(RasterPath path) {
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    timers_.emplace_back(ctx, 6);
+    timers_.emplace_back(ctx, 6);  // at most: clear, raster, raster large, raster hw, shade, post
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
