@@ -131,5 +131,134 @@ TEST_F(RasterTest, HardwareAndComputeIdsAgree) {
   }
 }
 
+// A closed cube [-1, 1]³ seen from inside: its faces wound to face the centre. Every axis is cut at the same
+// coordinates (no T-junctions), given as pixel positions s of the 64×64 view from the centre looking at -z
+// with a 90° lens (x = s / 32 - 1 on the z = -1 face): pixel centres (vertices exactly on them), a run of
+// 1/16-pixel steps (tiny and thin triangles), and the cube's edges; all on the 1/256-pixel grid. Zero-area
+// triangles (a repeated vertex, three points on a line) are added to each face. The z = -1 face comes first.
+constexpr uint32_t kCubeSize = 64;
+std::vector<double> cubeCuts() {
+  std::vector<double> s = {0, 64};
+  for (int k = 0; k < 64; k += 8) s.push_back(k + 0.5);
+  s.push_back(63.5);
+  for (int i = 1; i < 16; ++i) s.push_back(20 + i / 16.0);
+  std::sort(s.begin(), s.end());
+  s.erase(std::unique(s.begin(), s.end()), s.end());
+  return s;
+}
+
+Scene insideCube() {
+  const std::vector<double> cuts = cubeCuts();
+  Scene scene;
+  scene.materials.push_back(Material{});
+  Mesh m;
+  const uint32_t n = uint32_t(cuts.size());
+  for (int face = 0; face < 6; ++face) {
+    const int axis = face < 2 ? 2 : face < 4 ? 0 : 1;  // -z, +z, -x, +x, -y, +y
+    const float side = face % 2 ? 1.0f : -1.0f;
+    const uint32_t base = uint32_t(m.positions.size());
+    for (uint32_t j = 0; j < n; ++j)
+      for (uint32_t i = 0; i < n; ++i) {
+        glm::vec3 p;
+        p[axis] = side;
+        p[(axis + 1) % 3] = float(cuts[i] / 32 - 1);
+        p[(axis + 2) % 3] = float(1 - cuts[j] / 32);
+        m.positions.push_back(p);
+        m.normals.push_back(glm::vec3(0.0f));
+      }
+    auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
+      const glm::vec3 nrm = glm::cross(m.positions[b] - m.positions[a], m.positions[c] - m.positions[a]);
+      if (nrm[axis] * side > 0) std::swap(b, c);  // facing the centre
+      m.indices.insert(m.indices.end(), {a, b, c});
+    };
+    for (uint32_t j = 0; j + 1 < n; ++j)
+      for (uint32_t i = 0; i + 1 < n; ++i) {
+        const uint32_t v = base + j * n + i;
+        add(v, v + 1, v + n + 1);
+        add(v, v + n + 1, v + n);
+      }
+    m.indices.insert(m.indices.end(), {base, base, base + n + 1, base + 1, base + 2, base + 3});  // zero area
+  }
+  for (const glm::vec3& p : m.positions) m.bounds.extend(p);
+  scene.meshes.push_back(std::move(m));
+  return scene;
+}
+
+// Which triangles of `mesh`'s first `count` cover pixel centre (x, y) of the straight view by the documented
+// rule (docs/raster.md), from the construction's exact pixel positions: vertices on the 1/256-pixel grid,
+// edge functions positive inside (clockwise on screen, y down), ties to top and left edges.
+std::vector<uint32_t> owners(const Mesh& mesh, uint32_t count, uint32_t x, uint32_t y) {
+  std::vector<uint32_t> out;
+  for (uint32_t t = 0; t < count; ++t) {
+    glm::i64vec2 v[3];
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 p = mesh.positions[mesh.indices[3 * t + k]];  // on z = -1: screen = 32 (x + 1), 32 (1 - y)
+      v[k] = glm::i64vec2(std::llround((p.x + 1.0) * 32 * 256), std::llround((1.0 - p.y) * 32 * 256));
+    }
+    const int64_t area = (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[1].y - v[0].y) * (v[2].x - v[0].x);
+    if (area == 0) continue;
+    if (area < 0) std::swap(v[1], v[2]);
+    const glm::i64vec2 c(int64_t(x) * 256 + 128, int64_t(y) * 256 + 128);
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) {
+      const glm::i64vec2 a = v[(k + 1) % 3], d = v[(k + 2) % 3] - a;
+      const int64_t e = d.x * (c.y - a.y) - d.y * (c.x - a.x);
+      inside &= e > 0 || (e == 0 && (d.y < 0 || (d.y == 0 && d.x > 0)));
+    }
+    if (inside) out.push_back(t);
+  }
+  return out;
+}
+
+// No pixel left uncovered from inside the closed cube: straight (vertices on pixel centres), turned, and
+// from near a corner (not nearer than the near plane reaches), where faces cross the plane w = 0 (handed to
+// the hardware) and lie behind the camera.
+TEST_F(RasterTest, ClosedMeshFromInsideLeavesNoHole) {
+  const Scene scene = insideCube();
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  render::HeadlessRenderer r(*ctx, gpu, {kCubeSize, kCubeSize});
+  Lens lens;
+  lens.fovYDeg = 90.0f;
+  lens.zNear = 0.05f;
+  lens.zFar = 10.0f;
+  const CameraPose poses[] = {{{0, 0, 0}, 0, 0},          {{0, 0, 0}, 30, 20},          {{0, 0, 0}, -45, 60},
+                              {{0.7f, -0.6f, 0.5f}, 150, -30}, {{0.85f, 0.85f, -0.85f}, 45, 35}};
+  for (const CameraPose& pose : poses) {
+    SCOPED_TRACE(testing::Message() << "yaw " << pose.yawDeg << ", pitch " << pose.pitchDeg);
+    const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);
+    size_t holes = 0;
+    for (uint32_t i = 0; i < cs.size(); ++i)
+      if (cs[i] == VIS_EMPTY && ++holes <= 5) ADD_FAILURE() << "hole at " << i % kCubeSize << "," << i / kCubeSize;
+    EXPECT_EQ(holes, 0u);
+  }
+}
+
+// Seen straight, every pixel centre of the z = -1 face is owned by exactly one triangle by the rule, and the
+// compute rasteriser gives it to that one: on shared edges and vertices too (a rule covering both sides
+// of an edge would leave the smaller id there, one covering neither a hole).
+TEST_F(RasterTest, SharedEdgesAreCoveredOnceByTheTopLeftRule) {
+  const Scene scene = insideCube();
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  render::HeadlessRenderer r(*ctx, gpu, {kCubeSize, kCubeSize});
+  Lens lens;
+  lens.fovYDeg = 90.0f;
+  lens.zNear = 0.05f;
+  const std::vector<uint32_t> cs = ids(r, {{0, 0, 0}, 0, 0}, lens, RasterPath::Compute);
+  const Mesh& mesh = scene.meshes[0];
+  const uint32_t n = uint32_t(cubeCuts().size()), faceTriangles = 2 * (n - 1) * (n - 1) + 2;
+  size_t wrong = 0, onEdge = 0;
+  for (uint32_t y = 0; y < kCubeSize; ++y)
+    for (uint32_t x = 0; x < kCubeSize; ++x) {
+      const std::vector<uint32_t> o = owners(mesh, faceTriangles, x, y);
+      ASSERT_EQ(o.size(), 1u) << "the reference rule is not watertight at " << x << "," << y;
+      onEdge += x % 8 == 0 || y % 8 == 0 || x == 63 || y == 63;  // the centre is on a cut: a shared edge
+      const uint32_t got = cs[y * kCubeSize + x];
+      if (got != o[0] && ++wrong <= 5)
+        ADD_FAILURE() << "pixel " << x << "," << y << ": triangle " << got << ", the rule gives " << o[0];
+    }
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_GT(onEdge, 500u) << "too few pixel centres on shared edges to test the rule";
+}
+
 }  // namespace
 }  // namespace rtr
