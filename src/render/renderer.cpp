@@ -166,6 +166,7 @@ void Renderer::createTargets(VkExtent2D extent, bool visibility) {
     depth_ = vk::Image(ctx_, {extent, kDepthFormat, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0, 0, "scene depth"});
     vis_ = {};
     extent_ = extent;
+    if (raster_) raster_->resize(extent);
   }
   if (visibility && !vis_.handle())
     vis_ = vk::Image(ctx_, {extent, kVisFormat, 1,
