@@ -114,7 +114,8 @@ class Renderer {
   std::array<VisShade, 3> shade_;  // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
   std::optional<ComputeRaster> raster_;  // built on first use
   RasterPath lastRaster_ = RasterPath::Auto;
-  bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false;
+  bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
+  uint64_t triangles_ = 0;
   uint32_t primitiveBits_ = 0;  // low bits of a visibility id: the primitive index
   MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;

@@ -97,7 +97,9 @@ TEST_F(RasterTest, HardwareAndComputeIdsAgree) {
     Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
     lens.zNear = 0.05f;  // near enough that geometry crosses it
     const std::vector<uint32_t> hw = ids(r, pose, lens, RasterPath::Hardware);
-    ASSERT_EQ(r.renderer().rasterFor({}), RasterPath::Compute);
+    render::RenderSettings asked;
+    asked.raster = RasterPath::Compute;
+    ASSERT_EQ(r.renderer().rasterFor(asked), RasterPath::Compute);
     const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);
     const glm::dmat4 vp = glm::dmat4(projectionMatrix(lens, 320.0f / 180.0f) * viewMatrix(pose));
     size_t covered = 0, same = 0, offEdge = 0;
