@@ -25,6 +25,7 @@ class HeadlessRenderer {
   // Renders one frame and returns its visibility ids, row by row (VIS_EMPTY where nothing was drawn).
   std::vector<uint32_t> ids(const CameraPose& pose, const Lens& lens, const RenderSettings& settings);
   const Renderer& renderer() const { return renderer_; }
+  Renderer& renderer() { return renderer_; }
   // Renders `frames` frames, one submission each, and returns every frame's per-pass GPU times.
   std::vector<std::vector<std::pair<std::string, double>>> bench(const CameraPose& pose, const Lens& lens,
                                                                  const RenderSettings& settings, int frames);

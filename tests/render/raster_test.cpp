@@ -133,6 +133,20 @@ TEST_F(RasterTest, HardwareAndComputeIdsAgree) {
   }
 }
 
+// Hot reload (rebuildPipelines) replaces the compute rasteriser too: the next frame's ids are the same.
+TEST_F(RasterTest, RebuiltPipelinesGiveTheSameIds) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  render::HeadlessRenderer r(*ctx, gpu, {160, 90});
+  const CameraPose pose = scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 160.0f / 90.0f));
+  const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
+  const std::vector<uint32_t> before = ids(r, pose, lens, RasterPath::Compute);
+  r.renderer().rebuildPipelines();
+  const std::vector<uint32_t> after = ids(r, pose, lens, RasterPath::Compute);
+  EXPECT_EQ(before, after);
+  EXPECT_GT(std::count_if(after.begin(), after.end(), [](uint32_t id) { return id != VIS_EMPTY; }), 160 * 90 / 4);
+}
+
 // A closed cube [-1, 1]³ seen from inside: its faces wound to face the centre. Every axis is cut at the same
 // coordinates (no T-junctions), given as pixel positions s of the 64×64 view from the centre looking at -z
 // with a 90° lens (x = s / 32 - 1 on the z = -1 face): pixel centres (vertices exactly on them), a run of
