@@ -18,7 +18,11 @@ layout(set = 0, binding = 3, std430) readonly buffer Positions { float positions
 layout(set = 0, binding = 4, std430) readonly buffer Normals { float normals[]; };
 layout(set = 0, binding = 5, std430) readonly buffer Indices32 { uint indices32[]; };
 layout(set = 0, binding = 6, std430) readonly buffer Indices16 { uint indices16[]; };  // two per word
+#ifdef VIS_BUFFER  // the compute rasteriser's: (depth << 32 | id) per pixel, row by row (raster.h)
+layout(set = 0, binding = 7, std430) readonly buffer Visibility { uvec2 visibility[]; };  // x: the low half
+#else
 layout(set = 0, binding = 7) uniform utexture2D visibility;
+#endif
 layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D sceneColor;
 #if HAS_TEXCOORDS
 layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
@@ -56,7 +60,11 @@ vec4 sampleOr(uint index, vec2 uv, vec2 gx, vec2 gy, vec4 fallback) {
 void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(p, imageSize(sceneColor)))) return;
+#ifdef VIS_BUFFER
+  const uint packed = visibility[p.y * imageSize(sceneColor).x + p.x].x;
+#else
   const uint packed = texelFetch(visibility, p, 0).x;
+#endif
   if (packed == VIS_EMPTY) {
     imageStore(sceneColor, p, vec4(0.0, 0.0, 0.0, 1.0));  // the forward pass's clear colour
     return;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstring>
 
+#include "cluster.h"
 #include "core/image.hpp"
 #include "scene/textures.hpp"
 #include "vk/check.hpp"
@@ -19,6 +20,21 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 VkFormat textureFormat(const Texture& t) {
   if (decodeChannels(t) == 1) return VK_FORMAT_R8_UNORM;
   return decodeSrgb(t) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+}
+
+// Clusters of one draw until the scene brings its own: consecutive runs of up to CLUSTER_MAX_TRIANGLES
+// triangles, a bounding sphere around the bounding box of their vertices, the cone disabled.
+void appendClusters(const Mesh& m, uint32_t draw, uint32_t flags, std::vector<shader::GpuCluster>& out) {
+  const uint32_t triangles = uint32_t(m.indices.size() / 3);
+  for (uint32_t first = 0; first < triangles; first += CLUSTER_MAX_TRIANGLES) {
+    const uint32_t count = std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - first);
+    Bounds b;
+    for (uint32_t i = 3 * first; i < 3 * (first + count); ++i) b.extend(m.positions[m.indices[i]]);
+    const glm::vec3 c = 0.5f * (b.min + b.max);
+    float r = 0.0f;
+    for (uint32_t i = 3 * first; i < 3 * (first + count); ++i) r = std::max(r, glm::length(m.positions[m.indices[i]] - c));
+    out.push_back({glm::vec4(c, r), glm::vec4(0, 0, 1, 2), draw, first, count, flags});
+  }
 }
 
 // Appends `bytes` to a staging byte vector at an offset aligned for copies, returning the offset.
@@ -52,6 +68,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
   std::vector<uint16_t> idx16;
   std::vector<uint32_t> idx32;
   std::vector<shader::GpuDraw> drawInfo;
+  std::vector<shader::GpuCluster> clusters;
   for (const Mesh& m : scene.meshes) {
     if (m.indices.empty()) continue;
     const Material& mat = scene.materials.at(m.material);
@@ -84,6 +101,9 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     drawInfo.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
                         (d.indexType == VK_INDEX_TYPE_UINT16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});
     draws_[size_t(kind)].push_back(d);
+    const bool masked = kind == DrawKind::AlphaMasked && mat.texture(TextureSlot::AlphaMask) != kNoTexture;
+    appendClusters(m, d.id, (kind == DrawKind::AlphaMasked ? CLUSTER_DOUBLE_SIDED : 0u) | (masked ? CLUSTER_ALPHA_MASKED : 0u),
+                   clusters);
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
   }
@@ -122,6 +142,9 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "materials");
   const size_t oDraw = makeBuffer(drawInfo_, drawInfo.data(), drawInfo.size() * sizeof(shader::GpuDraw),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "draws");
+  const size_t oCluster = makeBuffer(clusters_, clusters.data(), clusters.size() * sizeof(shader::GpuCluster),
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "clusters");
+  clusterCount_ = uint32_t(clusters.size());
   std::vector<size_t> texOffsets;
   for (size_t i = 0; i < used.size(); ++i) {
     const Texture& t = scene.textures[used[i]];
@@ -152,6 +175,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     copy(indices32_, oI32);
     copy(materials_, oMat);
     copy(drawInfo_, oDraw);
+    copy(clusters_, oCluster);
     vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT |
                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,

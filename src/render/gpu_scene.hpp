@@ -46,6 +46,8 @@ class GpuScene {
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }
   VkBuffer drawInfo() const { return drawInfo_.handle(); }  // GpuDraw per draw, for shading in compute
+  VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), draw by draw
+  uint32_t clusterCount() const { return clusterCount_; }
   uint32_t textureCount() const { return uint32_t(textures_.size()); }
   std::vector<VkDescriptorImageInfo> textureDescriptors() const;
   const Bounds& bounds() const { return bounds_; }
@@ -53,7 +55,8 @@ class GpuScene {
 
  private:
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
-  vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_;
+  vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, clusters_;
+  uint32_t clusterCount_ = 0;
   std::vector<vk::Image> textures_;
   vk::Sampler sampler_;
   Bounds bounds_;

@@ -59,6 +59,19 @@ HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens,
   return out;
 }
 
+std::vector<uint32_t> HeadlessRenderer::ids(const CameraPose& pose, const Lens& lens, const RenderSettings& settings) {
+  const VkDeviceSize pixels = VkDeviceSize(extent_.width) * extent_.height;
+  if (!idReadback_.handle())
+    idReadback_ = vk::Buffer(ctx_, pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "id readback");
+  uint32_t bytes = 0;
+  frame(pose, lens, settings, [&](VkCommandBuffer cb) { bytes = renderer_.copyIds(cb, idReadback_.handle()); });
+  idReadback_.invalidate();
+  const auto* words = static_cast<const uint32_t*>(idReadback_.mapped());
+  std::vector<uint32_t> out(pixels);
+  for (VkDeviceSize i = 0; i < pixels; ++i) out[i] = words[i * (bytes / 4)];  // the low half of a 64-bit entry
+  return out;
+}
+
 std::vector<std::vector<std::pair<std::string, double>>> HeadlessRenderer::bench(const CameraPose& pose, const Lens& lens,
                                                                                  const RenderSettings& settings, int frames) {
   std::vector<std::vector<std::pair<std::string, double>>> out;

@@ -22,6 +22,10 @@ class HeadlessRenderer {
   // Renders `frames` frames (the last one is read back).
   HeadlessFrame render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings, int frames = 1,
                        bool readSceneColor = false);
+  // Renders one frame and returns its visibility ids, row by row (VIS_EMPTY where nothing was drawn).
+  std::vector<uint32_t> ids(const CameraPose& pose, const Lens& lens, const RenderSettings& settings);
+  const Renderer& renderer() const { return renderer_; }
+  Renderer& renderer() { return renderer_; }
   // Renders `frames` frames, one submission each, and returns every frame's per-pass GPU times.
   std::vector<std::vector<std::pair<std::string, double>>> bench(const CameraPose& pose, const Lens& lens,
                                                                  const RenderSettings& settings, int frames);
@@ -39,7 +43,7 @@ class HeadlessRenderer {
   Renderer renderer_;
   vk::FrameRing ring_;  // one frame: each is waited for (a read-back, a timing)
   vk::Image target_;
-  vk::Buffer readback_, colorReadback_;
+  vk::Buffer readback_, colorReadback_, idReadback_;
 };
 
 }  // namespace rtr::render

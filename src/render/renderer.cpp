@@ -41,11 +41,14 @@ bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding
 }  // namespace
 
 const char* toString(ShadingPath path) { return path == ShadingPath::Forward ? "forward" : "visibility"; }
+const char* toString(RasterPath path) {
+  return path == RasterPath::Hardware ? "hardware" : path == RasterPath::Compute ? "compute" : "auto";
+}
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    timers_.emplace_back(ctx, 4);
+    timers_.emplace_back(ctx, 6);  // at most: clear, raster, raster large, raster hw, shade, post
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
@@ -54,12 +57,27 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
   for (size_t k = 0; k < kDrawKindCount; ++k)
     for (const DrawItem& d : scene.draws(DrawKind(k))) ++draws, maxTriangles = std::max(maxTriangles, d.indexCount / 3);
   primitiveBits_ = 32 - uint32_t(std::bit_width(draws));
-  canUseVisibility_ = features.geometryShader && draws > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
+  for (size_t k = 0; k < kDrawKindCount; ++k)
+    for (const DrawItem& d : scene.draws(DrawKind(k))) triangles_ += d.indexCount / 3;
+  cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  canHardware_ = features.geometryShader;
+  canCompute_ = ComputeRaster::supported(ctx);
+  canUseVisibility_ = (canHardware_ || canCompute_) && draws > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
 }
 
 ShadingPath Renderer::pathFor(const RenderSettings& s) const {
   return s.shading == ShadingPath::Visibility && s.mode == VIEW_SHADED && canUseVisibility_ ? ShadingPath::Visibility
                                                                                            : ShadingPath::Forward;
+}
+
+RasterPath Renderer::rasterFor(const RenderSettings& s) const {
+  // The default per device type, the faster one measured (docs/raster.md): compute on GPUs; on a CPU
+  // device (lavapipe) compute from about 100 k triangles (even there; hardware 2-3x faster at 11 k,
+  // compute 3-5x faster at 1 M).
+  const bool computeFaster = !cpuDevice_ || triangles_ >= 100000;
+  const RasterPath wanted = s.raster != RasterPath::Auto ? s.raster : computeFaster ? RasterPath::Compute : RasterPath::Hardware;
+  if (wanted == RasterPath::Compute) return canCompute_ ? RasterPath::Compute : RasterPath::Hardware;
+  return canHardware_ ? RasterPath::Hardware : RasterPath::Compute;
 }
 
 Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* frag, VkFormat colorFormat,
@@ -102,13 +120,15 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
   return out;
 }
 
-Renderer::VisShade Renderer::makeShade() const {
+Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
   const bool textured = scene_.texcoords() != VK_NULL_HANDLE;
+  const char* shader = fromBuffer ? (textured ? "vis_shade_buffer.comp" : "vis_shade_buffer_untextured.comp")
+                                  : (textured ? "vis_shade.comp" : "vis_shade_untextured.comp");
   vk::LayoutOptions options{.pushDescriptorSets = {0}};
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
   VisShade v;
   v.pipeline.emplace(
-      vk::makeComputePipeline(ctx_, vk::loadShader(textured ? "vis_shade.comp" : "vis_shade_untextured.comp"), options));
+      vk::makeComputePipeline(ctx_, vk::loadShader(shader), options));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     auto textures = scene_.textureDescriptors();
@@ -120,19 +140,26 @@ Renderer::VisShade Renderer::makeShade() const {
 void Renderer::ensurePipelines(PipelineSet set) {
   if (pipelines_[set]) return;
   pipelines_[set] = makePipelines(set);
-  if (set == kVisibility) shade_ = makeShade();
 }
 
 void Renderer::rebuildPipelines() {
   // Build all that exist first, swap after: a failure leaves the running pipelines untouched.
   std::array<std::optional<KindPipelines>, kPipelineSetCount> fresh;
-  VisShade shade;
+  std::array<VisShade, 3> shade;
+  std::optional<ComputeRaster> raster;
   for (int set = 0; set < kPipelineSetCount; ++set)
     if (pipelines_[set]) fresh[set] = makePipelines(PipelineSet(set));
-  if (pipelines_[kVisibility]) shade = makeShade();
+  for (RasterPath r : {RasterPath::Hardware, RasterPath::Compute})
+    if (shade_[size_t(r)].pipeline) shade[size_t(r)] = makeShade(r == RasterPath::Compute);
+  if (raster_) raster.emplace(ctx_, scene_);
   vkDeviceWaitIdle(ctx_.device());
   pipelines_ = std::move(fresh);
   shade_ = std::move(shade);
+  if (raster) {
+    raster->resize(extent_);
+    raster_.reset();
+    raster_.emplace(std::move(*raster));
+  }
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -145,9 +172,11 @@ void Renderer::createTargets(VkExtent2D extent, bool visibility) {
     depth_ = vk::Image(ctx_, {extent, kDepthFormat, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0, 0, "scene depth"});
     vis_ = {};
     extent_ = extent;
+    if (raster_) raster_->resize(extent);
   }
   if (visibility && !vis_.handle())
-    vis_ = vk::Image(ctx_, {extent, kVisFormat, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, 0, 0,
+    vis_ = vk::Image(ctx_, {extent, kVisFormat, 1,
+                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0,
                             "visibility"});
 }
 
@@ -188,8 +217,9 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
   }
 }
 
-void Renderer::shadeVisibility(VkCommandBuffer cb) {
-  const vk::Pipeline& c = *shade_.pipeline;
+void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
+  const VisShade& shade = shade_[size_t(raster)];
+  const vk::Pipeline& c = *shade.pipeline;
   c.bind(cb);
   // A scene may lack one index width: any storage buffer fills that binding (no draw reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
@@ -202,12 +232,13 @@ void Renderer::shadeVisibility(VkCommandBuffer cb) {
       .buffer(4, scene_.normals())
       .buffer(5, i32)
       .buffer(6, i16)
-      .image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
+  if (raster == RasterPath::Compute) w.buffer(7, raster_->ids());
+  else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   if (hasBinding(c.layout, 0, 9)) w.buffer(9, scene_.texcoords());
   w.push(cb, c);
   c.push(cb, shader::VisShadePush{primitiveBits_});
-  if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade_.textures.get(1));
+  if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade.textures.get(1));
   const auto& group = c.layout.interface().stages.at(0).localSize;  // one thread per pixel
   vkCmdDispatch(cb, (extent_.width + group[0] - 1) / group[0], (extent_.height + group[1] - 1) / group[1], 1);
 }
@@ -220,10 +251,19 @@ void Renderer::frame(FrameContext& fc) {
   const RenderSettings& s = fc.settings;
   const RenderTarget& target = fc.target;
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
+  const RasterPath raster = visibility ? rasterFor(s) : RasterPath::Auto;
+  const bool compute = raster == RasterPath::Compute;
   const PipelineSet set = visibility ? kVisibility : s.mode == VIEW_SHADED ? kShaded : kDebug;
-  if (target.extent.width != extent_.width || target.extent.height != extent_.height || (visibility && !vis_.handle()))
-    createTargets(target.extent, visibility);
-  ensurePipelines(set);
+  if (target.extent.width != extent_.width || target.extent.height != extent_.height ||
+      (raster == RasterPath::Hardware && !vis_.handle()))
+    createTargets(target.extent, raster == RasterPath::Hardware);
+  if (compute && !raster_) {
+    raster_.emplace(ctx_, scene_);
+    raster_->resize(extent_);
+  }
+  if (!compute) ensurePipelines(set);
+  if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);
+  lastRaster_ = raster;
   const float aspect = float(target.extent.width) / float(target.extent.height);
 
   shader::FrameUniforms u{};
@@ -259,6 +299,18 @@ void Renderer::frame(FrameContext& fc) {
   vk::GpuTimer& timer = timers_[frame];
   timer.reset(cb);
   timer.begin(cb);
+  if (compute) {
+    raster_->record(cb, uniforms_, primitiveBits_, timer);
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    vk::require(cb, {{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
+    shadeVisibility(cb, raster);
+    timer.mark(cb, "shade");
+    post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
+    timer.mark(cb, "post");
+    return;
+  }
   // Old contents are discarded; the tracker waits for the previous frame's readers (post or shading pass).
   const vk::Image& target0 = visibility ? vis_ : color_;
   vk::require(cb, {{target0.tracked(), vk::Use::ColorAttachment, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, true},
@@ -293,11 +345,31 @@ void Renderer::frame(FrameContext& fc) {
   if (visibility) {
     vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
                      {color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
-    shadeVisibility(cb);
+    shadeVisibility(cb, raster);
     timer.mark(cb, "shade");
   }
   post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
   timer.mark(cb, "post");
+}
+
+}  // namespace rtr::render
+
+namespace rtr::render {
+
+uint32_t Renderer::copyIds(VkCommandBuffer cb, VkBuffer dst) {
+  if (lastRaster_ == RasterPath::Compute) {
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    const VkBufferCopy region{0, 0, VkDeviceSize(extent_.width) * extent_.height * 8};
+    vkCmdCopyBuffer(cb, raster_->ids(), dst, 1, &region);
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                      VK_ACCESS_2_HOST_READ_BIT);
+    return 8;
+  }
+  if (lastRaster_ != RasterPath::Hardware) throw Error("copyIds: the last frame made no visibility ids");
+  vk::require(cb, vis_.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
+  vk::copyImageToHost(cb, vis_.handle(), extent_, dst);
+  return 4;
 }
 
 }  // namespace rtr::render

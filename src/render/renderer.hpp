@@ -11,6 +11,7 @@
 #include "frame.h"
 #include "render/gpu_scene.hpp"
 #include "render/post.hpp"
+#include "render/raster.hpp"
 #include "scene/lights.hpp"
 #include "vk/commands.hpp"
 #include "vk/frame_ring.hpp"
@@ -24,9 +25,15 @@ namespace rtr::render {
 enum class ShadingPath { Forward, Visibility };
 const char* toString(ShadingPath path);
 
+// Who rasterises the visibility buffer: the hardware (an R32 id image, depth-tested) or the compute
+// rasteriser (render/raster.hpp, a 64-bit buffer); Auto: the device's default (defaultRaster).
+enum class RasterPath { Auto, Hardware, Compute };
+const char* toString(RasterPath path);
+
 struct RenderSettings {
   int mode = VIEW_SHADED;         // VIEW_* from frame.h
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
+  RasterPath raster = RasterPath::Auto;
   float lodBias = 0.0f;
   MosaicMode mosaic = MosaicMode::Compute;
   // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;
@@ -72,6 +79,13 @@ class Renderer {
   // The path a frame with these settings takes: Visibility needs the geometryShader feature
   // (gl_PrimitiveID), a shaded view and ids that fit 32 bits; otherwise Forward.
   ShadingPath pathFor(const RenderSettings& settings) const;
+  // Who rasterises the visibility buffer for these settings (Hardware or Compute; Auto resolved): the one
+  // asked for where the device can, else the other.
+  RasterPath rasterFor(const RenderSettings& settings) const;
+  // Records a copy of the last frame's visibility ids into `dst` (host-visible, 8 bytes a pixel at most);
+  // returns the bytes per pixel written: 4 (hardware: the id) or 8 (compute: id in the low half).
+  uint32_t copyIds(VkCommandBuffer cb, VkBuffer dst);
+  uint32_t primitiveBits() const { return primitiveBits_; }
 
  private:
   struct ScenePipelines {
@@ -87,18 +101,21 @@ class Renderer {
   void createTargets(VkExtent2D extent, bool visibility);
   ScenePipelines makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull) const;
   KindPipelines makePipelines(PipelineSet set) const;
-  VisShade makeShade() const;
+  VisShade makeShade(bool fromBuffer) const;
   void ensurePipelines(PipelineSet set);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set);
-  void shadeVisibility(VkCommandBuffer cb);
+  void shadeVisibility(VkCommandBuffer cb, RasterPath raster);
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
   uint32_t framesInFlight_;
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
-  VisShade shade_;
-  bool canUseVisibility_ = false;
+  std::array<VisShade, 3> shade_;  // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
+  std::optional<ComputeRaster> raster_;  // built on first use
+  RasterPath lastRaster_ = RasterPath::Auto;
+  bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
+  uint64_t triangles_ = 0;
   uint32_t primitiveBits_ = 0;  // low bits of a visibility id: the primitive index
   MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;

@@ -185,6 +185,13 @@ Context::Context(const ContextOptions& options) {
     VkPhysicalDeviceFeatures supported{};
     vkGetPhysicalDeviceFeatures(physical_, &supported);
     f2.features.geometryShader = supported.geometryShader;
+    // The compute rasteriser (render/raster.hpp): 64-bit atomicMin on a storage buffer, also from the
+    // fragment stage for the triangles it hands to the hardware; optional, enabled where all are supported.
+    VkPhysicalDeviceVulkan12Features s12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    VkPhysicalDeviceFeatures2 s2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &s12};
+    vkGetPhysicalDeviceFeatures2(physical_, &s2);
+    if (supported.shaderInt64 && supported.fragmentStoresAndAtomics && s12.shaderBufferInt64Atomics)
+      f2.features.shaderInt64 = f2.features.fragmentStoresAndAtomics = f12.shaderBufferInt64Atomics = VK_TRUE;
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

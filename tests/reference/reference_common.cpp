@@ -70,6 +70,7 @@ CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const Pose
   render::RenderSettings s;
   s.mode = view == View::Shaded ? VIEW_SHADED : view == View::Normals ? VIEW_NORMAL : VIEW_LINEAR_DEPTH;
   s.mosaic = render::MosaicMode::Off;
+  s.raster = o.raster;
   s.lights = rs.lights;
   const Lens lens = tracer.resolveLens(ts);  // the tracer's near/far: depth / far means the same on both sides
 

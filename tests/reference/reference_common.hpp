@@ -7,6 +7,7 @@
 #include "core/compare.hpp"
 #include "core/image.hpp"
 #include "reference_scenes.hpp"
+#include "render/renderer.hpp"
 #include "scene/load.hpp"
 #include "vk/context.hpp"
 
@@ -49,6 +50,7 @@ struct PairOptions {
   // Compiled shaders to use for the GPU instead of the build's (RTR_SHADER_DIR for the lifetime of the
   // renderer's pipeline creation); used by the broken-BRDF test.
   std::optional<std::filesystem::path> shaderDir;
+  render::RasterPath raster = render::RasterPath::Auto;  // who rasterises the shaded view's visibility ids
 };
 
 // Renders a case on both sides.

@@ -22,15 +22,22 @@ const char* const kCases[] = {"temple_nave",   "temple_aisle",  "cornell_box",  
                               "temple_nave_textured", "temple_aisle_textured", "cube_backplane_falloff",
                               "two_lights", "two_lights_falloff", "headlight"};
 
+// The shaded view runs once per visibility rasteriser (the debug views are forward: no ids).
 struct Param {
   std::string name;
   View view;
+  render::RasterPath raster = render::RasterPath::Auto;
+  std::string label() const {
+    return name + "_" + viewName(view) + (raster == render::RasterPath::Auto ? "" : std::string("_") + render::toString(raster));
+  }
 };
 
 std::vector<Param> allParams() {
   std::vector<Param> out;
-  for (const char* c : kCases)
-    for (View v : {View::Shaded, View::Normals, View::Depth}) out.push_back({c, v});
+  for (const char* c : kCases) {
+    for (auto r : {render::RasterPath::Hardware, render::RasterPath::Compute}) out.push_back({c, View::Shaded, r});
+    for (View v : {View::Normals, View::Depth}) out.push_back({c, v});
+  }
   return out;
 }
 
@@ -41,8 +48,10 @@ TEST_P(ReferenceTest, GpuMatchesCpu) {
   const auto poses = loadPoses(posesFile());
   ASSERT_TRUE(poses.count(p.name)) << p.name << " has no pose in " << posesFile();
   const ReferenceScene rs = makeScene(p.name, outDir() / "work");
-  const CasePair pair = renderPair(*ctx, rs, poses.at(p.name), p.view);
-  const std::string id = p.name + "_" + viewName(p.view);
+  PairOptions options;
+  options.raster = p.raster;
+  const CasePair pair = renderPair(*ctx, rs, poses.at(p.name), p.view, options);
+  const std::string id = p.label();
 
   // Not blank: a comparison of two black images proves nothing.
   EXPECT_EQ(blankReason(pair.gpu), "") << id + " GPU";
@@ -62,7 +71,7 @@ TEST_P(ReferenceTest, GpuMatchesCpu) {
 
 INSTANTIATE_TEST_SUITE_P(Cases, ReferenceTest, ::testing::ValuesIn(allParams()),
                          [](const ::testing::TestParamInfo<Param>& i) {
-                           return i.param.name + "_" + viewName(i.param.view);
+                           return i.param.label();
                          });
 
 // Every case in poses.txt is run, every run case has a pose, and each has its comment.

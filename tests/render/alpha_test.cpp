@@ -53,10 +53,14 @@ TEST_F(VulkanTest, AlphaMaskedQuadDiscardsAndLightsBothFaces) {
     s.lights.ambient = glm::vec3(0.0f);  // lit only by the light: an unlit face would be black
     Lens lens;
     lens.fovYDeg = 60.0f;
-    for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility}) {
+    for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
+                                {render::ShadingPath::Visibility, render::RasterPath::Hardware},
+                                {render::ShadingPath::Visibility, render::RasterPath::Compute}}) {
       s.shading = path;
+      s.raster = raster;
       for (bool back : {false, true}) {
-        SCOPED_TRACE(testing::Message() << render::toString(path) << (back ? " back" : " front"));
+        SCOPED_TRACE(testing::Message() << render::toString(path) << ", " << render::toString(raster)
+                                        << (back ? " back" : " front"));
         CameraPose pose{{0, 0, back ? -2.5f : 2.5f}, back ? 180.0f : 0.0f, 0.0f};
         s.lights.lights = {Light{}};
         s.lights.lights[0].position = pose.position;

@@ -37,8 +37,10 @@ class FrameTest : public test::VulkanTest {
     VulkanTest::TearDown();
   }
   render::HeadlessFrame render(int mode, bool readColor = false,
-                               render::ShadingPath path = render::ShadingPath::Visibility, float lodBias = 0.0f) {
+                               render::ShadingPath path = render::ShadingPath::Visibility, float lodBias = 0.0f,
+                               render::RasterPath raster = render::RasterPath::Auto) {
     RenderSettings s;
+    s.raster = raster;
     s.mode = mode;
     s.shading = path;
     s.lodBias = lodBias;
@@ -71,7 +73,9 @@ TEST_F(FrameTest, ShadedFrameIsFiniteAndLit) {
     }
     EXPECT_GT(sum / (3.0 * kW * kH), 0.01) << "the shaded frame is (nearly) black";
     const bool vis = path == render::ShadingPath::Visibility;
-    EXPECT_EQ(f.gpuTimes.size(), vis ? 3u : 2u);
+    // Hardware ids: visibility, shade, post; compute: clear, raster, raster large, raster hw, shade, post.
+    const bool compute = renderer->renderer().rasterFor({}) == render::RasterPath::Compute;
+    EXPECT_EQ(f.gpuTimes.size(), !vis ? 2u : compute ? 6u : 3u);
     EXPECT_EQ(ranPass(f, "shade"), vis);
   }
   EXPECT_GT(gpu->stats().meshes16, 0u) << "small meshes should use 16-bit indices";
@@ -81,11 +85,14 @@ TEST_F(FrameTest, ShadedFrameIsFiniteAndLit) {
 // forward path (BRDF per fragment, LOD from the rasteriser's derivatives) show the same image: same
 // coverage, same BRDF; only the rounding of the interpolation and of the LOD differ. Tolerance
 // (docs/shading.md): displayed 8-bit values within 3 on at least 99.5 % of pixels and within 24 on all.
+// The compute rasteriser's ids differ from the hardware's on a few edge pixels (tests/render/raster_test.cpp),
+// where another triangle (or the background) shows: the bound on all pixels holds for hardware ids only.
 TEST_F(FrameTest, VisibilityPathMatchesForward) {
+  for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
   for (float bias : {0.0f, 1.5f}) {
-    SCOPED_TRACE(testing::Message() << "LOD bias " << bias);
+    SCOPED_TRACE(testing::Message() << "LOD bias " << bias << ", " << render::toString(raster) << " raster");
     auto fwd = render(VIEW_SHADED, false, render::ShadingPath::Forward, bias);
-    auto vis = render(VIEW_SHADED, false, render::ShadingPath::Visibility, bias);
+    auto vis = render(VIEW_SHADED, false, render::ShadingPath::Visibility, bias, raster);
     ASSERT_TRUE(ranPass(vis, "shade") && !ranPass(fwd, "shade"));
     size_t over = 0, lit = 0;
     int worst = 0;
@@ -100,7 +107,7 @@ TEST_F(FrameTest, VisibilityPathMatchesForward) {
     std::printf("bias %.1f: %zu of %zu pixels differ by more than 3, worst %d\n", bias, over, n, worst);
     EXPECT_GT(lit, n / 2) << "comparing mostly black images proves nothing";
     EXPECT_LE(over, n / 200);
-    EXPECT_LE(worst, 24);
+    if (raster == render::RasterPath::Hardware) EXPECT_LE(worst, 24);
   }
 }
 
@@ -148,7 +155,9 @@ TEST_F(FrameTest, EveryViewModeRendersWithoutValidationMessages) {
 //   [visibility] the ids go to the shading compute pass, which discards the colour image and writes it;
 //   the colour image is sampled by the post pass (compute, or fragment for the graphics mosaic), which
 //   discards the target after last frame's read-back copy; the target goes to the read-back copy.
-std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::MosaicMode mosaic) {
+//   The compute rasteriser's buffers are synchronised by memory barriers, which the log does not list: its
+//   frame starts at the shading pass.
+std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::MosaicMode mosaic, bool computeIds) {
   const bool vis = path == render::ShadingPath::Visibility, raster = mosaic == render::MosaicMode::Graphics;
   const std::string postRead = raster ? "FRAGMENT_SHADER" : "COMPUTE_SHADER";
   const std::string first = vis ? "visibility" : "scene colour";
@@ -157,8 +166,10 @@ std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::M
       first + ": UNDEFINED -> COLOR_ATTACHMENT, " + firstReader + "/NONE -> COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE",
       "scene depth: UNDEFINED -> DEPTH_ATTACHMENT, EARLY_FRAGMENT_TESTS|LATE_FRAGMENT_TESTS/DEPTH_STENCIL_ATTACHMENT_WRITE"
       " -> EARLY_FRAGMENT_TESTS|LATE_FRAGMENT_TESTS/DEPTH_STENCIL_ATTACHMENT_WRITE"};
+  if (vis && computeIds) out.clear();
   if (vis) {
-    out.push_back("visibility: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> "
+    if (!computeIds)
+      out.push_back("visibility: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> "
                   "COMPUTE_SHADER/SHADER_SAMPLED_READ");
     out.push_back("scene colour: UNDEFINED -> GENERAL, " + postRead + "/NONE -> COMPUTE_SHADER/SHADER_STORAGE_WRITE");
     out.push_back("scene colour: GENERAL -> SHADER_READ_ONLY, COMPUTE_SHADER/SHADER_STORAGE_WRITE -> " + postRead +
@@ -176,16 +187,19 @@ std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::M
 
 TEST_F(FrameTest, OneFrameRecordsExactlyTheBarriersItNeeds) {
   for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility})
+    for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
     for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics}) {
-      SCOPED_TRACE(std::string(render::toString(path)) + ", mosaic " + render::toString(mosaic));
+      SCOPED_TRACE(std::string(render::toString(path)) + ", mosaic " + render::toString(mosaic) + ", " +
+                   render::toString(raster) + " raster");
       RenderSettings s;
       s.shading = path;
       s.mosaic = mosaic;
+      s.raster = raster;
       renderer->render(pose, lens, s);  // the previous frame, read back like the next
       vk::beginBarrierLog();
       renderer->render(pose, lens, s);
       const std::vector<std::string> got = vk::endBarrierLog();
-      const std::vector<std::string> want = steadyFrameBarriers(path, mosaic);
+      const std::vector<std::string> want = steadyFrameBarriers(path, mosaic, raster == render::RasterPath::Compute);
       EXPECT_EQ(got.size(), want.size());
       for (size_t i = 0; i < std::max(got.size(), want.size()); ++i)
         EXPECT_EQ(i < got.size() ? got[i] : "(none)", i < want.size() ? want[i] : "(none)") << "barrier " << i;

@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
                "rtr-view"};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "off", light, lightColor,
               ambient = "0.02", mtl;
-  std::string shadingPath = render::toString(o.settings.shading);
+  std::string shadingPath = render::toString(o.settings.shading), raster = render::toString(o.settings.raster);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_option("--mtl", mtl, "OBJ: take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
@@ -134,6 +134,8 @@ int main(int argc, char** argv) {
   app.add_option("--mosaic", mosaic, "post process: off (the scene plainly) | compute | graphics (the brief's captures: compute)")->capture_default_str();
   app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward")
       ->check(CLI::IsMember({"visibility", "forward"}))->capture_default_str();
+  app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
+      ->check(CLI::IsMember({"auto", "hardware", "compute"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
   app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
@@ -170,6 +172,9 @@ int main(int argc, char** argv) {
     o.mips = mipModes.at(mips);
     o.settings.mosaic = mosaicModes.at(mosaic);
     o.settings.shading = shadingPath == "forward" ? render::ShadingPath::Forward : render::ShadingPath::Visibility;
+    o.settings.raster = raster == "hardware" ? render::RasterPath::Hardware
+                        : raster == "compute" ? render::RasterPath::Compute
+                                              : render::RasterPath::Auto;
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
   } catch (const std::exception& e) {
     return cli::fail("rtr-view", e);

@@ -1,0 +1,33 @@
+#version 460
+// Compute rasteriser (docs/raster.md): one workgroup per cluster, a thread per triangle. Vertices are
+// snapped to 1/256 pixel; integer edge functions with the top-left rule decide which pixel centres a
+// triangle covers, so a shared edge is covered exactly once; each covered pixel gets one 64-bit atomicMin
+// of (depth, id). Triangles with a bounding box over kSharedArea pixels go to the tile list (one entry per
+// RASTER_TILE² tile, raster_large.comp); those touching w <= 0 or leaving the guard band, and all of
+// alpha-masked clusters, go to the hardware hand-off list (raster_hw.vert/frag).
+#extension GL_GOOGLE_include_directive : require
+#include "raster_tri.glsl"
+
+layout(local_size_x = RASTER_GROUP) in;
+
+void main() {
+  const uint clusterIndex = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  if (clusterIndex >= pc.clusterCount) return;
+  const uint local = gl_LocalInvocationID.x;
+  Tri t;
+  const uint kind = local < clusters[clusterIndex].triangleCount ? setup(clusterIndex, local, t) : kSkip;
+  const uint ref = (clusterIndex << RASTER_LOCAL_BITS) | local;
+  if (kind == kSmall) {
+    for (int y = t.box.y; y <= t.box.w; ++y)
+      for (int x = t.box.x; x <= t.box.z; ++x) rasterPixel(t, ivec2(x, y));
+  } else if (kind == kLarge) {
+    const ivec2 tiles = (t.box.zw - t.box.xy + RASTER_TILE) / RASTER_TILE;
+    const uint n = uint(tiles.x * tiles.y), first = atomicAdd(largeCount, n);
+    // A full list hands the triangle to the hardware; its reserved entries that fit are marked empty.
+    const bool fits = first + n <= RASTER_LARGE_CAPACITY;
+    for (uint i = 0u; i < n && first + i < RASTER_LARGE_CAPACITY; ++i) largeTiles[first + i] = uvec2(fits ? ref : ~0u, i);
+    if (!fits) hwTriangles[atomicAdd(vertexCount, 3u) / 3u] = ref;
+  } else if (kind == kHardware) {
+    hwTriangles[atomicAdd(vertexCount, 3u) / 3u] = ref;
+  }
+}

@@ -1,0 +1,48 @@
+// Triangle fetch shared by the compute rasteriser and its hardware hand-off: cluster -> draw -> indices
+// -> positions, the same buffers the shading pass reads.
+#extension GL_GOOGLE_include_directive : require
+#include "frame.h"
+#include "cluster.h"
+#include "raster.h"
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 1, std430) readonly buffer Clusters { GpuCluster clusters[]; };
+layout(set = 0, binding = 2, std430) readonly buffer Draws { GpuDraw draws[]; };
+layout(set = 0, binding = 3, std430) readonly buffer Positions { float positions[]; };
+layout(set = 0, binding = 4, std430) readonly buffer Indices32 { uint indices32[]; };
+layout(set = 0, binding = 5, std430) readonly buffer Indices16 { uint indices16[]; };  // two per word
+// The vertex stage may not write storage buffers (vertexPipelineStoresAndAtomics is not enabled).
+#ifndef RASTER_VIS_ACCESS
+#define RASTER_VIS_ACCESS
+#endif
+#ifndef RASTER_LIST_ACCESS
+#define RASTER_LIST_ACCESS
+#endif
+layout(set = 0, binding = 6, std430) RASTER_VIS_ACCESS buffer Vis { uint64_t vis[]; };
+// The triangles handed to the hardware, after a VkDrawIndirectCommand (3 vertices each).
+layout(set = 0, binding = 7, std430) RASTER_LIST_ACCESS buffer HardwareList {
+  uint vertexCount, instanceCount, firstVertex, firstInstance;
+  uint hwTriangles[];
+};
+// Large triangles' tiles (raster.comp -> raster_large.comp): (triangle as in hwTriangles, tile index).
+layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
+  uint largeCount, largePad0, largePad1, largePad2;
+  uvec2 largeTiles[];
+};
+layout(push_constant) uniform Push { RasterPush pc; };
+
+vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
+
+uint vertexIndex(GpuDraw d, uint i) {
+  if ((d.flags & DRAW_INDEX16) == 0u) return indices32[d.firstIndex + i];
+  uint k = d.firstIndex + i;
+  return (indices16[k >> 1] >> ((k & 1u) * 16u)) & 0xFFFFu;  // little-endian halves
+}
+
+// Vertex indices (into the streams) of triangle `local` of cluster `c`.
+uvec3 triangleVertices(GpuCluster c, GpuDraw d, uint local) {
+  const uint k = 3u * (c.firstTriangle + local);
+  return uvec3(vertexIndex(d, k), vertexIndex(d, k + 1u), vertexIndex(d, k + 2u)) + d.vertexOffset;
+}
+
+uint64_t packVis(float depth, uint id) { return (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(id); }

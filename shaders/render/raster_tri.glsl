@@ -1,0 +1,79 @@
+// The compute rasteriser's triangle setup and per-pixel test, shared by raster.comp (small triangles, a
+// thread each) and raster_large.comp (large ones, a workgroup per 32x32 tile).
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#include "raster_fetch.glsl"
+
+const int kOne = 1 << RASTER_SUBPIXEL_BITS;
+const uint kSkip = 0u, kSmall = 1u, kLarge = 2u, kHardware = 3u;
+
+struct Tri {
+  ivec2 v[3];  // fixed point, ordered so that the edge functions are positive inside
+  vec3 z;      // depth (z/w) at each vertex
+  ivec4 box;   // pixels: min x, min y, max x, max y (inclusive)
+  int64_t area2;
+  uint id;
+};
+
+// Edge function of a -> b at p: twice the signed area of (a, b, p); the top-left rule's bias makes it
+// negative on edges that are neither top nor left (y down, the triangle clockwise on screen).
+int64_t edge(ivec2 a, ivec2 b, ivec2 p) {
+  const ivec2 d = b - a;
+  const bool topLeft = d.y < 0 || (d.y == 0 && d.x > 0);
+  return int64_t(d.x) * int64_t(p.y - a.y) - int64_t(d.y) * int64_t(p.x - a.x) - (topLeft ? 0l : 1l);
+}
+
+// Bounding boxes over this many pixels are rasterised tile by tile (raster_large.comp).
+layout(constant_id = 0) const uint kSharedArea = RASTER_SHARED_AREA;
+
+uint setup(uint clusterIndex, uint local, out Tri t) {
+  const GpuCluster c = clusters[clusterIndex];
+  const GpuDraw d = draws[c.draw];
+  t.id = (c.draw << pc.primitiveBits) | (c.firstTriangle + local);
+  if ((c.flags & CLUSTER_ALPHA_MASKED) != 0u) return kHardware;
+  const uvec3 tri = triangleVertices(c, d, local);
+  const vec4 p[3] = vec4[3](frame.viewProj * vec4(position(tri.x), 1.0), frame.viewProj * vec4(position(tri.y), 1.0),
+                            frame.viewProj * vec4(position(tri.z), 1.0));
+  // Outside one plane of the view volume (behind the camera included): nothing to draw.
+  for (int k = 0; k < 3; ++k) {
+    if (p[0][k] > p[0].w && p[1][k] > p[1].w && p[2][k] > p[2].w) return kSkip;
+    if (k < 2 && p[0][k] < -p[0].w && p[1][k] < -p[1].w && p[2][k] < -p[2].w) return kSkip;
+  }
+  if (p[0].z < 0.0 && p[1].z < 0.0 && p[2].z < 0.0) return kSkip;
+  if (min(p[0].w, min(p[1].w, p[2].w)) <= 0.0) return kHardware;
+  const vec2 size = vec2(pc.width, pc.height);
+  ivec2 v[3];
+  for (int i = 0; i < 3; ++i) {
+    const vec2 s = (p[i].xy / p[i].w * 0.5 + 0.5) * size;  // the viewport transform
+    if (any(greaterThan(abs(s - 0.5 * size), vec2(RASTER_GUARD_BAND)))) return kHardware;
+    v[i] = ivec2(floor(s * float(kOne) + 0.5));
+    t.z[i] = p[i].z / p[i].w;
+  }
+  // Vulkan's facing: counter-clockwise in framebuffer coordinates (y down) is front, i.e. area2 < 0 here.
+  t.area2 = int64_t(v[1].x - v[0].x) * int64_t(v[2].y - v[0].y) - int64_t(v[1].y - v[0].y) * int64_t(v[2].x - v[0].x);
+  if (t.area2 == 0l || (t.area2 > 0l && (c.flags & CLUSTER_DOUBLE_SIDED) == 0u)) return kSkip;
+  if (t.area2 < 0l) {  // the other order: positive inside
+    t.area2 = -t.area2;
+    const ivec2 tv = v[1]; v[1] = v[2]; v[2] = tv;
+    const float tz = t.z[1]; t.z[1] = t.z[2]; t.z[2] = tz;
+  }
+  t.v = v;
+  // Pixels whose centres (x + 0.5) lie in the snapped bounding box, clipped to the image.
+  const ivec2 lo = min(v[0], min(v[1], v[2])), hi = max(v[0], max(v[1], v[2]));
+  t.box.xy = max((lo - kOne / 2 + kOne - 1) >> RASTER_SUBPIXEL_BITS, ivec2(0));
+  t.box.zw = min((hi - kOne / 2) >> RASTER_SUBPIXEL_BITS, ivec2(pc.width, pc.height) - 1);
+  if (any(greaterThan(t.box.xy, t.box.zw))) return kSkip;
+  const ivec2 extent = t.box.zw - t.box.xy + 1;
+  return uint(extent.x) * uint(extent.y) > kSharedArea ? kLarge : kSmall;
+}
+
+void rasterPixel(Tri t, ivec2 px) {
+  const ivec2 c = px * kOne + kOne / 2;
+  const int64_t e0 = edge(t.v[1], t.v[2], c), e1 = edge(t.v[2], t.v[0], c), e2 = edge(t.v[0], t.v[1], c);
+  if (e0 < 0l || e1 < 0l || e2 < 0l) return;
+  // The bias is at most 1 of area2 (>= 1): barycentrics from the unbiased edges are not worth the cost.
+  const float z = (float(e0) * t.z[0] + float(e1) * t.z[1] + float(e2) * t.z[2]) / float(t.area2);
+  if (z < 0.0 || z > 1.0) return;  // the hardware's near and far clipping (w > 0 everywhere here)
+  atomicMin(vis[px.y * int(pc.width) + px.x], packVis(z, t.id));
+}
+

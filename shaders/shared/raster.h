@@ -1,0 +1,33 @@
+// The compute rasteriser's constants and push block, shared by render/raster.cpp and its shaders
+// (docs/raster.md). Visibility buffer: one uint64 per pixel, (floatBitsToUint(depth) << 32) | id, id as in
+// frame.h (draw << primitiveBits | primitive); RASTER_CLEAR (id VIS_EMPTY) where nothing was drawn.
+#ifndef RTR_SHADERS_SHARED_RASTER_H
+#define RTR_SHADERS_SHARED_RASTER_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace rtr::shader {
+typedef uint32_t uint;
+#endif
+
+#define RASTER_GROUP 128         // raster.comp: one workgroup per cluster, a thread per triangle
+#define RASTER_CLEAR_GROUP 256   // raster_clear.comp: a thread per pixel
+#define RASTER_SUBPIXEL_BITS 8   // fixed-point vertex positions: 1/256 pixel
+#define RASTER_GUARD_BAND 16384.0 // px from the image centre; beyond it (or w <= 0) the hardware draws it
+#define RASTER_SHARED_AREA 256u  // default: bounding boxes over this many pixels are rasterised tile by tile
+#define RASTER_TILE 32           // raster_large.comp: a workgroup per tile of RASTER_TILE² pixels of a triangle
+#define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
+#define RASTER_LARGE_GROUPS 1024u         // raster_large.comp's persistent workgroups
+#define RASTER_LOCAL_BITS 7u     // hardware list entry: cluster << RASTER_LOCAL_BITS | triangle in cluster
+
+struct RasterPush {
+  uint width;
+  uint height;
+  uint primitiveBits;  // of an id: the primitive index (frame.h)
+  uint clusterCount;
+};
+
+#ifdef __cplusplus
+}  // namespace rtr::shader
+#endif
+#endif

@@ -1,0 +1,38 @@
+#pragma once
+// The compute rasteriser of the visibility buffer (docs/raster.md): a clear pass, one workgroup per
+// cluster writing (depth << 32 | id) per pixel with 64-bit atomicMin, a pass over the large triangles'
+// tiles, and an indirect hardware draw of the triangles it hands off (crossing w = 0, outside the guard
+// band, alpha-masked) into the same buffer.
+// RTR_RASTER_SHARED_AREA (environment, a benchmarking knob): the bounding-box area in pixels above which a
+// triangle is rasterised by tiles rather than by its own thread (default RASTER_SHARED_AREA, raster.h).
+#include <optional>
+
+#include "render/gpu_scene.hpp"
+#include "vk/commands.hpp"
+#include "vk/frame_ring.hpp"
+#include "vk/pipeline.hpp"
+
+namespace rtr::render {
+
+class ComputeRaster {
+ public:
+  // Whether the device has what it needs (64-bit buffer atomics, also in fragment shaders).
+  static bool supported(const vk::Context& ctx);
+  ComputeRaster(const vk::Context& ctx, const GpuScene& scene);
+
+  void resize(VkExtent2D extent);  // the caller has waited for the device to be idle
+  // Records the three passes, each timed ("clear", "raster", "raster large", "raster hw"); afterwards ids() is written
+  // (compute and fragment stages), for a compute reader after a barrier the caller makes (vis_shade).
+  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer);
+  VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
+
+ private:
+  const vk::Context& ctx_;
+  const GpuScene& scene_;
+  vk::Pipeline clear_, raster_, large_, hardware_;
+  vk::DescriptorSets textures_;  // the hand-off's set 1
+  vk::Buffer vis_, hwList_, largeList_;
+  VkExtent2D extent_{0, 0};
+};
+
+}  // namespace rtr::render
