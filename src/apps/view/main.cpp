@@ -80,9 +80,9 @@ int runHeadless(const ViewOptions& o) {
   render::GpuScene gpuScene(ctx, scene, o.mips);
   const auto& st = gpuScene.stats();
   std::fprintf(stderr, "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
-               "decode %.0f ms, upload %.0f ms, mips %.3f ms GPU\n",
+               "decode %.0f ms, geometry %.0f ms, texture upload %.0f ms, mips %.3f ms GPU\n",
                o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16,
-               st.triangles, st.textures, st.decodeMs, st.uploadMs, st.mipGpuMs);
+               st.triangles, st.textures, st.decodeMs, st.geometryMs, st.textureUploadMs, st.mipGpuMs);
   const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(o.lens, scene.bounds(), pose);
   const render::RenderSettings settings = sceneSettings(o, scene);
