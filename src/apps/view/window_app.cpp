@@ -111,13 +111,13 @@ int runWindowed(const ViewOptions& o) {
   uint32_t extCount = 0;
   const char** exts = glfwGetRequiredInstanceExtensions(&extCount);
   if (!exts) throw Error("GLFW found no Vulkan surface support");
-  vk::ContextOptions co = vk::optionsFromEnvironment();
-  if (o.validation) co.validation = true;
-  if (!o.device.empty()) co.device = o.device;
+  vk::ContextOptions co = contextOptions(o);
   co.instanceExtensions.assign(exts, exts + extCount);
   co.presentation = true;
   vk::Context ctx(co);
   checkSizeFits(o, ctx);
+  const DeviceChoice choice = chooseForDevice(o, ctx);
+  app.settings.shading = choice.shading;
 
   GLFWwindow* window = glfwCreateWindow(int(o.width), int(o.height), "rtr-view", nullptr, nullptr);
   if (!window) throw Error("cannot create a window");
@@ -145,7 +145,7 @@ int runWindowed(const ViewOptions& o) {
   std::fprintf(stderr, "rtr-view: move speed %.9g units/s (Shift x%g, Ctrl x%g)\n", speeds.base, speeds.fastFactor,
                speeds.slowFactor);
 
-  render::GpuScene gpuScene(ctx, scene, o.mips);
+  render::GpuScene gpuScene(ctx, scene, choice.mips);
   {
     ViewFrames frames(ctx, surface, {o.width, o.height}, gpuScene);
     TraceOverlay traced(scene);
