@@ -6,6 +6,8 @@
 #include <iostream>
 #include <map>
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 
 #include "core/cli.hpp"
@@ -111,13 +113,15 @@ int runHeadless(const ViewOptions& o) {
   phase("instance and device");
   Scene scene = loadScene(o.scene, o.load);
   phase("scene file read");
-  // A load that takes over half a second says how far it is, on one stderr line.
+  // A load that takes over half a second says how far it is: one line rewritten on a terminal, else a
+  // line a second.
   const auto loadStart = Clock::now();
   auto lastShown = loadStart;
+  const bool terminal = ::isatty(2);
   const render::LoadProgress progress = [&](const char* what, size_t done, size_t total) {
-    if (since(loadStart) < 500 || (done < total && since(lastShown) < 250)) return;
-    std::fprintf(stderr, "\rrtr-view: %s %zu/%zu", what, done, total);
-    if (done == total) std::fprintf(stderr, "\n");
+    if (since(loadStart) < 500 || (done < total && since(lastShown) < (terminal ? 250 : 1000))) return;
+    std::fprintf(stderr, "%srtr-view: %s %zu/%zu%s", terminal ? "\r" : "", what, done, total,
+                 terminal && done < total ? "" : "\n");
     lastShown = Clock::now();
   };
   render::GpuScene gpuScene(ctx, scene, choice.mips, progress);
@@ -139,6 +143,8 @@ int runHeadless(const ViewOptions& o) {
   render::RenderSettings settings = sceneSettings(o, scene);
   settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
+  phase("renderer setup (targets, passes)", setupPipelineMs);
   std::optional<render::HeadlessFrame> first;
   if (o.timings) {
     first = renderer.render(pose, lens, settings, 1);
@@ -150,7 +156,7 @@ int runHeadless(const ViewOptions& o) {
     else
       std::snprintf(name, sizeof name, "pipeline creation (%u, cache hits not reported)", ps.created);
     timeline.add(name, ps.ms);
-    phase("first frame complete (renderer setup, frame, read-back)", ps.ms - pipelineMsBefore);
+    phase("first frame complete (record, GPU, read-back)", ps.ms - pipelineMsBefore - setupPipelineMs);
     std::fprintf(stderr, "rtr-view: %s", timeline.format(totalMs).c_str());
   }
   if (o.bench > 0) {
