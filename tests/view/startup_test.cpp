@@ -68,7 +68,7 @@ TEST_F(StartupTest, TimingsPhasesAddUpToTheTotal) {
   const std::vector<std::string> expected = {
       "process start to Vulkan (exec, libraries, options)", "instance and device", "scene file read",
       "texture decode", "geometry upload", "texture upload", "mips",
-      "renderer setup (targets, passes)", "first frame complete (record, GPU, read-back)", "sum of the phases", "total from process start"};
+      "renderer setup (start pose, targets)", "first frame complete (record, GPU, read-back)", "sum of the phases", "total from process start"};
   for (const auto& name : expected) EXPECT_TRUE(p.count(name)) << "no phase '" << name << "' in:\n" << r.out;
   double sum = 0;
   int pipelineRows = 0;

@@ -144,7 +144,7 @@ int runHeadless(const ViewOptions& o) {
   settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
   const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
-  phase("renderer setup (targets, passes)", setupPipelineMs);
+  phase("renderer setup (start pose, targets)", setupPipelineMs);
   std::optional<render::HeadlessFrame> first;
   if (o.timings) {
     first = renderer.render(pose, lens, settings, 1);
