@@ -47,7 +47,7 @@ DeviceDefaults deviceDefaults(VkPhysicalDeviceType type) {
   if (type == VK_PHYSICAL_DEVICE_TYPE_CPU)
     return {ShadingPath::Forward, MipMode::Blit, "a CPU device, measured fastest there"};
   return {ShadingPath::Visibility, MipMode::Compute,
-          "a GPU, measured fastest on a discrete one"};
+          "a GPU, measured fastest with a discrete one"};
 }
 
 }  // namespace rtr::render

@@ -53,9 +53,10 @@ vk::ContextOptions contextOptions(const ViewOptions& o) {
 DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
   const render::DeviceDefaults d = render::deviceDefaults(ctx.deviceType());
   DeviceChoice c{o.shadingGiven ? o.settings.shading : d.shading, o.mipsGiven ? o.mips : d.mips};
-  std::fprintf(stderr, "rtr-view: %s shading (%s), %s mips (%s) on %s",
+  // No " on " in this line: scripts take the first line with one for the device line below.
+  std::fprintf(stderr, "rtr-view: %s: %s shading (%s), %s mips (%s)", ctx.deviceName().c_str(),
                render::toString(c.shading), o.shadingGiven ? "--shading-path" : "default",
-               render::toString(c.mips), o.mipsGiven ? "--mips" : "default", ctx.deviceName().c_str());
+               render::toString(c.mips), o.mipsGiven ? "--mips" : "default");
   if (!o.shadingGiven || !o.mipsGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
   std::fprintf(stderr, "\n");
   return c;
