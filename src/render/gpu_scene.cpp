@@ -55,7 +55,8 @@ struct WriteTask {
 
 }  // namespace
 
-GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress) {
+GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
+                   GeometryUpload upload) {
   bounds_ = scene.bounds();
   vk::PipelineCache& pipelines = ctx.pipelineCache();
 
@@ -162,7 +163,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   for (size_t i = 0; i < kTargets; ++i) {
     Target& tg = targets[i];
     if (tg.size == 0) continue;
-    *tg.buffer = vk::Buffer(ctx, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::DeviceWrite, names[i]);
+    *tg.buffer = vk::Buffer(ctx, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                            upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
     tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
     if (!tg.dst) {
       tg.stagingOffset = stagingSize;

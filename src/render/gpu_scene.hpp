@@ -45,9 +45,14 @@ struct GpuSceneStats {
 // Told how far a long load is: what it does, how many of how many are done (serialised calls).
 using LoadProgress = std::function<void(const char* what, size_t done, size_t total)>;
 
+// How the geometry reaches device memory: written in place where the host can map it (Auto), or always
+// through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
+enum class GeometryUpload { Auto, Staging };
+
 class GpuScene {
  public:
-  GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {});
+  GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {},
+           GeometryUpload upload = GeometryUpload::Auto);
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
   bool hasDraws(DrawKind k) const { return !draws_[size_t(k)].empty(); }

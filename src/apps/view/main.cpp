@@ -239,6 +239,7 @@ int main(int argc, char** argv) {
     o.lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
+    if (o.timings && !o.headless) throw UsageError("--timings needs --headless (the window prints no start-up phases yet)");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
     const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
                                                           {"blit", render::MipMode::Blit}};
