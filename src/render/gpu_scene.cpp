@@ -1,8 +1,13 @@
 #include "render/gpu_scene.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
+#include <functional>
+#include <future>
+#include <mutex>
+#include <thread>
 
 #include "cluster.h"
 #include "core/image.hpp"
@@ -10,6 +15,7 @@
 #include "vk/check.hpp"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
+#include "vk/pipeline_cache.hpp"
 
 namespace rtr::render {
 namespace {
@@ -20,6 +26,18 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 VkFormat textureFormat(const Texture& t) {
   if (decodeChannels(t) == 1) return VK_FORMAT_R8_UNORM;
   return decodeSrgb(t) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+}
+
+// Runs work(i) for i in [0, n) on all cores.
+void parallelFor(size_t n, const std::function<void(size_t)>& work) {
+  std::atomic<size_t> next{0};
+  std::vector<std::future<void>> workers;
+  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), n);
+  for (size_t w = 0; w < threads; ++w)
+    workers.push_back(std::async(std::launch::async, [&] {
+      for (size_t i; (i = next++) < n;) work(i);
+    }));
+  for (auto& w : workers) w.get();  // rethrows the first error
 }
 
 // Clusters of one draw until the scene brings its own: consecutive runs of up to CLUSTER_MAX_TRIANGLES
@@ -37,60 +55,76 @@ void appendClusters(const Mesh& m, uint32_t draw, uint32_t flags, std::vector<sh
   }
 }
 
-// Appends `bytes` to a staging byte vector at an offset aligned for copies, returning the offset.
-size_t append(std::vector<uint8_t>& staging, const void* bytes, size_t size) {
-  size_t offset = (staging.size() + 15) & ~size_t(15);
-  staging.resize(offset + size);
-  std::memcpy(staging.data() + offset, bytes, size);
-  return offset;
-}
+// Where one mesh's data goes in the scene-wide streams (counts of elements, not bytes).
+struct MeshSlot {
+  const Mesh* mesh;
+  size_t vertex, index;  // first vertex; first index in the 16- or 32-bit stream
+  bool index16;
+};
+
+// A piece of the geometry writing small enough to spread a single large mesh over all cores.
+struct WriteTask {
+  uint32_t slot;
+  bool indices;
+  size_t begin, end;
+};
 
 }  // namespace
 
-GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) {
-  const auto t0 = Clock::now();
+GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
+                   GeometryUpload upload) {
   bounds_ = scene.bounds();
+  vk::PipelineCache& pipelines = ctx.pipelineCache();
 
-  // Which textures are sampled (scene/textures.hpp), decoded on all cores.
+  // Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
+  // decoded straight into that texture's own staging buffer.
+  auto t = Clock::now();
   const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
   std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
   for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
-  const bool anyTexcoords = std::any_of(scene.meshes.begin(), scene.meshes.end(),
-                                        [](const Mesh& m) { return !m.texcoords.empty() && !m.indices.empty(); });
-  std::vector<TexelData> texels(used.size());
-  decodeTextures(scene, used, [&](size_t i, TexelData&& t) { texels[i] = std::move(t); });
-  stats_.decodeMs = msSince(t0);
-  const auto t1 = Clock::now();
+  struct Staged {
+    vk::Buffer buffer;
+    VkExtent2D extent;
+  };
+  std::vector<Staged> staged(used.size());
+  std::mutex progressMutex;
+  size_t decoded = 0;
+  decodeTextures(scene, used, [&](size_t i, TexelData&& texels) {
+    Staged& s = staged[i];
+    s.extent = {texels.width, texels.height};
+    s.buffer = vk::Buffer(ctx, std::max<size_t>(texels.texels.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                          vk::MemoryUse::Upload);
+    std::memcpy(s.buffer.mapped(), texels.texels.data(), texels.texels.size());
+    s.buffer.flush();
+    if (progress) {
+      const std::lock_guard lock(progressMutex);
+      progress("decoding textures", ++decoded, used.size());
+    }
+  });
+  stats_.decodeMs = msSince(t);
 
   // Geometry: one stream per attribute for all meshes; indices 16-bit where the mesh has <= 65536 vertices.
-  std::vector<glm::vec3> positions, normals;
-  std::vector<glm::vec2> texcoords;
-  std::vector<uint16_t> idx16;
-  std::vector<uint32_t> idx32;
+  t = Clock::now();
+  const bool anyTexcoords = std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                                        [](const Mesh& m) { return !m.texcoords.empty() && !m.indices.empty(); });
+  std::vector<MeshSlot> slots;
   std::vector<shader::GpuDraw> drawInfo;
   std::vector<shader::GpuCluster> clusters;
+  size_t vertices = 0, count16 = 0, count32 = 0;
   for (const Mesh& m : scene.meshes) {
     if (m.indices.empty()) continue;
     const Material& mat = scene.materials.at(m.material);
+    const bool index16 = m.positions.size() <= 65536;
     DrawItem d;
     d.material = m.material;
     d.indexCount = uint32_t(m.indices.size());
-    d.vertexOffset = int32_t(positions.size());
-    if (m.positions.size() <= 65536) {
-      d.indexType = VK_INDEX_TYPE_UINT16;
-      d.firstIndex = uint32_t(idx16.size());
-      for (uint32_t i : m.indices) idx16.push_back(uint16_t(i));
-      ++stats_.meshes16;
-    } else {
-      d.firstIndex = uint32_t(idx32.size());
-      idx32.insert(idx32.end(), m.indices.begin(), m.indices.end());
-    }
-    positions.insert(positions.end(), m.positions.begin(), m.positions.end());
-    normals.insert(normals.end(), m.normals.begin(), m.normals.end());
-    if (anyTexcoords) {
-      if (m.texcoords.empty()) texcoords.resize(positions.size(), glm::vec2(0.0f));
-      else texcoords.insert(texcoords.end(), m.texcoords.begin(), m.texcoords.end());
-    }
+    d.vertexOffset = int32_t(vertices);
+    d.indexType = index16 ? VK_INDEX_TYPE_UINT16 : VK_INDEX_TYPE_UINT32;
+    d.firstIndex = uint32_t(index16 ? count16 : count32);
+    slots.push_back({&m, vertices, d.firstIndex, index16});
+    (index16 ? count16 : count32) += m.indices.size();
+    stats_.meshes16 += index16;
+    vertices += m.positions.size();
     const bool textured = !m.texcoords.empty();
     // Two-sided materials go to the alpha-tested pipeline, which does not cull (with no mask texture
     // the alpha is 1 and nothing is discarded). alphaTested is the same rule the tracer cuts out by.
@@ -99,7 +133,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
                                                                                : DrawKind::Opaque;
     d.id = uint32_t(drawInfo.size());
     drawInfo.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
-                        (d.indexType == VK_INDEX_TYPE_UINT16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});
+                        (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});
     draws_[size_t(kind)].push_back(d);
     const bool masked = kind == DrawKind::AlphaMasked && mat.texture(TextureSlot::AlphaMask) != kNoTexture;
     appendClusters(m, d.id, (kind == DrawKind::AlphaMasked ? CLUSTER_DOUBLE_SIDED : 0u) | (masked ? CLUSTER_ALPHA_MASKED : 0u),
@@ -107,8 +141,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
   }
-  stats_.vertices = uint32_t(positions.size());
-  if (idx16.size() % 2) idx16.push_back(0);  // keep the buffer size a multiple of 4
+  stats_.vertices = uint32_t(vertices);
+  count16 += count16 % 2;  // keep the buffer size a multiple of 4
 
   std::vector<shader::GpuMaterial> materials;
   for (const Material& m : scene.materials) {
@@ -124,86 +158,147 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
   }
   if (materials.empty()) materials.push_back({});
 
-  // One staging buffer for everything; then one submission: copies, then mip generation.
-  std::vector<uint8_t> staging;
-  auto makeBuffer = [&](vk::Buffer& dst, const void* data, size_t size, VkBufferUsageFlags usage, const char* name) {
-    if (size == 0) return size_t(0);
-    dst = vk::Buffer(ctx, size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, name);
-    return append(staging, data, size);
+  // Each buffer is device-local. Where the device lets the host write such memory (lavapipe, a GPU with
+  // a large BAR) the data is written there directly; else into one staging buffer, then copied.
+  struct Target {
+    vk::Buffer* buffer;
+    size_t size;
+    uint8_t* dst = nullptr;
+    size_t stagingOffset = 0;
   };
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  const size_t oPos = makeBuffer(positions_, positions.data(), positions.size() * 12, kVertex, "positions");
-  const size_t oNrm = makeBuffer(normals_, normals.data(), normals.size() * 12, kVertex, "normals");
-  const size_t oUv = makeBuffer(texcoords_, texcoords.data(), texcoords.size() * 8, kVertex, "texcoords");
-  const size_t oI16 = makeBuffer(indices16_, idx16.data(), idx16.size() * 2, kIndex, "indices16");
-  const size_t oI32 = makeBuffer(indices32_, idx32.data(), idx32.size() * 4, kIndex, "indices32");
-  const size_t oMat = makeBuffer(materials_, materials.data(), materials.size() * sizeof(shader::GpuMaterial),
-                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "materials");
-  const size_t oDraw = makeBuffer(drawInfo_, drawInfo.data(), drawInfo.size() * sizeof(shader::GpuDraw),
-                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "draws");
-  const size_t oCluster = makeBuffer(clusters_, clusters.data(), clusters.size() * sizeof(shader::GpuCluster),
-                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, "clusters");
+  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kCluster, kTargets };
+  std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
+                                        {&normals_, vertices * 12},
+                                        {&texcoords_, anyTexcoords ? vertices * 8 : 0},
+                                        {&indices16_, count16 * 2},
+                                        {&indices32_, count32 * 4},
+                                        {&materials_, materials.size() * sizeof(shader::GpuMaterial)},
+                                        {&drawInfo_, drawInfo.size() * sizeof(shader::GpuDraw)},
+                                        {&clusters_, clusters.size() * sizeof(shader::GpuCluster)}}};
+  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex, kVertex, kVertex, kIndex, kIndex, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions", "normals", "texcoords", "indices16", "indices32", "materials", "draws", "clusters"};
   clusterCount_ = uint32_t(clusters.size());
-  std::vector<size_t> texOffsets;
-  for (size_t i = 0; i < used.size(); ++i) {
-    const Texture& t = scene.textures[used[i]];
-    textures_.emplace_back(ctx, textureDesc({texels[i].width, texels[i].height}, textureFormat(t)));
-    texOffsets.push_back(append(staging, texels[i].texels.data(), texels[i].texels.size()));
-  }
-  texels.clear();
-  stats_.textures = uint32_t(textures_.size());
-
-  vk::Buffer stage(ctx, std::max<size_t>(staging.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "scene staging");
-  std::memcpy(stage.mapped(), staging.data(), staging.size());
-  stage.flush();
-  staging = {};
-
-  MipGenerator mipGen(ctx);
-  std::vector<MipViews> mipViews;  // alive until the submission has completed
-  vk::GpuTimer timer(ctx, 1);
-  vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-    auto copy = [&](const vk::Buffer& dst, size_t offset) {
-      if (!dst.handle()) return;
-      VkBufferCopy region{offset, 0, dst.size()};
-      vkCmdCopyBuffer(cb, stage.handle(), dst.handle(), 1, &region);
-    };
-    copy(positions_, oPos);
-    copy(normals_, oNrm);
-    copy(texcoords_, oUv);
-    copy(indices16_, oI16);
-    copy(indices32_, oI32);
-    copy(materials_, oMat);
-    copy(drawInfo_, oDraw);
-    copy(clusters_, oCluster);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT |
-                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_2_INDEX_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-    std::vector<vk::ImageBarrier> toDst;
-    for (auto& img : textures_)
-      toDst.push_back({img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                       VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                       VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
-    if (!toDst.empty()) vk::barrier(cb, toDst);
-    for (size_t i = 0; i < textures_.size(); ++i) {
-      VkBufferImageCopy region{};
-      region.bufferOffset = texOffsets[i];
-      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      region.imageExtent = {textures_[i].extent().width, textures_[i].extent().height, 1};
-      vkCmdCopyBufferToImage(cb, stage.handle(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  size_t stagingSize = 0;
+  for (size_t i = 0; i < kTargets; ++i) {
+    Target& tg = targets[i];
+    if (tg.size == 0) continue;
+    *tg.buffer = vk::Buffer(ctx, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                            upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
+    tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
+    if (!tg.dst) {
+      tg.stagingOffset = stagingSize;
+      stagingSize += (tg.size + 15) & ~size_t(15);
     }
-    timer.reset(cb);
-    timer.begin(cb);
-    std::vector<const vk::Image*> batch;
-    for (const auto& img : textures_) batch.push_back(&img);
-    mipViews.push_back(mipGen.record(cb, batch, mipMode));  // all textures, one barrier per step
-    timer.mark(cb, "mips");
-  });
-  if (!textures_.empty()) stats_.mipGpuMs = timer.results().at(0).second;
-  stats_.uploadMs = msSince(t1);
+  }
+  vk::Buffer staging;
+  if (stagingSize) {
+    staging = vk::Buffer(ctx, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
+    for (Target& tg : targets)
+      if (tg.size && !tg.dst) tg.dst = static_cast<uint8_t*>(staging.mapped()) + tg.stagingOffset;
+  }
+  if (targets[kMat].size) std::memcpy(targets[kMat].dst, materials.data(), targets[kMat].size);
+  if (targets[kDraw].size) std::memcpy(targets[kDraw].dst, drawInfo.data(), targets[kDraw].size);
+  if (targets[kCluster].size) std::memcpy(targets[kCluster].dst, clusters.data(), targets[kCluster].size);
 
+  // Pieces of at most 256 Ki vertices or 1 Mi indices, written on all cores.
+  constexpr size_t kVertexChunk = size_t(1) << 18, kIndexChunk = size_t(1) << 20;
+  std::vector<WriteTask> tasks;
+  for (uint32_t s = 0; s < slots.size(); ++s) {
+    for (size_t b = 0, n = slots[s].mesh->positions.size(); b < n; b += kVertexChunk)
+      tasks.push_back({s, false, b, std::min(n, b + kVertexChunk)});
+    for (size_t b = 0, n = slots[s].mesh->indices.size(); b < n; b += kIndexChunk)
+      tasks.push_back({s, true, b, std::min(n, b + kIndexChunk)});
+  }
+  parallelFor(tasks.size(), [&](size_t i) {
+    const WriteTask& task = tasks[i];
+    const MeshSlot& slot = slots[task.slot];
+    const Mesh& m = *slot.mesh;
+    const size_t n = task.end - task.begin;
+    if (task.indices) {
+      if (slot.index16) {
+        auto* dst = reinterpret_cast<uint16_t*>(targets[kI16].dst) + slot.index + task.begin;
+        for (size_t k = 0; k < n; ++k) dst[k] = uint16_t(m.indices[task.begin + k]);
+      } else {
+        std::memcpy(targets[kI32].dst + (slot.index + task.begin) * 4, &m.indices[task.begin], n * 4);
+      }
+      return;
+    }
+    const size_t v = slot.vertex + task.begin;
+    std::memcpy(targets[kPos].dst + v * 12, &m.positions[task.begin], n * 12);
+    // A stream a mesh lacks reads as zeros, so that every stream stays aligned with the positions.
+    auto stream = [&](uint8_t* dst, const auto& src, size_t stride) {
+      const size_t have = std::min(n, src.size() > task.begin ? src.size() - task.begin : 0);
+      if (have) std::memcpy(dst + v * stride, &src[task.begin], have * stride);
+      if (have < n) std::memset(dst + (v + have) * stride, 0, (n - have) * stride);
+    };
+    stream(targets[kNrm].dst, m.normals, 12);
+    if (anyTexcoords) stream(targets[kUv].dst, m.texcoords, 8);
+  });
+  for (const Target& tg : targets)
+    if (tg.size) (tg.buffer->mapped() ? *tg.buffer : staging).flush();
+  if (staging.handle())
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+      for (const Target& tg : targets)
+        if (tg.size && !tg.buffer->mapped()) {
+          VkBufferCopy region{tg.stagingOffset, 0, tg.size};
+          vkCmdCopyBuffer(cb, staging.handle(), tg.buffer->handle(), 1, &region);
+        }
+      // Also orders the copies before the frames' reads, which come in later submissions.
+      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT |
+                            VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_2_INDEX_READ_BIT |
+                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    });
+  staging = {};
+  stats_.geometryMs = msSince(t);
+  stats_.geometryBytes = 0;
+  for (const Target& tg : targets) stats_.geometryBytes += tg.size;
+
+  // Texture upload: one submission of copies into level 0.
+  t = Clock::now();
+  for (size_t i = 0; i < used.size(); ++i)
+    textures_.emplace_back(ctx, textureDesc(staged[i].extent, textureFormat(scene.textures[used[i]])));
+  stats_.textures = uint32_t(textures_.size());
+  if (!textures_.empty())
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+      std::vector<vk::ImageBarrier> toDst;
+      for (auto& img : textures_)
+        toDst.push_back({img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
+                         VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
+      vk::barrier(cb, toDst);
+      for (size_t i = 0; i < textures_.size(); ++i) {
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {staged[i].extent.width, staged[i].extent.height, 1};
+        vkCmdCopyBufferToImage(cb, staged[i].buffer.handle(), textures_[i].handle(),
+                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+      }
+    });
+  staged.clear();
+  stats_.textureUploadMs = msSince(t);
+
+  // Mips, in a submission of their own (their pipelines' creation is counted as pipeline creation).
+  t = Clock::now();
+  const double pipelineMs = pipelines.stats().ms;
   if (!textures_.empty()) {
+    MipGenerator mipGen(ctx);
+    MipViews views;  // alive until the submission has completed
+    vk::GpuTimer timer(ctx, 1);
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+      timer.reset(cb);
+      timer.begin(cb);
+      std::vector<const vk::Image*> batch;
+      for (const auto& img : textures_) batch.push_back(&img);
+      views = mipGen.record(cb, batch, mipMode);  // all textures, one barrier per step
+      timer.mark(cb, "mips");
+    });
+    stats_.mipGpuMs = timer.results().at(0).second;
+
     VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
     si.magFilter = si.minFilter = VK_FILTER_LINEAR;
     si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;  // trilinear
@@ -214,6 +309,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode) 
     VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &raw));
     sampler_ = vk::Sampler(ctx.device(), raw);
   }
+  stats_.mipsMs = msSince(t) - (pipelines.stats().ms - pipelineMs);
 }
 
 std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors() const {

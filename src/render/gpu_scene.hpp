@@ -1,8 +1,11 @@
 #pragma once
 // A scene on the GPU: vertex streams, index buffers (16-bit where a mesh allows; both also readable as
-// storage buffers by the visibility path's shading pass), the material and draw buffers and the textures that some drawn material uses (decoded on several threads, uploaded through one
-// staging buffer, mips generated on the GPU). Nothing the scene does not use is created.
+// storage buffers by the visibility path's shading pass), the material and draw buffers, and the textures
+// that some drawn material uses (decoded on all cores into staging buffers, mips generated on the GPU).
+// Geometry is written on all cores straight into device-local memory where the host can write it (every
+// CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "frame.h"
@@ -28,14 +31,28 @@ struct DrawItem {
   uint32_t id = 0;           // index of its GpuDraw in drawInfo() (visibility path)
 };
 
+// The loading phases, in order; they do not overlap, and together they are the constructor's time
+// (pipeline creation for the mips aside, which the context's pipeline cache counts).
 struct GpuSceneStats {
   uint32_t meshes = 0, triangles = 0, vertices = 0, textures = 0, meshes16 = 0;
-  double decodeMs = 0, uploadMs = 0, mipGpuMs = 0;
+  double decodeMs = 0;          // texture files decoded on all cores, into staging memory
+  double geometryMs = 0;        // vertex and index streams laid out, written and (where needed) copied
+  double textureUploadMs = 0;   // staging memory to level 0 of each texture
+  double mipsMs = 0, mipGpuMs = 0;  // mip chains: wall time, and the GPU's share of it
+  size_t geometryBytes = 0;
 };
+
+// Told how far a long load is: what it does, how many of how many are done (serialised calls).
+using LoadProgress = std::function<void(const char* what, size_t done, size_t total)>;
+
+// How the geometry reaches device memory: written in place where the host can map it (Auto), or always
+// through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
+enum class GeometryUpload { Auto, Staging };
 
 class GpuScene {
  public:
-  GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips);
+  GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {},
+           GeometryUpload upload = GeometryUpload::Auto);
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
   bool hasDraws(DrawKind k) const { return !draws_[size_t(k)].empty(); }

@@ -1,5 +1,8 @@
 #pragma once
 // The pose that frames a scene when no pose is given, the same for rtr-view and rtr-trace.
+#include <span>
+#include <vector>
+
 #include <glm/mat4x4.hpp>
 
 #include "core/camera.hpp"
@@ -17,5 +20,7 @@ CameraPose framingPose(const Scene& scene, const Lens& lens, float aspect, const
 
 // Front-facing area of the scene's triangles projected on the plane facing `toViewer` (scene space).
 double frontArea(const Scene& scene, const glm::vec3& toViewer);
+// The same for several directions in one pass over the triangles.
+std::vector<double> frontAreas(const Scene& scene, std::span<const glm::vec3> toViewer);
 
 }  // namespace rtr

@@ -8,6 +8,7 @@
 #include <vk_mem_alloc.h>
 
 #include "vk/check.hpp"
+#include "vk/pipeline_cache.hpp"
 
 namespace rtr::vk {
 namespace {
@@ -99,6 +100,11 @@ ContextOptions optionsFromEnvironment() {
 #endif
   if (const char* v = std::getenv("RTR_VALIDATION")) o.validation = o.syncValidation = std::strcmp(v, "0") != 0;
   if (const char* d = std::getenv("RTR_DEVICE")) o.device = d;
+  if (const char* c = std::getenv("RTR_PIPELINE_CACHE")) {
+    if (std::strcmp(c, "0") != 0 && std::strcmp(c, "off") != 0) o.pipelineCacheDir = c;
+  } else if (!std::getenv("RTR_TEST")) {
+    o.pipelineCacheDir = defaultPipelineCacheDir();
+  }
   return o;
 }
 
@@ -216,6 +222,7 @@ Context::Context(const ContextOptions& options) {
     ai.instance = instance_;
     ai.vulkanApiVersion = VK_API_VERSION_1_3;
     VK_CHECK(vmaCreateAllocator(&ai, &allocator_));
+    pipelineCache_ = std::make_unique<PipelineCache>(device_, properties_, options.pipelineCacheDir);
   } catch (...) {
     release();
     throw;
@@ -226,6 +233,7 @@ Context::~Context() { release(); }
 
 void Context::release() {
   if (device_) vkDeviceWaitIdle(device_);
+  pipelineCache_.reset();  // saves it
   if (allocator_) vmaDestroyAllocator(allocator_);
   if (device_) vkDestroyDevice(device_, nullptr);
   if (messenger_) {

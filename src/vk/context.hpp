@@ -3,6 +3,8 @@
 // instance extensions its surface needs and creates the surface itself.
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,16 +14,21 @@ typedef struct VmaAllocator_T* VmaAllocator;
 
 namespace rtr::vk {
 
+class PipelineCache;
+
 struct ContextOptions {
   bool validation = false;            // Khronos validation layer + debug messenger (fails loudly if missing)
   bool syncValidation = false;        // synchronization validation (tests turn it on)
   std::string device;                 // "" = best; else an index ("1") or a substring of the device name
   std::vector<const char*> instanceExtensions;  // e.g. those GLFW needs for a surface
   bool presentation = false;          // enable VK_KHR_swapchain on the device
+  std::filesystem::path pipelineCacheDir;  // where the pipeline cache file lives; empty: not on disk
 };
 
 // Options from the environment: RTR_VALIDATION=1 enables validation (+ sync validation),
-// RTR_DEVICE picks the device. Debug builds validate by default.
+// RTR_DEVICE picks the device. Debug builds validate by default. RTR_PIPELINE_CACHE=DIR keeps the
+// pipeline cache in DIR, =0 or =off keeps none; unset, the user's cache folder, except under tests
+// (RTR_TEST set), which never touch it unless they name a folder.
 ContextOptions optionsFromEnvironment();
 
 class Context {
@@ -48,6 +55,9 @@ class Context {
   static void resetValidationMessageCount();
 
   PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn() const { return pushDescriptorFn_; }
+  VkPhysicalDeviceType deviceType() const { return properties_.deviceType; }
+  // Every pipeline is created through it (vk/pipeline.cpp), which also counts them and their time.
+  PipelineCache& pipelineCache() const { return *pipelineCache_; }
 
   // Names an object in validation messages and debuggers (no-op without validation).
   void setName(uint64_t handle, VkObjectType type, const char* name) const;
@@ -64,6 +74,7 @@ class Context {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queueFamily_ = 0;
   VmaAllocator allocator_ = nullptr;
+  std::unique_ptr<PipelineCache> pipelineCache_;
   PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn_ = nullptr;
 };
 

@@ -1,12 +1,14 @@
 #include "vk/pipeline.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <mutex>
 #include <unistd.h>
 
 #include "vk/check.hpp"
 #include "vk/context.hpp"
+#include "vk/pipeline_cache.hpp"
 
 namespace rtr::vk {
 
@@ -133,16 +135,35 @@ uint32_t formatSize(VkFormat f) {
   }
 }
 
+// Creation feedback for one pipeline (core in Vulkan 1.3), handed to the cache's counters with the time
+// from `start` (reflection and layouts included).
+struct Feedback {
+  VkPipelineCreationFeedback pipeline{};
+  std::vector<VkPipelineCreationFeedback> stages;
+  VkPipelineCreationFeedbackCreateInfo info{VK_STRUCTURE_TYPE_PIPELINE_CREATION_FEEDBACK_CREATE_INFO};
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  explicit Feedback(size_t stageCount) : stages(stageCount) {
+    info.pPipelineCreationFeedback = &pipeline;
+    info.pipelineStageCreationFeedbackCount = uint32_t(stages.size());
+    info.pPipelineStageCreationFeedbacks = stages.data();
+  }
+  void record(const Context& ctx) const {
+    ctx.pipelineCache().record(
+        pipeline, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+};
+
 }  // namespace
 
 Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, const LayoutOptions& options,
                              const std::vector<SpecializationConstant>& specialization) {
+  Feedback feedback(1);
   Pipeline p;
   p.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
   p.layout = PipelineLayout(ctx, reflectPipeline({shader}), options);
   ShaderModuleHandle module = createModule(ctx.device(), shader);
   Specialization spec(specialization);
-  VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO, &feedback.info};
   ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
@@ -150,13 +171,15 @@ Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, cons
   ci.stage.pSpecializationInfo = spec.get();
   ci.layout = p.layout.handle();
   VkPipeline raw;
-  VK_CHECK(vkCreateComputePipelines(ctx.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &raw));
+  VK_CHECK(vkCreateComputePipelines(ctx.device(), ctx.pipelineCache().handle(), 1, &ci, nullptr, &raw));
   p.pipeline = PipelineHandle(ctx.device(), raw);
+  feedback.record(ctx);
   ctx.setName(uint64_t(raw), VK_OBJECT_TYPE_PIPELINE, shader.name.c_str());
   return p;
 }
 
 Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const LayoutOptions& options) {
+  Feedback feedback(d.modules.size());
   Pipeline p;
   p.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
   p.layout = PipelineLayout(ctx, reflectPipeline(d.modules), options);
@@ -227,6 +250,7 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   ri.colorAttachmentCount = uint32_t(d.colorFormats.size());
   ri.pColorAttachmentFormats = d.colorFormats.data();
   ri.depthAttachmentFormat = d.depthFormat;
+  ri.pNext = &feedback.info;
 
   VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &ri};
   gi.stageCount = uint32_t(stages.size());
@@ -241,8 +265,9 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   gi.pDynamicState = &dy;
   gi.layout = p.layout.handle();
   VkPipeline raw;
-  VK_CHECK(vkCreateGraphicsPipelines(ctx.device(), VK_NULL_HANDLE, 1, &gi, nullptr, &raw));
+  VK_CHECK(vkCreateGraphicsPipelines(ctx.device(), ctx.pipelineCache().handle(), 1, &gi, nullptr, &raw));
   p.pipeline = PipelineHandle(ctx.device(), raw);
+  feedback.record(ctx);
   return p;
 }
 

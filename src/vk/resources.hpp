@@ -55,6 +55,10 @@ enum class MemoryUse {
   Device,    // GPU only
   Upload,    // host writes once, sequentially; mapped
   Readback,  // host reads; mapped, cached
+  // Device-local, and mapped for sequential writes where the device has host-visible device-local
+  // memory (a discrete GPU with a large BAR; every CPU device): mapped() is null where it has not, and
+  // the data must go through a staging buffer.
+  DeviceWrite,
 };
 
 class Buffer {
@@ -68,7 +72,7 @@ class Buffer {
 
   VkBuffer handle() const { return buffer_; }
   VkDeviceSize size() const { return size_; }
-  void* mapped() const { return mapped_; }  // non-null for Upload and Readback
+  void* mapped() const { return mapped_; }  // non-null for Upload and Readback (DeviceWrite: see there)
   void flush() const;       // after host writes
   void invalidate() const;  // before host reads
 

@@ -107,7 +107,9 @@ TEST_F(FrameTest, VisibilityPathMatchesForward) {
     std::printf("bias %.1f: %zu of %zu pixels differ by more than 3, worst %d\n", bias, over, n, worst);
     EXPECT_GT(lit, n / 2) << "comparing mostly black images proves nothing";
     EXPECT_LE(over, n / 200);
-    if (raster == render::RasterPath::Hardware) EXPECT_LE(worst, 24);
+    if (raster == render::RasterPath::Hardware) {
+      EXPECT_LE(worst, 24);
+    }
   }
 }
 

@@ -65,9 +65,9 @@ fi
 frame_rows() {  # frame_rows TAG SCENE SIZES...
   local tag=$1 scene=$2; shift 2
   for size in "$@"; do
-    row "frame-$tag-$size-pbr" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic compute
+    row "frame-$tag-$size-pbr" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic compute --shading-path visibility
     row "frame-$tag-$size-pbr-forward" rtr-view "$scene" --headless --size "$size" --bench $frames --shading-path forward --mosaic compute
-    row "frame-$tag-$size-pbr-graphics" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic graphics
+    row "frame-$tag-$size-pbr-graphics" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic graphics --shading-path visibility
     row "frame-$tag-$size-textured" rtr-view "$scene" --headless --size "$size" --bench $frames --mode 13 --mosaic compute
   done
 }

@@ -1,8 +1,12 @@
 // rtr-view: the Vulkan viewer. Headless (--headless: no window, no display) or in a GLFW window.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <optional>
 #include <iostream>
 #include <map>
+
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -10,9 +14,11 @@
 #include "core/error.hpp"
 #include "options.hpp"
 #include "render/headless.hpp"
+#include "render/startup.hpp"
 #include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "vk/context.hpp"
+#include "vk/pipeline_cache.hpp"
 
 namespace rtr::view {
 
@@ -34,6 +40,26 @@ render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
   s.lights = resolveLights(scene, o.lightOptions);
   if (!s.lights.note.empty()) std::fprintf(stderr, "rtr-view: note: %s\n", s.lights.note.c_str());
   return s;
+}
+
+vk::ContextOptions contextOptions(const ViewOptions& o) {
+  vk::ContextOptions co = vk::optionsFromEnvironment();
+  if (o.validation) co.validation = true;
+  if (!o.device.empty()) co.device = o.device;
+  if (!o.pipelineCache) co.pipelineCacheDir.clear();
+  return co;
+}
+
+DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
+  const render::DeviceDefaults d = render::deviceDefaults(ctx.deviceType());
+  DeviceChoice c{o.shadingGiven ? o.settings.shading : d.shading, o.mipsGiven ? o.mips : d.mips};
+  // No " on " in this line: scripts take the first line with one for the device line below.
+  std::fprintf(stderr, "rtr-view: %s: %s shading (%s), %s mips (%s)", ctx.deviceName().c_str(),
+               render::toString(c.shading), o.shadingGiven ? "--shading-path" : "default",
+               render::toString(c.mips), o.mipsGiven ? "--mips" : "default");
+  if (!o.shadingGiven || !o.mipsGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
+  std::fprintf(stderr, "\n");
+  return c;
 }
 
 namespace {
@@ -71,28 +97,76 @@ void printBench(const std::vector<std::vector<std::pair<std::string, double>>>& 
 }  // namespace
 
 int runHeadless(const ViewOptions& o) {
-  vk::ContextOptions co = vk::optionsFromEnvironment();
-  if (o.validation) co.validation = true;
-  if (!o.device.empty()) co.device = o.device;
-  vk::Context ctx(co);
+  // The phases tile the time: each runs from the end of the one before (those of the scene upload are
+  // timed inside it), so their sum against the total, measured on its own, shows any time left out.
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  render::StartupTimeline timeline;
+  timeline.add("process start to Vulkan (exec, libraries, options)", render::msSinceProcessStart());
+  auto last = Clock::now();
+  const auto phase = [&](const std::string& name, double lessMs = 0) {
+    timeline.add(name, since(last) - lessMs);
+    last = Clock::now();
+  };
+  vk::Context ctx(contextOptions(o));
   checkSizeFits(o, ctx);
+  const DeviceChoice choice = chooseForDevice(o, ctx);
+  phase("instance and device");
   Scene scene = loadScene(o.scene, o.load);
-  render::GpuScene gpuScene(ctx, scene, o.mips);
+  phase("scene file read");
+  // A load that takes over half a second says how far it is: one line rewritten on a terminal, else a
+  // line a second.
+  const auto loadStart = Clock::now();
+  auto lastShown = loadStart;
+  const bool terminal = ::isatty(2);
+  const render::LoadProgress progress = [&](const char* what, size_t done, size_t total) {
+    if (since(loadStart) < 500 || (done < total && since(lastShown) < (terminal ? 250 : 1000))) return;
+    std::fprintf(stderr, "%srtr-view: %s %zu/%zu%s", terminal ? "\r" : "", what, done, total,
+                 terminal && done < total ? "" : "\n");
+    lastShown = Clock::now();
+  };
+  render::GpuScene gpuScene(ctx, scene, choice.mips, progress);
   const auto& st = gpuScene.stats();
+  timeline.add("texture decode", st.decodeMs);
+  timeline.add("geometry upload", st.geometryMs);
+  timeline.add("texture upload", st.textureUploadMs);
+  timeline.add("mips", st.mipsMs);
+  last = Clock::now();
+  const double pipelineMsBefore = ctx.pipelineCache().stats().ms;
   std::fprintf(stderr, "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
-               "decode %.0f ms, upload %.0f ms, mips %.3f ms GPU\n",
+               "decode %.0f ms, geometry %.0f ms (%.2f GB/s), texture upload %.0f ms, mips %.3f ms GPU\n",
                o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16,
-               st.triangles, st.textures, st.decodeMs, st.uploadMs, st.mipGpuMs);
+               st.triangles, st.textures, st.decodeMs, st.geometryMs,
+               st.geometryMs > 0 ? double(st.geometryBytes) / st.geometryMs * 1e-6 : 0.0, st.textureUploadMs,
+               st.mipGpuMs);
   const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(o.lens, scene.bounds(), pose);
-  const render::RenderSettings settings = sceneSettings(o, scene);
+  render::RenderSettings settings = sceneSettings(o, scene);
+  settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
+  phase("renderer setup (start pose, targets)", setupPipelineMs);
+  std::optional<render::HeadlessFrame> first;
+  if (o.timings) {
+    first = renderer.render(pose, lens, settings, 1);
+    const double totalMs = render::msSinceProcessStart();
+    const vk::PipelineStats ps = ctx.pipelineCache().stats();
+    char name[120];
+    if (ps.reported == ps.created)
+      std::snprintf(name, sizeof name, "pipeline creation (%u, %u from the cache)", ps.created, ps.cacheHits);
+    else
+      std::snprintf(name, sizeof name, "pipeline creation (%u, cache hits not reported)", ps.created);
+    timeline.add(name, ps.ms);
+    phase("first frame complete (record, GPU, read-back)", ps.ms - pipelineMsBefore - setupPipelineMs);
+    std::fprintf(stderr, "rtr-view: %s", timeline.format(totalMs).c_str());
+  }
   if (o.bench > 0) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
   }
   if (!o.screenshot.empty()) {
-    render::HeadlessFrame frame = renderer.render(pose, lens, settings, std::max(1, o.frames));
+    render::HeadlessFrame frame = first && o.frames <= 1 ? std::move(*first)
+                                                         : renderer.render(pose, lens, settings, std::max(1, o.frames));
     if (settings.lights.lights.empty() && allBlack(frame.image))
       std::fprintf(stderr, "rtr-view: warning: the image is all black (no lights: --no-default-light)\n");
     const std::string& out = o.screenshot;
@@ -130,10 +204,13 @@ int main(int argc, char** argv) {
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(cli::integer(1, 100000));
   app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay): .png, .jpg, .exr or .hdr");
   app.add_flag("--force", o.force, "overwrite an existing screenshot");
-  app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit")->capture_default_str();
+  CLI::Option* mipsOpt = app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit "
+                                        "(default: the device's fastest, docs/startup.md)");
   app.add_option("--mosaic", mosaic, "post process: off (the scene plainly) | compute | graphics (the brief's captures: compute)")->capture_default_str();
-  app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward")
-      ->check(CLI::IsMember({"visibility", "forward"}))->capture_default_str();
+  CLI::Option* shadingOpt =
+      app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward "
+                     "(default: the device's fastest, docs/startup.md)")
+          ->check(CLI::IsMember({"visibility", "forward"}));
   app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
       ->check(CLI::IsMember({"auto", "hardware", "compute"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
@@ -149,6 +226,9 @@ int main(int argc, char** argv) {
   app.add_flag("--orbit", o.orbit, "start in orbit camera mode: left-drag turns about a target, scroll zooms, middle-drag pans (windowed)");
   app.add_option("--device", o.device, "Vulkan device index or name substring (default: discrete GPU first)");
   app.add_flag("--validation", o.validation, "enable the Vulkan validation layer");
+  app.add_flag("--timings", o.timings, "print the start-up phases in ms (headless), from process start to the first frame");
+  app.add_flag("!--no-pipeline-cache", o.pipelineCache,
+               "neither read nor write the pipeline cache ($XDG_CACHE_HOME/rtr or ~/.cache/rtr; RTR_PIPELINE_CACHE=DIR|off)");
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
 
   try {
@@ -162,6 +242,7 @@ int main(int argc, char** argv) {
     o.lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
+    if (o.timings && !o.headless) throw UsageError("--timings needs --headless (the window prints no start-up phases yet)");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
     const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
                                                           {"blit", render::MipMode::Blit}};
@@ -170,6 +251,8 @@ int main(int argc, char** argv) {
     if (!mipModes.count(mips)) throw UsageError("--mips '" + mips + "': expected compute or blit");
     if (!mosaicModes.count(mosaic)) throw UsageError("--mosaic '" + mosaic + "': expected off, compute or graphics");
     o.mips = mipModes.at(mips);
+    o.mipsGiven = mipsOpt->count() > 0;
+    o.shadingGiven = shadingOpt->count() > 0;
     o.settings.mosaic = mosaicModes.at(mosaic);
     o.settings.shading = shadingPath == "forward" ? render::ShadingPath::Forward : render::ShadingPath::Visibility;
     o.settings.raster = raster == "hardware" ? render::RasterPath::Hardware

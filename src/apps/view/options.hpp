@@ -9,9 +9,7 @@
 #include "scene/lights.hpp"
 #include "scene/load.hpp"
 
-namespace rtr::vk {
-class Context;
-}
+#include "vk/context.hpp"
 
 namespace rtr::view {
 
@@ -33,6 +31,9 @@ struct ViewOptions {
   bool orbit = false;              // start in orbit camera mode (windowed)
   std::string device;
   bool validation = false;
+  bool shadingGiven = false, mipsGiven = false;  // --shading-path / --mips given: no per-device default
+  bool timings = false;            // print the start-up phases
+  bool pipelineCache = true;       // keep compiled pipelines in the user's cache folder
 };
 
 constexpr uint32_t kMaxSize = 32768;  // the largest image side any Vulkan device offers today
@@ -44,6 +45,16 @@ CameraPose startPose(const ViewOptions& o, const Scene& scene);
 // The render settings for `scene`: o.settings with the scene's lights (scene/lights.hpp), the choice
 // said once on stderr when it is not simply the scene's own lights.
 render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene);
+
+// The Vulkan context options: the environment's (vk::optionsFromEnvironment), then the flags.
+vk::ContextOptions contextOptions(const ViewOptions& o);
+// The shading path and mip mode for `ctx`'s device: the flags where given, else the per-device defaults
+// (render/startup.hpp), the choice and its reason said once on stderr.
+struct DeviceChoice {
+  render::ShadingPath shading;
+  render::MipMode mips;
+};
+DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx);
 
 int runHeadless(const ViewOptions& o);
 int runWindowed(const ViewOptions& o);

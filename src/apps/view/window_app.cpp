@@ -223,19 +223,19 @@ int runWindowed(const ViewOptions& opts) {
   cur.scene = std::make_unique<Scene>(loadScene(o.scene, o.load));
   app.settings = sceneSettings(o, *cur.scene);
   app.lens = o.lens;
-  app.mips = o.mips;
   if (o.orbit) app.camera.setMode(CameraMode::Orbit);
 
   uint32_t extCount = 0;
   const char** exts = glfwGetRequiredInstanceExtensions(&extCount);
   if (!exts) throw Error("GLFW found no Vulkan surface support");
-  vk::ContextOptions co = vk::optionsFromEnvironment();
-  if (o.validation) co.validation = true;
-  if (!o.device.empty()) co.device = o.device;
+  vk::ContextOptions co = contextOptions(o);
   co.instanceExtensions.assign(exts, exts + extCount);
   co.presentation = true;
   vk::Context ctx(co);
   checkSizeFits(o, ctx);
+  const DeviceChoice choice = chooseForDevice(o, ctx);
+  app.settings.shading = choice.shading;
+  app.mips = choice.mips;
 
   GLFWwindow* window = glfwCreateWindow(int(o.width), int(o.height), "rtr-view", nullptr, nullptr);
   if (!window) throw Error("cannot create a window");

@@ -1,0 +1,53 @@
+#include "render/startup.hpp"
+
+#include <time.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace rtr::render {
+
+double msSinceProcessStart() {
+  // Field 22 of /proc/self/stat: the start time in clock ticks since boot (after the command name,
+  // which may hold spaces, hence the search for its closing parenthesis).
+  std::ifstream in("/proc/self/stat");
+  std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t close = stat.rfind(')');
+  if (close == std::string::npos) return 0;
+  std::istringstream fields(stat.substr(close + 2));
+  std::string field;
+  unsigned long long ticks = 0;
+  for (int i = 3; i <= 22 && fields >> field; ++i)
+    if (i == 22) ticks = std::stoull(field);
+  timespec now{};
+  clock_gettime(CLOCK_BOOTTIME, &now);
+  const double startMs = double(ticks) * 1000.0 / double(sysconf(_SC_CLK_TCK));
+  return double(now.tv_sec) * 1e3 + double(now.tv_nsec) * 1e-6 - startMs;
+}
+
+std::string StartupTimeline::format(double totalMs) const {
+  std::string out = "start-up phases (ms):\n";
+  char line[160];
+  double sum = 0;
+  for (const auto& [name, ms] : phases_) {
+    std::snprintf(line, sizeof line, "  %-58s %9.1f\n", name.c_str(), ms);
+    out += line;
+    sum += ms;
+  }
+  std::snprintf(line, sizeof line, "  %-58s %9.1f\n  %-58s %9.1f\n", "sum of the phases", sum,
+                "total from process start", totalMs);
+  return out + line;
+}
+
+DeviceDefaults deviceDefaults(VkPhysicalDeviceType type) {
+  // A CPU rasteriser (lavapipe) pays the same for fragment and compute work, so the visibility path's
+  // extra pass only costs; and its blit chain beats the compute mips there.
+  if (type == VK_PHYSICAL_DEVICE_TYPE_CPU)
+    return {ShadingPath::Forward, MipMode::Blit, "a CPU device, measured fastest there"};
+  return {ShadingPath::Visibility, MipMode::Compute,
+          "a GPU, measured fastest with a discrete one"};
+}
+
+}  // namespace rtr::render

@@ -1,0 +1,121 @@
+// rtr-view's start-up as a user meets it: --timings phases that account for the whole time, the defaults
+// chosen for the device (and flags that override them), the pipeline cache kept where it is told.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <regex>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_paths.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+struct ViewRun {
+  int status = -1;
+  std::string out;
+};
+
+class StartupTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() / ("rtr-startup-" + std::to_string(::getpid()) + "-" +
+                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  // rtr-view on the small temple, headless, with `args`; `env` are env(1)'s words in front.
+  ViewRun view(const std::string& args, const std::string& env = "") {
+    const std::string cmd = "env " + env + " " + rtr::test::toolPath("rtr-view") + " " +
+                            (rtr::test::assetDir() / "temple.rtrscene").string() + " --headless --size 320x180 " +
+                            "--screenshot " + (dir / "shot.png").string() + " --force " + args + " 2>&1";
+    ViewRun r;
+    FILE* pipe = popen(cmd.c_str(), "r");
+    char buf[4096];
+    while (size_t n = fread(buf, 1, sizeof buf, pipe)) r.out.append(buf, n);
+    const int status = pclose(pipe);
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+  }
+  fs::path dir;
+};
+
+// The phases printed by --timings, by name, and the two totals.
+std::map<std::string, double> phases(const std::string& out) {
+  std::map<std::string, double> p;
+  std::istringstream in(out.substr(out.find("start-up phases (ms):")));
+  std::string line;
+  std::getline(in, line);
+  static const std::regex row(R"(^  (\S.*\S) +(-?[0-9]+\.[0-9])$)");
+  std::smatch m;
+  while (std::getline(in, line) && std::regex_match(line, m, row)) p[m[1]] = std::stod(m[2]);
+  return p;
+}
+
+TEST_F(StartupTest, TimingsPhasesAddUpToTheTotal) {
+  const ViewRun r = view("--timings");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto p = phases(r.out);
+  const std::vector<std::string> expected = {
+      "process start to Vulkan (exec, libraries, options)", "instance and device", "scene file read",
+      "texture decode", "geometry upload", "texture upload", "mips",
+      "renderer setup (start pose, targets)", "first frame complete (record, GPU, read-back)", "sum of the phases", "total from process start"};
+  for (const auto& name : expected) EXPECT_TRUE(p.count(name)) << "no phase '" << name << "' in:\n" << r.out;
+  double sum = 0;
+  int pipelineRows = 0;
+  for (const auto& [name, ms] : p) {
+    if (name == "sum of the phases" || name == "total from process start") continue;
+    EXPECT_GE(ms, 0.0) << name;
+    sum += ms;
+    pipelineRows += name.rfind("pipeline creation (", 0) == 0;
+  }
+  EXPECT_EQ(pipelineRows, 1) << r.out;
+  const double total = p.at("total from process start");
+  EXPECT_GT(total, p.at("instance and device"));
+  EXPECT_NEAR(sum, total, 3.0) << "time not in any phase:\n" << r.out;
+}
+
+TEST_F(StartupTest, CpuDeviceGetsItsDefaultsAndFlagsOverride) {
+  const ViewRun plain = view("");
+  ASSERT_EQ(plain.status, 0) << plain.out;
+  if (plain.out.find("llvmpipe") == std::string::npos) GTEST_SKIP() << "not on lavapipe: " << plain.out;
+  // The documented choice (docs/startup.md), and the frame really took the forward path.
+  EXPECT_THAT(plain.out, HasSubstr(": forward shading (default), blit mips (default): the defaults for a CPU device"));
+  EXPECT_THAT(plain.out, HasSubstr("  scene: "));
+  EXPECT_THAT(plain.out, ::testing::Not(HasSubstr("  shade: ")));
+
+  const ViewRun flags = view("--shading-path visibility --mips compute");
+  ASSERT_EQ(flags.status, 0) << flags.out;
+  EXPECT_THAT(flags.out, HasSubstr(": visibility shading (--shading-path), compute mips (--mips)\n"));
+  EXPECT_THAT(flags.out, ::testing::Not(HasSubstr("the defaults for")));
+  EXPECT_THAT(flags.out, HasSubstr("  shade: "));
+}
+
+TEST_F(StartupTest, PipelineCacheGoesWhereItIsToldAndNowhereWhenOff) {
+  const fs::path cache = dir / "cache";
+  ASSERT_EQ(view("", "RTR_PIPELINE_CACHE=" + cache.string()).status, 0);
+  ASSERT_TRUE(fs::is_directory(cache));
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(cache)) files += e.path().filename().string().rfind("pipelines-", 0) == 0;
+  EXPECT_EQ(files, 1);
+
+  const fs::path home = dir / "home";
+  const ViewRun off = view("--no-pipeline-cache", "-u RTR_TEST -u XDG_CACHE_HOME HOME=" + home.string());
+  ASSERT_EQ(off.status, 0) << off.out;
+  EXPECT_FALSE(fs::exists(home / ".cache/rtr")) << off.out;
+  // Without the flag the same run keeps it in the user's cache folder.
+  const ViewRun on = view("", "-u RTR_TEST -u XDG_CACHE_HOME HOME=" + home.string());
+  ASSERT_EQ(on.status, 0) << on.out;
+  EXPECT_TRUE(fs::is_directory(home / ".cache/rtr")) << on.out;
+}
+
+}  // namespace
