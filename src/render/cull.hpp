@@ -1,0 +1,83 @@
+#pragma once
+// GPU-driven cluster culling (docs/culling.md). A compute pass tests every GpuCluster (cluster.h) against
+// the frustum, its back-face cone and a hierarchical depth pyramid, and writes the indices of the visible
+// ones compacted into one buffer plus an indirect dispatch argument of one workgroup per visible cluster;
+// culled clusters are counted by reason. The tests themselves are shaders/shared/cull.h (shared with the
+// CPU reference of the tests).
+//
+// Use, per frame:  pyramid.build(cb, depthView, layout);  culler.record(cb, clusters, n, camera, &pyramid);
+// then vkCmdDispatchIndirect(cb, culler.counts(), 0) with a shader that reads culler.visible().
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "cull.h"
+#include "vk/pipeline.hpp"
+#include "scene/scene.hpp"
+#include "vk/resources.hpp"
+
+namespace rtr::vk { class Context; }
+
+namespace rtr::render {
+
+// The GpuCluster records of a scene whose meshes have clusters, numbered by draw as GpuScene numbers its
+// GpuDraws (the meshes that have triangles, in order).
+std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
+
+// The farthest depth per texel of a depth image, level by level: texel t of level L covers the pixels p
+// with p >> (L + 1) == t (level 0 is half the image, padded to powers of two).
+class DepthPyramid {
+ public:
+  DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent);
+  // Records the build from `depth` (a sampled view whose .r is depth: a D32 depth-aspect view or an R32F
+  // image, in `depthLayout`, written before this by the compute or fragment stage with the barrier the
+  // writer owes). Leaves the pyramid readable by compute shaders.
+  void build(VkCommandBuffer cb, VkImageView depth, VkImageLayout depthLayout);
+  VkImageView view() const { return image_.view(); }  // all levels, R32F, layout GENERAL
+  VkExtent2D depthExtent() const { return depthExtent_; }
+  uint32_t levels() const { return image_.mipLevels(); }
+  const vk::Image& image() const { return image_; }
+  static VkExtent2D pyramidExtent(VkExtent2D depth);  // level 0's
+
+ private:
+  const vk::Context& ctx_;
+  VkExtent2D depthExtent_;
+  vk::Image image_;
+  std::vector<vk::ImageView> levelViews_;  // per level: storage (write) and sampled (read by the next level)
+  vk::Pipeline pipeline_;
+  bool initialised_ = false;
+};
+
+struct CullCamera {
+  glm::mat4 viewProj{1.0f};  // projectionMatrix * viewMatrix (src/core/camera.hpp)
+  glm::vec3 eye{0.0f};
+  bool orthographic = false;  // no cone test (it assumes rays from the eye)
+};
+
+struct CullTests {
+  bool frustum = true, cone = true, occlusion = true;  // occlusion only when a pyramid is given
+};
+
+class ClusterCuller {
+ public:
+  ClusterCuller(const vk::Context& ctx, uint32_t maxClusters);
+  // Records the pass over `count` GpuClusters in `clusters` (a storage buffer). With a pyramid, clusters
+  // hidden behind its depths are culled too: conservative for the view the pyramid was built from (a
+  // cluster whose every point lies behind that view's depth there cannot be seen in that view). Ends with
+  // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
+  void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
+              const DepthPyramid* pyramid, CullTests tests = {});
+  VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
+  VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
+  uint32_t maxClusters() const { return maxClusters_; }
+
+ private:
+  const vk::Context& ctx_;
+  uint32_t maxClusters_;
+  vk::Buffer visible_, counts_;
+  vk::Image noPyramid_;  // 1×1 stand-in so the pass always has a valid binding
+  vk::Pipeline pipeline_;
+};
+
+}  // namespace rtr::render
