@@ -1,7 +1,7 @@
 #include "scene/rtrscene.hpp"
 
-#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -67,6 +67,7 @@ void readClusters(ByteReader& r, Mesh& m, const std::string& which) {
                      " triangles or the file");
   m.clusters.resize(count);
   uint32_t next = 0;
+  std::vector<uint32_t> seenIn(count ? m.positions.size() : 0, ~0u);  // per vertex: the last cluster that used it
   for (uint32_t i = 0; i < count; ++i) {
     Cluster& c = m.clusters[i];
     const size_t cAt = r.pos();
@@ -85,16 +86,14 @@ void readClusters(ByteReader& r, Mesh& m, const std::string& which) {
       r.failAt(cAt + 36, cw + ": triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
                              std::to_string(std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - next)));
     next += c.triangleCount;
-    uint32_t seen[CLUSTER_MAX_VERTICES];
     uint32_t distinct = 0;
     const float slack = c.radius * 1e-4f + 1e-6f * (std::abs(c.center.x) + std::abs(c.center.y) + std::abs(c.center.z));
     for (size_t k = size_t(c.firstTriangle) * 3; k < size_t(next) * 3; ++k) {
       const uint32_t v = m.indices[k];
-      if (std::find(seen, seen + distinct, v) == seen + distinct) {
-        if (distinct == CLUSTER_MAX_VERTICES)
-          r.failAt(cAt, cw + ": more than " + std::to_string(CLUSTER_MAX_VERTICES) + " vertices");
-        seen[distinct++] = v;
-      }
+      if (seenIn[v] == i) continue;  // each vertex checked once per cluster
+      seenIn[v] = i;
+      if (++distinct > CLUSTER_MAX_VERTICES)
+        r.failAt(cAt, cw + ": more than " + std::to_string(CLUSTER_MAX_VERTICES) + " vertices");
       if (!(glm::length(m.positions[v] - c.center) <= c.radius + slack))
         r.failAt(cAt, cw + ": vertex " + std::to_string(v) + " lies outside its bounding sphere");
     }
