@@ -79,6 +79,10 @@ void readClusters(ByteReader& r, Mesh& m, const std::string& which) {
     c.firstTriangle = r.u32("a cluster record");
     c.triangleCount = r.u32("a cluster record");
     if (!(c.radius >= 0.0f)) r.failAt(cAt + 12, cw + ": negative radius");
+    // A cone that culls (cutoff < 1) has a unit axis and a cutoff >= 0 (meshoptimizer's); others would cull
+    // clusters that face the eye.
+    if (c.coneCutoff < 1.0f && (c.coneCutoff < 0.0f || std::abs(glm::length(c.coneAxis) - 1.0f) > 1e-3f))
+      r.failAt(cAt + 16, cw + ": cone axis not a unit vector or cutoff below 0");
     if (c.firstTriangle != next)
       r.failAt(cAt + 32, cw + ": first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
                              " (clusters tile the triangles in order)");

@@ -198,6 +198,16 @@ TEST(Clusters, RtrSceneRefusesDamagedClusters) {
   EXPECT_THAT(patched(2, 28, &nan), HasSubstr("a cluster's cone is not finite"));
   EXPECT_THAT(patched(3, 12, &tiny), HasSubstr("cluster 3: vertex"));
   EXPECT_THAT(patched(3, 12, &negative), HasSubstr("cluster 3: negative radius"));
+  const float halfAxis = 0.5f;  // x of the axis only; cutoff set below 1 so the cone counts
+  const float cullingCutoff = 0.5f;
+  std::string cone = good;
+  std::memcpy(cone.data() + first + 4 * 40 + 16, &halfAxis, 4);
+  std::memcpy(cone.data() + first + 4 * 40 + 16 + 4, &zero, 4);
+  std::memcpy(cone.data() + first + 4 * 40 + 16 + 8, &zero, 4);
+  std::memcpy(cone.data() + first + 4 * 40 + 28, &cullingCutoff, 4);
+  reseal(cone);
+  EXPECT_THAT(decodeError(cone), HasSubstr("cluster 4: cone axis not a unit vector or cutoff below 0"));
+  EXPECT_THAT(patched(4, 28, &negative), HasSubstr("cluster 4: cone axis not a unit vector or cutoff below 0"));
   // The last cluster shortened: the triangles are not all covered.
   const uint32_t shorter = s.meshes[0].clusters.back().triangleCount - 1;
   EXPECT_THAT(patched(n - 1, 36, &shorter), HasSubstr("clusters cover"));
