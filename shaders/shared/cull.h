@@ -19,6 +19,14 @@ namespace rtr::shader {
 #define CULL_CONE 2u       // perspective cameras only: the test assumes rays from the eye
 #define CULL_OCCLUSION 4u  // against the depth pyramid bound to the pass
 
+// CullPush::phase. Two-phase occlusion culling (docs/culling.md): EARLY passes the clusters visible last
+// frame (per the history buffer) through frustum and cone only; once they are drawn and the pyramid built
+// from that depth, LATE tests every cluster against it, lists the visible ones not drawn early, and
+// rewrites the history. SINGLE tests every cluster once and leaves the history alone.
+#define CULL_SINGLE 0u
+#define CULL_EARLY 1u
+#define CULL_LATE 2u
+
 // Why a cluster was culled: the index of its counter after the indirect dispatch arguments.
 #define CULL_VISIBLE 0u
 #define CULL_BY_FRUSTUM 1u
@@ -40,7 +48,8 @@ struct CullPush {  // 112 bytes
   uint width;        // the depth source's size in pixels (the pyramid's level 0 is half of it, rounded up)
   uint height;
   uint pyramidLevels;
-  uint pad0, pad1, pad2;
+  uint phase;        // CULL_SINGLE, CULL_EARLY or CULL_LATE
+  uint pad0, pad1;
 };
 
 RTR_FN vec4 matrixRow(mat4 m, int i) { return vec4(m[0][i], m[1][i], m[2][i], m[3][i]); }

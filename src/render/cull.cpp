@@ -96,12 +96,18 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                            VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                        vk::MemoryUse::Device, "cull counts");
+  history_ = vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device,
+                        "cluster history");
   vk::ImageDesc d;
   d.format = kPyramidFormat;
   d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
   d.name = "no depth pyramid";
   noPyramid_ = vk::Image(ctx, d);
   vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+    vkCmdFillBuffer(cb, history_.handle(), 0, VK_WHOLE_SIZE, 0);  // no cluster was visible before
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
     vk::barrier(cb, {{noPyramid_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_READ_BIT}});
   });
@@ -109,7 +115,7 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
 }
 
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
-                           const DepthPyramid* pyramid, CullTests tests) {
+                           const DepthPyramid* pyramid, CullTests tests, CullPhase phase) {
   if (count > maxClusters_) throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   constexpr auto kConsumers = kCompute | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
@@ -127,6 +133,7 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
   push.count = count;
   push.flags = (tests.frustum ? CULL_FRUSTUM : 0u) | (tests.cone && !camera.orthographic ? CULL_CONE : 0u) |
                (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u);
+  push.phase = uint32_t(phase);
   if (pyramid) {
     push.width = pyramid->depthExtent().width;
     push.height = pyramid->depthExtent().height;
@@ -138,10 +145,11 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
       .buffer(1, counts_.handle())
       .buffer(2, visible_.handle())
       .image(3, pyramid ? pyramid->view() : noPyramid_.view(), VK_IMAGE_LAYOUT_GENERAL)
+      .buffer(4, history_.handle())
       .push(cb, pipeline_);
   pipeline_.push(cb, push);
   vkCmdDispatch(cb, (count + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE, 1, 1);
-  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_WRITE_BIT, kConsumers, kConsumerReads);
+  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_WRITE_BIT, kConsumers, kConsumerReads | VK_ACCESS_2_SHADER_WRITE_BIT);
 }
 
 }  // namespace rtr::render

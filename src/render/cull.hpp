@@ -59,15 +59,21 @@ struct CullTests {
   bool frustum = true, cone = true, occlusion = true;  // occlusion only when a pyramid is given
 };
 
+// Single: every cluster tested once (occlusion conservative only for the view the pyramid was built from).
+// Early + Late: two-phase occlusion, conservative for any camera motion; per frame: record(Early), draw
+// visible(), build the pyramid from that depth, record(Late) with it, draw visible() (the clusters Early
+// did not list). The culler keeps the per-cluster history between frames (all "not visible" at first).
+enum class CullPhase : uint32_t { Single = CULL_SINGLE, Early = CULL_EARLY, Late = CULL_LATE };
+
 class ClusterCuller {
  public:
   ClusterCuller(const vk::Context& ctx, uint32_t maxClusters);
-  // Records the pass over `count` GpuClusters in `clusters` (a storage buffer). With a pyramid, clusters
-  // hidden behind its depths are culled too: conservative for the view the pyramid was built from (a
-  // cluster whose every point lies behind that view's depth there cannot be seen in that view). Ends with
+  // Records the pass over `count` GpuClusters in `clusters` (a storage buffer; the same clusters every
+  // frame for Early/Late). With a pyramid (not used by Early), clusters hidden behind its depths are culled
+  // too: a cluster whose every point lies behind that depth image there cannot be seen above it. Ends with
   // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
   void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
-              const DepthPyramid* pyramid, CullTests tests = {});
+              const DepthPyramid* pyramid, CullTests tests = {}, CullPhase phase = CullPhase::Single);
   VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
   VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
   uint32_t maxClusters() const { return maxClusters_; }
@@ -75,7 +81,7 @@ class ClusterCuller {
  private:
   const vk::Context& ctx_;
   uint32_t maxClusters_;
-  vk::Buffer visible_, counts_;
+  vk::Buffer visible_, counts_, history_;
   vk::Image noPyramid_;  // 1×1 stand-in so the pass always has a valid binding
   vk::Pipeline pipeline_;
 };

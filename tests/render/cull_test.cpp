@@ -78,11 +78,12 @@ class CullTest : public test::VulkanTest {
  protected:
   // Runs the pass (the pyramid already built, or none) and reads back its list and counts.
   GpuResult cull(ClusterCuller& culler, const vk::Buffer& clusters, uint32_t count, const CullCamera& cam,
-                 const DepthPyramid* pyramid, const std::function<void(VkCommandBuffer)>& before = {}) {
+                 const DepthPyramid* pyramid, const std::function<void(VkCommandBuffer)>& before = {},
+                 render::CullPhase phase = render::CullPhase::Single) {
     vk::Buffer back(*ctx, 32 + size_t(count) * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "cull back");
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
       if (before) before(cb);
-      culler.record(cb, clusters.handle(), count, cam, pyramid);
+      culler.record(cb, clusters.handle(), count, cam, pyramid, {}, phase);
       VkBufferCopy a{0, 0, 32}, b{0, 32, size_t(count) * 4};
       vkCmdCopyBuffer(cb, culler.counts(), back.handle(), 1, &a);
       vkCmdCopyBuffer(cb, culler.visible(), back.handle(), 1, &b);
@@ -97,7 +98,8 @@ class CullTest : public test::VulkanTest {
     for (uint32_t i = 0; i < std::min(r.counts.dispatch[0], count); ++i) EXPECT_TRUE(r.visible.insert(ids[i]).second) << "listed twice";
     EXPECT_EQ(r.counts.dispatch[1], 1u);
     EXPECT_EQ(r.counts.dispatch[2], 1u);
-    EXPECT_EQ(r.counts.dispatch[0] + r.counts.culled[0] + r.counts.culled[1] + r.counts.culled[2], count);
+    if (phase == render::CullPhase::Single)
+      EXPECT_EQ(r.counts.dispatch[0] + r.counts.culled[0] + r.counts.culled[1] + r.counts.culled[2], count);
     return r;
   }
 
@@ -265,22 +267,26 @@ class IdRenderer {
 
   // Records the draw of the clusters `keep` says (all when empty), the ids' copy to the host, and leaves the
   // depth image readable by compute shaders in SHADER_READ_ONLY_OPTIMAL.
-  void record(VkCommandBuffer cb, const glm::mat4& viewProj, const std::vector<bool>& keep) {
-    vk::barrier(cb, {{ids_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_MEMORY_READ_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
-                     {depth_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                      VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, VK_ACCESS_2_MEMORY_READ_BIT,
+  // clear false: draws over what the last record left (its ids and depth).
+  void record(VkCommandBuffer cb, const glm::mat4& viewProj, const std::vector<bool>& keep, bool clear = true) {
+    const VkAccessFlags2 rw = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+    vk::barrier(cb, {{ids_.handle(), clear ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                      VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, rw, VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
+                     {depth_.handle(), clear ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                      VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, rw,
                       VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, 0, 1, VK_IMAGE_ASPECT_DEPTH_BIT}});
     VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     color.imageView = ids_.view();
     color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-    color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    color.loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
     color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     color.clearValue.color.uint32[0] = color.clearValue.color.uint32[1] = ~0u;
     VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     depth.imageView = depth_.view();
     depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
     depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     depth.clearValue.depthStencil = {1.0f, 0};
     VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
@@ -391,6 +397,65 @@ TEST_F(CullTest, NeverRemovesAVisibleClusterOfTheTemple) {
     for (int k = 0; k < 3; ++k) total[k + 1] += r.counts.culled[k];
   }
   for (int k = 1; k < 4; ++k) EXPECT_GT(total[k], 0u) << "reason " << k << " never culled: the test proves nothing about it";
+}
+
+// Two-phase occlusion while the camera jumps between views: each frame draws the clusters Early lists
+// (visible last frame), builds the pyramid from that depth, draws the ones Late adds; the result equals
+// the ids of all clusters, bit for bit, whatever the last frame saw.
+TEST_F(CullTest, TwoPhaseNeverRemovesAVisibleClusterWhileTheCameraMoves) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  const std::vector<GpuCluster> clusters = render::gpuClusters(scene);
+  const uint32_t n = uint32_t(clusters.size());
+  vk::Buffer buf(*ctx, n * sizeof(GpuCluster), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "clusters");
+  std::memcpy(buf.mapped(), clusters.data(), n * sizeof(GpuCluster));
+  buf.flush();
+  const VkExtent2D e{320, 200};
+  const float aspect = float(e.width) / float(e.height);
+  IdRenderer ids(*ctx, scene, e);
+  DepthPyramid pyramid(*ctx, e);
+  ClusterCuller culler(*ctx, n);
+  const Bounds b = scene.bounds();
+  const CameraPose inside = scene.defaultView.value_or(CameraPose{b.center(), 0, 0});
+  const std::vector<CameraPose> frames = {orbitFrame(b, Lens{}, aspect, 200.0f, -5.0f),
+                                          orbitFrame(b, Lens{}, aspect, 200.0f, -5.0f),
+                                          inside,
+                                          {inside.position, inside.yawDeg + 120.0f, inside.pitchDeg - 10.0f},
+                                          inside,
+                                          {inside.position + glm::vec3(0.3f, 0.0f, 0.4f), inside.yawDeg + 15.0f, inside.pitchDeg},
+                                          orbitFrame(b, Lens{}, aspect, 30.0f, -25.0f)};
+  uint32_t occluded = 0;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    SCOPED_TRACE(testing::Message() << "frame " << f);
+    const Lens lens = fitDepthRange(Lens{}, b, frames[f]);
+    const CullCamera cam = cameraFor(frames[f], lens, e);
+    vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) { ids.record(cb, cam.viewProj, {}); });
+    const std::vector<uint64_t> all = ids.ids();
+
+    const GpuResult early = cull(culler, buf, n, cam, nullptr, {}, render::CullPhase::Early);
+    std::vector<bool> keep(n, false);
+    for (uint32_t i : early.visible) keep[i] = true;
+    const GpuResult late = cull(culler, buf, n, cam, &pyramid, [&](VkCommandBuffer cb) {
+      ids.record(cb, cam.viewProj, keep);
+      pyramid.build(cb, ids.depthView(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    }, render::CullPhase::Late);
+    std::vector<bool> more(n, false);
+    for (uint32_t i : late.visible) {
+      EXPECT_FALSE(keep[i]) << "cluster " << i << " listed by both phases";
+      more[i] = true;
+    }
+    vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) { ids.record(cb, cam.viewProj, more, false); });
+    const std::vector<uint64_t> twoPhase = ids.ids();
+    size_t differing = 0;
+    for (size_t p = 0; p < all.size(); ++p) differing += all[p] != twoPhase[p];
+    EXPECT_EQ(differing, 0u) << "two-phase culling removed visible clusters";
+    std::printf("two-phase frame %zu: early %u, late %u more; late culled by frustum %u, cone %u, occlusion %u\n", f,
+                early.counts.dispatch[0], late.counts.dispatch[0], late.counts.culled[0], late.counts.culled[1],
+                late.counts.culled[2]);
+    if (f == 0) EXPECT_EQ(early.counts.dispatch[0], 0u) << "no history before the first frame";
+    if (f == 1) EXPECT_EQ(late.counts.dispatch[0], 0u) << "the same view again: the early phase drew everything";
+    occluded += late.counts.culled[2];
+  }
+  EXPECT_GT(occluded, 0u) << "nothing occluded: the test proves nothing about occlusion";
 }
 
 }  // namespace
