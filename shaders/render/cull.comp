@@ -21,7 +21,8 @@ bool occluded(vec4 sphere) {
   const ProjectedBox b = projectBox(sphere, pc.viewProj, pc.width, pc.height);
   if (b.inFront == 0u) return false;
   const int level = pyramidLevel(b.pixels, int(pc.pyramidLevels));
-  const ivec4 t = b.pixels >> (level + 1);
+  // Level sizes as DepthPyramid makes them (Vulkan mip sizes of half the image).
+  const ivec4 t = pyramidTexels(b.pixels, level, max(ivec2(1), ivec2(int(pc.width), int(pc.height)) >> (level + 1)));
   float farthest = 0.0f;
   for (int y = t.y; y <= t.w; ++y)
     for (int x = t.x; x <= t.z; ++x) farthest = max(farthest, texelFetch(pyramid, ivec2(x, y), level).r);

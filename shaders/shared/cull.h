@@ -112,14 +112,23 @@ RTR_FN ProjectedBox projectBox(vec4 sphere, mat4 viewProj, uint width, uint heig
   return b;
 }
 
-// The pyramid level whose texels cover the box's pixels with at most 2 × 2 texels. Pyramid level L holds,
-// per texel t, the farthest depth of the pixels p with p >> (L + 1) == t (sizes halve rounding up, so
-// this holds at every level, odd sizes included); level 0 is already half the image.
+// The depth pyramid: level 0 is half the image and each level half the last, rounding down (Vulkan's mip
+// sizes); texel t of a level holds the farthest of the texels 2t and 2t + 1 below it and, for the last
+// texel of an odd-sized level below, 2t + 2 too. So texel min(p >> (L + 1), size_L - 1) of level L covers
+// pixel p, at every level and for any image size.
+
+// The pyramid level whose texels cover the box's pixels with at most 2 × 2 texels.
 RTR_FN int pyramidLevel(ivec4 px, int levels) {
   int shift = 1;
   while (shift < levels && (((px.z >> shift) - (px.x >> shift)) > 1 || ((px.w >> shift) - (px.y >> shift)) > 1))
     ++shift;
   return shift - 1;
+}
+
+// The texels (min x, min y, max x, max y) of level `level`, of size `levelSize`, that cover the pixels.
+RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {
+  const ivec4 t = px >> (level + 1);
+  return ivec4(min(t.x, levelSize.x - 1), min(t.y, levelSize.y - 1), min(t.z, levelSize.x - 1), min(t.w, levelSize.y - 1));
 }
 
 #ifdef __cplusplus

@@ -11,12 +11,6 @@ namespace {
 
 constexpr VkFormat kPyramidFormat = VK_FORMAT_R32_SFLOAT;
 
-uint32_t pow2AtLeast(uint32_t n) {
-  uint32_t p = 1;
-  while (p < n) p *= 2;
-  return p;
-}
-
 uint32_t levelCount(VkExtent2D e) {
   uint32_t n = 1;
   for (uint32_t m = std::max(e.width, e.height); m > 1; m /= 2) ++n;
@@ -26,7 +20,7 @@ uint32_t levelCount(VkExtent2D e) {
 }  // namespace
 
 VkExtent2D DepthPyramid::pyramidExtent(VkExtent2D depth) {
-  return {pow2AtLeast((depth.width + 1) / 2), pow2AtLeast((depth.height + 1) / 2)};
+  return {std::max(1u, depth.width / 2), std::max(1u, depth.height / 2)};
 }
 
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene) {
@@ -48,9 +42,6 @@ std::vector<shader::GpuCluster> gpuClusters(const Scene& scene) {
 
 DepthPyramid::DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent) : ctx_(ctx), depthExtent_(depthExtent) {
   vk::ImageDesc d;
-  // Texel t of level L must cover exactly the pixels p with p >> (L + 1) == t (cull.h): sizes that halve
-  // rounding up. Vulkan's mip sizes round down, so level 0 is a power of two (its texels past half the
-  // image are written, from clamped reads, and never read).
   d.extent = pyramidExtent(depthExtent);
   d.format = kPyramidFormat;
   d.mipLevels = levelCount(d.extent);

@@ -25,8 +25,8 @@ namespace rtr::render {
 // GpuDraws (the meshes that have triangles, in order).
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
 
-// The farthest depth per texel of a depth image, level by level: texel t of level L covers the pixels p
-// with p >> (L + 1) == t (level 0 is half the image, padded to powers of two).
+// The farthest depth per texel of a depth image, level by level (level 0 half the image; which pixels a
+// texel covers: shaders/shared/cull.h).
 class DepthPyramid {
  public:
   DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent);

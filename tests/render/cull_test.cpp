@@ -41,10 +41,12 @@ HostPyramid cpuPyramid(const std::vector<float>& depth, VkExtent2D e, const std:
     std::vector<float> out(size_t(d.width) * d.height);
     for (uint32_t y = 0; y < d.height; ++y)
       for (uint32_t x = 0; x < d.width; ++x) {
+        // Sources 2t and 2t + 1, and up to the source's edge for the last texel (cull.h).
+        const uint32_t x1 = x + 1 == d.width ? s.width - 1 : std::min(2 * x + 1, s.width - 1);
+        const uint32_t y1 = y + 1 == d.height ? s.height - 1 : std::min(2 * y + 1, s.height - 1);
         float m = 0.0f;
-        for (uint32_t j = 0; j < 2; ++j)
-          for (uint32_t i = 0; i < 2; ++i)
-            m = std::max(m, (*src)[size_t(std::min(2 * y + j, s.height - 1)) * s.width + std::min(2 * x + i, s.width - 1)]);
+        for (uint32_t j = 2 * y; j <= y1; ++j)
+          for (uint32_t i = 2 * x; i <= x1; ++i) m = std::max(m, (*src)[size_t(j) * s.width + i]);
         out[size_t(y) * d.width + x] = m;
       }
     p.sizes.push_back(d);
@@ -62,7 +64,7 @@ uint32_t cpuCull(const GpuCluster& c, const CullCamera& cam, const HostPyramid* 
   const shader::ProjectedBox b = shader::projectBox(c.sphere, cam.viewProj, e.width, e.height);
   if (b.inFront == 0u) return CULL_VISIBLE;
   const int level = shader::pyramidLevel(b.pixels, int(pyr->levels.size()));
-  const glm::ivec4 t = b.pixels >> (level + 1);
+  const glm::ivec4 t = shader::pyramidTexels(b.pixels, level, glm::ivec2(pyr->sizes[level].width, pyr->sizes[level].height));
   float farthest = 0.0f;
   for (int y = t.y; y <= t.w; ++y)
     for (int x = t.x; x <= t.z; ++x) farthest = std::max(farthest, pyr->levels[level][size_t(y) * pyr->sizes[level].width + x]);
