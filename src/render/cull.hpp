@@ -5,16 +5,16 @@
 // culled clusters are counted by reason. The tests themselves are shaders/shared/cull.h (shared with the
 // CPU reference of the tests).
 //
-// Use, per frame:  pyramid.build(cb, depthView, layout);  culler.record(cb, clusters, n, camera, &pyramid);
-// then vkCmdDispatchIndirect(cb, culler.counts(), 0) with a shader that reads culler.visible().
+// Use, per frame (two-phase, CullPhase below): culler.record(Early); dispatch indirect on counts() over
+// visible(); pyramid.build(depth of that); culler.record(Late, &pyramid); dispatch again. docs/culling.md.
 #include <vector>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "cull.h"
-#include "vk/pipeline.hpp"
 #include "scene/scene.hpp"
+#include "vk/pipeline.hpp"
 #include "vk/resources.hpp"
 
 namespace rtr::vk { class Context; }
