@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "scene/binio.hpp"
+#include "scene/clusters.hpp"
 #include "scene/course.hpp"
 #include "scene/rtrscene.hpp"
 
@@ -145,7 +146,15 @@ BakeReport bake(const BakeOptions& opt) {
   }
   rep.textureSeconds = since(t0);
 
-  // 3. Encode and write (a temporary of our own, then rename; without --force, link, so that an output
+  // 3. Clusters (.rtrscene stores them; the course format has no place for them, its loader builds them).
+  if (!course) {
+    t0 = Clock::now();
+    if (opt.progress) opt.progress("clustering", 0.0);
+    buildMissingClusters(plan.scene);
+    rep.clusterSeconds = since(t0);
+  }
+
+  // 4. Encode and write (a temporary of our own, then rename; without --force, link, so that an output
   // another run made meanwhile is kept).
   t0 = Clock::now();
   if (opt.progress) opt.progress("writing", 0.0);

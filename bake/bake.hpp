@@ -28,7 +28,7 @@ struct BakeReport {
   ObjStats obj;
   size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0;
   uint64_t outputBytes = 0;
-  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, writeSeconds = 0, totalSeconds = 0;
+  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, writeSeconds = 0, totalSeconds = 0;
 };
 
 // Throws rtr::Error naming the file and place; on failure nothing it created is left behind.

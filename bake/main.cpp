@@ -52,9 +52,9 @@ int main(int argc, char** argv) {
     std::printf("  faces %zu, triangles %zu, degenerate skipped %zu\n", o.faces, o.triangles, o.degenerateSkipped);
     std::printf("  vertices %zu before welding, %zu after\n", o.verticesBeforeWeld, o.verticesAfterWeld);
     std::printf("  warnings %zu, output %.2f MB\n", o.warnings, double(r.outputBytes) / 1e6);
-    std::printf("  time: parse %.3f s (%.0f MB/s of OBJ text), weld %.3f s, textures %.3f s, write %.3f s, total %.3f s\n",
+    std::printf("  time: parse %.3f s (%.0f MB/s of OBJ text), weld %.3f s, textures %.3f s, clusters %.3f s, write %.3f s, total %.3f s\n",
                 r.parseSeconds, r.parseSeconds > 0 ? mb / r.parseSeconds : 0.0, r.weldSeconds, r.textureSeconds,
-                r.writeSeconds, r.totalSeconds);
+                r.clusterSeconds, r.writeSeconds, r.totalSeconds);
     return 0;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");

@@ -1,13 +1,16 @@
 #include "scene/load.hpp"
 
 #include "core/error.hpp"
+#include "scene/clusters.hpp"
 #include "scene/course.hpp"
 #include "scene/obj.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
 
-Scene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
+namespace {
+
+Scene loadAny(const std::filesystem::path& file, const LoadOptions& options) {
   const std::string n = file.filename().string();
   auto ends = [&](std::string_view s) { return n.size() >= s.size() && n.compare(n.size() - s.size(), s.size(), s) == 0; };
   if (ends(".obj") || ends(".obj.zst") || ends(".obj-zstd")) {
@@ -20,6 +23,14 @@ Scene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
   if (ends(".comp5892mesh")) return loadCourseMesh(file);
   if (ends(".rtrscene")) return loadRtrScene(file);
   throw fileError(file.string(), "", "unknown scene format (expected .obj, .obj.zst, .obj-zstd, .comp5892mesh, .rtrscene)");
+}
+
+}  // namespace
+
+Scene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
+  Scene scene = loadAny(file, options);
+  buildMissingClusters(scene);  // every format but .rtrscene version 3 (rtr-bake builds them there)
+  return scene;
 }
 
 }  // namespace rtr

@@ -1,7 +1,11 @@
 #include "scene/rtrscene.hpp"
 
 #include <cmath>
+#include <vector>
 
+#include <glm/geometric.hpp>
+
+#include "cluster.h"
 #include "scene/binio.hpp"
 
 namespace rtr {
@@ -50,12 +54,67 @@ glm::vec3 readVec(ByteReader& r, const char* what) {
   return v;
 }
 
+// Clusters must tile the mesh's triangles in order, each within the GPU's limits, its sphere holding its
+// vertices: the culling pass and the compute rasteriser trust them.
+void readClusters(ByteReader& r, Mesh& m, const std::string& which) {
+  const size_t at = r.pos();
+  const uint32_t count = r.u32("a cluster count");
+  for (int k = 0; k < 3; ++k)
+    if (r.u32("a cluster count") != 0) r.failAt(at + 4, which + ": reserved cluster field is not 0");
+  const uint32_t triangles = m.triangleCount();
+  if (count > triangles || uint64_t(count) * 40 > r.remaining())
+    r.failAt(at, which + ": cluster count " + std::to_string(count) + " does not fit its " + std::to_string(triangles) +
+                     " triangles or the file");
+  m.clusters.resize(count);
+  uint32_t next = 0;
+  std::vector<uint32_t> seenIn(count ? m.positions.size() : 0, ~0u);  // per vertex: the last cluster that used it
+  for (uint32_t i = 0; i < count; ++i) {
+    Cluster& c = m.clusters[i];
+    const size_t cAt = r.pos();
+    const std::string cw = which + ": cluster " + std::to_string(i);
+    c.center = readVec(r, "a cluster's sphere");
+    c.radius = readFinite(r, "a cluster's sphere");
+    c.coneAxis = readVec(r, "a cluster's cone");
+    c.coneCutoff = readFinite(r, "a cluster's cone");
+    c.firstTriangle = r.u32("a cluster record");
+    c.triangleCount = r.u32("a cluster record");
+    if (!(c.radius >= 0.0f)) r.failAt(cAt + 12, cw + ": negative radius");
+    // A cone that culls (cutoff < 1) has a unit axis and a cutoff >= 0 (meshoptimizer's); others would cull
+    // clusters that face the eye.
+    if (c.coneCutoff < 1.0f && (c.coneCutoff < 0.0f || std::abs(glm::length(c.coneAxis) - 1.0f) > 1e-3f))
+      r.failAt(cAt + 16, cw + ": cone axis not a unit vector or cutoff below 0");
+    if (c.firstTriangle != next)
+      r.failAt(cAt + 32, cw + ": first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
+                             " (clusters tile the triangles in order)");
+    if (c.triangleCount < 1 || c.triangleCount > CLUSTER_MAX_TRIANGLES || c.triangleCount > triangles - next)
+      r.failAt(cAt + 36, cw + ": triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
+                             std::to_string(std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - next)));
+    next += c.triangleCount;
+    uint32_t distinct = 0;
+    const float slack = c.radius * 1e-4f + 1e-6f * (std::abs(c.center.x) + std::abs(c.center.y) + std::abs(c.center.z));
+    for (size_t k = size_t(c.firstTriangle) * 3; k < size_t(next) * 3; ++k) {
+      const uint32_t v = m.indices[k];
+      if (seenIn[v] == i) continue;  // each vertex checked once per cluster
+      seenIn[v] = i;
+      if (++distinct > CLUSTER_MAX_VERTICES)
+        r.failAt(cAt, cw + ": more than " + std::to_string(CLUSTER_MAX_VERTICES) + " vertices");
+      if (!(glm::length(m.positions[v] - c.center) <= c.radius + slack))
+        r.failAt(cAt, cw + ": vertex " + std::to_string(v) + " lies outside its bounding sphere");
+    }
+  }
+  if (count && next != triangles)
+    r.failAt(at, which + ": clusters cover " + std::to_string(next) + " of " + std::to_string(triangles) + " triangles");
+  r.align(kAlign, "clusters");
+}
+
 }  // namespace
 
-std::string encodeRtrScene(const Scene& scene) {
+std::string encodeRtrScene(const Scene& scene, uint32_t version) {
+  if (version < 1 || version > kRtrSceneVersion || (version < 2 && !scene.lights.empty()))
+    throw Error("cannot encode .rtrscene version " + std::to_string(version) + (scene.lights.empty() ? "" : " with lights"));
   ByteWriter w;
   w.bytes(kMagic, 8);
-  w.u32(kRtrSceneVersion);
+  w.u32(version);
   w.u32(scene.defaultView ? kHasView : 0);
   w.u32(uint32_t(scene.textures.size()));
   w.u32(uint32_t(scene.materials.size()));
@@ -123,6 +182,19 @@ std::string encodeRtrScene(const Scene& scene) {
     else
       w.array(m.indices);
     w.pad(kAlign);
+    // Version 3: the clusters (zero: none stored, built at load).
+    if (version < 3) continue;
+    w.u32(uint32_t(m.clusters.size()));
+    w.data().append(12, '\0');
+    for (const Cluster& c : m.clusters) {  // 40 bytes each
+      writeVec(w, c.center);
+      w.f32(c.radius);
+      writeVec(w, c.coneAxis);
+      w.f32(c.coneCutoff);
+      w.u32(c.firstTriangle);
+      w.u32(c.triangleCount);
+    }
+    w.pad(kAlign);
   }
   std::string& out = w.data();
   const uint64_t payload = out.size() - kHeaderSize;
@@ -138,7 +210,7 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file) {
   r.raw(magic, 8, "the header");
   if (std::memcmp(magic, kMagic, 8) != 0) r.failAt(0, "not an .rtrscene file (magic mismatch)");
   const uint32_t version = r.u32("the header");
-  if (version != 1 && version != kRtrSceneVersion)
+  if (version < 1 || version > kRtrSceneVersion)
     r.failAt(8, "unsupported version " + std::to_string(version) + " (this build reads " + std::to_string(kRtrSceneVersion) + ")");
   const uint32_t flags = r.u32("the header");
   if (flags & ~uint32_t(kHasView)) r.failAt(12, "unknown header flags");
@@ -275,6 +347,7 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file) {
       if (m.indices[k] >= v)
         r.failAt(idxAt + size_t(k) * (mf & kIndex16 ? 2 : 4),
                  which + ": index " + std::to_string(m.indices[k]) + " out of range (" + std::to_string(v) + " vertices)");
+    if (version >= 3) readClusters(r, m, which);
   }
   if (r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
   return scene;

@@ -9,9 +9,10 @@
 
 namespace rtr {
 
-constexpr uint32_t kRtrSceneVersion = 2;  // 2 added lights; version 1 files still load
+constexpr uint32_t kRtrSceneVersion = 3;  // 2 added lights, 3 clusters; versions 1 and 2 still load
 
-std::string encodeRtrScene(const Scene& scene);
+// `version` below the current one writes an older layout (lights need 2, clusters 3), for tests of the reader.
+std::string encodeRtrScene(const Scene& scene, uint32_t version = kRtrSceneVersion);
 // Validates everything (sizes, counts, strings, indices, texture ids, finite values, checksum).
 Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file);
 Scene loadRtrScene(const std::filesystem::path& file);

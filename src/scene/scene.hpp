@@ -53,6 +53,15 @@ struct Material {
   uint32_t texture(TextureSlot s) const { return textures[uint32_t(s)]; }
 };
 
+// A run of at most 124 triangles of one mesh (scene/clusters.hpp), with the bounds culling tests it by.
+struct Cluster {
+  uint32_t firstTriangle = 0, triangleCount = 0;  // triangles [first, first + count) of the mesh
+  glm::vec3 center{0.0f};                         // bounding sphere, scene space
+  float radius = 0.0f;
+  glm::vec3 coneAxis{0.0f};                       // normal cone (shaders/shared/cluster.h); cutoff >= 1: none
+  float coneCutoff = 1.0f;
+};
+
 struct Mesh {
   std::string name;  // OBJ object/group name
   uint32_t material = 0;
@@ -61,6 +70,7 @@ struct Mesh {
   std::vector<glm::vec2> texcoords;  // empty when the source has none
   std::vector<uint32_t> indices;     // triangle list, local to the mesh
   Bounds bounds;
+  std::vector<Cluster> clusters;     // tile the triangles in order; empty until built (scene/clusters.hpp)
 
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
 };

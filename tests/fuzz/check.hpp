@@ -1,6 +1,7 @@
 #pragma once
 // What every fuzz target checks besides "no crash, no sanitizer report": a loaded scene is safe to use,
 // and a refusal names the input (the project's rule for bad input).
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -8,6 +9,7 @@
 #include <unistd.h>
 
 #include "core/error.hpp"
+#include "cluster.h"
 #include "scene/scene.hpp"
 
 namespace rtr::fuzz {
@@ -40,6 +42,14 @@ inline void checkScene(const Scene& s) {
     require(m.texcoords.empty() || m.texcoords.size() == m.positions.size(), "texcoord count differs");
     require(m.indices.size() % 3 == 0, "index count not a multiple of 3");
     for (uint32_t i : m.indices) require(i < m.positions.size(), "vertex index out of range");
+    uint32_t next = 0;  // clusters tile the triangles in order, within the GPU's limits
+    for (const Cluster& c : m.clusters) {
+      require(c.firstTriangle == next && c.triangleCount >= 1 && c.triangleCount <= CLUSTER_MAX_TRIANGLES, "cluster range");
+      require(std::isfinite(c.center.x + c.center.y + c.center.z + c.radius + c.coneCutoff) && c.radius >= 0.0f,
+              "cluster bounds");
+      next += c.triangleCount;
+    }
+    require(m.clusters.empty() || next == m.triangleCount(), "clusters do not cover the triangles");
   }
 }
 

@@ -92,7 +92,8 @@ TEST(CourseBytes, TempleBakeFollowsTheTable) {
     }
   EXPECT_EQ(nextNew, T);
 
-  const rtr::Scene src = rtr::loadScene(o.input);
+  // The course format stores no clusters, so the baker leaves the indices in the order the OBJ gave them.
+  const rtr::Scene src = rtr::loadObj(o.input);
   const uint32_t meshes = c.u32();
   ASSERT_EQ(meshes, src.meshes.size());
   for (uint32_t i = 0; i < meshes; ++i) {

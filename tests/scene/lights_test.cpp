@@ -126,9 +126,8 @@ TEST(Lights, RtrSceneStoresLightsAndStillReadsVersion1) {
 
   // A version-1 file: no lights, the light count field reserved (0). The header is outside the checksum.
   s.lights.clear();
-  std::string v1 = encodeRtrScene(s);
+  std::string v1 = encodeRtrScene(s, 1);
   const uint32_t one = 1;
-  std::memcpy(v1.data() + 8, &one, 4);
   const auto view = [](const std::string& b) { return std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(b.data()), b.size()); };
   EXPECT_TRUE(decodeRtrScene(view(v1), "v1.rtrscene").lights.empty());
   std::memcpy(v1.data() + 28, &one, 4);

@@ -119,9 +119,10 @@ TEST(RtrSceneLoader, ChecksumSizeAndStructure) {
   put32(b, 24, 0x40000000);
   reseal(b);
   EXPECT_THAT(rtrError(b), HasSubstr("at byte 24: mesh count 1073741824 cannot fit"));
-  // The last mesh's 16-bit indices sit at the end (padded to 16): the third index is at size-16+4.
+  // The last mesh's 16-bit indices (padded to 16) sit before its 16-byte cluster header (no clusters):
+  // the third index is at size-32+4.
   b = good;
-  b[good.size() - 12] = 9;
+  b[good.size() - 28] = 9;
   reseal(b);
   EXPECT_THAT(rtrError(b), HasSubstr("mesh 0: index 9 out of range"));
   // Texture table at 80 (4 + 4 + 11 bytes, padded to 112); the material at 112: flags, name (4 + 8),

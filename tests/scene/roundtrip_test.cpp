@@ -32,6 +32,13 @@ void expectSameMeshes(const Scene& a, const Scene& b) {
     EXPECT_EQ(x.indices, y.indices);
     EXPECT_EQ(x.bounds.min, y.bounds.min);
     EXPECT_EQ(x.bounds.max, y.bounds.max);
+    ASSERT_EQ(x.clusters.size(), y.clusters.size());  // stored by the baker or built at load: the same
+    for (size_t c = 0; c < x.clusters.size(); ++c) {
+      EXPECT_EQ(x.clusters[c].firstTriangle, y.clusters[c].firstTriangle);
+      EXPECT_EQ(x.clusters[c].triangleCount, y.clusters[c].triangleCount);
+      EXPECT_EQ(x.clusters[c].center, y.clusters[c].center);
+      EXPECT_EQ(x.clusters[c].coneCutoff, y.clusters[c].coneCutoff);
+    }
   }
 }
 

@@ -1,0 +1,45 @@
+#version 460
+// Cluster culling: one thread per cluster; frustum, back-face cone, then occlusion against the depth
+// pyramid (shaders/shared/cull.h has the tests and the phases). Visible clusters are appended to a compact list whose
+// length is the x of an indirect dispatch (one workgroup per visible cluster); culled ones are counted by
+// reason. The caller zeroes the counts (x = 0, y = z = 1) before the pass.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
+#include "cull.h"
+
+layout(local_size_x = CULL_GROUP_SIZE) in;
+
+layout(set = 0, binding = 0, std430) readonly buffer Clusters { GpuCluster clusters[]; };
+layout(set = 0, binding = 1, std430) buffer Counts { CullCounts counts; };
+layout(set = 0, binding = 2, std430) writeonly buffer Visible { uint visible[]; };
+layout(set = 0, binding = 3) uniform texture2D pyramid;  // R32F, farthest depth per texel (hiz.comp)
+layout(set = 0, binding = 4, std430) buffer History { uint history[]; };  // 1: visible in the last LATE pass
+
+layout(push_constant) uniform Push { CullPush pc; };
+
+bool occluded(vec4 sphere) {
+  const ProjectedBox b = projectBox(sphere, pc.viewProj, pc.width, pc.height);
+  if (b.inFront == 0u) return false;
+  const int level = pyramidLevel(b.pixels, int(pc.pyramidLevels));
+  // Level sizes as DepthPyramid makes them (Vulkan mip sizes of half the image).
+  const ivec4 t = pyramidTexels(b.pixels, level, max(ivec2(1), ivec2(int(pc.width), int(pc.height)) >> (level + 1)));
+  float farthest = 0.0f;
+  for (int y = t.y; y <= t.w; ++y)
+    for (int x = t.x; x <= t.z; ++x) farthest = max(farthest, texelFetch(pyramid, ivec2(x, y), level).r);
+  return b.nearestDepth > farthest;
+}
+
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.count) return;
+  const bool wasVisible = pc.phase != CULL_SINGLE && history[i] != 0u;
+  if (pc.phase == CULL_EARLY && !wasVisible) return;
+  const GpuCluster c = clusters[i];
+  uint reason = CULL_VISIBLE;
+  if ((pc.flags & CULL_FRUSTUM) != 0u && frustumCulls(c.sphere, pc.viewProj)) reason = CULL_BY_FRUSTUM;
+  else if ((pc.flags & CULL_CONE) != 0u && coneCulls(c.sphere, c.cone, pc.eye.xyz)) reason = CULL_BY_CONE;
+  else if ((pc.flags & CULL_OCCLUSION) != 0u && pc.phase != CULL_EARLY && occluded(c.sphere)) reason = CULL_BY_OCCLUSION;
+  if (pc.phase == CULL_LATE) history[i] = reason == CULL_VISIBLE ? 1u : 0u;
+  if (reason != CULL_VISIBLE) atomicAdd(counts.culled[reason - 1u], 1u);
+  else if (!(pc.phase == CULL_LATE && wasVisible)) visible[atomicAdd(counts.dispatch[0], 1u)] = i;
+}

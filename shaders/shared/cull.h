@@ -1,0 +1,138 @@
+// Cluster culling: the tests the compute pass (shaders/render/cull.comp) applies to each GpuCluster, in
+// the subset of GLSL that C++ with glm also compiles, so the CPU reference runs the very same formulas.
+// Keep to the common subset (shaders/shared/brdf.h says which). Depth is Vulkan's [0, 1], near 0 (projectionMatrix in src/core/camera.hpp), compared LESS.
+#ifndef RTR_SHADERS_SHARED_CULL_H
+#define RTR_SHADERS_SHARED_CULL_H
+
+#include "cluster.h"
+#include "shared.h"
+
+#ifdef __cplusplus
+namespace rtr::shader {
+#endif
+
+#define CULL_GROUP_SIZE 64
+#define HIZ_GROUP_SIZE 8
+
+// CullPush::flags: which tests run.
+#define CULL_FRUSTUM 1u
+#define CULL_CONE 2u       // perspective cameras only: the test assumes rays from the eye
+#define CULL_OCCLUSION 4u  // against the depth pyramid bound to the pass
+
+// CullPush::phase. Two-phase occlusion culling (docs/culling.md): EARLY passes the clusters visible last
+// frame (per the history buffer) through frustum and cone only; once they are drawn and the pyramid built
+// from that depth, LATE tests every cluster against it, lists the visible ones not drawn early, and
+// rewrites the history. SINGLE tests every cluster once and leaves the history alone.
+#define CULL_SINGLE 0u
+#define CULL_EARLY 1u
+#define CULL_LATE 2u
+
+// Why a cluster was culled: the index of its counter after the indirect dispatch arguments.
+#define CULL_VISIBLE 0u
+#define CULL_BY_FRUSTUM 1u
+#define CULL_BY_CONE 2u
+#define CULL_BY_OCCLUSION 3u
+
+// The counts buffer: VkDispatchIndirectCommand {visible clusters, 1, 1}, then the culled counts by reason.
+struct CullCounts {
+  uint dispatch[3];
+  uint culled[3];  // frustum, cone (back-facing), occlusion
+  uint pad[2];
+};
+
+struct CullPush {  // 112 bytes
+  mat4 viewProj;
+  vec4 eye;          // xyz
+  uint count;        // clusters in the input buffer
+  uint flags;        // CULL_*
+  uint width;        // the depth source's size in pixels (the pyramid's level 0 is half of it, rounded up)
+  uint height;
+  uint pyramidLevels;
+  uint phase;        // CULL_SINGLE, CULL_EARLY or CULL_LATE
+  uint pad0, pad1;
+};
+
+RTR_FN vec4 matrixRow(mat4 m, int i) { return vec4(m[0][i], m[1][i], m[2][i], m[3][i]); }
+
+// The sphere lies wholly outside one of the six clip planes (left, right, bottom, top, near, far).
+RTR_FN bool frustumCulls(vec4 sphere, mat4 viewProj) {
+  const vec4 r0 = matrixRow(viewProj, 0), r1 = matrixRow(viewProj, 1), r2 = matrixRow(viewProj, 2),
+             r3 = matrixRow(viewProj, 3);
+  vec4 planes[6];
+  planes[0] = r3 + r0;
+  planes[1] = r3 - r0;
+  planes[2] = r3 + r1;
+  planes[3] = r3 - r1;
+  planes[4] = r2;
+  planes[5] = r3 - r2;
+  for (int i = 0; i < 6; ++i) {
+    const vec3 n = vec3(planes[i].x, planes[i].y, planes[i].z);
+    if (dot(n, vec3(sphere.x, sphere.y, sphere.z)) + planes[i].w < -sphere.w * length(n)) return true;
+  }
+  return false;
+}
+
+// Every triangle of the cluster faces away from the eye (meshoptimizer's sphere-based cone test).
+RTR_FN bool coneCulls(vec4 sphere, vec4 cone, vec3 eye) {
+  const vec3 d = vec3(sphere.x, sphere.y, sphere.z) - eye;
+  return cone.w < 1.0f && dot(d, vec3(cone.x, cone.y, cone.z)) >= cone.w * length(d) + sphere.w;
+}
+
+// The sphere's scene-space bounding cube projected: the pixels it may cover (min x, min y, max x, max y,
+// clamped to the image) and the nearest depth of any of its points. inFront 0: a corner lies behind the
+// eye, so the box has no projection (never occlusion-culled).
+struct ProjectedBox {
+  ivec4 pixels;
+  float nearestDepth;
+  uint inFront;
+};
+
+RTR_FN ProjectedBox projectBox(vec4 sphere, mat4 viewProj, uint width, uint height) {
+  ProjectedBox b;
+  b.inFront = 1u;
+  b.nearestDepth = 1.0f;
+  vec2 lo = vec2(1e30f, 1e30f), hi = vec2(-1e30f, -1e30f);
+  for (int i = 0; i < 8; ++i) {
+    const vec3 corner = vec3(sphere.x + ((i & 1) != 0 ? sphere.w : -sphere.w),
+                             sphere.y + ((i & 2) != 0 ? sphere.w : -sphere.w),
+                             sphere.z + ((i & 4) != 0 ? sphere.w : -sphere.w));
+    const vec4 clip = viewProj * vec4(corner, 1.0f);
+    if (clip.w <= 1e-6f) b.inFront = 0u;
+    const vec3 ndc = vec3(clip.x, clip.y, clip.z) / max(clip.w, 1e-6f);
+    b.nearestDepth = min(b.nearestDepth, max(ndc.z, 0.0f));
+    lo = min(lo, vec2(ndc.x, ndc.y));
+    hi = max(hi, vec2(ndc.x, ndc.y));
+  }
+  // Pixel p covers [p, p + 1): a sample at any pixel centre inside [lo, hi] lies in the pixels
+  // floor(lo) .. floor(hi).
+  const vec2 size = vec2(float(width), float(height));
+  const vec2 pLo = clamp((lo * 0.5f + 0.5f) * size, vec2(0.0f, 0.0f), size - 1.0f);
+  const vec2 pHi = clamp((hi * 0.5f + 0.5f) * size, vec2(0.0f, 0.0f), size - 1.0f);
+  b.pixels = ivec4(int(floor(pLo.x)), int(floor(pLo.y)), int(floor(pHi.x)), int(floor(pHi.y)));
+  return b;
+}
+
+// The depth pyramid: level 0 is half the image and each level half the last, rounding down (Vulkan's mip
+// sizes); texel t of a level holds the farthest of the texels 2t and 2t + 1 below it and, for the last
+// texel of an odd-sized level below, 2t + 2 too. So texel min(p >> (L + 1), size_L - 1) of level L covers
+// pixel p, at every level and for any image size.
+
+// The pyramid level whose texels cover the box's pixels with at most 2 × 2 texels.
+RTR_FN int pyramidLevel(ivec4 px, int levels) {
+  int shift = 1;
+  while (shift < levels && (((px.z >> shift) - (px.x >> shift)) > 1 || ((px.w >> shift) - (px.y >> shift)) > 1))
+    ++shift;
+  return shift - 1;
+}
+
+// The texels (min x, min y, max x, max y) of level `level`, of size `levelSize`, that cover the pixels.
+RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {
+  const ivec4 t = px >> (level + 1);
+  return ivec4(min(t.x, levelSize.x - 1), min(t.y, levelSize.y - 1), min(t.z, levelSize.x - 1), min(t.w, levelSize.y - 1));
+}
+
+#ifdef __cplusplus
+static_assert(sizeof(CullPush) == 112 && sizeof(CullCounts) == 32);
+}  // namespace rtr::shader
+#endif
+#endif

@@ -1,0 +1,146 @@
+#include "render/cull.hpp"
+
+#include <algorithm>
+
+#include "core/error.hpp"
+#include "vk/commands.hpp"
+#include "vk/context.hpp"
+
+namespace rtr::render {
+namespace {
+
+constexpr VkFormat kPyramidFormat = VK_FORMAT_R32_SFLOAT;
+
+uint32_t levelCount(VkExtent2D e) {
+  uint32_t n = 1;
+  for (uint32_t m = std::max(e.width, e.height); m > 1; m /= 2) ++n;
+  return n;
+}
+
+}  // namespace
+
+VkExtent2D DepthPyramid::pyramidExtent(VkExtent2D depth) {
+  return {std::max(1u, depth.width / 2), std::max(1u, depth.height / 2)};
+}
+
+std::vector<shader::GpuCluster> gpuClusters(const Scene& scene) {
+  std::vector<shader::GpuCluster> out;
+  uint32_t draw = 0;
+  for (const Mesh& m : scene.meshes) {
+    if (m.indices.empty()) continue;
+    if (m.clusters.empty()) throw Error("mesh '" + m.name + "' has no clusters (scene/clusters.hpp builds them)");
+    const uint32_t mf = scene.materials.at(m.material).flags;
+    const uint32_t flags = (mf & kMaterialAlphaMasked ? CLUSTER_ALPHA_MASKED : 0u) |
+                           (mf & kMaterialDoubleSided ? CLUSTER_DOUBLE_SIDED : 0u);
+    for (const Cluster& c : m.clusters)
+      out.push_back({glm::vec4(c.center, c.radius), glm::vec4(c.coneAxis, c.coneCutoff), draw, c.firstTriangle,
+                     c.triangleCount, flags});
+    ++draw;
+  }
+  return out;
+}
+
+DepthPyramid::DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent) : ctx_(ctx), depthExtent_(depthExtent) {
+  vk::ImageDesc d;
+  d.extent = pyramidExtent(depthExtent);
+  d.format = kPyramidFormat;
+  d.mipLevels = levelCount(d.extent);
+  d.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+  d.name = "depth pyramid";
+  image_ = vk::Image(ctx, d);
+  for (uint32_t l = 0; l < d.mipLevels; ++l)
+    levelViews_.push_back(image_.createView(kPyramidFormat, l, 1, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT));
+  pipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("hiz.comp"), {.pushDescriptorSets = {0}});
+}
+
+void DepthPyramid::build(VkCommandBuffer cb, VkImageView depth, VkImageLayout depthLayout) {
+  constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  constexpr auto kReadWrite = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT;
+  if (!initialised_) {
+    vk::barrier(cb, {{image_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
+                      kCompute, VK_ACCESS_2_NONE, kReadWrite}});
+    initialised_ = true;
+  } else {  // the last frame's culling read it
+    vk::memoryBarrier(cb, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
+                      kCompute, kReadWrite);
+  }
+  pipeline_.bind(cb);
+  for (uint32_t l = 0; l < levelViews_.size(); ++l) {
+    const VkExtent2D e{std::max(1u, image_.extent().width >> l), std::max(1u, image_.extent().height >> l)};
+    vk::DescriptorWriter w(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE);
+    if (l == 0) w.image(0, depth, depthLayout);
+    else w.image(0, levelViews_[l - 1], VK_IMAGE_LAYOUT_GENERAL);
+    w.image(1, levelViews_[l], VK_IMAGE_LAYOUT_GENERAL);
+    w.push(cb, pipeline_);
+    vkCmdDispatch(cb, (e.width + HIZ_GROUP_SIZE - 1) / HIZ_GROUP_SIZE, (e.height + HIZ_GROUP_SIZE - 1) / HIZ_GROUP_SIZE, 1);
+    // Each level is the next one's source; the last is the culling pass's (and a read-back's) input.
+    vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_WRITE_BIT, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT,
+                      VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+  }
+}
+
+ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx_(ctx), maxClusters_(maxClusters) {
+  visible_ = vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Device,
+                        "visible clusters");
+  counts_ = vk::Buffer(ctx, sizeof(shader::CullCounts),
+                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                           VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                       vk::MemoryUse::Device, "cull counts");
+  history_ = vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device,
+                        "cluster history");
+  vk::ImageDesc d;
+  d.format = kPyramidFormat;
+  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
+  d.name = "no depth pyramid";
+  noPyramid_ = vk::Image(ctx, d);
+  vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+    vkCmdFillBuffer(cb, history_.handle(), 0, VK_WHOLE_SIZE, 0);  // no cluster was visible before
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    vk::barrier(cb, {{noPyramid_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
+                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_READ_BIT}});
+  });
+  pipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("cull.comp"), {.pushDescriptorSets = {0}});
+}
+
+void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
+                           const DepthPyramid* pyramid, CullTests tests, CullPhase phase) {
+  if (count > maxClusters_) throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
+  constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  constexpr auto kConsumers = kCompute | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
+  constexpr auto kConsumerReads = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT;
+  // The last frame's consumers are done with both buffers before they are reset and rewritten.
+  vk::memoryBarrier(cb, kConsumers, kConsumerReads, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0}, {0, 0}};  // the indirect dispatch's y and z are 1
+  vkCmdUpdateBuffer(cb, counts_.handle(), 0, sizeof(zero), &zero);
+  vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, kCompute,
+                    VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+
+  shader::CullPush push{};
+  push.viewProj = camera.viewProj;
+  push.eye = glm::vec4(camera.eye, 1.0f);
+  push.count = count;
+  push.flags = (tests.frustum ? CULL_FRUSTUM : 0u) | (tests.cone && !camera.orthographic ? CULL_CONE : 0u) |
+               (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u);
+  push.phase = uint32_t(phase);
+  if (pyramid) {
+    push.width = pyramid->depthExtent().width;
+    push.height = pyramid->depthExtent().height;
+    push.pyramidLevels = pyramid->levels();
+  }
+  pipeline_.bind(cb);
+  vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
+      .buffer(0, clusters)
+      .buffer(1, counts_.handle())
+      .buffer(2, visible_.handle())
+      .image(3, pyramid ? pyramid->view() : noPyramid_.view(), VK_IMAGE_LAYOUT_GENERAL)
+      .buffer(4, history_.handle())
+      .push(cb, pipeline_);
+  pipeline_.push(cb, push);
+  vkCmdDispatch(cb, (count + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE, 1, 1);
+  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_WRITE_BIT, kConsumers, kConsumerReads | VK_ACCESS_2_SHADER_WRITE_BIT);
+}
+
+}  // namespace rtr::render

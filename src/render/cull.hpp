@@ -1,0 +1,89 @@
+#pragma once
+// GPU-driven cluster culling (docs/culling.md). A compute pass tests every GpuCluster (cluster.h) against
+// the frustum, its back-face cone and a hierarchical depth pyramid, and writes the indices of the visible
+// ones compacted into one buffer plus an indirect dispatch argument of one workgroup per visible cluster;
+// culled clusters are counted by reason. The tests themselves are shaders/shared/cull.h (shared with the
+// CPU reference of the tests).
+//
+// Use, per frame (two-phase, CullPhase below): culler.record(Early); dispatch indirect on counts() over
+// visible(); pyramid.build(depth of that); culler.record(Late, &pyramid); dispatch again. docs/culling.md.
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "cull.h"
+#include "scene/scene.hpp"
+#include "vk/pipeline.hpp"
+#include "vk/resources.hpp"
+
+namespace rtr::vk { class Context; }
+
+namespace rtr::render {
+
+// The GpuCluster records of a scene whose meshes have clusters, numbered by draw as GpuScene numbers its
+// GpuDraws (the meshes that have triangles, in order).
+std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
+
+// The farthest depth per texel of a depth image, level by level (level 0 half the image; which pixels a
+// texel covers: shaders/shared/cull.h).
+class DepthPyramid {
+ public:
+  DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent);
+  // Records the build from `depth` (a sampled view whose .r is depth: a D32 depth-aspect view or an R32F
+  // image, in `depthLayout`, written before this by the compute or fragment stage with the barrier the
+  // writer owes). Leaves the pyramid readable by compute shaders.
+  void build(VkCommandBuffer cb, VkImageView depth, VkImageLayout depthLayout);
+  VkImageView view() const { return image_.view(); }  // all levels, R32F, layout GENERAL
+  VkExtent2D depthExtent() const { return depthExtent_; }
+  uint32_t levels() const { return image_.mipLevels(); }
+  const vk::Image& image() const { return image_; }
+  static VkExtent2D pyramidExtent(VkExtent2D depth);  // level 0's
+
+ private:
+  const vk::Context& ctx_;
+  VkExtent2D depthExtent_;
+  vk::Image image_;
+  std::vector<vk::ImageView> levelViews_;  // per level: storage (write) and sampled (read by the next level)
+  vk::Pipeline pipeline_;
+  bool initialised_ = false;
+};
+
+struct CullCamera {
+  glm::mat4 viewProj{1.0f};  // projectionMatrix * viewMatrix (src/core/camera.hpp)
+  glm::vec3 eye{0.0f};
+  bool orthographic = false;  // no cone test (it assumes rays from the eye)
+};
+
+struct CullTests {
+  bool frustum = true, cone = true, occlusion = true;  // occlusion only when a pyramid is given
+};
+
+// Single: every cluster tested once (occlusion conservative only for the view the pyramid was built from).
+// Early + Late: two-phase occlusion, conservative for any camera motion; per frame: record(Early), draw
+// visible(), build the pyramid from that depth, record(Late) with it, draw visible() (the clusters Early
+// did not list). The culler keeps the per-cluster history between frames (all "not visible" at first).
+enum class CullPhase : uint32_t { Single = CULL_SINGLE, Early = CULL_EARLY, Late = CULL_LATE };
+
+class ClusterCuller {
+ public:
+  ClusterCuller(const vk::Context& ctx, uint32_t maxClusters);
+  // Records the pass over `count` GpuClusters in `clusters` (a storage buffer; the same clusters every
+  // frame for Early/Late). With a pyramid (not used by Early), clusters hidden behind its depths are culled
+  // too: a cluster whose every point lies behind that depth image there cannot be seen above it. Ends with
+  // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
+  void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
+              const DepthPyramid* pyramid, CullTests tests = {}, CullPhase phase = CullPhase::Single);
+  VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
+  VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
+  uint32_t maxClusters() const { return maxClusters_; }
+
+ private:
+  const vk::Context& ctx_;
+  uint32_t maxClusters_;
+  vk::Buffer visible_, counts_, history_;
+  vk::Image noPyramid_;  // 1×1 stand-in so the pass always has a valid binding
+  vk::Pipeline pipeline_;
+};
+
+}  // namespace rtr::render

@@ -1,0 +1,21 @@
+#pragma once
+// Clusters (meshlets) of a mesh: the unit of GPU-driven culling and of the compute rasteriser
+// (shaders/shared/cluster.h has the GPU record and the culling rules). Built with meshoptimizer at bake
+// time or at load; building reorders the mesh's index buffer so that each cluster's triangles are
+// contiguous, which keeps a triangle's primitive id equal to firstTriangle + its index in the cluster.
+#include "scene/scene.hpp"
+
+namespace rtr {
+
+// Splits `mesh` into clusters of at most 64 vertices and 124 triangles, replacing mesh.clusters and
+// reordering mesh.indices cluster by cluster (every triangle kept, winding unchanged). `backfaceCone`
+// false (alpha-masked or double-sided materials) stores a cone that never culls (cutoff 1).
+void buildClusters(Mesh& mesh, bool backfaceCone);
+
+// Whether a mesh of this material may be back-face culled by its clusters' cones.
+bool conesCull(const Material& material);
+
+// Builds the clusters of every mesh that has triangles and none; returns how many meshes it built.
+size_t buildMissingClusters(Scene& scene);
+
+}  // namespace rtr
