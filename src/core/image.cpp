@@ -3,10 +3,11 @@
 #include <csetjmp>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
-#include <iterator>
 
 #include <jpeglib.h>
+#include <png.h>
 
 #include "core/error.hpp"
 
@@ -61,17 +62,121 @@ bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData
   return true;
 }
 
+// PNG through libpng: stb_image 2.27 reads past the end of a zlib stream as zero bits, so a 50-byte PNG
+// (found by fuzzing) decodes "forever", growing its buffer to 1.7 GB. libpng stops at the end of the data.
+// The transforms give what stb gave: palette and tRNS expanded, 1/2/4-bit grey scaled, 16 bits truncated
+// to 8, gamma ignored; the channel count is then converted by stb's rules (convertChannels).
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+constexpr uint32_t kMaxPngSide = 512;  // as stb.cpp: huge images only slow the fuzzers down
+#else
+constexpr uint32_t kMaxPngSide = 32768;
+#endif
+
+struct PngReader {
+  const std::vector<unsigned char>& bytes;
+  size_t at = 0;
+  std::string error;
+};
+
+// stb's luma (stbi__compute_y) and channel conversion, so PNG texels stay what they were under stb.
+uint8_t luma(uint8_t r, uint8_t g, uint8_t b) { return uint8_t((r * 77 + g * 150 + 29 * b) >> 8); }
+
+void convertChannels(const std::vector<uint8_t>& in, uint32_t n, TexelData& out) {
+  const uint32_t m = out.channels;
+  for (size_t i = 0, p = size_t(out.width) * out.height; i < p; ++i) {
+    const uint8_t* s = &in[i * n];
+    uint8_t* d = &out.texels[i * m];
+    const bool grey = n <= 2;
+    const uint8_t y = grey ? s[0] : luma(s[0], s[1], s[2]);
+    const uint8_t a = n == 2 ? s[1] : n == 4 ? s[3] : 255;
+    if (m <= 2) {
+      d[0] = y;
+    } else {
+      for (int c = 0; c < 3; ++c) d[c] = grey ? s[0] : s[c];
+    }
+    if (m == 2) d[1] = a;
+    if (m == 4) d[3] = a;
+  }
+}
+
+bool decodePng(const std::vector<unsigned char>& bytes, int channels, TexelData& out, std::string& error) {
+  PngReader reader{bytes};
+  png_structp png = png_create_read_struct(
+      PNG_LIBPNG_VER_STRING, &reader,
+      [](png_structp p, png_const_charp msg) {
+        static_cast<PngReader*>(png_get_error_ptr(p))->error = msg;
+        png_longjmp(p, 1);
+      },
+      [](png_structp, png_const_charp) {});  // warnings (recoverable damage) stay quiet
+  if (!png) return error = "out of memory", false;
+  png_infop info = png_create_info_struct(png);
+  std::vector<uint8_t> decoded;  // declared before setjmp: nothing with a destructor is made after it
+  std::vector<png_bytep> rows;
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    error = reader.error.empty() ? "not a valid PNG" : reader.error;
+    return false;
+  }
+  if (!info) png_error(png, "out of memory");
+  png_set_read_fn(png, &reader, [](png_structp p, png_bytep data, size_t size) {
+    PngReader& r = *static_cast<PngReader*>(png_get_io_ptr(p));
+    if (size > r.bytes.size() - r.at) png_error(p, "the file ends inside the image data");
+    std::memcpy(data, r.bytes.data() + r.at, size);
+    r.at += size;
+  });
+  png_set_user_limits(png, kMaxPngSide, kMaxPngSide);
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+  // Mutated files almost never carry valid checksums: let the fuzzers past them to the decoder.
+  png_set_crc_action(png, PNG_CRC_QUIET_USE, PNG_CRC_QUIET_USE);
+  png_set_option(png, PNG_IGNORE_ADLER32, PNG_OPTION_ON);
+#endif
+  png_read_info(png, info);
+  png_set_palette_to_rgb(png);
+  png_set_expand_gray_1_2_4_to_8(png);
+  if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+  png_set_strip_16(png);
+  const int passes = png_set_interlace_handling(png);
+  (void)passes;
+  png_read_update_info(png, info);
+  const uint32_t w = png_get_image_width(png, info), h = png_get_image_height(png, info);
+  const uint32_t n = png_get_channels(png, info);
+  if (n < 1 || n > 4 || png_get_rowbytes(png, info) != size_t(w) * n) png_error(png, "unsupported PNG layout");
+  out = {w, h, uint32_t(channels), {}};
+  std::vector<uint8_t>& target = n == uint32_t(channels) ? out.texels : decoded;  // converted after, if need be
+  target.resize(size_t(w) * h * n);
+  rows.resize(h);
+  for (uint32_t y = 0; y < h; ++y) rows[y] = target.data() + size_t(y) * w * n;
+  png_read_image(png, rows.data());
+  png_read_end(png, nullptr);
+  png_destroy_read_struct(&png, &info, nullptr);
+  if (n != uint32_t(channels)) {
+    out.texels.resize(size_t(w) * h * channels);
+    convertChannels(decoded, n, out);
+  }
+  return true;
+}
+
 }  // namespace
 
 TexelData loadImage(const std::filesystem::path& file, int channels) {
-  std::ifstream in(file, std::ios::binary);
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
   if (!in) throw fileError(file.string(), "", "cannot open image");
-  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw fileError(file.string(), "", "read error");
+  // One read of the whole file (an istreambuf_iterator copy took as long as decoding a large PNG).
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw fileError(file.string(), "", "cannot tell the file's size");
+  std::vector<unsigned char> bytes(static_cast<size_t>(size));
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) throw fileError(file.string(), "", "read error");
   if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8) {  // a JPEG start-of-image marker
     TexelData out;
     std::string error;
     if (!decodeJpeg(bytes, channels, out, error)) throw fileError(file.string(), "", "cannot decode JPEG: " + error);
+    return out;
+  }
+  if (bytes.size() >= 8 && png_sig_cmp(bytes.data(), 0, 8) == 0) {
+    TexelData out;
+    std::string error;
+    if (!decodePng(bytes, channels, out, error)) throw fileError(file.string(), "", "cannot decode PNG: " + error);
     return out;
   }
   int w = 0, h = 0, n = 0;

@@ -7,7 +7,9 @@
 #define STBI_MAX_DIMENSIONS 512
 #endif
 // JPEG is libjpeg-turbo's (core/image.cpp): stb 2.27's Huffman table builder writes out of bounds.
+// PNG is libpng's: stb 2.27 checks no CRC or zlib checksum, so damaged files decoded into wrong texels.
 #define STBI_NO_JPEG
+#define STBI_NO_PNG
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG

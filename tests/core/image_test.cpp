@@ -90,6 +90,47 @@ TEST_F(ImageWrite, FormatFollowsTheExtension) {
 
 // JPEG decodes through libjpeg-turbo: a smooth image comes back close (lossy) in every channel count the
 // texture slots ask for, alpha opaque; truncated or broken files are errors naming the file, never a crash.
+// A PNG asked for fewer or more channels: grey is stb's integer luma, alpha kept or opaque, as the
+// textures always had (the renderers' roughness and mask textures are read as one channel).
+TEST_F(ImageWrite, PngConvertsChannelsAsBefore) {
+  const ImageRGBA8 img = noise(37, 11);
+  saveImage(dir / "c.png", img);
+  for (int channels : {1, 2, 3}) {
+    const TexelData t = loadImage(dir / "c.png", channels);
+    ASSERT_EQ(t.texels.size(), size_t(37 * 11 * channels));
+    for (size_t i = 0; i < size_t(37 * 11); ++i) {
+      const uint8_t* s = &img.pixels[i * 4];
+      const uint8_t* d = &t.texels[i * channels];
+      if (channels == 3) {
+        ASSERT_TRUE(d[0] == s[0] && d[1] == s[1] && d[2] == s[2]) << "pixel " << i;
+      } else {
+        ASSERT_EQ(d[0], (s[0] * 77 + s[1] * 150 + s[2] * 29) >> 8) << "pixel " << i;
+        if (channels == 2) {
+          ASSERT_EQ(d[1], s[3]) << "pixel " << i;
+        }
+      }
+    }
+  }
+}
+
+// One bit flipped inside the compressed image data: stb_image 2.27 checks neither the chunk's CRC nor
+// zlib's checksum and decoded such a file into wrong texels without a word; now it is refused by name.
+TEST_F(ImageWrite, DamagedPngIsRefusedNotDecodedWrong) {
+  saveImage(dir / "ok.png", noise(64, 64));
+  std::string bytes = readAll(dir / "ok.png");
+  const size_t idat = bytes.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  ASSERT_GT(bytes.size(), idat + 300);
+  bytes[idat + 200] = char(bytes[idat + 200] ^ 0x10);
+  std::ofstream(dir / "flipped.png", std::ios::binary) << bytes;
+  try {
+    loadImage(dir / "flipped.png", 4);
+    ADD_FAILURE() << "a damaged PNG was decoded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("flipped.png"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(ImageWrite, JpegDecodesInEveryChannelCount) {
   ImageRGBA8 img{64, 48, std::vector<uint8_t>(64 * 48 * 4)};
   for (uint32_t y = 0; y < 48; ++y)
