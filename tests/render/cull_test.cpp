@@ -98,6 +98,7 @@ class CullTest : public test::VulkanTest {
     const uint32_t* ids = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(back.mapped()) + 32);
     EXPECT_LE(r.counts.dispatch[0], count);
     for (uint32_t i = 0; i < std::min(r.counts.dispatch[0], count); ++i) EXPECT_TRUE(r.visible.insert(ids[i]).second) << "listed twice";
+    EXPECT_EQ(r.counts.listed, r.counts.dispatch[0]);
     EXPECT_EQ(r.counts.dispatch[1], 1u);
     EXPECT_EQ(r.counts.dispatch[2], 1u);
     if (phase == render::CullPhase::Single) {
