@@ -1,7 +1,7 @@
 #version 460
 // Cluster culling: one thread per cluster; frustum, back-face cone, then occlusion against the depth
 // pyramid (shaders/shared/cull.h has the tests and the phases). Visible clusters are appended to a compact list whose
-// length is the x of an indirect dispatch (one workgroup per visible cluster); culled ones are counted by
+// length is the size of an indirect dispatch (one workgroup per visible cluster; cull.h); culled ones are counted by
 // reason. The caller zeroes the counts (x = 0, y = z = 1) before the pass.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
@@ -41,5 +41,10 @@ void main() {
   else if ((pc.flags & CULL_OCCLUSION) != 0u && pc.phase != CULL_EARLY && occluded(c.sphere)) reason = CULL_BY_OCCLUSION;
   if (pc.phase == CULL_LATE) history[i] = reason == CULL_VISIBLE ? 1u : 0u;
   if (reason != CULL_VISIBLE) atomicAdd(counts.culled[reason - 1u], 1u);
-  else if (!(pc.phase == CULL_LATE && wasVisible)) visible[atomicAdd(counts.dispatch[0], 1u)] = i;
+  else if (!(pc.phase == CULL_LATE && wasVisible)) {
+    const uint n = atomicAdd(counts.listed, 1u), maxX = max(pc.maxGroupsX, 1u);
+    visible[n] = i;
+    if (n < maxX) atomicMax(counts.dispatch[0], n + 1u);
+    if (n % maxX == 0u) atomicMax(counts.dispatch[1], n / maxX + 1u);
+  }
 }

@@ -6,13 +6,20 @@
 // RASTER_TILE² tile, raster_large.comp); those touching w <= 0 or leaving the guard band, and all of
 // alpha-masked clusters, go to the hardware hand-off list (raster_hw.vert/frag).
 #extension GL_GOOGLE_include_directive : require
+// With culling (pc.fromList), workgroup k takes the k-th entry of the culling pass's visible list
+// (cull.comp; dispatched indirectly from its counts).
 #include "raster_tri.glsl"
+#include "cull.h"
 
 layout(local_size_x = RASTER_GROUP) in;
 
+layout(set = 0, binding = 11, std430) readonly buffer VisibleClusters { uint visibleClusters[]; };
+layout(set = 0, binding = 12, std430) readonly buffer Counts { CullCounts cullCounts; };
+
 void main() {
-  const uint clusterIndex = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  if (clusterIndex >= pc.clusterCount) return;
+  const uint k = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  if (k >= (pc.fromList != 0u ? cullCounts.listed : pc.clusterCount)) return;
+  const uint clusterIndex = pc.fromList != 0u ? visibleClusters[k] : k;
   const uint local = gl_LocalInvocationID.x;
   Tri t;
   const uint kind = local < clusters[clusterIndex].triangleCount ? setup(clusterIndex, local, t) : kSkip;

@@ -25,8 +25,9 @@ layout(set = 0, binding = 7, std430) RASTER_LIST_ACCESS buffer HardwareList {
   uint hwTriangles[];
 };
 // Large triangles' tiles (raster.comp -> raster_large.comp): (triangle as in hwTriangles, tile index).
+// raster_large.comp takes entries [largeFirst, largeCount): with culling, the second phase's only.
 layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
-  uint largeCount, largePad0, largePad1, largePad2;
+  uint largeCount, largeFirst, largePad1, largePad2;
   uvec2 largeTiles[];
 };
 layout(push_constant) uniform Push { RasterPush pc; };

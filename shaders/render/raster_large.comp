@@ -10,7 +10,7 @@ shared Tri shared_t;
 
 void main() {
   const uint count = min(largeCount, RASTER_LARGE_CAPACITY);
-  for (uint e = gl_WorkGroupID.x; e < count; e += gl_NumWorkGroups.x) {
+  for (uint e = largeFirst + gl_WorkGroupID.x; e < count; e += gl_NumWorkGroups.x) {
     const uvec2 entry = largeTiles[e];  // uniform in the group
     if (entry.x == ~0u) continue;
     // One thread sets the triangle up for the group.

@@ -34,10 +34,13 @@ namespace rtr::shader {
 #define CULL_BY_OCCLUSION 3u
 
 // The counts buffer: VkDispatchIndirectCommand {visible clusters, 1, 1}, then the culled counts by reason.
+// Over CullPush::maxGroupsX visible clusters the dispatch is two-dimensional, {maxGroupsX, rows, 1}: a
+// workgroup's list entry is then gl_WorkGroupID.y * maxGroupsX + gl_WorkGroupID.x (below `listed`).
 struct CullCounts {
   uint dispatch[3];
   uint culled[3];  // frustum, cone (back-facing), occlusion
-  uint pad[2];
+  uint listed;     // entries in the visible list
+  uint pad;
 };
 
 struct CullPush {  // 112 bytes
@@ -49,7 +52,8 @@ struct CullPush {  // 112 bytes
   uint height;
   uint pyramidLevels;
   uint phase;        // CULL_SINGLE, CULL_EARLY or CULL_LATE
-  uint pad0, pad1;
+  uint maxGroupsX;   // the device's maxComputeWorkGroupCount[0] (at most 65535): wider lists go 2D
+  uint pad1;
 };
 
 RTR_FN vec4 matrixRow(mat4 m, int i) { return vec4(m[0][i], m[1][i], m[2][i], m[3][i]); }

@@ -25,6 +25,8 @@ struct RasterPush {
   uint height;
   uint primitiveBits;  // of an id: the primitive index (frame.h)
   uint clusterCount;
+  uint fromList;       // raster.comp: clusters from the culling pass's visible list, not all of them
+  uint pad0, pad1, pad2;
 };
 
 #ifdef __cplusplus

@@ -1,6 +1,7 @@
 #include "render/cull.hpp"
 
 #include <algorithm>
+#include <functional>
 
 #include "core/error.hpp"
 #include "vk/commands.hpp"
@@ -54,6 +55,29 @@ DepthPyramid::DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent) : ctx
 }
 
 void DepthPyramid::build(VkCommandBuffer cb, VkImageView depth, VkImageLayout depthLayout) {
+  buildLevels(cb, [&](VkImageView level0) {
+    pipeline_.bind(cb);
+    vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
+        .image(0, depth, depthLayout)
+        .image(1, level0, VK_IMAGE_LAYOUT_GENERAL)
+        .push(cb, pipeline_);
+  });
+}
+
+void DepthPyramid::buildFromBuffer(VkCommandBuffer cb, VkBuffer vis) {
+  if (!fromBuffer_.layout.handle())
+    fromBuffer_ = vk::makeComputePipeline(ctx_, vk::loadShader("hiz_buffer.comp"), {.pushDescriptorSets = {0}});
+  buildLevels(cb, [&](VkImageView level0) {
+    fromBuffer_.bind(cb);
+    vk::DescriptorWriter(ctx_, fromBuffer_.layout, 0, VK_NULL_HANDLE)
+        .buffer(0, vis)
+        .image(1, level0, VK_IMAGE_LAYOUT_GENERAL)
+        .push(cb, fromBuffer_);
+    fromBuffer_.push(cb, glm::uvec2(depthExtent_.width, depthExtent_.height));
+  });
+}
+
+void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<void(VkImageView)>& bindLevel0) {
   constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   constexpr auto kReadWrite = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT;
   if (!initialised_) {
@@ -64,14 +88,17 @@ void DepthPyramid::build(VkCommandBuffer cb, VkImageView depth, VkImageLayout de
     vk::memoryBarrier(cb, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
                       kCompute, kReadWrite);
   }
-  pipeline_.bind(cb);
   for (uint32_t l = 0; l < levelViews_.size(); ++l) {
     const VkExtent2D e{std::max(1u, image_.extent().width >> l), std::max(1u, image_.extent().height >> l)};
-    vk::DescriptorWriter w(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE);
-    if (l == 0) w.image(0, depth, depthLayout);
-    else w.image(0, levelViews_[l - 1], VK_IMAGE_LAYOUT_GENERAL);
-    w.image(1, levelViews_[l], VK_IMAGE_LAYOUT_GENERAL);
-    w.push(cb, pipeline_);
+    if (l == 0) {
+      bindLevel0(levelViews_[0]);
+    } else {
+      if (l == 1) pipeline_.bind(cb);
+      vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
+          .image(0, levelViews_[l - 1], VK_IMAGE_LAYOUT_GENERAL)
+          .image(1, levelViews_[l], VK_IMAGE_LAYOUT_GENERAL)
+          .push(cb, pipeline_);
+    }
     vkCmdDispatch(cb, (e.width + HIZ_GROUP_SIZE - 1) / HIZ_GROUP_SIZE, (e.height + HIZ_GROUP_SIZE - 1) / HIZ_GROUP_SIZE, 1);
     // Each level is the next one's source; the last is the culling pass's (and a read-back's) input.
     vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_WRITE_BIT, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT,
@@ -113,7 +140,7 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
   constexpr auto kConsumerReads = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
   vk::memoryBarrier(cb, kConsumers, kConsumerReads, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0}, {0, 0}};  // the indirect dispatch's y and z are 1
+  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0}, 0, 0};  // the indirect dispatch's y and z are 1
   vkCmdUpdateBuffer(cb, counts_.handle(), 0, sizeof(zero), &zero);
   vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, kCompute,
                     VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
@@ -125,6 +152,7 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
   push.flags = (tests.frustum ? CULL_FRUSTUM : 0u) | (tests.cone && !camera.orthographic ? CULL_CONE : 0u) |
                (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u);
   push.phase = uint32_t(phase);
+  push.maxGroupsX = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0], 65535u);
   if (pyramid) {
     push.width = pyramid->depthExtent().width;
     push.height = pyramid->depthExtent().height;

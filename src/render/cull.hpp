@@ -7,6 +7,7 @@
 //
 // Use, per frame (two-phase, CullPhase below): culler.record(Early); dispatch indirect on counts() over
 // visible(); pyramid.build(depth of that); culler.record(Late, &pyramid); dispatch again. docs/culling.md.
+#include <functional>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -34,6 +35,9 @@ class DepthPyramid {
   // image, in `depthLayout`, written before this by the compute or fragment stage with the barrier the
   // writer owes). Leaves the pyramid readable by compute shaders.
   void build(VkCommandBuffer cb, VkImageView depth, VkImageLayout depthLayout);
+  // The same from the compute rasteriser's 64-bit visibility buffer (raster.h; depthExtent() pixels,
+  // written by compute shaders before a barrier the writer owes), its level 0 read from the buffer directly.
+  void buildFromBuffer(VkCommandBuffer cb, VkBuffer vis);
   VkImageView view() const { return image_.view(); }  // all levels, R32F, layout GENERAL
   VkExtent2D depthExtent() const { return depthExtent_; }
   uint32_t levels() const { return image_.mipLevels(); }
@@ -45,7 +49,8 @@ class DepthPyramid {
   VkExtent2D depthExtent_;
   vk::Image image_;
   std::vector<vk::ImageView> levelViews_;  // per level: storage (write) and sampled (read by the next level)
-  vk::Pipeline pipeline_;
+  vk::Pipeline pipeline_, fromBuffer_;  // fromBuffer_: level 0 from a visibility buffer, made on first use
+  void buildLevels(VkCommandBuffer cb, const std::function<void(VkImageView)>& bindLevel0);
   bool initialised_ = false;
 };
 

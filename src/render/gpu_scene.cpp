@@ -40,9 +40,17 @@ void parallelFor(size_t n, const std::function<void(size_t)>& work) {
   for (auto& w : workers) w.get();  // rethrows the first error
 }
 
-// Clusters of one draw until the scene brings its own: consecutive runs of up to CLUSTER_MAX_TRIANGLES
-// triangles, a bounding sphere around the bounding box of their vertices, the cone disabled.
+// The GPU records of one draw's clusters: the mesh's own (meshoptimizer, scene/clusters.hpp) or, for a
+// mesh built without them (tests), consecutive runs of up to CLUSTER_MAX_TRIANGLES triangles with a
+// bounding sphere around their vertices' box and no cone. A draw the hardware does not cull (double-sided,
+// alpha-masked) gets no cone either, whatever its material says.
 void appendClusters(const Mesh& m, uint32_t draw, uint32_t flags, std::vector<shader::GpuCluster>& out) {
+  const float noCone = 2.0f;
+  for (const Cluster& c : m.clusters)
+    out.push_back({glm::vec4(c.center, c.radius),
+                   glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff), draw,
+                   c.firstTriangle, c.triangleCount, flags});
+  if (!m.clusters.empty()) return;
   const uint32_t triangles = uint32_t(m.indices.size() / 3);
   for (uint32_t first = 0; first < triangles; first += CLUSTER_MAX_TRIANGLES) {
     const uint32_t count = std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - first);
@@ -51,7 +59,7 @@ void appendClusters(const Mesh& m, uint32_t draw, uint32_t flags, std::vector<sh
     const glm::vec3 c = 0.5f * (b.min + b.max);
     float r = 0.0f;
     for (uint32_t i = 3 * first; i < 3 * (first + count); ++i) r = std::max(r, glm::length(m.positions[m.indices[i]] - c));
-    out.push_back({glm::vec4(c, r), glm::vec4(0, 0, 1, 2), draw, first, count, flags});
+    out.push_back({glm::vec4(c, r), glm::vec4(0, 0, 1, noCone), draw, first, count, flags});
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 #include "raster.h"
@@ -17,7 +18,8 @@ bool ComputeRaster::supported(const vk::Context& ctx) {
   return f2.features.shaderInt64 && f2.features.fragmentStoresAndAtomics && f12.shaderBufferInt64Atomics;
 }
 
-ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene) : ctx_(ctx), scene_(scene) {
+ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
+    : ctx_(ctx), scene_(scene), culled_(framesInFlight, false) {
   const vk::LayoutOptions push{.pushDescriptorSets = {0}};
   clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
   uint32_t sharedArea = RASTER_SHARED_AREA;
@@ -41,8 +43,19 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene) : ct
   hwList_ = vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryUse::Device,
                        "raster hand-off");
-  largeList_ = vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+  largeList_ = vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
+                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                           vk::MemoryUse::Device, "raster tiles");
+  cullReadback_ = vk::Buffer(ctx, 2 * sizeof(shader::CullCounts) * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             vk::MemoryUse::Readback, "cull counts read-back");
+}
+
+std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame) const {
+  if (!culled_.at(frame)) return std::nullopt;
+  cullReadback_.invalidate();
+  shader::CullCounts c[2];
+  std::memcpy(c, static_cast<const char*>(cullReadback_.mapped()) + sizeof c * frame, sizeof c);
+  return CullStats{scene_.clusterCount(), c[0].listed, c[1].listed, c[1].culled[0], c[1].culled[1], c[1].culled[2]};
 }
 
 void ComputeRaster::resize(VkExtent2D extent) {
@@ -50,63 +63,92 @@ void ComputeRaster::resize(VkExtent2D extent) {
   vis_ = vk::Buffer(ctx_, VkDeviceSize(extent.width) * extent.height * 8,
                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Device,
                     "visibility (64-bit)");
+  pyramid_.reset();
   extent_ = extent;
 }
 
 void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits,
-                           vk::GpuTimer& timer) {
+                           vk::GpuTimer& timer, uint32_t frame, const CullCamera* cull) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
   const VkBuffer uv = scene_.texcoords() ? scene_.texcoords() : scene_.positions();
-  auto bind = [&](const vk::Pipeline& p) {
+  const bool culling = cull && scene_.clusterCount() > 0;
+  if (culling && !culler_) culler_.emplace(ctx_, scene_.clusterCount());
+  if (culling && !pyramid_) pyramid_.emplace(ctx_, extent_);
+  culled_.at(frame) = culling;
+  auto bind = [&](const vk::Pipeline& p, bool fromList = false) {
     p.bind(cb);
     vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
     for (const vk::ReflectedBinding& b : p.layout.interface().bindings) {
       if (b.set != 0) continue;
+      const VkBuffer list = culler_ ? culler_->visible() : scene_.clusters();  // not read without culling
+      const VkBuffer counts = culler_ ? culler_->counts() : scene_.clusters();
       const VkBuffer buffers[] = {uniforms.buffer, scene_.clusters(), scene_.drawInfo(), scene_.positions(),
                                   i32, i16, vis_.handle(), hwList_.handle(), scene_.materials(), uv,
-                                  largeList_.handle()};
+                                  largeList_.handle(), list, counts};
       if (b.binding == 0) w.buffer(0, uniforms.buffer, uniforms.offset, sizeof(shader::FrameUniforms));
       else w.buffer(b.binding, buffers[b.binding]);
     }
     w.push(cb, p);
-    p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, scene_.clusterCount()});
+    p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, scene_.clusterCount(), fromList, 0, 0, 0});
   };
+  constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  constexpr auto kReadWrite = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
   // The previous frame's readers of both buffers (shading, the indirect draw) before they are cleared.
   vk::memoryBarrier(cb,
-                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
-                        VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT |
-                        VK_PIPELINE_STAGE_2_COPY_BIT,
-                    VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
-                        VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
-                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+                    kCompute | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
+                        VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
+                    kReadWrite | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT, kCompute,
+                    VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   bind(clear_);
   const uint32_t pixels = extent_.width * extent_.height;
   vkCmdDispatch(cb, (pixels + RASTER_CLEAR_GROUP - 1) / RASTER_CLEAR_GROUP, 1, 1);
   timer.mark(cb, "clear");
-  vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                    VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-  if (scene_.clusterCount() > 0) {
-    bind(raster_);
-    // Workgroup counts per dimension are limited (65535 on many devices): clusters over x, then y.
-    const uint32_t maxX = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0], 65535u);
-    const uint32_t x = std::min(scene_.clusterCount(), maxX);
-    vkCmdDispatch(cb, x, (scene_.clusterCount() + x - 1) / x, 1);
-    timer.mark(cb, "raster");
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kCompute, kReadWrite);
+  const VkDeviceSize countsSize = sizeof(shader::CullCounts);
+  const VkBufferCopy toReadback[2] = {{0, 2 * countsSize * frame, countsSize}, {0, (2 * frame + 1) * countsSize, countsSize}};
+  // Both rasteriser passes over the clusters: all of them, or (culling) the culler's list, indirectly.
+  auto rasterise = [&](const char* name, const char* largeName) {
+    bind(raster_, culling);
+    if (culling) {
+      vkCmdDispatchIndirect(cb, culler_->counts(), 0);
+    } else {
+      // Workgroup counts per dimension are limited (65535 on many devices): clusters over x, then y.
+      const uint32_t maxX = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0], 65535u);
+      const uint32_t x = std::min(scene_.clusterCount(), maxX);
+      vkCmdDispatch(cb, x, (scene_.clusterCount() + x - 1) / x, 1);
+    }
+    timer.mark(cb, name);
+    vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kCompute, kReadWrite);
     bind(large_);
     vkCmdDispatch(cb, RASTER_LARGE_GROUPS, 1, 1);
-    timer.mark(cb, "raster large");
+    timer.mark(cb, largeName);
+  };
+  if (culling) {
+    culler_->record(cb, scene_.clusters(), scene_.clusterCount(), *cull, nullptr, {}, CullPhase::Early);
+    vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[0]);
+    timer.mark(cb, "cull early");
+    rasterise("raster early", "raster large early");
+    // The pyramid reads the depth drawn so far; the late phase's tile pass starts after the early tiles.
+    vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT,
+                      kReadWrite | VK_ACCESS_2_TRANSFER_READ_BIT);
+    const VkBufferCopy firstLate{0, 4, 4};  // largeCount -> largeFirst (raster_fetch.glsl)
+    vkCmdCopyBuffer(cb, largeList_.handle(), largeList_.handle(), 1, &firstLate);
+    pyramid_->buildFromBuffer(cb, vis_.handle());
+    timer.mark(cb, "pyramid");
+    // Its first barrier orders the copies above before its reset, its second makes them visible to compute.
+    culler_->record(cb, scene_.clusters(), scene_.clusterCount(), *cull, &*pyramid_, {}, CullPhase::Late);
+    vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
+    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                      VK_ACCESS_2_HOST_READ_BIT);
+    timer.mark(cb, "cull");
   }
-  vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+  if (scene_.clusterCount() > 0) rasterise("raster", "raster large");
+  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                     VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
                         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+                    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | kReadWrite);
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};
   ri.layerCount = 1;

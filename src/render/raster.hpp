@@ -6,7 +6,9 @@
 // RTR_RASTER_SHARED_AREA (environment, a benchmarking knob): the bounding-box area in pixels above which a
 // triangle is rasterised by tiles rather than by its own thread (default RASTER_SHARED_AREA, raster.h).
 #include <optional>
+#include <vector>
 
+#include "render/cull.hpp"
 #include "render/gpu_scene.hpp"
 #include "vk/commands.hpp"
 #include "vk/frame_ring.hpp"
@@ -18,13 +20,23 @@ class ComputeRaster {
  public:
   // Whether the device has what it needs (64-bit buffer atomics, also in fragment shaders).
   static bool supported(const vk::Context& ctx);
-  ComputeRaster(const vk::Context& ctx, const GpuScene& scene);
+  ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight);
 
   void resize(VkExtent2D extent);  // the caller has waited for the device to be idle
-  // Records the three passes, each timed ("clear", "raster", "raster large", "raster hw"); afterwards ids() is written
-  // (compute and fragment stages), for a compute reader after a barrier the caller makes (vis_shade).
-  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer);
+  // Records the passes, each timed ("clear", "raster", "raster large", "raster hw"); afterwards ids() is
+  // written (compute and fragment stages), for a compute reader after a barrier the caller makes (vis_shade).
+  // With `cull` (the frame's camera), two-phase cluster culling (docs/culling.md): "cull early" lists the
+  // clusters visible last frame, "raster early" + "raster large early" draw them, "pyramid" reduces their
+  // depth, "cull" tests the rest against it, and the passes above draw those; the hardware hand-off once.
+  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer,
+              uint32_t frame, const CullCamera* cull);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
+  // The culling counts of the last completed use of `frame` (none if it did not cull).
+  struct CullStats {
+    uint32_t clusters = 0, early = 0, late = 0;  // listed by each phase
+    uint32_t frustum = 0, cone = 0, occlusion = 0;  // culled, by the late phase (every cluster tested)
+  };
+  std::optional<CullStats> cullStats(uint32_t frame) const;
 
  private:
   const vk::Context& ctx_;
@@ -33,6 +45,10 @@ class ComputeRaster {
   vk::DescriptorSets textures_;  // the hand-off's set 1
   vk::Buffer vis_, hwList_, largeList_;
   VkExtent2D extent_{0, 0};
+  std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
+  std::optional<DepthPyramid> pyramid_;
+  vk::Buffer cullReadback_;              // per frame in flight: the early and the late CullCounts
+  std::vector<bool> culled_;             // per frame in flight: whether its last use culled
 };
 
 }  // namespace rtr::render

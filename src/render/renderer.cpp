@@ -48,7 +48,7 @@ const char* toString(RasterPath path) {
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    timers_.emplace_back(ctx, 6);  // at most: clear, raster, raster large, raster hw, shade, post
+    timers_.emplace_back(ctx, 12);  // at most: ComputeRaster::record's nine passes, shade, post
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
@@ -151,7 +151,7 @@ void Renderer::rebuildPipelines() {
     if (pipelines_[set]) fresh[set] = makePipelines(PipelineSet(set));
   for (RasterPath r : {RasterPath::Hardware, RasterPath::Compute})
     if (shade_[size_t(r)].pipeline) shade[size_t(r)] = makeShade(r == RasterPath::Compute);
-  if (raster_) raster.emplace(ctx_, scene_);
+  if (raster_) raster.emplace(ctx_, scene_, framesInFlight_);
   vkDeviceWaitIdle(ctx_.device());
   pipelines_ = std::move(fresh);
   shade_ = std::move(shade);
@@ -258,7 +258,7 @@ void Renderer::frame(FrameContext& fc) {
       (raster == RasterPath::Hardware && !vis_.handle()))
     createTargets(target.extent, raster == RasterPath::Hardware);
   if (compute && !raster_) {
-    raster_.emplace(ctx_, scene_);
+    raster_.emplace(ctx_, scene_, framesInFlight_);
     raster_->resize(extent_);
   }
   if (!compute) ensurePipelines(set);
@@ -300,7 +300,8 @@ void Renderer::frame(FrameContext& fc) {
   timer.reset(cb);
   timer.begin(cb);
   if (compute) {
-    raster_->record(cb, uniforms_, primitiveBits_, timer);
+    const CullCamera cam{u.viewProj, pose.position, lens.orthographic};
+    raster_->record(cb, uniforms_, primitiveBits_, timer, frame, s.cull ? &cam : nullptr);
     vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT);

@@ -34,6 +34,7 @@ struct RenderSettings {
   int mode = VIEW_SHADED;         // VIEW_* from frame.h
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   RasterPath raster = RasterPath::Auto;
+  bool cull = true;  // compute raster only: two-phase cluster culling (docs/culling.md); never changes the image
   float lodBias = 0.0f;
   MosaicMode mosaic = MosaicMode::Compute;
   // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;
@@ -86,6 +87,10 @@ class Renderer {
   // returns the bytes per pixel written: 4 (hardware: the id) or 8 (compute: id in the low half).
   uint32_t copyIds(VkCommandBuffer cb, VkBuffer dst);
   uint32_t primitiveBits() const { return primitiveBits_; }
+  // The culling counts of the last completed use of `frame`; none where it did not cull.
+  std::optional<ComputeRaster::CullStats> cullStats(uint32_t frame) const {
+    return raster_ ? raster_->cullStats(frame) : std::nullopt;
+  }
 
  private:
   struct ScenePipelines {

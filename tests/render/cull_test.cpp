@@ -96,12 +96,20 @@ class CullTest : public test::VulkanTest {
     GpuResult r;
     std::memcpy(&r.counts, back.mapped(), 32);
     const uint32_t* ids = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(back.mapped()) + 32);
-    EXPECT_LE(r.counts.dispatch[0], count);
-    for (uint32_t i = 0; i < std::min(r.counts.dispatch[0], count); ++i) EXPECT_TRUE(r.visible.insert(ids[i]).second) << "listed twice";
-    EXPECT_EQ(r.counts.dispatch[1], 1u);
+    EXPECT_LE(r.counts.listed, count);
+    for (uint32_t i = 0; i < std::min(r.counts.listed, count); ++i) EXPECT_TRUE(r.visible.insert(ids[i]).second) << "listed twice";
+    // One workgroup per entry: {listed, 1, 1}, or two-dimensional past the device's (or 65 535) groups in x.
+    const uint32_t maxX = std::min(ctx->properties().limits.maxComputeWorkGroupCount[0], 65535u);
+    if (r.counts.listed <= maxX) {
+      EXPECT_EQ(r.counts.dispatch[0], r.counts.listed);
+      EXPECT_EQ(r.counts.dispatch[1], 1u);
+    } else {
+      EXPECT_EQ(r.counts.dispatch[0], maxX);
+      EXPECT_EQ(r.counts.dispatch[1], (r.counts.listed + maxX - 1) / maxX);
+    }
     EXPECT_EQ(r.counts.dispatch[2], 1u);
     if (phase == render::CullPhase::Single) {
-      EXPECT_EQ(r.counts.dispatch[0] + r.counts.culled[0] + r.counts.culled[1] + r.counts.culled[2], count);
+      EXPECT_EQ(r.counts.listed + r.counts.culled[0] + r.counts.culled[1] + r.counts.culled[2], count);
     }
     return r;
   }
@@ -396,8 +404,8 @@ TEST_F(CullTest, NeverRemovesAVisibleClusterOfTheTemple) {
     EXPECT_GT(covered, all.size() / 20) << "the view sees little of the temple";
     EXPECT_EQ(differing, 0u) << "culling removed visible clusters";
     std::printf("temple %-15s %u clusters: visible %u, culled by frustum %u, cone %u, occlusion %u; %zu px covered\n", name, n,
-                r.counts.dispatch[0], r.counts.culled[0], r.counts.culled[1], r.counts.culled[2], covered);
-    total[0] += r.counts.dispatch[0];
+                r.counts.listed, r.counts.culled[0], r.counts.culled[1], r.counts.culled[2], covered);
+    total[0] += r.counts.listed;
     for (int k = 0; k < 3; ++k) total[k + 1] += r.counts.culled[k];
   }
   for (int k = 1; k < 4; ++k) EXPECT_GT(total[k], 0u) << "reason " << k << " never culled: the test proves nothing about it";
@@ -453,17 +461,36 @@ TEST_F(CullTest, TwoPhaseNeverRemovesAVisibleClusterWhileTheCameraMoves) {
     for (size_t p = 0; p < all.size(); ++p) differing += all[p] != twoPhase[p];
     EXPECT_EQ(differing, 0u) << "two-phase culling removed visible clusters";
     std::printf("two-phase frame %zu: early %u, late %u more; late culled by frustum %u, cone %u, occlusion %u\n", f,
-                early.counts.dispatch[0], late.counts.dispatch[0], late.counts.culled[0], late.counts.culled[1],
+                early.counts.listed, late.counts.listed, late.counts.culled[0], late.counts.culled[1],
                 late.counts.culled[2]);
     if (f == 0) {
-      EXPECT_EQ(early.counts.dispatch[0], 0u) << "no history before the first frame";
+      EXPECT_EQ(early.counts.listed, 0u) << "no history before the first frame";
     }
     if (f == 1) {
-      EXPECT_EQ(late.counts.dispatch[0], 0u) << "the same view again: the early phase drew everything";
+      EXPECT_EQ(late.counts.listed, 0u) << "the same view again: the early phase drew everything";
     }
     occluded += late.counts.culled[2];
   }
   EXPECT_GT(occluded, 0u) << "nothing occluded: the test proves nothing about occlusion";
+}
+
+
+// More visible clusters than one dimension of workgroups holds: the indirect dispatch goes two-dimensional
+// and the list still holds every cluster once.
+TEST_F(CullTest, ListsLongerThanOneDispatchRowGoTwoDimensional) {
+  const uint32_t n = 70000;
+  std::vector<GpuCluster> clusters(n);
+  for (uint32_t i = 0; i < n; ++i)  // all in front of the camera, no cone
+    clusters[i] = {glm::vec4(float(i % 7) * 0.1f, float(i % 5) * 0.1f, 0.0f, 0.1f), glm::vec4(0, 0, 1, 2), 0, 0, 1, 0};
+  vk::Buffer buf(*ctx, n * sizeof(GpuCluster), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "clusters");
+  std::memcpy(buf.mapped(), clusters.data(), n * sizeof(GpuCluster));
+  buf.flush();
+  ClusterCuller culler(*ctx, n);
+  const CameraPose pose{{0.0f, 0.0f, 5.0f}, 0.0f, 0.0f};
+  const GpuResult r = cull(culler, buf, n, cameraFor(pose, Lens{}, {64, 64}), nullptr);
+  EXPECT_EQ(r.counts.listed, n);
+  EXPECT_EQ(r.visible.size(), n);
+  EXPECT_EQ(r.counts.dispatch[2], 1u);
 }
 
 }  // namespace

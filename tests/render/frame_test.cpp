@@ -73,9 +73,10 @@ TEST_F(FrameTest, ShadedFrameIsFiniteAndLit) {
     }
     EXPECT_GT(sum / (3.0 * kW * kH), 0.01) << "the shaded frame is (nearly) black";
     const bool vis = path == render::ShadingPath::Visibility;
-    // Hardware ids: visibility, shade, post; compute: clear, raster, raster large, raster hw, shade, post.
+    // Hardware ids: visibility, shade, post; compute, culling (the default): clear, cull early, raster early,
+    // raster large early, pyramid, cull, raster, raster large, raster hw, shade, post.
     const bool compute = renderer->renderer().rasterFor({}) == render::RasterPath::Compute;
-    EXPECT_EQ(f.gpuTimes.size(), !vis ? 2u : compute ? 6u : 3u);
+    EXPECT_EQ(f.gpuTimes.size(), !vis ? 2u : compute ? 11u : 3u);
     EXPECT_EQ(ranPass(f, "shade"), vis);
   }
   EXPECT_GT(gpu->stats().meshes16, 0u) << "small meshes should use 16-bit indices";
@@ -158,7 +159,7 @@ TEST_F(FrameTest, EveryViewModeRendersWithoutValidationMessages) {
 //   the colour image is sampled by the post pass (compute, or fragment for the graphics mosaic), which
 //   discards the target after last frame's read-back copy; the target goes to the read-back copy.
 //   The compute rasteriser's buffers are synchronised by memory barriers, which the log does not list: its
-//   frame starts at the shading pass.
+//   frame starts at the shading pass, with cluster culling (its pyramid stays in GENERAL) or without.
 std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::MosaicMode mosaic, bool computeIds) {
   const bool vis = path == render::ShadingPath::Visibility, raster = mosaic == render::MosaicMode::Graphics;
   const std::string postRead = raster ? "FRAGMENT_SHADER" : "COMPUTE_SHADER";
@@ -190,10 +191,12 @@ std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::M
 TEST_F(FrameTest, OneFrameRecordsExactlyTheBarriersItNeeds) {
   for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility})
     for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
-    for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics}) {
+    for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics})
+    for (bool cull : {true, false}) {
       SCOPED_TRACE(std::string(render::toString(path)) + ", mosaic " + render::toString(mosaic) + ", " +
-                   render::toString(raster) + " raster");
+                   render::toString(raster) + " raster, cull " + (cull ? "on" : "off"));
       RenderSettings s;
+      s.cull = cull;
       s.shading = path;
       s.mosaic = mosaic;
       s.raster = raster;

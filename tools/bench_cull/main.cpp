@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
         std::memcpy(&c, back.mapped(), sizeof(c));
         const Times p = stats(pyr), k = stats(cull);
         std::printf("| %s | %s | %.4f / %.4f | %.4f / %.4f | %u | %u | %u | %u |\n", size.c_str(), name, p.minMs, p.medianMs,
-                    k.minMs, k.medianMs, c.dispatch[0], c.culled[0], c.culled[1], c.culled[2]);
+                    k.minMs, k.medianMs, c.listed, c.culled[0], c.culled[1], c.culled[2]);
       }
     }
     return 0;

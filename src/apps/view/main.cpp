@@ -163,6 +163,12 @@ int runHeadless(const ViewOptions& o) {
   if (o.bench > 0) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
+    if (const auto c = renderer.renderer().cullStats(0)) {
+      const double n = std::max(1u, c->clusters);
+      std::printf("cull: %u clusters; listed early %u, late %u; culled by frustum %u (%.1f %%), cone %u (%.1f %%), "
+                  "occlusion %u (%.1f %%)\n", c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone,
+                  100 * c->cone / n, c->occlusion, 100 * c->occlusion / n);
+    }
   }
   if (!o.screenshot.empty()) {
     render::HeadlessFrame frame = first && o.frames <= 1 ? std::move(*first)
@@ -213,6 +219,9 @@ int main(int argc, char** argv) {
           ->check(CLI::IsMember({"visibility", "forward"}));
   app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
       ->check(CLI::IsMember({"auto", "hardware", "compute"}))->capture_default_str();
+  std::string cull = "on";
+  app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
+      ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
   app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
@@ -258,6 +267,7 @@ int main(int argc, char** argv) {
     o.settings.raster = raster == "hardware" ? render::RasterPath::Hardware
                         : raster == "compute" ? render::RasterPath::Compute
                                               : render::RasterPath::Auto;
+    o.settings.cull = cull == "on";
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
   } catch (const std::exception& e) {
     return cli::fail("rtr-view", e);
