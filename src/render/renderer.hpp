@@ -34,7 +34,10 @@ struct RenderSettings {
   int mode = VIEW_SHADED;         // VIEW_* from frame.h
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   RasterPath raster = RasterPath::Auto;
-  bool cull = true;  // compute raster only: two-phase cluster culling (docs/culling.md); never changes the image
+  // Compute raster only: two-phase cluster culling (docs/culling.md); never changes the image. Off by default:
+  // on the H200 its fixed cost (depth pyramid + two cull passes, 0.10-0.13 ms at 4K) exceeded the raster time
+  // it saved in every measured scene, up to 10 M triangles (docs/raster.md).
+  bool cull = false;
   float lodBias = 0.0f;
   MosaicMode mosaic = MosaicMode::Compute;
   // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;

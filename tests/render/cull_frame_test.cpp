@@ -59,8 +59,12 @@ TEST_F(CullFrameTest, CulledFramesEqualUnculledOnesAlongACameraPath) {
                 "%zu px covered\n", f, c->clusters, c->early, c->late, c->frustum, c->cone, c->occlusion, covered);
     EXPECT_LE(c->early + c->late + c->frustum + c->cone, c->clusters + c->early) << "counted once per pass";
     EXPECT_LE(c->frustum + c->cone + c->occlusion, c->clusters);
-    if (f == 0) EXPECT_EQ(c->early, 0u) << "no history before the first frame";
-    if (f == 1) EXPECT_EQ(c->late, 0u) << "the same view again: the early phase drew all";
+    if (f == 0) {
+      EXPECT_EQ(c->early, 0u) << "no history before the first frame";
+    }
+    if (f == 1) {
+      EXPECT_EQ(c->late, 0u) << "the same view again: the early phase drew all";
+    }
     culled[0] += c->frustum, culled[1] += c->cone, culled[2] += c->occlusion;
   }
   // Every test must have culled something along the path, or equal frames prove little.

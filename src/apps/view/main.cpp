@@ -219,7 +219,7 @@ int main(int argc, char** argv) {
           ->check(CLI::IsMember({"visibility", "forward"}));
   app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
       ->check(CLI::IsMember({"auto", "hardware", "compute"}))->capture_default_str();
-  std::string cull = "on";
+  std::string cull = "off";
   app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
