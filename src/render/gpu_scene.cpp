@@ -299,22 +299,41 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     });
     stats_.mipGpuMs = timer.results().at(0).second;
 
-    VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-    si.magFilter = si.minFilter = VK_FILTER_LINEAR;
-    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;  // trilinear
-    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
-    si.maxLod = VK_LOD_CLAMP_NONE;
-    si.anisotropyEnable = VK_FALSE;  // the mip-level view must show what trilinear filtering picks
-    VkSampler raw;
-    VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &raw));
-    sampler_ = vk::Sampler(ctx.device(), raw);
+    sampler_ = makeSampler(ctx, {});
   }
   stats_.mipsMs = msSince(t) - (pipelines.stats().ms - pipelineMs);
 }
 
-std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors() const {
+const char* toString(TextureFilter f) {
+  return f == TextureFilter::Trilinear ? "trilinear" : f == TextureFilter::NearestMip ? "nearest-mip" : "nearest";
+}
+
+float maxAnisotropy(const vk::Context& ctx) {
+  VkPhysicalDeviceFeatures features{};
+  vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
+  return features.samplerAnisotropy ? ctx.properties().limits.maxSamplerAnisotropy : 1.0f;
+}
+
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings) {
+  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  const bool nearest = settings.filter == TextureFilter::Nearest;
+  si.magFilter = si.minFilter = nearest ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+  si.mipmapMode = settings.filter == TextureFilter::Trilinear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  si.maxLod = VK_LOD_CLAMP_NONE;
+  // Off by default: the mip-level view must show what plain trilinear filtering picks.
+  const float anisotropy = std::clamp(settings.anisotropy, 1.0f, maxAnisotropy(ctx));
+  si.anisotropyEnable = anisotropy > 1.0f;
+  si.maxAnisotropy = anisotropy;
+  VkSampler raw;
+  VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &raw));
+  return vk::Sampler(ctx.device(), raw);
+}
+
+std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors(VkSampler sampler) const {
   std::vector<VkDescriptorImageInfo> out;
-  for (const auto& t : textures_) out.push_back({sampler_, t.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  for (const auto& t : textures_)
+    out.push_back({sampler ? sampler : sampler_.get(), t.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   return out;
 }
 

@@ -45,6 +45,20 @@ struct GpuSceneStats {
 // Told how far a long load is: what it does, how many of how many are done (serialised calls).
 using LoadProgress = std::function<void(const char* what, size_t done, size_t total)>;
 
+// How the scene's textures are sampled (the brief's mip experiments, task 1.4): trilinear; the nearest mip
+// level, filtered linearly within it; or nearest texel of the nearest level. Anisotropy 1 is off.
+enum class TextureFilter { Trilinear, NearestMip, Nearest };
+const char* toString(TextureFilter filter);
+struct SamplerSettings {
+  TextureFilter filter = TextureFilter::Trilinear;
+  float anisotropy = 1.0f;
+  bool operator==(const SamplerSettings&) const = default;
+};
+// The largest anisotropy the device samples with: 1 without the samplerAnisotropy feature.
+float maxAnisotropy(const vk::Context& ctx);
+// A repeat-wrapping sampler for scene textures; the anisotropy is clamped to maxAnisotropy(ctx).
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings);
+
 // How the geometry reaches device memory: written in place where the host can map it (Auto), or always
 // through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
 enum class GeometryUpload { Auto, Staging };
@@ -66,7 +80,8 @@ class GpuScene {
   VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), draw by draw
   uint32_t clusterCount() const { return clusterCount_; }
   uint32_t textureCount() const { return uint32_t(textures_.size()); }
-  std::vector<VkDescriptorImageInfo> textureDescriptors() const;
+  // Every texture with `sampler` (none: the default trilinear one).
+  std::vector<VkDescriptorImageInfo> textureDescriptors(VkSampler sampler = VK_NULL_HANDLE) const;
   const Bounds& bounds() const { return bounds_; }
   const GpuSceneStats& stats() const { return stats_; }
 

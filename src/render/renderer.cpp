@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "vk/check.hpp"
 #include "vk/context.hpp"
 
 namespace rtr::render {
@@ -46,7 +47,7 @@ const char* toString(RasterPath path) {
 }
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
+    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), sampler_(makeSampler(ctx, {})), post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 6);  // at most: clear, raster, raster large, raster hw, shade, post
   }
@@ -93,7 +94,7 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   p.pipeline.emplace(vk::makeGraphicsPipeline(ctx_, d, options));
   const vk::PipelineLayout& layout = p.pipeline->layout;
   p.sets = vk::DescriptorSets(ctx_, layout, framesInFlight_);
-  auto textures = scene_.textureDescriptors();
+  auto textures = scene_.textureDescriptors(sampler_);
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
     if (layout.setCount() == 0) break;
     // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
@@ -131,7 +132,7 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
       vk::makeComputePipeline(ctx_, vk::loadShader(shader), options));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
-    auto textures = scene_.textureDescriptors();
+    auto textures = scene_.textureDescriptors(sampler_);
     if (!textures.empty()) vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
   }
   return v;
@@ -160,6 +161,26 @@ void Renderer::rebuildPipelines() {
     raster_.reset();
     raster_.emplace(std::move(*raster));
   }
+}
+
+void Renderer::setSampler(const SamplerSettings& settings) {
+  // Samplers are cheap: a new one, and the texture sets written again once no frame uses them (a user's
+  // change in the panel, not a per-frame cost).
+  VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+  sampler_ = makeSampler(ctx_, settings);
+  samplerSettings_ = settings;
+  const auto textures = scene_.textureDescriptors(sampler_);
+  if (textures.empty()) return;
+  for (auto& set : pipelines_) {
+    if (!set) continue;
+    for (ScenePipelines& p : *set)
+      if (p.pipeline && p.pipeline->layout.setCount() > 1)
+        for (uint32_t frame = 0; frame < framesInFlight_; ++frame)
+          vk::DescriptorWriter(ctx_, p.pipeline->layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
+  }
+  for (VisShade& v : shade_)
+    if (v.pipeline && v.pipeline->layout.setCount() > 1)
+      vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -261,6 +282,7 @@ void Renderer::frame(FrameContext& fc) {
     raster_.emplace(ctx_, scene_);
     raster_->resize(extent_);
   }
+  if (s.sampler != samplerSettings_) setSampler(s.sampler);
   if (!compute) ensurePipelines(set);
   if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);
   lastRaster_ = raster;
@@ -273,6 +295,7 @@ void Renderer::frame(FrameContext& fc) {
   u.ambient = glm::vec4(s.lights.ambient, 0.0f);
   static_assert(MAX_LIGHTS == kMaxLights);
   u.lightCount.x = uint32_t(std::min(s.lights.lights.size(), kMaxLights));
+  u.lightCount.y = s.sampler.filter != TextureFilter::Trilinear;  // the mip view shows whole levels
   for (uint32_t i = 0; i < u.lightCount.x; ++i) {
     const Light& l = s.lights.lights[i];
     const glm::vec3 p = l.kind == Light::Kind::Headlight ? pose.position : l.position;

@@ -35,6 +35,7 @@ struct RenderSettings {
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   RasterPath raster = RasterPath::Auto;
   float lodBias = 0.0f;
+  SamplerSettings sampler;        // how scene textures are filtered (mip experiments)
   MosaicMode mosaic = MosaicMode::Compute;
   // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;
   // the apps resolve them once from the scene and the command line (scene/lights.hpp).
@@ -105,10 +106,13 @@ class Renderer {
   void ensurePipelines(PipelineSet set);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set);
   void shadeVisibility(VkCommandBuffer cb, RasterPath raster);
+  void setSampler(const SamplerSettings& settings);
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
   uint32_t framesInFlight_;
+  SamplerSettings samplerSettings_;
+  vk::Sampler sampler_;  // the texture descriptors' sampler, made from samplerSettings_
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   std::array<VisShade, 3> shade_;  // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer

@@ -181,6 +181,19 @@ def main():
         check(screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1]) != before_view, "the mip-level view changes with it")
         check(pose() == p0, "a drag on the panel does not move the camera")
 
+        # The filter buttons: the nearest mip level changes the mip-level view; trilinear brings its frame back
+        # (the texture descriptors rewritten between frames, under the validation layer).
+        trilinear_view = screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1])
+        click("nearest-mip")
+        wait_title("| nearest-mip x1 |")
+        settle()
+        check(screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1]) != trilinear_view, "nearest-mip changes the mip-level view")
+        click("trilinear")
+        wait_title("| trilinear x1 |")
+        settle()
+        check(screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1]) == trilinear_view,
+              "back to trilinear: the same mip-level view, pixel for pixel")
+
         # The screenshot button: a PNG beside the scene, without the panel, never overwriting.
         click("screenshot")
         shot1 = viewer.wait_line("err", r"rtr-view: saved (\S+)").group(1)

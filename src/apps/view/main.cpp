@@ -59,6 +59,9 @@ DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
                render::toString(c.mips), o.mipsGiven ? "--mips" : "default");
   if (!o.shadingGiven || !o.mipsGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
   std::fprintf(stderr, "\n");
+  if (const float max = render::maxAnisotropy(ctx); o.settings.sampler.anisotropy > max)
+    std::fprintf(stderr, "rtr-view: note: --anisotropy %g: %s samples with at most %g\n", o.settings.sampler.anisotropy,
+                 ctx.deviceName().c_str(), max);
   return c;
 }
 
@@ -191,7 +194,8 @@ int main(int argc, char** argv) {
                "Esc quit.",
                "rtr-view"};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "off", light, lightColor,
-              ambient = "0.02", mtl;
+              ambient = "0.02", mtl,
+              filter = "trilinear";
   std::string shadingPath = render::toString(o.settings.shading), raster = render::toString(o.settings.raster);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_option("--mtl", mtl, "OBJ: take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
@@ -214,6 +218,12 @@ int main(int argc, char** argv) {
   app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
       ->check(CLI::IsMember({"auto", "hardware", "compute"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
+  app.add_option("--filter", filter, "texture filter: trilinear | nearest-mip (nearest level, bilinear in it) | nearest "
+                 "(nearest texel of the nearest level)")
+      ->check(CLI::IsMember({"trilinear", "nearest-mip", "nearest"}))->capture_default_str();
+  app.add_option("--anisotropy", o.settings.sampler.anisotropy,
+                 "anisotropic filtering, 1 (off) up to the device's maxSamplerAnisotropy (more is clamped, with a note)")
+      ->check(cli::number(1, 64))->capture_default_str();
   app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
   app.add_flag("--falloff", o.lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
@@ -255,6 +265,9 @@ int main(int argc, char** argv) {
     o.shadingGiven = shadingOpt->count() > 0;
     o.settings.mosaic = mosaicModes.at(mosaic);
     o.settings.shading = shadingPath == "forward" ? render::ShadingPath::Forward : render::ShadingPath::Visibility;
+    o.settings.sampler.filter = filter == "nearest" ? render::TextureFilter::Nearest
+                                : filter == "nearest-mip" ? render::TextureFilter::NearestMip
+                                                          : render::TextureFilter::Trilinear;
     o.settings.raster = raster == "hardware" ? render::RasterPath::Hardware
                         : raster == "compute" ? render::RasterPath::Compute
                                               : render::RasterPath::Auto;

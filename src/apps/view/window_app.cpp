@@ -401,7 +401,7 @@ int runWindowed(const ViewOptions& opts) {
     if (app.panel) {
       const auto& st = cur.gpu->stats();
       PanelFacts facts{scenePath, st.meshes, uint32_t(scene.materials.size()), st.textures, st.triangles, st.mipGpuMs,
-                       traced.visible() ? traced.status() : std::string(), shaderError};
+                       traced.visible() ? traced.status() : std::string(), shaderError, render::maxAnisotropy(ctx)};
       drawPanel(app, facts, history);
     }
     ImGui::Render();
@@ -438,9 +438,10 @@ int runWindowed(const ViewOptions& opts) {
     if (titleTimer > 0.25) {  // the window title: mode, timings, tracer status (the window test reads it)
       titleTimer = 0;
       char buf[160];
-      std::snprintf(buf, sizeof buf, "rtr-view | mode %d | %s | mosaic %s | lod bias %.2f | %s | CPU frame %.2f ms",
+      std::snprintf(buf, sizeof buf, "rtr-view | mode %d | %s | mosaic %s | lod bias %.2f | %s x%g | %s | CPU frame %.2f ms",
                     app.settings.mode, modeName(app.settings.mode), render::toString(app.settings.mosaic),
-                    app.settings.lodBias, app.camera.mode() == CameraMode::Orbit ? "orbit" : "fly", cpuFrameMs);
+                    app.settings.lodBias, render::toString(app.settings.sampler.filter), app.settings.sampler.anisotropy,
+                    app.camera.mode() == CameraMode::Orbit ? "orbit" : "fly", cpuFrameMs);
       std::string title = buf;
       for (const auto& [name, ms] : frames.gpuTimes()) {
         std::snprintf(buf, sizeof buf, " | %s %.3f ms", name.c_str(), ms);
