@@ -5,6 +5,8 @@
 // Geometry is written on all cores straight into device-local memory where the host can write it (every
 // CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
 #include <array>
+#include <atomic>
+#include <future>
 #include <functional>
 #include <vector>
 
@@ -63,10 +65,25 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings)
 // through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
 enum class GeometryUpload { Auto, Staging };
 
+// Whether the constructor returns with the textures on the GPU (Wait), or leaves them decoding on worker
+// threads (Deferred): until updateTextures() takes them in, every material shows its factors alone.
+enum class TextureLoad { Wait, Deferred };
+
 class GpuScene {
  public:
+  // `scene` and `progress` must outlive a Deferred texture load (or the object).
   GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {},
-           GeometryUpload upload = GeometryUpload::Auto);
+           GeometryUpload upload = GeometryUpload::Auto, TextureLoad textures = TextureLoad::Wait);
+  ~GpuScene();
+  GpuScene(const GpuScene&) = delete;
+  GpuScene& operator=(const GpuScene&) = delete;
+
+  // Deferred load, between frames: once the textures are decoded (at once, with `wait`), waits for the
+  // device to be idle, uploads them, generates their mips and points the materials at them; true then
+  // (once). Renderers notice by texturesReady() and write their texture descriptors.
+  bool updateTextures(bool wait = false);
+  bool texturesReady() const { return !decoding_.valid(); }
+  size_t texturesDecoded() const { return decoded_; }  // of textureCount(), while loading
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
   bool hasDraws(DrawKind k) const { return !draws_[size_t(k)].empty(); }
@@ -79,13 +96,27 @@ class GpuScene {
   VkBuffer drawInfo() const { return drawInfo_.handle(); }  // GpuDraw per draw, for shading in compute
   VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), draw by draw
   uint32_t clusterCount() const { return clusterCount_; }
-  uint32_t textureCount() const { return uint32_t(textures_.size()); }
-  // Every texture with `sampler` (none: the default trilinear one).
+  uint32_t textureCount() const { return stats_.textures; }  // also while they load
+  // Every texture with `sampler` (none: the default trilinear one); none until texturesReady().
   std::vector<VkDescriptorImageInfo> textureDescriptors(VkSampler sampler = VK_NULL_HANDLE) const;
   const Bounds& bounds() const { return bounds_; }
   const GpuSceneStats& stats() const { return stats_; }
 
  private:
+  void finishTextures();  // staging buffers to images, mips, sampler
+
+  const vk::Context& ctx_;
+  MipMode mipMode_;
+  LoadProgress progress_;
+  struct Staged {
+    vk::Buffer buffer;
+    VkExtent2D extent;
+  };
+  std::vector<Staged> staged_;     // decoded texels, until uploaded
+  std::vector<VkFormat> formats_;  // of each texture
+  std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in
+  std::atomic<size_t> decoded_{0};
+  std::future<void> decoding_;     // valid while a deferred decode has not been taken in
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, clusters_;
   uint32_t clusterCount_ = 0;

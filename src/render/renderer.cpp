@@ -47,7 +47,12 @@ const char* toString(RasterPath path) {
 }
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), sampler_(makeSampler(ctx, {})), post_(ctx) {
+    : ctx_(ctx),
+      scene_(scene),
+      framesInFlight_(framesInFlight),
+      sampler_(makeSampler(ctx, {})),
+      texturesBound_(scene.texturesReady()),
+      post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 6);  // at most: clear, raster, raster large, raster hw, shade, post
   }
@@ -163,12 +168,7 @@ void Renderer::rebuildPipelines() {
   }
 }
 
-void Renderer::setSampler(const SamplerSettings& settings) {
-  // Samplers are cheap: a new one, and the texture sets written again once no frame uses them (a user's
-  // change in the panel, not a per-frame cost).
-  VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
-  sampler_ = makeSampler(ctx_, settings);
-  samplerSettings_ = settings;
+void Renderer::writeTextureSets() {
   const auto textures = scene_.textureDescriptors(sampler_);
   if (textures.empty()) return;
   for (auto& set : pipelines_) {
@@ -271,6 +271,16 @@ void Renderer::frame(FrameContext& fc) {
   const Lens& lens = fc.lens;
   const RenderSettings& s = fc.settings;
   const RenderTarget& target = fc.target;
+  // The texture sets are written again once no frame uses them, for a new sampler (samplers are cheap; a
+  // user's change in the panel) or the textures of a deferred load arriving (the compute rasteriser, which
+  // samples alpha masks, is then rebuilt with them).
+  const bool arrived = scene_.texturesReady() && !texturesBound_;
+  if (s.sampler != samplerSettings_ || arrived) {
+    VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+    if (s.sampler != samplerSettings_) sampler_ = makeSampler(ctx_, s.sampler), samplerSettings_ = s.sampler;
+    if (arrived) raster_.reset(), texturesBound_ = true;
+    writeTextureSets();
+  }
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
   const RasterPath raster = visibility ? rasterFor(s) : RasterPath::Auto;
   const bool compute = raster == RasterPath::Compute;
@@ -282,7 +292,6 @@ void Renderer::frame(FrameContext& fc) {
     raster_.emplace(ctx_, scene_);
     raster_->resize(extent_);
   }
-  if (s.sampler != samplerSettings_) setSampler(s.sampler);
   if (!compute) ensurePipelines(set);
   if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);
   lastRaster_ = raster;

@@ -88,6 +88,9 @@ def main():
 
         viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--size", f"{SIZE[0]}x{SIZE[1]}"], env)
         viewer.wait_line("err", r"move speed")
+        # The textures load while frames go on (the materials show their factors meanwhile): every frame this
+        # test compares comes after they are in.
+        viewer.wait_line("err", r"rtr-view: 13 textures in: ")
         win = xdo_out("search", "--sync", "--name", "^rtr-view").split()[0]
         xdo("windowfocus", "--sync", win)
 

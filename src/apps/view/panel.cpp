@@ -142,6 +142,12 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     track("message");
   }
   if (!facts.shaderError.empty()) ImGui::TextColored(ImVec4(1, 0.35f, 0.3f, 1), "shader error: %s", facts.shaderError.c_str());
+  if (facts.texturesLoading) {  // a bar while a deferred load decodes (the materials show their factors)
+    char label[64];
+    std::snprintf(label, sizeof label, "textures %zu/%u", facts.texturesDecoded, facts.textures);
+    ImGui::ProgressBar(facts.textures ? float(facts.texturesDecoded) / float(facts.textures) : 0.0f, ImVec2(-1, 0), label);
+    track("textures");
+  }
   // First, where no open section pushes it out of a small window.
   if (ImGui::Button("screenshot (PNG beside the scene)")) s.screenshotRequested = true;
   track("screenshot");

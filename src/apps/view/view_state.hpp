@@ -37,6 +37,8 @@ struct PanelFacts {
   double mipGpuMs = 0;
   std::string traceStatus, shaderError;
   float maxAnisotropy = 1;  // the device's; 1: no anisotropic filtering
+  size_t texturesDecoded = 0;     // of `textures`
+  bool texturesLoading = false;   // not all in yet: materials show their factors
 };
 
 // The last kFrames frames' CPU time and per-pass GPU times, for the panel's graphs.
