@@ -263,20 +263,28 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
 
-  if (!decoding_.valid()) finishTextures();
+  if (!decoding_.valid()) finishTextures(), ready_ = true;
 }
 
 GpuScene::~GpuScene() {
   if (decoding_.valid()) decoding_.wait();  // it writes into this object's staging buffers
-}
+}  // a pending upload waits for its submission, before the images go
 
 bool GpuScene::updateTextures(bool wait) {
-  if (!decoding_.valid() || (!wait && decoding_.wait_for(std::chrono::seconds(0)) != std::future_status::ready))
-    return false;
-  decoding_.get();  // rethrows a decoding error
+  if (ready_) return false;
+  if (!upload_) {  // still decoding
+    if (!wait && decoding_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+    decoding_.get();  // rethrows a decoding error
+    startUpload();
+  }
+  if (!wait && !upload_->submission->done()) return false;
+  upload_->submission->wait();
+  stats_.textureUploadMs = msSince(upload_->start);
+  stats_.mipGpuMs = upload_->timer.results().at(0).second;
+  upload_.reset();
+  staged_.clear();
   // Frames in flight read the material buffer: rewritten once none does (once per load).
   VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
-  finishTextures();
   const size_t bytes = texturedMaterials_.size() * sizeof(shader::GpuMaterial);
   if (materials_.mapped()) {
     std::memcpy(materials_.mapped(), texturedMaterials_.data(), bytes);
@@ -294,7 +302,45 @@ bool GpuScene::updateTextures(bool wait) {
     });
   }
   texturedMaterials_ = {};
+  ready_ = true;
   return true;
+}
+
+// A deferred load's upload and mips: one submission, polled by updateTextures() while frames go on.
+void GpuScene::startUpload() {
+  createTextures();
+  upload_ = std::make_unique<PendingUpload>(ctx_);
+  upload_->start = Clock::now();
+  upload_->submission.emplace(ctx_, [&](VkCommandBuffer cb) {
+    recordUpload(cb);
+    upload_->timer.reset(cb);
+    upload_->timer.begin(cb);
+    std::vector<const vk::Image*> batch;
+    for (const auto& img : textures_) batch.push_back(&img);
+    upload_->views = upload_->mips.record(cb, batch, mipMode_);  // its barriers wait for the copies
+    upload_->timer.mark(cb, "mips");
+  });
+}
+
+void GpuScene::createTextures() {
+  for (size_t i = 0; i < staged_.size(); ++i) textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
+  sampler_ = makeSampler(ctx_, {});
+}
+
+// Staging memory to level 0 of every texture.
+void GpuScene::recordUpload(VkCommandBuffer cb) const {
+  std::vector<vk::ImageBarrier> toDst;
+  for (auto& img : textures_)
+    toDst.push_back({img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                     VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
+  vk::barrier(cb, toDst);
+  for (size_t i = 0; i < textures_.size(); ++i) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {staged_[i].extent.width, staged_[i].extent.height, 1};
+    vkCmdCopyBufferToImage(cb, staged_[i].buffer.handle(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &region);
+  }
 }
 
 void GpuScene::finishTextures() {
@@ -302,23 +348,8 @@ void GpuScene::finishTextures() {
   vk::PipelineCache& pipelines = ctx.pipelineCache();
   // Texture upload: one submission of copies into level 0.
   auto t = Clock::now();
-  for (size_t i = 0; i < staged_.size(); ++i) textures_.emplace_back(ctx, textureDesc(staged_[i].extent, formats_[i]));
-  if (!textures_.empty())
-    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-      std::vector<vk::ImageBarrier> toDst;
-      for (auto& img : textures_)
-        toDst.push_back({img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                         VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                         VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
-      vk::barrier(cb, toDst);
-      for (size_t i = 0; i < textures_.size(); ++i) {
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {staged_[i].extent.width, staged_[i].extent.height, 1};
-        vkCmdCopyBufferToImage(cb, staged_[i].buffer.handle(), textures_[i].handle(),
-                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-      }
-    });
+  createTextures();
+  if (!textures_.empty()) vk::submitAndWait(ctx, [&](VkCommandBuffer cb) { recordUpload(cb); });
   staged_.clear();
   stats_.textureUploadMs = msSince(t);
 
@@ -338,8 +369,6 @@ void GpuScene::finishTextures() {
       timer.mark(cb, "mips");
     });
     stats_.mipGpuMs = timer.results().at(0).second;
-
-    sampler_ = makeSampler(ctx, {});
   }
   stats_.mipsMs = msSince(t) - (pipelines.stats().ms - pipelineMs);
 }
@@ -372,6 +401,7 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings)
 
 std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors(VkSampler sampler) const {
   std::vector<VkDescriptorImageInfo> out;
+  if (!ready_) return out;  // a deferred load's images exist before their upload completed
   for (const auto& t : textures_)
     out.push_back({sampler ? sampler : sampler_.get(), t.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   return out;

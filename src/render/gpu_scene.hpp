@@ -6,6 +6,9 @@
 // CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
 #include <array>
 #include <atomic>
+#include <chrono>
+#include <memory>
+#include <optional>
 #include <future>
 #include <functional>
 #include <vector>
@@ -13,6 +16,7 @@
 #include "frame.h"
 #include "render/mips.hpp"
 #include "scene/scene.hpp"
+#include "vk/commands.hpp"
 #include "vk/resources.hpp"
 
 namespace rtr::vk { class Context; }
@@ -78,11 +82,11 @@ class GpuScene {
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
 
-  // Deferred load, between frames: once the textures are decoded (at once, with `wait`), waits for the
-  // device to be idle, uploads them, generates their mips and points the materials at them; true then
-  // (once). Renderers notice by texturesReady() and write their texture descriptors.
+  // Deferred load, between frames: once the textures are decoded, submits their upload and mips; once
+  // those completed, waits for the device to be idle and points the materials at the textures: true then
+  // (once). `wait`: blocks until then. Renderers notice by texturesReady() and write their texture sets.
   bool updateTextures(bool wait = false);
-  bool texturesReady() const { return !decoding_.valid(); }
+  bool texturesReady() const { return ready_; }
   size_t texturesDecoded() const { return decoded_; }  // of textureCount(), while loading
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
@@ -103,7 +107,10 @@ class GpuScene {
   const GpuSceneStats& stats() const { return stats_; }
 
  private:
-  void finishTextures();  // staging buffers to images, mips, sampler
+  void finishTextures();  // staging buffers to images, mips (a waited load)
+  void startUpload();     // the same in one submission, not waited for (a deferred load)
+  void createTextures();
+  void recordUpload(VkCommandBuffer cb) const;
 
   const vk::Context& ctx_;
   MipMode mipMode_;
@@ -116,12 +123,22 @@ class GpuScene {
   std::vector<VkFormat> formats_;  // of each texture
   std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in
   std::atomic<size_t> decoded_{0};
-  std::future<void> decoding_;     // valid while a deferred decode has not been taken in
+  std::future<void> decoding_;     // a deferred load's decode, until taken in
+  bool ready_ = false;             // the textures are on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, clusters_;
   uint32_t clusterCount_ = 0;
   std::vector<vk::Image> textures_;
   vk::Sampler sampler_;
+  struct PendingUpload {  // alive until its submission completed
+    explicit PendingUpload(const vk::Context& ctx) : mips(ctx), timer(ctx, 1) {}
+    MipGenerator mips;
+    MipViews views;
+    vk::GpuTimer timer;
+    std::optional<vk::Submission> submission;
+    std::chrono::steady_clock::time_point start;
+  };
+  std::unique_ptr<PendingUpload> upload_;  // after textures_: destroyed (waited for) first
   Bounds bounds_;
   GpuSceneStats stats_;
 };

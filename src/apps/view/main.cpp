@@ -173,8 +173,8 @@ int runHeadless(const ViewOptions& o) {
   }
   if (gpuScene.updateTextures(true) && o.timings)  // how long the textures took, after the first frame
     std::fprintf(stderr, "rtr-view: textures in at %.0f ms from process start: decode %.0f ms (worker threads), "
-                 "texture upload %.0f ms, mips %.0f ms\n", render::msSinceProcessStart(), st.decodeMs,
-                 st.textureUploadMs, st.mipsMs);
+                 "upload and mips %.0f ms (mips %.3f ms GPU)\n", render::msSinceProcessStart(), st.decodeMs,
+                 st.textureUploadMs, st.mipGpuMs);
   if (o.bench > 0) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());

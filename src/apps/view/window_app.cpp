@@ -316,11 +316,12 @@ int runWindowed(const ViewOptions& opts) {
       if (cur.gpu->texturesReady())
         std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), cur.gpu->stats().mipGpuMs);
     }
-    // Textures decode on worker threads while frames go on; once decoded they are uploaded between frames.
+    // Textures decode on worker threads, then upload and get their mips in a submission of their own, while
+    // frames go on; then they are taken in between frames.
     if (cur.gpu->updateTextures()) {
       const auto& st = cur.gpu->stats();
-      std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload %.0f ms\n", st.textures,
-                   st.decodeMs, st.textureUploadMs);
+      std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload and mips %.0f ms\n",
+                   st.textures, st.decodeMs, st.textureUploadMs);
       std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), st.mipGpuMs);
     }
     ViewFrames& frames = *cur.frames;
