@@ -36,7 +36,16 @@ void main() {
   if (mode == VIEW_MIP_LEVEL) {
 #if HAS_TEXCOORDS
     uint t = materials[draw.material].textures.x;
-    c = t == NO_TEXTURE ? vec3(0.5) : mipColor(textureQueryLod(textures[t], inTexcoord).x + frame.params.y);
+    if (t == NO_TEXTURE) {
+      c = vec3(0.5);
+    } else {
+      vec2 q = textureQueryLod(textures[t], inTexcoord);
+      float level = q.x + frame.params.y;
+      // Nearest mip: the level the biased LOD rounds to (Vulkan: ceil(lod + 0.5) - 1), as the lookup takes.
+      if (frame.lightCount.y != 0u)
+        level = ceil(clamp(q.y + frame.params.y, 0.0, float(textureQueryLevels(textures[t]) - 1)) + 0.5) - 1.0;
+      c = mipColor(level);
+    }
 #else
     c = vec3(0.5);  // no texture coordinates: no mip level
 #endif

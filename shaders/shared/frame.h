@@ -41,7 +41,8 @@ struct FrameUniforms {
   vec4 rayDir;
   vec4 rayDx;
   vec4 rayDy;
-  uvec4 lightCount;   // x: lights in use (<= MAX_LIGHTS); debug views use the first
+  uvec4 lightCount;   // x: lights in use (<= MAX_LIGHTS); debug views use the first.
+                      // y: 1 where the sampler takes the nearest mip level (the mip view shows whole levels)
   GpuLight lights[MAX_LIGHTS];
 };
 

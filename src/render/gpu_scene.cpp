@@ -80,39 +80,40 @@ struct WriteTask {
 }  // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
-                   GeometryUpload upload) {
+                   GeometryUpload upload, TextureLoad textureLoad)
+    : ctx_(ctx), mipMode_(mipMode), progress_(progress) {
   bounds_ = scene.bounds();
-  vk::PipelineCache& pipelines = ctx.pipelineCache();
 
   // Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
-  // decoded straight into that texture's own staging buffer.
-  auto t = Clock::now();
+  // decoded straight into that texture's own staging buffer. Deferred: on a worker thread while the
+  // caller goes on (frames render with the materials' factors until updateTextures()).
   const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
   std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
   for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
-  struct Staged {
-    vk::Buffer buffer;
-    VkExtent2D extent;
-  };
-  std::vector<Staged> staged(used.size());
-  std::mutex progressMutex;
-  size_t decoded = 0;
-  decodeTextures(scene, used, [&](size_t i, TexelData&& texels) {
-    Staged& s = staged[i];
-    s.extent = {texels.width, texels.height};
-    s.buffer = vk::Buffer(ctx, std::max<size_t>(texels.texels.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                          vk::MemoryUse::Upload);
-    std::memcpy(s.buffer.mapped(), texels.texels.data(), texels.texels.size());
-    s.buffer.flush();
-    if (progress) {
+  for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i]));
+  staged_.resize(used.size());
+  stats_.textures = uint32_t(used.size());
+  auto decode = [this, &scene, used] {
+    const auto t = Clock::now();
+    std::mutex progressMutex;
+    decodeTextures(scene, used, [&](size_t i, TexelData&& texels) {
+      Staged& s = staged_[i];
+      s.extent = {texels.width, texels.height};
+      s.buffer = vk::Buffer(ctx_, std::max<size_t>(texels.texels.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                            vk::MemoryUse::Upload);
+      std::memcpy(s.buffer.mapped(), texels.texels.data(), texels.texels.size());
+      s.buffer.flush();
       const std::lock_guard lock(progressMutex);
-      progress("decoding textures", ++decoded, used.size());
-    }
-  });
-  stats_.decodeMs = msSince(t);
+      const size_t done = ++decoded_;
+      if (progress_) progress_("decoding textures", done, staged_.size());
+    });
+    stats_.decodeMs = msSince(t);
+  };
+  if (textureLoad == TextureLoad::Deferred && !used.empty()) decoding_ = std::async(std::launch::async, decode);
+  else decode();
 
   // Geometry: one stream per attribute for all meshes; indices 16-bit where the mesh has <= 65536 vertices.
-  t = Clock::now();
+  auto t = Clock::now();
   const bool anyTexcoords = std::any_of(scene.meshes.begin(), scene.meshes.end(),
                                         [](const Mesh& m) { return !m.texcoords.empty() && !m.indices.empty(); });
   std::vector<MeshSlot> slots;
@@ -165,6 +166,10 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     materials.push_back(g);
   }
   if (materials.empty()) materials.push_back({});
+  if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
+    texturedMaterials_ = materials;
+    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = NO_TEXTURE;
+  }
 
   // Each buffer is device-local. Where the device lets the host write such memory (lavapipe, a GPU with
   // a large BAR) the data is written there directly; else into one staging buffer, then copied.
@@ -266,28 +271,94 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
 
-  // Texture upload: one submission of copies into level 0.
-  t = Clock::now();
-  for (size_t i = 0; i < used.size(); ++i)
-    textures_.emplace_back(ctx, textureDesc(staged[i].extent, textureFormat(scene.textures[used[i]])));
-  stats_.textures = uint32_t(textures_.size());
-  if (!textures_.empty())
-    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-      std::vector<vk::ImageBarrier> toDst;
-      for (auto& img : textures_)
-        toDst.push_back({img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                         VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                         VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
-      vk::barrier(cb, toDst);
-      for (size_t i = 0; i < textures_.size(); ++i) {
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {staged[i].extent.width, staged[i].extent.height, 1};
-        vkCmdCopyBufferToImage(cb, staged[i].buffer.handle(), textures_[i].handle(),
-                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-      }
+  if (!decoding_.valid()) finishTextures(), ready_ = true;
+}
+
+GpuScene::~GpuScene() {
+  if (decoding_.valid()) decoding_.wait();  // it writes into this object's staging buffers
+}  // a pending upload waits for its submission, before the images go
+
+bool GpuScene::updateTextures(bool wait) {
+  if (ready_) return false;
+  if (!upload_) {  // still decoding
+    if (!wait && decoding_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+    decoding_.get();  // rethrows a decoding error
+    startUpload();
+  }
+  if (!wait && !upload_->submission->done()) return false;
+  upload_->submission->wait();
+  stats_.textureUploadMs = msSince(upload_->start);
+  stats_.mipGpuMs = upload_->timer.results().at(0).second;
+  upload_.reset();
+  staged_.clear();
+  // Frames in flight read the material buffer: rewritten once none does (once per load).
+  VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+  const size_t bytes = texturedMaterials_.size() * sizeof(shader::GpuMaterial);
+  if (materials_.mapped()) {
+    std::memcpy(materials_.mapped(), texturedMaterials_.data(), bytes);
+    materials_.flush();
+  } else {
+    vk::Buffer staging(ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "materials staging");
+    std::memcpy(staging.mapped(), texturedMaterials_.data(), bytes);
+    staging.flush();
+    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
+      const VkBufferCopy region{0, 0, bytes};
+      vkCmdCopyBuffer(cb, staging.handle(), materials_.handle(), 1, &region);
+      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     });
-  staged.clear();
+  }
+  texturedMaterials_ = {};
+  ready_ = true;
+  return true;
+}
+
+// A deferred load's upload and mips: one submission, polled by updateTextures() while frames go on.
+void GpuScene::startUpload() {
+  createTextures();
+  upload_ = std::make_unique<PendingUpload>(ctx_);
+  upload_->start = Clock::now();
+  upload_->submission.emplace(ctx_, [&](VkCommandBuffer cb) {
+    recordUpload(cb);
+    upload_->timer.reset(cb);
+    upload_->timer.begin(cb);
+    std::vector<const vk::Image*> batch;
+    for (const auto& img : textures_) batch.push_back(&img);
+    upload_->views = upload_->mips.record(cb, batch, mipMode_);  // its barriers wait for the copies
+    upload_->timer.mark(cb, "mips");
+  });
+}
+
+void GpuScene::createTextures() {
+  for (size_t i = 0; i < staged_.size(); ++i) textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
+  sampler_ = makeSampler(ctx_, {});
+}
+
+// Staging memory to level 0 of every texture.
+void GpuScene::recordUpload(VkCommandBuffer cb) const {
+  std::vector<vk::ImageBarrier> toDst;
+  for (auto& img : textures_)
+    toDst.push_back({img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                     VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
+  vk::barrier(cb, toDst);
+  for (size_t i = 0; i < textures_.size(); ++i) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {staged_[i].extent.width, staged_[i].extent.height, 1};
+    vkCmdCopyBufferToImage(cb, staged_[i].buffer.handle(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &region);
+  }
+}
+
+void GpuScene::finishTextures() {
+  const vk::Context& ctx = ctx_;
+  vk::PipelineCache& pipelines = ctx.pipelineCache();
+  // Texture upload: one submission of copies into level 0.
+  auto t = Clock::now();
+  createTextures();
+  if (!textures_.empty()) vk::submitAndWait(ctx, [&](VkCommandBuffer cb) { recordUpload(cb); });
+  staged_.clear();
   stats_.textureUploadMs = msSince(t);
 
   // Mips, in a submission of their own (their pipelines' creation is counted as pipeline creation).
@@ -302,27 +373,45 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       timer.begin(cb);
       std::vector<const vk::Image*> batch;
       for (const auto& img : textures_) batch.push_back(&img);
-      views = mipGen.record(cb, batch, mipMode);  // all textures, one barrier per step
+      views = mipGen.record(cb, batch, mipMode_);  // all textures, one barrier per step
       timer.mark(cb, "mips");
     });
     stats_.mipGpuMs = timer.results().at(0).second;
-
-    VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-    si.magFilter = si.minFilter = VK_FILTER_LINEAR;
-    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;  // trilinear
-    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
-    si.maxLod = VK_LOD_CLAMP_NONE;
-    si.anisotropyEnable = VK_FALSE;  // the mip-level view must show what trilinear filtering picks
-    VkSampler raw;
-    VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &raw));
-    sampler_ = vk::Sampler(ctx.device(), raw);
   }
   stats_.mipsMs = msSince(t) - (pipelines.stats().ms - pipelineMs);
 }
 
-std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors() const {
+const char* toString(TextureFilter f) {
+  return f == TextureFilter::Trilinear ? "trilinear" : f == TextureFilter::NearestMip ? "nearest-mip" : "nearest";
+}
+
+float maxAnisotropy(const vk::Context& ctx) {
+  VkPhysicalDeviceFeatures features{};
+  vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
+  return features.samplerAnisotropy ? ctx.properties().limits.maxSamplerAnisotropy : 1.0f;
+}
+
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings) {
+  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  const bool nearest = settings.filter == TextureFilter::Nearest;
+  si.magFilter = si.minFilter = nearest ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+  si.mipmapMode = settings.filter == TextureFilter::Trilinear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  si.maxLod = VK_LOD_CLAMP_NONE;
+  // Off by default: the mip-level view must show what plain trilinear filtering picks.
+  const float anisotropy = std::clamp(settings.anisotropy, 1.0f, maxAnisotropy(ctx));
+  si.anisotropyEnable = anisotropy > 1.0f;
+  si.maxAnisotropy = anisotropy;
+  VkSampler raw;
+  VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &raw));
+  return vk::Sampler(ctx.device(), raw);
+}
+
+std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors(VkSampler sampler) const {
   std::vector<VkDescriptorImageInfo> out;
-  for (const auto& t : textures_) out.push_back({sampler_, t.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  if (!ready_) return out;  // a deferred load's images exist before their upload completed
+  for (const auto& t : textures_)
+    out.push_back({sampler ? sampler : sampler_.get(), t.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   return out;
 }
 

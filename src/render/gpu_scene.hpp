@@ -5,12 +5,18 @@
 // Geometry is written on all cores straight into device-local memory where the host can write it (every
 // CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
 #include <array>
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <future>
 #include <functional>
 #include <vector>
 
 #include "frame.h"
 #include "render/mips.hpp"
 #include "scene/scene.hpp"
+#include "vk/commands.hpp"
 #include "vk/resources.hpp"
 
 namespace rtr::vk { class Context; }
@@ -45,14 +51,43 @@ struct GpuSceneStats {
 // Told how far a long load is: what it does, how many of how many are done (serialised calls).
 using LoadProgress = std::function<void(const char* what, size_t done, size_t total)>;
 
+// How the scene's textures are sampled (the brief's mip experiments, task 1.4): trilinear; the nearest mip
+// level, filtered linearly within it; or nearest texel of the nearest level. Anisotropy 1 is off.
+enum class TextureFilter { Trilinear, NearestMip, Nearest };
+const char* toString(TextureFilter filter);
+struct SamplerSettings {
+  TextureFilter filter = TextureFilter::Trilinear;
+  float anisotropy = 1.0f;
+  bool operator==(const SamplerSettings&) const = default;
+};
+// The largest anisotropy the device samples with: 1 without the samplerAnisotropy feature.
+float maxAnisotropy(const vk::Context& ctx);
+// A repeat-wrapping sampler for scene textures; the anisotropy is clamped to maxAnisotropy(ctx).
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings);
+
 // How the geometry reaches device memory: written in place where the host can map it (Auto), or always
 // through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
 enum class GeometryUpload { Auto, Staging };
 
+// Whether the constructor returns with the textures on the GPU (Wait), or leaves them decoding on worker
+// threads (Deferred): until updateTextures() takes them in, every material shows its factors alone.
+enum class TextureLoad { Wait, Deferred };
+
 class GpuScene {
  public:
+  // `scene` and `progress` must outlive a Deferred texture load (or the object).
   GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {},
-           GeometryUpload upload = GeometryUpload::Auto);
+           GeometryUpload upload = GeometryUpload::Auto, TextureLoad textures = TextureLoad::Wait);
+  ~GpuScene();
+  GpuScene(const GpuScene&) = delete;
+  GpuScene& operator=(const GpuScene&) = delete;
+
+  // Deferred load, between frames: once the textures are decoded, submits their upload and mips; once
+  // those completed, waits for the device to be idle and points the materials at the textures: true then
+  // (once). `wait`: blocks until then. Renderers notice by texturesReady() and write their texture sets.
+  bool updateTextures(bool wait = false);
+  bool texturesReady() const { return ready_; }
+  size_t texturesDecoded() const { return decoded_; }  // of textureCount(), while loading
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
   bool hasDraws(DrawKind k) const { return !draws_[size_t(k)].empty(); }
@@ -65,17 +100,45 @@ class GpuScene {
   VkBuffer drawInfo() const { return drawInfo_.handle(); }  // GpuDraw per draw, for shading in compute
   VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), draw by draw
   uint32_t clusterCount() const { return clusterCount_; }
-  uint32_t textureCount() const { return uint32_t(textures_.size()); }
-  std::vector<VkDescriptorImageInfo> textureDescriptors() const;
+  uint32_t textureCount() const { return stats_.textures; }  // also while they load
+  // Every texture with `sampler` (none: the default trilinear one); none until texturesReady().
+  std::vector<VkDescriptorImageInfo> textureDescriptors(VkSampler sampler = VK_NULL_HANDLE) const;
   const Bounds& bounds() const { return bounds_; }
   const GpuSceneStats& stats() const { return stats_; }
 
  private:
+  void finishTextures();  // staging buffers to images, mips (a waited load)
+  void startUpload();     // the same in one submission, not waited for (a deferred load)
+  void createTextures();
+  void recordUpload(VkCommandBuffer cb) const;
+
+  const vk::Context& ctx_;
+  MipMode mipMode_;
+  LoadProgress progress_;
+  struct Staged {
+    vk::Buffer buffer;
+    VkExtent2D extent;
+  };
+  std::vector<Staged> staged_;     // decoded texels, until uploaded
+  std::vector<VkFormat> formats_;  // of each texture
+  std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in
+  std::atomic<size_t> decoded_{0};
+  std::future<void> decoding_;     // a deferred load's decode, until taken in
+  bool ready_ = false;             // the textures are on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, clusters_;
   uint32_t clusterCount_ = 0;
   std::vector<vk::Image> textures_;
   vk::Sampler sampler_;
+  struct PendingUpload {  // alive until its submission completed
+    explicit PendingUpload(const vk::Context& ctx) : mips(ctx), timer(ctx, 1) {}
+    MipGenerator mips;
+    MipViews views;
+    vk::GpuTimer timer;
+    std::optional<vk::Submission> submission;
+    std::chrono::steady_clock::time_point start;
+  };
+  std::unique_ptr<PendingUpload> upload_;  // after textures_: destroyed (waited for) first
   Bounds bounds_;
   GpuSceneStats stats_;
 };

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "vk/check.hpp"
 #include "vk/context.hpp"
 
 namespace rtr::render {
@@ -46,7 +47,12 @@ const char* toString(RasterPath path) {
 }
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), post_(ctx) {
+    : ctx_(ctx),
+      scene_(scene),
+      framesInFlight_(framesInFlight),
+      sampler_(makeSampler(ctx, {})),
+      texturesBound_(scene.texturesReady()),
+      post_(ctx) {
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 12);  // at most: ComputeRaster::record's nine passes, shade, post
   }
@@ -93,7 +99,7 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   p.pipeline.emplace(vk::makeGraphicsPipeline(ctx_, d, options));
   const vk::PipelineLayout& layout = p.pipeline->layout;
   p.sets = vk::DescriptorSets(ctx_, layout, framesInFlight_);
-  auto textures = scene_.textureDescriptors();
+  auto textures = scene_.textureDescriptors(sampler_);
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
     if (layout.setCount() == 0) break;
     // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
@@ -131,7 +137,7 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
       vk::makeComputePipeline(ctx_, vk::loadShader(shader), options));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
-    auto textures = scene_.textureDescriptors();
+    auto textures = scene_.textureDescriptors(sampler_);
     if (!textures.empty()) vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
   }
   return v;
@@ -160,6 +166,21 @@ void Renderer::rebuildPipelines() {
     raster_.reset();
     raster_.emplace(std::move(*raster));
   }
+}
+
+void Renderer::writeTextureSets() {
+  const auto textures = scene_.textureDescriptors(sampler_);
+  if (textures.empty()) return;
+  for (auto& set : pipelines_) {
+    if (!set) continue;
+    for (ScenePipelines& p : *set)
+      if (p.pipeline && p.pipeline->layout.setCount() > 1)
+        for (uint32_t frame = 0; frame < framesInFlight_; ++frame)
+          vk::DescriptorWriter(ctx_, p.pipeline->layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
+  }
+  for (VisShade& v : shade_)
+    if (v.pipeline && v.pipeline->layout.setCount() > 1)
+      vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -250,6 +271,16 @@ void Renderer::frame(FrameContext& fc) {
   const Lens& lens = fc.lens;
   const RenderSettings& s = fc.settings;
   const RenderTarget& target = fc.target;
+  // The texture sets are written again once no frame uses them, for a new sampler (samplers are cheap; a
+  // user's change in the panel) or the textures of a deferred load arriving (the compute rasteriser, which
+  // samples alpha masks, is then rebuilt with them).
+  const bool arrived = scene_.texturesReady() && !texturesBound_;
+  if (s.sampler != samplerSettings_ || arrived) {
+    VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+    if (s.sampler != samplerSettings_) sampler_ = makeSampler(ctx_, s.sampler), samplerSettings_ = s.sampler;
+    if (arrived) raster_.reset(), texturesBound_ = true;
+    writeTextureSets();
+  }
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
   const RasterPath raster = visibility ? rasterFor(s) : RasterPath::Auto;
   const bool compute = raster == RasterPath::Compute;
@@ -273,6 +304,7 @@ void Renderer::frame(FrameContext& fc) {
   u.ambient = glm::vec4(s.lights.ambient, 0.0f);
   static_assert(MAX_LIGHTS == kMaxLights);
   u.lightCount.x = uint32_t(std::min(s.lights.lights.size(), kMaxLights));
+  u.lightCount.y = s.sampler.filter != TextureFilter::Trilinear;  // the mip view shows whole levels
   for (uint32_t i = 0; i < u.lightCount.x; ++i) {
     const Light& l = s.lights.lights[i];
     const glm::vec3 p = l.kind == Light::Kind::Headlight ? pose.position : l.position;

@@ -39,6 +39,7 @@ struct RenderSettings {
   // it saved in every measured scene, up to 10 M triangles (docs/raster.md).
   bool cull = false;
   float lodBias = 0.0f;
+  SamplerSettings sampler;        // how scene textures are filtered (mip experiments)
   MosaicMode mosaic = MosaicMode::Compute;
   // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;
   // the apps resolve them once from the scene and the command line (scene/lights.hpp).
@@ -113,10 +114,14 @@ class Renderer {
   void ensurePipelines(PipelineSet set);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set);
   void shadeVisibility(VkCommandBuffer cb, RasterPath raster);
+  void writeTextureSets();  // the texture array of every pipeline built, with sampler_
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
   uint32_t framesInFlight_;
+  SamplerSettings samplerSettings_;
+  vk::Sampler sampler_;  // the texture descriptors' sampler, made from samplerSettings_
+  bool texturesBound_;   // the scene's textures were ready when the texture sets were written
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   std::array<VisShade, 3> shade_;  // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer

@@ -5,20 +5,19 @@
 
 namespace rtr::vk {
 
-void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record) {
-  VkDevice device = ctx.device();
+Submission::Submission(const Context& ctx, const std::function<void(VkCommandBuffer)>& record) : device_(ctx.device()) {
   VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pi.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
   pi.queueFamilyIndex = ctx.queueFamily();
   VkCommandPool rawPool;
-  VK_CHECK(vkCreateCommandPool(device, &pi, nullptr, &rawPool));
-  CommandPool pool(device, rawPool);
+  VK_CHECK(vkCreateCommandPool(device_, &pi, nullptr, &rawPool));
+  pool_ = CommandPool(device_, rawPool);
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = pool;
+  ai.commandPool = pool_;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
   VkCommandBuffer cb;
-  VK_CHECK(vkAllocateCommandBuffers(device, &ai, &cb));
+  VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cb));
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(cb, &bi));
@@ -26,15 +25,35 @@ void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)
   VK_CHECK(vkEndCommandBuffer(cb));
   VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VkFence rawFence;
-  VK_CHECK(vkCreateFence(device, &fi, nullptr, &rawFence));
-  Fence fence(device, rawFence);
+  VK_CHECK(vkCreateFence(device_, &fi, nullptr, &rawFence));
+  fence_ = Fence(device_, rawFence);
   VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
   cbi.commandBuffer = cb;
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
   si.commandBufferInfoCount = 1;
   si.pCommandBufferInfos = &cbi;
-  VK_CHECK(vkQueueSubmit2(ctx.queue(), 1, &si, fence));
-  VK_CHECK(vkWaitForFences(device, 1, &rawFence, VK_TRUE, UINT64_MAX));
+  VK_CHECK(vkQueueSubmit2(ctx.queue(), 1, &si, fence_));
+}
+
+Submission::~Submission() {
+  if (!fence_) return;  // moved from
+  const VkFence f = fence_;
+  vkWaitForFences(device_, 1, &f, VK_TRUE, UINT64_MAX);
+}
+
+bool Submission::done() const {
+  const VkResult r = vkGetFenceStatus(device_, fence_);
+  if (r != VK_NOT_READY) VK_CHECK(r);
+  return r == VK_SUCCESS;
+}
+
+void Submission::wait() const {
+  const VkFence f = fence_;
+  VK_CHECK(vkWaitForFences(device_, 1, &f, VK_TRUE, UINT64_MAX));
+}
+
+void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record) {
+  Submission(ctx, record).wait();
 }
 
 void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images) {

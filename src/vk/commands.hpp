@@ -12,6 +12,22 @@ namespace rtr::vk {
 
 class Context;
 
+// Records `record` into a fresh command buffer and submits it, without waiting: done() polls, wait()
+// blocks; the destructor waits (the command buffer must not be freed while it runs).
+class Submission {
+ public:
+  Submission(const Context& ctx, const std::function<void(VkCommandBuffer)>& record);
+  Submission(Submission&&) = default;
+  ~Submission();
+  bool done() const;
+  void wait() const;
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  CommandPool pool_;
+  Fence fence_;
+};
+
 // Records `record` into a fresh command buffer, submits it and waits for it to finish.
 void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record);
 

@@ -88,6 +88,9 @@ def main():
 
         viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--size", f"{SIZE[0]}x{SIZE[1]}"], env)
         viewer.wait_line("err", r"move speed")
+        # The textures load while frames go on (the materials show their factors meanwhile): every frame this
+        # test compares comes after they are in.
+        viewer.wait_line("err", r"rtr-view: 13 textures in: ")
         win = xdo_out("search", "--sync", "--name", "^rtr-view").split()[0]
         xdo("windowfocus", "--sync", win)
 
@@ -180,6 +183,19 @@ def main():
         check(m and float(m.group(1)) > 1.0, f"dragging the slider raises the LOD bias ({m.group(0) if m else title()})")
         check(screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1]) != before_view, "the mip-level view changes with it")
         check(pose() == p0, "a drag on the panel does not move the camera")
+
+        # The filter buttons: the nearest mip level changes the mip-level view; trilinear brings its frame back
+        # (the texture descriptors rewritten between frames, under the validation layer).
+        trilinear_view = screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1])
+        click("nearest-mip")
+        wait_title("| nearest-mip x1 |")
+        settle()
+        check(screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1]) != trilinear_view, "nearest-mip changes the mip-level view")
+        click("trilinear")
+        wait_title("| trilinear x1 |")
+        settle()
+        check(screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1]) == trilinear_view,
+              "back to trilinear: the same mip-level view, pixel for pixel")
 
         # The screenshot button: a PNG beside the scene, without the panel, never overwriting.
         click("screenshot")

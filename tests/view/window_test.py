@@ -145,7 +145,9 @@ def main():
             return subprocess.run(["xdotool", *map(str, args)], env=env, check=True, capture_output=True, text=True,
                                   timeout=30).stdout.strip()
 
-        viewer = Viewer([viewer_bin, scene, "--validation", "--size", f"{SIZE[0]}x{SIZE[1]}", "--mosaic", "off"], env)
+        # --wait-textures: every frame compared has the textures (the panel test covers a deferred load).
+        viewer = Viewer([viewer_bin, scene, "--validation", "--wait-textures", "--size", f"{SIZE[0]}x{SIZE[1]}",
+                         "--mosaic", "off"], env)
         speed = float(viewer.wait_line("err", r"move speed ([0-9.eE+-]+) units/s").group(1))
         win = xdo_out("search", "--sync", "--name", "^rtr-view").split()[0]
         # No window manager: give the window the keyboard focus and put the pointer over it ourselves.

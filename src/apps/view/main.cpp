@@ -59,6 +59,9 @@ DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
                render::toString(c.mips), o.mipsGiven ? "--mips" : "default");
   if (!o.shadingGiven || !o.mipsGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
   std::fprintf(stderr, "\n");
+  if (const float max = render::maxAnisotropy(ctx); o.settings.sampler.anisotropy > max)
+    std::fprintf(stderr, "rtr-view: note: --anisotropy %g: %s samples with at most %g\n", o.settings.sampler.anisotropy,
+                 ctx.deviceName().c_str(), max);
   return c;
 }
 
@@ -125,20 +128,26 @@ int runHeadless(const ViewOptions& o) {
                  terminal && done < total ? "" : "\n");
     lastShown = Clock::now();
   };
-  render::GpuScene gpuScene(ctx, scene, choice.mips, progress);
-  const auto& st = gpuScene.stats();
-  timeline.add("texture decode", st.decodeMs);
+  const bool wait = o.waitTextures.value_or(true);
+  render::GpuScene gpuScene(ctx, scene, choice.mips, progress, render::GeometryUpload::Auto,
+                            wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred);
+  const auto& st = gpuScene.stats();  // the texture phases: once they are in
+  if (wait) timeline.add("texture decode", st.decodeMs);
   timeline.add("geometry upload", st.geometryMs);
-  timeline.add("texture upload", st.textureUploadMs);
-  timeline.add("mips", st.mipsMs);
+  if (wait) timeline.add("texture upload", st.textureUploadMs), timeline.add("mips", st.mipsMs);
   last = Clock::now();
   const double pipelineMsBefore = ctx.pipelineCache().stats().ms;
   std::fprintf(stderr, "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
-               "decode %.0f ms, geometry %.0f ms (%.2f GB/s), texture upload %.0f ms, mips %.3f ms GPU\n",
+               "geometry %.0f ms (%.2f GB/s)",
                o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16,
-               st.triangles, st.textures, st.decodeMs, st.geometryMs,
-               st.geometryMs > 0 ? double(st.geometryBytes) / st.geometryMs * 1e-6 : 0.0, st.textureUploadMs,
-               st.mipGpuMs);
+               st.triangles, st.textures, st.geometryMs,
+               st.geometryMs > 0 ? double(st.geometryBytes) / st.geometryMs * 1e-6 : 0.0);
+  if (wait)
+    std::fprintf(stderr, ", decode %.0f ms, texture upload %.0f ms, mips %.3f ms GPU", st.decodeMs, st.textureUploadMs,
+                 st.mipGpuMs);
+  else if (st.textures)
+    std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
+  std::fprintf(stderr, "\n");
   const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(o.lens, scene.bounds(), pose);
   render::RenderSettings settings = sceneSettings(o, scene);
@@ -147,8 +156,10 @@ int runHeadless(const ViewOptions& o) {
   const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
   phase("renderer setup (start pose, targets)", setupPipelineMs);
   std::optional<render::HeadlessFrame> first;
+  // --no-wait-textures: the first frame is rendered before the textures are in (the materials' factors);
+  // they are taken in after it, for the frames that follow.
+  if (o.timings || !wait) first = renderer.render(pose, lens, settings, 1);
   if (o.timings) {
-    first = renderer.render(pose, lens, settings, 1);
     const double totalMs = render::msSinceProcessStart();
     const vk::PipelineStats ps = ctx.pipelineCache().stats();
     char name[120];
@@ -160,6 +171,10 @@ int runHeadless(const ViewOptions& o) {
     phase("first frame complete (record, GPU, read-back)", ps.ms - pipelineMsBefore - setupPipelineMs);
     std::fprintf(stderr, "rtr-view: %s", timeline.format(totalMs).c_str());
   }
+  if (gpuScene.updateTextures(true) && o.timings)  // how long the textures took, after the first frame
+    std::fprintf(stderr, "rtr-view: textures in at %.0f ms from process start: decode %.0f ms (worker threads), "
+                 "upload and mips %.0f ms (mips %.3f ms GPU)\n", render::msSinceProcessStart(), st.decodeMs,
+                 st.textureUploadMs, st.mipGpuMs);
   if (o.bench > 0) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
@@ -197,7 +212,9 @@ int main(int argc, char** argv) {
                "Esc quit.",
                "rtr-view"};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "off", light, lightColor,
-              ambient = "0.02", mtl;
+              ambient = "0.02", mtl,
+              filter = "trilinear";
+  bool waitTextures = true;
   std::string shadingPath = render::toString(o.settings.shading), raster = render::toString(o.settings.raster);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_option("--mtl", mtl, "OBJ: take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
@@ -223,6 +240,12 @@ int main(int argc, char** argv) {
   app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
+  app.add_option("--filter", filter, "texture filter: trilinear | nearest-mip (nearest level, bilinear in it) | nearest "
+                 "(nearest texel of the nearest level)")
+      ->check(CLI::IsMember({"trilinear", "nearest-mip", "nearest"}))->capture_default_str();
+  app.add_option("--anisotropy", o.settings.sampler.anisotropy,
+                 "anisotropic filtering, 1 (off) up to the device's maxSamplerAnisotropy (more is clamped, with a note)")
+      ->check(cli::number(1, 64))->capture_default_str();
   app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
   app.add_flag("--falloff", o.lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
@@ -235,6 +258,9 @@ int main(int argc, char** argv) {
   app.add_flag("--orbit", o.orbit, "start in orbit camera mode: left-drag turns about a target, scroll zooms, middle-drag pans (windowed)");
   app.add_option("--device", o.device, "Vulkan device index or name substring (default: discrete GPU first)");
   app.add_flag("--validation", o.validation, "enable the Vulkan validation layer");
+  CLI::Option* waitOpt = app.add_flag("--wait-textures,!--no-wait-textures", waitTextures,
+               "the first frame waits for the textures (default: yes with --headless; in the window materials show "
+               "their factors until their textures are in)");
   app.add_flag("--timings", o.timings, "print the start-up phases in ms (headless), from process start to the first frame");
   app.add_flag("!--no-pipeline-cache", o.pipelineCache,
                "neither read nor write the pipeline cache ($XDG_CACHE_HOME/rtr or ~/.cache/rtr; RTR_PIPELINE_CACHE=DIR|off)");
@@ -261,9 +287,13 @@ int main(int argc, char** argv) {
     if (!mosaicModes.count(mosaic)) throw UsageError("--mosaic '" + mosaic + "': expected off, compute or graphics");
     o.mips = mipModes.at(mips);
     o.mipsGiven = mipsOpt->count() > 0;
+    if (waitOpt->count()) o.waitTextures = waitTextures;
     o.shadingGiven = shadingOpt->count() > 0;
     o.settings.mosaic = mosaicModes.at(mosaic);
     o.settings.shading = shadingPath == "forward" ? render::ShadingPath::Forward : render::ShadingPath::Visibility;
+    o.settings.sampler.filter = filter == "nearest" ? render::TextureFilter::Nearest
+                                : filter == "nearest-mip" ? render::TextureFilter::NearestMip
+                                                          : render::TextureFilter::Trilinear;
     o.settings.raster = raster == "hardware" ? render::RasterPath::Hardware
                         : raster == "compute" ? render::RasterPath::Compute
                                               : render::RasterPath::Auto;

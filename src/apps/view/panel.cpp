@@ -1,6 +1,7 @@
 // The windowed viewer's settings panel: every setting that has a key, the lights, the camera, the tracer,
 // scene facts and the frame-time graphs.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -141,6 +142,15 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     track("message");
   }
   if (!facts.shaderError.empty()) ImGui::TextColored(ImVec4(1, 0.35f, 0.3f, 1), "shader error: %s", facts.shaderError.c_str());
+  if (facts.texturesLoading) {  // a bar while a deferred load decodes (the materials show their factors)
+    char label[64];
+    std::snprintf(label, sizeof label, "textures %zu/%u", facts.texturesDecoded, facts.textures);
+    ImGui::ProgressBar(facts.textures ? float(facts.texturesDecoded) / float(facts.textures) : 0.0f, ImVec2(-1, 0), label);
+    track("textures");
+  }
+  // First, where no open section pushes it out of a small window.
+  if (ImGui::Button("screenshot (PNG beside the scene)")) s.screenshotRequested = true;
+  track("screenshot");
 
   if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) {
     if (ImGui::BeginCombo("view", modeName(s.settings.mode))) {
@@ -175,6 +185,20 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::TextDisabled("%.3f ms GPU", facts.mipGpuMs);
     ImGui::SliderFloat("LOD bias", &s.settings.lodBias, -4.0f, 4.0f, "%.2f");
     track("lodbias");
+    // Sampler changes take effect on the next frame (the renderer rewrites its texture descriptors).
+    render::SamplerSettings& sampler = s.settings.sampler;
+    ImGui::Text("filter:");
+    for (auto f : {render::TextureFilter::Trilinear, render::TextureFilter::NearestMip, render::TextureFilter::Nearest}) {
+      ImGui::SameLine();
+      radio(render::toString(f), sampler.filter, f);
+    }
+    if (facts.maxAnisotropy > 1) {
+      ImGui::SliderFloat("anisotropy", &sampler.anisotropy, 1.0f, facts.maxAnisotropy, sampler.anisotropy > 1 ? "%.0fx" : "off");
+      track("anisotropy");
+      sampler.anisotropy = std::clamp(std::round(sampler.anisotropy), 1.0f, facts.maxAnisotropy);
+    } else {
+      ImGui::TextDisabled("anisotropy: not supported by the device");
+    }
     ImGui::Text("shading path: %s", render::toString(s.settings.shading));
   }
   if (ImGui::CollapsingHeader("Lights")) lightsSection(s);
@@ -186,8 +210,6 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
                 facts.triangles);
     ImGui::TextDisabled("drop an .obj, .obj.zst, .rtrscene or .comp5892mesh on the window to load it");
   }
-  if (ImGui::Button("screenshot (PNG beside the scene)")) s.screenshotRequested = true;
-  track("screenshot");
   if (ImGui::CollapsingHeader("Timing", ImGuiTreeNodeFlags_DefaultOpen)) {
     graph("CPU frame", history.cpuMs);
     for (const auto& [name, values] : history.gpuMs) {

@@ -36,6 +36,9 @@ struct PanelFacts {
   uint32_t meshes = 0, materials = 0, textures = 0, triangles = 0;
   double mipGpuMs = 0;
   std::string traceStatus, shaderError;
+  float maxAnisotropy = 1;  // the device's; 1: no anisotropic filtering
+  size_t texturesDecoded = 0;     // of `textures`
+  bool texturesLoading = false;   // not all in yet: materials show their factors
 };
 
 // The last kFrames frames' CPU time and per-pass GPU times, for the panel's graphs.

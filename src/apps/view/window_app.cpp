@@ -183,8 +183,9 @@ struct Loaded {
     frames.reset();
     gpu.reset();
   }
-  void build(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D extent, render::MipMode mips) {
-    gpu = std::make_unique<render::GpuScene>(ctx, *scene, mips);
+  void build(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D extent, render::MipMode mips, bool waitTextures) {
+    gpu = std::make_unique<render::GpuScene>(ctx, *scene, mips, render::LoadProgress{}, render::GeometryUpload::Auto,
+                                             waitTextures ? render::TextureLoad::Wait : render::TextureLoad::Deferred);
     frames = std::make_unique<ViewFrames>(ctx, surface, extent, *gpu);
     traced = std::make_unique<TraceOverlay>(ctx, *scene);
   }
@@ -257,7 +258,8 @@ int runWindowed(const ViewOptions& opts) {
   o.camera.reset();  // a dropped scene starts from its own view
   // The scene's GPU objects go before the surface, window and device, however the loop ends.
   struct Release { Loaded& l; const vk::Context& c; ~Release() { l.release(c); } } releaseGuard{cur, ctx};
-  cur.build(ctx, surface, {o.width, o.height}, app.mips);
+  const bool waitTextures = o.waitTextures.value_or(false);
+  cur.build(ctx, surface, {o.width, o.height}, app.mips, waitTextures);
   std::string scenePath = o.scene;
 
   std::unique_ptr<ShaderWatcher> watcher;
@@ -310,8 +312,17 @@ int runWindowed(const ViewOptions& opts) {
         cur.scene = std::move(dropped);
         startScene(app, o, *cur.scene);
       }
-      cur.build(ctx, surface, e, app.mips);
-      std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), cur.gpu->stats().mipGpuMs);
+      cur.build(ctx, surface, e, app.mips, waitTextures);
+      if (cur.gpu->texturesReady())
+        std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), cur.gpu->stats().mipGpuMs);
+    }
+    // Textures decode on worker threads, then upload and get their mips in a submission of their own, while
+    // frames go on; then they are taken in between frames.
+    if (cur.gpu->updateTextures()) {
+      const auto& st = cur.gpu->stats();
+      std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload and mips %.0f ms\n",
+                   st.textures, st.decodeMs, st.textureUploadMs);
+      std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), st.mipGpuMs);
     }
     ViewFrames& frames = *cur.frames;
     TraceOverlay& traced = *cur.traced;
@@ -401,7 +412,8 @@ int runWindowed(const ViewOptions& opts) {
     if (app.panel) {
       const auto& st = cur.gpu->stats();
       PanelFacts facts{scenePath, st.meshes, uint32_t(scene.materials.size()), st.textures, st.triangles, st.mipGpuMs,
-                       traced.visible() ? traced.status() : std::string(), shaderError};
+                       traced.visible() ? traced.status() : std::string(), shaderError, render::maxAnisotropy(ctx),
+                       cur.gpu->texturesDecoded(), !cur.gpu->texturesReady()};
       drawPanel(app, facts, history);
     }
     ImGui::Render();
@@ -438,9 +450,10 @@ int runWindowed(const ViewOptions& opts) {
     if (titleTimer > 0.25) {  // the window title: mode, timings, tracer status (the window test reads it)
       titleTimer = 0;
       char buf[160];
-      std::snprintf(buf, sizeof buf, "rtr-view | mode %d | %s | mosaic %s | lod bias %.2f | %s | CPU frame %.2f ms",
+      std::snprintf(buf, sizeof buf, "rtr-view | mode %d | %s | mosaic %s | lod bias %.2f | %s x%g | %s | CPU frame %.2f ms",
                     app.settings.mode, modeName(app.settings.mode), render::toString(app.settings.mosaic),
-                    app.settings.lodBias, app.camera.mode() == CameraMode::Orbit ? "orbit" : "fly", cpuFrameMs);
+                    app.settings.lodBias, render::toString(app.settings.sampler.filter), app.settings.sampler.anisotropy,
+                    app.camera.mode() == CameraMode::Orbit ? "orbit" : "fly", cpuFrameMs);
       std::string title = buf;
       for (const auto& [name, ms] : frames.gpuTimes()) {
         std::snprintf(buf, sizeof buf, " | %s %.3f ms", name.c_str(), ms);
