@@ -439,6 +439,7 @@ template class HugeArray<TriPack>;
 RTR_DECLARE_TRAVERSAL(sse)
 RTR_DECLARE_TRAVERSAL(avx2)
 RTR_DECLARE_TRAVERSAL(avx512)
+RTR_DECLARE_TRAVERSAL(counted)
 #undef RTR_DECLARE_TRAVERSAL
 
 namespace {
@@ -453,6 +454,9 @@ struct Traversal {
 };
 #define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket}
 constexpr Traversal kTraversals[] = {RTR_TRAVERSAL(sse), RTR_TRAVERSAL(avx2), RTR_TRAVERSAL(avx512)};
+constexpr Traversal kCounted = RTR_TRAVERSAL(counted);
+std::atomic<bool> counting{false};
+thread_local BvhCounters threadCounters;
 #undef RTR_TRAVERSAL
 }  // namespace
 
@@ -483,6 +487,15 @@ BvhIsa Bvh::setIsa(BvhIsa isa) {
 
 BvhIsa Bvh::isa() { return currentIsa.load(std::memory_order_relaxed); }
 
+void Bvh::setCounting(bool on) { counting = on; }
+BvhCounters& Bvh::counters() { return threadCounters; }
+
+namespace {
+const Traversal& traversal() {
+  return counting.load(std::memory_order_relaxed) ? kCounted : kTraversals[int(Bvh::isa())];
+}
+}  // namespace
+
 const char* Bvh::isaName(BvhIsa isa) {
   switch (isa) {
     case BvhIsa::Sse: return "SSE4.2";
@@ -495,26 +508,26 @@ const char* Bvh::isaName(BvhIsa isa) {
 Hit Bvh::closest(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return h;
-  kTraversals[int(isa())].closest({nodes_.data(), packs_.data(), root_}, ray, method, h);
+  traversal().closest({nodes_.data(), packs_.data(), root_}, ray, method, h);
   return h;
 }
 
 bool Bvh::occluded(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return false;
-  return kTraversals[int(isa())].occluded({nodes_.data(), packs_.data(), root_}, ray, method, h);
+  return traversal().occluded({nodes_.data(), packs_.data(), root_}, ray, method, h);
 }
 
 std::array<Hit, 2> Bvh::closestPair(const std::array<Ray, 2>& rays, IntersectMethod method) const {
   std::array<Hit, 2> h;
-  if (root_ != kEmpty) kTraversals[int(isa())].closestPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
+  if (root_ != kEmpty) traversal().closestPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
   return h;
 }
 
 std::array<bool, 2> Bvh::occludedPair(const std::array<Ray, 2>& rays, IntersectMethod method) const {
   std::array<Hit, 2> h;
   if (root_ == kEmpty) return {false, false};
-  const unsigned m = kTraversals[int(isa())].occludedPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
+  const unsigned m = traversal().occludedPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
   return {(m & 1) != 0, (m & 2) != 0};
 }
 
@@ -522,11 +535,12 @@ void Bvh::closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method) co
   for (int i = 0; i < n; ++i) hits[i] = Hit{};
   if (root_ == kEmpty || n <= 0) return;
   if (n == 1) { hits[0] = closest(rays[0], method); return; }
-  const Traversal& tr = kTraversals[int(isa())];
+  const Traversal& tr = traversal();
   const View v{nodes_.data(), packs_.data(), root_};
   // Rays with a near-tie between two candidates are traced again alone (bvh_packet.inl).
   for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits); retry; retry &= retry - 1) {
     const int i = __builtin_ctz(retry);
+    if (&tr == &kCounted) ++threadCounters.retries;
     hits[i] = Hit{};
     tr.closest(v, rays[i], method, hits[i]);
   }
@@ -536,7 +550,7 @@ unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method) const {
   if (root_ == kEmpty || n <= 0) return 0;
   if (n == 1) return unsigned(occluded(rays[0], method));
   Hit scratch[8];
-  return kTraversals[int(isa())].occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch);
+  return traversal().occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch);
 }
 
 }  // namespace rtr::trace

@@ -96,6 +96,7 @@ struct PacketWalker {
 
   // The rays of `active` whose box test passes child c of node n, with their entry distances.
   RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F tHitV, F& tNearOut) const {
+    RTR_COUNT(c.childTests += 1; c.childTestRays += unsigned(__builtin_popcount(active)));
     const F zero = set1(0.0f);
     F tn[3], tf[3];
     for (int i = 0; i < kSlabs; ++i) {
@@ -131,6 +132,7 @@ struct PacketWalker {
   // Tests node `ref`'s children against the packet: false when no ray meets any; else ref/active are
   // the child to visit next and its rays, the other children are on the stack.
   RTR_INLINE bool visitNode(PacketEntry* stack, int& sp, uint32_t& ref, unsigned& active) const {
+    RTR_COUNT(c.packetNodes += 1; c.packetNodeRays += unsigned(__builtin_popcount(active)));
     const Node& n = bvh.nodes[ref];
     const F tHitV = load(cull);
     unsigned slots = bits(le(load(n.box[0][0]), load(n.box[1][0])));  // empty slots have lo > hi
@@ -187,8 +189,10 @@ struct PacketWalker {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
     const F tLimit = set1(cull[i] < tMax[i] ? cull[i] : tMax[i]);
     const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+    RTR_COUNT(c.leaves += 1);
     for (uint32_t p = first; p < first + np; ++p) {
       const TriPack& pk = bvh.packs[p];
+      RTR_COUNT(c.packs += 1; c.triangles += unsigned(__builtin_popcount(realLanes(pk))));
       const F Az = load(pk.v[0][w.kz]) - w.oz, Bz = load(pk.v[1][w.kz]) - w.oz, Cz = load(pk.v[2][w.kz]) - w.oz;
       const F ax = (load(pk.v[0][w.kx]) - w.ox) - w.sx * Az, ay = (load(pk.v[0][w.ky]) - w.oy) - w.sy * Az;
       const F bx = (load(pk.v[1][w.kx]) - w.ox) - w.sx * Bz, by = (load(pk.v[1][w.ky]) - w.oy) - w.sy * Bz;
@@ -228,6 +232,7 @@ struct PacketWalker {
 
   // Ray i alone from node or leaf `ref` on: its single-ray walk; returns whether it is occluded (any hit).
   RTR_INLINE bool alone(int i, uint32_t ref) {
+    RTR_COUNT(c.lone += 1);
     const W& w = walker(i);
     uint64_t stack[kStackSize];
     if constexpr (AnyHit) {
@@ -262,6 +267,7 @@ struct PacketWalker {
           break;
         }
         if (ref & Bvh::kLeafBit) {
+          RTR_COUNT(c.packetLeaves += 1; c.packetLeafRays += unsigned(__builtin_popcount(active)));
           for (unsigned b = active; b; b &= b - 1) {
             const int i = ctz(b);
             if constexpr (AnyHit) {
@@ -296,6 +302,7 @@ struct PacketWalker {
 
 template <bool AnyHit, unsigned Parallel>
 unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
+  RTR_COUNT(c.packets += 1);
   PacketWalker<AnyHit, Parallel> p(bvh, rays, n, hits, method);
   return p.run((1u << n) - 1);
 }

@@ -114,6 +114,21 @@ constexpr SlabAxes slabAxesOf(unsigned parallel) {
 
 #define RTR_INLINE inline __attribute__((always_inline))
 
+// Counting (bvh_counted.cpp only): RTR_COUNT(c.nodes += 1) adds to the thread's BvhCounters; elsewhere
+// it compiles to nothing.
+#if RTR_BVH_COUNT
+#define RTR_COUNT(...) do { BvhCounters& c = Bvh::counters(); __VA_ARGS__; } while (0)
+#else
+#define RTR_COUNT(...) do {} while (0)
+#endif
+
+// The real triangles of a pack (a short pack repeats its last one).
+inline unsigned realLanes(const TriPack& pk) {
+  unsigned m = 1;
+  for (int lane = 1; lane < 8; ++lane) m |= unsigned(pk.prim[lane] != pk.prim[lane - 1]) << lane;
+  return m;
+}
+
 // Where a walk is: the stack's fill, the node or leaf to visit next, the closest hit so far. The stack
 // itself (kStackSize entries) is passed beside it: as a member it kept the compiler from holding these
 // in registers (measured about 5 % slower, VM). An entry: the entry distance's bits above the node reference,
@@ -208,6 +223,7 @@ struct Walker {
   // Tests the inner node at.ref's children: false when it meets none; else at.ref is the child to visit
   // next and the others are on the stack.
   RTR_INLINE bool visitNode(uint64_t* stack, Cursor& at, F tHitV) const {
+    RTR_COUNT(c.nodes += 1);
     const Node& n = bvh.nodes[at.ref];
     const float* b = &n.box[0][0][0];
     const F zero = set1(0.0f);
@@ -284,8 +300,10 @@ struct Walker {
   RTR_INLINE bool testLeaf(Cursor& at, Hit& hit, F tHitV) const {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
     const uint32_t first = at.ref & 0x0FFFFFFFu, np = ((at.ref >> 28) & 7u) + 1;
+    RTR_COUNT(c.leaves += 1);
     for (uint32_t p = first; p < first + np; ++p) {
       const TriPack& pk = bvh.packs[p];
+      RTR_COUNT(c.packs += 1; c.triangles += unsigned(__builtin_popcount(realLanes(pk))));
       if (method != IntersectMethod::Watertight) {
         for (int lane = 0; lane < 8; ++lane) {
           const uint32_t prim = pk.prim[lane];
@@ -507,3 +525,4 @@ unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectM
 }  // namespace rtr::trace::RTR_BVH_ISA
 
 #undef RTR_INLINE
+#undef RTR_COUNT

@@ -2,6 +2,7 @@
 // t, barycentrics and triangle bit for bit, and the same shadow answer, on every ISA.
 #include "trace/bvh.hpp"
 
+#include <cstring>
 #include <random>
 
 #include <glm/geometric.hpp>
@@ -194,6 +195,47 @@ TEST(Packets, CameraPacketsIncludingImageBorders) {
     EXPECT_GT(hits, rays.size() / 8);
     EXPECT_LT(hits, rays.size());
   }
+}
+
+// The counting traversal (bench-trace's work per ray): the same results, and counts that add up.
+TEST(Packets, CountersCountTheWorkAndChangeNoResult) {
+  const Mesh sphere = uvSphere({0.0f, 0.0f, 0.0f}, 1.0f, 48, 96);
+  const Bvh bvh(trianglesOf(sphere), {}, 1);
+  const Ray hit{{0.01f, 0.02f, 5.0f}, {0.0f, 0.0f, -1.0f}}, miss{{0.0f, 5.0f, 5.0f}, {0.0f, 0.0f, -1.0f}};
+  const Hit plain = bvh.closest(hit);
+  Bvh::counters() = {};
+  bvh.closest(hit);
+  EXPECT_EQ(Bvh::counters().nodes, 0u) << "counted while counting is off";
+  Bvh::setCounting(true);
+  const Hit counted = bvh.closest(hit);
+  const BvhCounters one = Bvh::counters();
+  EXPECT_EQ(std::memcmp(&plain, &counted, sizeof plain), 0);
+  EXPECT_GE(one.nodes, 2u);
+  EXPECT_GE(one.leaves, 1u);
+  EXPECT_GE(one.packs, one.leaves);
+  EXPECT_GE(one.triangles, one.packs);
+  EXPECT_LE(one.triangles, 8 * one.packs);
+  Bvh::counters() = {};
+  bvh.closest(miss);  // misses the root's children: one node visit, nothing else
+  EXPECT_EQ(Bvh::counters().nodes, 1u);
+  EXPECT_EQ(Bvh::counters().leaves, 0u);
+  // Eight copies of one ray: every lane live everywhere, no ray ever alone.
+  Bvh::counters() = {};
+  Ray rays[8];
+  Hit h[8];
+  for (Ray& r : rays) r = hit;
+  bvh.closest8(rays, 8, h);
+  const BvhCounters p = Bvh::counters();
+  Bvh::setCounting(false);
+  Bvh::counters() = {};
+  EXPECT_EQ(std::memcmp(&plain, &h[7], sizeof plain), 0);
+  EXPECT_EQ(p.packets, 1u);
+  EXPECT_GE(p.packetNodes, 2u);
+  EXPECT_EQ(p.packetNodeRays, 8 * p.packetNodes);
+  EXPECT_GE(p.packetLeaves, 1u);
+  EXPECT_EQ(p.packetLeafRays, 8 * p.packetLeaves);
+  EXPECT_EQ(p.lone, 0u);
+  EXPECT_EQ(p.packetTriangles + p.triangles, 8 * one.triangles) << "each ray tests what it tests alone";
 }
 
 TEST(Packets, EmptyBvh) {

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <initializer_list>
 #include <map>
 #include <random>
 #include <string>
@@ -213,6 +214,43 @@ void explain(const Ray& r, const Hit& ours, const Hit& theirs, const std::vector
     std::printf("    triangle %u, t %.9g, edge functions %.3g %.3g %.3g: %s\n", h.prim, h.t, e[0], e[1], e[2], kind.c_str());
 }
 
+struct RaySet { const char* name; const std::vector<Ray>* rays; bool any; };
+
+// What each ray costs in work, single rays and packets of eight (BvhCounters, the counting traversal on
+// one thread): where a row stays below Embree's packets, these say whether nodes, leaves or idle SIMD
+// lanes bound it.
+void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
+  Bvh::setCounting(true);
+  std::printf("\nWork per ray (counted): single rays, one at a time; packets of 8 (lanes = rays: `live` is the share of "
+              "the 8 lanes with a ray at a packet's node visits, box tests and leaf visits; `1-ray` work is done with lanes = "
+              "boxes or triangles: rays walking on alone, retried, and leaves tested ray by ray):\n\n"
+              "| rays | single: nodes | leaves | packs | triangles | packets: node visits a packet | live at nodes | "
+              "live at box tests | leaf visits a packet | live at leaves | 8-ray triangle tests | 1-ray nodes | 1-ray triangles | "
+              "alone | retried |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const RaySet& s : sets) {
+    const std::vector<Ray>& rays = *s.rays;
+    const double n = double(std::max<size_t>(1, rays.size()));
+    Bvh::counters() = {};
+    for (const Ray& r : rays) s.any ? void(bvh.occluded(r)) : void(bvh.closest(r));
+    const BvhCounters one = Bvh::counters();
+    Bvh::counters() = {};
+    for (size_t i = 0; i < rays.size(); i += 8) {
+      const int k = int(std::min<size_t>(8, rays.size() - i));
+      Hit h[8];
+      if (s.any) bvh.occluded8(&rays[i], k); else bvh.closest8(&rays[i], k, h);
+    }
+    const BvhCounters p = Bvh::counters();
+    auto share = [](uint64_t live, uint64_t visits) { return visits ? double(live) / (8.0 * double(visits)) : 0.0; };
+    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.0f %% | %.2f | %.0f %% | %.2f | %.2f | %.2f | %.3f | %.4f |\n",
+                s.name, one.nodes / n, one.leaves / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
+                100.0 * share(p.packetNodeRays, p.packetNodes), 100.0 * share(p.childTestRays, p.childTests),
+                8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), p.packetTriangles / n, p.nodes / n,
+                p.triangles / n, p.lone / n, p.retries / n);
+  }
+  Bvh::counters() = {};
+  Bvh::setCounting(false);
+}
+
 void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, unsigned threads, int res,
                 bool sphere, bool quick, bool explainAll, int reps) {
   std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
@@ -332,6 +370,8 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
     std::printf("Our packets of 8 against our single rays (primary, orthographic, shadow, mirror): %zu of %zu rays differ\n",
                 differ, total);
   }
+  printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
+                      {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
   std::printf("\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8 | Embree rtcIntersect1/Occluded1 "
               "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
