@@ -433,8 +433,8 @@ template class HugeArray<TriPack>;
   bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&); \
   unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
   unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
-  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*); \
-  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*); \
+  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
+  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
   }
 RTR_DECLARE_TRAVERSAL(sse)
 RTR_DECLARE_TRAVERSAL(avx2)
@@ -449,13 +449,14 @@ struct Traversal {
   bool (*occluded)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
   unsigned (*closestPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
   unsigned (*occludedPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
-  unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*);
-  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*);
+  unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
+  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
 };
 #define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket}
 constexpr Traversal kTraversals[] = {RTR_TRAVERSAL(sse), RTR_TRAVERSAL(avx2), RTR_TRAVERSAL(avx512)};
 constexpr Traversal kCounted = RTR_TRAVERSAL(counted);
 std::atomic<bool> counting{false};
+std::atomic<int> packetLeafRays{Bvh::kPacketLeafRays};
 thread_local BvhCounters threadCounters;
 #undef RTR_TRAVERSAL
 }  // namespace
@@ -488,6 +489,7 @@ BvhIsa Bvh::setIsa(BvhIsa isa) {
 BvhIsa Bvh::isa() { return currentIsa.load(std::memory_order_relaxed); }
 
 void Bvh::setCounting(bool on) { counting = on; }
+void Bvh::setPacketLeafRays(int n) { packetLeafRays = n; }
 BvhCounters& Bvh::counters() { return threadCounters; }
 
 namespace {
@@ -538,7 +540,7 @@ void Bvh::closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method) co
   const Traversal& tr = traversal();
   const View v{nodes_.data(), packs_.data(), root_};
   // Rays with a near-tie between two candidates are traced again alone (bvh_packet.inl).
-  for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits); retry; retry &= retry - 1) {
+  for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits, packetLeafRays.load(std::memory_order_relaxed)); retry; retry &= retry - 1) {
     const int i = __builtin_ctz(retry);
     if (&tr == &kCounted) ++threadCounters.retries;
     hits[i] = Hit{};
@@ -550,7 +552,8 @@ unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method) const {
   if (root_ == kEmpty || n <= 0) return 0;
   if (n == 1) return unsigned(occluded(rays[0], method));
   Hit scratch[8];
-  return traversal().occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch);
+  return traversal().occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch,
+                                      packetLeafRays.load(std::memory_order_relaxed));
 }
 
 }  // namespace rtr::trace

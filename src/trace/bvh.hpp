@@ -97,6 +97,11 @@ class Bvh {
   // Bit i set: ray i is occluded.
   unsigned occluded8(const Ray* rays, int n, IntersectMethod method = IntersectMethod::Watertight) const;
 
+  // A packet tests a leaf with lanes = rays (each triangle against all its live rays at once) when at
+  // least this many rays are live there and all share the watertight test's axis order; else ray by ray
+  // (lanes = triangles). For tests and benchmarks: setPacketLeafRays(9) = always ray by ray.
+  static constexpr int kPacketLeafRays = 5;
+  static void setPacketLeafRays(int n);
   // Counting (tests and benchmarks): while on, every query of this process runs the counting traversal
   // (SSE, slower) and adds to its thread's counters.
   static void setCounting(bool on);

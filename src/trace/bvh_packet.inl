@@ -54,13 +54,19 @@ struct PacketWalker {
   F org[3], rdir[3], rdirFar[3];
 #endif
   alignas(32) float tMax[8], cull[8], best[8], second[8];
+  // The watertight test's per-ray constants with lanes = rays, for leaves tested all rays at once; valid
+  // when every ray has the same axis order kx, ky, kz (sameShear).
+  F shO[3], shS[3];
+  int kx = 0, ky = 0, kz = 0;
+  bool sameShear = true;
+  const int leafRays;
   alignas(W) unsigned char walkers[8][sizeof(W)];  // each ray's single-ray walk, for leaves and lone rays
 
   const W& walker(int i) const { return *reinterpret_cast<const W*>(walkers[i]); }
 
-  RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, Hit* h, IntersectMethod m)
-      : bvh(view), rays(r), hits(h) {
-    alignas(32) float o[3][8], d[3][8];
+  RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, Hit* h, IntersectMethod m, int minLeafRays)
+      : bvh(view), rays(r), hits(h), leafRays(minLeafRays) {
+    alignas(32) float o[3][8], d[3][8], so[3][8], ss[3][8];
     for (int i = 0; i < 8; ++i) {
       const Ray& ray = r[i < n ? i : 0];
       o[0][i] = ray.origin.x; o[1][i] = ray.origin.y; o[2][i] = ray.origin.z;
@@ -68,7 +74,15 @@ struct PacketWalker {
       tMax[i] = cull[i] = ray.tMax;
       best[i] = second[i] = kInf;
       if (i < n) new (walkers[i]) W(view, ray, m);
+      // Walker's shear constants, by the same operations.
+      const W& w = walker(i < n ? i : 0);
+      if (i == 0) { kx = w.kx; ky = w.ky; kz = w.kz; }
+      sameShear = sameShear && w.kx == kx && w.ky == ky && w.kz == kz;
+      const float szs = 1.0f / d[w.kz][i];
+      so[0][i] = o[w.kx][i]; so[1][i] = o[w.ky][i]; so[2][i] = o[w.kz][i];
+      ss[0][i] = d[w.kx][i] * szs; ss[1][i] = d[w.ky][i] * szs; ss[2][i] = szs;
     }
+    for (int a = 0; a < 3; ++a) { shO[a] = load(so[a]); shS[a] = load(ss[a]); }
     // Per ray, the operations of Walker's constructor (there done three axes at a time, here eight
     // rays at a time: the same per-lane results), so the boxes are culled exactly as for a single ray.
     const F zero = set1(0.0f);
@@ -230,6 +244,68 @@ struct PacketWalker {
     }
   }
 
+  // Leaf `ref` with lanes = rays: each real triangle against all `active` rays at once, each lane with
+  // exactly Walker::testLeaf's operations for its ray (closest hit: leafCandidates' rules). Any hit:
+  // returns the rays found occluded.
+  RTR_INLINE unsigned leafAllRays(uint32_t ref, unsigned active) {
+    const F zero = set1(0.0f), signBit = set1(-0.0f);
+    const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+    unsigned occluded = 0;
+    for (uint32_t p = first; p < first + np; ++p) {
+      const TriPack& pk = bvh.packs[p];
+      unsigned tris = realLanes(pk);
+      if constexpr (AnyHit) tris &= ~topBits(pk.prim);  // shadow casters only
+      const F tLimit = load(AnyHit ? tMax : cull);  // cull ≤ tMax (offer)
+      for (; tris; tris &= tris - 1) {
+        const int lane = ctz(tris);
+        RTR_COUNT(c.packetTriangles += unsigned(__builtin_popcount(active)));
+        const F Az = set1(pk.v[0][kz][lane]) - shO[2], Bz = set1(pk.v[1][kz][lane]) - shO[2], Cz = set1(pk.v[2][kz][lane]) - shO[2];
+        const F ax = (set1(pk.v[0][kx][lane]) - shO[0]) - shS[0] * Az, ay = (set1(pk.v[0][ky][lane]) - shO[1]) - shS[1] * Az;
+        const F bx = (set1(pk.v[1][kx][lane]) - shO[0]) - shS[0] * Bz, by = (set1(pk.v[1][ky][lane]) - shO[1]) - shS[1] * Bz;
+        const F cx = (set1(pk.v[2][kx][lane]) - shO[0]) - shS[0] * Cz, cy = (set1(pk.v[2][ky][lane]) - shO[1]) - shS[1] * Cz;
+        const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W3 = bx * ay - by * ax;
+        unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W3, zero)) & active;
+        unsigned m = ~bits((U ^ V) | (V ^ W3)) & active & ~edge;
+        if ((m | edge) == 0) continue;
+        const F det = U + V + W3;
+        const F T = U * (shS[2] * Az) + V * (shS[2] * Bz) + W3 * (shS[2] * Cz);
+        const F detSign = det & signBit;
+        const F Ts = T ^ detSign;
+        m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));
+        if constexpr (AnyHit) {
+          occluded |= m;
+          for (edge &= ~m; edge; edge &= edge - 1) {
+            const int i = ctz(edge);
+            WatertightRay r(rays[i]);
+            float b1, b2;
+            if (intersectWatertight(r, laneTriangle(pk, lane), b1, b2) > 0.0f) occluded |= 1u << i;
+          }
+          active &= ~occluded;
+          if (!active) return occluded;
+          continue;
+        }
+        if (m) {
+          const F inv = set1(1.0f) / det;
+          alignas(32) float tv[8], iv[8], vv[8], wv[8];
+          store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W3);
+          for (; m; m &= m - 1) {
+            const int i = ctz(m);
+            const float t = tv[i];
+            if (t > 0.0f && t < tMax[i]) offer(i, t, vv[i] * iv[i], wv[i] * iv[i], pk.prim[lane]);
+          }
+        }
+        for (; edge; edge &= edge - 1) {
+          const int i = ctz(edge);
+          WatertightRay r(rays[i]);
+          float b1, b2;
+          const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
+          if (t > 0.0f) offer(i, t, b1, b2, pk.prim[lane]);
+        }
+      }
+    }
+    return occluded;
+  }
+
   // Ray i alone from node or leaf `ref` on: its single-ray walk; returns whether it is occluded (any hit).
   RTR_INLINE bool alone(int i, uint32_t ref) {
     RTR_COUNT(c.lone += 1);
@@ -268,6 +344,10 @@ struct PacketWalker {
         }
         if (ref & Bvh::kLeafBit) {
           RTR_COUNT(c.packetLeaves += 1; c.packetLeafRays += unsigned(__builtin_popcount(active)));
+          if (sameShear && __builtin_popcount(active) >= leafRays) {
+            done |= leafAllRays(ref, active);
+            break;
+          }
           for (unsigned b = active; b; b &= b - 1) {
             const int i = ctz(b);
             if constexpr (AnyHit) {
@@ -301,9 +381,9 @@ struct PacketWalker {
 };
 
 template <bool AnyHit, unsigned Parallel>
-unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
+unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
   RTR_COUNT(c.packets += 1);
-  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, hits, method);
+  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, hits, method, leafRays);
   return p.run((1u << n) - 1);
 }
 

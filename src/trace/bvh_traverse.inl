@@ -482,18 +482,18 @@ unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
 // use the watertight test; others go ray by ray. Closest hit: returns the rays the caller must trace
 // again alone (ties, see bvh_packet.inl). Any hit: returns the occluded rays.
 template <bool AnyHit>
-unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
+unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
   const unsigned p = parallelAxes(rays[0]);
   bool same = method == IntersectMethod::Watertight && n > 1;
   for (int i = 1; i < n && same; ++i) same = parallelAxes(rays[i]) == p;
   switch (same ? p : 8u) {
-    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, method, hits);
-    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, method, hits);
-    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, method, hits);
-    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, method, hits);
-    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, method, hits);
-    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, method, hits);
-    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, method, hits);
+    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, method, hits, leafRays);
+    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, method, hits, leafRays);
+    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, method, hits, leafRays);
+    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, method, hits, leafRays);
+    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, method, hits, leafRays);
+    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, method, hits, leafRays);
+    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, method, hits, leafRays);
     case 7: return 0;
     default: {
       unsigned m = 0;
@@ -515,11 +515,11 @@ unsigned closestPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod meth
 unsigned occludedPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod method, Hit* scratch) {
   return dispatchPair<true>(bvh, rays, method, scratch);
 }
-unsigned closestPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
-  return dispatchPacket<false>(bvh, rays, n, method, hits);
+unsigned closestPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
+  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays);
 }
-unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch) {
-  return dispatchPacket<true>(bvh, rays, n, method, scratch);
+unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch, int leafRays) {
+  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays);
 }
 
 }  // namespace rtr::trace::RTR_BVH_ISA

@@ -23,12 +23,16 @@ std::vector<Triangle> trianglesOf(const Mesh& m, glm::vec3 offset = glm::vec3(0.
   return tris;
 }
 
-// Every group of `width` consecutive rays as one packet against each ray alone, on every ISA; returns
-// the number of hits (of the last ISA) so callers can check the case is not vacuous.
+// Every group of `width` consecutive rays as one packet against each ray alone, on every ISA, with leaves
+// tested all rays at once wherever two or more rays reach them, and always ray by ray; returns the
+// number of hits (of the last pass) so callers can check the case is not vacuous.
 size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, int width = 8, const char* what = "") {
   size_t hits = 0;
-  for (BvhIsa isa : {BvhIsa::Avx512, BvhIsa::Avx2, BvhIsa::Sse}) {
+  for (int pass = 0; pass < 6; ++pass) {
+    const BvhIsa isa = pass % 3 == 0 ? BvhIsa::Avx512 : pass % 3 == 1 ? BvhIsa::Avx2 : BvhIsa::Sse;
+    const int leafRays = pass < 3 ? 2 : 9;
     Bvh::setIsa(isa);
+    Bvh::setPacketLeafRays(leafRays);
     hits = 0;
     for (size_t i = 0; i < rays.size(); i += width) {
       const int n = int(std::min<size_t>(width, rays.size() - i));
@@ -39,11 +43,12 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
         const Hit one = bvh.closest(rays[i + k]);
         const bool occ1 = bvh.occluded(rays[i + k]);
         if (h[k].prim != one.prim || h[k].t != one.t || h[k].b1 != one.b1 || h[k].b2 != one.b2 || (occ >> k & 1) != occ1) {
-          ADD_FAILURE() << what << " " << Bvh::isaName(isa) << " ray " << i + k << " of a packet of " << n
+          ADD_FAILURE() << what << " " << Bvh::isaName(isa) << (leafRays == 2 ? ", leaves all rays at once" : ", leaves ray by ray") << ", ray " << i + k << " of a packet of " << n
                         << ": triangle " << h[k].prim << " t " << h[k].t << " b " << h[k].b1 << " " << h[k].b2
                         << " occluded " << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b "
                         << one.b1 << " " << one.b2 << " occluded " << occ1;
           Bvh::setIsa(BvhIsa::Avx512);
+          Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
           return 0;
         }
         hits += one.hit();
@@ -51,6 +56,7 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
     }
   }
   Bvh::setIsa(BvhIsa::Avx512);
+  Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
   return hits;
 }
 
