@@ -62,10 +62,19 @@ struct PacketWalker {
   const int leafRays;
   alignas(W) unsigned char walkers[8][sizeof(W)];  // each ray's single-ray walk, for leaves and lone rays
 
-  const W& walker(int i) const { return *reinterpret_cast<const W*>(walkers[i]); }
+  IntersectMethod method;
+  unsigned built = 0;  // the walkers constructed so far: only rays that need one pay its set-up
+  // (on the temple most packets miss after a node or two, and eight set-ups cost more than the walk)
+  RTR_INLINE const W& walker(int i) {
+    if (!(built >> i & 1)) {
+      new (walkers[i]) W(bvh, rays[i], method);
+      built |= 1u << i;
+    }
+    return *reinterpret_cast<const W*>(walkers[i]);
+  }
 
   RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, Hit* h, IntersectMethod m, int minLeafRays)
-      : bvh(view), rays(r), hits(h), leafRays(minLeafRays) {
+      : bvh(view), rays(r), hits(h), leafRays(minLeafRays), method(m) {
     alignas(32) float o[3][8], d[3][8], so[3][8], ss[3][8];
     for (int i = 0; i < 8; ++i) {
       const Ray& ray = r[i < n ? i : 0];
@@ -73,14 +82,14 @@ struct PacketWalker {
       d[0][i] = ray.direction.x; d[1][i] = ray.direction.y; d[2][i] = ray.direction.z;
       tMax[i] = cull[i] = ray.tMax;
       best[i] = second[i] = kInf;
-      if (i < n) new (walkers[i]) W(view, ray, m);
       // Walker's shear constants, by the same operations.
-      const W& w = walker(i < n ? i : 0);
-      if (i == 0) { kx = w.kx; ky = w.ky; kz = w.kz; }
-      sameShear = sameShear && w.kx == kx && w.ky == ky && w.kz == kz;
-      const float szs = 1.0f / d[w.kz][i];
-      so[0][i] = o[w.kx][i]; so[1][i] = o[w.ky][i]; so[2][i] = o[w.kz][i];
-      ss[0][i] = d[w.kx][i] * szs; ss[1][i] = d[w.ky][i] * szs; ss[2][i] = szs;
+      int x, y, z;
+      W::shearAxes(&d[0][i], 8, x, y, z);
+      if (i == 0) { kx = x; ky = y; kz = z; }
+      sameShear = sameShear && x == kx && y == ky && z == kz;
+      const float szs = 1.0f / d[z][i];
+      so[0][i] = o[x][i]; so[1][i] = o[y][i]; so[2][i] = o[z][i];
+      ss[0][i] = d[x][i] * szs; ss[1][i] = d[y][i] * szs; ss[2][i] = szs;
     }
     for (int a = 0; a < 3; ++a) { shO[a] = load(so[a]); shS[a] = load(ss[a]); }
     // Per ray, the operations of Walker's constructor (there done three axes at a time, here eight

@@ -210,14 +210,20 @@ struct Walker {
     // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
     // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
     // must shear identically), inline here and sharing the reciprocal with the slab test.
-    const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[1]), __builtin_fabsf(d[2])};
-    kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
-    kx = kz == 2 ? 0 : kz + 1;
-    ky = kx == 2 ? 0 : kx + 1;
-    if (d[kz] < 0.0f) { const int t = kx; kx = ky; ky = t; }
+    shearAxes(d, 1, kx, ky, kz);
     const float szs = rcp[kz];
     ox = set1(o[kx]); oy = set1(o[ky]); oz = set1(o[kz]);
     sx = set1(d[kx] * szs); sy = set1(d[ky] * szs); sz = set1(szs);
+  }
+
+  // The watertight test's axis order for direction d[0], d[stride], d[2 * stride] (packets keep theirs
+  // by axis): kz the largest component, kx and ky swapped where it is negative.
+  RTR_INLINE static void shearAxes(const float* d, int stride, int& kx, int& ky, int& kz) {
+    const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[stride]), __builtin_fabsf(d[2 * stride])};
+    kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz * stride] < 0.0f) { const int t = kx; kx = ky; ky = t; }
   }
 
   // Tests the inner node at.ref's children: false when it meets none; else at.ref is the child to visit
