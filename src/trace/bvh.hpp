@@ -40,9 +40,10 @@ struct BvhCounters {
   uint64_t nodes = 0, leaves = 0, packs = 0, triangles = 0;
   // Eight rays against one box or triangle (lanes = rays): packets walked, their node visits and the rays
   // live at each, child boxes tested and the rays tested at each, leaf visits and the rays live at each,
-  // ray-triangle tests with lanes = rays, rays left to walk on alone, rays traced again (near-ties).
+  // triangles tested against all live rays at once and the rays in those tests, rays left to walk on
+  // alone, rays traced again (near-ties).
   uint64_t packets = 0, packetNodes = 0, packetNodeRays = 0, childTests = 0, childTestRays = 0;
-  uint64_t packetLeaves = 0, packetLeafRays = 0, packetTriangles = 0, lone = 0, retries = 0;
+  uint64_t packetLeaves = 0, packetLeafRays = 0, triangleTests = 0, packetTriangles = 0, lone = 0, retries = 0;
 };
 
 // A fixed-size array in memory the kernel is asked to back with 2 MB pages (transparent huge pages):

@@ -267,7 +267,7 @@ struct PacketWalker {
       const F tLimit = load(AnyHit ? tMax : cull);  // cull ≤ tMax (offer)
       for (; tris; tris &= tris - 1) {
         const int lane = ctz(tris);
-        RTR_COUNT(c.packetTriangles += unsigned(__builtin_popcount(active)));
+        RTR_COUNT(c.triangleTests += 1; c.packetTriangles += unsigned(__builtin_popcount(active)));
         const F Az = set1(pk.v[0][kz][lane]) - shO[2], Bz = set1(pk.v[1][kz][lane]) - shO[2], Cz = set1(pk.v[2][kz][lane]) - shO[2];
         const F ax = (set1(pk.v[0][kx][lane]) - shO[0]) - shS[0] * Az, ay = (set1(pk.v[0][ky][lane]) - shO[1]) - shS[1] * Az;
         const F bx = (set1(pk.v[1][kx][lane]) - shO[0]) - shS[0] * Bz, by = (set1(pk.v[1][ky][lane]) - shO[1]) - shS[1] * Bz;

@@ -217,16 +217,17 @@ void explain(const Ray& r, const Hit& ours, const Hit& theirs, const std::vector
 struct RaySet { const char* name; const std::vector<Ray>* rays; bool any; };
 
 // What each ray costs in work, single rays and packets of eight (BvhCounters, the counting traversal on
-// one thread): where a row stays below Embree's packets, these say whether nodes, leaves or idle SIMD
-// lanes bound it.
+// one thread; the counts do not depend on the machine): where a row stays below Embree's packets, these
+// say whether nodes, leaves or idle SIMD lanes bound it. An 8-wide pass: one ray against a node's eight
+// boxes or a pack's eight triangles, or one box or triangle against a packet's eight lanes.
 void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
   Bvh::setCounting(true);
-  std::printf("\nWork per ray (counted): single rays, one at a time; packets of 8 (lanes = rays: `live` is the share of "
-              "the 8 lanes with a ray at a packet's node visits, box tests and leaf visits; `1-ray` work is done with lanes = "
-              "boxes or triangles: rays walking on alone, retried, and leaves tested ray by ray):\n\n"
-              "| rays | single: nodes | leaves | packs | triangles | packets: node visits a packet | live at nodes | "
-              "live at box tests | leaf visits a packet | live at leaves | 8-ray triangle tests | 1-ray nodes | 1-ray triangles | "
-              "alone | retried |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("\nWork per ray (counted; a pass: one 8-wide box or triangle test, lanes = boxes or triangles for one ray, "
+              "or lanes = rays for a packet; `live`: the share of a packet's 8 lanes with a ray):\n\n"
+              "| rays | single: node visits | packs | triangles | packets: node visits a packet | box tests a node visit | "
+              "live at box tests | leaf visits a packet | live at leaves | box passes a ray: single / packets | "
+              "triangle passes a ray: single / packets (of them lanes = rays) | walks alone a ray | retried |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const RaySet& s : sets) {
     const std::vector<Ray>& rays = *s.rays;
     const double n = double(std::max<size_t>(1, rays.size()));
@@ -241,18 +242,21 @@ void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
     }
     const BvhCounters p = Bvh::counters();
     auto share = [](uint64_t live, uint64_t visits) { return visits ? double(live) / (8.0 * double(visits)) : 0.0; };
-    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.0f %% | %.2f | %.0f %% | %.2f | %.2f | %.2f | %.3f | %.4f |\n",
-                s.name, one.nodes / n, one.leaves / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
-                100.0 * share(p.packetNodeRays, p.packetNodes), 100.0 * share(p.childTestRays, p.childTests),
-                8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), p.packetTriangles / n, p.nodes / n,
-                p.triangles / n, p.lone / n, p.retries / n);
+    // Packets' passes: their box and triangle tests plus the single-ray work of rays walking alone, retried,
+    // or testing a leaf ray by ray.
+    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.2f | %.0f %% | %.2f / %.2f | %.2f / %.2f (%.2f) | %.3f | %.4f |\n",
+                s.name, one.nodes / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
+                p.packetNodes ? double(p.childTests) / double(p.packetNodes) : 0.0, 100.0 * share(p.childTestRays, p.childTests),
+                8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), one.nodes / n,
+                (p.childTests + p.nodes) / n, one.packs / n, (p.triangleTests + p.packs) / n, p.triangleTests / n, p.lone / n,
+                p.retries / n);
   }
   Bvh::counters() = {};
   Bvh::setCounting(false);
 }
 
 void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, unsigned threads, int res,
-                bool sphere, bool quick, bool explainAll, int reps, int leafRays) {
+                bool sphere, bool quick, bool explainAll, int reps, int leafRays, bool countOnly) {
   std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
               res, threads, Bvh::isaName(Bvh::isa()));
   const auto t0 = Clock::now();
@@ -374,6 +378,14 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   }
   printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
                       {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
+  if (countOnly) {  // and the same with every leaf tested ray by ray
+    std::printf("\nThe same, every leaf of a packet tested ray by ray (--leaf-rays 9):\n");
+    Bvh::setPacketLeafRays(9);
+    printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
+                        {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
+    Bvh::setPacketLeafRays(leafRays);
+    return;
+  }
   std::printf("\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8, leaves ray by ray "
               "| ours, packets of 8 (leaves all rays at once from %d live) | Embree rtcIntersect1/Occluded1 "
               "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n", leafRays);
@@ -495,7 +507,7 @@ int main(int argc, char** argv) {
   int res = 1024;
   uint32_t rings = 707;
   std::vector<std::string> scenes;
-  bool quick = false, explainAll = false;
+  bool quick = false, explainAll = false, countOnly = false;
   int reps = 3, leafRays = Bvh::kPacketLeafRays;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -506,14 +518,16 @@ int main(int argc, char** argv) {
     else if (a == "--reps" && i + 1 < argc) reps = std::atoi(argv[++i]);
     else if (a == "--leaf-rays" && i + 1 < argc) leafRays = std::atoi(argv[++i]);
     else if (a == "--quick") quick = true;
+    else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--explain") explainAll = true;
     else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
     else if (a == "--avx2") Bvh::setIsa(BvhIsa::Avx2);
-    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N]\n"
+    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only]\n"
                               "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
                               "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
                               "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
                               "  --explain: one line per hit/miss disagreement with Embree\n"
+                              "  --count-only: builds, agreement and work per ray (counted), no timing\n"
                               "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"); return 2; }
   }
   if (threads == 0 || res <= 0 || rings < 2 || reps < 1) { std::fprintf(stderr, "bench-trace: bad argument\n"); return 2; }
@@ -523,11 +537,11 @@ int main(int argc, char** argv) {
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
     tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
-  benchScene("UV sphere", tris, sphere.bounds, threads, res, true, quick, explainAll, reps, leafRays);
+  benchScene("UV sphere", tris, sphere.bounds, threads, res, true, quick, explainAll, reps, leafRays, countOnly);
   for (const std::string& f : scenes) {
     try {
       const Scene s = loadScene(f);
-      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false, quick, explainAll, reps, leafRays);
+      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false, quick, explainAll, reps, leafRays, countOnly);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "bench-trace: %s\n", e.what());
       return 1;
