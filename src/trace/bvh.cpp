@@ -540,7 +540,7 @@ BvhIsa Bvh::setIsa(BvhIsa isa) {
 
 BvhIsa Bvh::isa() { return currentIsa.load(std::memory_order_relaxed); }
 
-void Bvh::setCounting(bool on) { counting = on; }
+void Bvh::setCounting(bool on) { counting = on && cpuHas(BvhIsa::Avx2); }
 void Bvh::setPacketLeafRays(int n) { packetLeafRays = n; }
 BvhCounters& Bvh::counters() { return threadCounters; }
 

@@ -39,10 +39,10 @@ struct BvhCounters {
   // again, and leaves a packet tests ray by ray.
   uint64_t nodes = 0, leaves = 0, packs = 0, triangles = 0;
   // Eight rays against one box or triangle (lanes = rays): packets walked, their node visits and the rays
-  // live at each, child boxes tested and the rays tested at each, leaf visits and the rays live at each,
+  // live at each, the packet's interval against a node's eight boxes (lanes = boxes), child boxes tested and the rays tested at each, leaf visits and the rays live at each,
   // triangles tested against all live rays at once and the rays in those tests, rays left to walk on
   // alone, rays traced again (near-ties).
-  uint64_t packets = 0, packetNodes = 0, packetNodeRays = 0, childTests = 0, childTestRays = 0;
+  uint64_t packets = 0, packetNodes = 0, packetNodeRays = 0, intervalTests = 0, childTests = 0, childTestRays = 0;
   uint64_t packetLeaves = 0, packetLeafRays = 0, triangleTests = 0, packetTriangles = 0, lone = 0, retries = 0;
 };
 
@@ -104,7 +104,7 @@ class Bvh {
   static constexpr int kPacketLeafRays = 5;
   static void setPacketLeafRays(int n);
   // Counting (tests and benchmarks): while on, every query of this process runs the counting traversal
-  // (SSE, slower) and adds to its thread's counters.
+  // (the AVX2 code, slower; no counting on a CPU without AVX2) and adds to its thread's counters.
   static void setCounting(bool on);
   static BvhCounters& counters();
 

@@ -22,6 +22,11 @@ inline float hmin(F a) {
   const __m128 m2 = _mm_min_ps(m, _mm_movehl_ps(m, m));
   return _mm_cvtss_f32(_mm_min_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
 }
+inline float hmax(F a) {
+  const __m128 m = _mm_max_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
+  const __m128 m2 = _mm_max_ps(m, _mm_movehl_ps(m, m));
+  return _mm_cvtss_f32(_mm_max_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
+}
 #else
 inline F sel(F mask, F x, F y) { return {_mm_blendv_ps(y.a, x.a, mask.a), _mm_blendv_ps(y.b, x.b, mask.b)}; }
 inline float hmin(F x) {
@@ -60,6 +65,16 @@ struct PacketWalker {
   int kx = 0, ky = 0, kz = 0;
   bool sameShear = true;
   const int leafRays;
+#if RTR_BVH_AVX2
+  // The packet's interval: per axis, bounds over its rays of the slab constants, for one conservative
+  // test of a node's eight children at once (lanes = children) before each child is tested against the
+  // rays (lanes = rays). Without it a node visit costs one 8-wide pass per child, as many passes a ray as
+  // single rays take (counted: docs/bench/trace.md, round 8). Only when every ray has the same sign on
+  // each axis and finite, non-zero constants (then no bound is NaN).
+  float rnLo[3], rnHi[3], qnHi[3], rfLo[3], rfHi[3], qfLo[3], oLo[3], oHi[3];  // o: on parallel axes
+  int nearOff[3], farOff[3];
+  bool interval = false;
+#endif
   alignas(W) unsigned char walkers[8][sizeof(W)];  // each ray's single-ray walk, for leaves and lone rays
 
   IntersectMethod method;
@@ -115,7 +130,47 @@ struct PacketWalker {
       rdirFar[a] = rcp * set1(kFarScale);
 #endif
     }
+#if RTR_BVH_AVX2
+    // Vector reductions: most temple packets visit a node or two, so this set-up is a good part of them.
+    const F inf = set1(kInf);
+    F ok = set1(bitsFloat(0xFFFFFFFFu));
+    for (int a = 0; a < 3; ++a) { oLo[a] = hmin(oAxis[a]); oHi[a] = hmax(oAxis[a]); }
+    for (int i = 0; i < kSlabs; ++i) {
+      const int a = kSlabAxes.axis[i];
+      ok = ok & lt(rNear[a] & absMask, inf) & lt(rFar[a] & absMask, inf) & lt(qNear[a] & absMask, inf) &
+           lt(qFar[a] & absMask, inf) & neq(rNear[a], zero) & neq(rFar[a], zero);
+      const unsigned signs = bits(neg[a]);
+      if (signs != 0 && signs != 0xFFu) ok = set1(0.0f);
+      rnLo[a] = hmin(rNear[a]); rnHi[a] = hmax(rNear[a]); qnHi[a] = hmax(qNear[a]);
+      rfLo[a] = hmin(rFar[a]); rfHi[a] = hmax(rFar[a]); qfLo[a] = hmin(qFar[a]);
+      const int nearSide = signs ? 1 : 0;
+      nearOff[a] = (nearSide * 3 + a) * 8;
+      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+    }
+    interval = bits(ok) == 0xFFu;
+#endif
   }
+
+#if RTR_BVH_AVX2
+  // The children of n that some ray of the packet may meet: never one that a ray's own test would visit
+  // (the exact FMA rounds monotonically, so the bounds' FMA bounds every ray's; no operand is NaN).
+  RTR_INLINE unsigned intervalHits(const Node& n, F tHitV) const {
+    RTR_COUNT(c.intervalTests += 1);
+    const float* b = &n.box[0][0][0];
+    const F zero = set1(0.0f);
+    F lo = zero, hi = set1(hmax(tHitV));
+    for (int i = 0; i < kSlabs; ++i) {
+      const int a = kSlabAxes.axis[i];
+      const F nb = load(b + nearOff[a]), fb = load(b + farOff[a]);
+      lo = vmax(lo, fmsub(nb, sel(lt(nb, zero), set1(rnHi[a]), set1(rnLo[a])), set1(qnHi[a])));
+      hi = vmin(hi, fmsub(fb, sel(lt(fb, zero), set1(rfLo[a]), set1(rfHi[a])), set1(qfLo[a])));
+    }
+    F in = le(lo, hi);
+    for (int a = 0; a < 3; ++a)  // an axis the rays run parallel to: some origin within the slab
+      if (Parallel >> a & 1) in = in & le(load(n.box[0][a]), set1(oHi[a])) & ge(load(n.box[1][a]), set1(oLo[a]));
+    return bits(in);
+  }
+#endif
 
   // The rays of `active` whose box test passes child c of node n, with their entry distances.
   RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F tHitV, F& tNearOut) const {
@@ -159,6 +214,9 @@ struct PacketWalker {
     const Node& n = bvh.nodes[ref];
     const F tHitV = load(cull);
     unsigned slots = bits(le(load(n.box[0][0]), load(n.box[1][0])));  // empty slots have lo > hi
+#if RTR_BVH_AVX2
+    if (interval) slots &= intervalHits(n, tHitV);
+#endif
     F tn[8];
     unsigned mk[8];
     uint64_t keys[8];

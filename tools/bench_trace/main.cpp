@@ -248,7 +248,7 @@ void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
                 s.name, one.nodes / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
                 p.packetNodes ? double(p.childTests) / double(p.packetNodes) : 0.0, 100.0 * share(p.childTestRays, p.childTests),
                 8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), one.nodes / n,
-                (p.childTests + p.nodes) / n, one.packs / n, (p.triangleTests + p.packs) / n, p.triangleTests / n, p.lone / n,
+                (p.intervalTests + p.childTests + p.nodes) / n, one.packs / n, (p.triangleTests + p.packs) / n, p.triangleTests / n, p.lone / n,
                 p.retries / n);
   }
   Bvh::counters() = {};
