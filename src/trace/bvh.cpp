@@ -5,9 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <future>
+#include <condition_variable>
+#include <deque>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <thread>
 #include <vector>
@@ -78,6 +81,62 @@ double sahCost(const Node* nodes, uint32_t root) {
   return rootArea > 0.0 ? kNodeCost + total / rootArea : 0.0;
 }
 
+// The build's threads, started once per build: split chunks near the root and whole subtrees below are
+// queued as tasks. (std::async started a thread per chunk of every split near the root and per subtree.)
+// A thread waiting for its tasks runs queued ones meanwhile, so nested waits never starve the pool.
+class TaskPool {
+ public:
+  struct Group { std::atomic<int> left{0}; };
+  explicit TaskPool(unsigned workers) {
+    for (unsigned i = 0; i < workers; ++i) threads_.emplace_back([this] { work(); });
+  }
+  ~TaskPool() {
+    { std::lock_guard lock(mutex_); stop_ = true; }
+    wake_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+  void run(Group& g, std::function<void()> f) {
+    g.left.fetch_add(1);
+    { std::lock_guard lock(mutex_); queue_.push_back([&g, f = std::move(f)] { f(); g.left.fetch_sub(1); }); }
+    wake_.notify_one();
+  }
+  void wait(Group& g) {
+    while (g.left.load() > 0)
+      if (!runOne()) std::this_thread::yield();
+  }
+
+ private:
+  bool runOne() {
+    std::function<void()> f;
+    {
+      std::lock_guard lock(mutex_);
+      if (queue_.empty()) return false;
+      f = std::move(queue_.back());  // the newest: the waiter's own task, most likely
+      queue_.pop_back();
+    }
+    f();
+    return true;
+  }
+  void work() {
+    for (;;) {
+      std::function<void()> f;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+        if (queue_.empty()) return;
+        f = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      f();
+    }
+  }
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> queue_;
+  bool stop_ = false;
+  std::vector<std::thread> threads_;
+};
+
 }  // namespace
 
 // Top-down build straight into 8-wide nodes: a node's range is split by binned SAH, and the child with
@@ -89,8 +148,9 @@ struct BvhBuilder {
   std::unique_ptr<Node[]> nodes;
   std::unique_ptr<TriPack[]> packs;
   std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
-  std::atomic<int> running{0};  // subtree threads at work
+  TaskPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
+  static constexpr uint32_t kSubtreeTask = 4096;  // triangles from which a subtree is a task of its own
   static constexpr uint32_t kParallelChunk = 64 * 1024;  // refs per thread below which binning stays serial
 
   struct Split {
@@ -187,11 +247,11 @@ struct BvhBuilder {
 
   // Runs fn(c) for c in [0, chunks), chunk 0 on this thread.
   template <class Fn>
-  static void parallelFor(uint32_t chunks, const Fn& fn) {
-    std::vector<std::future<void>> jobs;
-    for (uint32_t c = 1; c < chunks; ++c) jobs.push_back(std::async(std::launch::async, [&fn, c] { fn(c); }));
+  void parallelFor(uint32_t chunks, const Fn& fn) const {
+    TaskPool::Group g;
+    for (uint32_t c = 1; c < chunks; ++c) pool->run(g, [&fn, c] { fn(c); });
     fn(0);
-    for (auto& j : jobs) j.get();
+    pool->wait(g);
   }
 
   // Moves the refs of bins ≤ s.bin in front. The k-th misplaced ref from the front trades places with the
@@ -338,27 +398,17 @@ struct BvhBuilder {
       }
       node.child[k] = Bvh::kLeafBit;  // empty slots: a leaf of one pack that the box test never reaches
     }
-    std::future<uint32_t> pending[kWidth];
+    // Large subtrees are tasks for the pool, the last one built here; the tree is the same whatever
+    // thread builds what (the copy-out orders it).
+    TaskPool::Group g;
+    int last = count - 1;
+    while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < kSubtreeTask)) --last;
     for (int k = 0; k < count; ++k) {
-      if (c[k].leaf) { node.child[k] = makeLeaf(c[k].r); continue; }
-      // A thread for a large subtree whenever there is room (up to 2 × threads at work, one thread: none):
-      // a fixed budget, spent near the root, left whole 100 K-triangle subtrees to one thread late on.
-      bool spawn = false;
-      if (c[k].r.size() > 20000 && threads > 1) {
-        spawn = running.fetch_add(1) < int(threads) * 2 - 1;
-        if (!spawn) running.fetch_sub(1);
-      }
-      if (spawn)
-        pending[k] = std::async(std::launch::async, [this, rr = c[k].r] {
-          const uint32_t i = build(rr);
-          running.fetch_sub(1);
-          return i;
-        });
-      else
-        node.child[k] = build(c[k].r);
+      if (c[k].leaf) node.child[k] = makeLeaf(c[k].r);
+      else if (pool && k != last && c[k].r.size() >= kSubtreeTask) pool->run(g, [this, &node, k, rr = c[k].r] { node.child[k] = build(rr); });
+      else node.child[k] = build(c[k].r);
     }
-    for (int k = 0; k < count; ++k)
-      if (pending[k].valid()) node.child[k] = pending[k].get();
+    if (pool) pool->wait(g);
     nodes[index] = node;
     return index;
   }
@@ -390,6 +440,8 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   b.nodes.reset(new Node[n + 1]);
   b.packs.reset(new TriPack[n + 1]);
   b.threads = threads;
+  std::unique_ptr<TaskPool> pool;
+  if (threads > 1) b.pool = (pool = std::make_unique<TaskPool>(threads - 1)).get();
   const auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   stats_.refSeconds = since(start);
   const auto treeStart = std::chrono::steady_clock::now();
@@ -433,12 +485,13 @@ template class HugeArray<TriPack>;
   bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&); \
   unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
   unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
-  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*); \
-  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*); \
+  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
+  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
   }
 RTR_DECLARE_TRAVERSAL(sse)
 RTR_DECLARE_TRAVERSAL(avx2)
 RTR_DECLARE_TRAVERSAL(avx512)
+RTR_DECLARE_TRAVERSAL(counted)
 #undef RTR_DECLARE_TRAVERSAL
 
 namespace {
@@ -448,11 +501,15 @@ struct Traversal {
   bool (*occluded)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
   unsigned (*closestPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
   unsigned (*occludedPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
-  unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*);
-  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*);
+  unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
+  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
 };
 #define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket}
 constexpr Traversal kTraversals[] = {RTR_TRAVERSAL(sse), RTR_TRAVERSAL(avx2), RTR_TRAVERSAL(avx512)};
+constexpr Traversal kCounted = RTR_TRAVERSAL(counted);
+std::atomic<bool> counting{false};
+std::atomic<int> packetLeafRays{Bvh::kPacketLeafRays};
+thread_local BvhCounters threadCounters;
 #undef RTR_TRAVERSAL
 }  // namespace
 
@@ -483,6 +540,16 @@ BvhIsa Bvh::setIsa(BvhIsa isa) {
 
 BvhIsa Bvh::isa() { return currentIsa.load(std::memory_order_relaxed); }
 
+void Bvh::setCounting(bool on) { counting = on && cpuHas(BvhIsa::Avx2); }
+void Bvh::setPacketLeafRays(int n) { packetLeafRays = n; }
+BvhCounters& Bvh::counters() { return threadCounters; }
+
+namespace {
+const Traversal& traversal() {
+  return counting.load(std::memory_order_relaxed) ? kCounted : kTraversals[int(Bvh::isa())];
+}
+}  // namespace
+
 const char* Bvh::isaName(BvhIsa isa) {
   switch (isa) {
     case BvhIsa::Sse: return "SSE4.2";
@@ -495,26 +562,26 @@ const char* Bvh::isaName(BvhIsa isa) {
 Hit Bvh::closest(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return h;
-  kTraversals[int(isa())].closest({nodes_.data(), packs_.data(), root_}, ray, method, h);
+  traversal().closest({nodes_.data(), packs_.data(), root_}, ray, method, h);
   return h;
 }
 
 bool Bvh::occluded(const Ray& ray, IntersectMethod method) const {
   Hit h;
   if (root_ == kEmpty) return false;
-  return kTraversals[int(isa())].occluded({nodes_.data(), packs_.data(), root_}, ray, method, h);
+  return traversal().occluded({nodes_.data(), packs_.data(), root_}, ray, method, h);
 }
 
 std::array<Hit, 2> Bvh::closestPair(const std::array<Ray, 2>& rays, IntersectMethod method) const {
   std::array<Hit, 2> h;
-  if (root_ != kEmpty) kTraversals[int(isa())].closestPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
+  if (root_ != kEmpty) traversal().closestPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
   return h;
 }
 
 std::array<bool, 2> Bvh::occludedPair(const std::array<Ray, 2>& rays, IntersectMethod method) const {
   std::array<Hit, 2> h;
   if (root_ == kEmpty) return {false, false};
-  const unsigned m = kTraversals[int(isa())].occludedPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
+  const unsigned m = traversal().occludedPair({nodes_.data(), packs_.data(), root_}, rays.data(), method, h.data());
   return {(m & 1) != 0, (m & 2) != 0};
 }
 
@@ -522,11 +589,12 @@ void Bvh::closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method) co
   for (int i = 0; i < n; ++i) hits[i] = Hit{};
   if (root_ == kEmpty || n <= 0) return;
   if (n == 1) { hits[0] = closest(rays[0], method); return; }
-  const Traversal& tr = kTraversals[int(isa())];
+  const Traversal& tr = traversal();
   const View v{nodes_.data(), packs_.data(), root_};
   // Rays with a near-tie between two candidates are traced again alone (bvh_packet.inl).
-  for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits); retry; retry &= retry - 1) {
+  for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits, packetLeafRays.load(std::memory_order_relaxed)); retry; retry &= retry - 1) {
     const int i = __builtin_ctz(retry);
+    if (&tr == &kCounted) ++threadCounters.retries;
     hits[i] = Hit{};
     tr.closest(v, rays[i], method, hits[i]);
   }
@@ -536,7 +604,8 @@ unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method) const {
   if (root_ == kEmpty || n <= 0) return 0;
   if (n == 1) return unsigned(occluded(rays[0], method));
   Hit scratch[8];
-  return kTraversals[int(isa())].occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch);
+  return traversal().occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch,
+                                      packetLeafRays.load(std::memory_order_relaxed));
 }
 
 }  // namespace rtr::trace

@@ -31,6 +31,21 @@ struct BvhStats {
   double sahCost = 0.0;  // expected node and pack tests of a ray through the root box (bvh.cpp)
 };
 
+// What the traversals did, counted only while Bvh::setCounting(true) (a separate, counting copy of the
+// traversal runs then: the timed ones count nothing). Per thread; reset it with Bvh::counters() = {}.
+struct BvhCounters {
+  // One ray against eight boxes or triangles (lanes = boxes, triangles): node visits, leaf visits, packs
+  // and real triangles (not padding) tested. Single rays, a packet's rays walking on alone or traced
+  // again, and leaves a packet tests ray by ray.
+  uint64_t nodes = 0, leaves = 0, packs = 0, triangles = 0;
+  // Eight rays against one box or triangle (lanes = rays): packets walked, their node visits and the rays
+  // live at each, the packet's interval against a node's eight boxes (lanes = boxes), child boxes tested and the rays tested at each, leaf visits and the rays live at each,
+  // triangles tested against all live rays at once and the rays in those tests, rays left to walk on
+  // alone, rays traced again (near-ties).
+  uint64_t packets = 0, packetNodes = 0, packetNodeRays = 0, intervalTests = 0, childTests = 0, childTestRays = 0;
+  uint64_t packetLeaves = 0, packetLeafRays = 0, triangleTests = 0, packetTriangles = 0, lone = 0, retries = 0;
+};
+
 // A fixed-size array in memory the kernel is asked to back with 2 MB pages (transparent huge pages):
 // traversal jumps all over tens of MB, and 4 KB pages would miss the TLB on most node visits.
 template <class T>
@@ -82,6 +97,16 @@ class Bvh {
   void closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method = IntersectMethod::Watertight) const;
   // Bit i set: ray i is occluded.
   unsigned occluded8(const Ray* rays, int n, IntersectMethod method = IntersectMethod::Watertight) const;
+
+  // A packet tests a leaf with lanes = rays (each triangle against all its live rays at once) when at
+  // least this many rays are live there and all share the watertight test's axis order; else ray by ray
+  // (lanes = triangles). For tests and benchmarks: setPacketLeafRays(9) = always ray by ray.
+  static constexpr int kPacketLeafRays = 5;
+  static void setPacketLeafRays(int n);
+  // Counting (tests and benchmarks): while on, every query of this process runs the counting traversal
+  // (the AVX2 code, slower; no counting on a CPU without AVX2) and adds to its thread's counters.
+  static void setCounting(bool on);
+  static BvhCounters& counters();
 
   const BvhStats& stats() const { return stats_; }
   bool empty() const { return root_ == kEmpty; }

@@ -22,6 +22,11 @@ inline float hmin(F a) {
   const __m128 m2 = _mm_min_ps(m, _mm_movehl_ps(m, m));
   return _mm_cvtss_f32(_mm_min_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
 }
+inline float hmax(F a) {
+  const __m128 m = _mm_max_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
+  const __m128 m2 = _mm_max_ps(m, _mm_movehl_ps(m, m));
+  return _mm_cvtss_f32(_mm_max_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
+}
 #else
 inline F sel(F mask, F x, F y) { return {_mm_blendv_ps(y.a, x.a, mask.a), _mm_blendv_ps(y.b, x.b, mask.b)}; }
 inline float hmin(F x) {
@@ -54,21 +59,54 @@ struct PacketWalker {
   F org[3], rdir[3], rdirFar[3];
 #endif
   alignas(32) float tMax[8], cull[8], best[8], second[8];
+  // The watertight test's per-ray constants with lanes = rays, for leaves tested all rays at once; valid
+  // when every ray has the same axis order kx, ky, kz (sameShear).
+  F shO[3], shS[3];
+  int kx = 0, ky = 0, kz = 0;
+  bool sameShear = true;
+  const int leafRays;
+#if RTR_BVH_AVX2
+  // The packet's interval: per axis, bounds over its rays of the slab constants, for one conservative
+  // test of a node's eight children at once (lanes = children) before each child is tested against the
+  // rays (lanes = rays). Without it a node visit costs one 8-wide pass per child, as many passes a ray as
+  // single rays take (counted: docs/bench/trace.md, round 8). Only when every ray has the same sign on
+  // each axis and finite, non-zero constants (then no bound is NaN).
+  float rnLo[3], rnHi[3], qnHi[3], rfLo[3], rfHi[3], qfLo[3], oLo[3], oHi[3];  // o: on parallel axes
+  int nearOff[3], farOff[3];
+  bool interval = false;
+#endif
   alignas(W) unsigned char walkers[8][sizeof(W)];  // each ray's single-ray walk, for leaves and lone rays
 
-  const W& walker(int i) const { return *reinterpret_cast<const W*>(walkers[i]); }
+  IntersectMethod method;
+  unsigned built = 0;  // the walkers constructed so far: only rays that need one pay its set-up
+  // (on the temple most packets miss after a node or two, and eight set-ups cost more than the walk)
+  RTR_INLINE const W& walker(int i) {
+    if (!(built >> i & 1)) {
+      new (walkers[i]) W(bvh, rays[i], method);
+      built |= 1u << i;
+    }
+    return *reinterpret_cast<const W*>(walkers[i]);
+  }
 
-  RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, Hit* h, IntersectMethod m)
-      : bvh(view), rays(r), hits(h) {
-    alignas(32) float o[3][8], d[3][8];
+  RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, Hit* h, IntersectMethod m, int minLeafRays)
+      : bvh(view), rays(r), hits(h), leafRays(minLeafRays), method(m) {
+    alignas(32) float o[3][8], d[3][8], so[3][8], ss[3][8];
     for (int i = 0; i < 8; ++i) {
       const Ray& ray = r[i < n ? i : 0];
       o[0][i] = ray.origin.x; o[1][i] = ray.origin.y; o[2][i] = ray.origin.z;
       d[0][i] = ray.direction.x; d[1][i] = ray.direction.y; d[2][i] = ray.direction.z;
       tMax[i] = cull[i] = ray.tMax;
       best[i] = second[i] = kInf;
-      if (i < n) new (walkers[i]) W(view, ray, m);
+      // Walker's shear constants, by the same operations.
+      int x, y, z;
+      W::shearAxes(&d[0][i], 8, x, y, z);
+      if (i == 0) { kx = x; ky = y; kz = z; }
+      sameShear = sameShear && x == kx && y == ky && z == kz;
+      const float szs = 1.0f / d[z][i];
+      so[0][i] = o[x][i]; so[1][i] = o[y][i]; so[2][i] = o[z][i];
+      ss[0][i] = d[x][i] * szs; ss[1][i] = d[y][i] * szs; ss[2][i] = szs;
     }
+    for (int a = 0; a < 3; ++a) { shO[a] = load(so[a]); shS[a] = load(ss[a]); }
     // Per ray, the operations of Walker's constructor (there done three axes at a time, here eight
     // rays at a time: the same per-lane results), so the boxes are culled exactly as for a single ray.
     const F zero = set1(0.0f);
@@ -92,10 +130,51 @@ struct PacketWalker {
       rdirFar[a] = rcp * set1(kFarScale);
 #endif
     }
+#if RTR_BVH_AVX2
+    // Vector reductions: most temple packets visit a node or two, so this set-up is a good part of them.
+    const F inf = set1(kInf);
+    F ok = set1(bitsFloat(0xFFFFFFFFu));
+    for (int a = 0; a < 3; ++a) { oLo[a] = hmin(oAxis[a]); oHi[a] = hmax(oAxis[a]); }
+    for (int i = 0; i < kSlabs; ++i) {
+      const int a = kSlabAxes.axis[i];
+      ok = ok & lt(rNear[a] & absMask, inf) & lt(rFar[a] & absMask, inf) & lt(qNear[a] & absMask, inf) &
+           lt(qFar[a] & absMask, inf) & neq(rNear[a], zero) & neq(rFar[a], zero);
+      const unsigned signs = bits(neg[a]);
+      if (signs != 0 && signs != 0xFFu) ok = set1(0.0f);
+      rnLo[a] = hmin(rNear[a]); rnHi[a] = hmax(rNear[a]); qnHi[a] = hmax(qNear[a]);
+      rfLo[a] = hmin(rFar[a]); rfHi[a] = hmax(rFar[a]); qfLo[a] = hmin(qFar[a]);
+      const int nearSide = signs ? 1 : 0;
+      nearOff[a] = (nearSide * 3 + a) * 8;
+      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+    }
+    interval = bits(ok) == 0xFFu;
+#endif
   }
+
+#if RTR_BVH_AVX2
+  // The children of n that some ray of the packet may meet: never one that a ray's own test would visit
+  // (the exact FMA rounds monotonically, so the bounds' FMA bounds every ray's; no operand is NaN).
+  RTR_INLINE unsigned intervalHits(const Node& n, F tHitV) const {
+    RTR_COUNT(c.intervalTests += 1);
+    const float* b = &n.box[0][0][0];
+    const F zero = set1(0.0f);
+    F lo = zero, hi = set1(hmax(tHitV));
+    for (int i = 0; i < kSlabs; ++i) {
+      const int a = kSlabAxes.axis[i];
+      const F nb = load(b + nearOff[a]), fb = load(b + farOff[a]);
+      lo = vmax(lo, fmsub(nb, sel(lt(nb, zero), set1(rnHi[a]), set1(rnLo[a])), set1(qnHi[a])));
+      hi = vmin(hi, fmsub(fb, sel(lt(fb, zero), set1(rfLo[a]), set1(rfHi[a])), set1(qfLo[a])));
+    }
+    F in = le(lo, hi);
+    for (int a = 0; a < 3; ++a)  // an axis the rays run parallel to: some origin within the slab
+      if (Parallel >> a & 1) in = in & le(load(n.box[0][a]), set1(oHi[a])) & ge(load(n.box[1][a]), set1(oLo[a]));
+    return bits(in);
+  }
+#endif
 
   // The rays of `active` whose box test passes child c of node n, with their entry distances.
   RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F tHitV, F& tNearOut) const {
+    RTR_COUNT(c.childTests += 1; c.childTestRays += unsigned(__builtin_popcount(active)));
     const F zero = set1(0.0f);
     F tn[3], tf[3];
     for (int i = 0; i < kSlabs; ++i) {
@@ -131,9 +210,13 @@ struct PacketWalker {
   // Tests node `ref`'s children against the packet: false when no ray meets any; else ref/active are
   // the child to visit next and its rays, the other children are on the stack.
   RTR_INLINE bool visitNode(PacketEntry* stack, int& sp, uint32_t& ref, unsigned& active) const {
+    RTR_COUNT(c.packetNodes += 1; c.packetNodeRays += unsigned(__builtin_popcount(active)));
     const Node& n = bvh.nodes[ref];
     const F tHitV = load(cull);
     unsigned slots = bits(le(load(n.box[0][0]), load(n.box[1][0])));  // empty slots have lo > hi
+#if RTR_BVH_AVX2
+    if (interval) slots &= intervalHits(n, tHitV);
+#endif
     F tn[8];
     unsigned mk[8];
     uint64_t keys[8];
@@ -187,8 +270,10 @@ struct PacketWalker {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
     const F tLimit = set1(cull[i] < tMax[i] ? cull[i] : tMax[i]);
     const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+    RTR_COUNT(c.leaves += 1);
     for (uint32_t p = first; p < first + np; ++p) {
       const TriPack& pk = bvh.packs[p];
+      RTR_COUNT(c.packs += 1; c.triangles += unsigned(__builtin_popcount(realLanes(pk))));
       const F Az = load(pk.v[0][w.kz]) - w.oz, Bz = load(pk.v[1][w.kz]) - w.oz, Cz = load(pk.v[2][w.kz]) - w.oz;
       const F ax = (load(pk.v[0][w.kx]) - w.ox) - w.sx * Az, ay = (load(pk.v[0][w.ky]) - w.oy) - w.sy * Az;
       const F bx = (load(pk.v[1][w.kx]) - w.ox) - w.sx * Bz, by = (load(pk.v[1][w.ky]) - w.oy) - w.sy * Bz;
@@ -226,8 +311,71 @@ struct PacketWalker {
     }
   }
 
+  // Leaf `ref` with lanes = rays: each real triangle against all `active` rays at once, each lane with
+  // exactly Walker::testLeaf's operations for its ray (closest hit: leafCandidates' rules). Any hit:
+  // returns the rays found occluded.
+  RTR_INLINE unsigned leafAllRays(uint32_t ref, unsigned active) {
+    const F zero = set1(0.0f), signBit = set1(-0.0f);
+    const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
+    unsigned occluded = 0;
+    for (uint32_t p = first; p < first + np; ++p) {
+      const TriPack& pk = bvh.packs[p];
+      unsigned tris = realLanes(pk);
+      if constexpr (AnyHit) tris &= ~topBits(pk.prim);  // shadow casters only
+      const F tLimit = load(AnyHit ? tMax : cull);  // cull ≤ tMax (offer)
+      for (; tris; tris &= tris - 1) {
+        const int lane = ctz(tris);
+        RTR_COUNT(c.triangleTests += 1; c.packetTriangles += unsigned(__builtin_popcount(active)));
+        const F Az = set1(pk.v[0][kz][lane]) - shO[2], Bz = set1(pk.v[1][kz][lane]) - shO[2], Cz = set1(pk.v[2][kz][lane]) - shO[2];
+        const F ax = (set1(pk.v[0][kx][lane]) - shO[0]) - shS[0] * Az, ay = (set1(pk.v[0][ky][lane]) - shO[1]) - shS[1] * Az;
+        const F bx = (set1(pk.v[1][kx][lane]) - shO[0]) - shS[0] * Bz, by = (set1(pk.v[1][ky][lane]) - shO[1]) - shS[1] * Bz;
+        const F cx = (set1(pk.v[2][kx][lane]) - shO[0]) - shS[0] * Cz, cy = (set1(pk.v[2][ky][lane]) - shO[1]) - shS[1] * Cz;
+        const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W3 = bx * ay - by * ax;
+        unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W3, zero)) & active;
+        unsigned m = ~bits((U ^ V) | (V ^ W3)) & active & ~edge;
+        if ((m | edge) == 0) continue;
+        const F det = U + V + W3;
+        const F T = U * (shS[2] * Az) + V * (shS[2] * Bz) + W3 * (shS[2] * Cz);
+        const F detSign = det & signBit;
+        const F Ts = T ^ detSign;
+        m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));
+        if constexpr (AnyHit) {
+          occluded |= m;
+          for (edge &= ~m; edge; edge &= edge - 1) {
+            const int i = ctz(edge);
+            WatertightRay r(rays[i]);
+            float b1, b2;
+            if (intersectWatertight(r, laneTriangle(pk, lane), b1, b2) > 0.0f) occluded |= 1u << i;
+          }
+          active &= ~occluded;
+          if (!active) return occluded;
+          continue;
+        }
+        if (m) {
+          const F inv = set1(1.0f) / det;
+          alignas(32) float tv[8], iv[8], vv[8], wv[8];
+          store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W3);
+          for (; m; m &= m - 1) {
+            const int i = ctz(m);
+            const float t = tv[i];
+            if (t > 0.0f && t < tMax[i]) offer(i, t, vv[i] * iv[i], wv[i] * iv[i], pk.prim[lane]);
+          }
+        }
+        for (; edge; edge &= edge - 1) {
+          const int i = ctz(edge);
+          WatertightRay r(rays[i]);
+          float b1, b2;
+          const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
+          if (t > 0.0f) offer(i, t, b1, b2, pk.prim[lane]);
+        }
+      }
+    }
+    return occluded;
+  }
+
   // Ray i alone from node or leaf `ref` on: its single-ray walk; returns whether it is occluded (any hit).
   RTR_INLINE bool alone(int i, uint32_t ref) {
+    RTR_COUNT(c.lone += 1);
     const W& w = walker(i);
     uint64_t stack[kStackSize];
     if constexpr (AnyHit) {
@@ -262,6 +410,11 @@ struct PacketWalker {
           break;
         }
         if (ref & Bvh::kLeafBit) {
+          RTR_COUNT(c.packetLeaves += 1; c.packetLeafRays += unsigned(__builtin_popcount(active)));
+          if (sameShear && __builtin_popcount(active) >= leafRays) {
+            done |= leafAllRays(ref, active);
+            break;
+          }
           for (unsigned b = active; b; b &= b - 1) {
             const int i = ctz(b);
             if constexpr (AnyHit) {
@@ -295,8 +448,9 @@ struct PacketWalker {
 };
 
 template <bool AnyHit, unsigned Parallel>
-unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
-  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, hits, method);
+unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
+  RTR_COUNT(c.packets += 1);
+  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, hits, method, leafRays);
   return p.run((1u << n) - 1);
 }
 

@@ -114,6 +114,21 @@ constexpr SlabAxes slabAxesOf(unsigned parallel) {
 
 #define RTR_INLINE inline __attribute__((always_inline))
 
+// Counting (bvh_counted.cpp only): RTR_COUNT(c.nodes += 1) adds to the thread's BvhCounters; elsewhere
+// it compiles to nothing.
+#if RTR_BVH_COUNT
+#define RTR_COUNT(...) do { BvhCounters& c = Bvh::counters(); __VA_ARGS__; } while (0)
+#else
+#define RTR_COUNT(...) do {} while (0)
+#endif
+
+// The real triangles of a pack (a short pack repeats its last one).
+inline unsigned realLanes(const TriPack& pk) {
+  unsigned m = 1;
+  for (int lane = 1; lane < 8; ++lane) m |= unsigned(pk.prim[lane] != pk.prim[lane - 1]) << lane;
+  return m;
+}
+
 // Where a walk is: the stack's fill, the node or leaf to visit next, the closest hit so far. The stack
 // itself (kStackSize entries) is passed beside it: as a member it kept the compiler from holding these
 // in registers (measured about 5 % slower, VM). An entry: the entry distance's bits above the node reference,
@@ -195,19 +210,26 @@ struct Walker {
     // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
     // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
     // must shear identically), inline here and sharing the reciprocal with the slab test.
-    const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[1]), __builtin_fabsf(d[2])};
-    kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
-    kx = kz == 2 ? 0 : kz + 1;
-    ky = kx == 2 ? 0 : kx + 1;
-    if (d[kz] < 0.0f) { const int t = kx; kx = ky; ky = t; }
+    shearAxes(d, 1, kx, ky, kz);
     const float szs = rcp[kz];
     ox = set1(o[kx]); oy = set1(o[ky]); oz = set1(o[kz]);
     sx = set1(d[kx] * szs); sy = set1(d[ky] * szs); sz = set1(szs);
   }
 
+  // The watertight test's axis order for direction d[0], d[stride], d[2 * stride] (packets keep theirs
+  // by axis): kz the largest component, kx and ky swapped where it is negative.
+  RTR_INLINE static void shearAxes(const float* d, int stride, int& kx, int& ky, int& kz) {
+    const float ad[3] = {__builtin_fabsf(d[0]), __builtin_fabsf(d[stride]), __builtin_fabsf(d[2 * stride])};
+    kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz * stride] < 0.0f) { const int t = kx; kx = ky; ky = t; }
+  }
+
   // Tests the inner node at.ref's children: false when it meets none; else at.ref is the child to visit
   // next and the others are on the stack.
   RTR_INLINE bool visitNode(uint64_t* stack, Cursor& at, F tHitV) const {
+    RTR_COUNT(c.nodes += 1);
     const Node& n = bvh.nodes[at.ref];
     const float* b = &n.box[0][0][0];
     const F zero = set1(0.0f);
@@ -284,8 +306,10 @@ struct Walker {
   RTR_INLINE bool testLeaf(Cursor& at, Hit& hit, F tHitV) const {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
     const uint32_t first = at.ref & 0x0FFFFFFFu, np = ((at.ref >> 28) & 7u) + 1;
+    RTR_COUNT(c.leaves += 1);
     for (uint32_t p = first; p < first + np; ++p) {
       const TriPack& pk = bvh.packs[p];
+      RTR_COUNT(c.packs += 1; c.triangles += unsigned(__builtin_popcount(realLanes(pk))));
       if (method != IntersectMethod::Watertight) {
         for (int lane = 0; lane < 8; ++lane) {
           const uint32_t prim = pk.prim[lane];
@@ -464,18 +488,18 @@ unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
 // use the watertight test; others go ray by ray. Closest hit: returns the rays the caller must trace
 // again alone (ties, see bvh_packet.inl). Any hit: returns the occluded rays.
 template <bool AnyHit>
-unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
+unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
   const unsigned p = parallelAxes(rays[0]);
   bool same = method == IntersectMethod::Watertight && n > 1;
   for (int i = 1; i < n && same; ++i) same = parallelAxes(rays[i]) == p;
   switch (same ? p : 8u) {
-    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, method, hits);
-    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, method, hits);
-    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, method, hits);
-    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, method, hits);
-    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, method, hits);
-    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, method, hits);
-    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, method, hits);
+    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, method, hits, leafRays);
+    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, method, hits, leafRays);
+    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, method, hits, leafRays);
+    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, method, hits, leafRays);
+    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, method, hits, leafRays);
+    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, method, hits, leafRays);
+    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, method, hits, leafRays);
     case 7: return 0;
     default: {
       unsigned m = 0;
@@ -497,13 +521,14 @@ unsigned closestPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod meth
 unsigned occludedPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod method, Hit* scratch) {
   return dispatchPair<true>(bvh, rays, method, scratch);
 }
-unsigned closestPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits) {
-  return dispatchPacket<false>(bvh, rays, n, method, hits);
+unsigned closestPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
+  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays);
 }
-unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch) {
-  return dispatchPacket<true>(bvh, rays, n, method, scratch);
+unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch, int leafRays) {
+  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays);
 }
 
 }  // namespace rtr::trace::RTR_BVH_ISA
 
 #undef RTR_INLINE
+#undef RTR_COUNT

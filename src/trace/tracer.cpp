@@ -153,7 +153,8 @@ bool Tracer::shadowed(const Ray& r, const Frame& f, Counters& c) const {
   }
 }
 
-glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c) const {
+glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c,
+                        const Shadows* pre) const {
   const TraceSettings& s = *f.s;
   const Material& mat = *sp.material;
   const glm::vec3 v = -glm::normalize(r.direction);
@@ -169,11 +170,12 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
   // on, a sample behind the surface itself or blocked gives nothing (Phong keeps its ambient Ka x Lc).
   glm::vec3 color = pbr ? f.ambient * glm::clamp(in.baseColor, 0.0f, 1.0f) + in.emissive : mat.ke;
   const int n = std::max(1, s.areaLightSamples);
+  size_t slot = 0;
   for (const Light& light : f.lights) {
     if (!pbr) color += blinnPhongAmbient(mat, light.color);
     const int samples = light.kind == Light::Kind::Area ? n : 1;
     glm::vec3 direct(0.0f);
-    for (int i = 0; i < samples; ++i) {
+    for (int i = 0; i < samples; ++i, ++slot) {
       const glm::vec3 toLight = light.samplePoint(i, samples) - sp.position;
       if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
       const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
@@ -182,7 +184,12 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
       if (d == glm::vec3(0.0f)) continue;
       if (s.shadows) {
         if (glm::dot(sp.geomNormal, ls.l) <= 0.0f) continue;
-        if (shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c)) continue;
+        if (pre && (pre->known[slot] >> pre->lane & 1)) {
+          ++c.shadow;
+          if (pre->blocked[slot] >> pre->lane & 1) continue;
+        } else if (shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c)) {
+          continue;
+        }
       }
       direct += d;
     }
@@ -191,10 +198,48 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
   return color;
 }
 
-glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
-                        const Hit* first) const {
+void Tracer::shadowPackets(const Visible* vis, int n, const Frame& f, std::vector<uint8_t>& known,
+                           std::vector<uint8_t>& blocked) const {
   const TraceSettings& s = *f.s;
-  const Visible vis = closestVisible(r, cone, f, c, first);
+  known.clear();
+  blocked.clear();
+  const bool pbr = s.shading == Shading::Pbr;
+  // Alpha-tested scenes take shadow rays as chains of closest hits (shadowed()): those stay single.
+  if (!useBvh_ || !s.shadows || (!pbr && s.shading != Shading::Phong) || (f.tex && anyAlphaTested_)) return;
+  const int ns = std::max(1, s.areaLightSamples);
+  for (const Light& light : f.lights) {
+    const int samples = light.kind == Light::Kind::Area ? ns : 1;
+    for (int i = 0; i < samples; ++i) {
+      // local()'s conditions for a shadow ray, but not whether the light's term is zero (that needs the
+      // material's inputs): such a ray is traced for nothing, its answer unused.
+      std::array<Ray, 8> rays;
+      int lanes[8], m = 0;
+      for (int k = 0; k < n; ++k) {
+        const Visible& v = vis[k];
+        if (!v.hit.hit() || (!pbr && isLightMaterial(*v.sp.material))) continue;
+        const glm::vec3 toLight = light.samplePoint(i, samples) - v.sp.position;
+        if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
+        const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
+        if (glm::dot(v.sp.geomNormal, ls.l) <= 0.0f) continue;
+        rays[m] = spawnRay(v.sp.position, v.sp.geomNormal, toLight, 1.0f);
+        lanes[m++] = k;
+      }
+      const unsigned occ = m ? bvh_.occluded8(rays.data(), m, s.intersect) : 0u;
+      uint8_t kn = 0, bl = 0;
+      for (int j = 0; j < m; ++j) {
+        kn = uint8_t(kn | 1u << lanes[j]);
+        if (occ >> j & 1) bl = uint8_t(bl | 1u << lanes[j]);
+      }
+      known.push_back(kn);
+      blocked.push_back(bl);
+    }
+  }
+}
+
+glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
+                        const Visible* first, const Shadows* pre) const {
+  const TraceSettings& s = *f.s;
+  const Visible vis = first ? *first : closestVisible(r, cone, f, c, nullptr);
   if (s.shading == Shading::Depth) {
     if (!vis.hit.hit()) return glm::vec3(1.0f);
     return glm::vec3(std::clamp(vis.t * glm::dot(r.direction, f.depthAxis) / f.depthFar, 0.0f, 1.0f));
@@ -202,7 +247,7 @@ glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame
   if (!vis.hit.hit()) return s.background;
   const SurfacePoint& sp = vis.sp;
   if (s.shading == Shading::Normals) return glm::abs(sp.normal);  // the brief's "interpolation" view
-  const glm::vec3 col = local(vis.ray, sp, vis.coneWidth, f, c);
+  const glm::vec3 col = local(vis.ray, sp, vis.coneWidth, f, c, pre);
   const float m = std::clamp(sp.material->mirror, 0.0f, 1.0f);
   if (m <= 0.0f || bounces <= 0) return col;  // out of bounces: the surface's own colour
   // Task 7: reflect about the shading normal (the geometric one if that would dive under the surface).
@@ -301,6 +346,7 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
     Counters c;
     uint64_t primary = 0;
+    std::vector<uint8_t> known, blocked;
     for (;;) {
       if (cancel && cancel->load(std::memory_order_relaxed)) break;
       const uint32_t tile = next.fetch_add(1);
@@ -308,7 +354,8 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
       const TileRect rect{(tile % tilesX) * ts, (tile / tilesX) * ts, std::min(s.width, (tile % tilesX + 1) * ts),
                           std::min(s.height, (tile / tilesX + 1) * ts)};
       // Primary rays go through the BVH eight at a time (a packet of neighbouring pixels of a row:
-      // Bvh::closest8, the same hits as one at a time), then each pixel is shaded on its own.
+      // Bvh::closest8, the same hits as one at a time), then their shadow rays, a packet per light
+      // sample (Bvh::occluded8, the same answers), then each pixel is shaded on its own.
       for (uint32_t y = rect.y0; y < rect.y1; ++y)
         for (uint32_t x = rect.x0; x < rect.x1; x += 8) {
           const uint32_t n = std::min(8u, rect.x1 - x);
@@ -321,8 +368,12 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
           }
           std::array<Hit, 8> first;
           if (useBvh_) bvh_.closest8(rays.data(), int(n), first.data(), s.intersect);
+          std::array<Visible, 8> vis;
+          for (uint32_t k = 0; k < n; ++k) vis[k] = closestVisible(rays[k], frame.camera, frame, c, useBvh_ ? &first[k] : nullptr);
+          shadowPackets(vis.data(), int(n), frame, known, blocked);
           for (uint32_t k = 0; k < n; ++k) {
-            glm::vec3 col = shade(rays[k], frame.camera, s.bounces, frame, c, useBvh_ ? &first[k] : nullptr);
+            const Shadows pre{known.data(), blocked.data(), int(k)};
+            glm::vec3 col = shade(rays[k], frame.camera, s.bounces, frame, c, &vis[k], known.empty() ? nullptr : &pre);
             // Debug views hold their value as displayed: encode so that sRGB output shows it unchanged.
             if (debugView) col = {srgbToLinear(col.x), srgbToLinear(col.y), srgbToLinear(col.z)};
             out.at(x + k, y) = glm::vec4(col, 1.0f);

@@ -135,12 +135,24 @@ class Tracer {
     float coneWidth = 0.0f;
     float t = 0.0f;
   };
+  // Shadow answers the render loop traced ahead for a packet's pixels: slot j is the j-th light sample
+  // of local()'s loop, bit `lane` of known[j] says it was traced, of blocked[j] that it is occluded.
+  struct Shadows {
+    const uint8_t* known;
+    const uint8_t* blocked;
+    int lane;
+  };
   Frame makeFrame(const TraceSettings& s) const;
-  // `first`: r's closest hit when the caller has traced it already (the render loop traces primary rays
-  // in pairs), else null.
+  // `first`: what r sees when the caller has traced it already (the render loop traces primary rays in
+  // packets), else null; `pre`: shadow rays traced ahead for it, else null.
   glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
-                  const Hit* first = nullptr) const;
-  glm::vec3 local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c) const;
+                  const Visible* first = nullptr, const Shadows* pre = nullptr) const;
+  glm::vec3 local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c,
+                  const Shadows* pre = nullptr) const;
+  // The shadow rays local() will ask for at these n ≤ 8 hits, traced as packets, one per light sample
+  // (all go to the same point): known/blocked as in Shadows, left empty where local() must trace alone.
+  void shadowPackets(const Visible* vis, int n, const Frame& f, std::vector<uint8_t>& known,
+                     std::vector<uint8_t>& blocked) const;
   bool cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const;
   Visible closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c, const Hit* first) const;
   bool shadowed(const Ray& r, const Frame& f, Counters& c) const;

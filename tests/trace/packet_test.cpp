@@ -2,6 +2,7 @@
 // t, barycentrics and triangle bit for bit, and the same shadow answer, on every ISA.
 #include "trace/bvh.hpp"
 
+#include <cstring>
 #include <random>
 
 #include <glm/geometric.hpp>
@@ -22,12 +23,16 @@ std::vector<Triangle> trianglesOf(const Mesh& m, glm::vec3 offset = glm::vec3(0.
   return tris;
 }
 
-// Every group of `width` consecutive rays as one packet against each ray alone, on every ISA; returns
-// the number of hits (of the last ISA) so callers can check the case is not vacuous.
+// Every group of `width` consecutive rays as one packet against each ray alone, on every ISA, with leaves
+// tested all rays at once wherever two or more rays reach them, and always ray by ray; returns the
+// number of hits (of the last pass) so callers can check the case is not vacuous.
 size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, int width = 8, const char* what = "") {
   size_t hits = 0;
-  for (BvhIsa isa : {BvhIsa::Avx512, BvhIsa::Avx2, BvhIsa::Sse}) {
+  for (int pass = 0; pass < 6; ++pass) {
+    const BvhIsa isa = pass % 3 == 0 ? BvhIsa::Avx512 : pass % 3 == 1 ? BvhIsa::Avx2 : BvhIsa::Sse;
+    const int leafRays = pass < 3 ? 2 : 9;
     Bvh::setIsa(isa);
+    Bvh::setPacketLeafRays(leafRays);
     hits = 0;
     for (size_t i = 0; i < rays.size(); i += width) {
       const int n = int(std::min<size_t>(width, rays.size() - i));
@@ -38,11 +43,12 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
         const Hit one = bvh.closest(rays[i + k]);
         const bool occ1 = bvh.occluded(rays[i + k]);
         if (h[k].prim != one.prim || h[k].t != one.t || h[k].b1 != one.b1 || h[k].b2 != one.b2 || (occ >> k & 1) != occ1) {
-          ADD_FAILURE() << what << " " << Bvh::isaName(isa) << " ray " << i + k << " of a packet of " << n
+          ADD_FAILURE() << what << " " << Bvh::isaName(isa) << (leafRays == 2 ? ", leaves all rays at once" : ", leaves ray by ray") << ", ray " << i + k << " of a packet of " << n
                         << ": triangle " << h[k].prim << " t " << h[k].t << " b " << h[k].b1 << " " << h[k].b2
                         << " occluded " << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b "
                         << one.b1 << " " << one.b2 << " occluded " << occ1;
           Bvh::setIsa(BvhIsa::Avx512);
+          Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
           return 0;
         }
         hits += one.hit();
@@ -50,6 +56,7 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
     }
   }
   Bvh::setIsa(BvhIsa::Avx512);
+  Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
   return hits;
 }
 
@@ -194,6 +201,47 @@ TEST(Packets, CameraPacketsIncludingImageBorders) {
     EXPECT_GT(hits, rays.size() / 8);
     EXPECT_LT(hits, rays.size());
   }
+}
+
+// The counting traversal (bench-trace's work per ray): the same results, and counts that add up.
+TEST(Packets, CountersCountTheWorkAndChangeNoResult) {
+  const Mesh sphere = uvSphere({0.0f, 0.0f, 0.0f}, 1.0f, 48, 96);
+  const Bvh bvh(trianglesOf(sphere), {}, 1);
+  const Ray hit{{0.01f, 0.02f, 5.0f}, {0.0f, 0.0f, -1.0f}}, miss{{0.0f, 5.0f, 5.0f}, {0.0f, 0.0f, -1.0f}};
+  const Hit plain = bvh.closest(hit);
+  Bvh::counters() = {};
+  bvh.closest(hit);
+  EXPECT_EQ(Bvh::counters().nodes, 0u) << "counted while counting is off";
+  Bvh::setCounting(true);
+  const Hit counted = bvh.closest(hit);
+  const BvhCounters one = Bvh::counters();
+  EXPECT_EQ(std::memcmp(&plain, &counted, sizeof plain), 0);
+  EXPECT_GE(one.nodes, 2u);
+  EXPECT_GE(one.leaves, 1u);
+  EXPECT_GE(one.packs, one.leaves);
+  EXPECT_GE(one.triangles, one.packs);
+  EXPECT_LE(one.triangles, 8 * one.packs);
+  Bvh::counters() = {};
+  bvh.closest(miss);  // misses the root's children: one node visit, nothing else
+  EXPECT_EQ(Bvh::counters().nodes, 1u);
+  EXPECT_EQ(Bvh::counters().leaves, 0u);
+  // Eight copies of one ray: every lane live everywhere, no ray ever alone.
+  Bvh::counters() = {};
+  Ray rays[8];
+  Hit h[8];
+  for (Ray& r : rays) r = hit;
+  bvh.closest8(rays, 8, h);
+  const BvhCounters p = Bvh::counters();
+  Bvh::setCounting(false);
+  Bvh::counters() = {};
+  EXPECT_EQ(std::memcmp(&plain, &h[7], sizeof plain), 0);
+  EXPECT_EQ(p.packets, 1u);
+  EXPECT_GE(p.packetNodes, 2u);
+  EXPECT_EQ(p.packetNodeRays, 8 * p.packetNodes);
+  EXPECT_GE(p.packetLeaves, 1u);
+  EXPECT_EQ(p.packetLeafRays, 8 * p.packetLeaves);
+  EXPECT_EQ(p.lone, 0u);
+  EXPECT_EQ(p.packetTriangles + p.triangles, 8 * one.triangles) << "each ray tests what it tests alone";
 }
 
 TEST(Packets, EmptyBvh) {

@@ -322,6 +322,19 @@ TEST(Tracer, TilesCoverTheImageOnceAndThreadsAgree) {
   for (uint32_t y = 0; y < ts.height; ++y)
     for (uint32_t x = 0; x < ts.width; ++x)
       ASSERT_EQ(glm::vec3(a.at(x, y)), t.traceAndShade(t.calculateRay(ts, x, y), ts.bounces, ts)) << x << "," << y;
+  // Shadow rays traced as packets (one per light sample, all pixels of a packet at once) change nothing:
+  // several samples of the area light, and pbr.
+  for (const Shading shading : {Shading::Phong, Shading::Pbr}) {
+    TraceSettings t2 = ts;
+    t2.shading = shading;
+    t2.areaLightSamples = 3;
+    ImageF c;
+    const RenderStats st2 = t.render(t2, c);
+    EXPECT_GT(st2.shadowRays, st2.primaryRays / 10);
+    for (uint32_t y = 0; y < t2.height; ++y)
+      for (uint32_t x = 0; x < t2.width; ++x)
+        ASSERT_EQ(glm::vec3(c.at(x, y)), t.traceAndShade(t.calculateRay(t2, x, y), t2.bounces, t2)) << x << "," << y;
+  }
   // Cancel from the first tile's callback: the render stops early.
   std::atomic<bool> cancel{false};
   const RenderStats cst = t.render(ts, b, [&](const TileRect&) { cancel = true; }, &cancel);

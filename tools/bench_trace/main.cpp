@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <initializer_list>
 #include <map>
 #include <random>
 #include <string>
@@ -213,8 +214,49 @@ void explain(const Ray& r, const Hit& ours, const Hit& theirs, const std::vector
     std::printf("    triangle %u, t %.9g, edge functions %.3g %.3g %.3g: %s\n", h.prim, h.t, e[0], e[1], e[2], kind.c_str());
 }
 
+struct RaySet { const char* name; const std::vector<Ray>* rays; bool any; };
+
+// What each ray costs in work, single rays and packets of eight (BvhCounters, the counting traversal on
+// one thread; the counts do not depend on the machine): where a row stays below Embree's packets, these
+// say whether nodes, leaves or idle SIMD lanes bound it. An 8-wide pass: one ray against a node's eight
+// boxes or a pack's eight triangles, or one box or triangle against a packet's eight lanes.
+void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
+  Bvh::setCounting(true);
+  std::printf("\nWork per ray (counted; a pass: one 8-wide box or triangle test, lanes = boxes or triangles for one ray, "
+              "or lanes = rays for a packet; `live`: the share of a packet's 8 lanes with a ray):\n\n"
+              "| rays | single: node visits | packs | triangles | packets: node visits a packet | box tests a node visit | "
+              "live at box tests | leaf visits a packet | live at leaves | box passes a ray: single / packets | "
+              "triangle passes a ray: single / packets (of them lanes = rays) | walks alone a ray | retried |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const RaySet& s : sets) {
+    const std::vector<Ray>& rays = *s.rays;
+    const double n = double(std::max<size_t>(1, rays.size()));
+    Bvh::counters() = {};
+    for (const Ray& r : rays) s.any ? void(bvh.occluded(r)) : void(bvh.closest(r));
+    const BvhCounters one = Bvh::counters();
+    Bvh::counters() = {};
+    for (size_t i = 0; i < rays.size(); i += 8) {
+      const int k = int(std::min<size_t>(8, rays.size() - i));
+      Hit h[8];
+      if (s.any) bvh.occluded8(&rays[i], k); else bvh.closest8(&rays[i], k, h);
+    }
+    const BvhCounters p = Bvh::counters();
+    auto share = [](uint64_t live, uint64_t visits) { return visits ? double(live) / (8.0 * double(visits)) : 0.0; };
+    // Packets' passes: their box and triangle tests plus the single-ray work of rays walking alone, retried,
+    // or testing a leaf ray by ray.
+    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.2f | %.0f %% | %.2f / %.2f | %.2f / %.2f (%.2f) | %.3f | %.4f |\n",
+                s.name, one.nodes / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
+                p.packetNodes ? double(p.childTests) / double(p.packetNodes) : 0.0, 100.0 * share(p.childTestRays, p.childTests),
+                8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), one.nodes / n,
+                (p.intervalTests + p.childTests + p.nodes) / n, one.packs / n, (p.triangleTests + p.packs) / n, p.triangleTests / n, p.lone / n,
+                p.retries / n);
+  }
+  Bvh::counters() = {};
+  Bvh::setCounting(false);
+}
+
 void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, unsigned threads, int res,
-                bool sphere, bool quick, bool explainAll, int reps) {
+                bool sphere, bool quick, bool explainAll, int reps, int leafRays, bool countOnly) {
   std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
               res, threads, Bvh::isaName(Bvh::isa()));
   const auto t0 = Clock::now();
@@ -314,8 +356,10 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
       }
     std::printf("\nEmbree's packets of 8 against its single rays: %zu of %zu packets differ\n", differ, total);
   }
-  // Our packets against our single rays, every ray of every set: t, barycentrics and triangle bit for bit.
-  {
+  // Our packets against our single rays, every ray of every set: t, barycentrics and triangle bit for bit;
+  // with leaves tested all rays at once wherever two rays reach them, and as set (--leaf-rays).
+  for (int lr : {2, leafRays}) {
+    Bvh::setPacketLeafRays(lr);
     size_t differ = 0, total = 0;
     for (auto* set : {&primary, &ortho, &shadow, &mirror})
       for (size_t i = 0; i < set->size(); i += 8) {
@@ -329,12 +373,23 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
           differ += std::memcmp(&one, &h[k], sizeof one) != 0;
         }
       }
-    std::printf("Our packets of 8 against our single rays (primary, orthographic, shadow, mirror): %zu of %zu rays differ\n",
-                differ, total);
+    std::printf("Our packets of 8 (leaves all rays at once from %d live rays) against our single rays (primary, orthographic, "
+                "shadow, mirror): %zu of %zu rays differ\n", lr, differ, total);
   }
-  std::printf("\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8 | Embree rtcIntersect1/Occluded1 "
-              "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
+                      {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
+  if (countOnly) {  // and the same with every leaf tested ray by ray
+    std::printf("\nThe same, every leaf of a packet tested ray by ray (--leaf-rays 9):\n");
+    Bvh::setPacketLeafRays(9);
+    printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
+                        {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
+    Bvh::setPacketLeafRays(leafRays);
+    return;
+  }
+  std::printf("\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8, leaves ray by ray "
+              "| ours, packets of 8 (leaves all rays at once from %d live) | Embree rtcIntersect1/Occluded1 "
+              "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n", leafRays);
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<unsigned> counts{1};
   if (threads > 1) counts.push_back(threads);
   for (unsigned th : counts) {
@@ -345,7 +400,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
       const size_t pairs = rays.size() / 2;  // an odd last ray goes alone
       // Alternate the four, best of each: a machine that slows down for a while slows all. Each turn
       // runs twice, so that the best run finds its own BVH in the caches, not the other's.
-      double single = 1e30, paired = 1e30, ours8 = 1e30, theirs = 1e30, theirs8 = 1e30;
+      double single = 1e30, paired = 1e30, ours8 = 1e30, ours8r = 1e30, theirs = 1e30, theirs8 = 1e30;
       for (int r = 0; r < reps; ++r) {
         single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
           return s.any ? uint32_t(bvh.occluded(rays[i])) : bvh.closest(rays[i]).prim;
@@ -357,7 +412,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
           const auto h = bvh.closestPair(two);
           return h[0].prim + h[1].prim;
         }));
-        ours8 = std::min(ours8, timed((rays.size() + 7) / 8, th, 2, [&](size_t i) {
+        auto packets8 = [&](size_t i) {
           const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
           if (s.any) return uint32_t(__builtin_popcount(bvh.occluded8(&rays[8 * i], n)));
           Hit h[8];
@@ -365,7 +420,11 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
           uint32_t acc = 0;
           for (int k = 0; k < n; ++k) acc += h[k].prim;
           return acc;
-        }));
+        };
+        ours8 = std::min(ours8, timed((rays.size() + 7) / 8, th, 2, packets8));
+        Bvh::setPacketLeafRays(9);  // every leaf ray by ray (lanes = triangles), as before round 8
+        ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
+        Bvh::setPacketLeafRays(leafRays);
         theirs = std::min(theirs, timed(rays.size(), th, 2, [&](size_t i) {
           return s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
         }));
@@ -380,9 +439,9 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
         std::snprintf(t8, sizeof t8, "%.2f", rays.size() / theirs8 * 1e-6);
         std::snprintf(r8, sizeof r8, "%.2f×", theirs8 / ours8);
       }
-      std::printf("| %s | %u | %.2f | %.2f | %.2f | %.2f | %s | %.2f× | %.2f× | %s |\n", s.name, th, rays.size() / single * 1e-6,
-                  rays.size() / paired * 1e-6, rays.size() / ours8 * 1e-6, rays.size() / theirs * 1e-6, t8, theirs / single,
-                  theirs / paired, r8);
+      std::printf("| %s | %u | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %.2f× | %.2f× | %s |\n", s.name, th, rays.size() / single * 1e-6,
+                  rays.size() / paired * 1e-6, rays.size() / ours8r * 1e-6, rays.size() / ours8 * 1e-6, rays.size() / theirs * 1e-6,
+                  t8, theirs / single, theirs / paired, r8);
     }
   }
   if (quick) return;
@@ -448,8 +507,8 @@ int main(int argc, char** argv) {
   int res = 1024;
   uint32_t rings = 707;
   std::vector<std::string> scenes;
-  bool quick = false, explainAll = false;
-  int reps = 3;
+  bool quick = false, explainAll = false, countOnly = false;
+  int reps = 3, leafRays = Bvh::kPacketLeafRays;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
@@ -457,27 +516,32 @@ int main(int argc, char** argv) {
     else if (a == "--rings" && i + 1 < argc) rings = uint32_t(std::atoi(argv[++i]));
     else if (a == "--scene" && i + 1 < argc) scenes.push_back(argv[++i]);
     else if (a == "--reps" && i + 1 < argc) reps = std::atoi(argv[++i]);
+    else if (a == "--leaf-rays" && i + 1 < argc) leafRays = std::atoi(argv[++i]);
     else if (a == "--quick") quick = true;
+    else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--explain") explainAll = true;
     else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
     else if (a == "--avx2") Bvh::setIsa(BvhIsa::Avx2);
-    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain]\n"
+    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only]\n"
                               "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
                               "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
                               "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
-                              "  --explain: one line per hit/miss disagreement with Embree\n"); return 2; }
+                              "  --explain: one line per hit/miss disagreement with Embree\n"
+                              "  --count-only: builds, agreement and work per ray (counted), no timing\n"
+                              "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"); return 2; }
   }
   if (threads == 0 || res <= 0 || rings < 2 || reps < 1) { std::fprintf(stderr, "bench-trace: bad argument\n"); return 2; }
+  Bvh::setPacketLeafRays(leafRays);
   if (!quick) benchRoutines();
   const Mesh sphere = uvSphere({0, 0, 0}, 1.0f, rings, rings + 1);
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
     tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
-  benchScene("UV sphere", tris, sphere.bounds, threads, res, true, quick, explainAll, reps);
+  benchScene("UV sphere", tris, sphere.bounds, threads, res, true, quick, explainAll, reps, leafRays, countOnly);
   for (const std::string& f : scenes) {
     try {
       const Scene s = loadScene(f);
-      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false, quick, explainAll, reps);
+      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false, quick, explainAll, reps, leafRays, countOnly);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "bench-trace: %s\n", e.what());
       return 1;
