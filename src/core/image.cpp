@@ -67,7 +67,7 @@ bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData
 // The transforms give what stb gave: palette and tRNS expanded, 1/2/4-bit grey scaled, 16 bits truncated
 // to 8, gamma ignored; the channel count is then converted by stb's rules (convertChannels).
 #ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
-constexpr uint32_t kMaxPngSide = 512;  // as stb.cpp: huge images only slow the fuzzers down
+constexpr uint32_t kMaxPngSide = 128;  // as stb.cpp: large images only slow the fuzzers down
 #else
 constexpr uint32_t kMaxPngSide = 32768;
 #endif

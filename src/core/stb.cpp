@@ -4,7 +4,7 @@
 #ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
 // A 21-byte TGA header can ask for a 2048² image, which takes 20-37 s to decode under the fuzz build's
 // instrumentation (0.2 s in a release build): the fuzzers would spend their time there.
-#define STBI_MAX_DIMENSIONS 512
+#define STBI_MAX_DIMENSIONS 128
 #endif
 // JPEG is libjpeg-turbo's (core/image.cpp): stb 2.27's Huffman table builder writes out of bounds.
 // PNG is libpng's: stb 2.27 checks no CRC or zlib checksum, so damaged files decoded into wrong texels.
