@@ -8,8 +8,10 @@
 #endif
 // JPEG is libjpeg-turbo's (core/image.cpp): stb 2.27's Huffman table builder writes out of bounds.
 // PNG is libpng's: stb 2.27 checks no CRC or zlib checksum, so damaged files decoded into wrong texels.
-#define STBI_NO_JPEG
-#define STBI_NO_PNG
+// stb keeps only TGA and BMP: its PNM reader overflows an int on long numbers (found by fuzzing), and
+// GIF, PSD, PIC, PNM and HDR are no texture format a scene here names.
+#define STBI_ONLY_TGA
+#define STBI_ONLY_BMP
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG

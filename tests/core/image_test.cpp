@@ -131,6 +131,21 @@ TEST_F(ImageWrite, DamagedPngIsRefusedNotDecodedWrong) {
   }
 }
 
+// Formats no scene names as a texture are not decoded at all (stb's PNM reader overflows on long numbers):
+// refused, naming the file, like any file that is no image.
+TEST_F(ImageWrite, UnsupportedFormatsAreRefusedByName) {
+  std::ofstream(dir / "t.ppm", std::ios::binary) << "P6 2 2 255\n" << std::string(12, '\x7f');
+  std::ofstream(dir / "t.gif", std::ios::binary) << "GIF89a" << std::string(20, '\0');
+  for (const char* f : {"t.ppm", "t.gif"}) {
+    try {
+      loadImage(dir / f, 4);
+      ADD_FAILURE() << f << " was decoded";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(ImageWrite, JpegDecodesInEveryChannelCount) {
   ImageRGBA8 img{64, 48, std::vector<uint8_t>(64 * 48 * 4)};
   for (uint32_t y = 0; y < 48; ++y)
