@@ -98,6 +98,23 @@ private:
 
 // Whole file into memory; throws rtr::Error naming the file.
 std::vector<uint8_t> readFileBytes(const std::filesystem::path& file);
+
+// A file's bytes mapped read-only: no copy, pages come in as the decoder reads them (a 10M-triangle
+// scene's read was most of its start-up). Our tools replace files by rename, never rewrite them in place
+// (core/atomic_file), so the mapping of a file being replaced keeps the old bytes. Throws rtr::Error
+// naming the file.
+class MappedFile {
+ public:
+  explicit MappedFile(const std::filesystem::path& file);
+  ~MappedFile();
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  std::span<const uint8_t> bytes() const { return {static_cast<const uint8_t*>(data_), size_}; }
+
+ private:
+  void* data_ = nullptr;
+  size_t size_ = 0;
+};
 // 64-bit checksum over bytes (word-wise multiply-xorshift; detects corruption, not tampering).
 uint64_t checksum64(std::span<const uint8_t> data);
 

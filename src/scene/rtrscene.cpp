@@ -354,8 +354,8 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file) {
 }
 
 Scene loadRtrScene(const std::filesystem::path& file) {
-  const std::vector<uint8_t> bytes = readFileBytes(file);
-  Scene s = decodeRtrScene(bytes, file.string());
+  const MappedFile mapped(file);
+  Scene s = decodeRtrScene(mapped.bytes(), file.string());
   s.baseDir = file.parent_path();
   return s;
 }

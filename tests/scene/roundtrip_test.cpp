@@ -1,9 +1,13 @@
 // Both baked formats round-trip through the loader to the meshes and materials that were baked.
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
 #include "bake.hpp"
+#include "core/error.hpp"
 #include "scene/course.hpp"
 #include "scene/load.hpp"
 #include "scene/rtrscene.hpp"
@@ -142,4 +146,29 @@ TEST(RoundTrip, SixteenAndThirtyTwoBitIndicesAndMissingAttributes) {
   const Scene got = decodeRtrScene({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "mem.rtrscene");
   expectSameMeshes(s, got);
   EXPECT_TRUE(got.meshes[1].normals.empty());
+}
+
+// loadRtrScene maps the file instead of reading it: the scene is the one decoded from the same bytes in
+// memory; an empty file, a folder and a missing file are refused naming the path.
+TEST(RoundTrip, MappedFileLoadsWhatTheBytesDecodeTo) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rtr_mapped_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const Scene s = loadScene(test::sourceDir() / "assets-src/rt/cornell_box.obj");
+  const std::string bytes = encodeRtrScene(s);
+  std::ofstream(dir / "a.rtrscene", std::ios::binary) << bytes;
+  const Scene mapped = loadRtrScene(dir / "a.rtrscene");
+  const Scene inMemory = decodeRtrScene({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "a.rtrscene");
+  expectSameMeshes(inMemory, mapped);
+  EXPECT_EQ(mapped.baseDir, dir);
+  std::ofstream(dir / "empty.rtrscene");
+  std::filesystem::create_directories(dir / "folder.rtrscene");
+  for (const char* f : {"empty.rtrscene", "folder.rtrscene", "missing.rtrscene"}) {
+    try {
+      loadRtrScene(dir / f);
+      ADD_FAILURE() << f << " loaded";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
