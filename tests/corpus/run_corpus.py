@@ -6,50 +6,13 @@ or hang (timeout). Rendered images must not be all black, and models whose MTL h
 texture-like colour variety. Exit 0: all good, 1: a failure, 77: the corpus is not installed (CTest skip).
 Usage: run_corpus.py BIN_DIR [--table] [--timeout S] [--keep DIR]
 """
-import os, re, struct, subprocess, sys, tempfile, zlib
+import os, re, subprocess, sys, tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from pngread import read_png  # noqa: E402
 
 CORPUS = ["/usr/share/assimp/models/OBJ", "/usr/share/assimp/models/invalid"]
 SIZE = "320x240"
-
-
-def read_png(path):
-    """RGBA8 pixels of a non-interlaced 8-bit PNG (what stb writes) as (width, height, bytes)."""
-    data = open(path, "rb").read()
-    if data[:8] != b"\x89PNG\r\n\x1a\n":
-        raise ValueError(path + ": not a PNG")
-    pos, idat, w = 8, b"", 0
-    while pos < len(data):
-        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        pos += 12 + n
-        if kind == b"IHDR":
-            w, h, depth, ctype, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            if depth != 8 or interlace:
-                raise ValueError(path + ": only 8-bit non-interlaced PNG is read here")
-            bpp = {6: 4, 2: 3, 0: 1, 4: 2}[ctype]
-        elif kind == b"IDAT":
-            idat += body
-    raw, stride = zlib.decompress(idat), w * bpp
-    out, prev = bytearray(), bytearray(stride)
-    for y in range(h):
-        f, row = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = row[i - bpp] if i >= bpp else 0
-            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
-            if f == 1: row[i] = (row[i] + a) & 255
-            elif f == 2: row[i] = (row[i] + b) & 255
-            elif f == 3: row[i] = (row[i] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                row[i] = (row[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        out += row
-        prev = row
-    rgb = bytearray()
-    for i in range(0, len(out), bpp):
-        px = out[i:i + bpp]
-        rgb += px[:3] if bpp >= 3 else bytes([px[0]] * 3)
-    return w, h, bytes(rgb)
 
 
 def image_stats(path):

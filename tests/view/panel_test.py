@@ -9,48 +9,17 @@ are handed to the window's drop callback (xdotool cannot drag files).
 import math
 import os
 import shutil
-import struct
 import subprocess
 import sys
 import tempfile
 import time
-import zlib
 
 from window_test import SKIP, Fail, Viewer, check, finish, screen_pixels, start_xvfb
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from pngread import read_png  # noqa: E402
+
 SIZE = (480, 360)
-
-
-def read_png(path):
-    """(width, height, [(r, g, b)]) of an 8-bit RGB/RGBA, non-interlaced PNG."""
-    data = open(path, "rb").read()
-    pos, idat, w = 8, b"", 0
-    while pos < len(data):
-        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        if kind == b"IHDR":
-            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
-            if depth != 8 or ctype not in (2, 6):
-                raise Fail(f"{path}: unexpected PNG format (depth {depth}, colour type {ctype})")
-            bpp = 3 if ctype == 2 else 4
-        elif kind == b"IDAT":
-            idat += body
-        pos += 12 + n
-    raw, stride, prev, px = zlib.decompress(idat), w * bpp, bytearray(w * bpp), []
-    for y in range(h):
-        f, row = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a, b, c = (row[i - bpp] if i >= bpp else 0), prev[i], (prev[i - bpp] if i >= bpp else 0)
-            if f == 1: row[i] = (row[i] + a) & 255
-            elif f == 2: row[i] = (row[i] + b) & 255
-            elif f == 3: row[i] = (row[i] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                row[i] = (row[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        px += [tuple(row[x * bpp:x * bpp + 3]) for x in range(w)]
-        prev = row
-    return w, h, px
 
 
 def main():
@@ -208,7 +177,8 @@ def main():
         xdo("key", "F1")
         settle()
         hidden = frame()
-        w, h, px = read_png(shot1)
+        w, h, rgb = read_png(shot1)
+        px = [tuple(rgb[i:i + 3]) for i in range(0, len(rgb), 3)]
         check((w, h) == SIZE and px == hidden, "the screenshot holds the frame without the panel, pixel for pixel")
         xdo("key", "F1")
         settle()
