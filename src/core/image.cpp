@@ -1,5 +1,6 @@
 #include "core/image.hpp"
 
+#include <algorithm>
 #include <csetjmp>
 #include <cmath>
 #include <cstdio>
@@ -7,6 +8,7 @@
 #include <fstream>
 
 #include <jpeglib.h>
+#include <jerror.h>
 #include <png.h>
 
 #include "core/error.hpp"
@@ -24,8 +26,17 @@ struct JpegError {
   char message[JMSG_LENGTH_MAX];
 };
 
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+constexpr uint32_t kMaxImageSide = 128;  // as stb.cpp: large images only slow the fuzzers down
+#else
+constexpr uint32_t kMaxImageSide = 32768;
+#endif
+
 // JPEG through libjpeg-turbo: stb_image 2.27 (Debian 12) writes out of bounds on some malformed Huffman
-// tables (found by fuzzing), and libjpeg-turbo is the faster decoder anyway.
+// tables (found by fuzzing), and libjpeg-turbo is the faster decoder anyway. A file whose data ends early
+// is refused, not padded with grey: libjpeg calls that a warning, and a 650-byte file declaring 30000²
+// pixels then decoded into gigabytes of filler (found by fuzzing). The texels grow row by row, so such a
+// header costs no more than the rows its data really holds.
 bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData& out, std::string& error) {
   jpeg_decompress_struct cinfo{};
   JpegError err{};
@@ -35,7 +46,9 @@ bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData
     (*c->err->format_message)(c, e->message);
     std::longjmp(e->jump, 1);
   };
-  err.mgr.output_message = [](j_common_ptr) {};  // warnings (corrupt data recovered from) stay quiet
+  err.mgr.emit_message = [](j_common_ptr c, int level) {  // other warnings (recovered damage) stay quiet
+    if (level < 0 && (c->err->msg_code == JWRN_JPEG_EOF || c->err->msg_code == JWRN_HIT_MARKER)) c->err->error_exit(c);
+  };
   std::vector<unsigned char> rgb;  // declared before setjmp: nothing with a destructor is made after it
   if (setjmp(err.jump)) {
     jpeg_destroy_decompress(&cinfo);
@@ -45,14 +58,21 @@ bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData
   jpeg_create_decompress(&cinfo);
   jpeg_mem_src(&cinfo, bytes.data(), static_cast<unsigned long>(bytes.size()));
   jpeg_read_header(&cinfo, TRUE);
+  if (cinfo.image_width > kMaxImageSide || cinfo.image_height > kMaxImageSide) {
+    std::snprintf(err.message, sizeof err.message, "%ux%u is larger than %u a side", cinfo.image_width,
+                  cinfo.image_height, kMaxImageSide);
+    std::longjmp(err.jump, 1);
+  }
   const bool grey = channels <= 2;  // 1: grey, 2: grey + alpha, 3: RGB, 4: RGBA (alpha opaque)
   cinfo.out_color_space = grey ? JCS_GRAYSCALE : JCS_RGB;
   jpeg_start_decompress(&cinfo);
   const uint32_t w = cinfo.output_width, h = cinfo.output_height, n = uint32_t(cinfo.output_components);
-  rgb.resize(size_t(w) * h * n);
+  const size_t row = size_t(w) * n;
+  rgb.reserve(std::min(row * h, bytes.size() * 64 + (size_t(16) << 20)));  // the rest grows as rows come
   while (cinfo.output_scanline < h) {
-    JSAMPROW row = rgb.data() + size_t(cinfo.output_scanline) * w * n;
-    jpeg_read_scanlines(&cinfo, &row, 1);
+    rgb.resize(rgb.size() + row);
+    JSAMPROW p = rgb.data() + size_t(cinfo.output_scanline) * row;
+    jpeg_read_scanlines(&cinfo, &p, 1);
   }
   jpeg_finish_decompress(&cinfo);
   jpeg_destroy_decompress(&cinfo);
@@ -66,11 +86,6 @@ bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData
 // (found by fuzzing) decodes "forever", growing its buffer to 1.7 GB. libpng stops at the end of the data.
 // The transforms give what stb gave: palette and tRNS expanded, 1/2/4-bit grey scaled, 16 bits truncated
 // to 8, gamma ignored; the channel count is then converted by stb's rules (convertChannels).
-#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
-constexpr uint32_t kMaxPngSide = 128;  // as stb.cpp: large images only slow the fuzzers down
-#else
-constexpr uint32_t kMaxPngSide = 32768;
-#endif
 
 struct PngReader {
   const std::vector<unsigned char>& bytes;
@@ -124,7 +139,7 @@ bool decodePng(const std::vector<unsigned char>& bytes, int channels, TexelData&
     std::memcpy(data, r.bytes.data() + r.at, size);
     r.at += size;
   });
-  png_set_user_limits(png, kMaxPngSide, kMaxPngSide);
+  png_set_user_limits(png, kMaxImageSide, kMaxImageSide);
 #ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
   // Mutated files almost never carry valid checksums: let the fuzzers past them to the decoder.
   png_set_crc_action(png, PNG_CRC_QUIET_USE, PNG_CRC_QUIET_USE);

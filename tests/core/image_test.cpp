@@ -146,6 +146,28 @@ TEST_F(ImageWrite, UnsupportedFormatsAreRefusedByName) {
   }
 }
 
+// A JPEG whose data ends early is refused by name, not padded with grey: libjpeg only warns. Before, a
+// header claiming 30000² pixels over the same few hundred bytes of data decoded into 900 MB of filler.
+TEST_F(ImageWrite, JpegWhoseDataEndsEarlyIsRefused) {
+  saveImage(dir / "ok.jpg", noise(64, 48));
+  const std::string bytes = readAll(dir / "ok.jpg");
+  ASSERT_NO_THROW(loadImage(dir / "ok.jpg", 1));
+  std::ofstream(dir / "cut.jpg", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  std::string big = bytes;
+  const size_t sof = big.find("\xFF\xC0");
+  ASSERT_NE(sof, std::string::npos);
+  for (size_t at : {sof + 5, sof + 7}) big[at] = char(30000 >> 8), big[at + 1] = char(30000 & 255);  // height, width
+  std::ofstream(dir / "huge.jpg", std::ios::binary) << big;
+  for (const char* f : {"cut.jpg", "huge.jpg"}) {
+    try {
+      const TexelData t = loadImage(dir / f, 1);
+      ADD_FAILURE() << f << " was decoded as " << t.width << "x" << t.height;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(ImageWrite, JpegDecodesInEveryChannelCount) {
   ImageRGBA8 img{64, 48, std::vector<uint8_t>(64 * 48 * 4)};
   for (uint32_t y = 0; y < 48; ++y)
