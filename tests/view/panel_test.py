@@ -55,11 +55,27 @@ def main():
             return subprocess.run(["xdotool", *map(str, args)], env=env, check=True, capture_output=True, text=True,
                                   timeout=30).stdout.strip()
 
-        viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--size", f"{SIZE[0]}x{SIZE[1]}"], env)
+        viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--timings", "--size", f"{SIZE[0]}x{SIZE[1]}"], env)
         viewer.wait_line("err", r"move speed")
         # The textures load while frames go on (the materials show their factors meanwhile): every frame this
         # test compares comes after they are in.
         viewer.wait_line("err", r"rtr-view: 13 textures in: ")
+        # --timings in the window: the start-up phases tile the time to the first frame on screen.
+        viewer.wait_line("err", r"^  total from process start ")
+        err = viewer.lines("err")
+        rows = {}
+        for line in err[err.index("rtr-view: start-up phases (ms):") + 1:]:
+            name, ms = line.strip().rsplit(None, 1)
+            rows[name] = float(ms)
+            if name == "total from process start":
+                break
+        total = rows.pop("total from process start")
+        rows.pop("sum of the phases")
+        for want in ("scene file read", "instance and device", "first frame (record, GPU, present)"):
+            check(want in rows, f"the start-up phases have '{want}' ({sorted(rows)})")
+        check(any(n.startswith("pipeline creation (") for n in rows), "the start-up phases count the pipelines")
+        check(all(v >= 0 for v in rows.values()) and abs(sum(rows.values()) - total) <= 3.0,
+              f"the start-up phases add up to the total ({sum(rows.values()):.1f} against {total:.1f} ms)")
         win = xdo_out("search", "--sync", "--name", "^rtr-view").split()[0]
         xdo("windowfocus", "--sync", win)
 
@@ -111,6 +127,23 @@ def main():
         panel = latest_rect("lodbias")
         right = panel[2] + 20  # the view right of the panel
         check(right < SIZE[0] - 40, f"the panel leaves the right of the window free (widgets end at x={panel[2]})")
+        # The panel's start-up section (scrolled into view) opens on the phases; closed and scrolled back after.
+        xdo("mousemove", "--window", win, (panel[0] + panel[2]) // 2, SIZE[1] // 2)
+        xdo("click", "--repeat", "15", "--delay", "30", "5")
+        time.sleep(0.5)
+        header = latest_rect("start-up")
+        check(header[3] < SIZE[1], f"the start-up section's header scrolls into view ({header})")
+        settle()
+        closed = frame()
+        click("start-up")
+        settle()
+        check(frame() != closed, "the panel's start-up section opens")
+        check(rect("start-up:total")[1] > header[3], "it shows the time to the first frame under its header")
+        click("start-up")
+        xdo("mousemove", "--window", win, (panel[0] + panel[2]) // 2, SIZE[1] // 2)
+        xdo("click", "--repeat", "15", "--delay", "30", "4")
+        time.sleep(0.5)
+        check(latest_rect("lodbias") == panel, "the panel scrolls back")
 
         # A view chosen in the panel's combo gives the same frame as its key.
         xdo("key", "5")

@@ -261,7 +261,7 @@ int main(int argc, char** argv) {
   CLI::Option* waitOpt = app.add_flag("--wait-textures,!--no-wait-textures", waitTextures,
                "the first frame waits for the textures (default: yes with --headless; in the window materials show "
                "their factors until their textures are in)");
-  app.add_flag("--timings", o.timings, "print the start-up phases in ms (headless), from process start to the first frame");
+  app.add_flag("--timings", o.timings, "print the start-up phases in ms, from process start to the first frame (the window's panel shows them too)");
   app.add_flag("!--no-pipeline-cache", o.pipelineCache,
                "neither read nor write the pipeline cache ($XDG_CACHE_HOME/rtr or ~/.cache/rtr; RTR_PIPELINE_CACHE=DIR|off)");
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
@@ -277,7 +277,6 @@ int main(int argc, char** argv) {
     o.lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
-    if (o.timings && !o.headless) throw UsageError("--timings needs --headless (the window prints no start-up phases yet)");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
     const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
                                                           {"blit", render::MipMode::Blit}};

@@ -218,6 +218,15 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
       ImGui::PopID();
     }
   }
+  const bool startupOpen = ImGui::CollapsingHeader("Start-up");  // the phases --timings prints
+  track("start-up");
+  if (startupOpen && facts.startup && !facts.startup->empty()) {
+    for (const auto& [name, ms] : *facts.startup) ImGui::Text("%8.1f ms  %s", ms, name.c_str());
+    ImGui::Text("%8.1f ms  first frame on screen, from process start", facts.startupTotalMs);
+    track("start-up:total");
+    if (facts.texturesInAtMs > 0) ImGui::Text("%8.1f ms  textures in, from process start", facts.texturesInAtMs);
+    else if (facts.textures) ImGui::TextDisabled("textures still loading");
+  }
   ImGui::End();
 }
 

@@ -39,6 +39,8 @@ struct PanelFacts {
   float maxAnisotropy = 1;  // the device's; 1: no anisotropic filtering
   size_t texturesDecoded = 0;     // of `textures`
   bool texturesLoading = false;   // not all in yet: materials show their factors
+  const std::vector<std::pair<std::string, double>>* startup = nullptr;  // phases in ms; empty before the first frame
+  double startupTotalMs = 0, texturesInAtMs = 0;                         // from process start; 0: not yet
 };
 
 // The last kFrames frames' CPU time and per-pass GPU times, for the panel's graphs.

@@ -16,6 +16,7 @@
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "options.hpp"
+#include "render/startup.hpp"
 #include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "shader_watch.hpp"
@@ -23,6 +24,7 @@
 #include "view_state.hpp"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
+#include "vk/pipeline_cache.hpp"
 
 namespace rtr::view {
 namespace {
@@ -217,11 +219,26 @@ void startScene(ViewState& app, const ViewOptions& o, const Scene& scene) {
 
 int runWindowed(const ViewOptions& opts) {
   ViewOptions o = opts;
+  // Start-up phases, as headless --timings prints them: each runs from the end of the one before, less the
+  // pipelines it made (one row of their own), so the rows tile the time to the first frame on screen.
+  using Clock = std::chrono::steady_clock;
+  render::StartupTimeline timeline;
+  std::unique_ptr<vk::Context> ctxHolder;  // made below; its pipeline time is subtracted from each phase
+  timeline.add("process start to the viewer (exec, libraries, options)", render::msSinceProcessStart());
+  auto phaseStart = Clock::now();
+  double pipelineMs = 0;
+  const auto phase = [&](const char* name) {
+    const double p = ctxHolder ? ctxHolder->pipelineCache().stats().ms : 0;
+    timeline.add(name, std::chrono::duration<double, std::milli>(Clock::now() - phaseStart).count() - (p - pipelineMs));
+    pipelineMs = p;
+    phaseStart = Clock::now();
+  };
   GlfwSession glfw;
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   ViewState app;
   Loaded cur;
   cur.scene = std::make_unique<Scene>(loadScene(o.scene, o.load));
+  phase("scene file read");
   app.settings = sceneSettings(o, *cur.scene);
   app.lens = o.lens;
   if (o.orbit) app.camera.setMode(CameraMode::Orbit);
@@ -232,11 +249,13 @@ int runWindowed(const ViewOptions& opts) {
   vk::ContextOptions co = contextOptions(o);
   co.instanceExtensions.assign(exts, exts + extCount);
   co.presentation = true;
-  vk::Context ctx(co);
+  ctxHolder = std::make_unique<vk::Context>(co);
+  const vk::Context& ctx = *ctxHolder;
   checkSizeFits(o, ctx);
   const DeviceChoice choice = chooseForDevice(o, ctx);
   app.settings.shading = choice.shading;
   app.mips = choice.mips;
+  phase("instance and device");
 
   GLFWwindow* window = glfwCreateWindow(int(o.width), int(o.height), "rtr-view", nullptr, nullptr);
   if (!window) throw Error("cannot create a window");
@@ -253,6 +272,7 @@ int runWindowed(const ViewOptions& opts) {
   glfwSetDropCallback(window, onDrop);
   glfwSetFramebufferSizeCallback(window, onResize);
   ImGuiSession imgui(window);
+  phase("window, surface and panel");
 
   startScene(app, o, *cur.scene);
   o.camera.reset();  // a dropped scene starts from its own view
@@ -260,7 +280,10 @@ int runWindowed(const ViewOptions& opts) {
   struct Release { Loaded& l; const vk::Context& c; ~Release() { l.release(c); } } releaseGuard{cur, ctx};
   const bool waitTextures = o.waitTextures.value_or(false);
   cur.build(ctx, surface, {o.width, o.height}, app.mips, waitTextures);
+  phase(waitTextures ? "scene to the GPU (geometry, textures, mips), swapchain" : "geometry to the GPU, swapchain");
   std::string scenePath = o.scene;
+  std::vector<std::pair<std::string, double>> startup;  // for the panel, once the first frame is on screen
+  double startupTotal = 0, texturesInAt = 0;
 
   std::unique_ptr<ShaderWatcher> watcher;
   if (o.watch) watcher = std::make_unique<ShaderWatcher>(RTR_SHADER_SOURCE_DIR);
@@ -320,6 +343,7 @@ int runWindowed(const ViewOptions& opts) {
     // frames go on; then they are taken in between frames.
     if (cur.gpu->updateTextures()) {
       const auto& st = cur.gpu->stats();
+      if (texturesInAt == 0) texturesInAt = render::msSinceProcessStart();
       std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload and mips %.0f ms\n",
                    st.textures, st.decodeMs, st.textureUploadMs);
       std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), st.mipGpuMs);
@@ -413,7 +437,7 @@ int runWindowed(const ViewOptions& opts) {
       const auto& st = cur.gpu->stats();
       PanelFacts facts{scenePath, st.meshes, uint32_t(scene.materials.size()), st.textures, st.triangles, st.mipGpuMs,
                        traced.visible() ? traced.status() : std::string(), shaderError, render::maxAnisotropy(ctx),
-                       cur.gpu->texturesDecoded(), !cur.gpu->texturesReady()};
+                       cur.gpu->texturesDecoded(), !cur.gpu->texturesReady(), &startup, startupTotal, texturesInAt};
       drawPanel(app, facts, history);
     }
     ImGui::Render();
@@ -427,6 +451,16 @@ int runWindowed(const ViewOptions& opts) {
     ImageRGBA8 shot;
     if (!frames.frame({uint32_t(fbw), uint32_t(fbh)}, in, &shot)) continue;  // swapchain out of date: next time
     history.add(dt * 1000.0f, frames.gpuTimes());
+    if (frameNumber == 0) {  // the first frame is on screen (presented; its GPU work waited for)
+      VK_CHECK(vkDeviceWaitIdle(ctx.device()));
+      phase("first frame (record, GPU, present)");
+      startupTotal = render::msSinceProcessStart();
+      const vk::PipelineStats ps = ctx.pipelineCache().stats();
+      timeline.add("pipeline creation (" + std::to_string(ps.created) + ", " + std::to_string(ps.cacheHits) +
+                       " from the cache)", ps.ms);
+      startup = timeline.phases();
+      if (o.timings) std::fprintf(stderr, "rtr-view: %s", timeline.format(startupTotal).c_str());
+    }
     if (takeShot) {
       saveImage(o.screenshot, shot, {o.force ? Replace::Yes : Replace::No, true});
       std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());
