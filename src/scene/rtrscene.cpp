@@ -386,7 +386,7 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
 }
 
 Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, unsigned threads) {
-  if (reinterpret_cast<uintptr_t>(bytes.data()) % alignof(uint32_t) != 0) {  // the arrays are read in place
+  if (!bytes.empty() && reinterpret_cast<uintptr_t>(bytes.data()) % alignof(uint32_t) != 0) {  // arrays read in place
     std::vector<uint32_t> aligned((bytes.size() + 3) / 4);
     std::memcpy(aligned.data(), bytes.data(), bytes.size());
     return decodeRtrScene({reinterpret_cast<const uint8_t*>(aligned.data()), bytes.size()}, file, threads);
