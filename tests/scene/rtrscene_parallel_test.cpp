@@ -147,6 +147,30 @@ TEST(RtrSceneParallel, TheFirstFaultInTheFileIsReportedAtAnyThreadCount) {
   }
 }
 
+// A piece of clusters starts from where the record before it says the last one ended: a damaged record
+// there must not send the next piece reading past the indices.
+TEST(RtrSceneParallel, ADamagedClusterBeforeAPieceIsReportedNotFollowed) {
+  const Scene s = severalMeshes();
+  ASSERT_GT(s.meshes[1].clusters.size(), 2048u);
+  const std::string good = encodeRtrScene(s);
+  Scene two = s;
+  two.meshes.resize(2);
+  const size_t records = encodeRtrScene(two).size() - (s.meshes[1].clusters.size() * 40 + 15) / 16 * 16;
+  // Cluster 2047 (the last of the first piece) claims to run to triangle 2^31; cluster 2048 starts there.
+  const Cluster& c = s.meshes[1].clusters[2047];
+  const uint32_t count = (1u << 31) - c.firstTriangle, first = 1u << 31;
+  std::string b = good;
+  uint32_t was;
+  std::memcpy(&was, b.data() + records + 2047 * 40 + 32, 4);
+  ASSERT_EQ(was, c.firstTriangle);
+  std::memcpy(b.data() + records + 2047 * 40 + 36, &count, 4);
+  std::memcpy(b.data() + records + 2048 * 40 + 32, &first, 4);
+  reseal(b);
+  for (unsigned threads : {1u, 8u})
+    EXPECT_THAT(decodeError(b, threads), HasSubstr("at byte " + std::to_string(records + 2047 * 40 + 36) +
+                                                   ": mesh 1: cluster 2047: triangle count " + std::to_string(count)));
+}
+
 TEST(RtrSceneParallel, PieceChecksumIsItsDefinitionAtAnyThreadCount) {
   std::mt19937 rng(7);
   std::vector<uint8_t> data(9 * kChecksumPiece + 17);
