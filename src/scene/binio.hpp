@@ -73,13 +73,20 @@ public:
                      " bytes left");
     return n;
   }
+  // Passes over n elements of `size` bytes (to be read in place later); returns where they start.
+  size_t skipArray(size_t n, size_t size, const char* what) {
+    if (n > remaining() / size)
+      fail(std::string("file ends inside ") + what + " (" + std::to_string(n) + " elements of " +
+           std::to_string(size) + " bytes, " + std::to_string(remaining()) + " bytes left)");
+    const size_t at = pos_;
+    pos_ += n * size;
+    return at;
+  }
   template <class T>
   void array(std::vector<T>& v, size_t n, const char* what) {
-    if (n > remaining() / sizeof(T))
-      fail(std::string("file ends inside ") + what + " (" + std::to_string(n) + " elements of " +
-           std::to_string(sizeof(T)) + " bytes, " + std::to_string(remaining()) + " bytes left)");
+    const size_t at = skipArray(n, sizeof(T), what);
     v.resize(n);
-    raw(v.data(), n * sizeof(T), what);
+    if (n) std::memcpy(v.data(), d_.data() + at, n * sizeof(T));
   }
   void skip(size_t n, const char* what) { need(n, what); pos_ += n; }
   void align(size_t a, const char* what) { skip((a - pos_ % a) % a, what); }
@@ -115,7 +122,13 @@ class MappedFile {
   void* data_ = nullptr;
   size_t size_ = 0;
 };
-// 64-bit checksum over bytes (word-wise multiply-xorshift; detects corruption, not tampering).
+// 64-bit checksum over bytes (word-wise multiply-xorshift; detects corruption, not tampering). One chain
+// of dependent multiplies: it cannot be split over threads.
 uint64_t checksum64(std::span<const uint8_t> data);
+
+// The same strength on all cores: checksum64 of each 1 MiB piece, then checksum64 of those values as
+// little-endian u64s. The pieces do not depend on the thread count (`threads` 0: one per core).
+constexpr size_t kChecksumPiece = size_t(1) << 20;
+uint64_t pieceChecksum64(std::span<const uint8_t> data, unsigned threads = 0);
 
 }  // namespace rtr

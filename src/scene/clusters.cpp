@@ -3,13 +3,10 @@
 #include <meshoptimizer.h>
 
 #include <algorithm>
-#include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
 
 #include "cluster.h"
 #include "core/error.hpp"
+#include "scene/parallel.hpp"
 
 namespace rtr {
 
@@ -58,26 +55,10 @@ size_t buildMissingClusters(Scene& scene) {
     if (m.clusters.empty() && !m.indices.empty()) todo.push_back(&m);
   // Meshes are independent: on all cores, biggest first.
   std::sort(todo.begin(), todo.end(), [](Mesh* a, Mesh* b) { return a->indices.size() > b->indices.size(); });
-  std::atomic<size_t> next{0};
-  std::exception_ptr failed;
-  std::mutex failedMutex;
-  auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < todo.size();) {
-      Mesh& m = *todo[i];
-      try {
-        buildClusters(m, m.material >= scene.materials.size() || conesCull(scene.materials[m.material]));
-      } catch (...) {
-        std::lock_guard lock(failedMutex);
-        failed = std::current_exception();
-      }
-    }
-  };
-  const unsigned threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), todo.size());
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (failed) std::rethrow_exception(failed);
+  parallelFor(todo.size(), 0, [&](size_t i) {
+    Mesh& m = *todo[i];
+    buildClusters(m, m.material >= scene.materials.size() || conesCull(scene.materials[m.material]));
+  });
   return todo.size();
 }
 

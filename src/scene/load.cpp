@@ -29,7 +29,7 @@ Scene loadAny(const std::filesystem::path& file, const LoadOptions& options) {
 
 Scene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
   Scene scene = loadAny(file, options);
-  buildMissingClusters(scene);  // every format but .rtrscene version 3 (rtr-bake builds them there)
+  buildMissingClusters(scene);  // every format but .rtrscene version 3 or later (rtr-bake builds them there)
   return scene;
 }
 

@@ -9,12 +9,16 @@
 
 namespace rtr {
 
-constexpr uint32_t kRtrSceneVersion = 3;  // 2 added lights, 3 clusters; versions 1 and 2 still load
+// 2 added lights, 3 clusters, 4 a checksum summed on all cores (pieceChecksum64); versions 1-3 still load.
+constexpr uint32_t kRtrSceneVersion = 4;
 
-// `version` below the current one writes an older layout (lights need 2, clusters 3), for tests of the reader.
+// `version` below the current one writes an older layout (lights need 2, clusters 3, the checksum of
+// version 4), for tests of the reader.
 std::string encodeRtrScene(const Scene& scene, uint32_t version = kRtrSceneVersion);
-// Validates everything (sizes, counts, strings, indices, texture ids, finite values, checksum).
-Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file);
+// Validates everything (sizes, counts, strings, indices, texture ids, finite values, clusters, checksum).
+// The checksum (version 4), the arrays and their checks run on `threads` threads (0: one per core, or
+// one for a file under 4 MiB); the scene and any fault reported do not depend on the count.
+Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, unsigned threads = 0);
 Scene loadRtrScene(const std::filesystem::path& file);
 
 }  // namespace rtr

@@ -141,7 +141,7 @@ std::string decodeError(const std::string& bytes) {
 void reseal(std::string& b) {
   const uint64_t payload = b.size() - 80;
   std::memcpy(b.data() + 32, &payload, 8);
-  const uint64_t sum = checksum64({reinterpret_cast<const uint8_t*>(b.data()) + 80, payload});
+  const uint64_t sum = pieceChecksum64({reinterpret_cast<const uint8_t*>(b.data()) + 80, payload});
   std::memcpy(b.data() + 40, &sum, 8);
 }
 

@@ -56,7 +56,7 @@ void put32(std::string& b, size_t at, uint32_t v) { std::memcpy(b.data() + at, &
 
 // Re-seals an edited .rtrscene so that the structural checks behind the checksum get exercised.
 void reseal(std::string& b) {
-  uint64_t sum = checksum64({reinterpret_cast<const uint8_t*>(b.data()) + 80, b.size() - 80});
+  uint64_t sum = pieceChecksum64({reinterpret_cast<const uint8_t*>(b.data()) + 80, b.size() - 80});
   std::memcpy(b.data() + 40, &sum, 8);
 }
 

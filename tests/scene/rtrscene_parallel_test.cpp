@@ -1,0 +1,208 @@
+// The .rtrscene decoder on several threads: the scene and any fault it reports are those of one thread;
+// version 4's piece checksum is its definition at any thread count; files of older versions still load.
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "scene/binio.hpp"
+#include "scene/clusters.hpp"
+#include "scene/rtrscene.hpp"
+#include "test_paths.hpp"
+
+using namespace rtr;
+using ::testing::HasSubstr;
+
+namespace {
+
+// A height field of n×n quads; `attributes` false leaves out normals and texcoords.
+Mesh grid(uint32_t n, float x0, bool attributes) {
+  Mesh m;
+  m.name = "grid" + std::to_string(n);
+  for (uint32_t y = 0; y <= n; ++y)
+    for (uint32_t x = 0; x <= n; ++x) {
+      const float fx = float(x) / float(n), fy = float(y) / float(n);
+      m.positions.push_back({x0 + fx * 4.0f, 0.3f * std::sin(fx * 17.0f) * std::cos(fy * 11.0f), fy * 4.0f});
+      if (attributes) m.normals.push_back(glm::vec3(fx, 1.0f, fy));
+      if (attributes) m.texcoords.push_back({fx, fy});
+    }
+  for (uint32_t y = 0; y < n; ++y)
+    for (uint32_t x = 0; x < n; ++x) {
+      const uint32_t a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      m.indices.insert(m.indices.end(), {a, c, b, b, c, d});
+    }
+  for (const glm::vec3& p : m.positions) m.bounds.extend(p);
+  return m;
+}
+
+// Several meshes: one big enough that its arrays and clusters are checked in several pieces (32-bit
+// indices), small ones with 16-bit indices, one without attributes, one empty; a light and a texture.
+Scene severalMeshes() {
+  Scene s;
+  s.textures.push_back(Texture{"t.png", true, 4});
+  s.materials.resize(2);
+  s.materials[1].textures[0] = 0;
+  s.meshes.push_back(grid(20, 0.0f, true));
+  s.meshes.push_back(grid(400, 5.0f, true));  // 160 801 vertices, 960 000 indices, ~2 600 clusters
+  s.meshes.push_back(grid(30, -5.0f, false));
+  s.meshes.push_back(Mesh{});
+  s.meshes.back().name = "empty";
+  s.meshes.push_back(grid(7, 10.0f, true));
+  s.meshes[1].material = 1;
+  s.lights.push_back(Light{});
+  buildMissingClusters(s);
+  return s;
+}
+
+Scene decode(const std::string& bytes, unsigned threads) {
+  return decodeRtrScene({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "p.rtrscene", threads);
+}
+
+std::string decodeError(const std::string& bytes, unsigned threads) {
+  try {
+    decode(bytes, threads);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+void expectSameMeshes(const Scene& got, const Scene& want) {
+  ASSERT_EQ(got.meshes.size(), want.meshes.size());
+  for (size_t i = 0; i < want.meshes.size(); ++i) {
+    const Mesh &g = got.meshes[i], &w = want.meshes[i];
+    SCOPED_TRACE("mesh " + std::to_string(i));
+    EXPECT_EQ(g.name, w.name);
+    EXPECT_EQ(g.material, w.material);
+    EXPECT_EQ(g.positions, w.positions);
+    EXPECT_EQ(g.normals, w.normals);
+    EXPECT_EQ(g.texcoords, w.texcoords);
+    EXPECT_EQ(g.indices, w.indices);
+    ASSERT_EQ(g.clusters.size(), w.clusters.size());
+    for (size_t k = 0; k < w.clusters.size(); ++k) {
+      const Cluster &a = g.clusters[k], &b = w.clusters[k];
+      ASSERT_TRUE(a.firstTriangle == b.firstTriangle && a.triangleCount == b.triangleCount && a.center == b.center &&
+                  a.radius == b.radius && a.coneAxis == b.coneAxis && a.coneCutoff == b.coneCutoff)
+          << "cluster " << k;
+    }
+  }
+}
+
+void reseal(std::string& b) {
+  const uint64_t sum = pieceChecksum64({reinterpret_cast<const uint8_t*>(b.data()) + 80, b.size() - 80});
+  std::memcpy(b.data() + 40, &sum, 8);
+}
+
+}  // namespace
+
+TEST(RtrSceneParallel, ManyThreadsDecodeWhatOneDoes) {
+  const Scene s = severalMeshes();
+  const std::string bytes = encodeRtrScene(s);
+  ASSERT_GT(bytes.size(), 4u * kChecksumPiece) << "the checksum should run in several pieces";
+  const Scene one = decode(bytes, 1);
+  expectSameMeshes(one, s);
+  for (unsigned threads : {2u, 3u, 8u, 0u}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const Scene many = decode(bytes, threads);
+    expectSameMeshes(many, one);
+    EXPECT_EQ(encodeRtrScene(many), bytes);  // everything else (lights, textures, materials, bounds) too
+  }
+  // The same scene in version 3 (one checksum chain) decodes to the same meshes.
+  expectSameMeshes(decode(encodeRtrScene(s, 3), 8), one);
+}
+
+// Faults in several pieces: the one at the lowest offset is reported, however many threads ran.
+TEST(RtrSceneParallel, TheFirstFaultInTheFileIsReportedAtAnyThreadCount) {
+  const Scene s = severalMeshes();
+  const std::string good = encodeRtrScene(s);
+  // The big mesh's last index (32-bit; 960 000 of them, no padding), just before its cluster header and
+  // records, which end where mesh 2 starts: at the size of the file with meshes 0 and 1 only.
+  Scene two = s;
+  two.meshes.resize(2);
+  const size_t clusterSection = 16 + (s.meshes[1].clusters.size() * 40 + 15) / 16 * 16;
+  const size_t lastIndexAt = encodeRtrScene(two).size() - clusterSection - 4;
+  uint32_t was;
+  std::memcpy(&was, good.data() + lastIndexAt, 4);
+  ASSERT_EQ(was, s.meshes[1].indices.back());
+  std::string b = good;
+  const uint32_t bad = 1u << 30;
+  std::memcpy(b.data() + lastIndexAt, &bad, 4);
+  reseal(b);
+  const std::string bigFault = decodeError(b, 1);
+  EXPECT_THAT(bigFault, HasSubstr("index 1073741824 out of range (160801 vertices)"));
+  // Now also a position of mesh 0, far before it, whose check is among the cheapest pieces and runs last
+  // on one thread: that one is reported.
+  const glm::vec3 p0 = s.meshes[0].positions[7];
+  const size_t posAt = good.find(std::string(reinterpret_cast<const char*>(&p0), 12));
+  ASSERT_NE(posAt, std::string::npos);
+  const float nan = std::nanf("");
+  std::memcpy(b.data() + posAt, &nan, 4);
+  reseal(b);
+  for (unsigned threads : {1u, 2u, 8u}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    EXPECT_THAT(decodeError(b, threads), HasSubstr("p.rtrscene:at byte " + std::to_string(posAt) + ": mesh 0: position 7 is not finite"));
+  }
+}
+
+// A piece of clusters starts from where the record before it says the last one ended: a damaged record
+// there must not send the next piece reading past the indices.
+TEST(RtrSceneParallel, ADamagedClusterBeforeAPieceIsReportedNotFollowed) {
+  const Scene s = severalMeshes();
+  ASSERT_GT(s.meshes[1].clusters.size(), 2048u);
+  const std::string good = encodeRtrScene(s);
+  Scene two = s;
+  two.meshes.resize(2);
+  const size_t records = encodeRtrScene(two).size() - (s.meshes[1].clusters.size() * 40 + 15) / 16 * 16;
+  // Cluster 2047 (the last of the first piece) claims to run to triangle 2^31; cluster 2048 starts there.
+  const Cluster& c = s.meshes[1].clusters[2047];
+  const uint32_t count = (1u << 31) - c.firstTriangle, first = 1u << 31;
+  std::string b = good;
+  uint32_t was;
+  std::memcpy(&was, b.data() + records + 2047 * 40 + 32, 4);
+  ASSERT_EQ(was, c.firstTriangle);
+  std::memcpy(b.data() + records + 2047 * 40 + 36, &count, 4);
+  std::memcpy(b.data() + records + 2048 * 40 + 32, &first, 4);
+  reseal(b);
+  for (unsigned threads : {1u, 8u})
+    EXPECT_THAT(decodeError(b, threads), HasSubstr("at byte " + std::to_string(records + 2047 * 40 + 36) +
+                                                   ": mesh 1: cluster 2047: triangle count " + std::to_string(count)));
+}
+
+TEST(RtrSceneParallel, PieceChecksumIsItsDefinitionAtAnyThreadCount) {
+  std::mt19937 rng(7);
+  std::vector<uint8_t> data(9 * kChecksumPiece + 17);
+  for (uint8_t& v : data) v = uint8_t(rng());
+  for (size_t size : {size_t(0), size_t(5), kChecksumPiece, 4 * kChecksumPiece + 3, data.size()}) {
+    const std::span<const uint8_t> d(data.data(), size);
+    std::vector<uint64_t> sums;  // the definition: checksum64 of each 1 MiB piece, then of those sums
+    for (size_t at = 0; at < size; at += kChecksumPiece)
+      sums.push_back(checksum64(d.subspan(at, std::min(kChecksumPiece, size - at))));
+    const uint64_t want = checksum64({reinterpret_cast<const uint8_t*>(sums.data()), sums.size() * 8});
+    for (unsigned threads : {1u, 3u, 0u}) EXPECT_EQ(pieceChecksum64(d, threads), want) << size << " bytes, " << threads << " threads";
+  }
+  // Two pieces swapped: a different sum.
+  std::vector<uint8_t> swapped = data;
+  std::swap_ranges(swapped.begin(), swapped.begin() + kChecksumPiece, swapped.begin() + kChecksumPiece);
+  EXPECT_NE(pieceChecksum64(swapped), pieceChecksum64(data));
+}
+
+TEST(RtrSceneParallel, Version4RefusesADamagedPieceAndOlderFilesStillLoad) {
+  const std::string good = encodeRtrScene(severalMeshes());
+  std::string b = good;
+  b[80 + 3 * kChecksumPiece + 11] ^= 4;  // one bit in the fourth piece
+  for (unsigned threads : {1u, 8u}) EXPECT_THAT(decodeError(b, threads), HasSubstr("p.rtrscene:at byte 40: checksum mismatch"));
+  // A file written by a build of version 3 (one checksum chain over the payload) still loads; damaged,
+  // it is refused.
+  const auto old = readFileBytes(test::sourceDir() / "tests/fuzz/corpus/fuzz_rtrscene/cube_backplane-v3.rtrscene");
+  std::string v3(old.begin(), old.end());
+  ASSERT_EQ(v3[8], 3);
+  EXPECT_EQ(decodeError(v3, 1), "(no error)");
+  v3[v3.size() - 20] ^= 1;
+  EXPECT_THAT(decodeError(v3, 1), HasSubstr("at byte 40: checksum mismatch"));
+  std::string v5 = good;
+  v5[8] = 5;
+  EXPECT_THAT(decodeError(v5, 1), HasSubstr("at byte 8: unsupported version 5 (this build reads 4)"));
+}
