@@ -28,8 +28,23 @@ inline F allMax(F a) {
   const __m256 m2 = _mm256_max_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
   return {_mm256_max_ps(m2, _mm256_shuffle_ps(m2, m2, _MM_SHUFFLE(2, 3, 0, 1)))};
 }
+inline float minLane(F a) { return _mm256_cvtss_f32(allMin(a).v); }
+// Lane i all ones where bit i of m is set.
+inline F laneMask(unsigned m) {
+  const __m256i b = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  return {_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(m)), b), b))};
+}
 #else
 inline F sel(F mask, F x, F y) { return {_mm_blendv_ps(y.a, x.a, mask.a), _mm_blendv_ps(y.b, x.b, mask.b)}; }
+inline float minLane(F x) {
+  const __m128 m = _mm_min_ps(x.a, x.b);
+  const __m128 m2 = _mm_min_ps(m, _mm_movehl_ps(m, m));
+  return _mm_cvtss_f32(_mm_min_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
+}
+inline F laneMask(unsigned m) {
+  const __m128i v = _mm_set1_epi32(int(m)), lo = _mm_setr_epi32(1, 2, 4, 8), hi = _mm_setr_epi32(16, 32, 64, 128);
+  return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, lo), lo)), _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, hi), hi))};
+}
 #endif
 
 // A packet's rays with lanes = rays (lanes n to 7 repeat ray 0), read once into vectors by scalar loads:
@@ -201,8 +216,9 @@ struct PacketWalker {
   }
 #endif
 
-  // The rays of `active` whose box test passes child c of node n, with their entry distances.
-  RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F tHitV, F& tNearOut) const {
+  // The rays of `active` (activeV: as a lane mask) whose box test passes child c of node n, with their
+  // entry distances and the nearest of those (a vector minimum: a loop over the rays mispredicts).
+  RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F activeV, F tHitV, F& tNearOut, float& nearest) const {
     RTR_COUNT(c.childTests += 1; c.childTestRays += unsigned(__builtin_popcount(active)));
     const F zero = set1(0.0f);
     F tn[3], tf[3];
@@ -233,7 +249,10 @@ struct PacketWalker {
     for (int a = 0; a < 3; ++a)
       if (Parallel >> a & 1) hitBox = hitBox & le(set1(n.box[0][a][c]), oAxis[a]) & ge(set1(n.box[1][a][c]), oAxis[a]);
     tNearOut = tNear;
-    return bits(hitBox) & active;
+    hitBox = hitBox & activeV;
+    const unsigned m = bits(hitBox);
+    if (m) nearest = minLane(sel(hitBox, tNear, set1(kInf)));
+    return m;
   }
 
   // Tests node `ref`'s children against the packet: false when no ray meets any; else ref/active are
@@ -250,16 +269,14 @@ struct PacketWalker {
     unsigned mk[8];
     uint64_t keys[8];
     int k = 0;
+    const F activeV = laneMask(active);
     for (; slots; slots &= slots - 1) {
       const int c = ctz(slots);
       F tNear;
-      const unsigned m = testChild(n, c, active, tHitV, tNear);
+      float mn;
+      const unsigned m = testChild(n, c, active, activeV, tHitV, tNear, mn);
       if (!m) continue;
       // Order children by the nearest entry among their rays (farthest first for any hit, as Walker).
-      alignas(32) float lanes[8];
-      store(lanes, tNear);
-      float mn = kInf;
-      for (unsigned b = m; b; b &= b - 1) mn = lanes[ctz(b)] < mn ? lanes[ctz(b)] : mn;
       const uint32_t d32 = floatBits(mn);
       const uint64_t key = uint64_t(AnyHit ? ~d32 : d32) << 32 | uint32_t(c);
       tn[c] = tNear;
