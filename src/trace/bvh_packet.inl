@@ -1,8 +1,9 @@
 // Packets of up to eight rays through the BVH (included by bvh_traverse.inl, inside its namespace; the
 // same rules: inline, no glm or std function templates). Lanes are rays here: a node's children are
 // tested one after another against all rays of the packet at once, each ray with exactly the slab
-// arithmetic of its single-ray walk. Leaves are tested ray by ray with the single-ray 8-wide triangle
-// test. A ray left alone in a subtree walks it as a single ray. See docs/tracer.md.
+// arithmetic of its single-ray walk. Leaves are tested all rays at once (lanes = rays) where enough rays
+// reach them, else ray by ray with the single-ray 8-wide triangle test. A ray left alone in a subtree
+// walks it as a single ray. See docs/tracer.md.
 //
 // Why the results equal the single-ray ones bit for bit:
 // * Any hit: a ray's tMax never changes, so each box and each triangle gets the same answer for a ray
@@ -100,7 +101,8 @@ struct PacketWalker {
   // test of a node's eight children at once (lanes = children) before each child is tested against the
   // rays (lanes = rays). Without it a node visit costs one 8-wide pass per child, as many passes a ray as
   // single rays take (counted: docs/bench/trace.md, round 8). Only when every ray has the same sign on
-  // each axis and finite, non-zero constants (then no bound is NaN).
+  // each axis and finite, non-zero constants, and finite origins on the axes the rays run parallel to
+  // (then no bound is NaN).
   F rnLo[3], rnHi[3], qnHi[3], rfLo[3], rfHi[3], qfLo[3], oLo[3], oHi[3];  // o: on parallel axes
   int nearOff[3], farOff[3];
   bool interval = false;
