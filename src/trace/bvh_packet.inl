@@ -220,7 +220,7 @@ struct PacketWalker {
 
   // The rays of `active` (activeV: as a lane mask) whose box test passes child c of node n, with their
   // entry distances and the nearest of those (a vector minimum: a loop over the rays mispredicts).
-  RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F activeV, F tHitV, F& tNearOut, float& nearest) const {
+  RTR_INLINE unsigned testChild(const Node& n, int c, [[maybe_unused]] unsigned active, F activeV, F tHitV, F& tNearOut, float& nearest) const {
     RTR_COUNT(c.childTests += 1; c.childTestRays += unsigned(__builtin_popcount(active)));
     const F zero = set1(0.0f);
     F tn[3], tf[3];
