@@ -133,9 +133,15 @@ struct PacketWalker {
 #if RTR_BVH_AVX2
     const F absMask = set1(bitsFloat(0x7FFFFFFFu));
 #endif
+#if RTR_BVH_AVX2
+    F rcpLo[3], rcpHi[3];
+#endif
     for (int a = 0; a < 3; ++a) {
       oAxis[a] = pr.o[a];
       const F rcp = set1(1.0f) / pr.d[a];
+#if RTR_BVH_AVX2
+      if (!(Parallel >> a & 1)) { rcpLo[a] = allMin(rcp); rcpHi[a] = allMax(rcp); }
+#endif
       neg[a] = lt(rcp, zero);
 #if RTR_BVH_AVX2
       rNear[a] = rcp * set1(1.0f - 0x1p-21f);
@@ -165,8 +171,12 @@ struct PacketWalker {
            lt(qFar[a] & absMask, inf) & neq(rNear[a], zero) & neq(rFar[a], zero);
       const unsigned signs = bits(neg[a]);
       if (signs != 0 && signs != 0xFFu) ok = set1(0.0f);
-      rnLo[a] = allMin(rNear[a]); rnHi[a] = allMax(rNear[a]); qnHi[a] = allMax(qNear[a]);
-      rfLo[a] = allMin(rFar[a]); rfHi[a] = allMax(rFar[a]); qfLo[a] = allMin(qFar[a]);
+      // A product with a positive constant rounds monotonically: the bounds of rNear and rFar are the
+      // bounds of the reciprocals times the same constants, two reductions fewer an axis.
+      rnLo[a] = rcpLo[a] * set1(1.0f - 0x1p-21f); rnHi[a] = rcpHi[a] * set1(1.0f - 0x1p-21f);
+      rfLo[a] = rcpLo[a] * set1(1.0f + 0x1p-21f); rfHi[a] = rcpHi[a] * set1(1.0f + 0x1p-21f);
+      qnHi[a] = allMax(qNear[a]);
+      qfLo[a] = allMin(qFar[a]);
       const int nearSide = signs ? 1 : 0;
       nearOff[a] = (nearSide * 3 + a) * 8;
       farOff[a] = ((1 - nearSide) * 3 + a) * 8;
