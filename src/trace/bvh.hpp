@@ -91,7 +91,7 @@ class Bvh {
   std::array<bool, 2> occludedPair(const std::array<Ray, 2>& rays, IntersectMethod method = IntersectMethod::Watertight) const;
 
   // Packets of up to eight coherent rays (neighbouring pixels, shadow rays to one light), each with
-  // exactly its single-ray result: the boxes are tested for all rays at once, the leaves ray by ray, and
+  // exactly its single-ray result: the boxes are tested for all rays at once, the leaves too or ray by ray, and
   // a ray left alone in a subtree walks on as a single ray (bvh_packet.inl). Rays that run parallel to
   // different axes, or another method than Watertight, go one at a time. n > 8 is taken as 8.
   void closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method = IntersectMethod::Watertight) const;

@@ -1,8 +1,9 @@
 // Packets of up to eight rays through the BVH (included by bvh_traverse.inl, inside its namespace; the
 // same rules: inline, no glm or std function templates). Lanes are rays here: a node's children are
 // tested one after another against all rays of the packet at once, each ray with exactly the slab
-// arithmetic of its single-ray walk. Leaves are tested ray by ray with the single-ray 8-wide triangle
-// test. A ray left alone in a subtree walks it as a single ray. See docs/tracer.md.
+// arithmetic of its single-ray walk. Leaves are tested all rays at once (lanes = rays) where enough rays
+// reach them, else ray by ray with the single-ray 8-wide triangle test. A ray left alone in a subtree
+// walks it as a single ray. See docs/tracer.md.
 //
 // Why the results equal the single-ray ones bit for bit:
 // * Any hit: a ray's tMax never changes, so each box and each triangle gets the same answer for a ray
@@ -17,24 +18,54 @@
 
 #if RTR_BVH_AVX2
 inline F sel(F mask, F a, F b) { return {_mm256_blendv_ps(b.v, a.v, mask.v)}; }  // mask ? a : b
-inline float hmin(F a) {
-  const __m128 m = _mm_min_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
-  const __m128 m2 = _mm_min_ps(m, _mm_movehl_ps(m, m));
-  return _mm_cvtss_f32(_mm_min_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
+// The min and max over the eight lanes, in every lane (no round trip through a scalar).
+inline F allMin(F a) {
+  const __m256 m = _mm256_min_ps(a.v, _mm256_permute2f128_ps(a.v, a.v, 1));
+  const __m256 m2 = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  return {_mm256_min_ps(m2, _mm256_shuffle_ps(m2, m2, _MM_SHUFFLE(2, 3, 0, 1)))};
 }
-inline float hmax(F a) {
-  const __m128 m = _mm_max_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
-  const __m128 m2 = _mm_max_ps(m, _mm_movehl_ps(m, m));
-  return _mm_cvtss_f32(_mm_max_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
+inline F allMax(F a) {
+  const __m256 m = _mm256_max_ps(a.v, _mm256_permute2f128_ps(a.v, a.v, 1));
+  const __m256 m2 = _mm256_max_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+  return {_mm256_max_ps(m2, _mm256_shuffle_ps(m2, m2, _MM_SHUFFLE(2, 3, 0, 1)))};
+}
+inline float minLane(F a) { return _mm256_cvtss_f32(allMin(a).v); }
+// Lane i all ones where bit i of m is set.
+inline F laneMask(unsigned m) {
+  const __m256i b = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  return {_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(m)), b), b))};
 }
 #else
 inline F sel(F mask, F x, F y) { return {_mm_blendv_ps(y.a, x.a, mask.a), _mm_blendv_ps(y.b, x.b, mask.b)}; }
-inline float hmin(F x) {
+inline float minLane(F x) {
   const __m128 m = _mm_min_ps(x.a, x.b);
   const __m128 m2 = _mm_min_ps(m, _mm_movehl_ps(m, m));
   return _mm_cvtss_f32(_mm_min_ss(m2, _mm_shuffle_ps(m2, m2, 1)));
 }
+inline F laneMask(unsigned m) {
+  const __m128i v = _mm_set1_epi32(int(m)), lo = _mm_setr_epi32(1, 2, 4, 8), hi = _mm_setr_epi32(16, 32, 64, 128);
+  return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, lo), lo)), _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, hi), hi))};
+}
 #endif
+
+// A packet's rays with lanes = rays (lanes n to 7 repeat ray 0), read once into vectors by scalar loads:
+// eight scalar stores read back as one vector stall on store forwarding, and a gather was slower still
+// (AMD VM); most temple packets end after a node or two, so their set-up is a good part of their time
+// (docs/bench/trace.md, round 9).
+struct PacketRays { F o[3], d[3], tMax; };
+RTR_INLINE F lanesOf(const float* const* p, int k) {  // p[i][k] in lane i
+#if RTR_BVH_AVX2
+  return {_mm256_setr_ps(p[0][k], p[1][k], p[2][k], p[3][k], p[4][k], p[5][k], p[6][k], p[7][k])};
+#else
+  return {_mm_setr_ps(p[0][k], p[1][k], p[2][k], p[3][k]), _mm_setr_ps(p[4][k], p[5][k], p[6][k], p[7][k])};
+#endif
+}
+RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
+  const float* p[8];
+  for (int i = 0; i < 8; ++i) p[i] = &r[i < n ? i : 0].origin.x;  // origin, direction, tMax: seven floats
+  static_assert(sizeof(Ray) == 7 * sizeof(float));
+  return {{lanesOf(p, 0), lanesOf(p, 1), lanesOf(p, 2)}, {lanesOf(p, 3), lanesOf(p, 4), lanesOf(p, 5)}, lanesOf(p, 6)};
+}
 
 constexpr float kTieWindow = 0x1p-10f;
 
@@ -60,18 +91,19 @@ struct PacketWalker {
 #endif
   alignas(32) float tMax[8], cull[8], best[8], second[8];
   // The watertight test's per-ray constants with lanes = rays, for leaves tested all rays at once; valid
-  // when every ray has the same axis order kx, ky, kz (sameShear).
+  // when every ray has the same axis order kx, ky, kz (sameShear). Made on the first such leaf (shear()).
   F shO[3], shS[3];
   int kx = 0, ky = 0, kz = 0;
-  bool sameShear = true;
-  const int leafRays;
+  bool sameShear = true, sheared = false;
+  const int nRays, leafRays;
 #if RTR_BVH_AVX2
   // The packet's interval: per axis, bounds over its rays of the slab constants, for one conservative
   // test of a node's eight children at once (lanes = children) before each child is tested against the
   // rays (lanes = rays). Without it a node visit costs one 8-wide pass per child, as many passes a ray as
   // single rays take (counted: docs/bench/trace.md, round 8). Only when every ray has the same sign on
-  // each axis and finite, non-zero constants (then no bound is NaN).
-  float rnLo[3], rnHi[3], qnHi[3], rfLo[3], rfHi[3], qfLo[3], oLo[3], oHi[3];  // o: on parallel axes
+  // each axis and finite, non-zero constants, and finite origins on the axes the rays run parallel to
+  // (then no bound is NaN).
+  F rnLo[3], rnHi[3], qnHi[3], rfLo[3], rfHi[3], qfLo[3], oLo[3], oHi[3];  // o: on parallel axes
   int nearOff[3], farOff[3];
   bool interval = false;
 #endif
@@ -88,34 +120,28 @@ struct PacketWalker {
     return *reinterpret_cast<const W*>(walkers[i]);
   }
 
-  RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, Hit* h, IntersectMethod m, int minLeafRays)
-      : bvh(view), rays(r), hits(h), leafRays(minLeafRays), method(m) {
-    alignas(32) float o[3][8], d[3][8], so[3][8], ss[3][8];
-    for (int i = 0; i < 8; ++i) {
-      const Ray& ray = r[i < n ? i : 0];
-      o[0][i] = ray.origin.x; o[1][i] = ray.origin.y; o[2][i] = ray.origin.z;
-      d[0][i] = ray.direction.x; d[1][i] = ray.direction.y; d[2][i] = ray.direction.z;
-      tMax[i] = cull[i] = ray.tMax;
-      best[i] = second[i] = kInf;
-      // Walker's shear constants, by the same operations.
-      int x, y, z;
-      W::shearAxes(&d[0][i], 8, x, y, z);
-      if (i == 0) { kx = x; ky = y; kz = z; }
-      sameShear = sameShear && x == kx && y == ky && z == kz;
-      const float szs = 1.0f / d[z][i];
-      so[0][i] = o[x][i]; so[1][i] = o[y][i]; so[2][i] = o[z][i];
-      ss[0][i] = d[x][i] * szs; ss[1][i] = d[y][i] * szs; ss[2][i] = szs;
-    }
-    for (int a = 0; a < 3; ++a) { shO[a] = load(so[a]); shS[a] = load(ss[a]); }
+  RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, const PacketRays& pr, Hit* h, IntersectMethod m,
+                          int minLeafRays)
+      : bvh(view), rays(r), hits(h), nRays(n), leafRays(minLeafRays), method(m) {
+    store(tMax, pr.tMax);
+    store(cull, pr.tMax);
+    store(best, set1(kInf));
+    store(second, set1(kInf));
     // Per ray, the operations of Walker's constructor (there done three axes at a time, here eight
     // rays at a time: the same per-lane results), so the boxes are culled exactly as for a single ray.
     const F zero = set1(0.0f);
 #if RTR_BVH_AVX2
     const F absMask = set1(bitsFloat(0x7FFFFFFFu));
 #endif
+#if RTR_BVH_AVX2
+    F rcpLo[3], rcpHi[3];
+#endif
     for (int a = 0; a < 3; ++a) {
-      oAxis[a] = load(o[a]);
-      const F rcp = set1(1.0f) / load(d[a]);
+      oAxis[a] = pr.o[a];
+      const F rcp = set1(1.0f) / pr.d[a];
+#if RTR_BVH_AVX2
+      if (!(Parallel >> a & 1)) { rcpLo[a] = allMin(rcp); rcpHi[a] = allMax(rcp); }
+#endif
       neg[a] = lt(rcp, zero);
 #if RTR_BVH_AVX2
       rNear[a] = rcp * set1(1.0f - 0x1p-21f);
@@ -131,24 +157,54 @@ struct PacketWalker {
 #endif
     }
 #if RTR_BVH_AVX2
-    // Vector reductions: most temple packets visit a node or two, so this set-up is a good part of them.
     const F inf = set1(kInf);
     F ok = set1(bitsFloat(0xFFFFFFFFu));
-    for (int a = 0; a < 3; ++a) { oLo[a] = hmin(oAxis[a]); oHi[a] = hmax(oAxis[a]); }
+    for (int a = 0; a < 3; ++a)
+      if (Parallel >> a & 1) {
+        ok = ok & lt(oAxis[a] & absMask, inf);
+        oLo[a] = allMin(oAxis[a]);
+        oHi[a] = allMax(oAxis[a]);
+      }
     for (int i = 0; i < kSlabs; ++i) {
       const int a = kSlabAxes.axis[i];
       ok = ok & lt(rNear[a] & absMask, inf) & lt(rFar[a] & absMask, inf) & lt(qNear[a] & absMask, inf) &
            lt(qFar[a] & absMask, inf) & neq(rNear[a], zero) & neq(rFar[a], zero);
       const unsigned signs = bits(neg[a]);
       if (signs != 0 && signs != 0xFFu) ok = set1(0.0f);
-      rnLo[a] = hmin(rNear[a]); rnHi[a] = hmax(rNear[a]); qnHi[a] = hmax(qNear[a]);
-      rfLo[a] = hmin(rFar[a]); rfHi[a] = hmax(rFar[a]); qfLo[a] = hmin(qFar[a]);
+      // A product with a positive constant rounds monotonically: the bounds of rNear and rFar are the
+      // bounds of the reciprocals times the same constants, two reductions fewer an axis.
+      rnLo[a] = rcpLo[a] * set1(1.0f - 0x1p-21f); rnHi[a] = rcpHi[a] * set1(1.0f - 0x1p-21f);
+      rfLo[a] = rcpLo[a] * set1(1.0f + 0x1p-21f); rfHi[a] = rcpHi[a] * set1(1.0f + 0x1p-21f);
+      qnHi[a] = allMax(qNear[a]);
+      qfLo[a] = allMin(qFar[a]);
       const int nearSide = signs ? 1 : 0;
       nearOff[a] = (nearSide * 3 + a) * 8;
       farOff[a] = ((1 - nearSide) * 3 + a) * 8;
     }
     interval = bits(ok) == 0xFFu;
 #endif
+  }
+
+  // Whether every ray has the same watertight axis order (then leaves can be tested all rays at once);
+  // the first call makes the shear constants, with Walker's operations for each ray.
+  RTR_INLINE bool shear() {
+    if (sheared) return sameShear;
+    sheared = true;
+    alignas(32) float so[3][8], ss[3][8];
+    for (int i = 0; i < 8; ++i) {
+      const Ray& ray = rays[i < nRays ? i : 0];
+      const float* o = &ray.origin.x;
+      const float* d = &ray.direction.x;
+      int x, y, z;
+      W::shearAxes(d, 1, x, y, z);
+      if (i == 0) { kx = x; ky = y; kz = z; }
+      sameShear = sameShear && x == kx && y == ky && z == kz;
+      const float szs = 1.0f / d[z];
+      so[0][i] = o[x]; so[1][i] = o[y]; so[2][i] = o[z];
+      ss[0][i] = d[x] * szs; ss[1][i] = d[y] * szs; ss[2][i] = szs;
+    }
+    for (int a = 0; a < 3; ++a) { shO[a] = load(so[a]); shS[a] = load(ss[a]); }
+    return sameShear;
   }
 
 #if RTR_BVH_AVX2
@@ -158,22 +214,23 @@ struct PacketWalker {
     RTR_COUNT(c.intervalTests += 1);
     const float* b = &n.box[0][0][0];
     const F zero = set1(0.0f);
-    F lo = zero, hi = set1(hmax(tHitV));
+    F lo = zero, hi = allMax(tHitV);
     for (int i = 0; i < kSlabs; ++i) {
       const int a = kSlabAxes.axis[i];
       const F nb = load(b + nearOff[a]), fb = load(b + farOff[a]);
-      lo = vmax(lo, fmsub(nb, sel(lt(nb, zero), set1(rnHi[a]), set1(rnLo[a])), set1(qnHi[a])));
-      hi = vmin(hi, fmsub(fb, sel(lt(fb, zero), set1(rfLo[a]), set1(rfHi[a])), set1(qfLo[a])));
+      lo = vmax(lo, fmsub(nb, sel(lt(nb, zero), rnHi[a], rnLo[a]), qnHi[a]));
+      hi = vmin(hi, fmsub(fb, sel(lt(fb, zero), rfLo[a], rfHi[a]), qfLo[a]));
     }
     F in = le(lo, hi);
     for (int a = 0; a < 3; ++a)  // an axis the rays run parallel to: some origin within the slab
-      if (Parallel >> a & 1) in = in & le(load(n.box[0][a]), set1(oHi[a])) & ge(load(n.box[1][a]), set1(oLo[a]));
+      if (Parallel >> a & 1) in = in & le(load(n.box[0][a]), oHi[a]) & ge(load(n.box[1][a]), oLo[a]);
     return bits(in);
   }
 #endif
 
-  // The rays of `active` whose box test passes child c of node n, with their entry distances.
-  RTR_INLINE unsigned testChild(const Node& n, int c, unsigned active, F tHitV, F& tNearOut) const {
+  // The rays of `active` (activeV: as a lane mask) whose box test passes child c of node n, with their
+  // entry distances and the nearest of those (a vector minimum: a loop over the rays mispredicts).
+  RTR_INLINE unsigned testChild(const Node& n, int c, [[maybe_unused]] unsigned active, F activeV, F tHitV, F& tNearOut, float& nearest) const {
     RTR_COUNT(c.childTests += 1; c.childTestRays += unsigned(__builtin_popcount(active)));
     const F zero = set1(0.0f);
     F tn[3], tf[3];
@@ -204,7 +261,10 @@ struct PacketWalker {
     for (int a = 0; a < 3; ++a)
       if (Parallel >> a & 1) hitBox = hitBox & le(set1(n.box[0][a][c]), oAxis[a]) & ge(set1(n.box[1][a][c]), oAxis[a]);
     tNearOut = tNear;
-    return bits(hitBox) & active;
+    hitBox = hitBox & activeV;
+    const unsigned m = bits(hitBox);
+    if (m) nearest = minLane(sel(hitBox, tNear, set1(kInf)));
+    return m;
   }
 
   // Tests node `ref`'s children against the packet: false when no ray meets any; else ref/active are
@@ -221,16 +281,14 @@ struct PacketWalker {
     unsigned mk[8];
     uint64_t keys[8];
     int k = 0;
+    const F activeV = laneMask(active);
     for (; slots; slots &= slots - 1) {
       const int c = ctz(slots);
       F tNear;
-      const unsigned m = testChild(n, c, active, tHitV, tNear);
+      float mn;
+      const unsigned m = testChild(n, c, active, activeV, tHitV, tNear, mn);
       if (!m) continue;
       // Order children by the nearest entry among their rays (farthest first for any hit, as Walker).
-      alignas(32) float lanes[8];
-      store(lanes, tNear);
-      float mn = kInf;
-      for (unsigned b = m; b; b &= b - 1) mn = lanes[ctz(b)] < mn ? lanes[ctz(b)] : mn;
       const uint32_t d32 = floatBits(mn);
       const uint64_t key = uint64_t(AnyHit ? ~d32 : d32) << 32 | uint32_t(c);
       tn[c] = tNear;
@@ -411,7 +469,7 @@ struct PacketWalker {
         }
         if (ref & Bvh::kLeafBit) {
           RTR_COUNT(c.packetLeaves += 1; c.packetLeafRays += unsigned(__builtin_popcount(active)));
-          if (sameShear && __builtin_popcount(active) >= leafRays) {
+          if (__builtin_popcount(active) >= leafRays && shear()) {
             done |= leafAllRays(ref, active);
             break;
           }
@@ -448,9 +506,10 @@ struct PacketWalker {
 };
 
 template <bool AnyHit, unsigned Parallel>
-unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
+unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, const PacketRays& pr, IntersectMethod method, Hit* hits,
+                    int leafRays) {
   RTR_COUNT(c.packets += 1);
-  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, hits, method, leafRays);
+  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays);
   return p.run((1u << n) - 1);
 }
 

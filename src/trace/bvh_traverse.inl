@@ -489,17 +489,22 @@ unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
 // again alone (ties, see bvh_packet.inl). Any hit: returns the occluded rays.
 template <bool AnyHit>
 unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
-  const unsigned p = parallelAxes(rays[0]);
   bool same = method == IntersectMethod::Watertight && n > 1;
-  for (int i = 1; i < n && same; ++i) same = parallelAxes(rays[i]) == p;
+  const PacketRays pr = gatherRays(rays, n);
+  unsigned p = 0;  // the axes every ray runs parallel to; same: no ray is parallel to another
+  for (int a = 0; a < 3; ++a) {
+    const unsigned zero = bits(eq(pr.d[a], set1(0.0f)));
+    if (zero == 0xFFu) p |= 1u << a;
+    else if (zero) same = false;
+  }
   switch (same ? p : 8u) {
-    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, method, hits, leafRays);
-    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, method, hits, leafRays);
-    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, method, hits, leafRays);
-    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, method, hits, leafRays);
-    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, method, hits, leafRays);
-    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, method, hits, leafRays);
-    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, method, hits, leafRays);
+    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, pr, method, hits, leafRays);
+    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, pr, method, hits, leafRays);
+    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, pr, method, hits, leafRays);
+    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, pr, method, hits, leafRays);
+    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, pr, method, hits, leafRays);
+    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, pr, method, hits, leafRays);
+    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, pr, method, hits, leafRays);
     case 7: return 0;
     default: {
       unsigned m = 0;

@@ -255,8 +255,17 @@ void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
   Bvh::setCounting(false);
 }
 
-void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, unsigned threads, int res,
-                bool sphere, bool quick, bool explainAll, int reps, int leafRays, bool countOnly) {
+struct Options {
+  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
+  bool quick = false, explainAll = false, countOnly = false;
+  bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
+};
+
+void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, bool sphere, const Options& o) {
+  const unsigned threads = o.threads;
+  const int res = o.res, reps = o.reps, leafRays = o.leafRays;
+  const bool quick = o.quick, explainAll = o.explainAll, countOnly = o.countOnly;
   std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
               res, threads, Bvh::isaName(Bvh::isa()));
   const auto t0 = Clock::now();
@@ -317,6 +326,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
 
   // Agreement on primary and mirror rays.
   for (auto* set : {&primary, &ortho, &mirror}) {
+    if (o.packetsOnly) break;
     size_t disagree = 0, otherTriangle = 0, farOff = 0;
     double maxRel = 0, maxRelSame = 0;
     std::map<std::string, size_t> kinds;
@@ -376,8 +386,9 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
     std::printf("Our packets of 8 (leaves all rays at once from %d live rays) against our single rays (primary, orthographic, "
                 "shadow, mirror): %zu of %zu rays differ\n", lr, differ, total);
   }
-  printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
-                      {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
+  if (!o.packetsOnly)
+    printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
+                        {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
   if (countOnly) {  // and the same with every leaf tested ray by ray
     std::printf("\nThe same, every leaf of a packet tested ray by ray (--leaf-rays 9):\n");
     Bvh::setPacketLeafRays(9);
@@ -402,10 +413,10 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
       // runs twice, so that the best run finds its own BVH in the caches, not the other's.
       double single = 1e30, paired = 1e30, ours8 = 1e30, ours8r = 1e30, theirs = 1e30, theirs8 = 1e30;
       for (int r = 0; r < reps; ++r) {
-        single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
+        if (!o.packetsOnly) single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
           return s.any ? uint32_t(bvh.occluded(rays[i])) : bvh.closest(rays[i]).prim;
         }));
-        paired = std::min(paired, timed(pairs + rays.size() % 2, th, 2, [&](size_t i) {
+        if (!o.packetsOnly) paired = std::min(paired, timed(pairs + rays.size() % 2, th, 2, [&](size_t i) {
           if (i == pairs) return s.any ? uint32_t(bvh.occluded(rays[2 * i])) : bvh.closest(rays[2 * i]).prim;
           const std::array<Ray, 2> two{rays[2 * i], rays[2 * i + 1]};
           if (s.any) { const auto o = bvh.occludedPair(two); return uint32_t(o[0]) + uint32_t(o[1]); }
@@ -423,9 +434,9 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
         };
         ours8 = std::min(ours8, timed((rays.size() + 7) / 8, th, 2, packets8));
         Bvh::setPacketLeafRays(9);  // every leaf ray by ray (lanes = triangles), as before round 8
-        ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
+        if (!o.packetsOnly) ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
         Bvh::setPacketLeafRays(leafRays);
-        theirs = std::min(theirs, timed(rays.size(), th, 2, [&](size_t i) {
+        if (!o.packetsOnly) theirs = std::min(theirs, timed(rays.size(), th, 2, [&](size_t i) {
           return s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
         }));
         if (packets)
@@ -439,9 +450,16 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
         std::snprintf(t8, sizeof t8, "%.2f", rays.size() / theirs8 * 1e-6);
         std::snprintf(r8, sizeof r8, "%.2f×", theirs8 / ours8);
       }
-      std::printf("| %s | %u | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %.2f× | %.2f× | %s |\n", s.name, th, rays.size() / single * 1e-6,
-                  rays.size() / paired * 1e-6, rays.size() / ours8r * 1e-6, rays.size() / ours8 * 1e-6, rays.size() / theirs * 1e-6,
-                  t8, theirs / single, theirs / paired, r8);
+      // Mrays/s and ratios; "–" where not timed (--packets-only).
+      auto fmt = [](double num, double t, const char* f) {
+        char b[32] = "–";
+        if (t < 1e30) std::snprintf(b, sizeof b, f, num / t);
+        return std::string(b);
+      };
+      const double n = double(rays.size()) * 1e-6;
+      std::printf("| %s | %u | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", s.name, th, fmt(n, single, "%.2f").c_str(),
+                  fmt(n, paired, "%.2f").c_str(), fmt(n, ours8r, "%.2f").c_str(), fmt(n, ours8, "%.2f").c_str(), fmt(n, theirs, "%.2f").c_str(),
+                  t8, fmt(theirs, single, "%.2f×").c_str(), fmt(theirs, paired, "%.2f×").c_str(), r8);
     }
   }
   if (quick) return;
@@ -503,12 +521,13 @@ void benchRoutines() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  int res = 1024;
+  Options o;
+  unsigned& threads = o.threads;
+  int &res = o.res, &reps = o.reps, &leafRays = o.leafRays;
+  bool &quick = o.quick, &explainAll = o.explainAll, &countOnly = o.countOnly;
   uint32_t rings = 707;
+  bool noSphere = false;
   std::vector<std::string> scenes;
-  bool quick = false, explainAll = false, countOnly = false;
-  int reps = 3, leafRays = Bvh::kPacketLeafRays;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
@@ -519,16 +538,20 @@ int main(int argc, char** argv) {
     else if (a == "--leaf-rays" && i + 1 < argc) leafRays = std::atoi(argv[++i]);
     else if (a == "--quick") quick = true;
     else if (a == "--count-only") quick = countOnly = true;
+    else if (a == "--packets-only") quick = o.packetsOnly = true;
+    else if (a == "--no-sphere") noSphere = true;
     else if (a == "--explain") explainAll = true;
     else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
     else if (a == "--avx2") Bvh::setIsa(BvhIsa::Avx2);
-    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only]\n"
+    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only] [--packets-only] [--no-sphere]\n"
                               "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
                               "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
                               "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
                               "  --explain: one line per hit/miss disagreement with Embree\n"
                               "  --count-only: builds, agreement and work per ray (counted), no timing\n"
-                              "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"); return 2; }
+                              "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"
+                              "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
+                              "  --no-sphere: only the --scene files\n"); return 2; }
   }
   if (threads == 0 || res <= 0 || rings < 2 || reps < 1) { std::fprintf(stderr, "bench-trace: bad argument\n"); return 2; }
   Bvh::setPacketLeafRays(leafRays);
@@ -537,11 +560,11 @@ int main(int argc, char** argv) {
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
     tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
-  benchScene("UV sphere", tris, sphere.bounds, threads, res, true, quick, explainAll, reps, leafRays, countOnly);
+  if (!noSphere) benchScene("UV sphere", tris, sphere.bounds, true, o);
   for (const std::string& f : scenes) {
     try {
       const Scene s = loadScene(f);
-      benchScene(f.c_str(), trianglesOf(s), s.bounds(), threads, res, false, quick, explainAll, reps, leafRays, countOnly);
+      benchScene(f.c_str(), trianglesOf(s), s.bounds(), false, o);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "bench-trace: %s\n", e.what());
       return 1;

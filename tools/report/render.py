@@ -188,26 +188,31 @@ class Report:
                "rays), and packets of eight neighbouring rays (`Bvh::closest8`/`occluded8`) against Embree's "
                "(`rtcIntersect8`/`rtcOccluded8`). \"ours / Embree\" is two in flight against `rtcIntersect1`. Ratios come from one run in which all take turns (each runs twice a "
                "turn, so it finds its own BVH in the caches), best of 3 turns; docs/bench/trace.md has the other "
-               "runs and the cost to the single-ray path.")
+               "runs, the work per ray counted, and what bounds each row.")
         self.w()
-        bars, packet_ratios = [], []
+        bars, packet_ratios, packet_bars = [], [], []
         for m in self.m:
             secs = self.trace_sections(m)
             if secs is None:
                 self.missing("tracer vs Embree", m, "trace")
                 continue
+            packet_rows, builds = [], []  # this machine's packets against Embree's, and the builds
             for title, sec in secs.items():
                 if title.startswith("Ray/triangle"):
                     continue
                 name = "1M-triangle UV sphere" if title.startswith("UV sphere") else "generated temple, Sun-Temple size"
                 short = "sphere" if title.startswith("UV sphere") else "temple"
                 build = re.search(r"BVH build: (.+)", sec)
-                agree = re.findall(r"agreement with Embree[^\n]*", sec)
+                agree = re.findall(r"agreement with Embree[^\n]*|Our packets of 8[^\n]*|Embree's packets of 8[^\n]*", sec)
+                times = build and re.search(r"ours ([\d.]+) s.*Embree \(quality high\) ([\d.]+) s", build.group(1))
+                if times:
+                    builds.append((short, float(times.group(1)), float(times.group(2))))
                 for header, rows in md_tables(sec):
                     if col(header, "rays") != 0 or col(header, "Embree") is None:
                         continue
                     cr = col(header, "ours /")
                     cp = col(header, "our packets /")
+                    co, ce = col(header, "packets of 8 ("), col(header, "rtcIntersect8")
                     self.w(f"**{m.label}, {name}** ({title.split(':', 1)[1].strip()})")
                     self.w()
                     if build:
@@ -218,11 +223,31 @@ class Report:
                         if cr is not None and num(r[cr]) is not None:
                             kind = {"shadow (any hit)": "shadow", "primary, orthographic": "ortho"}.get(r[0], r[0])
                             bars.append((f"{short} {kind} {r[1]}t\n{m.label}", num(r[cr]), m.label))
-                        if cp is not None and num(r[cp]) is not None and r[0] != "mirror":
-                            packet_ratios.append((num(r[cp]), m.label))
+                        if cp is not None and num(r[cp]) is not None:
+                            if r[0] != "mirror":
+                                packet_ratios.append((num(r[cp]), m.label))
+                            packet_rows.append([short, r[0], r[1], r[co] if co is not None else "–",
+                                                r[ce] if ce is not None else "–", r[cp]])
+                            kind = {"shadow (any hit)": "shadow", "primary, orthographic": "ortho"}.get(r[0], r[0])
+                            packet_bars.append((f"{short} {kind} {r[1]}t\n{m.label}", num(r[cp]), m.label))
                     for a in agree:
                         self.w(f"- {a}")
                     self.w()
+            if packet_rows:  # the packet columns of both scenes side by side, and the builds
+                self.w(f"**{m.label}: packets of eight, ours (`Bvh::closest8`/`occluded8`) against Embree "
+                       "(`rtcIntersect8`/`rtcOccluded8`)** (Mrays/s; ≥ 1.0× is the goal on primary, orthographic "
+                       "and shadow rays; mirror rays for comparison)")
+                self.w()
+                self.table(["scene", "rays", "threads", "ours, packets", "Embree, packets", "ours / Embree"], packet_rows)
+            if builds:
+                self.w("| BVH build, all threads | ours (s) | Embree, quality high (s) | ours / Embree time |")
+                self.w("|---|---:|---:|---:|")
+                for short, ours, theirs in builds:
+                    self.w(f"| {short} | {ours:.3f} | {theirs:.3f} | {ours / theirs:.2f}× |")
+                self.w()
+                worst = max(b[1] / b[2] for b in builds)
+                self.goals.append((f"BVH build ≤ 1.0× Embree's high-quality build time, all threads ({m.label})",
+                                   f"{worst:.2f}× (worst scene)", worst <= 1.0))
             self.source(m, "trace")
         if bars:
             fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(bars)), 4))
@@ -236,6 +261,15 @@ class Report:
                 mine = [b[1] for b in bars if b[2] == label]
                 self.goals.append((f"CPU tracer ≥ 1.0× Embree `rtcIntersect1` (watertight, two rays in flight), every row ({label})",
                                    f"{min(mine):.2f}–{max(mine):.2f}×", min(mine) >= 1.0))
+        if packet_bars:
+            fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(packet_bars)), 4))
+            ax.bar(range(len(packet_bars)), [b[1] for b in packet_bars],
+                   color=["tab:green" if b[1] >= 1 else "tab:red" for b in packet_bars])
+            ax.axhline(1.0, color="k", lw=0.8)
+            ax.set_xticks(range(len(packet_bars)), [b[0] for b in packet_bars], rotation=90, fontsize=7)
+            ax.set_ylabel("our packets / Embree packets (Mrays/s)")
+            ax.set_title("CPU tracer's packets of 8 relative to Embree rtcIntersect8/Occluded8 (≥ 1 is the goal)", fontsize=10)
+            self.plot(fig, "tracer_packets_vs_embree.png", "tracer packets vs Embree packets throughput ratio")
         for label in sorted({p[1] for p in packet_ratios}):
             mine = [p[0] for p in packet_ratios if p[1] == label]
             self.goals.append((f"CPU tracer's packets ≥ 1.0× Embree `rtcIntersect8`, primary, orthographic and shadow rays ({label})",
