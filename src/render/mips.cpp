@@ -45,8 +45,14 @@ const char* toString(MipMode mode) {
   switch (mode) {
     case MipMode::Blit: return "blit";
     case MipMode::Compute: return "compute";
+    case MipMode::Auto: return "auto";
   }
   return "?";
+}
+
+MipMode autoMipMode(MipMode mode, VkExtent2D e) {
+  if (mode != MipMode::Auto) return mode;
+  return uint64_t(e.width) * e.height < kAutoComputeMaxTexels ? MipMode::Compute : MipMode::Blit;
 }
 
 uint32_t mipLevelCount(VkExtent2D e) {
@@ -97,10 +103,13 @@ std::vector<MipDispatch> planMipDispatches(VkExtent2D extent) {
   return plan;
 }
 
-MipGenerator::MipGenerator(const vk::Context& ctx) : ctx_(ctx) {
-  vk::LayoutOptions push{.pushDescriptorSets = {0}};
-  even_ = vk::makeComputePipeline(ctx, vk::loadShader("mips_even.comp"), push);
-  general_ = vk::makeComputePipeline(ctx, vk::loadShader("mips.comp"), push);
+MipGenerator::MipGenerator(const vk::Context& ctx) : ctx_(ctx) {}
+
+const vk::Pipeline& MipGenerator::pipeline(bool even) const {
+  std::optional<vk::Pipeline>& p = even ? even_ : general_;
+  if (!p) p = vk::makeComputePipeline(ctx_, vk::loadShader(even ? "mips_even.comp" : "mips.comp"),
+                                      {.pushDescriptorSets = {0}});
+  return *p;
 }
 
 void MipGenerator::recordBlit(VkCommandBuffer cb, const vk::Image& image) const {
@@ -140,10 +149,16 @@ MipViews MipGenerator::record(VkCommandBuffer cb, const vk::Image& image, MipMod
 
 MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* const> images, MipMode mode) const {
   MipViews views;
-  if (mode == MipMode::Blit) {
-    for (const vk::Image* image : images) recordBlit(cb, *image);
-    return views;
+  std::vector<const vk::Image*> compute;
+  for (const vk::Image* image : images) {
+    if (autoMipMode(mode, image->extent()) == MipMode::Blit) recordBlit(cb, *image);
+    else compute.push_back(image);
   }
+  if (!compute.empty()) recordCompute(cb, compute, views);
+  return views;
+}
+
+void MipGenerator::recordCompute(VkCommandBuffer cb, std::span<const vk::Image* const> images, MipViews& views) const {
   const VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 
   // Per image: its storage views (from `base`), plan, and the scratch offset of each dispatch's last level.
@@ -203,7 +218,7 @@ MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* con
       if (k >= job.plan.size()) continue;
       const MipDispatch& d = job.plan[k];
       const VkExtent2D extent = job.image->extent();
-      const vk::Pipeline& p = d.even ? even_ : general_;
+      const vk::Pipeline& p = pipeline(d.even);
       if (bound != &p) {
         p.bind(cb);
         bound = &p;
@@ -226,7 +241,6 @@ MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* con
     }
   }
   if (!done.empty()) vk::barrier(cb, done);
-  return views;
 }
 
 }  // namespace rtr::render

@@ -10,6 +10,7 @@
 //   on exit   every level is in SHADER_READ_ONLY_OPTIMAL, its writes visible to fragment and compute
 //             shader reads that follow in the same queue.
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -20,8 +21,14 @@
 
 namespace rtr::render {
 
-enum class MipMode { Blit, Compute };
+// Auto: chosen per image by its size (autoMipMode), compute for small images and blit for large ones.
+enum class MipMode { Blit, Compute, Auto };
 const char* toString(MipMode mode);
+
+// Auto's crossover, measured on lavapipe (docs/startup.md): below it the blit chain's fixed cost per level
+// dominates and compute wins; from it on, compute's float passes cost more than the blits.
+constexpr uint64_t kAutoComputeMaxTexels = 256 * 256;
+MipMode autoMipMode(MipMode mode, VkExtent2D extent);  // `mode` itself unless Auto
 
 uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1
 
@@ -49,13 +56,15 @@ struct MipViews {
 
 class MipGenerator {
  public:
-  explicit MipGenerator(const vk::Context& ctx);  // once per context: builds the compute pipelines
+  // Builds its compute pipelines on first use, only those some image needs (none for blit chains).
+  explicit MipGenerator(const vk::Context& ctx);
 
   // Records the generation of levels 1.. of every image from its level 0 (see the layout contract above).
   // Batched: step k of every image's dispatch plan is recorded for all images, then ONE global barrier,
   // then step k + 1, so independent images' dispatches overlap on the GPU and a batch of textures costs
   // as many barriers as its longest plan has steps (2 for 1024², 3 for 1000x600), not that many per image.
-  // Images may differ in size and format. Blit mode records each image's blit chain in turn.
+  // Images may differ in size and format. Blit mode records each image's blit chain in turn; Auto records
+  // each image the way autoMipMode chooses, the compute ones batched as above.
   [[nodiscard]] MipViews record(VkCommandBuffer cb, std::span<const vk::Image* const> images,
                                 MipMode mode = MipMode::Compute) const;
   // One image: the batch of one.
@@ -63,8 +72,10 @@ class MipGenerator {
 
  private:
   void recordBlit(VkCommandBuffer cb, const vk::Image& image) const;
+  void recordCompute(VkCommandBuffer cb, std::span<const vk::Image* const> images, MipViews& views) const;
+  const vk::Pipeline& pipeline(bool even) const;
   const vk::Context& ctx_;
-  vk::Pipeline even_, general_;
+  mutable std::optional<vk::Pipeline> even_, general_;
 };
 
 }  // namespace rtr::render

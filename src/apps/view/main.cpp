@@ -227,7 +227,8 @@ int main(int argc, char** argv) {
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(cli::integer(1, 100000));
   app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay): .png, .jpg, .exr or .hdr");
   app.add_flag("--force", o.force, "overwrite an existing screenshot");
-  CLI::Option* mipsOpt = app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit "
+  CLI::Option* mipsOpt = app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit | auto (per texture: compute "
+                                        "when small, blit when large) "
                                         "(default: the device's fastest, docs/startup.md)");
   app.add_option("--mosaic", mosaic, "post process: off (the scene plainly) | compute | graphics (the brief's captures: compute)")->capture_default_str();
   CLI::Option* shadingOpt =
@@ -280,10 +281,11 @@ int main(int argc, char** argv) {
     if (o.timings && !o.headless) throw UsageError("--timings needs --headless (the window prints no start-up phases yet)");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
     const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
-                                                          {"blit", render::MipMode::Blit}};
+                                                          {"blit", render::MipMode::Blit},
+                                                          {"auto", render::MipMode::Auto}};
     const std::map<std::string, render::MosaicMode> mosaicModes{
         {"off", render::MosaicMode::Off}, {"compute", render::MosaicMode::Compute}, {"graphics", render::MosaicMode::Graphics}};
-    if (!mipModes.count(mips)) throw UsageError("--mips '" + mips + "': expected compute or blit");
+    if (!mipModes.count(mips)) throw UsageError("--mips '" + mips + "': expected compute, blit or auto");
     if (!mosaicModes.count(mosaic)) throw UsageError("--mosaic '" + mosaic + "': expected off, compute or graphics");
     o.mips = mipModes.at(mips);
     o.mipsGiven = mipsOpt->count() > 0;
