@@ -1,6 +1,7 @@
 #include "render/mips.hpp"
 
 #include <algorithm>
+#include <functional>
 
 #include "core/error.hpp"
 #include "mips_shared.h"
@@ -52,7 +53,7 @@ const char* toString(MipMode mode) {
 
 MipMode autoMipMode(MipMode mode, VkExtent2D e) {
   if (mode != MipMode::Auto) return mode;
-  return uint64_t(e.width) * e.height < kAutoComputeMaxTexels ? MipMode::Compute : MipMode::Blit;
+  return uint64_t(e.width) * e.height <= kAutoComputeMaxTexels ? MipMode::Compute : MipMode::Blit;
 }
 
 uint32_t mipLevelCount(VkExtent2D e) {
@@ -203,6 +204,14 @@ void MipGenerator::recordCompute(VkCommandBuffer cb, std::span<const vk::Image* 
     steps = std::max(steps, job.plan.size());
     jobs.push_back(std::move(job));
   }
+  // The shaders the plans use, made in parallel before recording.
+  std::vector<std::function<void()>> build;
+  for (bool even : {true, false})
+    if (std::any_of(jobs.begin(), jobs.end(), [&](const Job& j) {
+          return std::any_of(j.plan.begin(), j.plan.end(), [&](const MipDispatch& d) { return d.even == even; });
+        }))
+      build.push_back([this, even] { pipeline(even); });
+  vk::inParallel(build);
   if (scratchSize > 0)
     views.scratch = vk::Buffer(ctx_, scratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device, "mip scratch");
   if (!start.empty()) vk::barrier(cb, start);

@@ -25,9 +25,9 @@ namespace rtr::render {
 enum class MipMode { Blit, Compute, Auto };
 const char* toString(MipMode mode);
 
-// Auto's crossover, measured on lavapipe (docs/startup.md): below it the blit chain's fixed cost per level
-// dominates and compute wins; from it on, compute's float passes cost more than the blits.
-constexpr uint64_t kAutoComputeMaxTexels = 256 * 256;
+// Auto: compute for images of at most this many texels, blit for larger ones. The crossover measured on
+// lavapipe (docs/startup.md), warm: compute is up to 3x faster below it, blit up to 2x faster above.
+constexpr uint64_t kAutoComputeMaxTexels = 128 * 128;
 MipMode autoMipMode(MipMode mode, VkExtent2D extent);  // `mode` itself unless Auto
 
 uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1

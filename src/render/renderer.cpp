@@ -111,18 +111,23 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
 }
 
 Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
+  // The kinds' pipelines are made in parallel, only those the scene needs.
   KindPipelines out;
+  std::vector<std::function<void()>> jobs;
   for (size_t k = 0; k < kDrawKindCount; ++k) {
     const KindInfo& info = kKinds[k];
-    if (set != kVisibility) {
-      if (scene_.hasDraws(DrawKind(k)))  // only pipelines the scene needs
-        out[k] = makePipeline(info.vert, set == kDebug ? info.debug : info.shaded, kColorFormat, info.cull);
-      continue;
+    bool needed = scene_.hasDraws(DrawKind(k));
+    if (set == kVisibility) {  // by any kind drawn with this one's visibility pipeline
+      needed = false;
+      for (size_t j = 0; j < kDrawKindCount; ++j) needed |= size_t(kKinds[j].visAs) == k && scene_.hasDraws(DrawKind(j));
     }
-    bool needed = false;  // by any kind drawn with this one's visibility pipeline
-    for (size_t j = 0; j < kDrawKindCount; ++j) needed |= size_t(kKinds[j].visAs) == k && scene_.hasDraws(DrawKind(j));
-    if (needed) out[k] = makePipeline(info.visVert, info.visFrag, kVisFormat, info.cull);
+    if (!needed) continue;
+    jobs.push_back([this, set, &info, &slot = out[k]] {
+      slot = set == kVisibility ? makePipeline(info.visVert, info.visFrag, kVisFormat, info.cull)
+                                : makePipeline(info.vert, set == kDebug ? info.debug : info.shaded, kColorFormat, info.cull);
+    });
   }
+  vk::inParallel(jobs);
   return out;
 }
 
