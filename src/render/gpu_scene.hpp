@@ -118,7 +118,10 @@ class GpuScene {
   struct Staged {
     vk::Buffer buffer;
     VkExtent2D extent;
+    std::vector<VkDeviceSize> levels;  // a chain made on the CPU: each level's offset; else empty
   };
+  std::vector<bool> hostMips_;  // per texture: its chain was made on the CPU (uploaded whole)
+  std::vector<const vk::Image*> gpuMipBatch() const;  // the textures whose chains the GPU makes
   std::vector<Staged> staged_;     // decoded texels, until uploaded
   std::vector<VkFormat> formats_;  // of each texture
   std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in

@@ -16,19 +16,33 @@
 
 #include <vulkan/vulkan.h>
 
+#include "core/image.hpp"
 #include "vk/pipeline.hpp"
 #include "vk/resources.hpp"
 
 namespace rtr::render {
 
-// Auto: chosen per image by its size (autoMipMode), compute for small images and blit for large ones.
+// Auto: chosen per image by its size. Small images: a GpuScene computes their chains on the CPU as it
+// decodes them (hostMipChain: no pipeline, no GPU pass); MipGenerator, which has no texels, takes compute.
+// Large images: the blit chain. The default on a CPU device (docs/startup.md).
 enum class MipMode { Blit, Compute, Auto };
 const char* toString(MipMode mode);
 
-// Auto: compute for images of at most this many texels, blit for larger ones. The crossover measured on
-// lavapipe (docs/startup.md), warm: compute is up to 3x faster below it, blit up to 2x faster above.
-constexpr uint64_t kAutoComputeMaxTexels = 128 * 128;
-MipMode autoMipMode(MipMode mode, VkExtent2D extent);  // `mode` itself unless Auto
+// Auto's "small": at most this many texels. The crossover measured on lavapipe (docs/startup.md), warm:
+// compute is up to 3x faster than blit below it, blit up to 2x faster above; and a process's first blits
+// and compute pipelines cost 20-30 ms of compilation there, which the CPU chains avoid.
+constexpr uint64_t kAutoSmallTexels = 128 * 128;
+bool autoSmall(MipMode mode, VkExtent2D extent);  // Auto, and an image of at most kAutoSmallTexels
+MipMode autoMipMode(MipMode mode, VkExtent2D extent);  // on the GPU: `mode` itself unless Auto
+
+// The whole chain of an 8-bit texture (1 or 4 channels, sRGB as in `format`) on the CPU: the float64 box
+// filter of core/mip_reference.hpp, each level from the previous one in double (what the compute path
+// approximates within 1 LSB). Level k's bytes start at offsets[k] (16-byte aligned).
+struct HostMipChain {
+  std::vector<uint8_t> bytes;
+  std::vector<VkDeviceSize> offsets;
+};
+HostMipChain hostMipChain(const TexelData& level0, VkFormat format);
 
 uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1
 

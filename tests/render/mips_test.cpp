@@ -184,8 +184,33 @@ TEST_F(MipsTest, BatchedImagesWithinOneLsbOfReference) {
   }
 }
 
-// Auto takes each image's path by its size, in one record call: every chain equals, byte for byte, what
-// that path gives the image (compute for the small ones, blit for the large ones).
+// The chains made on the CPU for small textures under Auto: within 1 LSB of the float64 reference, as
+// the compute path (the limit the GPU paths are held to), for every size, format and both contents.
+TEST(HostMips, WithinOneLsbOfReference) {
+  uint32_t seed = 900;
+  for (VkExtent2D e : kSizes)
+    for (VkFormat f : kFormats)
+      for (bool binary : {false, true}) {
+        const TexelData src = randomTexels(e, f, seed++, binary);
+        const render::HostMipChain chain = render::hostMipChain(src, f);
+        const uint32_t levels = render::mipLevelCount(e);
+        ASSERT_EQ(chain.offsets.size(), levels) << label(e, f, MipMode::Auto);
+        std::vector<std::vector<uint8_t>> bytes;
+        for (uint32_t l = 0; l < levels; ++l) {
+          ASSERT_EQ(chain.offsets[l] % 16, 0u);
+          const size_t n = size_t(mipLevelSize(e.width, l)) * mipLevelSize(e.height, l) * src.channels;
+          ASSERT_LE(chain.offsets[l] + n, chain.bytes.size());
+          bytes.emplace_back(chain.bytes.begin() + chain.offsets[l], chain.bytes.begin() + chain.offsets[l] + n);
+        }
+        ASSERT_EQ(bytes[0], src.texels) << "level 0 changed, " << label(e, f, MipMode::Auto);
+        const MaxDiff d = compare(bytes, buildMipReference(src, encodingOf(f), MipSource::PreviousLevel));
+        EXPECT_LE(d.value, 1) << label(e, f, MipMode::Auto) << (binary ? " binary" : " random") << ", worst at " << d.where;
+      }
+}
+
+// On the GPU (MipGenerator, which has no texels), Auto takes each image's path by its size, in one record
+// call: every chain equals, byte for byte, what that path gives the image (compute for the small ones,
+// blit for the large ones).
 TEST_F(MipsTest, AutoGivesEachImageTheChainOfItsSizesPath) {
   EXPECT_EQ(render::autoMipMode(MipMode::Auto, {128, 128}), MipMode::Compute);
   EXPECT_EQ(render::autoMipMode(MipMode::Auto, {129, 128}), MipMode::Blit);
@@ -202,7 +227,7 @@ TEST_F(MipsTest, AutoGivesEachImageTheChainOfItsSizesPath) {
   const auto blit = runBatch(srcs, formats, MipMode::Blit), compute = runBatch(srcs, formats, MipMode::Compute);
   size_t blitted = 0;
   for (size_t i = 0; i < set.size(); ++i) {
-    const bool small = uint64_t(set[i].first.width) * set[i].first.height <= render::kAutoComputeMaxTexels;
+    const bool small = uint64_t(set[i].first.width) * set[i].first.height <= render::kAutoSmallTexels;
     EXPECT_TRUE(autoChains[i] == (small ? compute[i] : blit[i]))
         << label(set[i].first, set[i].second, MipMode::Auto) << ": not the chain of the " << (small ? "compute" : "blit") << " path";
     // Only a test that can tell the two paths apart for this image shows which one Auto took.
