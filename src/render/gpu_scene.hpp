@@ -1,7 +1,8 @@
 #pragma once
 // A scene on the GPU: vertex streams, index buffers (16-bit where a mesh allows; both also readable as
 // storage buffers by the visibility path's shading pass), the material and draw buffers, and the textures
-// that some drawn material uses (decoded on all cores into staging buffers, mips generated on the GPU).
+// that some drawn material uses (decoded on all cores into staging buffers, mips generated on the GPU, or
+// under MipMode::Auto on the CPU for small ones).
 // Geometry is written on all cores straight into device-local memory where the host can write it (every
 // CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
 #include <array>
