@@ -131,6 +131,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     const bool index16 = m.positions.size() <= 65536;
     DrawItem d;
     d.material = m.material;
+    if (!m.bounds.empty()) d.center = m.bounds.center();
     d.indexCount = uint32_t(m.indices.size());
     d.vertexOffset = int32_t(vertices);
     d.indexType = index16 ? VK_INDEX_TYPE_UINT16 : VK_INDEX_TYPE_UINT32;

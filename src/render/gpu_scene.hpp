@@ -36,6 +36,7 @@ struct DrawItem {
   int32_t vertexOffset = 0;
   VkIndexType indexType = VK_INDEX_TYPE_UINT32;
   uint32_t id = 0;           // index of its GpuDraw in drawInfo() (visibility path)
+  glm::vec3 center{0.0f};    // of its mesh's bounding box (frames draw the nearest first)
 };
 
 // The loading phases, in order; they do not overlap, and together they are the constructor's time
