@@ -99,9 +99,14 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     decodeTextures(scene, used, [&](size_t i, TexelData&& texels) {
       Staged& s = staged_[i];
       s.extent = {texels.width, texels.height};
-      s.buffer = vk::Buffer(ctx_, std::max<size_t>(texels.texels.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+      // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
+      HostMipChain chain;
+      if (autoSmall(mipMode_, s.extent)) chain = hostMipChain(texels, formats_[i]);
+      const std::vector<uint8_t>& bytes = chain.offsets.empty() ? texels.texels : chain.bytes;
+      s.levels = std::move(chain.offsets);
+      s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                             vk::MemoryUse::Upload);
-      std::memcpy(s.buffer.mapped(), texels.texels.data(), texels.texels.size());
+      std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
       s.buffer.flush();
       const std::lock_guard lock(progressMutex);
       const size_t done = ++decoded_;
@@ -126,6 +131,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     const bool index16 = m.positions.size() <= 65536;
     DrawItem d;
     d.material = m.material;
+    if (!m.bounds.empty()) d.center = m.bounds.center();
     d.indexCount = uint32_t(m.indices.size());
     d.vertexOffset = int32_t(vertices);
     d.indexType = index16 ? VK_INDEX_TYPE_UINT16 : VK_INDEX_TYPE_UINT32;
@@ -323,32 +329,56 @@ void GpuScene::startUpload() {
     recordUpload(cb);
     upload_->timer.reset(cb);
     upload_->timer.begin(cb);
-    std::vector<const vk::Image*> batch;
-    for (const auto& img : textures_) batch.push_back(&img);
-    upload_->views = upload_->mips.record(cb, batch, mipMode_);  // its barriers wait for the copies
+    upload_->views = upload_->mips.record(cb, gpuMipBatch(), mipMode_);  // its barriers wait for the copies
     upload_->timer.mark(cb, "mips");
   });
 }
 
 void GpuScene::createTextures() {
-  for (size_t i = 0; i < staged_.size(); ++i) textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
+  for (size_t i = 0; i < staged_.size(); ++i) {
+    textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
+    hostMips_.push_back(!staged_[i].levels.empty());
+  }
   sampler_ = makeSampler(ctx_, {});
 }
 
-// Staging memory to level 0 of every texture.
+std::vector<const vk::Image*> GpuScene::gpuMipBatch() const {
+  std::vector<const vk::Image*> batch;
+  for (size_t i = 0; i < textures_.size(); ++i)
+    if (!hostMips_[i]) batch.push_back(&textures_[i]);
+  return batch;
+}
+
+// Staging memory to level 0 of every texture (every level of those with their chain made on the CPU,
+// which are then ready for shaders: the mip generator's layout contract).
 void GpuScene::recordUpload(VkCommandBuffer cb) const {
-  std::vector<vk::ImageBarrier> toDst;
-  for (auto& img : textures_)
-    toDst.push_back({img.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
-                     VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1});
+  std::vector<vk::ImageBarrier> toDst, ready;
+  for (size_t i = 0; i < textures_.size(); ++i) {
+    const uint32_t levels = hostMips_[i] ? textures_[i].mipLevels() : 1;
+    toDst.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
+                     VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, levels});
+    if (hostMips_[i])
+      ready.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                       VK_PIPELINE_STAGE_2_COPY_BIT,
+                       VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, levels});
+  }
   vk::barrier(cb, toDst);
   for (size_t i = 0; i < textures_.size(); ++i) {
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {staged_[i].extent.width, staged_[i].extent.height, 1};
-    vkCmdCopyBufferToImage(cb, staged_[i].buffer.handle(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                           &region);
+    const Staged& st = staged_[i];
+    std::vector<VkBufferImageCopy> regions;
+    for (uint32_t l = 0; l < (hostMips_[i] ? st.levels.size() : 1); ++l) {
+      VkBufferImageCopy r{};
+      r.bufferOffset = hostMips_[i] ? st.levels[l] : 0;
+      r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, 1};
+      r.imageExtent = {std::max(1u, st.extent.width >> l), std::max(1u, st.extent.height >> l), 1};
+      regions.push_back(r);
+    }
+    vkCmdCopyBufferToImage(cb, st.buffer.handle(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           uint32_t(regions.size()), regions.data());
   }
+  if (!ready.empty()) vk::barrier(cb, ready);
 }
 
 void GpuScene::finishTextures() {
@@ -364,15 +394,13 @@ void GpuScene::finishTextures() {
   // Mips, in a submission of their own (their pipelines' creation is counted as pipeline creation).
   t = Clock::now();
   const double pipelineMs = pipelines.stats().ms;
-  if (!textures_.empty()) {
+  if (const std::vector<const vk::Image*> batch = gpuMipBatch(); !batch.empty()) {
     MipGenerator mipGen(ctx);
     MipViews views;  // alive until the submission has completed
     vk::GpuTimer timer(ctx, 1);
     vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
       timer.reset(cb);
       timer.begin(cb);
-      std::vector<const vk::Image*> batch;
-      for (const auto& img : textures_) batch.push_back(&img);
       views = mipGen.record(cb, batch, mipMode_);  // all textures, one barrier per step
       timer.mark(cb, "mips");
     });

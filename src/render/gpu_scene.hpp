@@ -1,7 +1,8 @@
 #pragma once
 // A scene on the GPU: vertex streams, index buffers (16-bit where a mesh allows; both also readable as
 // storage buffers by the visibility path's shading pass), the material and draw buffers, and the textures
-// that some drawn material uses (decoded on all cores into staging buffers, mips generated on the GPU).
+// that some drawn material uses (decoded on all cores into staging buffers, mips generated on the GPU, or
+// under MipMode::Auto on the CPU for small ones).
 // Geometry is written on all cores straight into device-local memory where the host can write it (every
 // CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
 #include <array>
@@ -35,6 +36,7 @@ struct DrawItem {
   int32_t vertexOffset = 0;
   VkIndexType indexType = VK_INDEX_TYPE_UINT32;
   uint32_t id = 0;           // index of its GpuDraw in drawInfo() (visibility path)
+  glm::vec3 center{0.0f};    // of its mesh's bounding box (frames draw the nearest first)
 };
 
 // The loading phases, in order; they do not overlap, and together they are the constructor's time
@@ -118,7 +120,10 @@ class GpuScene {
   struct Staged {
     vk::Buffer buffer;
     VkExtent2D extent;
+    std::vector<VkDeviceSize> levels;  // a chain made on the CPU: each level's offset; else empty
   };
+  std::vector<bool> hostMips_;  // per texture: its chain was made on the CPU (uploaded whole)
+  std::vector<const vk::Image*> gpuMipBatch() const;  // the textures whose chains the GPU makes
   std::vector<Staged> staged_;     // decoded texels, until uploaded
   std::vector<VkFormat> formats_;  // of each texture
   std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in

@@ -1,7 +1,5 @@
 #include "render/headless.hpp"
 
-#include <cstring>
-
 #include <glm/gtc/packing.hpp>
 
 #include "vk/context.hpp"
@@ -47,8 +45,8 @@ HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens,
   HeadlessFrame out;
   out.gpuTimes = renderer_.gpuTimes(0);
   readback_.invalidate();
-  out.image = {extent_.width, extent_.height, std::vector<uint8_t>(pixels * 4)};
-  std::memcpy(out.image.pixels.data(), readback_.mapped(), pixels * 4);
+  const auto* mapped = static_cast<const uint8_t*>(readback_.mapped());
+  out.image = {extent_.width, extent_.height, std::vector<uint8_t>(mapped, mapped + pixels * 4)};  // one pass, not zeroed first
   if (readSceneColor) {
     colorReadback_.invalidate();
     const auto* half = static_cast<const uint16_t*>(colorReadback_.mapped());

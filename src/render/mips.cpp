@@ -1,8 +1,12 @@
 #include "render/mips.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
 
 #include "core/error.hpp"
+#include "core/mip_reference.hpp"
 #include "mips_shared.h"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
@@ -45,8 +49,86 @@ const char* toString(MipMode mode) {
   switch (mode) {
     case MipMode::Blit: return "blit";
     case MipMode::Compute: return "compute";
+    case MipMode::Auto: return "auto";
   }
   return "?";
+}
+
+bool autoSmall(MipMode mode, VkExtent2D e) {
+  return mode == MipMode::Auto && uint64_t(e.width) * e.height <= kAutoSmallTexels;
+}
+
+MipMode autoMipMode(MipMode mode, VkExtent2D e) {
+  if (mode != MipMode::Auto) return mode;
+  return autoSmall(mode, e) ? MipMode::Compute : MipMode::Blit;
+}
+
+namespace {
+
+// One axis of a level from the previous one, the box rule of core/mip_reference.hpp: destination texel x
+// covers source [x*W/w, (x+1)*W/w), each source texel weighted by its overlap (at most 3 taps, as w =
+// max(1, W >> 1)). Flat arrays: first tap and three weights per destination texel.
+struct AxisTaps {
+  std::vector<uint32_t> first;
+  std::vector<float> weights;  // 3 per destination texel, unused ones 0
+};
+AxisTaps axisTaps(uint32_t src, uint32_t dst) {
+  AxisTaps t{std::vector<uint32_t>(dst), std::vector<float>(size_t(dst) * 3, 0.0f)};
+  for (uint64_t x = 0; x < dst; ++x) {
+    const uint64_t lo = x * src, hi = (x + 1) * src, i0 = lo / dst, i1 = (hi + dst - 1) / dst;
+    t.first[x] = uint32_t(i0);
+    for (uint64_t i = i0; i < i1; ++i)
+      t.weights[x * 3 + (i - i0)] = float(double(std::min((i + 1) * dst, hi) - std::max(i * dst, lo)) / double(src));
+  }
+  return t;
+}
+
+}  // namespace
+
+HostMipChain hostMipChain(const TexelData& level0, VkFormat format) {
+  // Linear light in float (as the compute shaders): sRGB colour channels through a 256-entry table, back
+  // through the table of the linear values where each byte's rounding interval starts.
+  const uint32_t ch = level0.channels;
+  const bool srgb = isSrgb(format) && ch == 4;
+  std::array<float, 256> decode{}, start{};  // start[b]: the smallest linear value encoded as b (b >= 1)
+  for (int b = 0; b < 256; ++b) {
+    decode[b] = float(decodeTexel(uint8_t(b), 0, TexelEncoding::Srgb));
+    const double s = (b - 0.5) / 255.0;
+    start[b] = float(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
+  }
+  auto isColour = [&](uint32_t c) { return srgb && c < 3; };
+  auto encode = [&](float v, uint32_t c) -> uint8_t {
+    v = std::clamp(v, 0.0f, 1.0f);
+    if (!isColour(c)) return uint8_t(std::floor(v * 255.0f + 0.5f));
+    return uint8_t(std::upper_bound(start.begin() + 1, start.end(), v) - start.begin() - 1);
+  };
+  uint32_t w = level0.width, h = level0.height;
+  std::vector<float> cur(level0.texels.size());
+  for (size_t i = 0; i < cur.size(); ++i)
+    cur[i] = isColour(uint32_t(i % ch)) ? decode[level0.texels[i]] : float(level0.texels[i]) / 255.0f;
+  HostMipChain out;
+  out.offsets.push_back(0);
+  out.bytes = level0.texels;
+  for (uint32_t level = 1; level < mipLevelCount({level0.width, level0.height}); ++level) {
+    const uint32_t dw = std::max(1u, w >> 1), dh = std::max(1u, h >> 1);
+    const AxisTaps tx = axisTaps(w, dw), ty = axisTaps(h, dh);
+    std::vector<float> rows(size_t(h) * dw * ch, 0.0f), next(size_t(dw) * dh * ch, 0.0f);
+    for (uint32_t y = 0; y < h; ++y)
+      for (uint32_t x = 0; x < dw; ++x)
+        for (uint32_t k = 0; k < 3 && tx.weights[x * 3 + k] > 0; ++k)
+          for (uint32_t c = 0; c < ch; ++c)
+            rows[(size_t(y) * dw + x) * ch + c] += tx.weights[x * 3 + k] * cur[(size_t(y) * w + tx.first[x] + k) * ch + c];
+    for (uint32_t y = 0; y < dh; ++y)
+      for (uint32_t k = 0; k < 3 && ty.weights[y * 3 + k] > 0; ++k)
+        for (size_t i = 0; i < size_t(dw) * ch; ++i)
+          next[size_t(y) * dw * ch + i] += ty.weights[y * 3 + k] * rows[size_t(ty.first[y] + k) * dw * ch + i];
+    out.offsets.push_back((out.bytes.size() + 15) & ~size_t(15));
+    out.bytes.resize(out.offsets.back() + next.size());
+    for (size_t i = 0; i < next.size(); ++i) out.bytes[out.offsets.back() + i] = encode(next[i], uint32_t(i % ch));
+    cur = std::move(next);
+    w = dw, h = dh;
+  }
+  return out;
 }
 
 uint32_t mipLevelCount(VkExtent2D e) {
@@ -97,10 +179,13 @@ std::vector<MipDispatch> planMipDispatches(VkExtent2D extent) {
   return plan;
 }
 
-MipGenerator::MipGenerator(const vk::Context& ctx) : ctx_(ctx) {
-  vk::LayoutOptions push{.pushDescriptorSets = {0}};
-  even_ = vk::makeComputePipeline(ctx, vk::loadShader("mips_even.comp"), push);
-  general_ = vk::makeComputePipeline(ctx, vk::loadShader("mips.comp"), push);
+MipGenerator::MipGenerator(const vk::Context& ctx) : ctx_(ctx) {}
+
+const vk::Pipeline& MipGenerator::pipeline(bool even) const {
+  std::optional<vk::Pipeline>& p = even ? even_ : general_;
+  if (!p) p = vk::makeComputePipeline(ctx_, vk::loadShader(even ? "mips_even.comp" : "mips.comp"),
+                                      {.pushDescriptorSets = {0}});
+  return *p;
 }
 
 void MipGenerator::recordBlit(VkCommandBuffer cb, const vk::Image& image) const {
@@ -140,10 +225,16 @@ MipViews MipGenerator::record(VkCommandBuffer cb, const vk::Image& image, MipMod
 
 MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* const> images, MipMode mode) const {
   MipViews views;
-  if (mode == MipMode::Blit) {
-    for (const vk::Image* image : images) recordBlit(cb, *image);
-    return views;
+  std::vector<const vk::Image*> compute;
+  for (const vk::Image* image : images) {
+    if (autoMipMode(mode, image->extent()) == MipMode::Blit) recordBlit(cb, *image);
+    else compute.push_back(image);
   }
+  if (!compute.empty()) recordCompute(cb, compute, views);
+  return views;
+}
+
+void MipGenerator::recordCompute(VkCommandBuffer cb, std::span<const vk::Image* const> images, MipViews& views) const {
   const VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 
   // Per image: its storage views (from `base`), plan, and the scratch offset of each dispatch's last level.
@@ -188,6 +279,14 @@ MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* con
     steps = std::max(steps, job.plan.size());
     jobs.push_back(std::move(job));
   }
+  // The shaders the plans use, made in parallel before recording.
+  std::vector<std::function<void()>> build;
+  for (bool even : {true, false})
+    if (std::any_of(jobs.begin(), jobs.end(), [&](const Job& j) {
+          return std::any_of(j.plan.begin(), j.plan.end(), [&](const MipDispatch& d) { return d.even == even; });
+        }))
+      build.push_back([this, even] { pipeline(even); });
+  vk::inParallel(build);
   if (scratchSize > 0)
     views.scratch = vk::Buffer(ctx_, scratchSize, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device, "mip scratch");
   if (!start.empty()) vk::barrier(cb, start);
@@ -203,7 +302,7 @@ MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* con
       if (k >= job.plan.size()) continue;
       const MipDispatch& d = job.plan[k];
       const VkExtent2D extent = job.image->extent();
-      const vk::Pipeline& p = d.even ? even_ : general_;
+      const vk::Pipeline& p = pipeline(d.even);
       if (bound != &p) {
         p.bind(cb);
         bound = &p;
@@ -226,7 +325,6 @@ MipViews MipGenerator::record(VkCommandBuffer cb, std::span<const vk::Image* con
     }
   }
   if (!done.empty()) vk::barrier(cb, done);
-  return views;
 }
 
 }  // namespace rtr::render

@@ -10,18 +10,39 @@
 //   on exit   every level is in SHADER_READ_ONLY_OPTIMAL, its writes visible to fragment and compute
 //             shader reads that follow in the same queue.
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include <vulkan/vulkan.h>
 
+#include "core/image.hpp"
 #include "vk/pipeline.hpp"
 #include "vk/resources.hpp"
 
 namespace rtr::render {
 
-enum class MipMode { Blit, Compute };
+// Auto: chosen per image by its size. Small images: a GpuScene computes their chains on the CPU as it
+// decodes them (hostMipChain: no pipeline, no GPU pass); MipGenerator, which has no texels, takes compute.
+// Large images: the blit chain. The default on a CPU device (docs/startup.md).
+enum class MipMode { Blit, Compute, Auto };
 const char* toString(MipMode mode);
+
+// Auto's "small": at most this many texels. The crossover measured on lavapipe (docs/startup.md), warm:
+// compute is up to 3x faster than blit below it, blit up to 2x faster above; and a process's first blits
+// and compute pipelines cost 20-30 ms of compilation there, which the CPU chains avoid.
+constexpr uint64_t kAutoSmallTexels = 128 * 128;
+bool autoSmall(MipMode mode, VkExtent2D extent);  // Auto, and an image of at most kAutoSmallTexels
+MipMode autoMipMode(MipMode mode, VkExtent2D extent);  // on the GPU: `mode` itself unless Auto
+
+// The whole chain of an 8-bit texture (1 or 4 channels, sRGB as in `format`) on the CPU: the float64 box
+// filter of core/mip_reference.hpp, each level from the previous one in double (what the compute path
+// approximates within 1 LSB). Level k's bytes start at offsets[k] (16-byte aligned).
+struct HostMipChain {
+  std::vector<uint8_t> bytes;
+  std::vector<VkDeviceSize> offsets;
+};
+HostMipChain hostMipChain(const TexelData& level0, VkFormat format);
 
 uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1
 
@@ -49,13 +70,15 @@ struct MipViews {
 
 class MipGenerator {
  public:
-  explicit MipGenerator(const vk::Context& ctx);  // once per context: builds the compute pipelines
+  // Builds its compute pipelines on first use, only those some image needs (none for blit chains).
+  explicit MipGenerator(const vk::Context& ctx);
 
   // Records the generation of levels 1.. of every image from its level 0 (see the layout contract above).
   // Batched: step k of every image's dispatch plan is recorded for all images, then ONE global barrier,
   // then step k + 1, so independent images' dispatches overlap on the GPU and a batch of textures costs
   // as many barriers as its longest plan has steps (2 for 1024², 3 for 1000x600), not that many per image.
-  // Images may differ in size and format. Blit mode records each image's blit chain in turn.
+  // Images may differ in size and format. Blit mode records each image's blit chain in turn; Auto records
+  // each image the way autoMipMode chooses, the compute ones batched as above.
   [[nodiscard]] MipViews record(VkCommandBuffer cb, std::span<const vk::Image* const> images,
                                 MipMode mode = MipMode::Compute) const;
   // One image: the batch of one.
@@ -63,8 +86,10 @@ class MipGenerator {
 
  private:
   void recordBlit(VkCommandBuffer cb, const vk::Image& image) const;
+  void recordCompute(VkCommandBuffer cb, std::span<const vk::Image* const> images, MipViews& views) const;
+  const vk::Pipeline& pipeline(bool even) const;
   const vk::Context& ctx_;
-  vk::Pipeline even_, general_;
+  mutable std::optional<vk::Pipeline> even_, general_;
 };
 
 }  // namespace rtr::render

@@ -41,6 +41,14 @@ bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding
 
 }  // namespace
 
+std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const glm::vec3& eye) {
+  std::vector<const DrawItem*> order;
+  for (const DrawItem& d : draws) order.push_back(&d);
+  const auto dist = [&](const DrawItem* d) { return glm::dot(d->center - eye, d->center - eye); };
+  std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return dist(a) < dist(b); });
+  return order;
+}
+
 const char* toString(ShadingPath path) { return path == ShadingPath::Forward ? "forward" : "visibility"; }
 const char* toString(RasterPath path) {
   return path == RasterPath::Hardware ? "hardware" : path == RasterPath::Compute ? "compute" : "auto";
@@ -111,18 +119,23 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
 }
 
 Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
+  // The kinds' pipelines are made in parallel, only those the scene needs.
   KindPipelines out;
+  std::vector<std::function<void()>> jobs;
   for (size_t k = 0; k < kDrawKindCount; ++k) {
     const KindInfo& info = kKinds[k];
-    if (set != kVisibility) {
-      if (scene_.hasDraws(DrawKind(k)))  // only pipelines the scene needs
-        out[k] = makePipeline(info.vert, set == kDebug ? info.debug : info.shaded, kColorFormat, info.cull);
-      continue;
+    bool needed = scene_.hasDraws(DrawKind(k));
+    if (set == kVisibility) {  // by any kind drawn with this one's visibility pipeline
+      needed = false;
+      for (size_t j = 0; j < kDrawKindCount; ++j) needed |= size_t(kKinds[j].visAs) == k && scene_.hasDraws(DrawKind(j));
     }
-    bool needed = false;  // by any kind drawn with this one's visibility pipeline
-    for (size_t j = 0; j < kDrawKindCount; ++j) needed |= size_t(kKinds[j].visAs) == k && scene_.hasDraws(DrawKind(j));
-    if (needed) out[k] = makePipeline(info.visVert, info.visFrag, kVisFormat, info.cull);
+    if (!needed) continue;
+    jobs.push_back([this, set, &info, &slot = out[k]] {
+      slot = set == kVisibility ? makePipeline(info.visVert, info.visFrag, kVisFormat, info.cull)
+                                : makePipeline(info.vert, set == kDebug ? info.debug : info.shaded, kColorFormat, info.cull);
+    });
   }
+  vk::inParallel(jobs);
   return out;
 }
 
@@ -201,7 +214,7 @@ void Renderer::createTargets(VkExtent2D extent, bool visibility) {
                             "visibility"});
 }
 
-void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
+void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye) {
   KindPipelines& pipelines = *pipelines_[set];
   const bool vis = set == kVisibility;
   // This frame index's sets are not in use (its previous frame's fence signalled): point them at this
@@ -226,7 +239,8 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set) {
     if (vis) vkCmdBindVertexBuffers(cb, 0, kKinds[size_t(info.visAs)].visStreams, visStreams, offsets);
     else vkCmdBindVertexBuffers(cb, 0, info.streams, forward, offsets);
     VkIndexType bound = VK_INDEX_TYPE_MAX_ENUM;
-    for (const DrawItem& d : scene_.draws(kind)) {
+    for (const DrawItem* dp : nearestFirst(scene_.draws(kind), eye)) {
+      const DrawItem& d = *dp;
       if (d.indexType != bound) {
         vkCmdBindIndexBuffer(cb, d.indexType == VK_INDEX_TYPE_UINT16 ? scene_.indices16() : scene_.indices32(), 0, d.indexType);
         bound = d.indexType;
@@ -371,7 +385,7 @@ void Renderer::frame(FrameContext& fc) {
   ri.pDepthAttachment = &depthAtt;
   vkCmdBeginRendering(cb, &ri);
   vk::setFullViewport(cb, target.extent);
-  drawScene(cb, frame, set);
+  drawScene(cb, frame, set, pose.position);
   vkCmdEndRendering(cb);
   timer.mark(cb, visibility ? "visibility" : "scene");
 

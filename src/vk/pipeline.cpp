@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
+#include <future>
 #include <cstdlib>
 #include <mutex>
 #include <unistd.h>
@@ -135,29 +137,30 @@ uint32_t formatSize(VkFormat f) {
   }
 }
 
-// Creation feedback for one pipeline (core in Vulkan 1.3), handed to the cache's counters with the time
-// from `start` (reflection and layouts included).
+// Creation feedback for one pipeline (core in Vulkan 1.3), handed to the cache's counters, which also
+// time the creation from construction (reflection and layouts included) to destruction.
 struct Feedback {
   VkPipelineCreationFeedback pipeline{};
   std::vector<VkPipelineCreationFeedback> stages;
   VkPipelineCreationFeedbackCreateInfo info{VK_STRUCTURE_TYPE_PIPELINE_CREATION_FEEDBACK_CREATE_INFO};
-  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-  explicit Feedback(size_t stageCount) : stages(stageCount) {
+  const Context& ctx;
+  bool created = false;
+  Feedback(const Context& c, size_t stageCount) : stages(stageCount), ctx(c) {
     info.pPipelineCreationFeedback = &pipeline;
     info.pipelineStageCreationFeedbackCount = uint32_t(stages.size());
     info.pPipelineStageCreationFeedbacks = stages.data();
+    ctx.pipelineCache().begin();
   }
-  void record(const Context& ctx) const {
-    ctx.pipelineCache().record(
-        pipeline, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
+  ~Feedback() { ctx.pipelineCache().end(created ? &pipeline : nullptr); }
+  Feedback(const Feedback&) = delete;
+  Feedback& operator=(const Feedback&) = delete;
 };
 
 }  // namespace
 
 Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, const LayoutOptions& options,
                              const std::vector<SpecializationConstant>& specialization) {
-  Feedback feedback(1);
+  Feedback feedback(ctx, 1);
   Pipeline p;
   p.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
   p.layout = PipelineLayout(ctx, reflectPipeline({shader}), options);
@@ -173,13 +176,13 @@ Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, cons
   VkPipeline raw;
   VK_CHECK(vkCreateComputePipelines(ctx.device(), ctx.pipelineCache().handle(), 1, &ci, nullptr, &raw));
   p.pipeline = PipelineHandle(ctx.device(), raw);
-  feedback.record(ctx);
+  feedback.created = true;
   ctx.setName(uint64_t(raw), VK_OBJECT_TYPE_PIPELINE, shader.name.c_str());
   return p;
 }
 
 Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const LayoutOptions& options) {
-  Feedback feedback(d.modules.size());
+  Feedback feedback(ctx, d.modules.size());
   Pipeline p;
   p.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
   p.layout = PipelineLayout(ctx, reflectPipeline(d.modules), options);
@@ -267,8 +270,26 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   VkPipeline raw;
   VK_CHECK(vkCreateGraphicsPipelines(ctx.device(), ctx.pipelineCache().handle(), 1, &gi, nullptr, &raw));
   p.pipeline = PipelineHandle(ctx.device(), raw);
-  feedback.record(ctx);
+  feedback.created = true;
   return p;
+}
+
+void inParallel(const std::vector<std::function<void()>>& jobs) {
+  if (jobs.empty()) return;
+  std::vector<std::future<void>> others;
+  for (size_t i = 0; i + 1 < jobs.size(); ++i) others.push_back(std::async(std::launch::async, jobs[i]));
+  std::exception_ptr failure;
+  try {
+    jobs.back()();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  for (auto& f : others) try {
+      f.get();
+    } catch (...) {
+      if (!failure) failure = std::current_exception();
+    }
+  if (failure) std::rethrow_exception(failure);
 }
 
 DescriptorSets::DescriptorSets(const Context& ctx, const PipelineLayout& layout, uint32_t copies) : copies_(copies) {

@@ -3,6 +3,7 @@
 // inputs are read from the shaders' SPIR-V (vk/reflect.hpp), never written by hand.
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 #include <deque>
@@ -90,6 +91,11 @@ struct GraphicsDesc {
   std::vector<SpecializationConstant> specialization;
 };
 Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& desc, const LayoutOptions& options = {});
+
+// Runs the jobs at once, all but the last on threads of their own, waits for all and rethrows the first
+// failure. For making pipelines in parallel: a driver compiles each on the calling thread, and creation
+// is thread-safe (the VkPipelineCache is internally synchronized: made without EXTERNALLY_SYNCHRONIZED).
+void inParallel(const std::vector<std::function<void()>>& jobs);
 
 // Descriptor sets for one pipeline layout, `copies` of each set (e.g. one per frame in flight).
 class DescriptorSets {

@@ -104,13 +104,20 @@ PipelineCache::~PipelineCache() {
   vkDestroyPipelineCache(device_, cache_, nullptr);
 }
 
-void PipelineCache::record(const VkPipelineCreationFeedback& f, double ms) {
+void PipelineCache::begin() {
   const std::lock_guard lock(mutex_);
+  if (active_++ == 0) busySince_ = std::chrono::steady_clock::now();
+}
+
+void PipelineCache::end(const VkPipelineCreationFeedback* f) {
+  const std::lock_guard lock(mutex_);
+  if (--active_ == 0)
+    stats_.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - busySince_).count();
+  if (!f) return;
   ++stats_.created;
-  stats_.ms += ms;
-  if (f.flags & VK_PIPELINE_CREATION_FEEDBACK_VALID_BIT) {
+  if (f->flags & VK_PIPELINE_CREATION_FEEDBACK_VALID_BIT) {
     ++stats_.reported;
-    if (f.flags & VK_PIPELINE_CREATION_FEEDBACK_APPLICATION_PIPELINE_CACHE_HIT_BIT) ++stats_.cacheHits;
+    if (f->flags & VK_PIPELINE_CREATION_FEEDBACK_APPLICATION_PIPELINE_CACHE_HIT_BIT) ++stats_.cacheHits;
   }
 }
 

@@ -4,6 +4,7 @@
 // version and the device's pipelineCacheUUID, and a checksum over the driver's bytes. A file that is
 // short, damaged or from another device or driver is ignored with one note and replaced on the next
 // save: the driver never sees bytes that were not checked. Counts every pipeline created through it.
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <mutex>
@@ -18,7 +19,8 @@ struct PipelineStats {
   uint32_t created = 0;    // pipelines created
   uint32_t cacheHits = 0;  // of those, found whole in the cache (creation feedback says so)
   uint32_t reported = 0;   // of those, with valid creation feedback (a driver may give none)
-  double ms = 0;           // wall time spent creating them (reflection, layouts, modules, pipelines)
+  double ms = 0;           // wall time while at least one was being made (reflection, layouts, modules,
+                           // the driver): pipelines made on parallel threads are not counted twice
 };
 
 // $XDG_CACHE_HOME/rtr, else $HOME/.cache/rtr; empty when neither is set.
@@ -36,7 +38,10 @@ class PipelineCache {
   const std::filesystem::path& file() const { return file_; }  // empty when not on disk
   bool loaded() const { return loaded_; }                       // a valid file was read
 
-  void record(const VkPipelineCreationFeedback& feedback, double ms);
+  // Around each pipeline's creation, from any thread: begin(), then end() with its creation feedback
+  // (nullptr when the creation failed).
+  void begin();
+  void end(const VkPipelineCreationFeedback* feedback);
   PipelineStats stats() const;
 
   // Writes the cache atomically when it holds more than was read; a failure is a note, not an error
@@ -52,6 +57,8 @@ class PipelineCache {
   std::vector<uint8_t> loadedBytes_;  // the driver's bytes as read, to skip saving what is unchanged
   mutable std::mutex mutex_;
   PipelineStats stats_;
+  uint32_t active_ = 0;  // creations under way
+  std::chrono::steady_clock::time_point busySince_;
 };
 
 }  // namespace rtr::vk

@@ -83,6 +83,28 @@ TEST_F(FrameTest, ShadedFrameIsFiniteAndLit) {
   EXPECT_GT(gpu->stats().meshes16, 0u) << "small meshes should use 16-bit indices";
 }
 
+// Scene draws go nearest first, by their meshes' box centres, so that the depth test rejects hidden
+// fragments before shading; ties keep the scene's order.
+TEST_F(FrameTest, DrawsGoNearestFirst) {
+  const auto& draws = gpu->draws(render::DrawKind::Opaque);
+  ASSERT_GE(draws.size(), 3u);
+  const auto order = render::nearestFirst(draws, pose.position);
+  ASSERT_EQ(order.size(), draws.size());
+  auto dist = [&](const render::DrawItem* d) { return glm::length(d->center - pose.position); };
+  for (size_t i = 1; i < order.size(); ++i) EXPECT_LE(dist(order[i - 1]), dist(order[i])) << "draw " << i;
+  EXPECT_NE(order.front(), &draws.front()) << "the temple's first mesh (the floor) is not the nearest";
+  // The centres are the meshes' own: the nearest draw is the one whose mesh's box centre is nearest.
+  float nearest = 1e30f;
+  for (const Mesh& m : scene.meshes)
+    if (!m.indices.empty() && m.material == order.front()->material) nearest = std::min(nearest, glm::length(m.bounds.center() - pose.position));
+  EXPECT_FLOAT_EQ(dist(order.front()), nearest);
+  // Equal distances keep their order.
+  std::vector<render::DrawItem> tied(3);
+  for (uint32_t i = 0; i < 3; ++i) tied[i].id = i, tied[i].center = glm::vec3(1, 0, 0);
+  const auto t = render::nearestFirst(tied, glm::vec3(0));
+  EXPECT_TRUE(t[0]->id == 0 && t[1]->id == 1 && t[2]->id == 2);
+}
+
 // The visibility path (ids rasterised, BRDF in compute, LOD from analytic texcoord differences) and the
 // forward path (BRDF per fragment, LOD from the rasteriser's derivatives) show the same image: same
 // coverage, same BRDF; only the rounding of the interpolation and of the LOD differ. Tolerance

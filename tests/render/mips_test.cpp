@@ -9,6 +9,7 @@
 #include "render/mips.hpp"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
+#include "vk/pipeline_cache.hpp"
 #include "vk_fixture.hpp"
 
 namespace rtr {
@@ -181,6 +182,75 @@ TEST_F(MipsTest, BatchedImagesWithinOneLsbOfReference) {
       EXPECT_LE(d.value, 1) << "batched " << label(set[i].first, set[i].second, mode) << ", worst at " << d.where;
     }
   }
+}
+
+// The chains made on the CPU for small textures under Auto: within 1 LSB of the float64 reference, as
+// the compute path (the limit the GPU paths are held to), for every size, format and both contents.
+TEST(HostMips, WithinOneLsbOfReference) {
+  uint32_t seed = 900;
+  for (VkExtent2D e : kSizes)
+    for (VkFormat f : kFormats)
+      for (bool binary : {false, true}) {
+        const TexelData src = randomTexels(e, f, seed++, binary);
+        const render::HostMipChain chain = render::hostMipChain(src, f);
+        const uint32_t levels = render::mipLevelCount(e);
+        ASSERT_EQ(chain.offsets.size(), levels) << label(e, f, MipMode::Auto);
+        std::vector<std::vector<uint8_t>> bytes;
+        for (uint32_t l = 0; l < levels; ++l) {
+          ASSERT_EQ(chain.offsets[l] % 16, 0u);
+          const size_t n = size_t(mipLevelSize(e.width, l)) * mipLevelSize(e.height, l) * src.channels;
+          ASSERT_LE(chain.offsets[l] + n, chain.bytes.size());
+          bytes.emplace_back(chain.bytes.begin() + chain.offsets[l], chain.bytes.begin() + chain.offsets[l] + n);
+        }
+        ASSERT_EQ(bytes[0], src.texels) << "level 0 changed, " << label(e, f, MipMode::Auto);
+        const MaxDiff d = compare(bytes, buildMipReference(src, encodingOf(f), MipSource::PreviousLevel));
+        EXPECT_LE(d.value, 1) << label(e, f, MipMode::Auto) << (binary ? " binary" : " random") << ", worst at " << d.where;
+      }
+}
+
+// On the GPU (MipGenerator, which has no texels), Auto takes each image's path by its size, in one record
+// call: every chain equals, byte for byte, what that path gives the image (compute for the small ones,
+// blit for the large ones).
+TEST_F(MipsTest, AutoGivesEachImageTheChainOfItsSizesPath) {
+  EXPECT_EQ(render::autoMipMode(MipMode::Auto, {128, 128}), MipMode::Compute);
+  EXPECT_EQ(render::autoMipMode(MipMode::Auto, {129, 128}), MipMode::Blit);
+  EXPECT_EQ(render::autoMipMode(MipMode::Blit, {4, 4}), MipMode::Blit);
+  const std::vector<std::pair<VkExtent2D, VkFormat>> set = {
+      {{256, 256}, VK_FORMAT_R8G8B8A8_SRGB}, {{17, 13}, VK_FORMAT_R8G8B8A8_SRGB}, {{200, 120}, VK_FORMAT_R8G8B8A8_UNORM},
+      {{64, 64}, VK_FORMAT_R8G8B8A8_UNORM},  {{1, 1}, VK_FORMAT_R8G8B8A8_SRGB},   {{257, 5}, VK_FORMAT_R8_UNORM},
+      {{128, 128}, VK_FORMAT_R8_UNORM}};
+  std::vector<TexelData> srcs;
+  std::vector<VkFormat> formats;
+  uint32_t seed = 700;
+  for (auto [e, f] : set) srcs.push_back(randomTexels(e, f, seed++, false)), formats.push_back(f);
+  const auto autoChains = runBatch(srcs, formats, MipMode::Auto);
+  const auto blit = runBatch(srcs, formats, MipMode::Blit), compute = runBatch(srcs, formats, MipMode::Compute);
+  size_t blitted = 0;
+  for (size_t i = 0; i < set.size(); ++i) {
+    const bool small = uint64_t(set[i].first.width) * set[i].first.height <= render::kAutoSmallTexels;
+    EXPECT_TRUE(autoChains[i] == (small ? compute[i] : blit[i]))
+        << label(set[i].first, set[i].second, MipMode::Auto) << ": not the chain of the " << (small ? "compute" : "blit") << " path";
+    // Only a test that can tell the two paths apart for this image shows which one Auto took.
+    if (blit[i] != compute[i]) blitted += !small;
+  }
+  EXPECT_GE(blitted, 2u) << "the paths differ on too few large images to tell them apart";
+}
+
+// Pipelines are made on first use, only those the images need: none for blit chains, only the general
+// shader for odd sizes (the README's scene on lavapipe made both for its blits: 28 of 37 ms).
+TEST_F(MipsTest, PipelinesAreMadeOnlyForImagesThatNeedThem) {
+  auto created = [&] { return ctx->pipelineCache().stats().created; };
+  const TexelData odd = randomTexels({37, 23}, VK_FORMAT_R8G8B8A8_SRGB, 9, false);
+  const TexelData even = randomTexels({64, 64}, VK_FORMAT_R8G8B8A8_SRGB, 10, false);
+  uint32_t before = created();
+  (void)run(even, VK_FORMAT_R8G8B8A8_SRGB, MipMode::Blit);
+  EXPECT_EQ(created(), before) << "blit chains need no pipeline";
+  before = created();
+  (void)run(odd, VK_FORMAT_R8G8B8A8_SRGB, MipMode::Compute);
+  EXPECT_EQ(created(), before + 1) << "odd sizes need the general shader alone";
+  before = created();
+  (void)runBatch({odd, even}, {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R8G8B8A8_SRGB}, MipMode::Compute);
+  EXPECT_EQ(created(), before + 2) << "a new generator makes both shaders, in parallel";
 }
 
 // Blits filter however the driver does (bilinear at odd sizes, own rounding): report the difference;

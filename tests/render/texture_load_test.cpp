@@ -5,6 +5,7 @@
 #include "core/image.hpp"
 #include "render/headless.hpp"
 #include "scene/load.hpp"
+#include "vk/pipeline_cache.hpp"
 #include "test_paths.hpp"
 #include "vk_fixture.hpp"
 
@@ -82,6 +83,38 @@ TEST_F(VulkanTest, DeferredTexturesShowFactorsThenMatchAWaitedLoad) {
         EXPECT_TRUE(a.render(pose, lens, s).image.pixels == b.render(pose, lens, s).image.pixels)
             << render::toString(path) << " " << render::toString(raster) << " mode " << mode;
       }
+}
+
+// --mips auto (the CPU device's default): the temple's small textures get chains made on the CPU as they
+// decode, so no mip pipeline is made and no mip pass runs; its frames differ from the compute path's
+// (within 1 LSB of the same reference per level) only slightly, and a deferred load matches a waited one.
+TEST_F(VulkanTest, AutoMipsMakeSmallTexturesChainsOnTheCpu) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  const CameraPose pose = *scene.defaultView;
+  const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
+  const uint32_t before = ctx->pipelineCache().stats().created;
+  const render::GpuScene host(*ctx, scene, render::MipMode::Auto);
+  EXPECT_EQ(ctx->pipelineCache().stats().created, before) << "a mip pipeline was made";
+  EXPECT_EQ(host.stats().mipGpuMs, 0.0) << "a mip pass ran";
+  const render::GpuScene compute(*ctx, scene, render::MipMode::Compute);
+  render::GpuScene deferred(*ctx, scene, render::MipMode::Auto, {}, render::GeometryUpload::Auto,
+                            render::TextureLoad::Deferred);
+  deferred.updateTextures(true);
+  render::HeadlessRenderer a(*ctx, host, {kW, kH}), b(*ctx, compute, {kW, kH}), c(*ctx, deferred, {kW, kH});
+  for (int mode : {VIEW_ALBEDO, VIEW_SHADED}) {
+    const auto s = settings(mode, render::ShadingPath::Forward);
+    const ImageRGBA8 x = a.render(pose, lens, s).image, y = b.render(pose, lens, s).image;
+    EXPECT_EQ(c.render(pose, lens, s).image.pixels, x.pixels) << "deferred and waited Auto loads differ, mode " << mode;
+    int worst = 0;
+    size_t differ = 0;
+    for (size_t i = 0; i < x.pixels.size(); ++i) {
+      worst = std::max(worst, std::abs(int(x.pixels[i]) - int(y.pixels[i])));
+      differ += x.pixels[i] != y.pixels[i];
+    }
+    std::printf("auto vs compute mips, view %d: %zu of %zu bytes differ, by at most %d\n", mode, differ, x.pixels.size(), worst);
+    EXPECT_LE(worst, 3) << "mode " << mode;  // 1 LSB per level, blended by trilinear filtering and shading
+    EXPECT_LT(differ, x.pixels.size() / 10) << "mode " << mode;
+  }
 }
 
 }  // namespace

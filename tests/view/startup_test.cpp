@@ -89,7 +89,7 @@ TEST_F(StartupTest, CpuDeviceGetsItsDefaultsAndFlagsOverride) {
   ASSERT_EQ(plain.status, 0) << plain.out;
   if (plain.out.find("llvmpipe") == std::string::npos) GTEST_SKIP() << "not on lavapipe: " << plain.out;
   // The documented choice (docs/startup.md), and the frame really took the forward path.
-  EXPECT_THAT(plain.out, HasSubstr(": forward shading (default), blit mips (default): the defaults for a CPU device"));
+  EXPECT_THAT(plain.out, HasSubstr(": forward shading (default), auto mips (default): the defaults for a CPU device"));
   EXPECT_THAT(plain.out, HasSubstr("  scene: "));
   EXPECT_THAT(plain.out, ::testing::Not(HasSubstr("  shade: ")));
 

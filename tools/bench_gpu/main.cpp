@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
 #include <random>
 #include <string>
 #include <vector>
@@ -229,11 +230,13 @@ int main(int argc, char** argv) {
   CLI::App app("GPU timings of the mip and mosaic passes");
   int runs = 25, warmup = 3, textures = 64;
   std::string only;
+  std::vector<std::string> sizes{"1024x1024", "1000x600"};
   bool perTexture = false;
   app.add_option("--runs", runs, "timed submissions per case (min / median)")->check(CLI::Range(1, 10000));
   app.add_option("--warmup", warmup, "untimed submissions first")->check(CLI::Range(0, 1000));
   app.add_option("--textures", textures, "textures per mip case")->check(CLI::Range(1, 1024));
   app.add_option("--only", only, "mips or mosaic")->check(CLI::IsMember({"mips", "mosaic"}));
+  app.add_option("--mip-sizes", sizes, "texture sizes of the mip cases (WxH ...)");
   app.add_flag("--mips-per-texture", perTexture, "one MipGenerator::record call per texture instead of one batch");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -242,8 +245,11 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     auto add = [&](std::vector<Row> r) { rows.insert(rows.end(), r.begin(), r.end()); };
     if (only != "mosaic") {
-      add(benchMips(ctx, {1024, 1024}, textures, warmup, runs, !perTexture));
-      add(benchMips(ctx, {1000, 600}, textures, warmup, runs, !perTexture));
+      for (const std::string& s : sizes) {
+        unsigned w = 0, h = 0;
+        if (std::sscanf(s.c_str(), "%ux%u", &w, &h) != 2 || !w || !h) throw std::runtime_error("--mip-sizes " + s + ": expected WxH");
+        add(benchMips(ctx, {w, h}, textures, warmup, runs, !perTexture));
+      }
     }
     if (only != "mips") {
       add(benchMosaic(ctx, {1920, 1080}, warmup, runs));

@@ -117,6 +117,38 @@ void writeMtl(const fs::path& file) {
   mat("mirror", "Kd 0.95 0.95 0.95\nPr 0.02\nPm 1\nN_mirr 1\n");
 }
 
+// Smooth value noise in [0, 1): bilinear between lattice hashes `cell` texels apart.
+float smoothNoise(float x, float y, float cell, int seed) {
+  const float fx = x / cell, fy = y / cell;
+  const int ix = int(std::floor(fx)), iy = int(std::floor(fy));
+  const float tx = fx - float(ix), ty = fy - float(iy);
+  auto h = [&](int a, int b) { return hash2(a + seed * 7919, b - seed * 104729); };
+  const float top = h(ix, iy) + tx * (h(ix + 1, iy) - h(ix, iy));
+  const float bottom = h(ix, iy + 1) + tx * (h(ix + 1, iy + 1) - h(ix, iy + 1));
+  return top + ty * (bottom - top);
+}
+
+// --textures N: N RGB textures of 1024², like a real set's (compressible: tiles, smooth noise and a tint
+// per texture, not random bytes), a material each and a gallery of N panels, one per material.
+void writeTextureSet(const fs::path& dir, int count, ObjWriter& o, std::ofstream& mtl) {
+  const int size = 1024;
+  for (int i = 0; i < count; ++i) {
+    const std::string name = "set_" + std::to_string(i);
+    const int tile = 64 << (i % 3);
+    const float tint[3] = {0.55f + 0.4f * hash2(i, 1), 0.5f + 0.4f * hash2(i, 2), 0.45f + 0.4f * hash2(i, 3)};
+    scenegen::writePng8(dir / (name + ".png"), size, size, 3, image(size, size, 3, [&](int x, int y, uint8_t* p) {
+      const bool grout = x % tile < 3 || y % tile < 3;
+      const float n = 0.55f * smoothNoise(float(x), float(y), 96.0f, i) + 0.3f * smoothNoise(float(x), float(y), 13.0f, i + 1000);
+      for (int c = 0; c < 3; ++c) p[c] = q(grout ? 0.3f : tint[c] * (0.45f + n));
+    }));
+    mtl << "\nnewmtl " << name << "\nKd 1 1 1\nPr 0.8\nPm 0\nmap_Kd textures/" << name << ".png\n";
+    // Panels on a wall behind the courtyard, 20 to a row.
+    o.object("panel_" + std::to_string(i), name);
+    const float x = -12.0f + 1.2f * float(i % 20), y = 0.2f + 1.2f * float(i / 20);
+    o.grid({x, y, -26.0f}, {1.0f, 0, 0}, {0, 1.0f, 0}, 1, 1, {1, 1});
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -124,7 +156,10 @@ int main(int argc, char** argv) {
   std::string out = "assets-src/temple";
   double scale = 1;
   bool plain = false;
+  int textures = 0;
   app.add_option("--out", out, "output folder");
+  app.add_option("--textures", textures, "also N textures of 1024x1024 on N panels (a real scene's texture set)")
+      ->check(CLI::Range(0, 10000));
   app.add_option("--scale", scale, "tessellation factor (100: about 1.6M vertices)")->check(CLI::Range(0.05, 10000.0));
   app.add_flag("--plain", plain, "write temple.obj instead of temple.obj.zst");
   CLI11_PARSE(app, argc, argv);
@@ -175,6 +210,10 @@ int main(int argc, char** argv) {
     }
     o.object("mirror", "mirror");
     o.grid({-2, 1.2f, -23.95f}, {4, 0, 0}, {0, 2.5f, 0}, 1, 1, {1, 1});
+    if (textures > 0) {
+      std::ofstream mtl(dir / "temple.mtl", std::ios::app);
+      writeTextureSet(dir / "textures", textures, o, mtl);
+    }
     o.finish();
     std::printf("wrote %s: %zu OBJ vertices (v records)\n", dir.c_str(), o.vertices());
   } catch (const std::exception& e) {

@@ -182,6 +182,8 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::SameLine();
     s.remipRequested |= radio("compute##mips", s.mips, render::MipMode::Compute);
     ImGui::SameLine();
+    s.remipRequested |= radio("auto##mips", s.mips, render::MipMode::Auto);
+    ImGui::SameLine();
     ImGui::TextDisabled("%.3f ms GPU", facts.mipGpuMs);
     ImGui::SliderFloat("LOD bias", &s.settings.lodBias, -4.0f, 4.0f, "%.2f");
     track("lodbias");
