@@ -7,7 +7,7 @@
 #     --runner CMD  how to start a binary: "CMD NAME ARGS" (e.g. .device/run.sh on the GPU machine);
 #                   default: build/release/bin/NAME
 #     --quick       fewer frames and runs (lavapipe at 4K takes about a second a frame)
-#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake
+#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake,startup
 # The rows and their exact arguments are fixed here, so a rerun measures the same thing (fixed seeds and
 # poses: tests/reference/poses.txt, the generated scenes).
 set -uo pipefail
@@ -92,5 +92,23 @@ if ! skipped bake; then  # ours vs tinyobjloader on the 175 MB temple (scale 300
      bin scenegen --out "$work/bake" --scale 300 >/dev/null 2>&1; then
     RTR_BENCH_OBJ="$work/bake/temple.obj" row bake bench_bake --benchmark_min_time=$((quick ? 1 : 3))
   fi
+fi
+if ! skipped startup; then  # start-up phases (--timings) at 4K: the default temple and generated 1M/3M/10M
+  # scenes baked with a stored view, each cold (an empty pipeline cache) and then warm (the cache filled)
+  sc=$work/startup
+  for s in 100 300 1000; do
+    bin scenegen --out "$sc/s$s" --scale $s >/dev/null 2>&1 &&
+      bin rtr-bake "$sc/s$s/temple.obj.zst" "$sc/s$s/temple.rtrscene" --view 0,2.2,-2.5,0,-3 >/dev/null 2>&1
+  done
+  for s in default 100 300 1000; do
+    scene=$sc/s$s/temple.rtrscene
+    [[ $s == default ]] && scene=$temple
+    [[ -f $scene ]] || continue
+    rm -rf "$sc/cache"
+    for run in cold warm; do
+      RTR_PIPELINE_CACHE=$sc/cache row "startup-$s-$run" rtr-view "$scene" --headless --size 3840x2160 --timings \
+        --screenshot "$work/startup.png" --force
+    done
+  done
 fi
 echo "collect: done -> $out" >&2
