@@ -7,7 +7,8 @@
 
 namespace rtr {
 
-// Splits `mesh` into clusters of at most 64 vertices and 124 triangles, replacing mesh.clusters and
+// Splits `mesh` into clusters of at most 64 vertices and 124 triangles (big meshes in pieces of 65 536
+// triangles on all cores, each piece clustered on its own), replacing mesh.clusters and
 // reordering mesh.indices cluster by cluster (every triangle kept, winding unchanged). `backfaceCone`
 // false (alpha-masked or double-sided materials) stores a cone that never culls (cutoff 1).
 void buildClusters(Mesh& mesh, bool backfaceCone);

@@ -63,7 +63,12 @@ void expectValidClusters(const Mesh& m) {
     std::vector<uint32_t> verts(m.indices.begin() + c.firstTriangle * 3, m.indices.begin() + (c.firstTriangle + c.triangleCount) * 3);
     std::sort(verts.begin(), verts.end());
     EXPECT_LE(std::unique(verts.begin(), verts.end()) - verts.begin(), CLUSTER_MAX_VERTICES);
-    for (uint32_t v : verts) EXPECT_LE(glm::length(m.positions[v] - c.center), c.radius * 1.0001f);
+    // The sphere bounds what can be drawn: degenerate triangles (no area, no pixels) may lie outside it.
+    for (uint32_t t = c.firstTriangle; t < c.firstTriangle + c.triangleCount; ++t) {
+      const uint32_t* i = &m.indices[size_t(t) * 3];
+      if (i[0] == i[1] || i[1] == i[2] || i[0] == i[2]) continue;
+      for (int k = 0; k < 3; ++k) EXPECT_LE(glm::length(m.positions[i[k]] - c.center), c.radius * 1.0001f);
+    }
     next += c.triangleCount;
   }
   EXPECT_EQ(next, m.triangleCount());
@@ -84,6 +89,29 @@ TEST(Clusters, KeepEveryTriangleAndItsWinding) {
   EXPECT_EQ(canonicalTriangles(m.indices), before);
   EXPECT_GT(m.clusters.size(), size_t(3200 / CLUSTER_MAX_TRIANGLES));
   expectValidClusters(m);
+}
+
+// A mesh over 65 536 triangles is clustered in pieces on all cores: still every triangle once with its
+// winding, clusters contiguous and within the limits, about as many as one piece would make, and the
+// scene's meshes get the same clusters as one by one.
+TEST(Clusters, BigMeshesAreClusteredInPiecesKeepingEveryTriangle) {
+  Mesh m = bumpyGrid(200);  // 80 002 triangles: two pieces
+  const auto before = canonicalTriangles(m.indices);
+  Scene s;
+  s.materials.resize(1);
+  s.meshes = {m, bumpyGrid(190)};
+  buildClusters(m, true);
+  EXPECT_EQ(canonicalTriangles(m.indices), before);
+  expectValidClusters(m);
+  Mesh one = bumpyGrid(180);  // 64 802 triangles: one piece
+  buildClusters(one, true);
+  const double perTriangle = double(one.clusters.size()) / one.triangleCount();
+  EXPECT_LE(double(m.clusters.size()) / m.triangleCount(), perTriangle * 1.02) << "pieces cost full clusters";
+  EXPECT_EQ(buildMissingClusters(s), 2u);
+  EXPECT_EQ(s.meshes[0].indices, m.indices);
+  ASSERT_EQ(s.meshes[0].clusters.size(), m.clusters.size());
+  for (size_t i = 0; i < m.clusters.size(); ++i) EXPECT_EQ(std::memcmp(&s.meshes[0].clusters[i], &m.clusters[i], sizeof(Cluster)), 0);
+  expectValidClusters(s.meshes[1]);
 }
 
 TEST(Clusters, ConesOnlyCullClustersFacingAway) {
