@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include <smmintrin.h>
 #include <sys/mman.h>
 
 #include <glm/common.hpp>
@@ -29,21 +30,40 @@ constexpr uint32_t kWidth = 8;     // children per node, triangles per pack
 constexpr float kNodeCost = 0.5f;  // one 8-wide box test against one 8-wide pack test
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// x, y, z in the first three lanes of an SSE register (the fourth 0): one instruction grows a box.
+// The operand order of min/max is glm's (min(a, b) = b < a ? b : a), so signed zeros land as before.
 struct Box {
-  glm::vec3 lo{kInf}, hi{-kInf};
-  void grow(const glm::vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-  void grow(const Box& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
+  __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);
+  void grow(__m128 p) { lo = _mm_min_ps(p, lo); hi = _mm_max_ps(p, hi); }
+  void grow(const Box& b) { lo = _mm_min_ps(b.lo, lo); hi = _mm_max_ps(b.hi, hi); }
   float halfArea() const {
-    const glm::vec3 e = glm::max(hi - lo, glm::vec3(0.0f));
-    return e.x * e.y + e.y * e.z + e.z * e.x;
+    alignas(16) float e[4];
+    _mm_store_ps(e, _mm_max_ps(_mm_setzero_ps(), _mm_sub_ps(hi, lo)));
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
   }
 };
 
+__m128 load3(const glm::vec3& v) { return _mm_set_ps(0.0f, v.z, v.y, v.x); }
+float lane(__m128 v, int a) {
+  alignas(16) float f[4];
+  _mm_store_ps(f, v);
+  return f[a];
+}
+
+// A triangle's box, its index kept in the fourth lane of `lo` (32 bytes, aligned: one load each).
 struct PrimRef {
-  Box box;
-  uint32_t id;
-  glm::vec3 centroid2() const { return box.lo + box.hi; }  // twice the centroid: saves a multiply
+  __m128 lo, hi;
+  uint32_t id() const { return uint32_t(_mm_extract_epi32(_mm_castps_si128(lo), 3)); }
+  __m128 boxLo() const { return _mm_blend_ps(lo, _mm_setzero_ps(), 8); }  // the index out of the way
+  Box box() const { return {boxLo(), hi}; }
+  __m128 centroid2() const { return _mm_add_ps(boxLo(), hi); }  // twice the centroid: saves a multiply
 };
+
+// The bin of each axis: int((c - lo) · scale) clamped to [0, kBins), as one SSE computation.
+__m128i binOf(__m128 c, __m128 lo, __m128 scale) {
+  const __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
+  return _mm_min_epi32(_mm_max_epi32(k, _mm_setzero_si128()), _mm_set1_epi32(kBins - 1));
+}
 
 struct Range {
   uint32_t begin = 0, end = 0;
@@ -71,7 +91,8 @@ double sahCost(const Node* nodes, uint32_t root) {
     stack.pop_back();
     for (int k = 0; k < int(kWidth); ++k) {
       if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty slot
-      if (&n == &nodes[root]) rootBox.grow(Box{{n.box[0][0][k], n.box[0][1][k], n.box[0][2][k]}, {n.box[1][0][k], n.box[1][1][k], n.box[1][2][k]}});
+      if (&n == &nodes[root])
+        rootBox.grow(Box{_mm_set_ps(0, n.box[0][2][k], n.box[0][1][k], n.box[0][0][k]), _mm_set_ps(0, n.box[1][2][k], n.box[1][1][k], n.box[1][0][k])});
       const uint32_t c = n.child[k];
       if (c & Bvh::kLeafBit) total += area(n, k) * double(((c >> 28) & 7u) + 1);
       else { total += area(n, k) * kNodeCost; stack.push_back(c); }
@@ -171,16 +192,17 @@ struct BvhBuilder {
   };
 
   // The bins of refs [begin, end).
-  Bins binRefs(uint32_t begin, uint32_t end, glm::vec3 lo, glm::vec3 scale) const {
+  Bins binRefs(uint32_t begin, uint32_t end, __m128 lo, __m128 scale) const {
     Bins out;
     const PrimRef* ref = refs.data();
     for (uint32_t i = begin; i < end; ++i) {
-      const PrimRef& p = ref[i];
-      const glm::vec3 c = p.centroid2();
+      const __m128 blo = ref[i].boxLo(), bhi = ref[i].hi, c = _mm_add_ps(blo, bhi);
+      alignas(16) int k[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(c, lo, scale));
       for (int a = 0; a < 3; ++a) {
-        const int k = std::clamp(int((c[a] - lo[a]) * scale[a]), 0, kBins - 1);
-        Bin& bin = out.bin[a][k];
-        bin.b.grow(p.box);
+        Bin& bin = out.bin[a][k[a]];
+        bin.b.lo = _mm_min_ps(blo, bin.b.lo);
+        bin.b.hi = _mm_max_ps(bhi, bin.b.hi);
         bin.c.grow(c);
         ++bin.n;
       }
@@ -193,9 +215,10 @@ struct BvhBuilder {
   // build has no subtrees yet to run side by side.
   Split findSplit(const Range& r) const {
     Bins all;
-    const glm::vec3 ext = r.cbounds.hi - r.cbounds.lo;
-    glm::vec3 scale;
-    for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
+    alignas(16) float ext[4], sc[4] = {};
+    _mm_store_ps(ext, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
+    for (int a = 0; a < 3; ++a) sc[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
+    const __m128 scale = _mm_load_ps(sc);
     const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
     if (chunks > 1) {
       std::vector<Bins> part(chunks);
@@ -259,10 +282,10 @@ struct BvhBuilder {
   // many do it: the tree does not depend on the thread count.
   void partition(const Split& s, const Range& r) {
     const int a = s.axis;
-    const float lo = r.cbounds.lo[a];
-    const float ext = r.cbounds.hi[a] - lo;
+    const float lo = lane(r.cbounds.lo, a);
+    const float ext = lane(r.cbounds.hi, a) - lo;
     const float scale = float(kBins) * 0.99999f / ext;
-    const auto left = [&](const PrimRef& p) { return std::clamp(int((p.centroid2()[a] - lo) * scale), 0, kBins - 1) <= s.bin; };
+    const auto left = [&](const PrimRef& p) { return std::clamp(int((lane(p.centroid2(), a) - lo) * scale), 0, kBins - 1) <= s.bin; };
     const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
     if (chunks <= 1) {
       uint32_t i = r.begin, j = r.end;
@@ -298,7 +321,7 @@ struct BvhBuilder {
   static Range boundsOf(const std::vector<PrimRef>& refs, uint32_t b, uint32_t e, uint32_t depth) {
     Range r;
     r.begin = b; r.end = e; r.depth = depth;
-    for (uint32_t i = b; i < e; ++i) { r.bounds.grow(refs[i].box); r.cbounds.grow(refs[i].centroid2()); }
+    for (uint32_t i = b; i < e; ++i) { r.bounds.grow(refs[i].box()); r.cbounds.grow(refs[i].centroid2()); }
     return r;
   }
 
@@ -322,11 +345,12 @@ struct BvhBuilder {
       if (n <= Bvh::kMaxLeafTriangles) return false;
     }
     // Median by count along the widest centroid axis.
-    const glm::vec3 e = r.cbounds.hi - r.cbounds.lo;
-    const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    alignas(16) float e[4];
+    _mm_store_ps(e, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
+    const int axis = e[0] >= e[1] && e[0] >= e[2] ? 0 : (e[1] >= e[2] ? 1 : 2);
     const uint32_t mid = r.begin + n / 2;
     std::nth_element(refs.begin() + r.begin, refs.begin() + mid, refs.begin() + r.end,
-                     [axis](const PrimRef& p, const PrimRef& q) { return p.centroid2()[axis] < q.centroid2()[axis]; });
+                     [axis](const PrimRef& p, const PrimRef& q) { return lane(p.centroid2(), axis) < lane(q.centroid2(), axis); });
     a = boundsOf(refs, r.begin, mid, r.depth + 1);
     b = boundsOf(refs, mid, r.end, r.depth + 1);
     return true;
@@ -339,7 +363,7 @@ struct BvhBuilder {
       TriPack& pack = packs[first + p];
       for (uint32_t lane = 0; lane < kWidth; ++lane) {
         const uint32_t i = std::min(r.begin + p * kWidth + lane, r.end - 1);  // short packs repeat the last
-        const uint32_t id = refs[i].id;
+        const uint32_t id = refs[i].id();
         const Triangle& t = tris[id];
         const glm::vec3* v[3] = {&t.v0, &t.v1, &t.v2};
         for (int k = 0; k < 3; ++k)
@@ -393,8 +417,8 @@ struct BvhBuilder {
     Node node;
     for (int k = 0; k < int(kWidth); ++k) {
       for (int a3 = 0; a3 < 3; ++a3) {
-        node.box[0][a3][k] = k < count ? c[k].r.bounds.lo[a3] : kInf;
-        node.box[1][a3][k] = k < count ? c[k].r.bounds.hi[a3] : -kInf;
+        node.box[0][a3][k] = k < count ? lane(c[k].r.bounds.lo, a3) : kInf;
+        node.box[1][a3][k] = k < count ? lane(c[k].r.bounds.hi, a3) : -kInf;
       }
       node.child[k] = Bvh::kLeafBit;  // empty slots: a leaf of one pack that the box test never reaches
     }
@@ -425,14 +449,13 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   b.refs.reserve(triangles.size());
   for (uint32_t i = 0; i < triangles.size(); ++i) {
     const Triangle& t = triangles[i];
-    PrimRef p;
-    p.box.grow(t.v0); p.box.grow(t.v1); p.box.grow(t.v2);
-    p.id = i;
+    Box box;
+    box.grow(load3(t.v0)); box.grow(load3(t.v1)); box.grow(load3(t.v2));
     // Triangles with non-finite coordinates can never be hit; keep them out of the boxes.
     bool finite = true;
-    for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(p.box.lo[a]) && std::isfinite(p.box.hi[a]);
+    for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(lane(box.lo, a)) && std::isfinite(lane(box.hi, a));
     if (!finite) continue;
-    b.refs.push_back(p);
+    b.refs.push_back({_mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(box.lo), int(i), 3)), box.hi});
   }
   const uint32_t n = uint32_t(b.refs.size());
   stats_.triangles = n;
