@@ -229,27 +229,61 @@ struct BvhBuilder {
       all = binRefs(r.begin, r.end, r.cbounds.lo, scale);
     }
     const auto& bins = all.bin;
-    Split best;
-    for (int a = 0; a < 3; ++a) {
-      if (!(ext[a] > 0.0f)) continue;
-      float rightCost[kBins];
-      Box acc;
-      uint32_t n = 0;
-      for (int k = kBins - 1; k > 0; --k) {
-        acc.grow(bins[a][k].b);
-        n += bins[a][k].n;
-        rightCost[k] = acc.halfArea() * float(packsFor(n));
-      }
-      acc = Box{};
-      n = 0;
-      for (int k = 0; k < kBins - 1; ++k) {
-        acc.grow(bins[a][k].b);
-        n += bins[a][k].n;
-        if (n == 0 || n == r.size()) continue;
-        const float cost = acc.halfArea() * float(packsFor(n)) + rightCost[k + 1];
-        if (cost < best.cost) { best.cost = cost; best.axis = a; best.bin = k; }
-      }
+    // The sweeps of the three axes side by side, lane a = axis a: the same arithmetic as one axis at a
+    // time (halfArea's order of operations, glm's operand order), so the same costs to the bit.
+    __m128 lo[3][kBins], hi[3][kBins];  // [x, y, z][bin], lanes: axes
+    __m128i count[kBins];
+    for (int k = 0; k < kBins; ++k) {
+      __m128 l0 = bins[0][k].b.lo, l1 = bins[1][k].b.lo, l2 = bins[2][k].b.lo, l3 = _mm_setzero_ps();
+      __m128 h0 = bins[0][k].b.hi, h1 = bins[1][k].b.hi, h2 = bins[2][k].b.hi, h3 = _mm_setzero_ps();
+      _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
+      _MM_TRANSPOSE4_PS(h0, h1, h2, h3);
+      lo[0][k] = l0; lo[1][k] = l1; lo[2][k] = l2;
+      hi[0][k] = h0; hi[1][k] = h1; hi[2][k] = h2;
+      count[k] = _mm_set_epi32(0, int(bins[2][k].n), int(bins[1][k].n), int(bins[0][k].n));
     }
+    struct Acc {
+      __m128 lo[3], hi[3];
+      __m128i n = _mm_setzero_si128();
+      Acc() { for (int i = 0; i < 3; ++i) { lo[i] = _mm_set1_ps(kInf); hi[i] = _mm_set1_ps(-kInf); } }
+      // Grows by bin k; returns halfArea() · packsFor(n) per axis.
+      __m128 add(const __m128 (&l)[3][kBins], const __m128 (&h)[3][kBins], const __m128i* c, int k) {
+        __m128 e[3];
+        for (int i = 0; i < 3; ++i) {
+          lo[i] = _mm_min_ps(l[i][k], lo[i]);
+          hi[i] = _mm_max_ps(h[i][k], hi[i]);
+          e[i] = _mm_max_ps(_mm_setzero_ps(), _mm_sub_ps(hi[i], lo[i]));
+        }
+        n = _mm_add_epi32(n, c[k]);
+        const __m128 area = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e[0], e[1]), _mm_mul_ps(e[1], e[2])), _mm_mul_ps(e[2], e[0]));
+        return _mm_mul_ps(area, _mm_cvtepi32_ps(_mm_srli_epi32(_mm_add_epi32(n, _mm_set1_epi32(int(kWidth) - 1)), 3)));
+      }
+    };
+    __m128 rightCost[kBins];
+    Acc acc;
+    for (int k = kBins - 1; k > 0; --k) rightCost[k] = acc.add(lo, hi, count, k);
+    acc = Acc{};
+    const __m128 inf = _mm_set1_ps(kInf);
+    const __m128i whole = _mm_set1_epi32(int(r.size()));
+    // Axes without extent take no split.
+    const __m128 flat = _mm_cmple_ps(_mm_load_ps(ext), _mm_setzero_ps());
+    __m128 bestCost = inf;
+    __m128i bestBin = _mm_setzero_si128();
+    for (int k = 0; k < kBins - 1; ++k) {
+      __m128 cost = _mm_add_ps(acc.add(lo, hi, count, k), rightCost[k + 1]);
+      const __m128i none = _mm_or_si128(_mm_cmpeq_epi32(acc.n, _mm_setzero_si128()), _mm_cmpeq_epi32(acc.n, whole));
+      cost = _mm_blendv_ps(cost, inf, _mm_or_ps(flat, _mm_castsi128_ps(none)));
+      const __m128 better = _mm_cmplt_ps(cost, bestCost);  // strictly: the first bin of equal cost wins
+      bestCost = _mm_blendv_ps(bestCost, cost, better);
+      bestBin = _mm_blendv_epi8(bestBin, _mm_set1_epi32(k), _mm_castps_si128(better));
+    }
+    alignas(16) float bc[4];
+    alignas(16) int bb[4];
+    _mm_store_ps(bc, bestCost);
+    _mm_store_si128(reinterpret_cast<__m128i*>(bb), bestBin);
+    Split best;
+    for (int a = 0; a < 3; ++a)  // the first axis of equal cost wins, as in a sweep of one axis after another
+      if (bc[a] < best.cost) { best.cost = bc[a]; best.axis = a; best.bin = bb[a]; }
     if (best.axis < 0) return best;
     // Child ranges' bounds straight from the bins.
     Range L, R;
