@@ -180,34 +180,33 @@ struct BvhBuilder {
     Range left, right;
   };
 
-  struct Bin { Box b, c; uint32_t n = 0; };
+  // Boxes and counts only: the children's centroid bounds come from the partition, which looks at every
+  // centroid anyway (half the bins to clear and grow).
   struct Bins {
-    Bin bin[3][kBins];
+    Box b[3][kBins];
+    uint32_t n[3][kBins] = {};
     // Min, max and sums: exact and order-free, so the bins (and the split) do not depend on how the
     // range was cut up between threads.
     void merge(const Bins& o) {
       for (int a = 0; a < 3; ++a)
-        for (int k = 0; k < kBins; ++k) { bin[a][k].b.grow(o.bin[a][k].b); bin[a][k].c.grow(o.bin[a][k].c); bin[a][k].n += o.bin[a][k].n; }
+        for (int k = 0; k < kBins; ++k) { b[a][k].grow(o.b[a][k]); n[a][k] += o.n[a][k]; }
     }
   };
 
-  // The bins of refs [begin, end).
-  Bins binRefs(uint32_t begin, uint32_t end, __m128 lo, __m128 scale) const {
-    Bins out;
+  // Adds refs [begin, end) to `out`.
+  void binRefs(uint32_t begin, uint32_t end, __m128 lo, __m128 scale, Bins& out) const {
     const PrimRef* ref = refs.data();
     for (uint32_t i = begin; i < end; ++i) {
-      const __m128 blo = ref[i].boxLo(), bhi = ref[i].hi, c = _mm_add_ps(blo, bhi);
+      const __m128 blo = ref[i].boxLo(), bhi = ref[i].hi;
       alignas(16) int k[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(c, lo, scale));
+      _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(_mm_add_ps(blo, bhi), lo, scale));
       for (int a = 0; a < 3; ++a) {
-        Bin& bin = out.bin[a][k[a]];
-        bin.b.lo = _mm_min_ps(blo, bin.b.lo);
-        bin.b.hi = _mm_max_ps(bhi, bin.b.hi);
-        bin.c.grow(c);
-        ++bin.n;
+        Box& b = out.b[a][k[a]];
+        b.lo = _mm_min_ps(blo, b.lo);
+        b.hi = _mm_max_ps(bhi, b.hi);
+        ++out.n[a][k[a]];
       }
     }
-    return out;
   }
 
   // Binned SAH over all three axes in one pass. Cost counts packs of eight, since a leaf's price is the
@@ -223,24 +222,23 @@ struct BvhBuilder {
     if (chunks > 1) {
       std::vector<Bins> part(chunks);
       const auto cut = [&](uint32_t c) { return r.begin + uint32_t(uint64_t(r.size()) * c / chunks); };
-      parallelFor(chunks, [&](uint32_t c) { part[c] = binRefs(cut(c), cut(c + 1), r.cbounds.lo, scale); });
+      parallelFor(chunks, [&](uint32_t c) { binRefs(cut(c), cut(c + 1), r.cbounds.lo, scale, part[c]); });
       for (const Bins& p : part) all.merge(p);
     } else {
-      all = binRefs(r.begin, r.end, r.cbounds.lo, scale);
+      binRefs(r.begin, r.end, r.cbounds.lo, scale, all);
     }
-    const auto& bins = all.bin;
     // The sweeps of the three axes side by side, lane a = axis a: the same arithmetic as one axis at a
     // time (halfArea's order of operations, glm's operand order), so the same costs to the bit.
     __m128 lo[3][kBins], hi[3][kBins];  // [x, y, z][bin], lanes: axes
     __m128i count[kBins];
     for (int k = 0; k < kBins; ++k) {
-      __m128 l0 = bins[0][k].b.lo, l1 = bins[1][k].b.lo, l2 = bins[2][k].b.lo, l3 = _mm_setzero_ps();
-      __m128 h0 = bins[0][k].b.hi, h1 = bins[1][k].b.hi, h2 = bins[2][k].b.hi, h3 = _mm_setzero_ps();
+      __m128 l0 = all.b[0][k].lo, l1 = all.b[1][k].lo, l2 = all.b[2][k].lo, l3 = _mm_setzero_ps();
+      __m128 h0 = all.b[0][k].hi, h1 = all.b[1][k].hi, h2 = all.b[2][k].hi, h3 = _mm_setzero_ps();
       _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
       _MM_TRANSPOSE4_PS(h0, h1, h2, h3);
       lo[0][k] = l0; lo[1][k] = l1; lo[2][k] = l2;
       hi[0][k] = h0; hi[1][k] = h1; hi[2][k] = h2;
-      count[k] = _mm_set_epi32(0, int(bins[2][k].n), int(bins[1][k].n), int(bins[0][k].n));
+      count[k] = _mm_set_epi32(0, int(all.n[2][k]), int(all.n[1][k]), int(all.n[0][k]));
     }
     struct Acc {
       __m128 lo[3], hi[3];
@@ -285,15 +283,12 @@ struct BvhBuilder {
     for (int a = 0; a < 3; ++a)  // the first axis of equal cost wins, as in a sweep of one axis after another
       if (bc[a] < best.cost) { best.cost = bc[a]; best.axis = a; best.bin = bb[a]; }
     if (best.axis < 0) return best;
-    // Child ranges' bounds straight from the bins.
+    // Child ranges' bounds straight from the bins (their centroid bounds: partition()).
     Range L, R;
     uint32_t nl = 0;
     for (int k = 0; k < kBins; ++k) {
-      const Bin& bin = bins[best.axis][k];
-      Range& side = k <= best.bin ? L : R;
-      side.bounds.grow(bin.b);
-      side.cbounds.grow(bin.c);
-      if (k <= best.bin) nl += bin.n;
+      (k <= best.bin ? L : R).bounds.grow(all.b[best.axis][k]);
+      if (k <= best.bin) nl += all.n[best.axis][k];
     }
     L.begin = r.begin; L.end = r.begin + nl; R.begin = L.end; R.end = r.end;
     L.depth = R.depth = r.depth + 1;
@@ -314,33 +309,45 @@ struct BvhBuilder {
   // Moves the refs of bins ≤ s.bin in front. The k-th misplaced ref from the front trades places with the
   // k-th misplaced one from the back (Hoare's scheme, as std::partition does it), whether one thread or
   // many do it: the tree does not depend on the thread count.
-  void partition(const Split& s, const Range& r) {
+  // And sets the two sides' centroid bounds (cb[0]: left, cb[1]: right, of every ref looked at).
+  void partition(Split& s, const Range& r) {
     const int a = s.axis;
     const float lo = lane(r.cbounds.lo, a);
     const float ext = lane(r.cbounds.hi, a) - lo;
     const float scale = float(kBins) * 0.99999f / ext;
-    const auto left = [&](const PrimRef& p) { return std::clamp(int((lane(p.centroid2(), a) - lo) * scale), 0, kBins - 1) <= s.bin; };
+    const auto left = [&](const PrimRef& p, Box* cb) {
+      const __m128 c = p.centroid2();
+      const bool l = std::clamp(int((lane(c, a) - lo) * scale), 0, kBins - 1) <= s.bin;
+      cb[!l].grow(c);
+      return l;
+    };
     const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
     if (chunks <= 1) {
+      Box cb[2];
       uint32_t i = r.begin, j = r.end;
       for (;;) {
-        while (i < j && left(refs[i])) ++i;
-        while (i < j && !left(refs[j - 1])) --j;
-        if (i >= j) return;
+        while (i < j && left(refs[i], cb)) ++i;
+        while (i < j && !left(refs[j - 1], cb)) --j;
+        if (i >= j) break;
         std::swap(refs[i++], refs[--j]);
       }
+      s.left.cbounds = cb[0];
+      s.right.cbounds = cb[1];
+      return;
     }
     // In parallel: list the misplaced refs of each side in that order, then swap the k-th pairs.
     const uint32_t mid = s.left.end;
     std::vector<std::vector<uint32_t>> front(chunks), back(chunks);
+    std::vector<std::array<Box, 2>> cb(chunks);
     const auto cut = [&](uint32_t b, uint32_t e, uint32_t c) { return b + uint32_t(uint64_t(e - b) * c / chunks); };
     parallelFor(chunks, [&](uint32_t c) {
       for (uint32_t i = cut(r.begin, mid, c); i < cut(r.begin, mid, c + 1); ++i)
-        if (!left(refs[i])) front[c].push_back(i);
+        if (!left(refs[i], cb[c].data())) front[c].push_back(i);
       // Back side from the end: chunk c covers the c-th stretch counted from r.end down.
       for (uint32_t i = r.end - cut(0, r.end - mid, c); i > r.end - cut(0, r.end - mid, c + 1); --i)
-        if (left(refs[i - 1])) back[c].push_back(i - 1);
+        if (left(refs[i - 1], cb[c].data())) back[c].push_back(i - 1);
     });
+    for (uint32_t c = 0; c < chunks; ++c) { s.left.cbounds.grow(cb[c][0]); s.right.cbounds.grow(cb[c][1]); }
     std::vector<uint32_t> f, b;
     for (uint32_t c = 0; c < chunks; ++c) {
       f.insert(f.end(), front[c].begin(), front[c].end());
@@ -366,7 +373,7 @@ struct BvhBuilder {
     if (n <= 1) return false;
     const bool tooDeep = r.depth > 48;
     if (!tooDeep) {
-      const Split s = findSplit(r);
+      Split s = findSplit(r);
       if (s.axis >= 0) {
         const float leafCost = r.bounds.halfArea() * float(packsFor(n));
         const float splitCost = kNodeCost * r.bounds.halfArea() + s.cost;
