@@ -168,6 +168,7 @@ struct BvhBuilder {
   std::vector<PrimRef> refs;
   std::unique_ptr<Node[]> nodes;
   std::unique_ptr<TriPack[]> packs;
+  std::unique_ptr<std::array<uint32_t, 2>[]> subtree;  // per node: nodes and packs of its subtree, itself included
   std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
   TaskPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
@@ -415,21 +416,30 @@ struct BvhBuilder {
     return Bvh::kLeafBit | ((np - 1) << 28) | first;
   }
 
-  // Writes the subtree at `ref` (a node or a leaf) into bvh's arrays in depth-first order; returns its
-  // new reference.
-  uint32_t relayout(uint32_t ref, Bvh& bvh, uint32_t& nextNode, uint32_t& nextPack) const {
-    if (ref & Bvh::kLeafBit) {
-      const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
-      for (uint32_t p = 0; p < np; ++p) bvh.packs_[nextPack + p] = packs[first + p];
-      nextPack += np;
-      return (ref & ~0x0FFFFFFFu) | (nextPack - np);
-    }
+  // Writes the subtree of node `ref` into bvh's arrays in depth-first order, its node at `node`, its packs
+  // from `pack` on: the subtree sizes place every child, so large subtrees are copied by the pool.
+  void relayout(uint32_t ref, Bvh& bvh, uint32_t node, uint32_t pack, TaskPool::Group& g) const {
     Node n = nodes[ref];
-    const uint32_t index = nextNode++;
-    for (int k = 0; k < int(kWidth); ++k)
-      if (n.box[0][0][k] <= n.box[1][0][k]) n.child[k] = relayout(n.child[k], bvh, nextNode, nextPack);  // not empty
-    bvh.nodes_[index] = n;
-    return index;
+    uint32_t nextNode = node + 1, nextPack = pack;
+    for (int k = 0; k < int(kWidth); ++k) {
+      if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty
+      const uint32_t c = n.child[k];
+      if (c & Bvh::kLeafBit) {
+        const uint32_t first = c & 0x0FFFFFFFu, np = ((c >> 28) & 7u) + 1;
+        std::copy(&packs[first], &packs[first] + np, &bvh.packs_[nextPack]);
+        n.child[k] = (c & ~0x0FFFFFFFu) | nextPack;
+        nextPack += np;
+        continue;
+      }
+      n.child[k] = nextNode;
+      if (pool && subtree[c][1] * kWidth >= kSubtreeTask)
+        pool->run(g, [this, c, &bvh, nextNode, nextPack, &g] { relayout(c, bvh, nextNode, nextPack, g); });
+      else
+        relayout(c, bvh, nextNode, nextPack, g);
+      nextNode += subtree[c][0];
+      nextPack += subtree[c][1];
+    }
+    bvh.nodes_[node] = n;
   }
 
   uint32_t build(const Range& r) {
@@ -475,6 +485,13 @@ struct BvhBuilder {
     }
     if (pool) pool->wait(g);
     nodes[index] = node;
+    std::array<uint32_t, 2> size{1, 0};
+    for (int k = 0; k < count; ++k) {
+      const uint32_t ch = node.child[k];
+      if (ch & Bvh::kLeafBit) size[1] += ((ch >> 28) & 7u) + 1;
+      else { size[0] += subtree[ch][0]; size[1] += subtree[ch][1]; }
+    }
+    subtree[index] = size;
     return index;
   }
 };
@@ -503,6 +520,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   if (n == 0) return;
   b.nodes.reset(new Node[n + 1]);
   b.packs.reset(new TriPack[n + 1]);
+  b.subtree.reset(new std::array<uint32_t, 2>[n + 1]);
   b.threads = threads;
   std::unique_ptr<TaskPool> pool;
   if (threads > 1) b.pool = (pool = std::make_unique<TaskPool>(threads - 1)).get();
@@ -514,8 +532,15 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
   nodes_ = HugeArray<Node>(b.nodeCount.load());
   packs_ = HugeArray<TriPack>(b.packCount.load());
-  uint32_t nextNode = 0, nextPack = 0;
-  root_ = b.relayout(root_, *this, nextNode, nextPack);
+  if (root_ & kLeafBit) {
+    std::copy(&b.packs[0], &b.packs[0] + packs_.size(), &packs_[0]);
+    root_ &= ~0x0FFFFFFFu;
+  } else {
+    TaskPool::Group g;
+    b.relayout(root_, *this, 0, 0, g);
+    if (b.pool) b.pool->wait(g);
+    root_ = 0;
+  }
   stats_.nodes = uint32_t(nodes_.size());
   stats_.packs = uint32_t(packs_.size());
   stats_.maxDepth = b.maxDepth.load();
