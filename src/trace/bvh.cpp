@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -165,7 +166,7 @@ class TaskPool {
 struct BvhBuilder {
   std::span<const Triangle> tris;
   std::span<const uint8_t> casts;
-  std::vector<PrimRef> refs;
+  std::unique_ptr<PrimRef[]> refs;
   std::unique_ptr<Node[]> nodes;
   std::unique_ptr<TriPack[]> packs;
   std::unique_ptr<std::array<uint32_t, 2>[]> subtree;  // per node: nodes and packs of its subtree, itself included
@@ -196,7 +197,7 @@ struct BvhBuilder {
 
   // Adds refs [begin, end) to `out`.
   void binRefs(uint32_t begin, uint32_t end, __m128 lo, __m128 scale, Bins& out) const {
-    const PrimRef* ref = refs.data();
+    const PrimRef* ref = refs.get();
     for (uint32_t i = begin; i < end; ++i) {
       const __m128 blo = ref[i].boxLo(), bhi = ref[i].hi;
       alignas(16) int k[4];
@@ -301,6 +302,7 @@ struct BvhBuilder {
   // Runs fn(c) for c in [0, chunks), chunk 0 on this thread.
   template <class Fn>
   void parallelFor(uint32_t chunks, const Fn& fn) const {
+    if (!pool) { for (uint32_t c = 0; c < chunks; ++c) fn(c); return; }
     TaskPool::Group g;
     for (uint32_t c = 1; c < chunks; ++c) pool->run(g, [&fn, c] { fn(c); });
     fn(0);
@@ -360,7 +362,7 @@ struct BvhBuilder {
     });
   }
 
-  static Range boundsOf(const std::vector<PrimRef>& refs, uint32_t b, uint32_t e, uint32_t depth) {
+  static Range boundsOf(const PrimRef* refs, uint32_t b, uint32_t e, uint32_t depth) {
     Range r;
     r.begin = b; r.end = e; r.depth = depth;
     for (uint32_t i = b; i < e; ++i) { r.bounds.grow(refs[i].box()); r.cbounds.grow(refs[i].centroid2()); }
@@ -391,10 +393,10 @@ struct BvhBuilder {
     _mm_store_ps(e, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
     const int axis = e[0] >= e[1] && e[0] >= e[2] ? 0 : (e[1] >= e[2] ? 1 : 2);
     const uint32_t mid = r.begin + n / 2;
-    std::nth_element(refs.begin() + r.begin, refs.begin() + mid, refs.begin() + r.end,
+    std::nth_element(&refs[r.begin], &refs[mid], &refs[r.end],
                      [axis](const PrimRef& p, const PrimRef& q) { return lane(p.centroid2(), axis) < lane(q.centroid2(), axis); });
-    a = boundsOf(refs, r.begin, mid, r.depth + 1);
-    b = boundsOf(refs, mid, r.end, r.depth + 1);
+    a = boundsOf(refs.get(), r.begin, mid, r.depth + 1);
+    b = boundsOf(refs.get(), mid, r.end, r.depth + 1);
     return true;
   }
 
@@ -504,30 +506,51 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   BvhBuilder b;
   b.tris = triangles;
   b.casts = castsShadow;
-  b.refs.reserve(triangles.size());
-  for (uint32_t i = 0; i < triangles.size(); ++i) {
-    const Triangle& t = triangles[i];
-    Box box;
-    box.grow(load3(t.v0)); box.grow(load3(t.v1)); box.grow(load3(t.v2));
-    // Triangles with non-finite coordinates can never be hit; keep them out of the boxes.
-    bool finite = true;
-    for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(lane(box.lo, a)) && std::isfinite(lane(box.hi, a));
-    if (!finite) continue;
-    b.refs.push_back({_mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(box.lo), int(i), 3)), box.hi});
+  b.threads = threads;
+  std::unique_ptr<TaskPool> pool;
+  if (threads > 1) b.pool = (pool = std::make_unique<TaskPool>(threads - 1)).get();
+  // The references and the root's bounds, by all threads: each chunk of triangles keeps its finite ones
+  // at its own start, and the chunks close up after (only where some were left out).
+  const uint32_t count = uint32_t(triangles.size());
+  b.refs.reset(new PrimRef[std::max(count, 1u)]);
+  const uint32_t chunks = std::max(1u, std::min(threads, count / 16384));
+  std::vector<uint32_t> kept(chunks);
+  std::vector<Range> part(chunks);
+  const auto cut = [&](uint32_t c) { return uint32_t(uint64_t(count) * c / chunks); };
+  b.parallelFor(chunks, [&](uint32_t c) {
+    uint32_t out = cut(c);
+    for (uint32_t i = cut(c); i < cut(c + 1); ++i) {
+      const Triangle& t = triangles[i];
+      Box box;
+      box.grow(load3(t.v0)); box.grow(load3(t.v1)); box.grow(load3(t.v2));
+      // Triangles with non-finite coordinates can never be hit; keep them out of the boxes.
+      bool finite = true;
+      for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(lane(box.lo, a)) && std::isfinite(lane(box.hi, a));
+      if (!finite) continue;
+      const PrimRef& p = b.refs[out++] = {_mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(box.lo), int(i), 3)), box.hi};
+      part[c].bounds.grow(p.box());
+      part[c].cbounds.grow(p.centroid2());
+    }
+    kept[c] = out - cut(c);
+  });
+  Range root;
+  uint32_t n = 0;
+  for (uint32_t c = 0; c < chunks; ++c) {
+    if (n != cut(c)) std::memmove(&b.refs[n], &b.refs[cut(c)], kept[c] * sizeof(PrimRef));
+    n += kept[c];
+    root.bounds.grow(part[c].bounds);
+    root.cbounds.grow(part[c].cbounds);
   }
-  const uint32_t n = uint32_t(b.refs.size());
+  root.end = n;
   stats_.triangles = n;
   if (n == 0) return;
   b.nodes.reset(new Node[n + 1]);
   b.packs.reset(new TriPack[n + 1]);
   b.subtree.reset(new std::array<uint32_t, 2>[n + 1]);
-  b.threads = threads;
-  std::unique_ptr<TaskPool> pool;
-  if (threads > 1) b.pool = (pool = std::make_unique<TaskPool>(threads - 1)).get();
   const auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   stats_.refSeconds = since(start);
   const auto treeStart = std::chrono::steady_clock::now();
-  root_ = b.build(BvhBuilder::boundsOf(b.refs, 0, n, 0));
+  root_ = b.build(root);
   stats_.treeSeconds = since(treeStart);
   // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
   nodes_ = HugeArray<Node>(b.nodeCount.load());
