@@ -521,12 +521,12 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
     uint32_t out = cut(c);
     for (uint32_t i = cut(c); i < cut(c + 1); ++i) {
       const Triangle& t = triangles[i];
+      // Triangles with non-finite coordinates can never be hit; keep them out of the boxes. (Each vertex:
+      // min and max pass a NaN over when the box already has a number.)
+      const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+      if (!finite(t.v0) || !finite(t.v1) || !finite(t.v2)) continue;
       Box box;
       box.grow(load3(t.v0)); box.grow(load3(t.v1)); box.grow(load3(t.v2));
-      // Triangles with non-finite coordinates can never be hit; keep them out of the boxes.
-      bool finite = true;
-      for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(lane(box.lo, a)) && std::isfinite(lane(box.hi, a));
-      if (!finite) continue;
       const PrimRef& p = b.refs[out++] = {_mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(box.lo), int(i), 3)), box.hi};
       part[c].bounds.grow(p.box());
       part[c].cbounds.grow(p.centroid2());
