@@ -315,27 +315,38 @@ struct BvhBuilder {
   // And sets the two sides' centroid bounds (cb[0]: left, cb[1]: right, of every ref looked at).
   void partition(Split& s, const Range& r) {
     const int a = s.axis;
-    const float lo = lane(r.cbounds.lo, a);
-    const float ext = lane(r.cbounds.hi, a) - lo;
-    const float scale = float(kBins) * 0.99999f / ext;
+    // findSplit's bin of axis a (lane a; the other lanes are not looked at).
+    const __m128 scale = _mm_set1_ps(float(kBins) * 0.99999f / (lane(r.cbounds.hi, a) - lane(r.cbounds.lo, a)));
+    const __m128i bin = _mm_set1_epi32(s.bin);
+    const auto isLeft = [&, lo = r.cbounds.lo](__m128 c) {
+      return !((_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(binOf(c, lo, scale), bin))) >> a) & 1);
+    };
     const auto left = [&](const PrimRef& p, Box* cb) {
       const __m128 c = p.centroid2();
-      const bool l = std::clamp(int((lane(c, a) - lo) * scale), 0, kBins - 1) <= s.bin;
+      const bool l = isLeft(c);
       cb[!l].grow(c);
       return l;
     };
     const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
     if (chunks <= 1) {
-      Box cb[2];
+      Box cl, cr;  // in registers: each loop knows which side it adds to
       uint32_t i = r.begin, j = r.end;
       for (;;) {
-        while (i < j && left(refs[i], cb)) ++i;
-        while (i < j && !left(refs[j - 1], cb)) --j;
+        for (; i < j; ++i) {
+          const __m128 c = refs[i].centroid2();
+          if (!isLeft(c)) { cr.grow(c); break; }
+          cl.grow(c);
+        }
+        for (; i < j; --j) {
+          const __m128 c = refs[j - 1].centroid2();
+          if (isLeft(c)) { cl.grow(c); break; }
+          cr.grow(c);
+        }
         if (i >= j) break;
         std::swap(refs[i++], refs[--j]);
       }
-      s.left.cbounds = cb[0];
-      s.right.cbounds = cb[1];
+      s.left.cbounds = cl;
+      s.right.cbounds = cr;
       return;
     }
     // In parallel: list the misplaced refs of each side in that order, then swap the k-th pairs.
