@@ -200,14 +200,18 @@ struct BvhBuilder {
     const PrimRef* ref = refs.get();
     for (uint32_t i = begin; i < end; ++i) {
       const __m128 blo = ref[i].boxLo(), bhi = ref[i].hi;
-      alignas(16) int k[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(_mm_add_ps(blo, bhi), lo, scale));
-      for (int a = 0; a < 3; ++a) {
-        Box& b = out.b[a][k[a]];
+      const __m128i k = binOf(_mm_add_ps(blo, bhi), lo, scale);
+      // Written out per axis, the bin numbers straight from the register (a loop over the axes through
+      // memory: tree phase 5 % slower on the VM).
+      const auto add = [&](int a, int bin) {
+        Box& b = out.b[a][bin];
         b.lo = _mm_min_ps(blo, b.lo);
         b.hi = _mm_max_ps(bhi, b.hi);
-        ++out.n[a][k[a]];
-      }
+        ++out.n[a][bin];
+      };
+      add(0, _mm_cvtsi128_si32(k));
+      add(1, _mm_extract_epi32(k, 1));
+      add(2, _mm_extract_epi32(k, 2));
     }
   }
 
