@@ -175,6 +175,7 @@ struct BvhBuilder {
   uint32_t threads = 1;
   static constexpr uint32_t kSubtreeTask = 4096;  // triangles from which a subtree is a task of its own
   static constexpr uint32_t kParallelChunk = 64 * 1024;  // refs per thread below which binning stays serial
+  static constexpr uint32_t kSmallRange = 24;  // ranges up to this size: findSplitSmall
 
   struct Split {
     int axis = -1, bin = 0;
@@ -219,11 +220,12 @@ struct BvhBuilder {
   // number of 8-wide triangle tests it takes. Ranges near the root are binned by all threads: there the
   // build has no subtrees yet to run side by side.
   Split findSplit(const Range& r) const {
-    Bins all;
     alignas(16) float ext[4], sc[4] = {};
     _mm_store_ps(ext, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
     for (int a = 0; a < 3; ++a) sc[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
     const __m128 scale = _mm_load_ps(sc);
+    if (r.size() <= kSmallRange) return findSplitSmall(r, scale, ext);
+    Bins all;
     const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
     if (chunks > 1) {
       std::vector<Bins> part(chunks);
@@ -300,6 +302,61 @@ struct BvhBuilder {
     L.depth = R.depth = r.depth + 1;
     best.left = L;
     best.right = R;
+    return best;
+  }
+
+  // The same split for a range of at most kSmallRange references (most splits: the bottom of the tree),
+  // without clearing and sweeping all 96 bins: only the bins in use are set and swept, one axis after
+  // another. An empty bin adds nothing to either side, so its cost is that of the bin before it and never
+  // wins (the first of equal costs does); the sums run in the full sweep's order.
+  Split findSplitSmall(const Range& r, __m128 scale, const float* ext) const {
+    const uint32_t n = r.size();
+    alignas(16) int bin[kSmallRange][4];
+    uint32_t used[3] = {};
+    for (uint32_t i = 0; i < n; ++i) {
+      _mm_store_si128(reinterpret_cast<__m128i*>(bin[i]), binOf(refs[r.begin + i].centroid2(), r.cbounds.lo, scale));
+      for (int a = 0; a < 3; ++a) used[a] |= 1u << bin[i][a];
+    }
+    Box box[3][kBins];  // uninitialised but for the bins in use
+    uint32_t count[3][kBins];
+    for (int a = 0; a < 3; ++a)
+      for (uint32_t u = used[a]; u; u &= u - 1) { box[a][__builtin_ctz(u)] = Box{}; count[a][__builtin_ctz(u)] = 0; }
+    for (uint32_t i = 0; i < n; ++i)
+      for (int a = 0; a < 3; ++a) {
+        box[a][bin[i][a]].grow(refs[r.begin + i].box());
+        ++count[a][bin[i][a]];
+      }
+    Split best;
+    for (int a = 0; a < 3; ++a) {
+      if (!(ext[a] > 0.0f)) continue;
+      int list[kBins], m = 0;
+      for (uint32_t u = used[a]; u; u &= u - 1) list[m++] = __builtin_ctz(u);
+      float rightCost[kBins];  // of bins list[i], list[i + 1], ...
+      Box acc;
+      uint32_t nr = 0;
+      for (int i = m - 1; i > 0; --i) {
+        acc.grow(box[a][list[i]]);
+        nr += count[a][list[i]];
+        rightCost[i] = acc.halfArea() * float(packsFor(nr));
+      }
+      acc = Box{};
+      uint32_t nl = 0;
+      for (int i = 0; i + 1 < m; ++i) {
+        acc.grow(box[a][list[i]]);
+        nl += count[a][list[i]];
+        const float cost = acc.halfArea() * float(packsFor(nl)) + rightCost[i + 1];
+        if (cost < best.cost) { best.cost = cost; best.axis = a; best.bin = list[i]; }
+      }
+    }
+    if (best.axis < 0) return best;
+    uint32_t nl = 0;
+    for (uint32_t u = used[best.axis]; u; u &= u - 1) {
+      const int k = __builtin_ctz(u);
+      (k <= best.bin ? best.left : best.right).bounds.grow(box[best.axis][k]);
+      if (k <= best.bin) nl += count[best.axis][k];
+    }
+    best.left.begin = r.begin; best.left.end = best.right.begin = r.begin + nl; best.right.end = r.end;
+    best.left.depth = best.right.depth = r.depth + 1;
     return best;
   }
 
