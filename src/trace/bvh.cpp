@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -15,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include <smmintrin.h>
 #include <sys/mman.h>
 
 #include <glm/common.hpp>
@@ -29,21 +31,40 @@ constexpr uint32_t kWidth = 8;     // children per node, triangles per pack
 constexpr float kNodeCost = 0.5f;  // one 8-wide box test against one 8-wide pack test
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// x, y, z in the first three lanes of an SSE register (the fourth 0): one instruction grows a box.
+// The operand order of min/max is glm's (min(a, b) = b < a ? b : a), so signed zeros land as before.
 struct Box {
-  glm::vec3 lo{kInf}, hi{-kInf};
-  void grow(const glm::vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-  void grow(const Box& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
+  __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);
+  void grow(__m128 p) { lo = _mm_min_ps(p, lo); hi = _mm_max_ps(p, hi); }
+  void grow(const Box& b) { lo = _mm_min_ps(b.lo, lo); hi = _mm_max_ps(b.hi, hi); }
   float halfArea() const {
-    const glm::vec3 e = glm::max(hi - lo, glm::vec3(0.0f));
-    return e.x * e.y + e.y * e.z + e.z * e.x;
+    alignas(16) float e[4];
+    _mm_store_ps(e, _mm_max_ps(_mm_setzero_ps(), _mm_sub_ps(hi, lo)));
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
   }
 };
 
+__m128 load3(const glm::vec3& v) { return _mm_set_ps(0.0f, v.z, v.y, v.x); }
+float lane(__m128 v, int a) {
+  alignas(16) float f[4];
+  _mm_store_ps(f, v);
+  return f[a];
+}
+
+// A triangle's box, its index kept in the fourth lane of `lo` (32 bytes, aligned: one load each).
 struct PrimRef {
-  Box box;
-  uint32_t id;
-  glm::vec3 centroid2() const { return box.lo + box.hi; }  // twice the centroid: saves a multiply
+  __m128 lo, hi;
+  uint32_t id() const { return uint32_t(_mm_extract_epi32(_mm_castps_si128(lo), 3)); }
+  __m128 boxLo() const { return _mm_blend_ps(lo, _mm_setzero_ps(), 8); }  // the index out of the way
+  Box box() const { return {boxLo(), hi}; }
+  __m128 centroid2() const { return _mm_add_ps(boxLo(), hi); }  // twice the centroid: saves a multiply
 };
+
+// The bin of each axis: int((c - lo) · scale) clamped to [0, kBins), as one SSE computation.
+__m128i binOf(__m128 c, __m128 lo, __m128 scale) {
+  const __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
+  return _mm_min_epi32(_mm_max_epi32(k, _mm_setzero_si128()), _mm_set1_epi32(kBins - 1));
+}
 
 struct Range {
   uint32_t begin = 0, end = 0;
@@ -71,7 +92,8 @@ double sahCost(const Node* nodes, uint32_t root) {
     stack.pop_back();
     for (int k = 0; k < int(kWidth); ++k) {
       if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty slot
-      if (&n == &nodes[root]) rootBox.grow(Box{{n.box[0][0][k], n.box[0][1][k], n.box[0][2][k]}, {n.box[1][0][k], n.box[1][1][k], n.box[1][2][k]}});
+      if (&n == &nodes[root])
+        rootBox.grow(Box{_mm_set_ps(0, n.box[0][2][k], n.box[0][1][k], n.box[0][0][k]), _mm_set_ps(0, n.box[1][2][k], n.box[1][1][k], n.box[1][0][k])});
       const uint32_t c = n.child[k];
       if (c & Bvh::kLeafBit) total += area(n, k) * double(((c >> 28) & 7u) + 1);
       else { total += area(n, k) * kNodeCost; stack.push_back(c); }
@@ -144,14 +166,16 @@ class TaskPool {
 struct BvhBuilder {
   std::span<const Triangle> tris;
   std::span<const uint8_t> casts;
-  std::vector<PrimRef> refs;
+  std::unique_ptr<PrimRef[]> refs;
   std::unique_ptr<Node[]> nodes;
   std::unique_ptr<TriPack[]> packs;
+  std::unique_ptr<std::array<uint32_t, 2>[]> subtree;  // per node: nodes and packs of its subtree, itself included
   std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
   TaskPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
   static constexpr uint32_t kSubtreeTask = 4096;  // triangles from which a subtree is a task of its own
   static constexpr uint32_t kParallelChunk = 64 * 1024;  // refs per thread below which binning stays serial
+  static constexpr uint32_t kSmallRange = 24;  // ranges up to this size: findSplitSmall
 
   struct Split {
     int axis = -1, bin = 0;
@@ -159,84 +183,120 @@ struct BvhBuilder {
     Range left, right;
   };
 
-  struct Bin { Box b, c; uint32_t n = 0; };
+  // Boxes and counts only: the children's centroid bounds come from the partition, which looks at every
+  // centroid anyway (half the bins to clear and grow).
   struct Bins {
-    Bin bin[3][kBins];
+    Box b[3][kBins];
+    uint32_t n[3][kBins] = {};
     // Min, max and sums: exact and order-free, so the bins (and the split) do not depend on how the
     // range was cut up between threads.
     void merge(const Bins& o) {
       for (int a = 0; a < 3; ++a)
-        for (int k = 0; k < kBins; ++k) { bin[a][k].b.grow(o.bin[a][k].b); bin[a][k].c.grow(o.bin[a][k].c); bin[a][k].n += o.bin[a][k].n; }
+        for (int k = 0; k < kBins; ++k) { b[a][k].grow(o.b[a][k]); n[a][k] += o.n[a][k]; }
     }
   };
 
-  // The bins of refs [begin, end).
-  Bins binRefs(uint32_t begin, uint32_t end, glm::vec3 lo, glm::vec3 scale) const {
-    Bins out;
-    const PrimRef* ref = refs.data();
+  // Adds refs [begin, end) to `out`.
+  void binRefs(uint32_t begin, uint32_t end, __m128 lo, __m128 scale, Bins& out) const {
+    const PrimRef* ref = refs.get();
     for (uint32_t i = begin; i < end; ++i) {
-      const PrimRef& p = ref[i];
-      const glm::vec3 c = p.centroid2();
-      for (int a = 0; a < 3; ++a) {
-        const int k = std::clamp(int((c[a] - lo[a]) * scale[a]), 0, kBins - 1);
-        Bin& bin = out.bin[a][k];
-        bin.b.grow(p.box);
-        bin.c.grow(c);
-        ++bin.n;
-      }
+      const __m128 blo = ref[i].boxLo(), bhi = ref[i].hi;
+      const __m128i k = binOf(_mm_add_ps(blo, bhi), lo, scale);
+      // Written out per axis, the bin numbers straight from the register (a loop over the axes through
+      // memory: tree phase 5 % slower on the VM).
+      const auto add = [&](int a, int bin) {
+        Box& b = out.b[a][bin];
+        b.lo = _mm_min_ps(blo, b.lo);
+        b.hi = _mm_max_ps(bhi, b.hi);
+        ++out.n[a][bin];
+      };
+      add(0, _mm_cvtsi128_si32(k));
+      add(1, _mm_extract_epi32(k, 1));
+      add(2, _mm_extract_epi32(k, 2));
     }
-    return out;
   }
 
   // Binned SAH over all three axes in one pass. Cost counts packs of eight, since a leaf's price is the
   // number of 8-wide triangle tests it takes. Ranges near the root are binned by all threads: there the
   // build has no subtrees yet to run side by side.
   Split findSplit(const Range& r) const {
+    alignas(16) float ext[4], sc[4] = {};
+    _mm_store_ps(ext, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
+    for (int a = 0; a < 3; ++a) sc[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
+    const __m128 scale = _mm_load_ps(sc);
+    if (r.size() <= kSmallRange) return findSplitSmall(r, scale, ext);
     Bins all;
-    const glm::vec3 ext = r.cbounds.hi - r.cbounds.lo;
-    glm::vec3 scale;
-    for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
     const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
     if (chunks > 1) {
       std::vector<Bins> part(chunks);
       const auto cut = [&](uint32_t c) { return r.begin + uint32_t(uint64_t(r.size()) * c / chunks); };
-      parallelFor(chunks, [&](uint32_t c) { part[c] = binRefs(cut(c), cut(c + 1), r.cbounds.lo, scale); });
+      parallelFor(chunks, [&](uint32_t c) { binRefs(cut(c), cut(c + 1), r.cbounds.lo, scale, part[c]); });
       for (const Bins& p : part) all.merge(p);
     } else {
-      all = binRefs(r.begin, r.end, r.cbounds.lo, scale);
+      binRefs(r.begin, r.end, r.cbounds.lo, scale, all);
     }
-    const auto& bins = all.bin;
+    // The sweeps of the three axes side by side, lane a = axis a: the same arithmetic as one axis at a
+    // time (halfArea's order of operations, glm's operand order), so the same costs to the bit.
+    __m128 lo[3][kBins], hi[3][kBins];  // [x, y, z][bin], lanes: axes
+    __m128i count[kBins];
+    for (int k = 0; k < kBins; ++k) {
+      __m128 l0 = all.b[0][k].lo, l1 = all.b[1][k].lo, l2 = all.b[2][k].lo, l3 = _mm_setzero_ps();
+      __m128 h0 = all.b[0][k].hi, h1 = all.b[1][k].hi, h2 = all.b[2][k].hi, h3 = _mm_setzero_ps();
+      _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
+      _MM_TRANSPOSE4_PS(h0, h1, h2, h3);
+      lo[0][k] = l0; lo[1][k] = l1; lo[2][k] = l2;
+      hi[0][k] = h0; hi[1][k] = h1; hi[2][k] = h2;
+      count[k] = _mm_set_epi32(0, int(all.n[2][k]), int(all.n[1][k]), int(all.n[0][k]));
+    }
+    struct Acc {
+      __m128 lo[3], hi[3];
+      __m128i n = _mm_setzero_si128();
+      Acc() { for (int i = 0; i < 3; ++i) { lo[i] = _mm_set1_ps(kInf); hi[i] = _mm_set1_ps(-kInf); } }
+      // Grows by bin k; returns halfArea() · packsFor(n) per axis.
+      __m128 add(const __m128 (&l)[3][kBins], const __m128 (&h)[3][kBins], const __m128i* c, int k) {
+        __m128 e[3];
+        for (int i = 0; i < 3; ++i) {
+          lo[i] = _mm_min_ps(l[i][k], lo[i]);
+          hi[i] = _mm_max_ps(h[i][k], hi[i]);
+          e[i] = _mm_max_ps(_mm_setzero_ps(), _mm_sub_ps(hi[i], lo[i]));
+        }
+        n = _mm_add_epi32(n, c[k]);
+        const __m128 area = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e[0], e[1]), _mm_mul_ps(e[1], e[2])), _mm_mul_ps(e[2], e[0]));
+        return _mm_mul_ps(area, _mm_cvtepi32_ps(_mm_srli_epi32(_mm_add_epi32(n, _mm_set1_epi32(int(kWidth) - 1)), 3)));
+      }
+    };
+    __m128 rightCost[kBins];
+    Acc acc;
+    for (int k = kBins - 1; k > 0; --k) rightCost[k] = acc.add(lo, hi, count, k);
+    acc = Acc{};
+    const __m128 inf = _mm_set1_ps(kInf);
+    const __m128i whole = _mm_set1_epi32(int(r.size()));
+    // Axes without extent take no split.
+    const __m128 flat = _mm_cmple_ps(_mm_load_ps(ext), _mm_setzero_ps());
+    __m128 bestCost = inf;
+    __m128i bestBin = _mm_setzero_si128();
+    for (int k = 0; k < kBins - 1; ++k) {
+      __m128 cost = _mm_add_ps(acc.add(lo, hi, count, k), rightCost[k + 1]);
+      const __m128i none = _mm_or_si128(_mm_cmpeq_epi32(acc.n, _mm_setzero_si128()), _mm_cmpeq_epi32(acc.n, whole));
+      cost = _mm_blendv_ps(cost, inf, _mm_or_ps(flat, _mm_castsi128_ps(none)));
+      const __m128 better = _mm_cmplt_ps(cost, bestCost);  // strictly: the first bin of equal cost wins
+      bestCost = _mm_blendv_ps(bestCost, cost, better);
+      bestBin = _mm_blendv_epi8(bestBin, _mm_set1_epi32(k), _mm_castps_si128(better));
+    }
+    alignas(16) float bc[4];
+    alignas(16) int bb[4];
+    _mm_store_ps(bc, bestCost);
+    _mm_store_si128(reinterpret_cast<__m128i*>(bb), bestBin);
     Split best;
-    for (int a = 0; a < 3; ++a) {
-      if (!(ext[a] > 0.0f)) continue;
-      float rightCost[kBins];
-      Box acc;
-      uint32_t n = 0;
-      for (int k = kBins - 1; k > 0; --k) {
-        acc.grow(bins[a][k].b);
-        n += bins[a][k].n;
-        rightCost[k] = acc.halfArea() * float(packsFor(n));
-      }
-      acc = Box{};
-      n = 0;
-      for (int k = 0; k < kBins - 1; ++k) {
-        acc.grow(bins[a][k].b);
-        n += bins[a][k].n;
-        if (n == 0 || n == r.size()) continue;
-        const float cost = acc.halfArea() * float(packsFor(n)) + rightCost[k + 1];
-        if (cost < best.cost) { best.cost = cost; best.axis = a; best.bin = k; }
-      }
-    }
+    for (int a = 0; a < 3; ++a)  // the first axis of equal cost wins, as in a sweep of one axis after another
+      if (bc[a] < best.cost) { best.cost = bc[a]; best.axis = a; best.bin = bb[a]; }
     if (best.axis < 0) return best;
-    // Child ranges' bounds straight from the bins.
+    // Child ranges' bounds straight from the bins (their centroid bounds: partition()).
     Range L, R;
     uint32_t nl = 0;
     for (int k = 0; k < kBins; ++k) {
-      const Bin& bin = bins[best.axis][k];
-      Range& side = k <= best.bin ? L : R;
-      side.bounds.grow(bin.b);
-      side.cbounds.grow(bin.c);
-      if (k <= best.bin) nl += bin.n;
+      (k <= best.bin ? L : R).bounds.grow(all.b[best.axis][k]);
+      if (k <= best.bin) nl += all.n[best.axis][k];
     }
     L.begin = r.begin; L.end = r.begin + nl; R.begin = L.end; R.end = r.end;
     L.depth = R.depth = r.depth + 1;
@@ -245,9 +305,65 @@ struct BvhBuilder {
     return best;
   }
 
+  // The same split for a range of at most kSmallRange references (most splits: the bottom of the tree),
+  // without clearing and sweeping all 96 bins: only the bins in use are set and swept, one axis after
+  // another. An empty bin adds nothing to either side, so its cost is that of the bin before it and never
+  // wins (the first of equal costs does); the sums run in the full sweep's order.
+  Split findSplitSmall(const Range& r, __m128 scale, const float* ext) const {
+    const uint32_t n = r.size();
+    alignas(16) int bin[kSmallRange][4];
+    uint32_t used[3] = {};
+    for (uint32_t i = 0; i < n; ++i) {
+      _mm_store_si128(reinterpret_cast<__m128i*>(bin[i]), binOf(refs[r.begin + i].centroid2(), r.cbounds.lo, scale));
+      for (int a = 0; a < 3; ++a) used[a] |= 1u << bin[i][a];
+    }
+    Box box[3][kBins];  // uninitialised but for the bins in use
+    uint32_t count[3][kBins];
+    for (int a = 0; a < 3; ++a)
+      for (uint32_t u = used[a]; u; u &= u - 1) { box[a][__builtin_ctz(u)] = Box{}; count[a][__builtin_ctz(u)] = 0; }
+    for (uint32_t i = 0; i < n; ++i)
+      for (int a = 0; a < 3; ++a) {
+        box[a][bin[i][a]].grow(refs[r.begin + i].box());
+        ++count[a][bin[i][a]];
+      }
+    Split best;
+    for (int a = 0; a < 3; ++a) {
+      if (!(ext[a] > 0.0f)) continue;
+      int list[kBins], m = 0;
+      for (uint32_t u = used[a]; u; u &= u - 1) list[m++] = __builtin_ctz(u);
+      float rightCost[kBins];  // of bins list[i], list[i + 1], ...
+      Box acc;
+      uint32_t nr = 0;
+      for (int i = m - 1; i > 0; --i) {
+        acc.grow(box[a][list[i]]);
+        nr += count[a][list[i]];
+        rightCost[i] = acc.halfArea() * float(packsFor(nr));
+      }
+      acc = Box{};
+      uint32_t nl = 0;
+      for (int i = 0; i + 1 < m; ++i) {
+        acc.grow(box[a][list[i]]);
+        nl += count[a][list[i]];
+        const float cost = acc.halfArea() * float(packsFor(nl)) + rightCost[i + 1];
+        if (cost < best.cost) { best.cost = cost; best.axis = a; best.bin = list[i]; }
+      }
+    }
+    if (best.axis < 0) return best;
+    uint32_t nl = 0;
+    for (uint32_t u = used[best.axis]; u; u &= u - 1) {
+      const int k = __builtin_ctz(u);
+      (k <= best.bin ? best.left : best.right).bounds.grow(box[best.axis][k]);
+      if (k <= best.bin) nl += count[best.axis][k];
+    }
+    best.left.begin = r.begin; best.left.end = best.right.begin = r.begin + nl; best.right.end = r.end;
+    best.left.depth = best.right.depth = r.depth + 1;
+    return best;
+  }
+
   // Runs fn(c) for c in [0, chunks), chunk 0 on this thread.
   template <class Fn>
   void parallelFor(uint32_t chunks, const Fn& fn) const {
+    if (!pool) { for (uint32_t c = 0; c < chunks; ++c) fn(c); return; }
     TaskPool::Group g;
     for (uint32_t c = 1; c < chunks; ++c) pool->run(g, [&fn, c] { fn(c); });
     fn(0);
@@ -257,33 +373,56 @@ struct BvhBuilder {
   // Moves the refs of bins ≤ s.bin in front. The k-th misplaced ref from the front trades places with the
   // k-th misplaced one from the back (Hoare's scheme, as std::partition does it), whether one thread or
   // many do it: the tree does not depend on the thread count.
-  void partition(const Split& s, const Range& r) {
+  // And sets the two sides' centroid bounds (cb[0]: left, cb[1]: right, of every ref looked at).
+  void partition(Split& s, const Range& r) {
     const int a = s.axis;
-    const float lo = r.cbounds.lo[a];
-    const float ext = r.cbounds.hi[a] - lo;
-    const float scale = float(kBins) * 0.99999f / ext;
-    const auto left = [&](const PrimRef& p) { return std::clamp(int((p.centroid2()[a] - lo) * scale), 0, kBins - 1) <= s.bin; };
+    // findSplit's bin of axis a (lane a; the other lanes are not looked at).
+    const __m128 scale = _mm_set1_ps(float(kBins) * 0.99999f / (lane(r.cbounds.hi, a) - lane(r.cbounds.lo, a)));
+    const __m128i bin = _mm_set1_epi32(s.bin);
+    const auto isLeft = [&, lo = r.cbounds.lo](__m128 c) {
+      return !((_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(binOf(c, lo, scale), bin))) >> a) & 1);
+    };
+    const auto left = [&](const PrimRef& p, Box* cb) {
+      const __m128 c = p.centroid2();
+      const bool l = isLeft(c);
+      cb[!l].grow(c);
+      return l;
+    };
     const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
     if (chunks <= 1) {
+      Box cl, cr;  // in registers: each loop knows which side it adds to
       uint32_t i = r.begin, j = r.end;
       for (;;) {
-        while (i < j && left(refs[i])) ++i;
-        while (i < j && !left(refs[j - 1])) --j;
-        if (i >= j) return;
+        for (; i < j; ++i) {
+          const __m128 c = refs[i].centroid2();
+          if (!isLeft(c)) { cr.grow(c); break; }
+          cl.grow(c);
+        }
+        for (; i < j; --j) {
+          const __m128 c = refs[j - 1].centroid2();
+          if (isLeft(c)) { cl.grow(c); break; }
+          cr.grow(c);
+        }
+        if (i >= j) break;
         std::swap(refs[i++], refs[--j]);
       }
+      s.left.cbounds = cl;
+      s.right.cbounds = cr;
+      return;
     }
     // In parallel: list the misplaced refs of each side in that order, then swap the k-th pairs.
     const uint32_t mid = s.left.end;
     std::vector<std::vector<uint32_t>> front(chunks), back(chunks);
+    std::vector<std::array<Box, 2>> cb(chunks);
     const auto cut = [&](uint32_t b, uint32_t e, uint32_t c) { return b + uint32_t(uint64_t(e - b) * c / chunks); };
     parallelFor(chunks, [&](uint32_t c) {
       for (uint32_t i = cut(r.begin, mid, c); i < cut(r.begin, mid, c + 1); ++i)
-        if (!left(refs[i])) front[c].push_back(i);
+        if (!left(refs[i], cb[c].data())) front[c].push_back(i);
       // Back side from the end: chunk c covers the c-th stretch counted from r.end down.
       for (uint32_t i = r.end - cut(0, r.end - mid, c); i > r.end - cut(0, r.end - mid, c + 1); --i)
-        if (left(refs[i - 1])) back[c].push_back(i - 1);
+        if (left(refs[i - 1], cb[c].data())) back[c].push_back(i - 1);
     });
+    for (uint32_t c = 0; c < chunks; ++c) { s.left.cbounds.grow(cb[c][0]); s.right.cbounds.grow(cb[c][1]); }
     std::vector<uint32_t> f, b;
     for (uint32_t c = 0; c < chunks; ++c) {
       f.insert(f.end(), front[c].begin(), front[c].end());
@@ -295,10 +434,10 @@ struct BvhBuilder {
     });
   }
 
-  static Range boundsOf(const std::vector<PrimRef>& refs, uint32_t b, uint32_t e, uint32_t depth) {
+  static Range boundsOf(const PrimRef* refs, uint32_t b, uint32_t e, uint32_t depth) {
     Range r;
     r.begin = b; r.end = e; r.depth = depth;
-    for (uint32_t i = b; i < e; ++i) { r.bounds.grow(refs[i].box); r.cbounds.grow(refs[i].centroid2()); }
+    for (uint32_t i = b; i < e; ++i) { r.bounds.grow(refs[i].box()); r.cbounds.grow(refs[i].centroid2()); }
     return r;
   }
 
@@ -309,7 +448,7 @@ struct BvhBuilder {
     if (n <= 1) return false;
     const bool tooDeep = r.depth > 48;
     if (!tooDeep) {
-      const Split s = findSplit(r);
+      Split s = findSplit(r);
       if (s.axis >= 0) {
         const float leafCost = r.bounds.halfArea() * float(packsFor(n));
         const float splitCost = kNodeCost * r.bounds.halfArea() + s.cost;
@@ -322,13 +461,14 @@ struct BvhBuilder {
       if (n <= Bvh::kMaxLeafTriangles) return false;
     }
     // Median by count along the widest centroid axis.
-    const glm::vec3 e = r.cbounds.hi - r.cbounds.lo;
-    const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    alignas(16) float e[4];
+    _mm_store_ps(e, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
+    const int axis = e[0] >= e[1] && e[0] >= e[2] ? 0 : (e[1] >= e[2] ? 1 : 2);
     const uint32_t mid = r.begin + n / 2;
-    std::nth_element(refs.begin() + r.begin, refs.begin() + mid, refs.begin() + r.end,
-                     [axis](const PrimRef& p, const PrimRef& q) { return p.centroid2()[axis] < q.centroid2()[axis]; });
-    a = boundsOf(refs, r.begin, mid, r.depth + 1);
-    b = boundsOf(refs, mid, r.end, r.depth + 1);
+    std::nth_element(&refs[r.begin], &refs[mid], &refs[r.end],
+                     [axis](const PrimRef& p, const PrimRef& q) { return lane(p.centroid2(), axis) < lane(q.centroid2(), axis); });
+    a = boundsOf(refs.get(), r.begin, mid, r.depth + 1);
+    b = boundsOf(refs.get(), mid, r.end, r.depth + 1);
     return true;
   }
 
@@ -339,7 +479,7 @@ struct BvhBuilder {
       TriPack& pack = packs[first + p];
       for (uint32_t lane = 0; lane < kWidth; ++lane) {
         const uint32_t i = std::min(r.begin + p * kWidth + lane, r.end - 1);  // short packs repeat the last
-        const uint32_t id = refs[i].id;
+        const uint32_t id = refs[i].id();
         const Triangle& t = tris[id];
         const glm::vec3* v[3] = {&t.v0, &t.v1, &t.v2};
         for (int k = 0; k < 3; ++k)
@@ -350,21 +490,30 @@ struct BvhBuilder {
     return Bvh::kLeafBit | ((np - 1) << 28) | first;
   }
 
-  // Writes the subtree at `ref` (a node or a leaf) into bvh's arrays in depth-first order; returns its
-  // new reference.
-  uint32_t relayout(uint32_t ref, Bvh& bvh, uint32_t& nextNode, uint32_t& nextPack) const {
-    if (ref & Bvh::kLeafBit) {
-      const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
-      for (uint32_t p = 0; p < np; ++p) bvh.packs_[nextPack + p] = packs[first + p];
-      nextPack += np;
-      return (ref & ~0x0FFFFFFFu) | (nextPack - np);
-    }
+  // Writes the subtree of node `ref` into bvh's arrays in depth-first order, its node at `node`, its packs
+  // from `pack` on: the subtree sizes place every child, so large subtrees are copied by the pool.
+  void relayout(uint32_t ref, Bvh& bvh, uint32_t node, uint32_t pack, TaskPool::Group& g) const {
     Node n = nodes[ref];
-    const uint32_t index = nextNode++;
-    for (int k = 0; k < int(kWidth); ++k)
-      if (n.box[0][0][k] <= n.box[1][0][k]) n.child[k] = relayout(n.child[k], bvh, nextNode, nextPack);  // not empty
-    bvh.nodes_[index] = n;
-    return index;
+    uint32_t nextNode = node + 1, nextPack = pack;
+    for (int k = 0; k < int(kWidth); ++k) {
+      if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty
+      const uint32_t c = n.child[k];
+      if (c & Bvh::kLeafBit) {
+        const uint32_t first = c & 0x0FFFFFFFu, np = ((c >> 28) & 7u) + 1;
+        std::copy(&packs[first], &packs[first] + np, &bvh.packs_[nextPack]);
+        n.child[k] = (c & ~0x0FFFFFFFu) | nextPack;
+        nextPack += np;
+        continue;
+      }
+      n.child[k] = nextNode;
+      if (pool && subtree[c][1] * kWidth >= kSubtreeTask)
+        pool->run(g, [this, c, &bvh, nextNode, nextPack, &g] { relayout(c, bvh, nextNode, nextPack, g); });
+      else
+        relayout(c, bvh, nextNode, nextPack, g);
+      nextNode += subtree[c][0];
+      nextPack += subtree[c][1];
+    }
+    bvh.nodes_[node] = n;
   }
 
   uint32_t build(const Range& r) {
@@ -393,8 +542,8 @@ struct BvhBuilder {
     Node node;
     for (int k = 0; k < int(kWidth); ++k) {
       for (int a3 = 0; a3 < 3; ++a3) {
-        node.box[0][a3][k] = k < count ? c[k].r.bounds.lo[a3] : kInf;
-        node.box[1][a3][k] = k < count ? c[k].r.bounds.hi[a3] : -kInf;
+        node.box[0][a3][k] = k < count ? lane(c[k].r.bounds.lo, a3) : kInf;
+        node.box[1][a3][k] = k < count ? lane(c[k].r.bounds.hi, a3) : -kInf;
       }
       node.child[k] = Bvh::kLeafBit;  // empty slots: a leaf of one pack that the box test never reaches
     }
@@ -410,6 +559,13 @@ struct BvhBuilder {
     }
     if (pool) pool->wait(g);
     nodes[index] = node;
+    std::array<uint32_t, 2> size{1, 0};
+    for (int k = 0; k < count; ++k) {
+      const uint32_t ch = node.child[k];
+      if (ch & Bvh::kLeafBit) size[1] += ((ch >> 28) & 7u) + 1;
+      else { size[0] += subtree[ch][0]; size[1] += subtree[ch][1]; }
+    }
+    subtree[index] = size;
     return index;
   }
 };
@@ -422,36 +578,64 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   BvhBuilder b;
   b.tris = triangles;
   b.casts = castsShadow;
-  b.refs.reserve(triangles.size());
-  for (uint32_t i = 0; i < triangles.size(); ++i) {
-    const Triangle& t = triangles[i];
-    PrimRef p;
-    p.box.grow(t.v0); p.box.grow(t.v1); p.box.grow(t.v2);
-    p.id = i;
-    // Triangles with non-finite coordinates can never be hit; keep them out of the boxes.
-    bool finite = true;
-    for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(p.box.lo[a]) && std::isfinite(p.box.hi[a]);
-    if (!finite) continue;
-    b.refs.push_back(p);
+  b.threads = threads;
+  std::unique_ptr<TaskPool> pool;
+  if (threads > 1) b.pool = (pool = std::make_unique<TaskPool>(threads - 1)).get();
+  // The references and the root's bounds, by all threads: each chunk of triangles keeps its finite ones
+  // at its own start, and the chunks close up after (only where some were left out).
+  const uint32_t count = uint32_t(triangles.size());
+  b.refs.reset(new PrimRef[std::max(count, 1u)]);
+  const uint32_t chunks = std::max(1u, std::min(threads, count / 16384));
+  std::vector<uint32_t> kept(chunks);
+  std::vector<Range> part(chunks);
+  const auto cut = [&](uint32_t c) { return uint32_t(uint64_t(count) * c / chunks); };
+  b.parallelFor(chunks, [&](uint32_t c) {
+    uint32_t out = cut(c);
+    for (uint32_t i = cut(c); i < cut(c + 1); ++i) {
+      const Triangle& t = triangles[i];
+      // Triangles with non-finite coordinates can never be hit; keep them out of the boxes. (Each vertex:
+      // min and max pass a NaN over when the box already has a number.)
+      const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+      if (!finite(t.v0) || !finite(t.v1) || !finite(t.v2)) continue;
+      Box box;
+      box.grow(load3(t.v0)); box.grow(load3(t.v1)); box.grow(load3(t.v2));
+      const PrimRef& p = b.refs[out++] = {_mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(box.lo), int(i), 3)), box.hi};
+      part[c].bounds.grow(p.box());
+      part[c].cbounds.grow(p.centroid2());
+    }
+    kept[c] = out - cut(c);
+  });
+  Range root;
+  uint32_t n = 0;
+  for (uint32_t c = 0; c < chunks; ++c) {
+    if (n != cut(c)) std::memmove(&b.refs[n], &b.refs[cut(c)], kept[c] * sizeof(PrimRef));
+    n += kept[c];
+    root.bounds.grow(part[c].bounds);
+    root.cbounds.grow(part[c].cbounds);
   }
-  const uint32_t n = uint32_t(b.refs.size());
+  root.end = n;
   stats_.triangles = n;
   if (n == 0) return;
   b.nodes.reset(new Node[n + 1]);
   b.packs.reset(new TriPack[n + 1]);
-  b.threads = threads;
-  std::unique_ptr<TaskPool> pool;
-  if (threads > 1) b.pool = (pool = std::make_unique<TaskPool>(threads - 1)).get();
+  b.subtree.reset(new std::array<uint32_t, 2>[n + 1]);
   const auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   stats_.refSeconds = since(start);
   const auto treeStart = std::chrono::steady_clock::now();
-  root_ = b.build(BvhBuilder::boundsOf(b.refs, 0, n, 0));
+  root_ = b.build(root);
   stats_.treeSeconds = since(treeStart);
   // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
   nodes_ = HugeArray<Node>(b.nodeCount.load());
   packs_ = HugeArray<TriPack>(b.packCount.load());
-  uint32_t nextNode = 0, nextPack = 0;
-  root_ = b.relayout(root_, *this, nextNode, nextPack);
+  if (root_ & kLeafBit) {
+    std::copy(&b.packs[0], &b.packs[0] + packs_.size(), &packs_[0]);
+    root_ &= ~0x0FFFFFFFu;
+  } else {
+    TaskPool::Group g;
+    b.relayout(root_, *this, 0, 0, g);
+    if (b.pool) b.pool->wait(g);
+    root_ = 0;
+  }
   stats_.nodes = uint32_t(nodes_.size());
   stats_.packs = uint32_t(packs_.size());
   stats_.maxDepth = b.maxDepth.load();

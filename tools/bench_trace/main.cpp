@@ -260,7 +260,37 @@ struct Options {
   int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
+  bool buildOnly = false;    // time only the builds, ours and Embree's alternately
 };
+
+// FNV-1a over the tree's nodes and packs (field by field: a Node has padding): equal hashes from two
+// binaries say they built the same tree.
+uint64_t treeHash(const Bvh& bvh) {
+  uint64_t h = 1469598103934665603ull;
+  const auto add = [&h](const void* p, size_t n) {
+    for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<const unsigned char*>(p)[i]) * 1099511628211ull;
+  };
+  const Bvh::View v = bvh.view();
+  add(&v.root, sizeof v.root);
+  for (uint32_t i = 0; i < bvh.stats().nodes; ++i) { add(v.nodes[i].box, sizeof v.nodes[i].box); add(v.nodes[i].child, sizeof v.nodes[i].child); }
+  for (uint32_t i = 0; i < bvh.stats().packs; ++i) { add(v.packs[i].v, sizeof v.packs[i].v); add(v.packs[i].prim, sizeof v.packs[i].prim); }
+  return h;
+}
+
+// --build-only: ours and Embree's builds alternately, every rep's phases, and the tree's hash.
+void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
+  for (int rep = 0; rep < o.reps; ++rep) {
+    const auto t0 = Clock::now();
+    const Bvh bvh(tris, {}, o.threads);
+    const double ours = seconds(t0);
+    const Embree em(tris, o.threads);
+    const BvhStats& st = bvh.stats();
+    std::printf("build %u threads: ours %.4f s (references %.4f, tree %.4f, copy-out %.4f), Embree %.4f s, ratio %.2f; "
+                "SAH cost %.4f, %u nodes, %u packs, tree hash %016llx\n", o.threads, ours, st.refSeconds, st.treeSeconds,
+                st.buildSeconds - st.refSeconds - st.treeSeconds, em.buildSeconds, ours / em.buildSeconds, st.sahCost, st.nodes,
+                st.packs, (unsigned long long)treeHash(bvh));
+  }
+}
 
 void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, bool sphere, const Options& o) {
   const unsigned threads = o.threads;
@@ -268,6 +298,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   const bool quick = o.quick, explainAll = o.explainAll, countOnly = o.countOnly;
   std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
               res, threads, Bvh::isaName(Bvh::isa()));
+  if (o.buildOnly) return benchBuilds(tris, o);
   const auto t0 = Clock::now();
   const Bvh bvh(tris, {}, threads);
   const double ourBuild = seconds(t0);
@@ -540,10 +571,11 @@ int main(int argc, char** argv) {
     else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--packets-only") quick = o.packetsOnly = true;
     else if (a == "--no-sphere") noSphere = true;
+    else if (a == "--build-only") quick = o.buildOnly = true;
     else if (a == "--explain") explainAll = true;
     else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
     else if (a == "--avx2") Bvh::setIsa(BvhIsa::Avx2);
-    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only] [--packets-only] [--no-sphere]\n"
+    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only] [--packets-only] [--build-only] [--no-sphere]\n"
                               "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
                               "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
                               "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
@@ -551,6 +583,7 @@ int main(int argc, char** argv) {
                               "  --count-only: builds, agreement and work per ray (counted), no timing\n"
                               "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"
                               "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
+                              "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
                               "  --no-sphere: only the --scene files\n"); return 2; }
   }
   if (threads == 0 || res <= 0 || rings < 2 || reps < 1) { std::fprintf(stderr, "bench-trace: bad argument\n"); return 2; }
