@@ -68,6 +68,11 @@ RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
 }
 
 constexpr float kTieWindow = 0x1p-10f;
+// Any hit: a packet with this many live rays or fewer walks on as single rays, two at a time
+// (alonePair): two interleaved single walks beat a packet of few live lanes. Shadow packets lose their
+// coherence on the temple (63 % of lanes live at box tests, 93 % with this): its shadow rays +15 %, the
+// sphere's -3 % (VM, docs/bench/trace.md round 10).
+constexpr int kAloneRays = 4;
 
 struct PacketEntry {
   F tNear;  // per ray; a ray whose entry is beyond its cull distance when popped drops out
@@ -485,18 +490,20 @@ struct PacketWalker {
     uint32_t heldRef = 0;
     for (;;) {
       for (;;) {
-        if ((active & (active - 1)) == 0) {  // one ray left: no packet to share the work with
-          const int i = ctz(active);
-          if constexpr (AnyHit) {
-            if (held < 0) {
-              held = i;
-              heldRef = ref;
-            } else {
-              done |= done >> held & 1 ? unsigned(alone(i, ref)) << i : alonePair(held, heldRef, i, ref);
-              held = -1;
+        if (__builtin_popcount(active) <= (AnyHit ? kAloneRays : 1)) {  // too few rays to share the work
+          for (; active; active &= active - 1) {
+            const int i = ctz(active);
+            if constexpr (AnyHit) {
+              if (held < 0) {
+                held = i;
+                heldRef = ref;
+              } else {
+                done |= done >> held & 1 ? unsigned(alone(i, ref)) << i : alonePair(held, heldRef, i, ref);
+                held = -1;
+              }
+            } else if (alone(i, ref)) {
+              done |= 1u << i;
             }
-          } else if (alone(i, ref)) {
-            done |= 1u << i;
           }
           break;
         }
