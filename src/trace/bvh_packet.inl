@@ -70,8 +70,8 @@ RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
 constexpr float kTieWindow = 0x1p-10f;
 // Any hit: a packet with this many live rays or fewer walks on as single rays, two at a time
 // (alonePair): two interleaved single walks beat a packet of few live lanes. Shadow packets lose their
-// coherence on the temple (63 % of lanes live at box tests, 93 % with this): its shadow rays +15 %, the
-// sphere's -3 % (VM, docs/bench/trace.md round 10).
+// coherence on the temple (63 % of lanes live at box tests, 93 % with this): its shadow rays +11-15 %,
+// the sphere's unchanged (VM, docs/bench/trace.md round 10).
 constexpr int kAloneRays = 4;
 
 struct PacketEntry {
@@ -459,15 +459,14 @@ struct PacketWalker {
     }
   }
 
-  // Any hit: rays a and b alone from `refA` and `refB` on (a and b may be the same ray), one node or leaf
-  // of each in turn, as Bvh::occludedPair: while one waits for memory the other works. Returns the rays
-  // found occluded.
-  RTR_INLINE unsigned alonePair(int a, uint32_t refA, int b, uint32_t refB) {
+  // Any hit: rays a and b alone from node or leaf `ref` on, one node or leaf of each in turn, as
+  // Bvh::occludedPair: while one waits for memory the other works. Returns the rays found occluded.
+  RTR_INLINE unsigned alonePair(int a, int b, uint32_t ref) {
     RTR_COUNT(c.lone += 2);
     const W& wa = walker(a);
     const W& wb = walker(b);
     uint64_t stackA[kStackSize], stackB[kStackSize];
-    Cursor atA{0, refA, tMax[a], false}, atB{0, refB, tMax[b], false};
+    Cursor atA{0, ref, tMax[a], false}, atB{0, ref, tMax[b], false};
     Hit scratch;
     bool moreA = true, moreB = true;
     while (moreA && moreB) {
@@ -485,22 +484,16 @@ struct PacketWalker {
     int sp = 0;
     uint32_t ref = bvh.root;
     unsigned done = 0;  // any hit: the rays already occluded
-    // Any hit: a ray left alone in a subtree waits here for a second one to walk beside it (alonePair).
-    int held = -1;
-    uint32_t heldRef = 0;
     for (;;) {
       for (;;) {
         if (__builtin_popcount(active) <= (AnyHit ? kAloneRays : 1)) {  // too few rays to share the work
-          for (; active; active &= active - 1) {
+          while (active) {
             const int i = ctz(active);
-            if constexpr (AnyHit) {
-              if (held < 0) {
-                held = i;
-                heldRef = ref;
-              } else {
-                done |= done >> held & 1 ? unsigned(alone(i, ref)) << i : alonePair(held, heldRef, i, ref);
-                held = -1;
-              }
+            active &= active - 1;
+            if (AnyHit && active) {
+              const int j = ctz(active);
+              active &= active - 1;
+              done |= alonePair(i, j, ref);
             } else if (alone(i, ref)) {
               done |= 1u << i;
             }
@@ -531,10 +524,7 @@ struct PacketWalker {
       }
       for (;;) {
         if (sp == 0) {
-          if constexpr (AnyHit) {
-            if (held >= 0 && !(done >> held & 1) && alone(held, heldRef)) done |= 1u << held;
-            return done;
-          }
+          if constexpr (AnyHit) return done;
           unsigned retry = 0;
           for (int i = 0; i < 8; ++i)
             if (best[i] < kInf && !(second[i] > best[i] * (1.0f + kTieWindow))) retry |= 1u << i;
