@@ -3,7 +3,7 @@
 // tested one after another against all rays of the packet at once, each ray with exactly the slab
 // arithmetic of its single-ray walk. Leaves are tested all rays at once (lanes = rays) where enough rays
 // reach them, else ray by ray with the single-ray 8-wide triangle test. A ray left alone in a subtree
-// walks it as a single ray. See docs/tracer.md.
+// walks it as a single ray (any hit: four rays or fewer, two at a time). See docs/tracer.md.
 //
 // Why the results equal the single-ray ones bit for bit:
 // * Any hit: a ray's tMax never changes, so each box and each triangle gets the same answer for a ray
@@ -70,7 +70,7 @@ RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
 constexpr float kTieWindow = 0x1p-10f;
 // Any hit: a packet with this many live rays or fewer walks on as single rays, two at a time
 // (alonePair): two interleaved single walks beat a packet of few live lanes. Shadow packets lose their
-// coherence on the temple (63 % of lanes live at box tests, 93 % with this): its shadow rays +11-15 %,
+// coherence on the temple (63 % of lanes live at box tests, 93 % with this): its shadow rays +9-14 %,
 // the sphere's unchanged (VM, docs/bench/trace.md round 10).
 constexpr int kAloneRays = 4;
 
