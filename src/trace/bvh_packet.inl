@@ -3,7 +3,7 @@
 // tested one after another against all rays of the packet at once, each ray with exactly the slab
 // arithmetic of its single-ray walk. Leaves are tested all rays at once (lanes = rays) where enough rays
 // reach them, else ray by ray with the single-ray 8-wide triangle test. A ray left alone in a subtree
-// walks it as a single ray. See docs/tracer.md.
+// walks it as a single ray (any hit: four rays or fewer, two at a time). See docs/tracer.md.
 //
 // Why the results equal the single-ray ones bit for bit:
 // * Any hit: a ray's tMax never changes, so each box and each triangle gets the same answer for a ray
@@ -68,6 +68,11 @@ RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
 }
 
 constexpr float kTieWindow = 0x1p-10f;
+// Any hit: a packet with this many live rays or fewer walks on as single rays, two at a time
+// (alonePair): two interleaved single walks beat a packet of few live lanes. Shadow packets lose their
+// coherence on the temple (63 % of lanes live at box tests, 93 % with this): its shadow rays +9-14 %,
+// the sphere's unchanged (VM, docs/bench/trace.md round 10).
+constexpr int kAloneRays = 4;
 
 struct PacketEntry {
   F tNear;  // per ray; a ray whose entry is beyond its cull distance when popped drops out
@@ -454,6 +459,25 @@ struct PacketWalker {
     }
   }
 
+  // Any hit: rays a and b alone from node or leaf `ref` on, one node or leaf of each in turn, as
+  // Bvh::occludedPair: while one waits for memory the other works. Returns the rays found occluded.
+  RTR_INLINE unsigned alonePair(int a, int b, uint32_t ref) {
+    RTR_COUNT(c.lone += 2);
+    const W& wa = walker(a);
+    const W& wb = walker(b);
+    uint64_t stackA[kStackSize], stackB[kStackSize];
+    Cursor atA{0, ref, tMax[a], false}, atB{0, ref, tMax[b], false};
+    Hit scratch;
+    bool moreA = true, moreB = true;
+    while (moreA && moreB) {
+      moreA = wa.step(stackA, atA, scratch);
+      moreB = wb.step(stackB, atB, scratch);
+    }
+    if (moreA) wa.run(stackA, atA, scratch);
+    if (moreB) wb.run(stackB, atB, scratch);
+    return unsigned(atA.found) << a | unsigned(atB.found) << b;
+  }
+
   // Walks the packet; any hit: returns the occluded rays; closest hit: the rays to trace again alone.
   RTR_INLINE unsigned run(unsigned active) {
     PacketEntry stack[kStackSize];
@@ -462,9 +486,18 @@ struct PacketWalker {
     unsigned done = 0;  // any hit: the rays already occluded
     for (;;) {
       for (;;) {
-        if ((active & (active - 1)) == 0) {  // one ray left: no packet to share the work with
-          const int i = ctz(active);
-          if (alone(i, ref)) done |= 1u << i;
+        if (__builtin_popcount(active) <= (AnyHit ? kAloneRays : 1)) {  // too few rays to share the work
+          while (active) {
+            const int i = ctz(active);
+            active &= active - 1;
+            if (AnyHit && active) {
+              const int j = ctz(active);
+              active &= active - 1;
+              done |= alonePair(i, j, ref);
+            } else if (alone(i, ref)) {
+              done |= 1u << i;
+            }
+          }
           break;
         }
         if (ref & Bvh::kLeafBit) {
