@@ -78,6 +78,14 @@ struct GpuResult {
 
 class CullTest : public test::VulkanTest {
  protected:
+  // The clusters in a storage buffer, as the renderer's culling reads them.
+  vk::Buffer clusterBuffer(const std::vector<GpuCluster>& clusters) {
+    vk::Buffer buf(*ctx, clusters.size() * sizeof(GpuCluster), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload,
+                   "clusters");
+    std::memcpy(buf.mapped(), clusters.data(), clusters.size() * sizeof(GpuCluster));
+    buf.flush();
+    return buf;
+  }
   // Runs the pass (the pyramid already built, or none) and reads back its list and counts.
   GpuResult cull(ClusterCuller& culler, const vk::Buffer& clusters, uint32_t count, const CullCamera& cam,
                  const DepthPyramid* pyramid, const std::function<void(VkCommandBuffer)>& before = {},
@@ -177,9 +185,7 @@ TEST_F(CullTest, GpuMatchesCpuForRandomClustersAndCameras) {
     c.cone = {glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f)), u(rng) * 2.4f - 1.2f};
     c.triangleCount = 1;
   }
-  vk::Buffer buf(*ctx, kCount * sizeof(GpuCluster), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "clusters");
-  std::memcpy(buf.mapped(), clusters.data(), kCount * sizeof(GpuCluster));
-  buf.flush();
+  const vk::Buffer buf = clusterBuffer(clusters);
 
   DepthPyramid pyramid(*ctx, e);
   ClusterCuller culler(*ctx, kCount);
@@ -364,9 +370,7 @@ TEST_F(CullTest, NeverRemovesAVisibleClusterOfTheTemple) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   const std::vector<GpuCluster> clusters = render::gpuClusters(scene);
   const uint32_t n = uint32_t(clusters.size());
-  vk::Buffer buf(*ctx, n * sizeof(GpuCluster), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "clusters");
-  std::memcpy(buf.mapped(), clusters.data(), n * sizeof(GpuCluster));
-  buf.flush();
+  const vk::Buffer buf = clusterBuffer(clusters);
   const VkExtent2D e{320, 200};
   const float aspect = float(e.width) / float(e.height);
   IdRenderer ids(*ctx, scene, e);
@@ -418,9 +422,7 @@ TEST_F(CullTest, TwoPhaseNeverRemovesAVisibleClusterWhileTheCameraMoves) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   const std::vector<GpuCluster> clusters = render::gpuClusters(scene);
   const uint32_t n = uint32_t(clusters.size());
-  vk::Buffer buf(*ctx, n * sizeof(GpuCluster), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "clusters");
-  std::memcpy(buf.mapped(), clusters.data(), n * sizeof(GpuCluster));
-  buf.flush();
+  const vk::Buffer buf = clusterBuffer(clusters);
   const VkExtent2D e{320, 200};
   const float aspect = float(e.width) / float(e.height);
   IdRenderer ids(*ctx, scene, e);
@@ -482,9 +484,7 @@ TEST_F(CullTest, ListsLongerThanOneDispatchRowGoTwoDimensional) {
   std::vector<GpuCluster> clusters(n);
   for (uint32_t i = 0; i < n; ++i)  // all in front of the camera, no cone
     clusters[i] = {glm::vec4(float(i % 7) * 0.1f, float(i % 5) * 0.1f, 0.0f, 0.1f), glm::vec4(0, 0, 1, 2), 0, 0, 1, 0};
-  vk::Buffer buf(*ctx, n * sizeof(GpuCluster), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "clusters");
-  std::memcpy(buf.mapped(), clusters.data(), n * sizeof(GpuCluster));
-  buf.flush();
+  const vk::Buffer buf = clusterBuffer(clusters);
   ClusterCuller culler(*ctx, n);
   const CameraPose pose{{0.0f, 0.0f, 5.0f}, 0.0f, 0.0f};
   const GpuResult r = cull(culler, buf, n, cameraFor(pose, Lens{}, {64, 64}), nullptr);
