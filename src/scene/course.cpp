@@ -39,7 +39,7 @@ std::string encodeCourseMesh(const Scene& scene) {
   }
   w.u32(uint32_t(scene.materials.size()));
   for (const Material& m : scene.materials)
-    for (uint32_t id : m.textures) w.u32(id);
+    for (uint32_t s = 0; s < kCourseSlotCount; ++s) w.u32(m.textures[s]);
   w.u32(uint32_t(scene.meshes.size()));
   for (const Mesh& m : scene.meshes) {
     const size_t v = m.positions.size();
@@ -91,7 +91,7 @@ Scene decodeCourseMesh(std::span<const uint8_t> bytes, const std::string& file) 
   for (uint32_t i = 0; i < matCount; ++i) {
     Material& m = raw.materials[i];
     m.name = "material" + std::to_string(i);
-    for (uint32_t s = 0; s < kTextureSlotCount; ++s) {
+    for (uint32_t s = 0; s < kCourseSlotCount; ++s) {
       const size_t at = r.pos();
       const uint32_t id = r.u32("a material texture index");
       if (id != kNoTexture && id >= texCount)

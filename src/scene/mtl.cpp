@@ -24,6 +24,7 @@ SlotFormat slotFormat(TextureSlot slot) {
     case TextureSlot::AlphaMask: return {true, 4};
     case TextureSlot::NormalMap: return {false, 3};
     case TextureSlot::Emissive: return {true, 4};
+    case TextureSlot::Occlusion: return {false, 1};
     default: return {false, 4};
   }
 }

@@ -335,7 +335,7 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     w.f32(m.mirror);
     w.f32(m.ior);
     w.f32(m.transparency);
-    for (uint32_t id : m.textures) w.u32(id);
+    for (uint32_t s = 0; s < kCourseSlotCount; ++s) w.u32(m.textures[s]);
   }
   w.pad(kAlign);
   for (const Mesh& m : scene.meshes) {
@@ -474,7 +474,8 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     m.mirror = readFinite(r, "a material factor");
     m.ior = readFinite(r, "a material factor");
     m.transparency = readFinite(r, "a material factor");
-    for (uint32_t& id : m.textures) {
+    for (uint32_t s = 0; s < kCourseSlotCount; ++s) {
+      uint32_t& id = m.textures[s];
       const size_t idAt = r.pos();
       id = r.u32("a material texture index");
       if (id != kNoTexture && id >= texCount)

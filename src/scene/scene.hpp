@@ -8,29 +8,62 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+
+#include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "core/bounds.hpp"
 #include "core/camera.hpp"
 
 namespace rtr {
 
-// Texture slots in the course format's order (FORMATS.md §1).
-enum class TextureSlot : uint32_t { BaseColor, Roughness, Metalness, AlphaMask, NormalMap, Emissive, Count };
+// Texture slots: the course format's six in its order (docs/formats.md), then glTF's occlusion, which
+// the course format does not store.
+enum class TextureSlot : uint32_t { BaseColor, Roughness, Metalness, AlphaMask, NormalMap, Emissive, Occlusion, Count };
 constexpr uint32_t kTextureSlotCount = uint32_t(TextureSlot::Count);
+constexpr uint32_t kCourseSlotCount = 6;  // the slots the course format and MTL files carry
 constexpr uint32_t kNoTexture = 0xFFFFFFFFu;
 
+// How a texture is sampled: glTF samplers. OBJ/MTL textures repeat and filter trilinearly (the default).
+enum class Wrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+struct SamplerDesc {
+  Wrap wrapU = Wrap::Repeat, wrapV = Wrap::Repeat;
+  bool nearestMag = false, nearestMin = false;  // nearest texel instead of linear
+  bool nearestMip = false;                      // nearest mip level instead of linear between two
+  bool operator==(const SamplerDesc&) const = default;
+};
+
 struct Texture {
-  std::filesystem::path path;  // absolute, or relative to Scene::baseDir
+  std::filesystem::path path;  // absolute, or relative to Scene::baseDir; with `bytes`: a name for messages
   bool srgb = false;
   uint8_t channels = 4;        // channel count the slot needs; loaders force it
+  // channels == 1: which channel of the decoded image it takes (glTF packs roughness in G, metalness
+  // in B, occlusion in R of its textures); 0 for a grey image.
+  uint8_t sourceChannel = 0;
+  SamplerDesc sampler;
+  // The encoded image (PNG, JPEG) held in memory: a glTF data URI or buffer view. Null: read `path`.
+  std::shared_ptr<const std::vector<uint8_t>> bytes;
+};
+
+// KHR_texture_transform: uv' = offset + R(rotation) · (scale ⊙ uv), taken from texcoord set `texCoord`.
+struct UvTransform {
+  glm::vec2 offset{0.0f};
+  float rotation = 0.0f;  // radians, counter-clockwise in uv space
+  glm::vec2 scale{1.0f};
+  uint32_t texCoord = 0;  // 0: Mesh::texcoords, 1: Mesh::texcoords1
+  bool identity() const { return offset == glm::vec2(0.0f) && rotation == 0.0f && scale == glm::vec2(1.0f); }
 };
 
 enum MaterialFlags : uint32_t {
   kMaterialAlphaMasked = 1u << 0,
   kMaterialDoubleSided = 1u << 1,
   kMaterialLight = 1u << 2,  // the ray tracer's lights: material name contains "light"
+  kMaterialBlend = 1u << 3,  // glTF alphaMode BLEND: drawn after the opaque ones, blended by its alpha
+  kMaterialUnlit = 1u << 4,  // KHR_materials_unlit: the base colour is the result
+  kMaterialGltf = 1u << 5,   // a glTF metallic-roughness material (its BRDF and texture conventions)
 };
 
 struct Material {
@@ -40,9 +73,14 @@ struct Material {
   glm::vec3 baseColor{1.0f};
   float roughness = 1.0f;
   float metalness = 0.0f;
-  glm::vec3 emissive{0.0f};
-  std::array<uint32_t, kTextureSlotCount> textures{kNoTexture, kNoTexture, kNoTexture,
+  glm::vec3 emissive{0.0f};   // glTF: emissiveFactor × KHR_materials_emissive_strength
+  float opacity = 1.0f;       // glTF baseColorFactor's alpha
+  float alphaCutoff = 0.5f;   // alpha-masked: texels below it are cut out
+  float normalScale = 1.0f;   // glTF normalTexture.scale
+  float occlusionStrength = 1.0f;
+  std::array<uint32_t, kTextureSlotCount> textures{kNoTexture, kNoTexture, kNoTexture, kNoTexture,
                                                    kNoTexture, kNoTexture, kNoTexture};
+  std::array<UvTransform, kTextureSlotCount> uv{};  // per slot; identity for OBJ/MTL
   // Classic Blinn-Phong factors (ray tracer, brief Part 1). Defaults per FORMATS.md §2.
   glm::vec3 ka{0.5f}, kd{0.5f}, ks{0.5f}, ke{0.0f};
   float ns = 1.0f;
@@ -68,8 +106,11 @@ struct Mesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;    // same count as positions
   std::vector<glm::vec2> texcoords;  // empty when the source has none
+  std::vector<glm::vec2> texcoords1; // a second uv set (glTF TEXCOORD_1); empty when none
+  std::vector<glm::vec4> tangents;   // xyz unit tangent, w ±1 bitangent sign (glTF); empty when none
+  std::vector<glm::vec4> colors;     // linear RGBA vertex colours (glTF COLOR_0, OBJ `v x y z r g b`); empty when none
   std::vector<uint32_t> indices;     // triangle list, local to the mesh
-  Bounds bounds;
+  Bounds bounds;                     // object space (before any instance transform)
   std::vector<Cluster> clusters;     // tile the triangles in order; empty until built (scene/clusters.hpp)
 
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
@@ -78,15 +119,25 @@ struct Mesh {
 // A light in scene space. Point lights and the ray tracer's area lights (FORMATS.md §2); a headlight sits
 // at the camera, wherever it is (the default light of a scene that has none: scene/lights.hpp).
 struct Light {
-  enum class Kind : uint32_t { Point, Area, Headlight };
+  // Spot and Directional: glTF's KHR_lights_punctual.
+  enum class Kind : uint32_t { Point, Area, Headlight, Spot, Directional };
   Kind kind = Kind::Point;
   glm::vec3 position{0.0f};  // point light position, or the area light's centre
   glm::vec3 color{1.0f};     // colour x intensity
   bool falloff = false;      // inverse-square falloff with distance
   glm::vec3 corner{0.0f}, edge1{0.0f}, edge2{0.0f};  // area light: corner + s·edge1 + t·edge2
   glm::vec3 normal{0.0f};    // area light: normal of its first face
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // spot and directional: the unit direction the light travels
+  float innerConeCos = 1.0f, outerConeCos = 0.0f;  // spot: full inside the inner cone, none outside the outer
+  float range = 0.0f;        // > 0: no light beyond this distance (glTF range); 0: unbounded
   // Where to aim shadow ray `i` of `n` (n = 1: the centre; otherwise a stratified grid on the quad).
   glm::vec3 samplePoint(int i, int n) const;
+};
+
+// One placement of a mesh: glTF nodes that use the same mesh share its geometry (instances, not copies).
+struct Instance {
+  uint32_t mesh = 0;
+  glm::mat4 transform{1.0f};  // object to scene space
 };
 
 struct Scene {
@@ -94,16 +145,17 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<Material> materials;
   std::vector<Mesh> meshes;
+  // Where the meshes are drawn. Empty: each mesh once, as it is (OBJ, the course format); otherwise only
+  // these placements are drawn, and a mesh no instance names is not.
+  std::vector<Instance> instances;
   std::optional<CameraPose> defaultView;
+  float defaultFovYDeg = 0.0f;  // the stored camera's vertical field of view (glTF); 0: the tool's own
   // Lights stored with the scene (.rtrscene, the course format's standard light). Empty: the scene's
   // lights are its `*light*` geometry (scene/lights.hpp).
   std::vector<Light> lights;
 
-  Bounds bounds() const {
-    Bounds b;
-    for (const Mesh& m : meshes) b.extend(m.bounds);
-    return b;
-  }
+  // Scene-space bounds of everything drawn (instances' transformed boxes).
+  Bounds bounds() const;
 };
 
 }  // namespace rtr
