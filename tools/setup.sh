@@ -11,6 +11,7 @@ BOOKWORM_PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev libcli11-dev libtinyobjloader-dev libmeshoptimizer-dev
   libdraco-dev gltfpack assimp-utils
   libimgui-dev xvfb xdotool x11-utils clang libclang-rt-14-dev python3 assimp-testmodels
+  libsimdjson-dev
 )
 # Not in bookworm: taken from later suites through a low apt pin (priority 100), by name only.
 PINNED_PKGS=(libspirv-reflect-dev/sid libvulkan-memory-allocator-dev/trixie)
