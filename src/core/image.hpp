@@ -33,6 +33,8 @@ struct TexelData {
 
 TexelData loadImage(const std::filesystem::path& file, int channels);  // throws rtr::Error naming the file
 void savePng(const std::filesystem::path& file, const ImageRGBA8& image);  // PNG whatever the name says
+// A linear-light image, .hdr (Radiance) or .exr (OpenEXR), as floats. Throws rtr::Error naming the file.
+ImageF loadLinearImage(const std::filesystem::path& file);
 
 // Output format by extension; anything else is a UsageError that lists these.
 enum class ImageFormat { Png, Jpg, Exr, Hdr };
