@@ -37,6 +37,8 @@ TexelData loadImage(const std::filesystem::path& file, int channels);  // throws
 // An encoded image (PNG, JPEG, or what stb reads) in memory; `name` names it in errors.
 TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, int channels);
 void savePng(const std::filesystem::path& file, const ImageRGBA8& image);  // PNG whatever the name says
+// A linear-light image, .hdr (Radiance) or .exr (OpenEXR), as floats. Throws rtr::Error naming the file.
+ImageF loadLinearImage(const std::filesystem::path& file);
 
 // Output format by extension; anything else is a UsageError that lists these.
 enum class ImageFormat { Png, Jpg, Exr, Hdr };

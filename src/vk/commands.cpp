@@ -68,7 +68,7 @@ void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images) {
     ib.newLayout = b.newLayout;
     ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     ib.image = b.image;
-    ib.subresourceRange = {b.aspect, b.baseMip, b.mipCount, 0, 1};
+    ib.subresourceRange = {b.aspect, b.baseMip, b.mipCount, 0, VK_REMAINING_ARRAY_LAYERS};
     bs.push_back(ib);
   }
   VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};

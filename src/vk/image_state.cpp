@@ -103,7 +103,7 @@ void require(VkCommandBuffer cb, std::initializer_list<Requirement> reqs) {
         b.dstAccessMask = u.access;
         b.oldLayout = b.newLayout = s.layout;
         b.image = r.image.image;
-        b.subresourceRange = {r.image.aspect, 0, VK_REMAINING_MIP_LEVELS, 0, 1};
+        b.subresourceRange = {r.image.aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
         bs.push_back(b);
         names.push_back(r.image.name);
       }
@@ -120,7 +120,7 @@ void require(VkCommandBuffer cb, std::initializer_list<Requirement> reqs) {
     b.oldLayout = r.discard ? VK_IMAGE_LAYOUT_UNDEFINED : s.layout;
     b.newLayout = u.layout;
     b.image = r.image.image;
-    b.subresourceRange = {r.image.aspect, 0, VK_REMAINING_MIP_LEVELS, 0, 1};
+    b.subresourceRange = {r.image.aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
     bs.push_back(b);
     names.push_back(r.image.name);
     if (u.write) s = {u.layout, r.stage, u.access & ~(VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT), 0};

@@ -58,12 +58,12 @@ bool isDepthFormat(VkFormat f) {
 
 Image::Image(const Context& ctx, const ImageDesc& desc) : device_(ctx.device()), allocator_(ctx.allocator()), desc_(desc) {
   VkImageCreateInfo ii{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  ii.flags = desc.flags;
+  ii.flags = desc.flags | (desc.cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0u);
   ii.imageType = VK_IMAGE_TYPE_2D;
   ii.format = desc.format;
   ii.extent = {desc.extent.width, desc.extent.height, 1};
   ii.mipLevels = desc.mipLevels;
-  ii.arrayLayers = 1;
+  ii.arrayLayers = desc.cube ? 6 : 1;
   ii.samples = VK_SAMPLE_COUNT_1_BIT;
   ii.tiling = VK_IMAGE_TILING_OPTIMAL;
   ii.usage = desc.usage;
@@ -79,15 +79,16 @@ Image::Image(const Context& ctx, const ImageDesc& desc) : device_(ctx.device()),
   if (desc.usage & kViewUsage) view_ = createView(desc.format, 0, desc.mipLevels, desc.viewUsage ? desc.viewUsage : desc.usage);
 }
 
-ImageView Image::createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage) const {
+ImageView Image::createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage,
+                            bool faces) const {
   VkImageViewUsageCreateInfo ui{VK_STRUCTURE_TYPE_IMAGE_VIEW_USAGE_CREATE_INFO};
   ui.usage = usage;
   VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, &ui};
   vi.image = image_;
-  vi.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  vi.viewType = !desc_.cube ? VK_IMAGE_VIEW_TYPE_2D : faces ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_CUBE;
   vi.format = format;
   vi.subresourceRange = {VkImageAspectFlags(isDepthFormat(format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT),
-                         baseMip, mipCount, 0, 1};
+                         baseMip, mipCount, 0, desc_.cube ? 6u : 1u};
   VkImageView view;
   VK_CHECK(vkCreateImageView(device_, &vi, nullptr, &view));
   return ImageView(device_, view);

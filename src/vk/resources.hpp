@@ -92,6 +92,7 @@ struct ImageDesc {
   VkImageCreateFlags flags = 0;     // e.g. MUTABLE_FORMAT for a UNORM storage view of an sRGB image
   VkImageUsageFlags viewUsage = 0;  // usage of the default view when narrower than `usage` (0: same)
   const char* name = nullptr;
+  bool cube = false;                // six layers, CUBE_COMPATIBLE; the default view is a cube
 };
 
 class Image {
@@ -115,8 +116,10 @@ class Image {
             VkImageAspectFlags(isDepthFormat(desc_.format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT)};
   }
 
-  // A view of a mip range in another (compatible) format with a given usage, owned by the caller.
-  ImageView createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage) const;
+  // A view of a mip range in another (compatible) format with a given usage, owned by the caller. A cube
+  // image's views are cubes, or arrays of its six faces (storage writes) where `faces` says so.
+  ImageView createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage,
+                       bool faces = false) const;
 
  private:
   VkDevice device_ = VK_NULL_HANDLE;

@@ -1,5 +1,5 @@
-// rtr-bench-gpu: times mip generation (64 textures, blit and compute) and the mosaic post-process
-// (compute, graphics, off) with GPU timestamps; min / median over --runs submissions after --warmup ones.
+// rtr-bench-gpu: times mip generation (64 textures, blit and compute), the mosaic post-process
+// (compute, graphics, off) and the environment's prefiltering passes with GPU timestamps; min / median over --runs submissions after --warmup ones.
 // Mips also report the largest difference, in LSB, of any texel of any texture from the float64 reference.
 // Prints a Markdown table and "csv," lines. Headless: no window, no validation unless RTR_VALIDATION=1.
 #include <algorithm>
@@ -14,7 +14,9 @@
 #include <glm/gtc/packing.hpp>
 
 #include "core/mip_reference.hpp"
+#include "render/environment_maps.hpp"
 #include "render/mips.hpp"
+#include "scene/environment.hpp"
 #include "render/post.hpp"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
@@ -228,6 +230,49 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
   return rows;
 }
 
+// The environment's prefiltering (render/environment_maps.hpp) of a generated sky of w x h, pass by pass:
+// each run builds the maps in one submission with its own timestamps.
+std::vector<Row> benchEnvironment(const vk::Context& ctx, VkExtent2D extent, int warmup, int runs) {
+  SkySettings sky;
+  sky.width = extent.width;
+  sky.height = extent.height;
+  const Environment env(makeSky(sky), 1.0f, 0.0f);
+  std::vector<std::vector<double>> ms;
+  std::vector<std::string> names;
+  render::EnvironmentMapSettings used;
+  for (int i = 0; i < warmup + runs; ++i) {
+    const render::EnvironmentMaps maps(ctx, env);
+    used = maps.settings();
+    if (i < warmup) continue;
+    double total = 0.0;
+    for (size_t p = 0; p < maps.times().size(); ++p) {
+      if (ms.size() <= p) ms.emplace_back(), names.push_back(maps.times()[p].first);
+      ms[p].push_back(maps.times()[p].second);
+      total += maps.times()[p].second;
+    }
+    if (ms.size() <= maps.times().size()) ms.emplace_back(), names.push_back("env total");
+    ms[maps.times().size()].push_back(total);
+  }
+  std::vector<Row> rows;
+  const std::string size = std::to_string(extent.width) + "x" + std::to_string(extent.height);
+  const std::string mode = "cube " + std::to_string(used.sourceSize) + " specular " + std::to_string(used.specularSize) +
+                           "x" + std::to_string(used.specularLevels) + " levels " + std::to_string(used.samples) + " samples";
+  for (size_t p = 0; p < ms.size(); ++p) {
+    std::sort(ms[p].begin(), ms[p].end());
+    Row r;
+    r.pass = names[p];
+    r.size = size;
+    r.mode = mode;
+    r.minMs = ms[p].front();
+    r.medianMs = ms[p][ms[p].size() / 2];
+    r.runs = runs;
+    r.error = "tests: CPU references (environment_maps_test)";
+    rows.push_back(r);
+  }
+  std::fprintf(stderr, "  environment %s: median total %.3f ms\n", size.c_str(), rows.back().medianMs);
+  return rows;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -239,7 +284,7 @@ int main(int argc, char** argv) {
   app.add_option("--runs", runs, "timed submissions per case (min / median)")->check(CLI::Range(1, 10000));
   app.add_option("--warmup", warmup, "untimed submissions first")->check(CLI::Range(0, 1000));
   app.add_option("--textures", textures, "textures per mip case")->check(CLI::Range(1, 1024));
-  app.add_option("--only", only, "mips or mosaic")->check(CLI::IsMember({"mips", "mosaic"}));
+  app.add_option("--only", only, "mips, mosaic or env")->check(CLI::IsMember({"mips", "mosaic", "env"}));
   app.add_option("--mip-sizes", sizes, "texture sizes of the mip cases (WxH ...)");
   app.add_flag("--mips-per-texture", perTexture, "one MipGenerator::record call per texture instead of one batch");
   CLI11_PARSE(app, argc, argv);
@@ -248,17 +293,18 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "device: %s (%s)\n", ctx.deviceName().c_str(), ctx.driverInfo().c_str());
     std::vector<Row> rows;
     auto add = [&](std::vector<Row> r) { rows.insert(rows.end(), r.begin(), r.end()); };
-    if (only != "mosaic") {
+    if (only.empty() || only == "mips") {
       for (const std::string& s : sizes) {
         unsigned w = 0, h = 0;
         if (std::sscanf(s.c_str(), "%ux%u", &w, &h) != 2 || !w || !h) throw std::runtime_error("--mip-sizes " + s + ": expected WxH");
         add(benchMips(ctx, {w, h}, textures, warmup, runs, !perTexture));
       }
     }
-    if (only != "mips") {
+    if (only.empty() || only == "mosaic") {
       add(benchMosaic(ctx, {1920, 1080}, warmup, runs));
       add(benchMosaic(ctx, {3840, 2160}, warmup, runs));
     }
+    if (only.empty() || only == "env") add(benchEnvironment(ctx, {2048, 1024}, std::min(warmup, 1), std::min(runs, 10)));
     std::printf("Device: %s (%s)\n\n", ctx.deviceName().c_str(), ctx.driverInfo().c_str());
     std::printf("| pass | size | mode | min ms | median ms | runs | error |\n|---|---|---|---:|---:|---:|---|\n");
     for (const Row& r : rows)

@@ -1,0 +1,49 @@
+#pragma once
+// An environment prepared for shading by the split-sum approximation, in compute (docs/environment.md):
+// the equirectangular map onto a cube with its mip chain (the source), a GGX-prefiltered specular cube
+// with one roughness per mip, diffuse irradiance as 9 spherical-harmonic coefficients, and the split-sum
+// BRDF table. Built in one submission when made; each pass timed. No window, no scene.
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scene/environment.hpp"
+#include "vk/resources.hpp"
+
+namespace rtr::vk { class Context; }
+
+namespace rtr::render {
+
+struct EnvironmentMapSettings {
+  uint32_t sourceSize = 0;     // source cube face; 0: a quarter of the map's width, 32..512, a power of two
+  uint32_t specularSize = 128; // level 0 of the specular cube (roughness 0)
+  uint32_t specularLevels = 5; // roughness (level / (levels - 1)); the last level is at least 8²
+  uint32_t samples = 256;      // half vectors per specular texel
+  uint32_t lutSize = 64;
+  uint32_t lutSamples = 256;
+};
+
+class EnvironmentMaps {
+ public:
+  // Throws rtr::Error for an empty environment or a device that cannot filter 32-bit float images.
+  EnvironmentMaps(const vk::Context& ctx, const Environment& env, const EnvironmentMapSettings& settings = {});
+
+  const vk::Image& source() const { return source_; }      // RGBA32F cube with mips
+  const vk::Image& specular() const { return specular_; }  // RGBA16F cube, roughness per mip
+  const vk::Image& brdfLut() const { return lut_; }        // RG16F (A, B)
+  VkBuffer sh() const { return sh_.handle(); }             // 9 vec4: rgb coefficients
+  VkSampler sampler() const { return sampler_; }           // linear, mips, clamped
+  const EnvironmentMapSettings& settings() const { return settings_; }
+  // GPU milliseconds of each pass of the build, in order: cube, source mips, specular, sh, lut.
+  const std::vector<std::pair<std::string, double>>& times() const { return times_; }
+
+ private:
+  EnvironmentMapSettings settings_;
+  vk::Image source_, specular_, lut_;
+  vk::Buffer sh_;
+  vk::Sampler sampler_;
+  std::vector<std::pair<std::string, double>> times_;
+};
+
+}  // namespace rtr::render

@@ -1,0 +1,217 @@
+#include "scene/cluster_lod.hpp"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "cluster.h"
+#include "cluster_lod.h"
+
+namespace rtr {
+
+namespace {
+
+using Indices = std::vector<uint32_t>;
+
+glm::vec4 sphereOf(const uint32_t* idx, size_t count, const Mesh& mesh) {
+  const meshopt_Bounds b =
+      meshopt_computeClusterBounds(idx, count, &mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3));
+  return {b.center[0], b.center[1], b.center[2], b.radius};
+}
+
+// The smallest sphere around both (exact for two spheres).
+glm::vec4 merge(glm::vec4 a, glm::vec4 b) {
+  const glm::vec3 ca(a), cb(b);
+  const float d = glm::length(cb - ca);
+  if (d + b.w <= a.w) return a;
+  if (d + a.w <= b.w) return b;
+  const float r = 0.5f * (d + a.w + b.w);
+  return glm::vec4(ca + (cb - ca) * ((r - a.w) / d), r * (1.0f + 1e-6f));  // a hair larger: rounding
+}
+
+// A triangle list over a vertex buffer of its own (meshoptimizer's builders cost per vertex they are
+// given, so a group's work must not scale with the whole mesh).
+struct Local {
+  std::vector<uint32_t> toMesh;  // local vertex -> mesh vertex
+  std::vector<glm::vec3> positions;
+  Indices indices;
+  Local(const Indices& tris, const Mesh& mesh) : indices(tris.size()) {
+    std::unordered_map<uint32_t, uint32_t> toLocal;
+    for (size_t i = 0; i < tris.size(); ++i) {
+      const auto [it, added] = toLocal.try_emplace(tris[i], uint32_t(toMesh.size()));
+      if (added) toMesh.push_back(tris[i]), positions.push_back(mesh.positions[tris[i]]);
+      indices[i] = it->second;
+    }
+  }
+};
+
+// Splits a triangle list into clusters of at most 64 vertices and 124 triangles (as the mesh's own).
+std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
+  constexpr size_t kMaxV = CLUSTER_MAX_VERTICES, kMaxT = CLUSTER_MAX_TRIANGLES;
+  const Local l(tris, mesh);
+  std::vector<meshopt_Meshlet> ml(meshopt_buildMeshletsBound(tris.size(), kMaxV, kMaxT));
+  std::vector<unsigned> verts(ml.size() * kMaxV);
+  std::vector<unsigned char> local(ml.size() * kMaxT * 3);
+  ml.resize(meshopt_buildMeshlets(ml.data(), verts.data(), local.data(), l.indices.data(), l.indices.size(),
+                                  &l.positions[0].x, l.positions.size(), sizeof(glm::vec3), kMaxV, kMaxT, 0.0f));
+  std::vector<Indices> out;
+  for (const meshopt_Meshlet& m : ml) {
+    Indices c(size_t(m.triangle_count) * 3);
+    for (size_t k = 0; k < c.size(); ++k) c[k] = l.toMesh[verts[m.vertex_offset + local[m.triangle_offset + k]]];
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// Groups of up to four clusters that share the most edges, grown greedily in the clusters' order (which
+// split() makes spatially coherent). Neighbours by shared edges keep each group's outer border short,
+// so locking it still leaves most of the group free to simplify.
+std::vector<std::vector<uint32_t>> groupClusters(const std::vector<Indices>& clusters) {
+  const uint32_t n = uint32_t(clusters.size());
+  std::unordered_map<uint64_t, uint32_t> edgeOwner;
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> shared(n);  // (neighbour, edges), per cluster
+  auto addShared = [&](uint32_t a, uint32_t b) {
+    for (auto* list : {&shared[a], &shared[b]}) {
+      const uint32_t other = list == &shared[a] ? b : a;
+      auto it = std::find_if(list->begin(), list->end(), [&](auto& p) { return p.first == other; });
+      if (it == list->end()) list->push_back({other, 1});
+      else ++it->second;
+    }
+  };
+  for (uint32_t c = 0; c < n; ++c)
+    for (size_t t = 0; t < clusters[c].size(); t += 3)
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t u = clusters[c][t + e], v = clusters[c][t + (e + 1) % 3];
+        const uint64_t key = uint64_t(std::min(u, v)) << 32 | std::max(u, v);
+        const auto [it, added] = edgeOwner.try_emplace(key, c);
+        if (!added && it->second != c) addShared(it->second, c);
+      }
+  std::vector<int> group(n, -1);
+  std::vector<std::vector<uint32_t>> groups;
+  for (uint32_t seed = 0; seed < n; ++seed) {
+    if (group[seed] >= 0) continue;
+    std::vector<uint32_t> g{seed};
+    group[seed] = int(groups.size());
+    while (g.size() < 4) {
+      uint32_t best = n, bestEdges = 0;
+      for (uint32_t m : g)
+        for (auto [nb, edges] : shared[m]) {
+          if (group[nb] >= 0) continue;
+          uint32_t total = 0;  // edges shared with the whole group
+          for (uint32_t k : g)
+            for (auto [nb2, e2] : shared[k])
+              if (nb2 == nb) total += e2;
+          if (total > bestEdges || (total == bestEdges && nb < best)) best = nb, bestEdges = total;
+          (void)edges;
+        }
+      if (best == n) break;
+      group[best] = int(groups.size());
+      g.push_back(best);
+    }
+    groups.push_back(std::move(g));
+  }
+  // A cluster left alone (its neighbours taken) joins the group it shares most edges with: alone it
+  // could not be simplified and would stay a root.
+  for (size_t gi = 0; gi < groups.size(); ++gi) {
+    if (groups[gi].size() != 1) continue;
+    const uint32_t c = groups[gi][0];
+    uint32_t best = n, bestEdges = 0;
+    for (auto [nb, edges] : shared[c])
+      if (groups[group[nb]].size() > 1 && (edges > bestEdges || (edges == bestEdges && nb < best))) best = nb, bestEdges = edges;
+    if (best == n) continue;
+    groups[group[best]].push_back(c);
+    group[c] = group[best];
+    groups[gi].clear();
+  }
+  std::erase_if(groups, [](const std::vector<uint32_t>& g) { return g.empty(); });
+  return groups;
+}
+
+// Simplifies a group's triangles towards half, its border locked, in a vertex buffer of its own (the
+// simplifier's cost follows the vertex count it is given). Returns the triangles (mesh vertex indices)
+// and the error in object-space units.
+Indices simplifyGroup(const Indices& tris, const Mesh& mesh, float& error) {
+  const Local l(tris, mesh);
+  Indices out(l.indices.size());
+  const size_t target = (tris.size() / 6) * 3;
+  float relative = 0.0f;
+  out.resize(meshopt_simplify(out.data(), l.indices.data(), l.indices.size(), &l.positions[0].x, l.positions.size(),
+                              sizeof(glm::vec3), target, 1.0f, meshopt_SimplifyLockBorder, &relative));
+  // The simplifier's error is relative to the extent of what it was given: back to object-space units.
+  error = relative * meshopt_simplifyScale(&l.positions[0].x, l.positions.size(), sizeof(glm::vec3));
+  for (uint32_t& i : out) i = l.toMesh[i];
+  return out;
+}
+
+}  // namespace
+
+size_t ClusterLod::triangles(uint32_t level) const {
+  size_t n = 0;
+  for (const LodCluster& c : clusters) n += c.level == level ? c.triangleCount : 0;
+  return n;
+}
+
+ClusterLod buildClusterLod(const Mesh& mesh) {
+  ClusterLod lod;
+  if (mesh.indices.empty() || mesh.positions.empty()) return lod;
+  const float scale = meshopt_simplifyScale(&mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3));
+  const float epsilon = std::max(scale, 1e-30f) * 1e-7f;  // parents' errors rise at least by this
+
+  auto add = [&](const Indices& tris, uint32_t level, glm::vec4 sphere, float error) {
+    LodCluster c;
+    c.firstIndex = uint32_t(lod.indices.size());
+    c.triangleCount = uint32_t(tris.size() / 3);
+    c.level = level;
+    const glm::vec4 own = sphereOf(tris.data(), tris.size(), mesh);
+    c.center = glm::vec3(own);
+    c.radius = own.w;
+    c.sphere = level == 0 ? own : sphere;
+    c.error = error;
+    c.parentSphere = c.sphere;
+    c.parentError = shader::LOD_ERROR_INFINITE;
+    lod.indices.insert(lod.indices.end(), tris.begin(), tris.end());
+    lod.clusters.push_back(c);
+    return uint32_t(lod.clusters.size() - 1);
+  };
+
+  std::vector<Indices> current = split(mesh.indices, mesh);
+  std::vector<uint32_t> ids;
+  for (const Indices& c : current) ids.push_back(add(c, 0, {}, 0.0f));
+  for (uint32_t level = 1; current.size() > 1; ++level) {
+    std::vector<Indices> next;
+    std::vector<uint32_t> nextIds;
+    for (const std::vector<uint32_t>& g : groupClusters(current)) {
+      if (g.size() < 2) continue;  // alone: nothing around it to share a border with; a root
+      Indices tris;
+      glm::vec4 sphere = lod.clusters[ids[g[0]]].sphere;
+      float childError = 0.0f;
+      for (uint32_t k : g) {
+        tris.insert(tris.end(), current[k].begin(), current[k].end());
+        sphere = merge(sphere, lod.clusters[ids[k]].sphere);
+        childError = std::max(childError, lod.clusters[ids[k]].error);
+      }
+      float error = 0.0f;
+      const Indices simpler = simplifyGroup(tris, mesh, error);
+      if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) continue;  // stuck: these stay roots
+      error = std::max(error, childError + epsilon);  // monotone up the hierarchy, strictly
+      for (uint32_t k : g) {
+        lod.clusters[ids[k]].parentError = error;
+        lod.clusters[ids[k]].parentSphere = sphere;
+      }
+      for (Indices& c : split(simpler, mesh)) {
+        nextIds.push_back(add(c, level, sphere, error));
+        next.push_back(std::move(c));
+      }
+    }
+    if (next.empty()) break;
+    lod.levels = level + 1;
+    current = std::move(next);
+    ids = std::move(nextIds);
+  }
+  lod.levels = std::max(lod.levels, 1u);
+  return lod;
+}
+
+}  // namespace rtr

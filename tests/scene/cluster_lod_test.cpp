@@ -1,0 +1,138 @@
+// The level-of-detail hierarchy: levels halve, errors and their spheres grow monotonically up the
+// hierarchy, threshold 0 selects exactly the mesh's own triangles, and every cut (any eye, any
+// threshold) of a closed mesh is closed: each edge used by exactly two triangles, so no crack.
+#include <cmath>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "cluster_lod.h"
+#include "scene/cluster_lod.hpp"
+
+namespace rtr {
+namespace {
+
+// A closed UV sphere with a bumpy radius (so simplification has real error), poles welded.
+Mesh bumpySphere(uint32_t rings, uint32_t segments) {
+  Mesh m;
+  m.positions.push_back({0, 1, 0});
+  for (uint32_t i = 1; i < rings; ++i)
+    for (uint32_t j = 0; j < segments; ++j) {
+      const float th = float(i) / rings * 3.14159265f, ph = float(j) / segments * 6.2831853f;
+      const float r = 1.0f + 0.05f * std::sin(7 * th) * std::cos(5 * ph);
+      m.positions.push_back(r * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+    }
+  m.positions.push_back({0, -1, 0});
+  const uint32_t south = uint32_t(m.positions.size() - 1);
+  auto at = [&](uint32_t i, uint32_t j) { return 1 + (i - 1) * segments + j % segments; };
+  for (uint32_t j = 0; j < segments; ++j) {
+    m.indices.insert(m.indices.end(), {0, at(1, j + 1), at(1, j)});
+    m.indices.insert(m.indices.end(), {south, at(rings - 1, j), at(rings - 1, j + 1)});
+  }
+  for (uint32_t i = 1; i + 1 < rings; ++i)
+    for (uint32_t j = 0; j < segments; ++j) {
+      m.indices.insert(m.indices.end(), {at(i, j), at(i, j + 1), at(i + 1, j)});
+      m.indices.insert(m.indices.end(), {at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)});
+    }
+  m.normals = m.positions;
+  return m;
+}
+
+// The triangles of the cut at `threshold` pixels from `eye` (1000 px / unit: a 60° view ~866 px high).
+std::vector<uint32_t> cut(const ClusterLod& lod, glm::vec3 eye, float threshold) {
+  std::vector<uint32_t> tris;
+  for (const LodCluster& c : lod.clusters)
+    if (shader::lodSelected(c.sphere, c.error, c.parentSphere, c.parentError, eye, 1000.0f, 0.01f, threshold))
+      tris.insert(tris.end(), lod.indices.begin() + c.firstIndex, lod.indices.begin() + c.firstIndex + c.triangleCount * 3);
+  return tris;
+}
+
+// Edges on the boundary of the triangles as an oriented surface: those walked a→b more often than b→a.
+// A closed surface has none. (A cut may hold a zero-area fin — one triangle of each of two groups over
+// three locked border vertices, back to back — which closes on itself and counts as no boundary.)
+size_t openEdges(const std::vector<uint32_t>& tris) {
+  std::map<std::pair<uint32_t, uint32_t>, int> walk;  // +1 for a→b with a < b, -1 for b→a
+  for (size_t t = 0; t < tris.size(); t += 3)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = tris[t + e], b = tris[t + (e + 1) % 3];
+      walk[{std::min(a, b), std::max(a, b)}] += a < b ? 1 : -1;
+    }
+  size_t bad = 0;
+  for (auto& [edge, n] : walk) bad += n != 0;
+  return bad;
+}
+
+TEST(ClusterLod, LevelsHalveAndStayWithinTheMemoryBound) {
+  const Mesh m = bumpySphere(100, 200);  // 39 600 triangles
+  const ClusterLod lod = buildClusterLod(m);
+  ASSERT_GE(lod.levels, 5u);
+  EXPECT_EQ(lod.triangles(0), m.indices.size() / 3);
+  for (uint32_t l = 1; l < lod.levels; ++l) {
+    EXPECT_LT(lod.triangles(l), lod.triangles(l - 1) * 0.75) << "level " << l;
+    if (l + 1 < lod.levels) EXPECT_GT(lod.triangles(l), lod.triangles(l - 1) * 0.3) << "level " << l;
+  }
+  EXPECT_LE(lod.indices.size(), m.indices.size() * 5 / 2);  // the hierarchy <= 2.5x the base triangles
+}
+
+TEST(ClusterLod, ErrorsAndSpheresGrowUpTheHierarchy) {
+  const Mesh m = bumpySphere(60, 120);
+  const ClusterLod lod = buildClusterLod(m);
+  size_t roots = 0;
+  for (const LodCluster& c : lod.clusters) {
+    EXPECT_LE(c.triangleCount, 124u);
+    if (c.level == 0) {
+      EXPECT_EQ(c.error, 0.0f);
+    }
+    if (c.parentError >= shader::LOD_ERROR_INFINITE) {
+      ++roots;
+      continue;
+    }
+    EXPECT_GT(c.parentError, c.error);
+    const float d = glm::length(glm::vec3(c.parentSphere) - glm::vec3(c.sphere));
+    EXPECT_LE(d + c.sphere.w, c.parentSphere.w * (1.0f + 1e-5f));  // the parent's sphere holds the child's
+  }
+  EXPECT_GE(roots, 1u);
+  EXPECT_LT(roots, lod.clusters.size() / 4);
+}
+
+TEST(ClusterLod, ThresholdZeroIsTheMeshItself) {
+  const Mesh m = bumpySphere(40, 80);
+  const ClusterLod lod = buildClusterLod(m);
+  std::vector<uint32_t> tris = cut(lod, {0, 0, 5}, 0.0f);
+  auto sorted = [](std::vector<uint32_t> t) {
+    std::vector<std::array<uint32_t, 3>> v;
+    for (size_t i = 0; i < t.size(); i += 3) {
+      std::array<uint32_t, 3> a{t[i], t[i + 1], t[i + 2]};
+      std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());  // same winding, fixed start
+      v.push_back(a);
+    }
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  EXPECT_EQ(sorted(tris), sorted(m.indices));
+}
+
+TEST(ClusterLod, EveryCutOfAClosedMeshIsClosed) {
+  const Mesh m = bumpySphere(100, 200);
+  ASSERT_EQ(openEdges(m.indices), 0u);
+  const ClusterLod lod = buildClusterLod(m);
+  size_t fewest = m.indices.size();
+  for (glm::vec3 eye : {glm::vec3(0, 0, 3), glm::vec3(0, 0, 30), glm::vec3(2, 1, 0), glm::vec3(0, 200, 0)})
+    for (float threshold : {0.25f, 1.0f, 4.0f, 32.0f}) {
+      const std::vector<uint32_t> tris = cut(lod, eye, threshold);
+      EXPECT_EQ(openEdges(tris), 0u) << "eye " << eye.x << "," << eye.y << "," << eye.z << " threshold " << threshold;
+      fewest = std::min(fewest, tris.size());
+    }
+  EXPECT_LT(fewest, m.indices.size() / 10);  // far away, coarse levels are chosen
+}
+
+TEST(ClusterLod, SameMeshSameHierarchy) {
+  const Mesh m = bumpySphere(30, 60);
+  const ClusterLod a = buildClusterLod(m), b = buildClusterLod(m);
+  EXPECT_EQ(a.indices, b.indices);
+  ASSERT_EQ(a.clusters.size(), b.clusters.size());
+  for (size_t i = 0; i < a.clusters.size(); ++i) EXPECT_EQ(a.clusters[i].parentError, b.clusters[i].parentError);
+}
+
+}  // namespace
+}  // namespace rtr
