@@ -3,6 +3,8 @@
 // JPEG, Radiance HDR and OpenEXR, always atomically (core/atomic_file.hpp).
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -31,8 +33,11 @@ struct TexelData {
   std::vector<uint8_t> texels;
 };
 
-TexelData loadImage(const std::filesystem::path& file, int channels);  // throws rtr::Error naming the file
+// Both throw rtr::Error naming the file (`name`): a bad or oversized header, a decode error, out of memory.
+TexelData loadImage(const std::filesystem::path& file, int channels);
+TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, int channels);
 void savePng(const std::filesystem::path& file, const ImageRGBA8& image);  // PNG whatever the name says
+void writePng(AtomicFile& file, const ImageRGBA8& image);  // into an open file; the caller commits it
 
 // Output format by extension; anything else is a UsageError that lists these.
 enum class ImageFormat { Png, Jpg, Exr, Hdr };
