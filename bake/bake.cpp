@@ -2,9 +2,11 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstring>
+#include <memory>
+#include <new>
+#include <system_error>
 #include <thread>
 
 #include "core/error.hpp"
@@ -12,6 +14,7 @@
 #include "scene/binio.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
+#include "scene/parallel.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
@@ -37,36 +40,29 @@ struct CreatedFiles {
 
 // Decodes every source texture with the channel count of its slot, on a few threads.
 void verifyTextures(const TexturePlan& plan, unsigned threads) {
-  std::atomic<size_t> next{0};
   std::vector<std::string> errors(plan.sources.size());
-  auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < plan.sources.size();) {
-      const auto& src = plan.sources[i];
-      if (src.empty()) continue;
-      std::error_code ec;
-      if (!std::filesystem::is_regular_file(src, ec)) {
-        errors[i] = src.string() + ": texture file named in the MTL does not exist";
-        continue;
-      }
-      try {
-        loadImage(src, plan.scene.textures[i].channels);
-      } catch (const Error& e) {
-        errors[i] = std::string(e.what()) + " (texture named in the MTL is not a readable image)";
-      }
+  parallelFor(plan.sources.size(), threads, [&](size_t i) {
+    const auto& src = plan.sources[i];
+    if (src.empty()) return;
+    std::error_code ec;
+    if (!std::filesystem::exists(src, ec)) {
+      errors[i] = src.string() + ": texture file named in the MTL does not exist";
+      return;
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+    try {
+      loadImage(src, plan.scene.textures[i].channels);
+    } catch (const Error& e) {
+      errors[i] = std::string(e.what()) + " (texture named in the MTL is not a readable image)";
+    }
+  });
   for (const std::string& e : errors)
     if (!e.empty()) throw Error(e);
 }
 
-void writeFallback(const std::filesystem::path& file, const std::string& name, Replace replace) {
+void writeFallback(AtomicFile& file, const std::string& name) {
   ImageRGBA8 img{1, 1, {255, 255, 255, 255}};
   if (name == kFallbackEmissive) img.pixels = {0, 0, 0, 255};
-  saveImage(file, img, {replace});
+  writePng(file, img);
 }
 
 // Creates `dir` and any missing parents, recording each folder it made.
@@ -109,20 +105,24 @@ BakeReport bake(const BakeOptions& opt) {
   oo.mtl = opt.mtl;
   if (opt.progress)
     oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
-  Scene scene = loadObj(opt.input, oo, &rep.obj);
+  const std::string input = opt.input.string();
+  Scene scene = stage("reading " + input, [&] { return loadObj(opt.input, oo, &rep.obj); });
   rep.parseSeconds = rep.obj.parseSeconds;
   rep.weldSeconds = rep.obj.weldSeconds;
   if (opt.view) scene.defaultView = opt.view;
   if (!opt.lights.empty()) scene.lights = opt.lights;
 
-  // 2. Textures: plan, check every source decodes and no destination would be overwritten, then copy.
+  // 2. Textures: plan, check every source decodes and no destination would be overwritten, then write
+  // each to a temporary beside its destination. They are put in place only once the scene is written too
+  // (step 4): a bake that fails anywhere, a full disk included, leaves an older output and its textures
+  // as they were.
   auto t0 = Clock::now();
   std::string sceneName = opt.output.filename().string();
   sceneName = sceneName.substr(0, sceneName.rfind('.'));
   TexturePlan plan = planTextures(scene, sceneName, course);
   scene = Scene{};
   if (opt.progress) opt.progress("checking textures", 0.0);
-  verifyTextures(plan, threads);
+  stage("checking the textures of " + input, [&] { verifyTextures(plan, threads); });
   const std::filesystem::path texDir = outDir / (sceneName + "-tex");
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
     const auto dst = outDir / plan.scene.textures[i].path;
@@ -130,18 +130,17 @@ BakeReport bake(const BakeOptions& opt) {
       throw OutputExists(dst.string() + ": texture exists; refusing to overwrite it without --force");
   }
   if (!plan.scene.textures.empty()) createFolders(texDir, created);
+  std::vector<std::unique_ptr<AtomicFile>> textures;
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
-    // Without --force a texture is only ever created, never replaced (FORMATS.md §1): AtomicFile's
-    // link-based commit lets exactly one of two concurrent bakes create it; the other stops here.
     const auto dst = outDir / plan.scene.textures[i].path;
-    const bool existed = std::filesystem::exists(dst, ec);
+    textures.push_back(std::make_unique<AtomicFile>(dst));
     if (plan.sources[i].empty()) {
-      writeFallback(dst, dst.filename().string(), replace);
+      writeFallback(*textures.back(), dst.filename().string());
       ++rep.fallbackTextures;
     } else {
-      copyFileAtomic(plan.sources[i], dst, replace);
+      textures.back()->writeFrom(plan.sources[i]);
     }
-    if (!existed) created.files.push_back(dst);
+    textures.back()->sync();  // closed: a scene of thousands of textures holds no descriptor for each
     if (opt.progress) opt.progress("copying textures", double(i + 1) / double(plan.scene.textures.size()));
   }
   rep.textureSeconds = since(t0);
@@ -150,16 +149,30 @@ BakeReport bake(const BakeOptions& opt) {
   if (!course) {
     t0 = Clock::now();
     if (opt.progress) opt.progress("clustering", 0.0);
-    buildMissingClusters(plan.scene);
+    try {
+      stage("clustering " + input, [&] { buildMissingClusters(plan.scene); });
+    } catch (const Error& e) {
+      throw fileError(input, "", e.what());
+    }
     rep.clusterSeconds = since(t0);
   }
 
-  // 4. Encode and write (a temporary of our own, then rename; without --force, link, so that an output
-  // another run made meanwhile is kept).
+  // 4. Encode and write the scene to its temporary, then put the textures and the scene in place. Without
+  // --force each goes in by link, so that an output another run made meanwhile is kept (and this run's
+  // textures already placed are removed again).
   t0 = Clock::now();
   if (opt.progress) opt.progress("writing", 0.0);
-  const std::string bytes = course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene);
-  writeFileAtomic(opt.output, bytes, replace);
+  const std::string bytes =
+      stage("encoding " + opt.output.string(), [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
+  AtomicFile sceneFile(opt.output);
+  sceneFile.write(bytes.data(), bytes.size());
+  sceneFile.sync();
+  for (auto& t : textures) {
+    const bool existed = std::filesystem::exists(t->target(), ec);
+    t->commit(replace);
+    if (!existed) created.files.push_back(t->target());
+  }
+  sceneFile.commit(replace);
   created.keep = true;
   rep.writeSeconds = since(t0);
   rep.outputBytes = bytes.size();

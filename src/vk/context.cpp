@@ -74,14 +74,14 @@ VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::string& wa
     unsigned long index = std::strtoul(want.c_str(), &end, 10);
     if (*end == '\0') {
       if (index >= devices.size())
-        throw Error("device index " + want + " out of range: " + std::to_string(devices.size()) + " device(s)");
+        throw UsageError("--device " + want + ": index out of range: " + std::to_string(devices.size()) + " device(s)");
       return devices[index];
     }
     for (auto d : devices)
       if (name(d).find(want) != std::string::npos) return d;
     std::string all;
     for (auto d : devices) all += "\n  " + name(d);
-    throw Error("no Vulkan device matches '" + want + "'; devices:" + all);
+    throw UsageError("--device '" + want + "': no Vulkan device matches; devices:" + all);
   }
   return *std::min_element(devices.begin(), devices.end(), [](VkPhysicalDevice a, VkPhysicalDevice b) {
     VkPhysicalDeviceProperties pa, pb;
@@ -273,6 +273,15 @@ const char* resultName(VkResult r) {
 #undef CASE
     default: return "VkResult(?)";
   }
+}
+
+VkDeviceSize Context::deviceHeapBytes() const {
+  VkPhysicalDeviceMemoryProperties mp;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
+  VkDeviceSize best = 0;
+  for (uint32_t i = 0; i < mp.memoryHeapCount; ++i)
+    if (mp.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) best = std::max(best, mp.memoryHeaps[i].size);
+  return best;
 }
 
 }  // namespace rtr::vk
