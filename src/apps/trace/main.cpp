@@ -33,8 +33,10 @@ int run(int argc, char** argv) {
                  "OBJ's mtllib, else NAME.mtl beside it)");
   app.add_option("-o,--output", outPath, "output image: .png or .jpg (sRGB), .exr or .hdr (linear radiance)")->required();
   app.add_flag("--force", force, "overwrite an existing output");
-  app.add_option("--size", size, "image size WxH")->capture_default_str();
-  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else one that frames the scene (docs/lights.md)");
+  app.add_option("--size", size, "image size WxH")->capture_default_str()
+      ->check(cli::checked([](const std::string& t) { cli::parseSize("--size", t); }, "WxH"));
+  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else one that frames the scene (docs/lights.md)")
+      ->check(cli::checked([](const std::string& t) { cli::parsePose("--camera", t); }, "X,Y,Z,YAW,PITCH"));
   app.add_option("--fov", fov, "vertical field of view in degrees (the viewer's default; the course uses 80)")
       ->capture_default_str()->check(cli::number(0, 180, true));
   app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, FORMATS.md §2)");
@@ -49,10 +51,13 @@ int run(int argc, char** argv) {
       ->capture_default_str()->check(CLI::IsMember({"halfplane", "watertight", "moller"}));
   app.add_option("--area-samples", s.areaLightSamples, "shadow rays per area light (1: its centre)")
       ->capture_default_str()->check(cli::integer(1, 1024));
-  app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
-  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
+  CLI::Option* lightOpt = app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights")
+      ->check(cli::checked([](const std::string& t) { cli::parseVec3("--light", t); }, "X,Y,Z"));
+  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
+      ->needs(lightOpt)->check(cli::checked([](const std::string& t) { cli::parseColor("--light-color", t); }, "R,G,B"));
   app.add_flag("--falloff", lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
-  app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str();
+  app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str()
+      ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
   app.add_flag("!--no-default-light", lightOptions.defaultLight,
                "a scene without lights gets no headlight (the brief's strict behaviour)");
   app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
@@ -75,8 +80,8 @@ int run(int argc, char** argv) {
   s.intersect = intersectName == "halfplane" ? IntersectMethod::HalfPlane
               : intersectName == "moller" ? IntersectMethod::MollerTrumbore : IntersectMethod::Watertight;
   if (!light.empty()) lightOptions.position = cli::parseVec3("--light", light);
-  if (!lightColor.empty()) lightOptions.color = cli::parseVec3("--light-color", lightColor);
-  lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
+  if (!lightColor.empty()) lightOptions.color = cli::parseColor("--light-color", lightColor);
+  lightOptions.ambient = cli::parseColor("--ambient", ambient, true);
   cli::checkImageOutput("-o", outPath, force);  // before tracing, not after
 
   LoadOptions load;
