@@ -89,8 +89,11 @@ int main(int argc, char** argv) {
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(1);  // the parent died before the line above took effect
 #if !defined(__SANITIZE_ADDRESS__) && !defined(RTR_NO_WORKER_LIMIT)  // ASan reserves terabytes of shadow
-    const rlimit limit{kWorkerMemory, kWorkerMemory};
-    ::setrlimit(RLIMIT_AS, &limit);
+    rlimit limit{};
+    if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur > kWorkerMemory) {  // only ever lowered
+      limit.rlim_cur = kWorkerMemory;
+      ::setrlimit(RLIMIT_AS, &limit);
+    }
 #endif
     const int rc = reflectAll(files, includes, json, noValidate, strict);
     std::cout.flush();

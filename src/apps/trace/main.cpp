@@ -1,7 +1,9 @@
 // rtr-trace: ray-trace a scene file into an image (brief Part 1; issue 6).
 #include <algorithm>
 #include <cstdio>
+#include <cstdint>
 #include <exception>
+#include <new>
 #include <string>
 
 #include <unistd.h>
@@ -19,6 +21,8 @@ namespace {
 
 using namespace rtr;
 using namespace rtr::trace;
+
+std::string gStage = "starting";  // what was under way, for an out-of-memory message
 
 int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)", "rtr-trace"};
@@ -89,7 +93,10 @@ int run(int argc, char** argv) {
   const Scene scene = loadScene(scenePath, load);
   s.lights = resolveLights(scene, lightOptions);
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
+  gStage = "building the BVH of " + scenePath;
   const Tracer tracer(scene, s.threads);
+  gStage = "tracing " + scenePath + " at " + std::to_string(w) + "x" + std::to_string(h) + " (" +
+           std::to_string((uint64_t(w) * h * sizeof(glm::vec4)) >> 20) + " MB of image)";
   const bool tty = !quiet && isatty(STDERR_FILENO);
   ImageF image;
   const RenderStats st = tracer.render(s, image, [&](const TileRect&) {
@@ -102,6 +109,7 @@ int run(int argc, char** argv) {
   if (s.lights->lights.empty() && s.shading != Shading::Normals && s.shading != Shading::Depth &&
       std::all_of(image.pixels.begin(), image.pixels.end(), [](const glm::vec4& p) { return glm::vec3(p) == glm::vec3(0.0f); }))
     std::fprintf(stderr, "rtr-trace: warning: the image is all black (no lights: --no-default-light)\n");
+  gStage = "writing " + outPath;
   saveImage(outPath, image, {force ? Replace::Yes : Replace::No, !quiet});
   if (!quiet) {
     if (s.shading == Shading::Pbr)
@@ -126,6 +134,8 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    return cli::fail("rtr-trace", Error("out of memory while " + gStage));
   } catch (const std::exception& e) {
     return cli::fail("rtr-trace", e);
   }
