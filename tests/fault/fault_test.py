@@ -177,6 +177,8 @@ try:
                        "out of memory before uploading", "rtr-view: a 16384² frame under 2 GB (was a crash)",
                        limit_as=2 << 30, timeout=120)
     check("would fit" in err, "rtr-view says what would fit")
+    expect_error(["rtr-view", temple, "--headless", "--size", "64x64", "--screenshot", out], "out of memory",
+                 "rtr-view under 600 MB (llvmpipe crashed in vkCreateDevice)", limit_as=600 << 20, timeout=120)
     check(not os.path.exists(out), "no image written by the failed runs")
 
     print("-- rtr-reflect's worker")

@@ -259,11 +259,9 @@ int runHeadless(const ViewOptions& o) {
   std::future<void> writing;
   int status = 0;
   try {
-    status = renderHeadless(o, writing);
+    status = stage("uploading or rendering " + o.scene, [&] { return renderHeadless(o, writing); });
   } catch (const vk::OutOfMemory& e) {
     throw Error("out of memory while uploading or rendering " + o.scene + ": " + e.what());
-  } catch (const std::bad_alloc&) {
-    throw Error("out of memory while uploading or rendering " + o.scene);
   }
   if (writing.valid()) {
     writing.get();  // rethrows a write error
