@@ -32,8 +32,19 @@ def number():
     return rng.choice(VALUES) if rng.random() < BAD else f"{rng.uniform(-10, 10):.4f}"
 
 
+def one_huge_value():
+    """The review's shape: a small valid mesh with one enormous coordinate (it aborted all tools)."""
+    n = rng.randint(3, 8)
+    vs = [[f"{rng.uniform(-10, 10):.4f}" for _ in range(3)] for _ in range(n)]
+    vs[rng.randrange(n)][rng.randrange(3)] = rng.choice(["-1e38", "1e38", "3.4e38", "1e20", "-1e19", "1e13", "1e12"])
+    faces = [f"f 1 {k} {k + 1}" for k in range(2, n)]
+    return "\n".join(["v " + " ".join(v) for v in vs] + faces).encode()
+
+
 def random_obj():
     global BAD
+    if rng.random() < 0.2:
+        return one_huge_value()
     BAD = rng.choice([0, 0, 0.003, 0.02, 0.2])
     lines, nv = [], rng.randint(0, 40)
     for _ in range(nv):
