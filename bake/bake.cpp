@@ -2,10 +2,12 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstring>
+#include <memory>
+#include <new>
 #include <set>
+#include <system_error>
 #include <thread>
 
 #include "core/error.hpp"
@@ -14,6 +16,7 @@
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
 #include "scene/load.hpp"
+#include "scene/parallel.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
@@ -45,43 +48,36 @@ struct CreatedFiles {
 
 // Decodes every source texture with the channel count of its slot, on a few threads.
 void verifyTextures(const TexturePlan& plan, unsigned threads, const std::string& namedIn) {
-  std::atomic<size_t> next{0};
   std::vector<std::string> errors(plan.sources.size());
-  auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < plan.sources.size();) {
-      const auto& src = plan.sources[i];
-      if (plan.bytes[i]) {
-        try {
-          decodeImage(*plan.bytes[i], plan.scene.textures[i].path.string(), plan.scene.textures[i].channels);
-        } catch (const Error& e) {
-          errors[i] = std::string(e.what()) + " (an image embedded in the glTF is not readable)";
-        }
-      }
-      if (src.empty()) continue;
-      std::error_code ec;
-      if (!std::filesystem::is_regular_file(src, ec)) {
-        errors[i] = src.string() + ": texture file named in the " + namedIn + " does not exist";
-        continue;
-      }
+  parallelFor(plan.sources.size(), threads, [&](size_t i) {
+    const auto& src = plan.sources[i];
+    if (plan.bytes[i]) {
       try {
-        loadImage(src, plan.scene.textures[i].channels);
+        decodeImage(*plan.bytes[i], plan.scene.textures[i].path.string(), plan.scene.textures[i].channels);
       } catch (const Error& e) {
-        errors[i] = std::string(e.what()) + " (texture named in the " + namedIn + " is not a readable image)";
+        errors[i] = std::string(e.what()) + " (an image embedded in the glTF is not readable)";
       }
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+    if (src.empty()) return;
+    std::error_code ec;
+    if (!std::filesystem::exists(src, ec)) {
+      errors[i] = src.string() + ": texture file named in the " + namedIn + " does not exist";
+      return;
+    }
+    try {
+      loadImage(src, plan.scene.textures[i].channels);
+    } catch (const Error& e) {
+      errors[i] = std::string(e.what()) + " (texture named in the " + namedIn + " is not a readable image)";
+    }
+  });
   for (const std::string& e : errors)
     if (!e.empty()) throw Error(e);
 }
 
-void writeFallback(const std::filesystem::path& file, const std::string& name, Replace replace) {
+void writeFallback(AtomicFile& file, const std::string& name) {
   ImageRGBA8 img{1, 1, {255, 255, 255, 255}};
   if (name == kFallbackEmissive) img.pixels = {0, 0, 0, 255};
-  saveImage(file, img, {replace});
+  writePng(file, img);
 }
 
 // Creates `dir` and any missing parents, recording each folder it made.
@@ -129,7 +125,7 @@ BakeReport bake(const BakeOptions& opt) {
     lo.warn = opt.warn;
     lo.note = opt.note;
     const auto t = Clock::now();
-    scene = loadScene(opt.input, lo);
+    scene = stage("reading " + opt.input.string(), [&] { return loadScene(opt.input, lo); });
     rep.parseSeconds = since(t);
     rep.gltf = true;
   } else {
@@ -139,7 +135,7 @@ BakeReport bake(const BakeOptions& opt) {
     oo.mtl = opt.mtl;
     if (opt.progress)
       oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
-    scene = loadObj(opt.input, oo, &rep.obj);
+    scene = stage("reading " + opt.input.string(), [&] { return loadObj(opt.input, oo, &rep.obj); });
     rep.parseSeconds = rep.obj.parseSeconds;
     rep.weldSeconds = rep.obj.weldSeconds;
   }
@@ -148,14 +144,18 @@ BakeReport bake(const BakeOptions& opt) {
   if (opt.view) scene.defaultView = opt.view;
   if (!opt.lights.empty()) scene.lights = opt.lights;
 
-  // 2. Textures: plan, check every source decodes and no destination would be overwritten, then copy.
+  // 2. Textures: plan, check every source decodes and no destination would be overwritten, then write
+  // each to a temporary beside its destination. They are put in place only once the scene is written too
+  // (step 4): a bake that fails anywhere, a full disk included, leaves an older output and its textures
+  // as they were.
+  const std::string input = opt.input.string();
   auto t0 = Clock::now();
   std::string sceneName = opt.output.filename().string();
   sceneName = sceneName.substr(0, sceneName.rfind('.'));
   TexturePlan plan = planTextures(scene, sceneName, course);
   scene = Scene{};
   if (opt.progress) opt.progress("checking textures", 0.0);
-  verifyTextures(plan, threads, gltf ? "glTF" : "MTL");
+  stage("checking the textures of " + input, [&] { verifyTextures(plan, threads, gltf ? "glTF" : "MTL"); });
   const std::filesystem::path texDir = outDir / (sceneName + "-tex");
   std::vector<bool> present(plan.scene.textures.size());  // an embedded image already there, byte for byte
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
@@ -171,23 +171,26 @@ BakeReport bake(const BakeOptions& opt) {
   }
   if (!plan.scene.textures.empty()) createFolders(texDir, created);
   std::set<std::filesystem::path> written;
+  std::vector<std::unique_ptr<AtomicFile>> textures;
+  std::vector<Replace> textureReplace;
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
-    // Without --force a texture is only ever created, never replaced (FORMATS.md §1): AtomicFile's
-    // link-based commit lets exactly one of two concurrent bakes create it; the other stops here.
     const auto dst = outDir / plan.scene.textures[i].path;
     if (present[i] || !written.insert(dst).second) continue;  // one file for textures sampled two ways
-    const bool existed = std::filesystem::exists(dst, ec);
-    if (plan.bytes[i]) {
+    textures.push_back(std::make_unique<AtomicFile>(dst));
+    if (plan.bytes[i]) {  // named by its content: never replaces another file
       const auto& b = *plan.bytes[i];
-      writeFileAtomic(dst, {reinterpret_cast<const char*>(b.data()), b.size()}, Replace::No);
+      textures.back()->write(b.data(), b.size());
+      textureReplace.push_back(Replace::No);
       ++rep.embeddedTextures;
     } else if (plan.sources[i].empty()) {
-      writeFallback(dst, dst.filename().string(), replace);
+      writeFallback(*textures.back(), dst.filename().string());
+      textureReplace.push_back(replace);
       ++rep.fallbackTextures;
     } else {
-      copyFileAtomic(plan.sources[i], dst, replace);
+      textures.back()->writeFrom(plan.sources[i]);
+      textureReplace.push_back(replace);
     }
-    if (!existed) created.files.push_back(dst);
+    textures.back()->sync();  // closed: a scene of thousands of textures holds no descriptor for each
     if (opt.progress) opt.progress("copying textures", double(i + 1) / double(plan.scene.textures.size()));
   }
   rep.textureSeconds = since(t0);
@@ -196,16 +199,30 @@ BakeReport bake(const BakeOptions& opt) {
   if (!course) {
     t0 = Clock::now();
     if (opt.progress) opt.progress("clustering", 0.0);
-    buildMissingClusters(plan.scene);
+    try {
+      stage("clustering " + input, [&] { buildMissingClusters(plan.scene); });
+    } catch (const Error& e) {
+      throw fileError(input, "", e.what());
+    }
     rep.clusterSeconds = since(t0);
   }
 
-  // 4. Encode and write (a temporary of our own, then rename; without --force, link, so that an output
-  // another run made meanwhile is kept).
+  // 4. Encode and write the scene to its temporary, then put the textures and the scene in place. Without
+  // --force each goes in by link, so that an output another run made meanwhile is kept (and this run's
+  // textures already placed are removed again).
   t0 = Clock::now();
   if (opt.progress) opt.progress("writing", 0.0);
-  const std::string bytes = course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene);
-  writeFileAtomic(opt.output, bytes, replace);
+  const std::string bytes =
+      stage("encoding " + opt.output.string(), [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
+  AtomicFile sceneFile(opt.output);
+  sceneFile.write(bytes.data(), bytes.size());
+  sceneFile.sync();
+  for (size_t k = 0; k < textures.size(); ++k) {
+    const bool existed = std::filesystem::exists(textures[k]->target(), ec);
+    textures[k]->commit(textureReplace[k]);
+    if (!existed) created.files.push_back(textures[k]->target());
+  }
+  sceneFile.commit(replace);
   created.keep = true;
   rep.writeSeconds = since(t0);
   rep.outputBytes = bytes.size();

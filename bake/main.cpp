@@ -21,9 +21,14 @@ int main(int argc, char** argv) {
   app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh); a missing folder is created")->required();
   app.add_option("--mtl", mtl, "take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--force", opt.force, "overwrite an existing output and textures");
-  app.add_option("--view", view, "default camera pose x,y,z,yaw,pitch (degrees)");
-  app.add_option("--light", light, "store a point light at x,y,z with the scene (.rtrscene); it replaces the scene's own");
-  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
+  using rtr::cli::checked;
+  app.add_option("--view", view, "default camera pose x,y,z,yaw,pitch (degrees)")
+      ->check(checked([](const std::string& t) { rtr::cli::parsePose("--view", t); }, "X,Y,Z,YAW,PITCH"));
+  CLI::Option* lightOpt =
+      app.add_option("--light", light, "store a point light at x,y,z with the scene (.rtrscene); it replaces the scene's own")
+          ->check(checked([](const std::string& t) { rtr::cli::parseVec3("--light", t); }, "X,Y,Z"));
+  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
+      ->needs(lightOpt)->check(checked([](const std::string& t) { rtr::cli::parseColor("--light-color", t); }, "R,G,B"));
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
@@ -43,7 +48,7 @@ int main(int argc, char** argv) {
     if (!light.empty()) {
       rtr::Light l;
       l.position = rtr::cli::parseVec3("--light", light);
-      if (!lightColor.empty()) l.color = rtr::cli::parseVec3("--light-color", lightColor);
+      if (!lightColor.empty()) l.color = rtr::cli::parseColor("--light-color", lightColor);
       opt.lights = {l};
     }
     const rtr::BakeReport r = rtr::bake(opt);

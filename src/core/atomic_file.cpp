@@ -15,6 +15,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
 namespace rtr {
 namespace {
@@ -138,11 +139,22 @@ void AtomicFile::write(const void* data, size_t size) {
   }
 }
 
-void AtomicFile::commit(Replace replace) {
+void AtomicFile::writeFrom(const std::filesystem::path& source) {
+  InputFile in(source);
+  char buf[1 << 16];
+  for (size_t n; (n = in.read(buf, sizeof buf)) > 0;) write(buf, n);
+}
+
+void AtomicFile::sync() {
+  if (fd_ < 0) return;
   if (::fsync(fd_) != 0) throw fileError(target_.string(), "", "cannot write: " + errnoText(errno));
   const int closed = ::close(fd_);
   fd_ = -1;
   if (closed != 0) throw fileError(target_.string(), "", "cannot write: " + errnoText(errno));
+}
+
+void AtomicFile::commit(Replace replace) {
+  sync();
   if (replace == Replace::Yes) {
     if (::rename(tmp_.c_str(), target_.c_str()) != 0)
       throw fileError(target_.string(), "", "cannot rename the temporary into place: " + errnoText(errno));
@@ -168,27 +180,8 @@ void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes, 
 }
 
 void copyFileAtomic(const std::filesystem::path& from, const std::filesystem::path& to, Replace replace) {
-  const int in = ::open(from.c_str(), O_RDONLY | O_CLOEXEC);
-  if (in < 0) throw fileError(from.string(), "", "cannot open: " + errnoText(errno));
   AtomicFile f(to);
-  char buf[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(in, buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int err = errno;
-      ::close(in);
-      throw fileError(from.string(), "", "cannot read: " + errnoText(err));
-    }
-    if (n == 0) break;
-    try {
-      f.write(buf, size_t(n));
-    } catch (...) {
-      ::close(in);
-      throw;
-    }
-  }
-  ::close(in);
+  f.writeFrom(from);
   f.commit(replace);
 }
 

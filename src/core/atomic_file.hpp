@@ -20,7 +20,12 @@ public:
 
   int fd() const { return fd_; }
   void write(const void* data, size_t size);  // all of it, or throws
-  // Makes the bytes the target's. With Replace::No, fails with OutputExists if the target exists by then
+  void writeFrom(const std::filesystem::path& source);  // a regular file's bytes (core/input_file), or throws
+  // fsync and close: the bytes are safely on disk under the temporary's name (a full disk has shown by
+  // now), to be put in place by commit() later — how several files become one unit (rtr-bake's scene and
+  // its textures).
+  void sync();
+  // Makes the bytes the target's (after sync(), unless done). With Replace::No, fails with OutputExists if the target exists by then
   // (checked by the kernel, so of two writers exactly one wins).
   void commit(Replace replace = Replace::Yes);
   const std::filesystem::path& target() const { return target_; }

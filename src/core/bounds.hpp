@@ -1,5 +1,6 @@
 #pragma once
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <glm/common.hpp>
@@ -7,6 +8,14 @@
 #include <glm/vec3.hpp>
 
 namespace rtr {
+
+// The largest coordinate a scene may hold, refused by every reader with the file and the place: the
+// cube of a difference of two coordinates (what intersection tests and meshoptimizer's cluster cones
+// compute) must stay below float's 3.4e38. Non-finite coordinates fail this test too.
+constexpr float kMaxCoordinate = 1e12f;
+inline bool coordinateOk(const glm::vec3& p) {
+  return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate && std::abs(p.z) <= kMaxCoordinate;
+}
 
 struct Bounds {
   glm::vec3 min{std::numeric_limits<float>::infinity()};

@@ -1,9 +1,14 @@
 #include "core/cli.hpp"
 
 #include <charconv>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <new>
+
+#include <unistd.h>
 
 #include "core/error.hpp"
 #include "core/image.hpp"
@@ -22,9 +27,10 @@ std::string fmt(double v) {
   return buf;
 }
 
-// The whole of `text` as a finite double, or nothing.
+// The whole of `text` as a finite double, or nothing: no blank before or after (strtod would skip the
+// leading ones only, so ' 5' and '5 ' were not treated alike).
 bool toDouble(const std::string& text, double& out) {
-  if (text.empty()) return false;
+  if (text.empty() || std::isspace(static_cast<unsigned char>(text[0]))) return false;
   char* end = nullptr;
   out = std::strtod(text.c_str(), &end);
   return *end == '\0' && std::isfinite(out);
@@ -56,7 +62,9 @@ int parse(CLI::App& app, int argc, char** argv) {
 }
 
 int fail(const std::string& tool, const std::exception& e) {
-  std::fprintf(stderr, "%s: error: %s\n", tool.c_str(), e.what());
+  // Each stage names itself (rtr::stage); this is the last net, so that no tool prints "std::bad_alloc".
+  const bool oom = dynamic_cast<const std::bad_alloc*>(&e) != nullptr;
+  std::fprintf(stderr, "%s: error: %s\n", tool.c_str(), oom ? "out of memory" : e.what());
   return dynamic_cast<const UsageError*>(&e) ? kExitUsage : kExitFailure;
 }
 
@@ -134,6 +142,26 @@ glm::vec3 parseVec3(const std::string& option, const std::string& text, bool sca
   return v;
 }
 
+glm::vec3 parseColor(const std::string& option, const std::string& text, bool scalarAllowed) {
+  const glm::vec3 c = parseVec3(option, text, scalarAllowed);
+  if (c.r < 0 || c.g < 0 || c.b < 0) throw UsageError(option + " '" + text + "': a colour cannot be negative");
+  return c;
+}
+
+CLI::Validator checked(std::function<void(const std::string&)> parse, const std::string& what) {
+  return CLI::Validator(
+      [parse](std::string& text) -> std::string {
+        try {
+          parse(text);
+          return {};
+        } catch (const UsageError& e) {  // CLI11 puts the option's name in front itself
+          const std::string m = e.what();
+          return m.rfind("--", 0) == 0 && m.find(' ') != std::string::npos ? m.substr(m.find(' ') + 1) : m;
+        }
+      },
+      what);
+}
+
 CameraPose parsePose(const std::string& option, const std::string& text) {
   try {
     return rtr::parsePose(text);
@@ -150,10 +178,14 @@ void checkImageOutput(const std::string& option, const std::filesystem::path& fi
   }
   std::error_code ec;
   const std::filesystem::path dir = file.parent_path().empty() ? "." : file.parent_path();
-  if (!std::filesystem::is_directory(dir, ec))
-    throw UsageError(option + " " + file.string() + ": folder '" + dir.string() + "' does not exist");
-  if (std::filesystem::exists(file, ec) && !force)
-    throw OutputExists(option + " " + file.string() + ": exists; use --force to overwrite it");
+  const std::string bad = option + " " + file.string() + ": ";
+  if (!std::filesystem::exists(dir, ec)) throw UsageError(bad + "folder '" + dir.string() + "' does not exist");
+  if (!std::filesystem::is_directory(dir, ec)) throw UsageError(bad + "'" + dir.string() + "' is not a folder");
+  if (std::filesystem::is_directory(file, ec)) throw UsageError(bad + "is a folder");
+  if (std::filesystem::exists(file, ec) && !force) throw OutputExists(bad + "exists; use --force to overwrite it");
+  // Checked before any work: a read-only folder must not be found after minutes of tracing.
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw UsageError(bad + "folder '" + dir.string() + "' is not writable (" + std::strerror(errno) + ")");
 }
 
 }  // namespace rtr::cli

@@ -38,8 +38,13 @@ struct Size { uint32_t width, height; };
 Size parseSize(const std::string& option, const std::string& text, uint32_t max = 16384);
 // "x,y,z", or one value for all three where `scalarAllowed` (a grey colour).
 glm::vec3 parseVec3(const std::string& option, const std::string& text, bool scalarAllowed = false);
+// parseVec3 of a colour: no component negative.
+glm::vec3 parseColor(const std::string& option, const std::string& text, bool scalarAllowed = false);
 CameraPose parsePose(const std::string& option, const std::string& text);
-// An image output: a known extension, an existing folder, and no existing file unless `force`.
+// A CLI11 check from one of the parse functions above, so that a bad or empty value is a parse error
+// (exit 2) before any work: ->check(cli::checked([](auto& t) { cli::parseColor("--light-color", t); }, "R,G,B")).
+CLI::Validator checked(std::function<void(const std::string&)> parse, const std::string& what);
+// An image output: a known extension, an existing writable folder, and no existing file unless `force`.
 void checkImageOutput(const std::string& option, const std::filesystem::path& file, bool force);
 
 }  // namespace rtr::cli

@@ -1,6 +1,8 @@
 #pragma once
 // One error type for every user-facing failure: the message names the file and the place.
+#include <new>
 #include <stdexcept>
+#include <system_error>
 #include <string>
 
 namespace rtr {
@@ -20,9 +22,24 @@ struct OutputExists : UsageError {
   using UsageError::UsageError;
 };
 
-// "file: at byte 123: what" / "file:12: what" — the place is whatever locates the fault for a person.
+// "file:12: what" for a line, "file: byte 123: what" or "file: mesh 'x': what" for any other place —
+// whatever locates the fault for a person.
 inline Error fileError(const std::string& file, const std::string& place, const std::string& what) {
-  return Error(file + (place.empty() ? "" : ":" + place) + ": " + what);
+  const bool line = !place.empty() && place.find_first_not_of("0123456789") == std::string::npos;
+  return Error(file + (place.empty() ? "" : (line ? ":" : ": ") + place) + ": " + what);
+}
+
+// Runs fn; running out of memory in it (std::bad_alloc, or a thread that cannot be started) becomes an
+// Error naming the stage and its file: stage("reading " + file, [&] { return load(file); }).
+template <class Fn>
+auto stage(const std::string& what, Fn&& fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const std::bad_alloc&) {
+    throw Error("out of memory while " + what);
+  } catch (const std::system_error& e) {
+    throw Error("while " + what + ": " + e.what());
+  }
 }
 
 }  // namespace rtr

@@ -5,13 +5,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <new>
+#include <span>
 
 #include <jpeglib.h>
 #include <jerror.h>
 #include <png.h>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
 #include <stb_image.h>  // the implementation is compiled in stb.cpp
 
@@ -156,6 +158,13 @@ bool decodePng(std::span<const uint8_t> bytes, int channels, TexelData& out, std
   const uint32_t w = png_get_image_width(png, info), h = png_get_image_height(png, info);
   const uint32_t n = png_get_channels(png, info);
   if (n < 1 || n > 4 || png_get_rowbytes(png, info) != size_t(w) * n) png_error(png, "unsupported PNG layout");
+  // Deflate packs at most about 1032 bytes into one: a header declaring more rows than the file can hold
+  // is refused before its texels are allocated (a 100-byte file may declare 32768² pixels).
+  if ((size_t(w) * n + 1) * h / 1032 > bytes.size()) {
+    reader.error = std::to_string(w) + "x" + std::to_string(h) + " pixels cannot come from a file of " +
+                   std::to_string(bytes.size()) + " bytes";
+    png_error(png, reader.error.c_str());
+  }
   out = {w, h, uint32_t(channels), {}};
   std::vector<uint8_t>& target = n == uint32_t(channels) ? out.texels : decoded;  // converted after, if need be
   target.resize(size_t(w) * h * n);
@@ -173,19 +182,7 @@ bool decodePng(std::span<const uint8_t> bytes, int channels, TexelData& out, std
 
 }  // namespace
 
-TexelData loadImage(const std::filesystem::path& file, int channels) {
-  std::ifstream in(file, std::ios::binary | std::ios::ate);
-  if (!in) throw fileError(file.string(), "", "cannot open image");
-  // One read of the whole file (an istreambuf_iterator copy took as long as decoding a large PNG).
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw fileError(file.string(), "", "cannot tell the file's size");
-  std::vector<unsigned char> bytes(static_cast<size_t>(size));
-  in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) throw fileError(file.string(), "", "read error");
-  return decodeImage(bytes, file.string(), channels);
-}
-
-TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, int channels) {
+TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, int channels) try {
   if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8) {  // a JPEG start-of-image marker
     TexelData out;
     std::string error;
@@ -198,16 +195,32 @@ TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, i
     if (!decodePng(bytes, channels, out, error)) throw fileError(name, "", "cannot decode PNG: " + error);
     return out;
   }
+  const int size = int(std::min<size_t>(bytes.size(), INT32_MAX));
   int w = 0, h = 0, n = 0;
-  stbi_uc* data = stbi_load_from_memory(bytes.data(), int(std::min<size_t>(bytes.size(), INT32_MAX)), &w, &h, &n, channels);
+  if (stbi_info_from_memory(bytes.data(), size, &w, &h, &n) && (uint32_t(w) > kMaxImageSide || uint32_t(h) > kMaxImageSide))
+    throw fileError(name, "", "cannot decode image: " + std::to_string(w) + "x" + std::to_string(h) +
+                                  " is larger than " + std::to_string(kMaxImageSide) + " a side");
+  stbi_uc* data = stbi_load_from_memory(bytes.data(), size, &w, &h, &n, channels);
   if (!data) {  // stb can fail without a reason
     const char* why = stbi_failure_reason();
     throw fileError(name, "", std::string("cannot decode image: ") + (why ? why : "not a supported image"));
   }
   TexelData out{uint32_t(w), uint32_t(h), uint32_t(channels), {}};
-  out.texels.assign(data, data + size_t(w) * h * channels);
+  try {
+    out.texels.assign(data, data + size_t(w) * h * channels);
+  } catch (...) {
+    stbi_image_free(data);
+    throw;
+  }
   stbi_image_free(data);
   return out;
+} catch (const std::bad_alloc&) {
+  throw fileError(name, "", "out of memory while decoding the image");
+}
+
+TexelData loadImage(const std::filesystem::path& file, int channels) {
+  const MappedFile mapped(file, "image");  // a regular file; pages read only as the decoder gets to them
+  return decodeImage(mapped.bytes(), file.string(), channels);
 }
 
 float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }

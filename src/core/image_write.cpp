@@ -281,12 +281,15 @@ void saveImage(const std::filesystem::path& file, const ImageF& linear, const Im
   f.commit(opt.replace);
 }
 
+void writePng(AtomicFile& f, const ImageRGBA8& image) {
+  checkSize(f.target(), image.width, image.height);
+  ProgressLine none(false, f.target());
+  writePng(f, image, none);
+}
+
 void savePng(const std::filesystem::path& file, const ImageRGBA8& image) {
   AtomicFile f(file);
-  {
-    ProgressLine none(false, file);
-    writePng(f, image, none);
-  }
+  writePng(f, image);
   f.commit();
 }
 

@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.hpp"  // writeFileAtomic: every baked file is written through it
 #include "core/error.hpp"
+#include "core/input_file.hpp"  // MappedFile
 
 namespace rtr {
 
@@ -41,7 +42,7 @@ public:
 
   [[noreturn]] void fail(const std::string& what) const { failAt(pos_, what); }
   [[noreturn]] void failAt(size_t at, const std::string& what) const {
-    throw fileError(file_, "at byte " + std::to_string(at), what);
+    throw fileError(file_, "byte " + std::to_string(at), what);
   }
   size_t pos() const { return pos_; }
   size_t remaining() const { return d_.size() - pos_; }
@@ -103,25 +104,10 @@ private:
   size_t pos_ = 0;
 };
 
-// Whole file into memory; throws rtr::Error naming the file.
-std::vector<uint8_t> readFileBytes(const std::filesystem::path& file);
+// Whole file into memory (opened through InputFile: a regular file, at most `maxBytes`); throws
+// rtr::Error naming the file.
+std::vector<uint8_t> readFileBytes(const std::filesystem::path& file, uint64_t maxBytes = uint64_t(1) << 32);
 
-// A file's bytes mapped read-only: no copy, pages come in as the decoder reads them (a 10M-triangle
-// scene's read was most of its start-up). Our tools replace files by rename, never rewrite them in place
-// (core/atomic_file), so the mapping of a file being replaced keeps the old bytes. Throws rtr::Error
-// naming the file.
-class MappedFile {
- public:
-  explicit MappedFile(const std::filesystem::path& file);
-  ~MappedFile();
-  MappedFile(const MappedFile&) = delete;
-  MappedFile& operator=(const MappedFile&) = delete;
-  std::span<const uint8_t> bytes() const { return {static_cast<const uint8_t*>(data_), size_}; }
-
- private:
-  void* data_ = nullptr;
-  size_t size_ = 0;
-};
 // 64-bit checksum over bytes (word-wise multiply-xorshift; detects corruption, not tampering). One chain
 // of dependent multiplies: it cannot be split over threads.
 uint64_t checksum64(std::span<const uint8_t> data);

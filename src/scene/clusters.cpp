@@ -6,6 +6,7 @@
 #include <span>
 
 #include "cluster.h"
+#include "core/bounds.hpp"
 #include "core/error.hpp"
 #include "scene/parallel.hpp"
 
@@ -60,6 +61,17 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
 constexpr size_t kPieceTriangles = size_t(1) << 16;
 
 void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backfaceCone) {
+  // meshoptimizer asserts (aborts) on non-finite cone math, which huge coordinates produce; every reader
+  // refuses them with its file and place, and nothing beyond the limit reaches it from elsewhere either.
+  for (const Mesh* m : meshes) {
+    for (size_t k = 0; k < m->positions.size(); ++k)
+      if (!coordinateOk(m->positions[k]))
+        throw Error("mesh '" + m->name + "': position " + std::to_string(k) +
+                    " is not finite or beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
+    for (const uint32_t i : m->indices)  // meshoptimizer asserts this too
+      if (i >= m->positions.size())
+        throw Error("mesh '" + m->name + "': index " + std::to_string(i) + " out of range");
+  }
   struct Job { size_t mesh, first, end; };
   std::vector<Job> jobs;
   for (size_t i = 0; i < meshes.size(); ++i)

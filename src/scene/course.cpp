@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 
+#include "core/bounds.hpp"
 #include "scene/binio.hpp"
 #include "scene/lights.hpp"
 
@@ -128,6 +129,9 @@ Scene decodeCourseMesh(std::span<const uint8_t> bytes, const std::string& file) 
       const glm::vec2 t = m.texcoords[k];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
         r.failAt(posAt + size_t(k) * 12, "mesh " + std::to_string(i) + ": position " + std::to_string(k) + " is not finite");
+      if (!coordinateOk(p))
+        r.failAt(posAt + size_t(k) * 12, "mesh " + std::to_string(i) + ": position " + std::to_string(k) +
+                                             " is beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
       if (!std::isfinite(nn.x + nn.y + nn.z) || !std::isfinite(t.x + t.y))
         r.failAt(posAt + size_t(v) * 12 + size_t(k) * 12, "mesh " + std::to_string(i) + ": vertex " + std::to_string(k) + " has a non-finite normal or texcoord");
       m.bounds.extend(p);
@@ -170,8 +174,8 @@ Scene decodeCourseMesh(std::span<const uint8_t> bytes, const std::string& file) 
 }
 
 Scene loadCourseMesh(const std::filesystem::path& file) {
-  const std::vector<uint8_t> bytes = readFileBytes(file);
-  Scene s = decodeCourseMesh(bytes, file.string());
+  const MappedFile mapped(file);  // the header is checked before the rest is read
+  Scene s = decodeCourseMesh(mapped.bytes(), file.string());
   s.baseDir = file.parent_path();
   return s;
 }

@@ -30,8 +30,13 @@ Scene loadAny(const std::filesystem::path& file, const LoadOptions& options) {
 }  // namespace
 
 Scene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
-  Scene scene = loadAny(file, options);
-  buildMissingClusters(scene);  // every format but .rtrscene version 3 or later (rtr-bake builds them there)
+  Scene scene = stage("reading " + file.string(), [&] { return loadAny(file, options); });
+  try {
+    // every format but .rtrscene version 3 or later (rtr-bake builds them there)
+    stage("clustering", [&] { buildMissingClusters(scene); });
+  } catch (const Error& e) {
+    throw fileError(file.string(), "", e.what());
+  }
   return scene;
 }
 

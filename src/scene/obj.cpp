@@ -6,14 +6,14 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <thread>
 #include <unordered_map>
 
+#include "core/bounds.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "scene/mtl.hpp"
 #include "scene/text.hpp"
 #include "scene/triangulate.hpp"
@@ -28,6 +28,7 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 constexpr size_t kChunk = size_t(4) << 20;
 constexpr size_t kMaxLine = size_t(64) << 20;
 constexpr size_t kMaxName = 32767;
+constexpr uint64_t kMaxMtlBytes = uint64_t(64) << 20;  // real ones are kilobytes; /dev/zero is refused anyway
 constexpr size_t kShownWarnings = 10;
 constexpr size_t kSniffBytes = 8192;  // how much of the start is checked for being text, as git does
 
@@ -109,7 +110,7 @@ private:
       if (c < 0x20 && c != '\n' && !text::isSpace(char(c)) && c != 0x1A) {  // 0x1A: DOS end-of-file mark
         char hex[8];
         std::snprintf(hex, sizeof hex, "0x%02X", c);
-        throw fileError(name_, "at byte " + std::to_string(offset + i),
+        throw fileError(name_, "byte " + std::to_string(offset + i),
                         std::string("control byte ") + hex + ": binary data, not a text OBJ file");
       }
     }
@@ -137,6 +138,9 @@ private:
         default: throw error(std::string("'") + key + "' coordinate is not a number");
       }
     }
+    if constexpr (N == 3)
+      if (key[1] == '\0' && !coordinateOk(v))  // 'v': the limit every reader applies
+        throw error("vertex coordinate beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
     out.push_back(v);
   }
 
@@ -404,15 +408,6 @@ Scene ObjParser::finish() {
   return scene;
 }
 
-std::string readWholeFile(const std::filesystem::path& file, const std::string& what) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw fileError(file.string(), "", "cannot open " + what + ": " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw fileError(file.string(), "", "read error");
-  return std::move(ss).str();
-}
-
 }  // namespace
 
 Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& readMtl, const ObjOptions& options,
@@ -437,7 +432,7 @@ Scene loadObj(const std::filesystem::path& file, const ObjOptions& options, ObjS
     const std::filesystem::path p = options.mtl && mtl == options.mtl->string() ? *options.mtl : dir / mtl;
     std::error_code ec;
     if (!std::filesystem::exists(p, ec)) return std::nullopt;
-    return readWholeFile(p, "material library");
+    return readInputFile(p, "material library", kMaxMtlBytes);
   };
   // NAME.mtl for NAME.obj, NAME.obj.zst and NAME.obj-zstd.
   std::string stem = file.filename().string();

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "cluster.h"
+#include "core/bounds.hpp"
 #include "scene/binio.hpp"
 #include "scene/parallel.hpp"
 
@@ -671,6 +672,8 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
                            std::to_string(r.remaining()) + " bytes left");
     m.bounds.min = readVec(r, "mesh bounds");
     m.bounds.max = readVec(r, "mesh bounds");
+    if (v > 0 && !(coordinateOk(m.bounds.min) && coordinateOk(m.bounds.max)))  // positions lie inside them
+      r.failAt(at + 16, which + ": bounds beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
     if (v == 0) m.bounds = Bounds{};
     m.name = readString(r, "a mesh name");
     r.align(kAlign, "a mesh record");

@@ -6,13 +6,10 @@
 #include <zstd.h>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
 namespace rtr {
 namespace {
-
-struct FileCloser {
-  void operator()(std::FILE* f) const { if (f) std::fclose(f); }
-};
 
 // Raw bytes from a file or memory, the layer under the optional zstd decoder.
 class RawSource {
@@ -24,24 +21,12 @@ public:
 
 class RawFile final : public RawSource {
 public:
-  explicit RawFile(const std::filesystem::path& file) : name_(file.string()) {
-    f_.reset(std::fopen(file.c_str(), "rb"));
-    if (!f_) throw fileError(name_, "", std::string("cannot open: ") + std::strerror(errno));
-    std::error_code ec;
-    size_ = std::filesystem::file_size(file, ec);
-    if (ec) size_ = 0;
-  }
-  size_t read(char* dst, size_t n) override {
-    size_t got = std::fread(dst, 1, n, f_.get());
-    if (got < n && std::ferror(f_.get())) throw fileError(name_, "", "read error");
-    return got;
-  }
-  uint64_t size() const override { return size_; }
+  explicit RawFile(const std::filesystem::path& file) : in_(file, "scene file") {}
+  size_t read(char* dst, size_t n) override { return in_.read(dst, n); }
+  uint64_t size() const override { return in_.size(); }
 
 private:
-  std::string name_;
-  std::unique_ptr<std::FILE, FileCloser> f_;
-  uint64_t size_ = 0;
+  InputFile in_;  // a regular file only, read no further than its size at open
 };
 
 class RawMemory final : public RawSource {
@@ -97,9 +82,9 @@ public:
           eof_ = true;
           // A stream ends cleanly only on a frame boundary with all output flushed.
           if (lastHint_ != 0)
-            throw fileError(name_, "at byte " + std::to_string(consumed_),
+            throw fileError(name_, "byte " + std::to_string(consumed_),
                             "truncated zstd stream (the compressed data ends inside a frame)");
-          if (!sawData_) throw fileError(name_, "at byte 0", "empty file is not a zstd stream");
+          if (!sawData_) throw fileError(name_, "byte 0", "empty file is not a zstd stream");
           break;
         }
         sawData_ = true;
@@ -109,7 +94,7 @@ public:
       size_t hint = ZSTD_decompressStream(z_.get(), &out, &inBuf_);
       consumed_ += inBuf_.pos - before;
       if (ZSTD_isError(hint))
-        throw fileError(name_, "at byte " + std::to_string(consumed_),
+        throw fileError(name_, "byte " + std::to_string(consumed_),
                         std::string("corrupt zstd stream: ") + ZSTD_getErrorName(hint));
       lastHint_ = hint;
       mayHoldOutput_ = out.pos == out.size;

@@ -1,6 +1,9 @@
 #include "vk/context.hpp"
 
+#include <sys/resource.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -12,6 +15,22 @@
 
 namespace rtr::vk {
 namespace {
+
+// llvmpipe's vkCreateDevice crashes (SIGSEGV inside the driver) when the address space runs out while it
+// starts its threads and LLVM: under `ulimit -v` 800 MB on the 2-core development VM, fine at 850 MB. A
+// CPU device is therefore refused up front below 1 GB, with the reason, instead of crashing.
+constexpr uint64_t kCpuDeviceAddressSpace = uint64_t(1) << 30;
+
+void checkCpuDeviceAddressSpace(const VkPhysicalDeviceProperties& p) {
+  rlimit r{};
+  if (p.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU || ::getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY ||
+      r.rlim_cur >= kCpuDeviceAddressSpace)
+    return;
+  throw Error(std::string("out of memory: ") + p.deviceName + " (a CPU device) needs about " +
+              std::to_string(kCpuDeviceAddressSpace >> 20) + " MB of address space to start; ulimit -v allows " +
+              std::to_string(uint64_t(r.rlim_cur) >> 20) + " MB");
+}
+
 
 std::atomic<uint32_t> g_validationMessages{0};
 
@@ -74,14 +93,14 @@ VkPhysicalDevice choosePhysicalDevice(VkInstance instance, const std::string& wa
     unsigned long index = std::strtoul(want.c_str(), &end, 10);
     if (*end == '\0') {
       if (index >= devices.size())
-        throw Error("device index " + want + " out of range: " + std::to_string(devices.size()) + " device(s)");
+        throw UsageError("--device " + want + ": index out of range: " + std::to_string(devices.size()) + " device(s)");
       return devices[index];
     }
     for (auto d : devices)
       if (name(d).find(want) != std::string::npos) return d;
     std::string all;
     for (auto d : devices) all += "\n  " + name(d);
-    throw Error("no Vulkan device matches '" + want + "'; devices:" + all);
+    throw UsageError("--device '" + want + "': no Vulkan device matches; devices:" + all);
   }
   return *std::min_element(devices.begin(), devices.end(), [](VkPhysicalDevice a, VkPhysicalDevice b) {
     VkPhysicalDeviceProperties pa, pb;
@@ -213,6 +232,7 @@ Context::Context(const ContextOptions& options) {
     dci.pQueueCreateInfos = &queueInfo;
     dci.enabledExtensionCount = uint32_t(deviceExtensions.size());
     dci.ppEnabledExtensionNames = deviceExtensions.data();
+    checkCpuDeviceAddressSpace(properties_);
     VK_CHECK(vkCreateDevice(physical_, &dci, nullptr, &device_));
     pushDescriptorFn_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
     vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
@@ -273,6 +293,15 @@ const char* resultName(VkResult r) {
 #undef CASE
     default: return "VkResult(?)";
   }
+}
+
+VkDeviceSize Context::deviceHeapBytes() const {
+  VkPhysicalDeviceMemoryProperties mp;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
+  VkDeviceSize best = 0;
+  for (uint32_t i = 0; i < mp.memoryHeapCount; ++i)
+    if (mp.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) best = std::max(best, mp.memoryHeaps[i].size);
+  return best;
 }
 
 }  // namespace rtr::vk

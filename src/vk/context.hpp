@@ -56,6 +56,8 @@ class Context {
 
   PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn() const { return pushDescriptorFn_; }
   VkPhysicalDeviceType deviceType() const { return properties_.deviceType; }
+  // The largest device-local memory heap, in bytes: what one scene and its targets must fit in.
+  VkDeviceSize deviceHeapBytes() const;
   // Every pipeline is created through it (vk/pipeline.cpp), which also counts them and their time.
   PipelineCache& pipelineCache() const { return *pipelineCache_; }
 

@@ -1,25 +1,22 @@
 #include "vk/glsl.hpp"
 
-#include <fstream>
 #include <memory>
 #include <mutex>
-#include <sstream>
 
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
 namespace rtr::vk {
 namespace {
 
+constexpr uint64_t kMaxGlslBytes = uint64_t(16) << 20;
+
 std::string readText(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw fileError(file.string(), "", "cannot open GLSL file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return readInputFile(file, "GLSL file", kMaxGlslBytes);
 }
 
 // Resolves #include "x" against the including file's folder, then the include folders.

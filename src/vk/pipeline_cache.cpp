@@ -3,10 +3,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 
 #include "core/atomic_file.hpp"
+#include "core/input_file.hpp"
 #include "vk/check.hpp"
 
 namespace rtr::vk {
@@ -82,10 +82,18 @@ PipelineCache::PipelineCache(VkDevice device, const VkPhysicalDeviceProperties& 
     int n = std::snprintf(name, sizeof name, "pipelines-%04x-%04x-%08x-", props.vendorID, props.deviceID, props.driverVersion);
     for (uint8_t b : props.pipelineCacheUUID) n += std::snprintf(name + n, sizeof name - n, "%02x", b);
     file_ = dir / (std::string(name) + ".bin");
-    std::ifstream in(file_, std::ios::binary);
-    if (in) {
-      std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      if (std::string why = whyNot(bytes, props); !why.empty())
+    std::error_code ec;
+    if (std::filesystem::exists(file_, ec)) {
+      std::vector<uint8_t> bytes;
+      std::string why;
+      try {  // our own file, but in the user's folder: a FIFO or a huge file there is ignored, not waited on
+        const std::string read = readInputFile(file_, "pipeline cache", uint64_t(1) << 30);
+        bytes.assign(read.begin(), read.end());
+        why = whyNot(bytes, props);
+      } catch (const Error& e) {
+        why = e.what();
+      }
+      if (!why.empty())
         note("pipeline cache " + file_.string() + " ignored (" + why + "); it will be rewritten");
       else
         initial.assign(bytes.begin() + sizeof(FileHeader), bytes.end());

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -11,9 +10,12 @@
 #include <spirv_reflect/spirv_reflect.h>
 
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
 namespace rtr::vk {
 namespace {
+
+constexpr uint64_t kMaxSpirvBytes = uint64_t(64) << 20;  // our largest module is a few hundred KB
 
 const char* resultName(SpvReflectResult r) {
   static const char* const names[] = {
@@ -33,7 +35,7 @@ void checkInstructionStream(const SpirvModule& s) {
   for (size_t i = 5; i < w.size();) {
     const uint32_t words = w[i] >> 16;
     if (words == 0 || words > w.size() - i)
-      throw fileError(s.name, "at word " + std::to_string(i),
+      throw fileError(s.name, "word " + std::to_string(i),
                       "not SPIR-V: an instruction of " + std::to_string(words) + " words in a module of " +
                           std::to_string(w.size()));
     i += words;
@@ -228,14 +230,12 @@ SpirvModule spirvFromBytes(const void* data, size_t size, const std::string& nam
     throw fileError(name, "", "not SPIR-V: size " + std::to_string(size) + " is not a multiple of 4 of at least 20 bytes");
   SpirvModule m{name, std::vector<uint32_t>(size / 4)};
   std::memcpy(m.code.data(), data, size);
-  if (m.code[0] != 0x07230203u) throw fileError(name, "at byte 0", "not SPIR-V: wrong magic number");
+  if (m.code[0] != 0x07230203u) throw fileError(name, "byte 0", "not SPIR-V: wrong magic number");
   return m;
 }
 
 SpirvModule readSpirv(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw fileError(file.string(), "", "cannot open SPIR-V file");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = readInputFile(file, "SPIR-V file", kMaxSpirvBytes);
   SpirvModule m = spirvFromBytes(bytes.data(), bytes.size(), file.string());
   m.name = file.filename().string();
   return m;

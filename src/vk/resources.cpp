@@ -2,10 +2,30 @@
 
 #include <vk_mem_alloc.h>
 
+#include <cstdint>
+#include <string>
+
 #include "vk/check.hpp"
 #include "vk/context.hpp"
 
 namespace rtr::vk {
+namespace {
+
+std::string mb(VkDeviceSize bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MB"; }
+
+// Allocation failures become OutOfMemory naming the object and its size; other failures stay VK_CHECK's.
+void checkAllocation(VkResult r, const char* call, const char* kind, const char* name, VkDeviceSize bytes) {
+  if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY || r == VK_ERROR_MEMORY_MAP_FAILED)
+    throw OutOfMemory(std::string(kind) + " '" + (name ? name : "unnamed") + "' needs " + mb(bytes) + ": " +
+                      resultName(r));
+  if (r < 0) throw Error(std::string(call) + " failed: " + resultName(r));
+}
+
+// A mapping that "succeeded" with an address no mapping has (lavapipe out of address space gave
+// 0xffffffffffffffff, MAP_FAILED) is a failed one.
+bool badMapping(const void* p) { return p == reinterpret_cast<const void*>(~uintptr_t(0)); }
+
+}  // namespace
 
 Buffer::Buffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use, const char* name)
     : allocator_(ctx.allocator()), size_(size) {
@@ -24,8 +44,14 @@ Buffer::Buffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, 
     ai.requiredFlags = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
   }
   VmaAllocationInfo info{};
-  VK_CHECK(vmaCreateBuffer(allocator_, &bi, &ai, &buffer_, &allocation_, &info));
+  checkAllocation(vmaCreateBuffer(allocator_, &bi, &ai, &buffer_, &allocation_, &info), "vmaCreateBuffer", "buffer",
+                  name, size);
   mapped_ = info.pMappedData;
+  const bool mustMap = use == MemoryUse::Upload || use == MemoryUse::Readback;
+  if (badMapping(mapped_) || (mustMap && !mapped_)) {
+    reset();
+    throw OutOfMemory(std::string("buffer '") + (name ? name : "unnamed") + "' of " + mb(size) + " cannot be mapped");
+  }
   if (name) ctx.setName(uint64_t(buffer_), VK_OBJECT_TYPE_BUFFER, name);
 }
 
@@ -70,7 +96,9 @@ Image::Image(const Context& ctx, const ImageDesc& desc) : device_(ctx.device()),
   ii.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
   VmaAllocationCreateInfo ai{};
   ai.usage = VMA_MEMORY_USAGE_AUTO_PREFER_DEVICE;
-  VK_CHECK(vmaCreateImage(allocator_, &ii, &ai, &image_, &allocation_, nullptr));
+  VmaAllocationInfo info{};
+  checkAllocation(vmaCreateImage(allocator_, &ii, &ai, &image_, &allocation_, &info), "vmaCreateImage", "image",
+                  desc.name, info.size ? info.size : VkDeviceSize(desc.extent.width) * desc.extent.height * 4);
   if (desc.name) ctx.setName(uint64_t(image_), VK_OBJECT_TYPE_IMAGE, desc.name);
   // A copy-only image has no view (Vulkan allows none for such usage).
   constexpr VkImageUsageFlags kViewUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |

@@ -6,6 +6,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "core/error.hpp"
 #include "vk/image_state.hpp"
 
 typedef struct VmaAllocation_T* VmaAllocation;
@@ -14,6 +15,12 @@ typedef struct VmaAllocator_T* VmaAllocator;
 namespace rtr::vk {
 
 class Context;
+
+// A buffer or image the device (or the host, for a CPU device) cannot allocate or map: the message says
+// what and how much; callers add the file and the stage ("out of memory while uploading FILE: ...").
+struct OutOfMemory : Error {
+  using Error::Error;
+};
 
 bool isDepthFormat(VkFormat f);
 

@@ -168,6 +168,32 @@ TEST_F(Cli, BadOptionValuesAreUsageErrorsNamingTheOption) {
       {"rtr-view", {c, "--headless", "--screenshot", png, "--ambient", "0.1,nan,0"}, "--ambient"},
       {"rtr-view", {c, "--headless", "--screenshot", png, "--light-color", "1,1"}, "--light-color"},
       {"rtr-trace", {c, "-o", png, "--ambient", "0.5,0.5"}, "--ambient"},
+      // Issue 33: empty values, blanks on either side, negative colours, a colour without its light, a
+      // device that matches nothing, an output folder that is a file.
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light-color", "nan"}, "--light-color"},
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light-color", "1,1,1"}, "--light"},
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light", "0,1,0", "--light-color", "1e40,1,1"}, "--light-color"},
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light", "0,1,0", "--light-color", ""}, "--light-color"},
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light", "0,1,0", "--light-color", "-1,1,1"}, "--light-color"},
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light", ""}, "--light"},
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--view", ""}, "--view"},
+      {"rtr-trace", {c, "-o", png, "--light", "0,1,0", "--light-color", ""}, "--light-color"},
+      {"rtr-trace", {c, "-o", png, "--light", "0,1,0", "--light-color", "-1,0,0"}, "--light-color"},
+      {"rtr-trace", {c, "-o", png, "--ambient", "-0.5"}, "--ambient"},
+      {"rtr-trace", {c, "-o", png, "--ambient", ""}, "--ambient"},
+      {"rtr-trace", {c, "-o", png, "--fov", " 5"}, "--fov"},
+      {"rtr-trace", {c, "-o", png, "--fov", "5 "}, "--fov"},
+      {"rtr-trace", {c, "-o", png, "--fov", ""}, "--fov"},
+      {"rtr-trace", {c, "-o", png, "--size", ""}, "--size"},
+      {"rtr-trace", {c, "-o", png, "--camera", ""}, "--camera"},
+      {"rtr-trace", {c, "-o", c + "/x.png"}, "is not a folder"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--ambient", "0,-1,0"}, "--ambient"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--light-color", "1,1,1"}, "--light"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--mode", " 5"}, "--mode"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--device", "no-such-device"}, "--device"},
+      {"scenegen", {"--scale", "nan"}, "--scale"},
+      {"scenegen", {"--scale", "1e9"}, "--scale"},
+      {"scenegen", {"--textures", "abc"}, "--textures"},
   };
   for (const BadValue& row : table) {
     std::string line = row.tool;

@@ -1,5 +1,8 @@
 // rtr-bake's bad-input cases: each gets a clear error, and nothing is left behind.
+#include <sys/resource.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <filesystem>
 #include <fstream>
@@ -101,4 +104,46 @@ TEST_F(Fixture, OutputFolderNotWritable) {
 
 TEST_F(Fixture, UnknownOutputExtension) {
   EXPECT_THAT(bakeError(out / "s.glb"), HasSubstr("unknown output format"));
+}
+
+// Disk full during a --force bake (a file size limit stands in for it: a write past it fails, EFBIG, as
+// ENOSPC would): the older scene and its textures stay as they were, and no temporary is left. Before,
+// the new textures were already in place when the scene's write failed.
+TEST_F(Fixture, FailedForcedBakeKeepsTheOlderOutputWhole) {
+  ASSERT_EQ(bakeError(out / "s.rtrscene"), "(no error)");
+  auto read = [](const fs::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string oldScene = read(out / "s.rtrscene"), oldTexture = read(out / "s-tex/tex.png");
+  // The new bake: another texture (9.6 KB) and a scene of a few hundred KB.
+  fs::copy_file(rtr::test::sourceDir() / "assets-src/temple/textures/column_col.png", dir / "tex.png",
+                fs::copy_options::overwrite_existing);
+  std::string obj = "mtllib s.mtl\nusemtl a\n";
+  constexpr int kN = 60;
+  for (int y = 0; y <= kN; ++y)
+    for (int x = 0; x <= kN; ++x) obj += "v " + std::to_string(x) + " " + std::to_string(y) + " 0\nvt 0 0\n";
+  for (int y = 0; y < kN; ++y)
+    for (int x = 0; x < kN; ++x) {
+      const int a = y * (kN + 1) + x + 1, b = a + 1, c = a + kN + 1, d = c + 1;
+      obj += "f " + std::to_string(a) + "/" + std::to_string(a) + " " + std::to_string(b) + "/" + std::to_string(b) + " " +
+             std::to_string(d) + "/" + std::to_string(d) + " " + std::to_string(c) + "/" + std::to_string(c) + "\n";
+    }
+  write("s.obj", obj);
+  const size_t before = filesIn(out);
+  rlimit old{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  const auto oldHandler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit limited = old;
+  limited.rlim_cur = 64 << 10;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limited), 0);
+  const std::string err = bakeError(out / "s.rtrscene", true);
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, oldHandler);
+  EXPECT_THAT(err, HasSubstr("s.rtrscene: cannot write: File too large"));
+  EXPECT_EQ(read(out / "s.rtrscene"), oldScene);
+  EXPECT_EQ(read(out / "s-tex/tex.png"), oldTexture);
+  EXPECT_EQ(filesIn(out), before);
+  EXPECT_EQ(bakeError(out / "s.rtrscene", true), "(no error)");  // with room, the new one goes in whole
+  EXPECT_EQ(read(out / "s-tex/tex.png"), read(dir / "tex.png"));
 }

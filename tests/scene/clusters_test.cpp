@@ -218,7 +218,7 @@ TEST(Clusters, RtrSceneRefusesDamagedClusters) {
   };
   const uint32_t tooMany = CLUSTER_MAX_TRIANGLES + 1, shifted = 1, zero = 0;
   const float nan = std::nanf(""), tiny = 1e-3f, negative = -1.0f;
-  EXPECT_THAT(patched(0, 36, &tooMany), HasSubstr("g.rtrscene:at byte " + std::to_string(first + 36) +
+  EXPECT_THAT(patched(0, 36, &tooMany), HasSubstr("g.rtrscene: byte " + std::to_string(first + 36) +
                                                   ": mesh 0: cluster 0: triangle count 125 not in 1..124"));
   EXPECT_THAT(patched(0, 36, &zero), HasSubstr("cluster 0: triangle count 0"));
   EXPECT_THAT(patched(1, 32, &shifted), HasSubstr("cluster 1: first triangle 1 is not"));

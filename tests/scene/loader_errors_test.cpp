@@ -68,39 +68,39 @@ TEST(CourseLoader, AcceptsTheSampleAndRefusesDamage) {
   const std::string good = encodeCourseMesh(sample());
   ASSERT_EQ(good.size(), 206u);
   EXPECT_EQ(courseError(good), "(no error)");
-  EXPECT_THAT(courseError(good.substr(0, 100)), HasSubstr("x.comp5892mesh:at byte 90: mesh 0: 3 vertices and 3 indices cannot fit"));
+  EXPECT_THAT(courseError(good.substr(0, 100)), HasSubstr("x.comp5892mesh: byte 90: mesh 0: 3 vertices and 3 indices cannot fit"));
   EXPECT_THAT(courseError(good + "x"), HasSubstr("1 bytes after the last mesh"));
   std::string b = good;
   b[3] = 'X';
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 0: not a .comp5892mesh file"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 0: not a .comp5892mesh file"));
   b = good;
   b[27] = 'x';
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 16: unsupported variant"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 16: unsupported variant"));
   b = good;
   put32(b, 36, 40000);
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 36: texture path length 40000"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 36: texture path length 40000"));
   b = good;
   put32(b, 32, 0x7FFFFFFF);
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 32: texture count 2147483647 cannot fit"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 32: texture count 2147483647 cannot fit"));
   b = good;
   put32(b, 58, 5);
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 58: texture index 5 out of range"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 58: texture index 5 out of range"));
   b = good;
   put32(b, 86, 1);
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 86: mesh 0: material index 1 out of range"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 86: mesh 0: material index 1 out of range"));
   b = good;
   put32(b, 90, 0x10000000);
   EXPECT_THAT(courseError(b), HasSubstr("cannot fit"));
   b = good;
   put32(b, 198, 3);
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 198: mesh 0: index 3 out of range"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 198: mesh 0: index 3 out of range"));
   b = good;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(b.data() + 110, &nan, 4);
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 110: mesh 0: position 1 is not finite"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 110: mesh 0: position 1 is not finite"));
   b = good;
   b[52] = 7;
-  EXPECT_THAT(courseError(b), HasSubstr("at byte 52: texture colour space 7"));
+  EXPECT_THAT(courseError(b), HasSubstr("byte 52: texture colour space 7"));
 }
 
 // Version 4's layout (the offsets below); version 5's new records: rtrscene_v5_test.cpp.
@@ -110,16 +110,16 @@ TEST(RtrSceneLoader, ChecksumSizeAndStructure) {
   EXPECT_EQ(good.size() % 16, 0u);
   std::string b = good;
   b[good.size() - 20] ^= 1;
-  EXPECT_THAT(rtrError(b), HasSubstr("x.rtrscene:at byte 40: checksum mismatch"));
-  EXPECT_THAT(rtrError(good.substr(0, good.size() - 16)), HasSubstr("at byte 32: payload size"));
+  EXPECT_THAT(rtrError(b), HasSubstr("x.rtrscene: byte 40: checksum mismatch"));
+  EXPECT_THAT(rtrError(good.substr(0, good.size() - 16)), HasSubstr("byte 32: payload size"));
   EXPECT_THAT(rtrError(good.substr(0, 30)), HasSubstr("file ends inside the header"));
   b = good;
   put32(b, 8, 99);
-  EXPECT_THAT(rtrError(b), HasSubstr("at byte 8: unsupported version 99"));
+  EXPECT_THAT(rtrError(b), HasSubstr("byte 8: unsupported version 99"));
   b = good;
   put32(b, 24, 0x40000000);
   reseal(b);
-  EXPECT_THAT(rtrError(b), HasSubstr("at byte 24: mesh count 1073741824 cannot fit"));
+  EXPECT_THAT(rtrError(b), HasSubstr("byte 24: mesh count 1073741824 cannot fit"));
   // The last mesh's 16-bit indices (padded to 16) sit before its 16-byte cluster header (no clusters):
   // the third index is at size-32+4.
   b = good;
@@ -135,5 +135,5 @@ TEST(RtrSceneLoader, ChecksumSizeAndStructure) {
   b = good;
   put32(b, 116, 50000);
   reseal(b);
-  EXPECT_THAT(rtrError(b), HasSubstr("at byte 116: a material name length 50000 is not below 32768"));
+  EXPECT_THAT(rtrError(b), HasSubstr("byte 116: a material name length 50000 is not below 32768"));
 }

@@ -135,9 +135,9 @@ TEST_F(Dir, NotAnObjIsAnErrorNamingTheFile) {
   write("utf16.obj", std::string("\xFE\xFF\0v\0 \0" "0", 9));
   EXPECT_THAT(errorOf(dir / "utf16.obj"), HasSubstr("utf16.obj: UTF-16 text"));
   write("nul.obj", std::string("v 0 0 0\nv 1 0 0\0\0\0", 18));
-  EXPECT_THAT(errorOf(dir / "nul.obj"), HasSubstr("nul.obj:at byte 15: control byte 0x00"));
+  EXPECT_THAT(errorOf(dir / "nul.obj"), HasSubstr("nul.obj: byte 15: control byte 0x00"));
   write("junk.obj", "\x89PNG\r\n\x1a\n\x01\x02junk");
-  EXPECT_THAT(errorOf(dir / "junk.obj"), HasSubstr("junk.obj:at byte 8: control byte 0x01"));
+  EXPECT_THAT(errorOf(dir / "junk.obj"), HasSubstr("junk.obj: byte 8: control byte 0x01"));
   write("empty.obj", "");
   EXPECT_THAT(errorOf(dir / "empty.obj"), HasSubstr("empty.obj: no faces"));
   write("text.obj", "Dear reader,\nthis is a letter.\n");

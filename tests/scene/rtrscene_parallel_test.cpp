@@ -143,7 +143,7 @@ TEST(RtrSceneParallel, TheFirstFaultInTheFileIsReportedAtAnyThreadCount) {
   reseal(b);
   for (unsigned threads : {1u, 2u, 8u}) {
     SCOPED_TRACE(std::to_string(threads) + " threads");
-    EXPECT_THAT(decodeError(b, threads), HasSubstr("p.rtrscene:at byte " + std::to_string(posAt) + ": mesh 0: position 7 is not finite"));
+    EXPECT_THAT(decodeError(b, threads), HasSubstr("p.rtrscene: byte " + std::to_string(posAt) + ": mesh 0: position 7 is not finite"));
   }
 }
 
@@ -167,7 +167,7 @@ TEST(RtrSceneParallel, ADamagedClusterBeforeAPieceIsReportedNotFollowed) {
   std::memcpy(b.data() + records + 2048 * 40 + 32, &first, 4);
   reseal(b);
   for (unsigned threads : {1u, 8u})
-    EXPECT_THAT(decodeError(b, threads), HasSubstr("at byte " + std::to_string(records + 2047 * 40 + 36) +
+    EXPECT_THAT(decodeError(b, threads), HasSubstr("byte " + std::to_string(records + 2047 * 40 + 36) +
                                                    ": mesh 1: cluster 2047: triangle count " + std::to_string(count)));
 }
 
@@ -193,7 +193,7 @@ TEST(RtrSceneParallel, Version4RefusesADamagedPieceAndOlderFilesStillLoad) {
   const std::string good = encodeRtrScene(severalMeshes());
   std::string b = good;
   b[80 + 3 * kChecksumPiece + 11] ^= 4;  // one bit in the fourth piece
-  for (unsigned threads : {1u, 8u}) EXPECT_THAT(decodeError(b, threads), HasSubstr("p.rtrscene:at byte 40: checksum mismatch"));
+  for (unsigned threads : {1u, 8u}) EXPECT_THAT(decodeError(b, threads), HasSubstr("p.rtrscene: byte 40: checksum mismatch"));
   // A file written by a build of version 3 (one checksum chain over the payload) still loads; damaged,
   // it is refused.
   const auto old = readFileBytes(test::sourceDir() / "tests/fuzz/corpus/fuzz_rtrscene/cube_backplane-v3.rtrscene");
@@ -201,8 +201,8 @@ TEST(RtrSceneParallel, Version4RefusesADamagedPieceAndOlderFilesStillLoad) {
   ASSERT_EQ(v3[8], 3);
   EXPECT_EQ(decodeError(v3, 1), "(no error)");
   v3[v3.size() - 20] ^= 1;
-  EXPECT_THAT(decodeError(v3, 1), HasSubstr("at byte 40: checksum mismatch"));
+  EXPECT_THAT(decodeError(v3, 1), HasSubstr("byte 40: checksum mismatch"));
   std::string v6 = good;
   v6[8] = 6;
-  EXPECT_THAT(decodeError(v6, 1), HasSubstr("at byte 8: unsupported version 6 (this build reads 5)"));
+  EXPECT_THAT(decodeError(v6, 1), HasSubstr("byte 8: unsupported version 6 (this build reads 5)"));
 }

@@ -193,7 +193,7 @@ TEST(ReflectModern, ModuleCutInsideAnInstructionIsAnError) {
       vk::reflectSpirvBytes(m.code.data(), words * 4, true);
       ADD_FAILURE() << "a module cut at word " << words << " was reflected";
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("<memory>:at word "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("<memory>: word "), std::string::npos) << e.what();
     }
   }
   EXPECT_GT(cuts, 100);

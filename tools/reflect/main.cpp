@@ -1,7 +1,10 @@
 // rtr-reflect: prints the interface of a pipeline's shaders, as the renderer derives its layouts from it.
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 
@@ -14,9 +17,20 @@
 
 namespace {
 
+// The worker's address-space limit: our largest pipeline reflects in well under 200 MB; a module that
+// makes SPIRV-Reflect or glslang run away is stopped here, not by the machine.
+constexpr rlim_t kWorkerMemory = rlim_t(2) << 30;
+
+std::string joined(const std::vector<std::string>& files) {
+  std::string names;
+  for (const auto& f : files) names += (names.empty() ? "" : ", ") + f;
+  return names;
+}
+
 int reflectAll(const std::vector<std::string>& files, const std::vector<std::string>& includes, bool json,
                bool noValidate, bool strict) {
   try {
+    return rtr::stage("reflecting " + joined(files), [&] {
     std::vector<std::filesystem::path> dirs(includes.begin(), includes.end());
     std::vector<rtr::vk::SpirvModule> modules;
     for (const auto& f : files) {
@@ -32,6 +46,7 @@ int reflectAll(const std::vector<std::string>& files, const std::vector<std::str
     const auto iface = rtr::vk::reflectPipeline(modules);
     std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
     return 0;
+    });
   } catch (const std::exception& e) {
     return rtr::cli::fail("rtr-reflect", e);
   }
@@ -66,9 +81,20 @@ int main(int argc, char** argv) {
   // SPIRV-Reflect (third party) asserts or crashes on some modules, even ones spirv-val accepts (found
   // by fuzzing, docs/fuzzing.md). The work runs in a child process so that the tool reports such a module
   // instead of dying with it.
+  // It dies with this process (SIGKILL when the parent goes, however it goes) and is bounded in memory.
   std::fflush(nullptr);
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid == 0) {
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(1);  // the parent died before the line above took effect
+#if !defined(__SANITIZE_ADDRESS__) && !defined(RTR_NO_WORKER_LIMIT)  // ASan reserves terabytes of shadow
+    rlimit limit{};
+    if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur > kWorkerMemory) {  // only ever lowered
+      limit.rlim_cur = kWorkerMemory;
+      ::setrlimit(RLIMIT_AS, &limit);
+    }
+#endif
     const int rc = reflectAll(files, includes, json, noValidate, strict);
     std::cout.flush();
     std::fflush(nullptr);
@@ -77,9 +103,7 @@ int main(int argc, char** argv) {
   int status = 0;
   if (pid < 0 || waitpid(pid, &status, 0) != pid) return reflectAll(files, includes, json, noValidate, strict);
   if (WIFEXITED(status)) return WEXITSTATUS(status);
-  std::string names;
-  for (const auto& f : files) names += (names.empty() ? "" : ", ") + f;
   std::fprintf(stderr, "rtr-reflect: error: %s: SPIRV-Reflect crashed reading it (signal %d); the module is "
-               "malformed in a way SPIRV-Reflect does not check\n", names.c_str(), WTERMSIG(status));
+               "malformed in a way SPIRV-Reflect does not check\n", joined(files).c_str(), WTERMSIG(status));
   return 1;
 }

@@ -11,6 +11,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/cli.hpp"
+#include "core/error.hpp"
 #include "objwriter.hpp"
 #include "png.hpp"
 
@@ -152,20 +154,23 @@ void writeTextureSet(const fs::path& dir, int count, ObjWriter& o, std::ofstream
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Generates the temple courtyard scene (zstd OBJ + MTL + PNG textures)"};
+  CLI::App app{"Generates the temple courtyard scene (zstd OBJ + MTL + PNG textures)", "scenegen"};
   std::string out = "assets-src/temple";
   double scale = 1;
   bool plain = false;
   int textures = 0;
   app.add_option("--out", out, "output folder");
   app.add_option("--textures", textures, "also N textures of 1024x1024 on N panels (a real scene's texture set)")
-      ->check(CLI::Range(0, 10000));
-  app.add_option("--scale", scale, "tessellation factor (100: about 1.6M vertices)")->check(CLI::Range(0.05, 10000.0));
+      ->check(rtr::cli::integer(0, 10000));
+  app.add_option("--scale", scale, "tessellation factor (100: about 1.6M vertices)")->check(rtr::cli::number(0.05, 10000.0));
   app.add_flag("--plain", plain, "write temple.obj instead of temple.obj.zst");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const fs::path dir = out;
-    fs::create_directories(dir);
+    if (dir.empty()) throw rtr::UsageError("--out: empty folder name");
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir)) throw rtr::Error(out + ": cannot create the output folder" + (ec ? ": " + ec.message() : ""));
     writeTextures(dir / "textures");
     writeMtl(dir / "temple.mtl");
     const float r = float(std::sqrt(scale));
@@ -217,7 +222,6 @@ int main(int argc, char** argv) {
     o.finish();
     std::printf("wrote %s: %zu OBJ vertices (v records)\n", dir.c_str(), o.vertices());
   } catch (const std::exception& e) {
-    std::cerr << "scenegen: error: " << e.what() << "\n";
-    return 1;
+    return rtr::cli::fail("scenegen", e);
   }
 }

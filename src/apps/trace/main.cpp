@@ -1,7 +1,9 @@
 // rtr-trace: ray-trace a scene file into an image (brief Part 1; issue 6).
 #include <algorithm>
 #include <cstdio>
+#include <cstdint>
 #include <exception>
+#include <new>
 #include <string>
 
 #include <unistd.h>
@@ -20,6 +22,8 @@ namespace {
 using namespace rtr;
 using namespace rtr::trace;
 
+std::string gStage = "starting";  // what was under way, for an out-of-memory message
+
 int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)", "rtr-trace"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "phong", shadows = "on",
@@ -33,8 +37,10 @@ int run(int argc, char** argv) {
                  "OBJ's mtllib, else NAME.mtl beside it)");
   app.add_option("-o,--output", outPath, "output image: .png or .jpg (sRGB), .exr or .hdr (linear radiance)")->required();
   app.add_flag("--force", force, "overwrite an existing output");
-  app.add_option("--size", size, "image size WxH")->capture_default_str();
-  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else one that frames the scene (docs/lights.md)");
+  app.add_option("--size", size, "image size WxH")->capture_default_str()
+      ->check(cli::checked([](const std::string& t) { cli::parseSize("--size", t); }, "WxH"));
+  app.add_option("--camera", camera, "camera pose x,y,z,yaw,pitch (degrees); default: the scene's stored view, else one that frames the scene (docs/lights.md)")
+      ->check(cli::checked([](const std::string& t) { cli::parsePose("--camera", t); }, "X,Y,Z,YAW,PITCH"));
   app.add_option("--fov", fov, "vertical field of view in degrees (the viewer's default; the course uses 80)")
       ->capture_default_str()->check(cli::number(0, 180, true));
   app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, FORMATS.md §2)");
@@ -49,10 +55,13 @@ int run(int argc, char** argv) {
       ->capture_default_str()->check(CLI::IsMember({"halfplane", "watertight", "moller"}));
   app.add_option("--area-samples", s.areaLightSamples, "shadow rays per area light (1: its centre)")
       ->capture_default_str()->check(cli::integer(1, 1024));
-  app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
-  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
+  CLI::Option* lightOpt = app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights")
+      ->check(cli::checked([](const std::string& t) { cli::parseVec3("--light", t); }, "X,Y,Z"));
+  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
+      ->needs(lightOpt)->check(cli::checked([](const std::string& t) { cli::parseColor("--light-color", t); }, "R,G,B"));
   app.add_flag("--falloff", lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
-  app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str();
+  app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str()
+      ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
   app.add_flag("!--no-default-light", lightOptions.defaultLight,
                "a scene without lights gets no headlight (the brief's strict behaviour)");
   app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
@@ -75,8 +84,8 @@ int run(int argc, char** argv) {
   s.intersect = intersectName == "halfplane" ? IntersectMethod::HalfPlane
               : intersectName == "moller" ? IntersectMethod::MollerTrumbore : IntersectMethod::Watertight;
   if (!light.empty()) lightOptions.position = cli::parseVec3("--light", light);
-  if (!lightColor.empty()) lightOptions.color = cli::parseVec3("--light-color", lightColor);
-  lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
+  if (!lightColor.empty()) lightOptions.color = cli::parseColor("--light-color", lightColor);
+  lightOptions.ambient = cli::parseColor("--ambient", ambient, true);
   cli::checkImageOutput("-o", outPath, force);  // before tracing, not after
 
   LoadOptions load;
@@ -84,7 +93,10 @@ int run(int argc, char** argv) {
   const Scene scene = loadScene(scenePath, load);
   s.lights = resolveLights(scene, lightOptions);
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
+  gStage = "building the BVH of " + scenePath;
   const Tracer tracer(scene, s.threads);
+  gStage = "tracing " + scenePath + " at " + std::to_string(w) + "x" + std::to_string(h) + " (" +
+           std::to_string((uint64_t(w) * h * sizeof(glm::vec4)) >> 20) + " MB of image)";
   const bool tty = !quiet && isatty(STDERR_FILENO);
   ImageF image;
   const RenderStats st = tracer.render(s, image, [&](const TileRect&) {
@@ -97,6 +109,7 @@ int run(int argc, char** argv) {
   if (s.lights->lights.empty() && s.shading != Shading::Normals && s.shading != Shading::Depth &&
       std::all_of(image.pixels.begin(), image.pixels.end(), [](const glm::vec4& p) { return glm::vec3(p) == glm::vec3(0.0f); }))
     std::fprintf(stderr, "rtr-trace: warning: the image is all black (no lights: --no-default-light)\n");
+  gStage = "writing " + outPath;
   saveImage(outPath, image, {force ? Replace::Yes : Replace::No, !quiet});
   if (!quiet) {
     if (s.shading == Shading::Pbr)
@@ -121,6 +134,8 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    return cli::fail("rtr-trace", Error("out of memory while " + gStage));
   } catch (const std::exception& e) {
     return cli::fail("rtr-trace", e);
   }

@@ -1,5 +1,7 @@
 // rtr-view: the Vulkan viewer. Headless (--headless: no window, no display) or in a GLFW window.
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <chrono>
 #include <cstdio>
 #include <future>
@@ -7,6 +9,7 @@
 #include <iostream>
 #include <map>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -20,6 +23,7 @@
 #include "scene/load.hpp"
 #include "vk/context.hpp"
 #include "vk/pipeline_cache.hpp"
+#include "vk/resources.hpp"
 
 namespace rtr::view {
 
@@ -34,6 +38,50 @@ void checkSizeFits(const ViewOptions& o, const vk::Context& ctx) {
   if (o.width > max || o.height > max)
     throw UsageError("--size " + std::to_string(o.width) + "x" + std::to_string(o.height) + ": " + ctx.deviceName() +
                      " makes images of at most " + std::to_string(max) + " pixels a side");
+}
+
+namespace {
+
+std::string mb(uint64_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MB"; }
+
+// What the address space limit (ulimit -v) leaves this process: a CPU device's memory is the process's own.
+uint64_t addressSpaceLeft() {
+  rlimit r{};
+  if (::getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return UINT64_MAX;
+  unsigned long pages = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%lu", &pages) != 1) pages = 0;
+    std::fclose(f);
+  }
+  const uint64_t used = uint64_t(pages) * uint64_t(::sysconf(_SC_PAGESIZE));
+  return r.rlim_cur > used ? r.rlim_cur - used : 0;
+}
+
+}  // namespace
+
+// Before the scene is allocated on the device: its geometry and the frame's targets (about 24 bytes a
+// pixel: colour, depth, ids, read-back) against the largest device heap and the address space left,
+// and what would fit when they do not.
+void checkMemoryFits(const ViewOptions& o, const vk::Context& ctx, const Scene& scene) {
+  uint64_t geometry = 0;
+  for (const Mesh& m : scene.meshes)
+    geometry += m.positions.size() * (12 + 12 + (m.texcoords.empty() ? 0 : 8)) + m.indices.size() * 4 +
+                m.clusters.size() * sizeof(Cluster);
+  constexpr uint64_t kTargetBytesPerPixel = 24;
+  const uint64_t targets = uint64_t(o.width) * o.height * kTargetBytesPerPixel;
+  const bool cpu = ctx.deviceType() == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const uint64_t heap = ctx.deviceHeapBytes(), left = cpu ? std::min<uint64_t>(heap, addressSpaceLeft()) : heap;
+  if (geometry + targets <= left) return;
+  std::string fits = "the geometry alone does not fit";
+  if (geometry < left) {
+    const uint32_t side = uint32_t(std::sqrt(double(left - geometry) / kTargetBytesPerPixel));
+    fits = side ? "a frame of up to " + std::to_string(side) + "x" + std::to_string(side) + " would fit"
+                : "no frame fits beside the geometry";
+  }
+  throw Error("out of memory before uploading " + o.scene + ": needs about " + mb(geometry) + " for its geometry and " +
+              mb(targets) + " for the " + std::to_string(o.width) + "x" + std::to_string(o.height) + " frame; " +
+              ctx.deviceName() + " has " + mb(left) + (left < heap ? " (the address space left under ulimit -v)" : "") +
+              ": " + fits);
 }
 
 render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
@@ -120,6 +168,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   const DeviceChoice choice = chooseForDevice(o, ctx);
   phase("instance and device");
   Scene scene = loadScene(o.scene, o.load);
+  checkMemoryFits(o, ctx, scene);
   phase("scene file read");
   // A load that takes over half a second says how far it is: one line rewritten on a terminal, else a
   // line a second.
@@ -208,7 +257,12 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
 
 int runHeadless(const ViewOptions& o) {
   std::future<void> writing;
-  const int status = renderHeadless(o, writing);
+  int status = 0;
+  try {
+    status = stage("uploading or rendering " + o.scene, [&] { return renderHeadless(o, writing); });
+  } catch (const vk::OutOfMemory& e) {
+    throw Error("out of memory while uploading or rendering " + o.scene + ": " + e.what());
+  }
   if (writing.valid()) {
     writing.get();  // rethrows a write error
     std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());
@@ -237,11 +291,13 @@ int main(int argc, char** argv) {
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_option("--mtl", mtl, "OBJ: take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
-  app.add_option("--size", size, "image size WxH")->capture_default_str();
-  app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)");
+  app.add_option("--size", size, "image size WxH")->capture_default_str()
+      ->check(cli::checked([](const std::string& t) { cli::parseSize("--size", t, view::kMaxSize); }, "WxH"));
+  app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)")
+      ->check(cli::checked([](const std::string& t) { cli::parsePose("--camera", t); }, "X,Y,Z,YAW,PITCH"));
   app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str()
       ->check(cli::number(0, 180, true));
-  app.add_option("--mode", o.settings.mode, "view mode 1-13 (1 shaded)")->check(CLI::Range(1, VIEW_COUNT))->capture_default_str();
+  app.add_option("--mode", o.settings.mode, "view mode 1-13 (1 shaded)")->check(cli::integer(1, VIEW_COUNT))->capture_default_str();
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(cli::integer(1, 100000));
   app.add_option("--screenshot", o.screenshot, "write the rendered frame (not the overlay): .png, .jpg, .exr or .hdr");
   app.add_flag("--force", o.force, "overwrite an existing screenshot");
@@ -265,10 +321,13 @@ int main(int argc, char** argv) {
   app.add_option("--anisotropy", o.settings.sampler.anisotropy,
                  "anisotropic filtering, 1 (off) up to the device's maxSamplerAnisotropy (more is clamped, with a note)")
       ->check(cli::number(1, 64))->capture_default_str();
-  app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights");
-  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
+  CLI::Option* lightOpt = app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights")
+      ->check(cli::checked([](const std::string& t) { cli::parseVec3("--light", t); }, "X,Y,Z"));
+  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
+      ->needs(lightOpt)->check(cli::checked([](const std::string& t) { cli::parseColor("--light-color", t); }, "R,G,B"));
   app.add_flag("--falloff", o.lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
-  app.add_option("--ambient", ambient, "ambient colour r,g,b (or one grey value)")->capture_default_str();
+  app.add_option("--ambient", ambient, "ambient colour r,g,b (or one grey value)")->capture_default_str()
+      ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
   app.add_flag("!--no-default-light", o.lightOptions.defaultLight,
                "a scene without lights gets no headlight (only ambient and emission light it)");
   app.add_option("--bench", o.bench, "time N frames after 10 warm-up frames; print per-pass GPU min/median")
@@ -292,8 +351,8 @@ int main(int argc, char** argv) {
     if (!camera.empty()) o.camera = cli::parsePose("--camera", camera);
     if (!mtl.empty()) o.load.mtl = mtl;
     if (!light.empty()) o.lightOptions.position = cli::parseVec3("--light", light);
-    if (!lightColor.empty()) o.lightOptions.color = cli::parseVec3("--light-color", lightColor);
-    o.lightOptions.ambient = cli::parseVec3("--ambient", ambient, true);
+    if (!lightColor.empty()) o.lightOptions.color = cli::parseColor("--light-color", lightColor);
+    o.lightOptions.ambient = cli::parseColor("--ambient", ambient, true);
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
