@@ -36,7 +36,7 @@ BakeReport bake(const BakeOptions& options);
 
 // The texture plan for an output named `sceneName`: paths become "<sceneName>-tex/<file name>", ids are
 // re-given at first appearance (materials in order, slots in course order), and with `courseFallbacks`
-// missing baseColor/roughness/metalness/emissive slots point at fallback textures (FORMATS.md §1).
+// missing baseColor/roughness/metalness/emissive slots point at fallback textures (docs/formats.md).
 struct TexturePlan {
   Scene scene;                                       // the scene to encode (shares nothing with the input)
   std::vector<std::filesystem::path> sources;        // per texture of `scene`: the file to copy; empty for fallbacks
