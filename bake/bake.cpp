@@ -2,13 +2,12 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstring>
-#include <thread>
 
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "core/parallel.hpp"
 #include "scene/binio.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
@@ -37,30 +36,17 @@ struct CreatedFiles {
 
 // Decodes every source texture with the channel count of its slot, on a few threads.
 void verifyTextures(const TexturePlan& plan, unsigned threads) {
-  std::atomic<size_t> next{0};
-  std::vector<std::string> errors(plan.sources.size());
-  auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < plan.sources.size();) {
-      const auto& src = plan.sources[i];
-      if (src.empty()) continue;
-      std::error_code ec;
-      if (!std::filesystem::is_regular_file(src, ec)) {
-        errors[i] = src.string() + ": texture file named in the MTL does not exist";
-        continue;
-      }
-      try {
-        loadImage(src, plan.scene.textures[i].channels);
-      } catch (const Error& e) {
-        errors[i] = std::string(e.what()) + " (texture named in the MTL is not a readable image)";
-      }
+  parallelFor(plan.sources.size(), threads, [&](size_t i) {
+    const auto& src = plan.sources[i];
+    if (src.empty()) return;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(src, ec)) throw Error(src.string() + ": texture file named in the MTL does not exist");
+    try {
+      loadImage(src, plan.scene.textures[i].channels);
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + " (texture named in the MTL is not a readable image)");
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  for (const std::string& e : errors)
-    if (!e.empty()) throw Error(e);
+  });
 }
 
 void writeFallback(const std::filesystem::path& file, const std::string& name, Replace replace) {
@@ -100,7 +86,7 @@ BakeReport bake(const BakeOptions& opt) {
     throw fileError(opt.output.string(), "", "output folder '" + outDir.string() + "' is not writable");
   if (opt.view && course && opt.warn) opt.warn("the .comp5892mesh format has no default view; --view ignored");
   if (!opt.lights.empty() && course && opt.warn) opt.warn("the .comp5892mesh format stores no lights; --light ignored");
-  const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = threadCount(opt.threads);
 
   // 1. Parse and weld.
   ObjOptions oo;
@@ -131,7 +117,7 @@ BakeReport bake(const BakeOptions& opt) {
   }
   if (!plan.scene.textures.empty()) createFolders(texDir, created);
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
-    // Without --force a texture is only ever created, never replaced (FORMATS.md §1): AtomicFile's
+    // Without --force a texture is only ever created, never replaced (docs/formats.md): AtomicFile's
     // link-based commit lets exactly one of two concurrent bakes create it; the other stops here.
     const auto dst = outDir / plan.scene.textures[i].path;
     const bool existed = std::filesystem::exists(dst, ec);

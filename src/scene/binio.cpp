@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 namespace {

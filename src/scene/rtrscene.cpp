@@ -10,7 +10,7 @@
 
 #include "cluster.h"
 #include "scene/binio.hpp"
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 namespace {
