@@ -12,11 +12,12 @@
 
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "core/parallel.hpp"
 #include "scene/binio.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
 #include "scene/load.hpp"
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
@@ -115,7 +116,7 @@ BakeReport bake(const BakeOptions& opt) {
     throw fileError(opt.output.string(), "", "output folder '" + outDir.string() + "' is not writable");
   if (opt.view && course && opt.warn) opt.warn("the .comp5892mesh format has no default view; --view ignored");
   if (!opt.lights.empty() && course && opt.warn) opt.warn("the .comp5892mesh format stores no lights; --light ignored");
-  const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = threadCount(opt.threads);
 
   // 1. Parse and weld (OBJ), or read the glTF (instances kept, embedded images held in memory).
   Scene scene;

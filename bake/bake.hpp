@@ -42,7 +42,7 @@ BakeReport bake(const BakeOptions& options);
 // held in memory: "<sceneName>-tex/<hash of its bytes>.png|.jpg"); textures that share a file and are
 // sampled alike become one. Ids: .rtrscene in the input's order; with `courseFallbacks` at first appearance
 // (materials in order, slots in course order), missing baseColor/roughness/metalness/emissive slots
-// pointing at fallback textures (FORMATS.md §1).
+// pointing at fallback textures (docs/formats.md).
 struct TexturePlan {
   Scene scene;                                       // the scene to encode (shares nothing with the input)
   std::vector<std::filesystem::path> sources;        // per texture of `scene`: the file to copy; empty otherwise

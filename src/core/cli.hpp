@@ -14,6 +14,8 @@
 #include <glm/vec3.hpp>
 
 #include "core/camera.hpp"
+#include "core/enum_names.hpp"
+#include "core/error.hpp"
 
 namespace rtr::cli {
 
@@ -32,6 +34,22 @@ int run(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
 // Validators for CLI11's ->check(): finite numbers in [lo, hi], or (lo, hi) where `open`.
 CLI::Validator number(double lo, double hi, bool open = false);
 CLI::Validator integer(long long lo, long long hi);
+
+// A validator that accepts the names of enum E's table (core/enum_names.hpp), its error listing them.
+template <class E>
+CLI::Validator oneOf() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return enumFromName<E>(text) ? std::string() : "'" + text + "': expected " + enumChoices<E>();
+      },
+      "{" + enumChoices<E>("|") + "}");
+}
+// The value named by `text` for an option checked with oneOf<E>(); an rtr::UsageError if none is.
+template <class E>
+E enumOption(const std::string& option, const std::string& text) {
+  if (const auto v = enumFromName<E>(text)) return *v;
+  throw UsageError(option + " '" + text + "': expected " + enumChoices<E>());
+}
 
 // Option values that CLI11 cannot check alone. Each throws rtr::UsageError naming the option.
 struct Size { uint32_t width, height; };

@@ -14,7 +14,6 @@
 #include <mutex>
 #include <thread>
 
-#include <sched.h>
 #include <unistd.h>
 
 #include <stb_image_write.h>
@@ -22,6 +21,7 @@
 
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 namespace {
@@ -58,13 +58,6 @@ private:
   bool done_ = false;
 };
 
-// The cores this process may run on (a cpuset or taskset may allow fewer than the machine has).
-unsigned usableCores() {
-  cpu_set_t set;
-  if (sched_getaffinity(0, sizeof set, &set) == 0) return unsigned(std::max(1, CPU_COUNT(&set)));
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
 void put32(std::string& s, uint32_t v) {
   const char b[4] = {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
   s.append(b, 4);
@@ -85,50 +78,44 @@ void chunk(AtomicFile& f, const char type[4], const void* data, size_t size) {
 
 // PNG with the "up" filter on every row and zlib level 1: measured the fastest at a size within a few
 // per cent of adaptive filtering (docs/viewer.md). Horizontal strips are deflated on all cores as
-// independent pieces of one zlib stream (each ends on a sync flush; their Adler-32s are combined).
+// independent pieces of one zlib stream (each ends on a sync flush; their Adler-32s are combined). The
+// strips are as many whatever the core count, so the file's bytes do not depend on the machine.
 void writePng(AtomicFile& f, const ImageRGBA8& img, ProgressLine& progress) {
   const size_t row = size_t(img.width) * 4, h = img.height;
-  const unsigned threads = std::min(usableCores(), 16u);
-  const size_t strips = std::min<size_t>(h, threads * 4);
+  const size_t strips = std::min<size_t>(h, 64);
   std::vector<std::string> out(strips);
   std::vector<uLong> adler(strips);
-  std::atomic<size_t> next{0}, rowsDone{0};
+  std::atomic<size_t> rowsDone{0};
   std::atomic<bool> failed{false};
-  auto work = [&] {
+  parallelFor(strips, std::min(threadCount(), 16u), [&](size_t s) {
     std::vector<Bytef> buf((row + 1) * 16);
-    for (size_t s; (s = next.fetch_add(1)) < strips;) {
-      const size_t y0 = h * s / strips, y1 = h * (s + 1) / strips;
-      z_stream z{};
-      if (deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) { failed = true; return; }
-      out[s].resize(deflateBound(&z, (row + 1) * (y1 - y0)) + 64);
-      z.next_out = reinterpret_cast<Bytef*>(out[s].data());
-      z.avail_out = uInt(out[s].size());
-      adler[s] = adler32(0, nullptr, 0);
-      for (size_t y = y0; y < y1; y += 16) {
-        const size_t ye = std::min(y1, y + 16);
-        Bytef* o = buf.data();
-        for (size_t yy = y; yy < ye; ++yy, o += row + 1) {
-          const uint8_t* c = img.pixels.data() + row * yy;
-          o[0] = yy ? 2 : 0;  // up; the first row has nothing above
-          if (yy) for (size_t i = 0; i < row; ++i) o[1 + i] = Bytef(c[i] - c[i - row]);
-          else std::memcpy(o + 1, c, row);
-        }
-        z.next_in = buf.data();
-        z.avail_in = uInt(o - buf.data());
-        adler[s] = adler32_z(adler[s], buf.data(), z.avail_in);
-        const int flush = ye < y1 ? Z_NO_FLUSH : s + 1 == strips ? Z_FINISH : Z_SYNC_FLUSH;
-        const int r = deflate(&z, flush);
-        if (r == Z_STREAM_ERROR || z.avail_in != 0) failed = true;
-        progress.fraction = double(rowsDone += ye - y) / double(h);
+    const size_t y0 = h * s / strips, y1 = h * (s + 1) / strips;
+    z_stream z{};
+    if (deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) throw fileError(f.target().string(), "", "PNG compression failed");
+    out[s].resize(deflateBound(&z, (row + 1) * (y1 - y0)) + 64);
+    z.next_out = reinterpret_cast<Bytef*>(out[s].data());
+    z.avail_out = uInt(out[s].size());
+    adler[s] = adler32(0, nullptr, 0);
+    for (size_t y = y0; y < y1; y += 16) {
+      const size_t ye = std::min(y1, y + 16);
+      Bytef* o = buf.data();
+      for (size_t yy = y; yy < ye; ++yy, o += row + 1) {
+        const uint8_t* c = img.pixels.data() + row * yy;
+        o[0] = yy ? 2 : 0;  // up; the first row has nothing above
+        if (yy) for (size_t i = 0; i < row; ++i) o[1 + i] = Bytef(c[i] - c[i - row]);
+        else std::memcpy(o + 1, c, row);
       }
-      out[s].resize(z.total_out);
-      deflateEnd(&z);
+      z.next_in = buf.data();
+      z.avail_in = uInt(o - buf.data());
+      adler[s] = adler32_z(adler[s], buf.data(), z.avail_in);
+      const int flush = ye < y1 ? Z_NO_FLUSH : s + 1 == strips ? Z_FINISH : Z_SYNC_FLUSH;
+      const int r = deflate(&z, flush);
+      if (r == Z_STREAM_ERROR || z.avail_in != 0) failed = true;
+      progress.fraction = double(rowsDone += ye - y) / double(h);
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+    out[s].resize(z.total_out);
+    deflateEnd(&z);
+  });
   if (failed) throw fileError(f.target().string(), "", "PNG compression failed");
 
   static const uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};

@@ -55,29 +55,31 @@ DepthPyramid::DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent) : ctx
 }
 
 void DepthPyramid::build(VkCommandBuffer cb, VkImageView depth, VkImageLayout depthLayout) {
-  buildLevels(cb, [&](VkImageView level0) {
+  buildLevels(cb, [&](VkImageView level0) -> const vk::Pipeline& {
     pipeline_.bind(cb);
     vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
         .image(0, depth, depthLayout)
         .image(1, level0, VK_IMAGE_LAYOUT_GENERAL)
         .push(cb, pipeline_);
+    return pipeline_;
   });
 }
 
 void DepthPyramid::buildFromBuffer(VkCommandBuffer cb, VkBuffer vis) {
   if (!fromBuffer_.layout.handle())
     fromBuffer_ = vk::makeComputePipeline(ctx_, vk::loadShader("hiz_buffer.comp"), {.pushDescriptorSets = {0}});
-  buildLevels(cb, [&](VkImageView level0) {
+  buildLevels(cb, [&](VkImageView level0) -> const vk::Pipeline& {
     fromBuffer_.bind(cb);
     vk::DescriptorWriter(ctx_, fromBuffer_.layout, 0, VK_NULL_HANDLE)
         .buffer(0, vis)
         .image(1, level0, VK_IMAGE_LAYOUT_GENERAL)
         .push(cb, fromBuffer_);
     fromBuffer_.push(cb, glm::uvec2(depthExtent_.width, depthExtent_.height));
+    return fromBuffer_;
   });
 }
 
-void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<void(VkImageView)>& bindLevel0) {
+void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk::Pipeline&(VkImageView)>& bindLevel0) {
   constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   constexpr auto kReadWrite = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT;
   if (!initialised_) {
@@ -85,13 +87,13 @@ void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<void(VkIm
                       kCompute, VK_ACCESS_2_NONE, kReadWrite}});
     initialised_ = true;
   } else {  // the last frame's culling read it
-    vk::memoryBarrier(cb, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
-                      kCompute, kReadWrite);
+    vk::bufferBarrier(cb, vk::kComputeRead | vk::kCopyRead, vk::kComputeReadWrite);
   }
   for (uint32_t l = 0; l < levelViews_.size(); ++l) {
     const VkExtent2D e{std::max(1u, image_.extent().width >> l), std::max(1u, image_.extent().height >> l)};
+    const vk::Pipeline* bound = &pipeline_;
     if (l == 0) {
-      bindLevel0(levelViews_[0]);
+      bound = &bindLevel0(levelViews_[0]);
     } else {
       if (l == 1) pipeline_.bind(cb);
       vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
@@ -99,10 +101,9 @@ void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<void(VkIm
           .image(1, levelViews_[l], VK_IMAGE_LAYOUT_GENERAL)
           .push(cb, pipeline_);
     }
-    vkCmdDispatch(cb, (e.width + HIZ_GROUP_SIZE - 1) / HIZ_GROUP_SIZE, (e.height + HIZ_GROUP_SIZE - 1) / HIZ_GROUP_SIZE, 1);
+    bound->dispatch(cb, e.width, e.height);
     // Each level is the next one's source; the last is the culling pass's (and a read-back's) input.
-    vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_WRITE_BIT, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT,
-                      VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead | vk::kCopyRead);
   }
 }
 
@@ -124,8 +125,7 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
   noPyramid_ = vk::Image(ctx, d);
   vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
     vkCmdFillBuffer(cb, history_.handle(), 0, VK_WHOLE_SIZE, 0);  // no cluster was visible before
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
     vk::barrier(cb, {{noPyramid_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_READ_BIT}});
   });
@@ -135,15 +135,12 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
                            const DepthPyramid* pyramid, CullTests tests, CullPhase phase) {
   if (count > maxClusters_) throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
-  constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-  constexpr auto kConsumers = kCompute | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
-  constexpr auto kConsumerReads = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT;
+  constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
-  vk::memoryBarrier(cb, kConsumers, kConsumerReads, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);
   const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0}, 0, 0};  // the indirect dispatch's y and z are 1
   vkCmdUpdateBuffer(cb, counts_.handle(), 0, sizeof(zero), &zero);
-  vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, kCompute,
-                    VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+  vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
 
   shader::CullPush push{};
   push.viewProj = camera.viewProj;
@@ -167,8 +164,8 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
       .buffer(4, history_.handle())
       .push(cb, pipeline_);
   pipeline_.push(cb, push);
-  vkCmdDispatch(cb, (count + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE, 1, 1);
-  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_WRITE_BIT, kConsumers, kConsumerReads | VK_ACCESS_2_SHADER_WRITE_BIT);
+  pipeline_.dispatch(cb, count);
+  vk::bufferBarrier(cb, vk::kComputeWrite, kConsumers | vk::kComputeWrite);
 }
 
 }  // namespace rtr::render

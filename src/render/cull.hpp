@@ -50,7 +50,7 @@ class DepthPyramid {
   vk::Image image_;
   std::vector<vk::ImageView> levelViews_;  // per level: storage (write) and sampled (read by the next level)
   vk::Pipeline pipeline_, fromBuffer_;  // fromBuffer_: level 0 from a visibility buffer, made on first use
-  void buildLevels(VkCommandBuffer cb, const std::function<void(VkImageView)>& bindLevel0);
+  void buildLevels(VkCommandBuffer cb, const std::function<const vk::Pipeline&(VkImageView)>& bindLevel0);
   bool initialised_ = false;
 };
 

@@ -11,6 +11,7 @@
 
 #include "cluster.h"
 #include "core/image.hpp"
+#include "core/parallel.hpp"
 #include "scene/textures.hpp"
 #include "vk/check.hpp"
 #include "vk/commands.hpp"
@@ -26,18 +27,6 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 VkFormat textureFormat(const Texture& t) {
   if (decodeChannels(t) == 1) return VK_FORMAT_R8_UNORM;
   return decodeSrgb(t) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
-}
-
-// Runs work(i) for i in [0, n) on all cores.
-void parallelFor(size_t n, const std::function<void(size_t)>& work) {
-  std::atomic<size_t> next{0};
-  std::vector<std::future<void>> workers;
-  const size_t threads = std::min<size_t>(std::max(1u, std::thread::hardware_concurrency()), n);
-  for (size_t w = 0; w < threads; ++w)
-    workers.push_back(std::async(std::launch::async, [&] {
-      for (size_t i; (i = next++) < n;) work(i);
-    }));
-  for (auto& w : workers) w.get();  // rethrows the first error
 }
 
 // The GPU records of one draw's clusters: the mesh's own (meshoptimizer, scene/clusters.hpp) or, for a
@@ -231,7 +220,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     for (size_t b = 0, n = slots[s].mesh->indices.size(); b < n; b += kIndexChunk)
       tasks.push_back({s, true, b, std::min(n, b + kIndexChunk)});
   }
-  parallelFor(tasks.size(), [&](size_t i) {
+  parallelFor(tasks.size(), 0, [&](size_t i) {
     const WriteTask& task = tasks[i];
     const MeshSlot& slot = slots[task.slot];
     const Mesh& m = *slot.mesh;
@@ -266,11 +255,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
           vkCmdCopyBuffer(cb, staging.handle(), tg.buffer->handle(), 1, &region);
         }
       // Also orders the copies before the frames' reads, which come in later submissions.
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT |
-                            VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_2_INDEX_READ_BIT |
-                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kVertexInput | vk::kFragmentRead | vk::kComputeRead);
     });
   staging = {};
   stats_.geometryMs = msSince(t);
@@ -310,9 +295,7 @@ bool GpuScene::updateTextures(bool wait) {
     vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
       const VkBufferCopy region{0, 0, bytes};
       vkCmdCopyBuffer(cb, staging.handle(), materials_.handle(), 1, &region);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kFragmentRead | vk::kComputeRead);
     });
   }
   texturedMaterials_ = {};
@@ -407,10 +390,6 @@ void GpuScene::finishTextures() {
     stats_.mipGpuMs = timer.results().at(0).second;
   }
   stats_.mipsMs = msSince(t) - (pipelines.stats().ms - pipelineMs);
-}
-
-const char* toString(TextureFilter f) {
-  return f == TextureFilter::Trilinear ? "trilinear" : f == TextureFilter::NearestMip ? "nearest-mip" : "nearest";
 }
 
 float maxAnisotropy(const vk::Context& ctx) {

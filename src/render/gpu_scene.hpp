@@ -14,6 +14,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "frame.h"
 #include "render/mips.hpp"
 #include "scene/scene.hpp"
@@ -56,7 +57,9 @@ using LoadProgress = std::function<void(const char* what, size_t done, size_t to
 // How the scene's textures are sampled (the brief's mip experiments, task 1.4): trilinear; the nearest mip
 // level, filtered linearly within it; or nearest texel of the nearest level. Anisotropy 1 is off.
 enum class TextureFilter { Trilinear, NearestMip, Nearest };
-const char* toString(TextureFilter filter);
+constexpr std::array<EnumName<TextureFilter>, 3> enumNames(TextureFilter) {
+  return {{{TextureFilter::Trilinear, "trilinear"}, {TextureFilter::NearestMip, "nearest-mip"}, {TextureFilter::Nearest, "nearest"}}};
+}
 struct SamplerSettings {
   TextureFilter filter = TextureFilter::Trilinear;
   float anisotropy = 1.0f;

@@ -45,15 +45,6 @@ bool axisFits(uint32_t size0, uint32_t levels) {
 
 }  // namespace
 
-const char* toString(MipMode mode) {
-  switch (mode) {
-    case MipMode::Blit: return "blit";
-    case MipMode::Compute: return "compute";
-    case MipMode::Auto: return "auto";
-  }
-  return "?";
-}
-
 bool autoSmall(MipMode mode, VkExtent2D e) {
   return mode == MipMode::Auto && uint64_t(e.width) * e.height <= kAutoSmallTexels;
 }
@@ -294,8 +285,7 @@ void MipGenerator::recordCompute(VkCommandBuffer cb, std::span<const vk::Image* 
   for (size_t k = 0; k < steps; ++k) {
     // Step k - 1's float copies are step k's sources. One barrier for the whole batch.
     if (k > 0)
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+      vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead);
     const vk::Pipeline* bound = nullptr;
     for (size_t j = 0; j < jobs.size(); ++j) {
       const Job& job = jobs[j];

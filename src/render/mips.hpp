@@ -9,6 +9,7 @@
 //   on entry  level 0 is in TRANSFER_DST_OPTIMAL (its upload recorded earlier), other levels UNDEFINED;
 //   on exit   every level is in SHADER_READ_ONLY_OPTIMAL, its writes visible to fragment and compute
 //             shader reads that follow in the same queue.
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -16,6 +17,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "core/enum_names.hpp"
 #include "core/image.hpp"
 #include "vk/pipeline.hpp"
 #include "vk/resources.hpp"
@@ -26,11 +28,13 @@ namespace rtr::render {
 // decodes them (hostMipChain: no pipeline, no GPU pass); MipGenerator, which has no texels, takes compute.
 // Large images: the blit chain. The default on a CPU device (docs/startup.md).
 enum class MipMode { Blit, Compute, Auto };
-const char* toString(MipMode mode);
+constexpr std::array<EnumName<MipMode>, 3> enumNames(MipMode) {
+  return {{{MipMode::Compute, "compute"}, {MipMode::Blit, "blit"}, {MipMode::Auto, "auto"}}};
+}
 
 // Auto's "small": at most this many texels. The crossover measured on lavapipe (docs/startup.md), warm:
-// compute is up to 3x faster than blit below it, blit up to 2x faster above; and a process's first blits
-// and compute pipelines cost 20-30 ms of compilation there, which the CPU chains avoid.
+// compute is faster than blit below it, blit faster above; and a process's first blits and compute
+// pipelines cost compilation there, which the CPU chains avoid.
 constexpr uint64_t kAutoSmallTexels = 128 * 128;
 bool autoSmall(MipMode mode, VkExtent2D extent);  // Auto, and an image of at most kAutoSmallTexels
 MipMode autoMipMode(MipMode mode, VkExtent2D extent);  // on the GPU: `mode` itself unless Auto

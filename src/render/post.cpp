@@ -7,15 +7,6 @@
 
 namespace rtr::render {
 
-const char* toString(MosaicMode mode) {
-  switch (mode) {
-    case MosaicMode::Off: return "off";
-    case MosaicMode::Compute: return "compute";
-    case MosaicMode::Graphics: return "graphics";
-  }
-  return "?";
-}
-
 MosaicPass::MosaicPass(const vk::Context& ctx) : ctx_(ctx) {
   compute_ = vk::makeComputePipeline(ctx, vk::loadShader("mosaic.comp"), {.pushDescriptorSets = {0}});
 }
@@ -62,11 +53,8 @@ void MosaicPass::record(VkCommandBuffer cb, vk::TrackedImage input, VkImageView 
         .image(1, outputView, VK_IMAGE_LAYOUT_GENERAL)
         .push(cb, c);
     c.push(cb, push);
-    // One thread per block; the workgroup's shape is the shader's (reflected) local size.
-    const auto& group = c.layout.interface().stages.at(0).localSize;
-    const uint32_t blocksX = (extent.width + block.width - 1) / block.width;
-    const uint32_t blocksY = (extent.height + block.height - 1) / block.height;
-    vkCmdDispatch(cb, (blocksX + group[0] - 1) / group[0], (blocksY + group[1] - 1) / group[1], 1);
+    // One thread per block.
+    c.dispatch(cb, (extent.width + block.width - 1) / block.width, (extent.height + block.height - 1) / block.height);
   }
 }
 

@@ -8,16 +8,20 @@
 // MosaicPass::record requires (vk/image_state.hpp) the input sampled in the stage that reads it and the
 // output written (previous contents discarded): STORAGE usage for Compute/Off, COLOR_ATTACHMENT usage for
 // Graphics. The output is left as written; the caller requires what comes next (copy, present).
+#include <array>
 #include <map>
 
 #include <vulkan/vulkan.h>
 
+#include "core/enum_names.hpp"
 #include "vk/pipeline.hpp"
 
 namespace rtr::render {
 
 enum class MosaicMode { Off, Compute, Graphics };
-const char* toString(MosaicMode mode);
+constexpr std::array<EnumName<MosaicMode>, 3> enumNames(MosaicMode) {
+  return {{{MosaicMode::Off, "off"}, {MosaicMode::Compute, "compute"}, {MosaicMode::Graphics, "graphics"}}};
+}
 
 class MosaicPass {
  public:

@@ -22,10 +22,8 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
     : ctx_(ctx), scene_(scene), culled_(framesInFlight, false) {
   const vk::LayoutOptions push{.pushDescriptorSets = {0}};
   clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
-  uint32_t sharedArea = RASTER_SHARED_AREA;
-  if (const char* env = std::getenv("RTR_RASTER_SHARED_AREA")) sharedArea = uint32_t(std::stoul(env));
-  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), push, {{0, sharedArea}});
-  large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), push, {{0, sharedArea}});
+  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), push, {{0, RASTER_SHARED_AREA}});
+  large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), push, {{0, RASTER_SHARED_AREA}});
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader("raster_hw.vert"), vk::loadShader("raster_hw.frag")};
   d.cullMode = VK_CULL_MODE_NONE;  // the fragment stage culls by the cluster's flags
@@ -93,19 +91,15 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     w.push(cb, p);
     p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, scene_.clusterCount(), fromList, 0, 0, 0});
   };
-  constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-  constexpr auto kReadWrite = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+  // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.
+  constexpr vk::BufferUse kReaders = vk::kComputeReadWrite | vk::kFragmentReadWrite | vk::kVertexReadWrite | vk::kIndirectRead;
   // The previous frame's readers of both buffers (shading, the indirect draw) before they are cleared.
-  vk::memoryBarrier(cb,
-                    kCompute | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
-                        VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                    kReadWrite | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT, kCompute,
-                    VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  vk::bufferBarrier(cb, kReaders | vk::kCopyRead, vk::kComputeWrite);
   bind(clear_);
   const uint32_t pixels = extent_.width * extent_.height;
-  vkCmdDispatch(cb, (pixels + RASTER_CLEAR_GROUP - 1) / RASTER_CLEAR_GROUP, 1, 1);
+  clear_.dispatch(cb, pixels);
   timer.mark(cb, "clear");
-  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kCompute, kReadWrite);
+  vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite);
   const VkDeviceSize countsSize = sizeof(shader::CullCounts);
   const VkBufferCopy toReadback[2] = {{0, 2 * countsSize * frame, countsSize}, {0, (2 * frame + 1) * countsSize, countsSize}};
   // Both rasteriser passes over the clusters: all of them, or (culling) the culler's list, indirectly.
@@ -120,7 +114,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
       vkCmdDispatch(cb, x, (scene_.clusterCount() + x - 1) / x, 1);
     }
     timer.mark(cb, name);
-    vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kCompute, kReadWrite);
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite);
     bind(large_);
     vkCmdDispatch(cb, RASTER_LARGE_GROUPS, 1, 1);
     timer.mark(cb, largeName);
@@ -131,8 +125,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     timer.mark(cb, "cull early");
     rasterise("raster early", "raster large early");
     // The pyramid reads the depth drawn so far; the late phase's tile pass starts after the early tiles.
-    vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kCompute | VK_PIPELINE_STAGE_2_COPY_BIT,
-                      kReadWrite | VK_ACCESS_2_TRANSFER_READ_BIT);
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kCopyRead);
     const VkBufferCopy firstLate{0, 4, 4};  // largeCount -> largeFirst (raster_fetch.glsl)
     vkCmdCopyBuffer(cb, largeList_.handle(), largeList_.handle(), 1, &firstLate);
     pyramid_->buildFromBuffer(cb, vis_.handle());
@@ -140,15 +133,11 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     // Its first barrier orders the copies above before its reset, its second makes them visible to compute.
     culler_->record(cb, scene_.clusters(), scene_.clusterCount(), *cull, &*pyramid_, {}, CullPhase::Late);
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                      VK_ACCESS_2_HOST_READ_BIT);
+    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     timer.mark(cb, "cull");
   }
   if (scene_.clusterCount() > 0) rasterise("raster", "raster large");
-  vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                    VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
-                        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | kReadWrite);
+  vk::bufferBarrier(cb, vk::kComputeWrite, kReaders);
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};
   ri.layerCount = 1;

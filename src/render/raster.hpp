@@ -3,8 +3,8 @@
 // cluster writing (depth << 32 | id) per pixel with 64-bit atomicMin, a pass over the large triangles'
 // tiles, and an indirect hardware draw of the triangles it hands off (crossing w = 0, outside the guard
 // band, alpha-masked) into the same buffer.
-// RTR_RASTER_SHARED_AREA (environment, a benchmarking knob): the bounding-box area in pixels above which a
-// triangle is rasterised by tiles rather than by its own thread (default RASTER_SHARED_AREA, raster.h).
+// RASTER_SHARED_AREA (raster.h, a specialization constant of both passes): the bounding-box area in pixels
+// above which a triangle is rasterised by tiles rather than by its own thread.
 #include <optional>
 #include <vector>
 

@@ -49,11 +49,6 @@ std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const
   return order;
 }
 
-const char* toString(ShadingPath path) { return path == ShadingPath::Forward ? "forward" : "visibility"; }
-const char* toString(RasterPath path) {
-  return path == RasterPath::Hardware ? "hardware" : path == RasterPath::Compute ? "compute" : "auto";
-}
-
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx),
       scene_(scene),
@@ -86,8 +81,7 @@ ShadingPath Renderer::pathFor(const RenderSettings& s) const {
 
 RasterPath Renderer::rasterFor(const RenderSettings& s) const {
   // The default per device type, the faster one measured (docs/raster.md): compute on GPUs; on a CPU
-  // device (lavapipe) compute from about 100 k triangles (even there; hardware 2-3x faster at 11 k,
-  // compute 3-5x faster at 1 M).
+  // device (lavapipe) compute from about 100 k triangles, where the two cross.
   const bool computeFaster = !cpuDevice_ || triangles_ >= 100000;
   const RasterPath wanted = s.raster != RasterPath::Auto ? s.raster : computeFaster ? RasterPath::Compute : RasterPath::Hardware;
   if (wanted == RasterPath::Compute) return canCompute_ ? RasterPath::Compute : RasterPath::Hardware;
@@ -274,8 +268,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
   w.push(cb, c);
   c.push(cb, shader::VisShadePush{primitiveBits_});
   if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade.textures.get(1));
-  const auto& group = c.layout.interface().stages.at(0).localSize;  // one thread per pixel
-  vkCmdDispatch(cb, (extent_.width + group[0] - 1) / group[0], (extent_.height + group[1] - 1) / group[1], 1);
+  c.dispatch(cb, extent_.width, extent_.height);  // one thread per pixel
 }
 
 void Renderer::frame(FrameContext& fc) {
@@ -348,9 +341,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute) {
     const CullCamera cam{u.viewProj, pose.position, lens.orthographic};
     raster_->record(cb, uniforms_, primitiveBits_, timer, frame, s.cull ? &cam : nullptr);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
     vk::require(cb, {{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
     shadeVisibility(cb, raster);
     timer.mark(cb, "shade");
@@ -405,12 +396,10 @@ namespace rtr::render {
 
 uint32_t Renderer::copyIds(VkCommandBuffer cb, VkBuffer dst) {
   if (lastRaster_ == RasterPath::Compute) {
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kCopyRead);
     const VkBufferCopy region{0, 0, VkDeviceSize(extent_.width) * extent_.height * 8};
     vkCmdCopyBuffer(cb, raster_->ids(), dst, 1, &region);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                      VK_ACCESS_2_HOST_READ_BIT);
+    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     return 8;
   }
   if (lastRaster_ != RasterPath::Hardware) throw Error("copyIds: the last frame made no visibility ids");

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "core/camera.hpp"
 #include "frame.h"
 #include "render/gpu_scene.hpp"
@@ -24,20 +25,24 @@ namespace rtr::render {
 // visibility buffer (triangle ids rasterised, BRDF in a compute pass; docs/design.md). Debug views
 // are always forward.
 enum class ShadingPath { Forward, Visibility };
-const char* toString(ShadingPath path);
+constexpr std::array<EnumName<ShadingPath>, 2> enumNames(ShadingPath) {
+  return {{{ShadingPath::Visibility, "visibility"}, {ShadingPath::Forward, "forward"}}};
+}
 
 // Who rasterises the visibility buffer: the hardware (an R32 id image, depth-tested) or the compute
 // rasteriser (render/raster.hpp, a 64-bit buffer); Auto: the device's default (defaultRaster).
 enum class RasterPath { Auto, Hardware, Compute };
-const char* toString(RasterPath path);
+constexpr std::array<EnumName<RasterPath>, 3> enumNames(RasterPath) {
+  return {{{RasterPath::Auto, "auto"}, {RasterPath::Hardware, "hardware"}, {RasterPath::Compute, "compute"}}};
+}
 
 struct RenderSettings {
   int mode = VIEW_SHADED;         // VIEW_* from frame.h
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   RasterPath raster = RasterPath::Auto;
   // Compute raster only: two-phase cluster culling (docs/culling.md); never changes the image. Off by default:
-  // on the H200 its fixed cost (depth pyramid + two cull passes, 0.10-0.13 ms at 4K) exceeded the raster time
-  // it saved in every measured scene, up to 10 M triangles (docs/raster.md).
+  // on the H200 its fixed cost (depth pyramid + two cull passes) exceeded the raster time it saved in
+  // every measured scene (docs/raster.md).
   bool cull = false;
   float lodBias = 0.0f;
   SamplerSettings sampler;        // how scene textures are filtered (mip experiments)
@@ -67,8 +72,8 @@ struct FrameContext {
 };
 
 // The draws nearest `eye` first (by their meshes' box centres; ties keep their order): drawn so, the depth
-// test rejects hidden fragments before they are shaded (on lavapipe the README scene's forward pass took
-// 4-7 % less; only fragments at equal depth could come out differently).
+// test rejects hidden fragments before they are shaded (measured: a shorter forward pass on lavapipe;
+// only fragments at equal depth could come out differently).
 std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const glm::vec3& eye);
 
 class Renderer {

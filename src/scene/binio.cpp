@@ -1,6 +1,6 @@
 #include "scene/binio.hpp"
 
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 

@@ -8,7 +8,7 @@
 #include "cluster.h"
 #include "core/bounds.hpp"
 #include "core/error.hpp"
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 
@@ -56,8 +56,8 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
 }
 
 // Big meshes are clustered in pieces of this many triangles (in index order), on all cores: a piece
-// ends with at most one part-filled cluster, and the result does not depend on the thread count
-// (a 1M-triangle scene's bake spent 0.9 s here on one core, its statue being one mesh).
+// ends with at most one part-filled cluster, and the result does not depend on the thread count (one
+// big mesh, such as a scanned statue, would otherwise keep one core busy while the others wait).
 constexpr size_t kPieceTriangles = size_t(1) << 16;
 
 void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backfaceCone) {

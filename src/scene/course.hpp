@@ -1,5 +1,5 @@
 #pragma once
-// The course's baked mesh format (.comp5892mesh, variant default-a12), FORMATS.md §1.
+// The course's baked mesh format (.comp5892mesh, variant default-a12), docs/formats.md.
 #include <filesystem>
 #include <span>
 #include <string>
@@ -9,7 +9,7 @@
 
 namespace rtr {
 
-// Fallback textures that the course format needs where a material has no map (FORMATS.md §1).
+// Fallback textures that the course format needs where a material has no map (docs/formats.md).
 // Readers map textures with these file names back to "no texture" (the factor defaults then apply).
 constexpr std::string_view kFallbackBaseColor = "rtr-fallback-basecolor.png";  // RGBA ones
 constexpr std::string_view kFallbackOne = "rtr-fallback-one.png";              // grey one: roughness, metalness

@@ -5,15 +5,15 @@
 #include <glm/matrix.hpp>
 
 #include "scene/lights.hpp"
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 
 std::vector<double> frontAreas(const Scene& scene, std::span<const glm::vec3> toViewer) {
   // One pass for every direction: the triangle's gathers and cross product are the cost, not the dots
-  // (framing a 10M-triangle scene took 0.6 s as one pass per direction). The pass runs on all cores in
+  // (one pass per direction took several times as long). The pass runs on all cores (parallelFor) in
   // pieces of a fixed size whose sums are added in piece order, so the result does not depend on the
-  // thread count (a 10M-triangle scene: 0.3 s on one core of the H200 host).
+  // thread count.
   constexpr size_t kPiece = size_t(1) << 16;  // triangles
   struct Piece { const Mesh* mesh; size_t first, end; };
   std::vector<Piece> pieces;

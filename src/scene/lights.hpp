@@ -2,7 +2,7 @@
 // Which lights light a scene, one rule for every tool (docs/lights.md):
 // 1. --light on the command line replaces the scene's lights with one point light;
 // 2. else the lights stored with the scene (.rtrscene; the course format's standard light);
-// 3. else its light geometry (FORMATS.md §2): every object whose material name contains "light" lights
+// 3. else its light geometry (docs/formats.md): every object whose material name contains "light" lights
 //    the scene with its Ke; two triangles make an area light (a parallelogram), anything else a point
 //    light at the centroid of its vertices;
 // 4. else, unless switched off, a headlight at the camera, announced once.
@@ -19,7 +19,7 @@ namespace rtr {
 
 constexpr size_t kMaxLights = 8;  // MAX_LIGHTS in shaders/shared/lights.h
 
-// The brief's standard light of the Vulkan part (FORMATS.md §1).
+// The brief's standard light of the Vulkan part (docs/formats.md).
 Light briefLight();
 
 bool isLightMaterial(const Material& m);  // flag set, or "light" in the name

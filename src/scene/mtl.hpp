@@ -15,7 +15,7 @@ struct MtlMaterial {
   std::array<std::string, kTextureSlotCount> maps;  // texture file per slot, as written (empty: none)
 };
 
-// Flags that follow from a material's name (FORMATS.md: ".DoubleSided" suffix, "light" in the name).
+// Flags that follow from a material's name (docs/formats.md: ".DoubleSided" suffix, "light" in the name).
 uint32_t flagsFromName(std::string_view name);
 
 // Parses MTL text; `file` labels errors ("file:line: what"). Unknown keys go to `warn`.
@@ -26,7 +26,7 @@ std::vector<MtlMaterial> parseMtl(std::string_view text, const std::string& file
 // roughness squared) becomes sqrt(2 / (Ns + 2)), the usual Phong-exponent-to-Beckmann match.
 float roughnessFromNs(float ns);
 
-// The slot conventions of the course format (FORMATS.md §1): colour space and channel count.
+// The slot conventions of the course format (docs/formats.md): colour space and channel count.
 struct SlotFormat { bool srgb; uint8_t channels; };
 SlotFormat slotFormat(TextureSlot slot);
 

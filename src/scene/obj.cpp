@@ -2,18 +2,19 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <optional>
 #include <thread>
+#include <sstream>
 #include <unordered_map>
 
 #include "core/bounds.hpp"
 #include "core/error.hpp"
 #include "core/input_file.hpp"
+#include "core/parallel.hpp"
 #include "scene/mtl.hpp"
 #include "scene/text.hpp"
 #include "scene/triangulate.hpp"
@@ -367,22 +368,10 @@ Scene ObjParser::finish() {
   // Weld meshes on a few threads; big meshes dominate, so hand them out one at a time.
   std::vector<Mesh> meshes(builds_.size());
   std::vector<WeldCounts> counts(builds_.size());
-  std::atomic<size_t> nextMesh{0};
-  auto worker = [&] {
-    for (size_t i; (i = nextMesh.fetch_add(1)) < builds_.size();) {
-      counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i]);
-      std::vector<Corner>().swap(builds_[i].corners);
-    }
-  };
-  unsigned n = opt_.threads ? opt_.threads : std::max(1u, std::thread::hardware_concurrency());
-  n = unsigned(std::min<size_t>(n, builds_.size()));
-  std::vector<std::exception_ptr> errors(n);
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < n; ++t)
-    pool.emplace_back([&, t] { try { worker(); } catch (...) { errors[t] = std::current_exception(); } });
-  try { worker(); } catch (...) { if (n) errors[0] = std::current_exception(); }
-  for (auto& t : pool) t.join();
-  for (auto& e : errors) if (e) std::rethrow_exception(e);
+  parallelFor(builds_.size(), opt_.threads, [&](size_t i) {
+    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i]);
+    std::vector<Corner>().swap(builds_[i].corners);
+  });
 
   for (size_t i = 0; i < builds_.size(); ++i) {
     stats_.verticesBeforeWeld += (counts[i].triangles + counts[i].degenerate) * 3;

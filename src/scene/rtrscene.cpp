@@ -11,7 +11,7 @@
 #include "cluster.h"
 #include "core/bounds.hpp"
 #include "scene/binio.hpp"
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 namespace {

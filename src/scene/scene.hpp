@@ -81,7 +81,7 @@ struct Material {
   std::array<uint32_t, kTextureSlotCount> textures{kNoTexture, kNoTexture, kNoTexture, kNoTexture,
                                                    kNoTexture, kNoTexture, kNoTexture};
   std::array<UvTransform, kTextureSlotCount> uv{};  // per slot; identity for OBJ/MTL
-  // Classic Blinn-Phong factors (ray tracer, brief Part 1). Defaults per FORMATS.md §2.
+  // Classic Blinn-Phong factors (ray tracer, brief Part 1). Defaults per docs/formats.md.
   glm::vec3 ka{0.5f}, kd{0.5f}, ks{0.5f}, ke{0.0f};
   float ns = 1.0f;
   float mirror = 0.0f;  // N_mirr
@@ -116,7 +116,7 @@ struct Mesh {
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
 };
 
-// A light in scene space. Point lights and the ray tracer's area lights (FORMATS.md §2); a headlight sits
+// A light in scene space. Point lights and the ray tracer's area lights (docs/formats.md); a headlight sits
 // at the camera, wherever it is (the default light of a scene that has none: scene/lights.hpp).
 struct Light {
   // Spot and Directional: glTF's KHR_lights_punctual.

@@ -1,13 +1,11 @@
 #include "scene/textures.hpp"
 
 #include <algorithm>
-#include <atomic>
-#include <future>
 #include <iostream>
 #include <mutex>
-#include <thread>
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr {
 
@@ -88,16 +86,7 @@ void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
     else std::cerr << "warning: " << msg << "\n";
     return fallbackTexels(decodeChannels(t));
   };
-  std::atomic<size_t> next{0};
-  std::vector<std::future<void>> workers;
-  const unsigned n = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(which.size())));
-  for (unsigned w = 0; w < n; ++w)
-    workers.push_back(std::async(std::launch::async, [&] {
-      for (size_t i; (i = next++) < which.size();) {
-        use(i, load(scene.textures.at(which[i])));
-      }
-    }));
-  for (auto& w : workers) w.get();  // rethrows the first error
+  parallelFor(which.size(), 0, [&](size_t i) { use(i, load(scene.textures.at(which[i]))); });
 }
 
 bool alphaTested(const Mesh& mesh, const Material& material) {

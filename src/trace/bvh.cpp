@@ -6,14 +6,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <condition_variable>
-#include <deque>
-#include <functional>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <new>
-#include <thread>
 #include <vector>
 
 #include <smmintrin.h>
@@ -22,6 +17,7 @@
 #include <glm/common.hpp>
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 
 namespace rtr::trace {
 namespace {
@@ -103,62 +99,6 @@ double sahCost(const Node* nodes, uint32_t root) {
   return rootArea > 0.0 ? kNodeCost + total / rootArea : 0.0;
 }
 
-// The build's threads, started once per build: split chunks near the root and whole subtrees below are
-// queued as tasks. (std::async started a thread per chunk of every split near the root and per subtree.)
-// A thread waiting for its tasks runs queued ones meanwhile, so nested waits never starve the pool.
-class TaskPool {
- public:
-  struct Group { std::atomic<int> left{0}; };
-  explicit TaskPool(unsigned workers) {
-    for (unsigned i = 0; i < workers; ++i) threads_.emplace_back([this] { work(); });
-  }
-  ~TaskPool() {
-    { std::lock_guard lock(mutex_); stop_ = true; }
-    wake_.notify_all();
-    for (std::thread& t : threads_) t.join();
-  }
-  void run(Group& g, std::function<void()> f) {
-    g.left.fetch_add(1);
-    { std::lock_guard lock(mutex_); queue_.push_back([&g, f = std::move(f)] { f(); g.left.fetch_sub(1); }); }
-    wake_.notify_one();
-  }
-  void wait(Group& g) {
-    while (g.left.load() > 0)
-      if (!runOne()) std::this_thread::yield();
-  }
-
- private:
-  bool runOne() {
-    std::function<void()> f;
-    {
-      std::lock_guard lock(mutex_);
-      if (queue_.empty()) return false;
-      f = std::move(queue_.back());  // the newest: the waiter's own task, most likely
-      queue_.pop_back();
-    }
-    f();
-    return true;
-  }
-  void work() {
-    for (;;) {
-      std::function<void()> f;
-      {
-        std::unique_lock lock(mutex_);
-        wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
-        if (queue_.empty()) return;
-        f = std::move(queue_.front());
-        queue_.pop_front();
-      }
-      f();
-    }
-  }
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::deque<std::function<void()>> queue_;
-  bool stop_ = false;
-  std::vector<std::thread> threads_;
-};
-
 }  // namespace
 
 // Top-down build straight into 8-wide nodes: a node's range is split by binned SAH, and the child with
@@ -171,7 +111,7 @@ struct BvhBuilder {
   std::unique_ptr<TriPack[]> packs;
   std::unique_ptr<std::array<uint32_t, 2>[]> subtree;  // per node: nodes and packs of its subtree, itself included
   std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
-  TaskPool* pool = nullptr;  // none for one thread
+  ThreadPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
   static constexpr uint32_t kSubtreeTask = 4096;  // triangles from which a subtree is a task of its own
   static constexpr uint32_t kParallelChunk = 64 * 1024;  // refs per thread below which binning stays serial
@@ -203,7 +143,7 @@ struct BvhBuilder {
       const __m128 blo = ref[i].boxLo(), bhi = ref[i].hi;
       const __m128i k = binOf(_mm_add_ps(blo, bhi), lo, scale);
       // Written out per axis, the bin numbers straight from the register (a loop over the axes through
-      // memory: tree phase 5 % slower on the VM).
+      // memory: a slower tree phase).
       const auto add = [&](int a, int bin) {
         Box& b = out.b[a][bin];
         b.lo = _mm_min_ps(blo, b.lo);
@@ -230,7 +170,7 @@ struct BvhBuilder {
     if (chunks > 1) {
       std::vector<Bins> part(chunks);
       const auto cut = [&](uint32_t c) { return r.begin + uint32_t(uint64_t(r.size()) * c / chunks); };
-      parallelFor(chunks, [&](uint32_t c) { binRefs(cut(c), cut(c + 1), r.cbounds.lo, scale, part[c]); });
+      chunked(chunks, [&](uint32_t c) { binRefs(cut(c), cut(c + 1), r.cbounds.lo, scale, part[c]); });
       for (const Bins& p : part) all.merge(p);
     } else {
       binRefs(r.begin, r.end, r.cbounds.lo, scale, all);
@@ -360,14 +300,11 @@ struct BvhBuilder {
     return best;
   }
 
-  // Runs fn(c) for c in [0, chunks), chunk 0 on this thread.
+  // fn(c) for c in [0, chunks), on the pool's threads when there is one.
   template <class Fn>
-  void parallelFor(uint32_t chunks, const Fn& fn) const {
-    if (!pool) { for (uint32_t c = 0; c < chunks; ++c) fn(c); return; }
-    TaskPool::Group g;
-    for (uint32_t c = 1; c < chunks; ++c) pool->run(g, [&fn, c] { fn(c); });
-    fn(0);
-    pool->wait(g);
+  void chunked(uint32_t chunks, const Fn& fn) const {
+    if (pool) parallelFor(*pool, chunks, fn);
+    else for (uint32_t c = 0; c < chunks; ++c) fn(c);
   }
 
   // Moves the refs of bins ≤ s.bin in front. The k-th misplaced ref from the front trades places with the
@@ -415,7 +352,7 @@ struct BvhBuilder {
     std::vector<std::vector<uint32_t>> front(chunks), back(chunks);
     std::vector<std::array<Box, 2>> cb(chunks);
     const auto cut = [&](uint32_t b, uint32_t e, uint32_t c) { return b + uint32_t(uint64_t(e - b) * c / chunks); };
-    parallelFor(chunks, [&](uint32_t c) {
+    chunked(chunks, [&](uint32_t c) {
       for (uint32_t i = cut(r.begin, mid, c); i < cut(r.begin, mid, c + 1); ++i)
         if (!left(refs[i], cb[c].data())) front[c].push_back(i);
       // Back side from the end: chunk c covers the c-th stretch counted from r.end down.
@@ -429,7 +366,7 @@ struct BvhBuilder {
       b.insert(b.end(), back[c].begin(), back[c].end());
     }
     if (f.size() != b.size()) throw Error("BVH build: partition counts disagree with the bins");  // never: same arithmetic
-    parallelFor(chunks, [&](uint32_t c) {
+    chunked(chunks, [&](uint32_t c) {
       for (size_t k = size_t(f.size()) * c / chunks; k < size_t(f.size()) * (c + 1) / chunks; ++k) std::swap(refs[f[k]], refs[b[k]]);
     });
   }
@@ -492,7 +429,7 @@ struct BvhBuilder {
 
   // Writes the subtree of node `ref` into bvh's arrays in depth-first order, its node at `node`, its packs
   // from `pack` on: the subtree sizes place every child, so large subtrees are copied by the pool.
-  void relayout(uint32_t ref, Bvh& bvh, uint32_t node, uint32_t pack, TaskPool::Group& g) const {
+  void relayout(uint32_t ref, Bvh& bvh, uint32_t node, uint32_t pack, ThreadPool::Group& g) const {
     Node n = nodes[ref];
     uint32_t nextNode = node + 1, nextPack = pack;
     for (int k = 0; k < int(kWidth); ++k) {
@@ -549,7 +486,7 @@ struct BvhBuilder {
     }
     // Large subtrees are tasks for the pool, the last one built here; the tree is the same whatever
     // thread builds what (the copy-out orders it).
-    TaskPool::Group g;
+    ThreadPool::Group g;
     int last = count - 1;
     while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < kSubtreeTask)) --last;
     for (int k = 0; k < count; ++k) {
@@ -574,13 +511,13 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   const auto start = std::chrono::steady_clock::now();
   if (triangles.size() > kMaxTriangles)
     throw Error("BVH: " + std::to_string(triangles.size()) + " triangles, at most " + std::to_string(kMaxTriangles));
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  threads = threadCount(threads);
   BvhBuilder b;
   b.tris = triangles;
   b.casts = castsShadow;
   b.threads = threads;
-  std::unique_ptr<TaskPool> pool;
-  if (threads > 1) b.pool = (pool = std::make_unique<TaskPool>(threads - 1)).get();
+  std::unique_ptr<ThreadPool> pool;
+  if (threads > 1) b.pool = (pool = std::make_unique<ThreadPool>(threads - 1)).get();
   // The references and the root's bounds, by all threads: each chunk of triangles keeps its finite ones
   // at its own start, and the chunks close up after (only where some were left out).
   const uint32_t count = uint32_t(triangles.size());
@@ -589,7 +526,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   std::vector<uint32_t> kept(chunks);
   std::vector<Range> part(chunks);
   const auto cut = [&](uint32_t c) { return uint32_t(uint64_t(count) * c / chunks); };
-  b.parallelFor(chunks, [&](uint32_t c) {
+  b.chunked(chunks, [&](uint32_t c) {
     uint32_t out = cut(c);
     for (uint32_t i = cut(c); i < cut(c + 1); ++i) {
       const Triangle& t = triangles[i];
@@ -631,7 +568,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
     std::copy(&b.packs[0], &b.packs[0] + packs_.size(), &packs_[0]);
     root_ &= ~0x0FFFFFFFu;
   } else {
-    TaskPool::Group g;
+    ThreadPool::Group g;
     b.relayout(root_, *this, 0, 0, g);
     if (b.pool) b.pool->wait(g);
     root_ = 0;

@@ -85,8 +85,8 @@ class Bvh {
   bool occluded(const Ray& ray, IntersectMethod method = IntersectMethod::Watertight) const;
   // The same for two rays at once, each with exactly the result it gets alone: the two walks are
   // interleaved, one node or leaf of each in turn, which keeps the core busier than one walk can
-  // (H200 host: 20-35 % more rays per second on the 1M sphere, nothing on rays that end after a few
-  // nodes: docs/bench/trace.md, round 5). Rays parallel to different axes go one at a time.
+  // (more rays per second on long walks, nothing on rays that end after a few nodes: docs/bench/trace.md,
+  // round 5). Rays parallel to different axes go one at a time.
   std::array<Hit, 2> closestPair(const std::array<Ray, 2>& rays, IntersectMethod method = IntersectMethod::Watertight) const;
   std::array<bool, 2> occludedPair(const std::array<Ray, 2>& rays, IntersectMethod method = IntersectMethod::Watertight) const;
 

@@ -76,8 +76,8 @@ inline unsigned topBits(const uint32_t* p) {
 #endif
 
 // The box test's min/max: on the bit patterns as integers where RTR_BVH_INT_MINMAX is set (the AVX-512
-// build: on the Intel host, 1 cycle against 4 for vmaxps), as floats elsewhere (on the AMD VM the
-// integer form was 3-4 % slower: vmaxps takes one cycle there and the integer unit adds a bypass).
+// build: on Intel, vmaxps takes several cycles where the integer form takes one), as floats elsewhere (on
+// AMD, vmaxps is as quick and the integer unit adds a bypass: measured slower, docs/bench/trace.md).
 #if RTR_BVH_INT_MINMAX
 inline F slabMax(F a, F b) { return imax(a, b); }
 inline F slabMin(F a, F b) { return imin(a, b); }
@@ -131,7 +131,7 @@ inline unsigned realLanes(const TriPack& pk) {
 
 // Where a walk is: the stack's fill, the node or leaf to visit next, the closest hit so far. The stack
 // itself (kStackSize entries) is passed beside it: as a member it kept the compiler from holding these
-// in registers (measured about 5 % slower, VM). An entry: the entry distance's bits above the node reference,
+// in registers (measured slower). An entry: the entry distance's bits above the node reference,
 // so one integer compare sorts.
 struct Cursor {
   int sp;
@@ -171,7 +171,7 @@ struct Walker {
     // a box the ray really meets is never culled. A NaN distance (an overflow) never culls either: the
     // test below is "not tNear > tFar". An axis the ray runs parallel to (orthographic views, axis-aligned
     // rays) has no slab distances (they would be infinite or NaN and cull nothing: every box across the
-    // view visited, ~300× slower); its test is exact instead, lo ≤ o ≤ hi.
+    // view visited); its test is exact instead, lo ≤ o ≤ hi.
     for (int a = 0; a < 3; ++a) oAxis[a] = set1(o[a]);
 #if RTR_BVH_AVX2
     // One FMA per slab: t = box·r − o·r. The near distance uses r shrunk by 8 ulps and o·r pushed up by

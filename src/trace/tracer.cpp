@@ -5,10 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
-#include <thread>
-
-#include <pmmintrin.h>
-#include <xmmintrin.h>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -16,6 +12,7 @@
 #include <glm/matrix.hpp>
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "scene/framing.hpp"
 #include "scene/textures.hpp"
 #include "trace/shade.hpp"
@@ -336,65 +333,52 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
   const uint32_t tilesX = (s.width + ts - 1) / ts, tilesY = (s.height + ts - 1) / ts;
   RenderStats stats;
   stats.tilesTotal = tilesX * tilesY;
-  std::atomic<uint32_t> next{0};
   std::mutex mutex;  // guards stats and the callback
   const bool debugView = s.shading == Shading::Normals || s.shading == Shading::Depth;
 
-  auto worker = [&] {
-    // Denormals only slow us down; flush them (this thread is ours, nothing to restore).
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+  parallelFor(stats.tilesTotal, s.threads, [&](size_t tile) {
+    if (cancel && cancel->load(std::memory_order_relaxed)) return;
+    const FlushDenormals flush;
     Counters c;
     uint64_t primary = 0;
     std::vector<uint8_t> known, blocked;
-    for (;;) {
-      if (cancel && cancel->load(std::memory_order_relaxed)) break;
-      const uint32_t tile = next.fetch_add(1);
-      if (tile >= stats.tilesTotal) break;
-      const TileRect rect{(tile % tilesX) * ts, (tile / tilesX) * ts, std::min(s.width, (tile % tilesX + 1) * ts),
-                          std::min(s.height, (tile / tilesX + 1) * ts)};
-      // Primary rays go through the BVH eight at a time (a packet of neighbouring pixels of a row:
-      // Bvh::closest8, the same hits as one at a time), then their shadow rays, a packet per light
-      // sample (Bvh::occluded8, the same answers), then each pixel is shaded on its own.
-      for (uint32_t y = rect.y0; y < rect.y1; ++y)
-        for (uint32_t x = rect.x0; x < rect.x1; x += 8) {
-          const uint32_t n = std::min(8u, rect.x1 - x);
-          std::array<Ray, 8> rays;
-          for (uint32_t k = 0; k < n; ++k) {
-            const CameraRay cr =
-                cameraRay(pose, s.lens, aspect, pixelToNdc(float(x + k) + 0.5f, float(y) + 0.5f, s.width, s.height));
-            rays[k] = {glm::vec3(frame.toScene * glm::vec4(cr.origin, 1.0f)),
-                       glm::vec3(frame.toScene * glm::vec4(cr.direction, 0.0f))};
-          }
-          std::array<Hit, 8> first;
-          if (useBvh_) bvh_.closest8(rays.data(), int(n), first.data(), s.intersect);
-          std::array<Visible, 8> vis;
-          for (uint32_t k = 0; k < n; ++k) vis[k] = closestVisible(rays[k], frame.camera, frame, c, useBvh_ ? &first[k] : nullptr);
-          shadowPackets(vis.data(), int(n), frame, known, blocked);
-          for (uint32_t k = 0; k < n; ++k) {
-            const Shadows pre{known.data(), blocked.data(), int(k)};
-            glm::vec3 col = shade(rays[k], frame.camera, s.bounces, frame, c, &vis[k], known.empty() ? nullptr : &pre);
-            // Debug views hold their value as displayed: encode so that sRGB output shows it unchanged.
-            if (debugView) col = {srgbToLinear(col.x), srgbToLinear(col.y), srgbToLinear(col.z)};
-            out.at(x + k, y) = glm::vec4(col, 1.0f);
-            ++primary;
-          }
+    const TileRect rect{uint32_t(tile % tilesX) * ts, uint32_t(tile / tilesX) * ts, std::min(s.width, uint32_t(tile % tilesX + 1) * ts),
+                        std::min(s.height, uint32_t(tile / tilesX + 1) * ts)};
+    // Primary rays go through the BVH eight at a time (a packet of neighbouring pixels of a row:
+    // Bvh::closest8, the same hits as one at a time), then their shadow rays, a packet per light
+    // sample (Bvh::occluded8, the same answers), then each pixel is shaded on its own.
+    for (uint32_t y = rect.y0; y < rect.y1; ++y)
+      for (uint32_t x = rect.x0; x < rect.x1; x += 8) {
+        const uint32_t n = std::min(8u, rect.x1 - x);
+        std::array<Ray, 8> rays;
+        for (uint32_t k = 0; k < n; ++k) {
+          const CameraRay cr =
+              cameraRay(pose, s.lens, aspect, pixelToNdc(float(x + k) + 0.5f, float(y) + 0.5f, s.width, s.height));
+          rays[k] = {glm::vec3(frame.toScene * glm::vec4(cr.origin, 1.0f)),
+                     glm::vec3(frame.toScene * glm::vec4(cr.direction, 0.0f))};
         }
-      std::lock_guard lock(mutex);
-      ++stats.tilesDone;
-      if (onTile) onTile(rect);
-    }
+        std::array<Hit, 8> first;
+        if (useBvh_) bvh_.closest8(rays.data(), int(n), first.data(), s.intersect);
+        std::array<Visible, 8> vis;
+        for (uint32_t k = 0; k < n; ++k) vis[k] = closestVisible(rays[k], frame.camera, frame, c, useBvh_ ? &first[k] : nullptr);
+        shadowPackets(vis.data(), int(n), frame, known, blocked);
+        for (uint32_t k = 0; k < n; ++k) {
+          const Shadows pre{known.data(), blocked.data(), int(k)};
+          glm::vec3 col = shade(rays[k], frame.camera, s.bounces, frame, c, &vis[k], known.empty() ? nullptr : &pre);
+          // Debug views hold their value as displayed: encode so that sRGB output shows it unchanged.
+          if (debugView) col = {srgbToLinear(col.x), srgbToLinear(col.y), srgbToLinear(col.z)};
+          out.at(x + k, y) = glm::vec4(col, 1.0f);
+          ++primary;
+        }
+      }
     std::lock_guard lock(mutex);
+    ++stats.tilesDone;
     stats.primaryRays += primary;
     stats.shadowRays += c.shadow;
     stats.reflectionRays += c.reflection;
     stats.alphaRays += c.alpha;
-  };
-  unsigned n = s.threads ? s.threads : std::max(1u, std::thread::hardware_concurrency());
-  n = std::min(n, stats.tilesTotal);
-  std::vector<std::thread> pool;
-  for (unsigned i = 0; i < n; ++i) pool.emplace_back(worker);
-  for (std::thread& t : pool) t.join();
+    if (onTile) onTile(rect);
+  });
   stats.cancelled = stats.tilesDone < stats.tilesTotal;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;

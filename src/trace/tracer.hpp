@@ -29,6 +29,9 @@ constexpr int N_BOUNCES = 5;  // the brief's default recursion depth for mirrors
 constexpr int kMaxAlphaLayers = 32;
 
 enum class Shading { Phong, Pbr, Normals, Depth };
+constexpr std::array<EnumName<Shading>, 4> enumNames(Shading) {
+  return {{{Shading::Phong, "phong"}, {Shading::Pbr, "pbr"}, {Shading::Normals, "normals"}, {Shading::Depth, "depth"}}};
+}
 
 struct TraceSettings {
   uint32_t width = 1280, height = 720;

@@ -77,13 +77,12 @@ void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images) {
   vkCmdPipelineBarrier2(cb, &di);
 }
 
-void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                   VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
+void bufferBarrier(VkCommandBuffer cb, BufferUse before, BufferUse after) {
   VkMemoryBarrier2 mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-  mb.srcStageMask = srcStage;
-  mb.srcAccessMask = srcAccess;
-  mb.dstStageMask = dstStage;
-  mb.dstAccessMask = dstAccess;
+  mb.srcStageMask = before.stage;
+  mb.srcAccessMask = before.access;
+  mb.dstStageMask = after.stage;
+  mb.dstAccessMask = after.access;
   VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   di.memoryBarrierCount = 1;
   di.pMemoryBarriers = &mb;
@@ -132,8 +131,7 @@ void copyImageToHost(VkCommandBuffer cb, VkImage image, VkExtent2D extent, VkBuf
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {extent.width, extent.height, 1};
   vkCmdCopyImageToBuffer(cb, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
-  memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                VK_ACCESS_2_HOST_READ_BIT);
+  bufferBarrier(cb, kCopyWrite, kHostRead);
 }
 
 void setFullViewport(VkCommandBuffer cb, VkExtent2D extent) {

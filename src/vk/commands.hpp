@@ -40,9 +40,31 @@ struct ImageBarrier {
   VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
 };
 void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images);
-// A global memory barrier (buffers, and images whose layout does not change).
-void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                   VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
+
+// Buffers are not tracked one by one: a pass states what touched them before and what touches them next,
+// `vk::bufferBarrier(cb, before, after)`, from the named uses below (combined with |). It records one
+// global memory barrier (all buffers, and images whose layout does not change).
+struct BufferUse {
+  VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 access = VK_ACCESS_2_NONE;
+};
+constexpr BufferUse operator|(BufferUse a, BufferUse b) { return {a.stage | b.stage, a.access | b.access}; }
+constexpr VkAccessFlags2 kShaderReadWrite = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT;
+constexpr BufferUse kComputeRead{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT};
+constexpr BufferUse kComputeWrite{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT};
+constexpr BufferUse kComputeReadWrite{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kShaderReadWrite};
+constexpr BufferUse kVertexReadWrite{VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT, kShaderReadWrite};
+constexpr BufferUse kFragmentRead{VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT};
+constexpr BufferUse kFragmentWrite{VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT};
+constexpr BufferUse kFragmentReadWrite{VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, kShaderReadWrite};
+constexpr BufferUse kIndirectRead{VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT};
+constexpr BufferUse kVertexInput{VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT,
+                                 VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_2_INDEX_READ_BIT};
+constexpr BufferUse kCopyRead{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT};
+constexpr BufferUse kCopyWrite{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
+constexpr BufferUse kTransferWrite{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};  // fill, update
+constexpr BufferUse kHostRead{VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT};
+void bufferBarrier(VkCommandBuffer cb, BufferUse before, BufferUse after);
 
 // Read-back: copies level 0 of a colour image (in TRANSFER_SRC_OPTIMAL) tightly packed into `buffer` and
 // makes the copy visible to the host once the submission's fence has signalled.

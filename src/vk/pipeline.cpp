@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <exception>
-#include <future>
 #include <cstdlib>
 #include <mutex>
 #include <unistd.h>
 
+#include "core/parallel.hpp"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
 #include "vk/pipeline_cache.hpp"
@@ -274,22 +274,28 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   return p;
 }
 
-void inParallel(const std::vector<std::function<void()>>& jobs) {
-  if (jobs.empty()) return;
-  std::vector<std::future<void>> others;
-  for (size_t i = 0; i + 1 < jobs.size(); ++i) others.push_back(std::async(std::launch::async, jobs[i]));
-  std::exception_ptr failure;
-  try {
-    jobs.back()();
-  } catch (...) {
-    failure = std::current_exception();
+VkExtent3D groupCount(const PipelineInterface& p, uint32_t x, uint32_t y, uint32_t z) {
+  if (p.stages.size() != 1 || p.stages[0].stage != VK_SHADER_STAGE_COMPUTE_BIT)
+    throw Error("groupCount: not a compute pipeline");
+  const StageInterface& st = p.stages[0];
+  const uint32_t n[3] = {x, y, z};
+  uint32_t g[3];
+  for (int i = 0; i < 3; ++i) {
+    const uint32_t size = st.localSize[i];
+    if (size == 0 || size == kSpecializedSize)
+      throw Error(st.module + ": groupCount needs a workgroup size written in the shader");
+    g[i] = n[i] / size + (n[i] % size != 0);
   }
-  for (auto& f : others) try {
-      f.get();
-    } catch (...) {
-      if (!failure) failure = std::current_exception();
-    }
-  if (failure) std::rethrow_exception(failure);
+  return {g[0], g[1], g[2]};
+}
+
+void Pipeline::dispatch(VkCommandBuffer cb, uint32_t x, uint32_t y, uint32_t z) const {
+  const VkExtent3D g = groupCount(layout.interface(), x, y, z);
+  vkCmdDispatch(cb, g.width, g.height, g.depth);
+}
+
+void inParallel(const std::vector<std::function<void()>>& jobs) {
+  parallelFor(jobs.size(), unsigned(jobs.size()), [&](size_t i) { jobs[i](); });
 }
 
 DescriptorSets::DescriptorSets(const Context& ctx, const PipelineLayout& layout, uint32_t copies) : copies_(copies) {

@@ -70,7 +70,13 @@ struct Pipeline {
     vkCmdPushConstants(cb, layout.handle(), pcs[0].stages, 0, sizeof(T), &data);
   }
   void throwPushSizeMismatch(size_t size) const;
+  // vkCmdDispatch of the workgroups that cover x × y × z invocations (groupCount).
+  void dispatch(VkCommandBuffer cb, uint32_t x, uint32_t y = 1, uint32_t z = 1) const;
 };
+
+// Workgroups that cover x × y × z invocations, one per item, with the compute shader's reflected
+// workgroup size: the one rounding every dispatch uses, so no size is written twice.
+VkExtent3D groupCount(const PipelineInterface& p, uint32_t x, uint32_t y = 1, uint32_t z = 1);
 
 struct SpecializationConstant { uint32_t id; uint32_t value; };
 
@@ -92,7 +98,7 @@ struct GraphicsDesc {
 };
 Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& desc, const LayoutOptions& options = {});
 
-// Runs the jobs at once, all but the last on threads of their own, waits for all and rethrows the first
+// Runs the jobs at once, each on a thread (parallelFor), waits for all and rethrows the first job's
 // failure. For making pipelines in parallel: a driver compiles each on the calling thread, and creation
 // is thread-safe (the VkPipelineCache is internally synchronized: made without EXTERNALLY_SYNCHRONIZED).
 void inParallel(const std::vector<std::function<void()>>& jobs);

@@ -273,8 +273,13 @@ PipelineInterface reflectPipeline(const std::vector<SpirvModule>& modules) {
       st.stage = VkShaderStageFlagBits(ep.shader_stage);
       st.entryPoint = ep.name ? ep.name : "";
       st.specConstants = specs;
+      // A ray-tracing pipeline may hold any number of shaders of each of its stages (its shader groups
+      // pick them); any other pipeline one per stage.
+      constexpr VkShaderStageFlags kRayTracing = VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_ANY_HIT_BIT_KHR |
+                                                 VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR |
+                                                 VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_CALLABLE_BIT_KHR;
       for (const auto& other : out.stages)
-        if (other.stage == st.stage)
+        if (other.stage == st.stage && !(st.stage & kRayTracing))
           throw Error(s.name + " '" + st.entryPoint + "' and " + other.module + " '" + other.entryPoint + "': both are " +
                       stageNames(st.stage) + " shaders");
       if (st.stage == VK_SHADER_STAGE_COMPUTE_BIT) st.localSize = {ep.local_size.x, ep.local_size.y, ep.local_size.z};

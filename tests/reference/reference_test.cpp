@@ -28,7 +28,7 @@ struct Param {
   View view;
   render::RasterPath raster = render::RasterPath::Auto;
   std::string label() const {
-    return name + "_" + viewName(view) + (raster == render::RasterPath::Auto ? "" : std::string("_") + render::toString(raster));
+    return name + "_" + viewName(view) + (raster == render::RasterPath::Auto ? "" : std::string("_") + rtr::enumName(raster));
   }
 };
 

@@ -97,8 +97,7 @@ class CullTest : public test::VulkanTest {
       VkBufferCopy a{0, 0, 32}, b{0, 32, size_t(count) * 4};
       vkCmdCopyBuffer(cb, culler.counts(), back.handle(), 1, &a);
       vkCmdCopyBuffer(cb, culler.visible(), back.handle(), 1, &b);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     });
     back.invalidate();
     GpuResult r;
@@ -145,8 +144,7 @@ class CullTest : public test::VulkanTest {
       layout(VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
       vkCmdCopyImageToBuffer(cb, p.image().handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.handle(), uint32_t(regions.size()), regions.data());
       layout(VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     });
     back.invalidate();
     const float* f = static_cast<const float*>(back.mapped());

@@ -62,7 +62,7 @@ bool ranPass(const render::HeadlessFrame& f, const std::string& name) {
 
 TEST_F(FrameTest, ShadedFrameIsFiniteAndLit) {
   for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility}) {
-    SCOPED_TRACE(render::toString(path));
+    SCOPED_TRACE(rtr::enumName(path));
     auto f = render(VIEW_SHADED, true, path);
     ASSERT_EQ(f.sceneColor.pixels.size(), size_t(kW) * kH);
     double sum = 0;
@@ -114,7 +114,7 @@ TEST_F(FrameTest, DrawsGoNearestFirst) {
 TEST_F(FrameTest, VisibilityPathMatchesForward) {
   for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
   for (float bias : {0.0f, 1.5f}) {
-    SCOPED_TRACE(testing::Message() << "LOD bias " << bias << ", " << render::toString(raster) << " raster");
+    SCOPED_TRACE(testing::Message() << "LOD bias " << bias << ", " << rtr::enumName(raster) << " raster");
     auto fwd = render(VIEW_SHADED, false, render::ShadingPath::Forward, bias);
     auto vis = render(VIEW_SHADED, false, render::ShadingPath::Visibility, bias, raster);
     ASSERT_TRUE(ranPass(vis, "shade") && !ranPass(fwd, "shade"));
@@ -216,8 +216,8 @@ TEST_F(FrameTest, OneFrameRecordsExactlyTheBarriersItNeeds) {
     for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
     for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics})
     for (bool cull : {true, false}) {
-      SCOPED_TRACE(std::string(render::toString(path)) + ", mosaic " + render::toString(mosaic) + ", " +
-                   render::toString(raster) + " raster, cull " + (cull ? "on" : "off"));
+      SCOPED_TRACE(std::string(rtr::enumName(path)) + ", mosaic " + rtr::enumName(mosaic) + ", " +
+                   rtr::enumName(raster) + " raster, cull " + (cull ? "on" : "off"));
       RenderSettings s;
       s.cull = cull;
       s.shading = path;

@@ -92,8 +92,7 @@ class MipsTest : public VulkanTest {
         vkCmdCopyImageToBuffer(cb, images[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(),
                                uint32_t(copies.size()), copies.data());
       }
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     });
     readback.invalidate();
     std::vector<std::vector<std::vector<uint8_t>>> out(srcs.size());
@@ -139,7 +138,7 @@ const VkFormat kFormats[] = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R8G8B8A8_UNORM, 
 std::string label(VkExtent2D e, VkFormat f, MipMode m) {
   std::ostringstream s;
   s << e.width << "x" << e.height << " "
-    << (f == VK_FORMAT_R8G8B8A8_SRGB ? "srgb" : f == VK_FORMAT_R8_UNORM ? "r8" : "unorm") << " " << render::toString(m);
+    << (f == VK_FORMAT_R8G8B8A8_SRGB ? "srgb" : f == VK_FORMAT_R8_UNORM ? "r8" : "unorm") << " " << rtr::enumName(m);
   return s.str();
 }
 
@@ -237,7 +236,7 @@ TEST_F(MipsTest, AutoGivesEachImageTheChainOfItsSizesPath) {
 }
 
 // Pipelines are made on first use, only those the images need: none for blit chains, only the general
-// shader for odd sizes (the README's scene on lavapipe made both for its blits: 28 of 37 ms).
+// shader for odd sizes (the README's scene on lavapipe made both for its blits, most of their time).
 TEST_F(MipsTest, PipelinesAreMadeOnlyForImagesThatNeedThem) {
   auto created = [&] { return ctx->pipelineCache().stats().created; };
   const TexelData odd = randomTexels({37, 23}, VK_FORMAT_R8G8B8A8_SRGB, 9, false);

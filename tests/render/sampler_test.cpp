@@ -77,7 +77,7 @@ TEST_F(SamplerTest, NearestMipViewShowsOnlyWholeLevels) {
 
 TEST_F(SamplerTest, FilterChangesTheShadedViewOnBothPathsAndSwitchesBack) {
   for (auto path : {render::ShadingPath::Visibility, render::ShadingPath::Forward}) {
-    SCOPED_TRACE(render::toString(path));
+    SCOPED_TRACE(rtr::enumName(path));
     const ImageRGBA8 trilinear = render(VIEW_SHADED, TextureFilter::Trilinear, path);
     const ImageRGBA8 nearestMip = render(VIEW_SHADED, TextureFilter::NearestMip, path);
     const ImageRGBA8 nearest = render(VIEW_SHADED, TextureFilter::Nearest, path);

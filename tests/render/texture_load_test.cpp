@@ -81,7 +81,7 @@ TEST_F(VulkanTest, DeferredTexturesShowFactorsThenMatchAWaitedLoad) {
       for (int mode : {VIEW_ALBEDO, VIEW_SHADED, VIEW_MIP_LEVEL}) {
         const auto s = settings(mode, path, raster);
         EXPECT_TRUE(a.render(pose, lens, s).image.pixels == b.render(pose, lens, s).image.pixels)
-            << render::toString(path) << " " << render::toString(raster) << " mode " << mode;
+            << rtr::enumName(path) << " " << rtr::enumName(raster) << " mode " << mode;
       }
 }
 

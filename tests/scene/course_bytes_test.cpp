@@ -1,5 +1,5 @@
 // An independent byte-level reading of the .comp5892mesh that rtr-bake writes, straight from the
-// FORMATS.md §1 table (it shares no code with the writer or the reader in src/scene).
+// docs/formats.md table (it shares no code with the writer or the reader in src/scene).
 #include <cstring>
 #include <filesystem>
 #include <fstream>

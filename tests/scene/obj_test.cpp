@@ -176,7 +176,7 @@ TEST(Obj, MaterialFieldsTexturesAndFlags) {
   EXPECT_FALSE(p.scene.textures[1].srgb);
   EXPECT_EQ(p.scene.textures[1].channels, 1);
   EXPECT_EQ(p.scene.textures[3].channels, 3);
-  // Defaults per FORMATS.md §2.
+  // Defaults per docs/formats.md.
   EXPECT_EQ(ms[1].ka, glm::vec3(0.5f));
   EXPECT_EQ(ms[1].ior, 1.0f);
 }

@@ -1,4 +1,4 @@
-// The small ray-tracer scenes in assets-src/rt load and follow the course conventions (FORMATS.md §2).
+// The small ray-tracer scenes in assets-src/rt load and follow the course conventions (docs/formats.md).
 #include <gtest/gtest.h>
 
 #include <glm/geometric.hpp>

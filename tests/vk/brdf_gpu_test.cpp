@@ -68,9 +68,8 @@ TEST_F(VulkanTest, GpuBrdfIsFiniteNonNegativeAndMatchesCpu) {
         .buffer(BRDF_GRID_BINDING_IN, in.handle())
         .buffer(BRDF_GRID_BINDING_OUT, out.handle())
         .push(cb, p);
-    vkCmdDispatch(cb, uint32_t((grid.size() + BRDF_GRID_LOCAL_SIZE - 1) / BRDF_GRID_LOCAL_SIZE), 1, 1);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    p.dispatch(cb, uint32_t(grid.size()));
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kHostRead);
   });
   out.invalidate();
   const auto* gpu = static_cast<const BrdfGridOutput*>(out.mapped());

@@ -31,9 +31,8 @@ TEST_F(VulkanTest, ComputeDispatchWritesEveryValue) {
     fill.bind(cb);
     fill.bindSet(cb, 0, sets.get(0));
     fill.push(cb, push);
-    vkCmdDispatch(cb, (kCount + 63) / 64, 1, 1);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    fill.dispatch(cb, kCount);
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kHostRead);
   });
   expectFilled(out, kCount, kOffset);
 }
@@ -49,9 +48,8 @@ TEST_F(VulkanTest, PushDescriptorsBindWithoutAPool) {
     fill.bind(cb);
     vk::DescriptorWriter(*ctx, fill.layout, 0, VK_NULL_HANDLE).buffer(0, out.handle()).push(cb, fill);
     fill.push(cb, push);
-    vkCmdDispatch(cb, (kCount + 63) / 64, 1, 1);
-    vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    fill.dispatch(cb, kCount);
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kHostRead);
   });
   expectFilled(out, kCount, 3);
 }
@@ -69,7 +67,7 @@ TEST_F(VulkanTest, GpuTimerMeasuresAPass) {
     fill.bind(cb);
     fill.bindSet(cb, 0, sets.get(0));
     fill.push(cb, push);
-    vkCmdDispatch(cb, (1 << 18) / 64, 1, 1);
+    fill.dispatch(cb, 1 << 18);
     timer.mark(cb, "fill");
   });
   auto r = timer.results();

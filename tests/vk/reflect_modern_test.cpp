@@ -4,7 +4,10 @@
 #include <array>
 #include <cstdio>
 #include <fstream>
+#include <filesystem>
 #include <memory>
+
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -163,6 +166,44 @@ TEST(ReflectModern, EachEntryPointOfAModuleIsAStageWithItsOwnResources) {
   EXPECT_EQ(findBinding(p, 0, 1).blockSize, 32u);
   ASSERT_EQ(p.pushConstants.size(), 1u);
   EXPECT_EQ(p.pushConstants[0].stages, VkShaderStageFlags(VK_SHADER_STAGE_FRAGMENT_BIT));
+}
+
+vk::SpirvModule assemble(const std::string& file) {
+  std::ifstream in(kData / file);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  vk::SpirvModule m{file, {}};
+  if (!spvtools::SpirvTools(SPV_ENV_VULKAN_1_3).Assemble(text, &m.code)) throw Error(file + ": does not assemble");
+  return m;
+}
+
+// A ray-tracing pipeline may hold several shaders of one stage (its groups pick them): not a conflict.
+TEST(ReflectModern, RayTracingLibraryWithTwoShadersOfAStage) {
+  const vk::PipelineInterface p = vk::reflectPipeline({assemble("rt_library.spvasm")});
+  ASSERT_EQ(p.stages.size(), 4u);
+  const std::pair<const char*, VkShaderStageFlagBits> want[] = {{"rgenA", VK_SHADER_STAGE_RAYGEN_BIT_KHR},
+                                                                {"rgenB", VK_SHADER_STAGE_RAYGEN_BIT_KHR},
+                                                                {"ahitA", VK_SHADER_STAGE_ANY_HIT_BIT_KHR},
+                                                                {"ahitB", VK_SHADER_STAGE_ANY_HIT_BIT_KHR}};
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(p.stages[i].entryPoint, want[i].first);
+    EXPECT_EQ(p.stages[i].stage, want[i].second);
+  }
+  EXPECT_EQ(findBinding(p, 0, 0).stages, VkShaderStageFlags(VK_SHADER_STAGE_RAYGEN_BIT_KHR));
+  EXPECT_EQ(findBinding(p, 0, 1).stages, VkShaderStageFlags(VK_SHADER_STAGE_ANY_HIT_BIT_KHR));
+  // Two shaders of one graphics stage still are one too many.
+  EXPECT_THROW(vk::reflectPipeline({compile("raygen.rgen"), compile("query.comp"), compile("query.comp")}), Error);
+}
+
+TEST(ReflectModernTool, RayTracingLibraryPrintsAndExitsZero) {
+  const vk::SpirvModule m = assemble("rt_library.spvasm");
+  const auto file = std::filesystem::temp_directory_path() / ("rtr_rt_library_" + std::to_string(getpid()) + ".spv");
+  std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(m.code.data()), std::streamsize(m.code.size() * 4));
+  int status = -1;
+  const std::string out = test::runTool("rtr-reflect", file.string(), &status);
+  std::filesystem::remove(file);
+  EXPECT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("rgenB"), std::string::npos) << out;
+  EXPECT_NE(out.find("ahitB"), std::string::npos) << out;
 }
 
 using test::VulkanTest;

@@ -27,6 +27,24 @@ std::string errorOf(const std::function<void()>& f) {
   return "";
 }
 
+// Every item gets a thread and no workgroup is wholly idle: ceil(n / size) per dimension, size reflected.
+TEST(Reflect, GroupCountCoversEveryItemWithTheReflectedSize) {
+  const vk::PipelineInterface fill = vk::reflectPipeline({vk::loadShader("fill.comp")});  // 64 x 1 x 1
+  const auto groups = [&](uint32_t x, uint32_t y = 1) {
+    const VkExtent3D g = vk::groupCount(fill, x, y);
+    return std::array<uint32_t, 3>{g.width, g.height, g.depth};
+  };
+  EXPECT_EQ(groups(0), (std::array<uint32_t, 3>{0, 1, 1}));
+  EXPECT_EQ(groups(1), (std::array<uint32_t, 3>{1, 1, 1}));
+  EXPECT_EQ(groups(64), (std::array<uint32_t, 3>{1, 1, 1}));
+  EXPECT_EQ(groups(65), (std::array<uint32_t, 3>{2, 1, 1}));
+  EXPECT_EQ(groups(1000, 3), (std::array<uint32_t, 3>{16, 3, 1}));
+  EXPECT_EQ(groups(UINT32_MAX), (std::array<uint32_t, 3>{(UINT32_MAX >> 6) + 1, 1, 1})) << "no overflow";
+  const vk::PipelineInterface graphics =
+      vk::reflectPipeline({vk::loadShader("mosaic.vert"), vk::loadShader("mosaic.frag")});
+  EXPECT_NE(errorOf([&] { vk::groupCount(graphics, 1); }).find("not a compute pipeline"), std::string::npos);
+}
+
 TEST(Reflect, FillShaderLayout) {
   vk::PipelineInterface p = vk::reflectPipeline({vk::loadShader("fill.comp")});
   ASSERT_EQ(p.stages.size(), 1u);

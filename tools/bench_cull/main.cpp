@@ -56,8 +56,7 @@ int main(int argc, char** argv) {
     vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
       const VkBufferCopy c{0, 0, bytes};
       vkCmdCopyBuffer(cb, stage.handle(), buf.handle(), 1, &c);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kComputeRead);
     });
     render::ClusterCuller culler(ctx, n);
     vk::Buffer back(ctx, sizeof(shader::CullCounts), VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "counts back");
@@ -99,8 +98,7 @@ int main(int argc, char** argv) {
             timer.mark(cb, "cull");
             const VkBufferCopy c{0, 0, sizeof(shader::CullCounts)};
             vkCmdCopyBuffer(cb, culler.counts(), back.handle(), 1, &c);
-            vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                              VK_ACCESS_2_HOST_READ_BIT);
+            vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
           });
           if (i < warmup) continue;
           const auto r = timer.results();

@@ -29,7 +29,7 @@
 #include "scene/load.hpp"
 #include "scene/obj.hpp"
 #include "scene/rtrscene.hpp"
-#include "scene/parallel.hpp"
+#include "core/parallel.hpp"
 
 extern char** environ;
 

@@ -13,17 +13,15 @@
 #include <map>
 #include <random>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <embree3/rtcore.h>
-#include <pmmintrin.h>
-#include <xmmintrin.h>
 
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/camera.hpp"
+#include "core/parallel.hpp"
 #include "scene/load.hpp"
 #include "trace/bvh.hpp"
 #include "trace/procedural.hpp"
@@ -37,27 +35,21 @@ namespace {
 
 double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
 
-// Runs f(i) for i in [0, n) over `threads` threads in blocks of 256; returns the best of `reps` wall times.
-// Each thread sums f's results privately: one shared sink written per ray would bounce its cache line
+// Runs f(i) for i in [0, n) over `threads` threads in pieces of 256; returns the best of `reps` wall times.
+// Each piece sums f's results privately: one shared sink written per ray would bounce its cache line
 // between the cores and cap both tracers at the same rate.
 double timed(size_t n, unsigned threads, int reps, const std::function<uint32_t(size_t)>& f) {
   static std::atomic<uint32_t> sink{0};
+  constexpr size_t kPiece = 256;
   double best = 1e30;
   for (int r = 0; r < reps; ++r) {
-    std::atomic<size_t> next{0};
     const auto start = Clock::now();
-    auto work = [&] {
-      _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-      _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    parallelFor((n + kPiece - 1) / kPiece, threads, [&](size_t p) {
+      const FlushDenormals flush;
       uint32_t acc = 0;
-      for (size_t b; (b = next.fetch_add(256)) < n;)
-        for (size_t i = b; i < std::min(n, b + 256); ++i) acc += f(i);
+      for (size_t i = p * kPiece; i < std::min(n, (p + 1) * kPiece); ++i) acc += f(i);
       sink.fetch_add(acc, std::memory_order_relaxed);
-    };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-    work();
-    for (auto& t : pool) t.join();
+    });
     best = std::min(best, seconds(start));
   }
   return best;
@@ -220,7 +212,7 @@ struct RaySet { const char* name; const std::vector<Ray>* rays; bool any; };
 // one thread; the counts do not depend on the machine): where a row stays below Embree's packets, these
 // say whether nodes, leaves or idle SIMD lanes bound it. An 8-wide pass: one ray against a node's eight
 // boxes or a pack's eight triangles, or one box or triangle against a packet's eight lanes.
-void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
+void printCounters(const Bvh& bvh, const std::vector<RaySet>& sets) {
   Bvh::setCounting(true);
   std::printf("\nWork per ray (counted; a pass: one 8-wide box or triangle test, lanes = boxes or triangles for one ray, "
               "or lanes = rays for a packet; `live`: the share of a packet's 8 lanes with a ray):\n\n"
@@ -256,7 +248,7 @@ void printCounters(const Bvh& bvh, std::initializer_list<RaySet> sets) {
 }
 
 struct Options {
-  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  unsigned threads = threadCount();
   int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
@@ -292,33 +284,21 @@ void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
   }
 }
 
-void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, bool sphere, const Options& o) {
-  const unsigned threads = o.threads;
-  const int res = o.res, reps = o.reps, leafRays = o.leafRays;
-  const bool quick = o.quick, explainAll = o.explainAll, countOnly = o.countOnly;
-  std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), res,
-              res, threads, Bvh::isaName(Bvh::isa()));
-  if (o.buildOnly) return benchBuilds(tris, o);
-  const auto t0 = Clock::now();
-  const Bvh bvh(tris, {}, threads);
-  const double ourBuild = seconds(t0);
-  const Embree em(tris, threads);
-  double oneThread = 0.0;
-  if (threads != 1) {  // the same tree on one thread (bvh.cpp): the parallel build's speed-up
-    const auto t1 = Clock::now();
-    const Bvh serial(tris, {}, 1);
-    oneThread = seconds(t1);
+// The rays every comparison uses: primary rays through pixel centres from the default framing pose (the
+// viewer's and rtr-trace's), the same view orthographic, and from our hits a shadow ray to a point light
+// and a mirror ray each (the same rays go to both tracers).
+struct Rays {
+  std::vector<Ray> primary, ortho, shadow, mirror;
+  std::vector<RaySet> sets() const {
+    return {{"primary", &primary, false}, {"primary, orthographic", &ortho, false}, {"shadow (any hit)", &shadow, true},
+            {"mirror", &mirror, false}};
   }
-  const BvhStats& st = bvh.stats();
-  std::printf("BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
-              "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
-              ourBuild, st.nodes, st.packs, st.maxDepth, st.sahCost, st.refSeconds, st.treeSeconds,
-              st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
+};
 
-  // Primary rays through pixel centres from the default framing pose (the viewer's and rtr-trace's).
+Rays makeRays(const std::vector<Triangle>& tris, const Bounds& bounds, bool sphere, const Bvh& bvh, int res) {
   Lens lens;
   CameraPose pose = frameBounds(bounds, lens, 1.0f);
-  // The unit sphere just inscribed in the square image (about 78 % of rays hit, as in ANCHORS.md).
+  // The unit sphere just inscribed in the square image (about 78 % of rays hit).
   if (sphere) pose.position = {0.0f, 0.0f, 1.01f / std::sin(glm::radians(lens.fovYDeg * 0.5f))};
   auto cameraRays = [&](const Lens& l) {
     std::vector<Ray> rays(size_t(res) * res);
@@ -329,35 +309,51 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
       }
     return rays;
   };
-  std::vector<Ray> primary = cameraRays(lens);
-  // The same view, orthographic: every ray runs parallel to two axes (the case that once made our
-  // traversal visit every box across the view).
+  Rays r;
+  r.primary = cameraRays(lens);
+  // Orthographic: every ray runs parallel to two axes (the case that once made our traversal visit every
+  // box across the view).
   Lens orthoLens = lens;
   orthoLens.orthographic = true;
   orthoLens.orthoHalfHeight = sphere ? 1.01f : 0.55f * std::max(bounds.extent().x, bounds.extent().y);
-  std::vector<Ray> ortho = cameraRays(orthoLens);
-  // Secondary rays from Embree's... no: from our hits (the same rays go to both).
-  std::vector<Hit> hits(primary.size());
-  for (size_t i = 0; i < primary.size(); ++i) hits[i] = bvh.closest(primary[i]);
+  r.ortho = cameraRays(orthoLens);
   const glm::vec3 light = bounds.center() + glm::vec3(0.3f, 1.0f, 0.8f) * glm::length(bounds.extent());
-  std::vector<Ray> shadow, mirror;
   size_t nHit = 0;
-  for (size_t i = 0; i < primary.size(); ++i) {
-    if (!hits[i].hit()) continue;
+  for (const Ray& ray : r.primary) {
+    const Hit h = bvh.closest(ray);
+    if (!h.hit()) continue;
     ++nHit;
-    const Triangle& t = tris[hits[i].prim];
-    const glm::vec3 p = (1 - hits[i].b1 - hits[i].b2) * t.v0 + hits[i].b1 * t.v1 + hits[i].b2 * t.v2;
+    const Triangle& t = tris[h.prim];
+    const glm::vec3 p = (1 - h.b1 - h.b2) * t.v0 + h.b1 * t.v1 + h.b2 * t.v2;
     glm::vec3 ng = glm::normalize(glm::cross(t.v1 - t.v0, t.v2 - t.v0));
-    if (glm::dot(ng, primary[i].direction) > 0) ng = -ng;
-    shadow.push_back(spawnRay(p, ng, light - p, 1.0f));
-    mirror.push_back(reflectRay(primary[i], ng, p, ng));
+    if (glm::dot(ng, ray.direction) > 0) ng = -ng;
+    r.shadow.push_back(spawnRay(p, ng, light - p, 1.0f));
+    r.mirror.push_back(reflectRay(ray, ng, p, ng));
   }
   std::printf("%.1f %% of primary rays hit; %zu shadow rays to a point light, %zu mirror rays\n\n",
-              100.0 * double(nHit) / double(primary.size()), shadow.size(), mirror.size());
+              100.0 * double(nHit) / double(r.primary.size()), r.shadow.size(), r.mirror.size());
+  return r;
+}
 
-  // Agreement on primary and mirror rays.
+// Ours and Embree's build, with ours on one thread too (the same tree: the parallel build's speed-up).
+void printBuilds(const std::vector<Triangle>& tris, const Bvh& bvh, double ourBuild, const Embree& em, unsigned threads) {
+  double oneThread = 0.0;
+  if (threads != 1) {
+    const auto t1 = Clock::now();
+    const Bvh serial(tris, {}, 1);
+    oneThread = seconds(t1);
+  }
+  const BvhStats& st = bvh.stats();
+  std::printf("BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
+              "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
+              ourBuild, st.nodes, st.packs, st.maxDepth, st.sahCost, st.refSeconds, st.treeSeconds,
+              st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
+}
+
+// Hit/miss and distance agreement with Embree on the primary, orthographic and mirror rays (and shadow rays).
+void printAgreement(const std::vector<Triangle>& tris, const Bvh& bvh, const Embree& em, const Rays& rays, bool explainAll) {
+  const std::vector<Ray>& primary = rays.primary, &ortho = rays.ortho, &mirror = rays.mirror, &shadow = rays.shadow;
   for (auto* set : {&primary, &ortho, &mirror}) {
-    if (o.packetsOnly) break;
     size_t disagree = 0, otherTriangle = 0, farOff = 0;
     double maxRel = 0, maxRelSame = 0;
     std::map<std::string, size_t> kinds;
@@ -381,12 +377,12 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
                 set == &primary ? (", shadow rays: " + std::to_string(shadowDisagree) + " disagreements").c_str() : "");
   }
 
-  // Ours twice: one ray at a time (Bvh::closest, as rtcIntersect1) and two rays in flight (Bvh::closestPair,
-  // as the tracer traces primary rays: neighbouring rays of the same set). The goal's ratio is against
-  // rtcIntersect1; Embree's own way of taking several rays at once, packets of eight neighbouring rays
-  // (rtcIntersect8, one SIMD traversal for all eight), is there for comparison.
-  const bool packets = em.packets();
-  if (packets) {  // the packets give the same answers as rtcIntersect1/Occluded1 (summed per packet)
+}
+
+// Our packets and Embree's against single rays: the same answers, bit for bit.
+void printPacketAgreement(const Bvh& bvh, const Embree& em, const Rays& rays, int leafRays) {
+  const std::vector<Ray>& primary = rays.primary, &ortho = rays.ortho, &mirror = rays.mirror, &shadow = rays.shadow;
+  if (em.packets()) {  // the packets give the same answers as rtcIntersect1/Occluded1 (summed per packet)
     size_t differ = 0, total = 0;
     for (auto* set : {&primary, &shadow, &mirror})
       for (size_t i = 0; i < set->size(); i += 8, ++total) {
@@ -417,17 +413,15 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
     std::printf("Our packets of 8 (leaves all rays at once from %d live rays) against our single rays (primary, orthographic, "
                 "shadow, mirror): %zu of %zu rays differ\n", lr, differ, total);
   }
-  if (!o.packetsOnly)
-    printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
-                        {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
-  if (countOnly) {  // and the same with every leaf tested ray by ray
-    std::printf("\nThe same, every leaf of a packet tested ray by ray (--leaf-rays 9):\n");
-    Bvh::setPacketLeafRays(9);
-    printCounters(bvh, {{"primary", &primary, false}, {"primary, orthographic", &ortho, false},
-                        {"shadow (any hit)", &shadow, true}, {"mirror", &mirror, false}});
-    Bvh::setPacketLeafRays(leafRays);
-    return;
-  }
+}
+
+// The speed table, on one and on all threads. Ours: one ray at a time (Bvh::closest, as rtcIntersect1), two
+// rays in flight (Bvh::closestPair, as the tracer traces primary rays) and packets of eight; the goal's
+// ratio is against rtcIntersect1, Embree's packets (rtcIntersect8) are there for comparison.
+void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Options& o) {
+  const unsigned threads = o.threads;
+  const int reps = o.reps, leafRays = o.leafRays;
+  const bool packets = em.packets();
   std::printf("\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8, leaves ray by ray "
               "| ours, packets of 8 (leaves all rays at once from %d live) | Embree rtcIntersect1/Occluded1 "
               "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n", leafRays);
@@ -435,9 +429,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   std::vector<unsigned> counts{1};
   if (threads > 1) counts.push_back(threads);
   for (unsigned th : counts) {
-    struct Set { const char* name; const std::vector<Ray>* rays; bool any; };
-    for (const Set& s : {Set{"primary", &primary, false}, Set{"primary, orthographic", &ortho, false},
-                         Set{"shadow (any hit)", &shadow, true}, Set{"mirror", &mirror, false}}) {
+    for (const RaySet& s : all.sets()) {
       const auto& rays = *s.rays;
       const size_t pairs = rays.size() / 2;  // an odd last ray goes alone
       // Alternate the four, best of each: a machine that slows down for a while slows all. Each turn
@@ -493,13 +485,40 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
                   t8, fmt(theirs, single, "%.2f×").c_str(), fmt(theirs, paired, "%.2f×").c_str(), r8);
     }
   }
-  if (quick) return;
+}
+
+// Primary rays through our BVH with each intersection routine, one thread.
+void printRoutines(const Bvh& bvh, const std::vector<Ray>& primary) {
   std::printf("\nPrimary rays through our BVH with the other routines (1 thread):\n\n| routine | Mrays/s |\n|---|---|\n");
   for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::MollerTrumbore, IntersectMethod::HalfPlane}) {
     const double t = timed(primary.size(), 1, 2, [&](size_t i) { return bvh.closest(primary[i], m).prim; });
     std::printf("| %s | %.2f |\n", m == IntersectMethod::Watertight ? "watertight (8-wide)" : m == IntersectMethod::HalfPlane ? "half-plane (scalar)" : "Möller–Trumbore (scalar)",
                 primary.size() / t * 1e-6);
   }
+}
+
+void benchScene(const char* label, const std::vector<Triangle>& tris, const Bounds& bounds, bool sphere, const Options& o) {
+  std::printf("\n## %s: %zu triangles, %ux%u primary rays, %u threads max, our traversal: %s\n\n", label, tris.size(), o.res,
+              o.res, o.threads, Bvh::isaName(Bvh::isa()));
+  if (o.buildOnly) return benchBuilds(tris, o);
+  const auto t0 = Clock::now();
+  const Bvh bvh(tris, {}, o.threads);
+  const double ourBuild = seconds(t0);
+  const Embree em(tris, o.threads);
+  printBuilds(tris, bvh, ourBuild, em, o.threads);
+  const Rays rays = makeRays(tris, bounds, sphere, bvh, o.res);
+  if (!o.packetsOnly) printAgreement(tris, bvh, em, rays, o.explainAll);
+  printPacketAgreement(bvh, em, rays, o.leafRays);
+  if (!o.packetsOnly) printCounters(bvh, rays.sets());
+  if (o.countOnly) {  // and the same with every leaf tested ray by ray
+    std::printf("\nThe same, every leaf of a packet tested ray by ray (--leaf-rays 9):\n");
+    Bvh::setPacketLeafRays(9);
+    printCounters(bvh, rays.sets());
+    Bvh::setPacketLeafRays(o.leafRays);
+    return;
+  }
+  printSpeeds(bvh, em, rays, o);
+  if (!o.quick) printRoutines(bvh, rays.primary);
 }
 
 // Single ray/triangle tests in a tight loop (scalar), and each routine's miss rate on a closed sphere seen

@@ -12,6 +12,8 @@ import os
 import re
 import sys
 
+from tables import col, md_tables, num  # noqa: E402  (tools/report/tables.py)
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -21,36 +23,6 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 
 
 # ---------------------------------------------------------------- reading the raw outputs
-
-def md_tables(text):
-    """Every markdown table in text: a list of (header, rows), cells stripped."""
-    out, lines, i = [], text.splitlines(), 0
-    while i < len(lines):
-        if lines[i].startswith("|") and i + 1 < len(lines) and re.match(r"^\|[-:| ]+\|\s*$", lines[i + 1]):
-            header = [c.strip() for c in lines[i].strip().strip("|").split("|")]
-            rows, i = [], i + 2
-            while i < len(lines) and lines[i].startswith("|"):
-                rows.append([c.strip() for c in lines[i].strip().strip("|").split("|")])
-                i += 1
-            out.append((header, rows))
-        else:
-            i += 1
-    return out
-
-
-def num(cell):
-    """The first number in a cell ('0.37×' -> 0.37, '192 (0.189 %)' -> 192), or None."""
-    m = re.search(r"-?\d+(?:\.\d+)?(?:e-?\d+)?", cell or "")
-    return float(m.group(0)) if m else None
-
-
-def col(header, *names):
-    """Index of the first column whose name contains one of names (case-insensitive), or None."""
-    for n in names:
-        for i, h in enumerate(header):
-            if n.lower() in h.lower():
-                return i
-    return None
 
 
 class Machine:
@@ -124,6 +96,30 @@ class Report:
             self.w(f"<sub>{m.label}: `{cmd}` — raw output `{m.rel(row)}`</sub>")
             self.w()
 
+    def scatter_done(self, fig, ax, plotted, name, caption, title, xlabel, ylabel, xlog=False):
+        """Labels a speed-vs-error scatter and writes it; drops the figure when nothing was plotted."""
+        if not plotted:
+            plt.close(fig)
+            return False
+        if xlog:
+            ax.set_xscale("log")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.set_title(title, fontsize=10)
+        ax.grid(alpha=0.3)
+        self.plot(fig, name, caption)
+        return True
+
+    def ratio_bars(self, bars, ylabel, title, name, caption):
+        """(label, ratio, ...) bars against 1.0, the goal: green where met."""
+        fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(bars)), 4))
+        ax.bar(range(len(bars)), [b[1] for b in bars], color=["tab:green" if b[1] >= 1 else "tab:red" for b in bars])
+        ax.axhline(1.0, color="k", lw=0.8)
+        ax.set_xticks(range(len(bars)), [b[0] for b in bars], rotation=90, fontsize=7)
+        ax.set_ylabel(ylabel)
+        ax.set_title(title, fontsize=10)
+        self.plot(fig, name, caption)
+
     def missing(self, what, m, row):
         self.w(f"- {what} on **{m.label}**: not measured — {m.failed(row)}.")
 
@@ -167,14 +163,9 @@ class Report:
                         any_point = True
                 self.w()
                 self.source(m, "trace")
-        if any_point:
-            ax.set_xlabel("speed: M ray–triangle tests/s (1 thread)")
-            ax.set_ylabel("error: % of rays that miss a closed mesh")
-            ax.set_title("Ray–triangle routines: speed vs misses", fontsize=10)
-            ax.grid(alpha=0.3)
-            self.plot(fig, "routines.png", "ray-triangle routines: speed vs miss rate")
-        else:
-            plt.close(fig)
+        self.scatter_done(fig, ax, any_point, "routines.png", "ray-triangle routines: speed vs miss rate",
+                          "Ray–triangle routines: speed vs misses", "speed: M ray–triangle tests/s (1 thread)",
+                          "error: % of rays that miss a closed mesh")
 
     # 2. CPU tracer vs Embree
     def tracer(self):
@@ -250,26 +241,17 @@ class Report:
                                    f"{worst:.2f}× (worst scene)", worst <= 1.0))
             self.source(m, "trace")
         if bars:
-            fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(bars)), 4))
-            ax.bar(range(len(bars)), [b[1] for b in bars], color=["tab:green" if b[1] >= 1 else "tab:red" for b in bars])
-            ax.axhline(1.0, color="k", lw=0.8)
-            ax.set_xticks(range(len(bars)), [b[0] for b in bars], rotation=90, fontsize=7)
-            ax.set_ylabel("ours / Embree (Mrays/s)")
-            ax.set_title("CPU tracer (two rays in flight) relative to Embree rtcIntersect1 (≥ 1 is the goal)", fontsize=10)
-            self.plot(fig, "tracer_vs_embree.png", "tracer vs Embree throughput ratio")
+            self.ratio_bars(bars, "ours / Embree (Mrays/s)",
+                            "CPU tracer (two rays in flight) relative to Embree rtcIntersect1 (≥ 1 is the goal)",
+                            "tracer_vs_embree.png", "tracer vs Embree throughput ratio")
             for label in sorted({b[2] for b in bars}):
                 mine = [b[1] for b in bars if b[2] == label]
                 self.goals.append((f"CPU tracer ≥ 1.0× Embree `rtcIntersect1` (watertight, two rays in flight), every row ({label})",
                                    f"{min(mine):.2f}–{max(mine):.2f}×", min(mine) >= 1.0))
         if packet_bars:
-            fig, ax = plt.subplots(figsize=(max(6, 0.5 * len(packet_bars)), 4))
-            ax.bar(range(len(packet_bars)), [b[1] for b in packet_bars],
-                   color=["tab:green" if b[1] >= 1 else "tab:red" for b in packet_bars])
-            ax.axhline(1.0, color="k", lw=0.8)
-            ax.set_xticks(range(len(packet_bars)), [b[0] for b in packet_bars], rotation=90, fontsize=7)
-            ax.set_ylabel("our packets / Embree packets (Mrays/s)")
-            ax.set_title("CPU tracer's packets of 8 relative to Embree rtcIntersect8/Occluded8 (≥ 1 is the goal)", fontsize=10)
-            self.plot(fig, "tracer_packets_vs_embree.png", "tracer packets vs Embree packets throughput ratio")
+            self.ratio_bars(packet_bars, "our packets / Embree packets (Mrays/s)",
+                            "CPU tracer's packets of 8 relative to Embree rtcIntersect8/Occluded8 (≥ 1 is the goal)",
+                            "tracer_packets_vs_embree.png", "tracer packets vs Embree packets throughput ratio")
         for label in sorted({p[1] for p in packet_ratios}):
             mine = [p[0] for p in packet_ratios if p[1] == label]
             self.goals.append((f"CPU tracer's packets ≥ 1.0× Embree `rtcIntersect8`, primary, orthographic and shadow rays ({label})",
@@ -320,15 +302,9 @@ class Report:
                         goal = 0.1 if size == "1024x1024" else 1.0
                         self.goals.append((f"compute mips ≤ {goal}× blit, 64 × {size} sRGB (H200)",
                                            f"{comp:.3f} vs {blit:.3f} ms = {comp / blit:.3f}×", comp / blit <= goal))
-        if plotted:
-            ax.set_xscale("log")
-            ax.set_xlabel("speed: GPU ms per set of 64 chains (log)")
-            ax.set_ylabel("error: max |chain − float64 reference| (LSB)")
-            ax.set_title("Mip chains: time vs error", fontsize=10)
-            ax.grid(alpha=0.3)
-            self.plot(fig, "mips.png", "mip chains: GPU time vs max error")
-        else:
-            plt.close(fig)
+        if not self.scatter_done(fig, ax, plotted, "mips.png", "mip chains: GPU time vs max error",
+                                 "Mip chains: time vs error", "speed: GPU ms per set of 64 chains (log)",
+                                 "error: max |chain − float64 reference| (LSB)", xlog=True):
             self.w("- The error columns were not in these runs' output.")
             self.w()
 
@@ -447,15 +423,10 @@ class Report:
                     ax.scatter([c], [0], color="tab:blue", s=12)
                     ax.annotate(r[0], (g, e), fontsize=6, xytext=(3, 3), textcoords="offset points")
                     plotted = True
-        if plotted:
-            ax.set_xscale("log")
-            ax.set_xlabel("speed: ms per 1920×1080 frame (red: GPU raster, blue: CPU trace; log)")
-            ax.set_ylabel("error: mean |GPU − CPU| (8-bit steps)")
-            ax.set_title("Raster vs ray trace: time vs error", fontsize=10)
-            ax.grid(alpha=0.3)
-            self.plot(fig, "raster_vs_trace.png", "GPU raster vs CPU trace time and error")
-        else:
-            plt.close(fig)
+        self.scatter_done(fig, ax, plotted, "raster_vs_trace.png", "GPU raster vs CPU trace time and error",
+                          "Raster vs ray trace: time vs error",
+                          "speed: ms per 1920×1080 frame (red: GPU raster, blue: CPU trace; log)",
+                          "error: mean |GPU − CPU| (8-bit steps)", xlog=True)
 
     # 7. bake
     def bake(self):
@@ -624,7 +595,7 @@ def main():
             "submissions after warm-up).", "", "## Machines", ""]
     for m in machines:
         head.append(f"- **{m.label}**: {m.caption()}" + (" (quick run: fewer frames)" if m.meta.get("quick") == "1" else ""))
-    head += ["", "## Goals against the anchors (`../shared/ANCHORS.md`)", "", "| goal | measured | met? |", "|---|---|---|"]
+    head += ["", "## Goals (set in `tools/report/render.py`)", "", "| goal | measured | met? |", "|---|---|---|"]
     for g, v, ok in rep.goals:
         head.append(f"| {g} | {v} | {'yes' if ok else '**no**'} |")
     head.append("")

@@ -43,16 +43,16 @@ int run(int argc, char** argv) {
       ->check(cli::checked([](const std::string& t) { cli::parsePose("--camera", t); }, "X,Y,Z,YAW,PITCH"));
   app.add_option("--fov", fov, "vertical field of view in degrees (the viewer's default; the course uses 80)")
       ->capture_default_str()->check(cli::number(0, 180, true));
-  app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, FORMATS.md §2)");
+  app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, docs/formats.md)");
   app.add_option("--ortho-height", orthoHeight, "half height of the orthographic volume")->check(cli::number(0, 1e30, true));
   app.add_option("--shading", shading, "phong | pbr | normals | depth")
-      ->capture_default_str()->check(CLI::IsMember({"phong", "pbr", "normals", "depth"}));
+      ->capture_default_str()->check(cli::oneOf<Shading>());
   app.add_option("--shadows", shadows, "on | off")->capture_default_str()->check(CLI::IsMember({"on", "off"}));
   app.add_option("--bounces", s.bounces, "mirror bounces (N_BOUNCES); 0 turns reflections off")
       ->capture_default_str()->check(cli::integer(0, 64));
   app.add_option("--threads", s.threads, "worker threads, 0 = every core")->capture_default_str()->check(cli::integer(0, 1024));
   app.add_option("--intersect", intersectName, "halfplane | watertight | moller")
-      ->capture_default_str()->check(CLI::IsMember({"halfplane", "watertight", "moller"}));
+      ->capture_default_str()->check(cli::oneOf<IntersectMethod>());
   app.add_option("--area-samples", s.areaLightSamples, "shadow rays per area light (1: its centre)")
       ->capture_default_str()->check(cli::integer(1, 1024));
   CLI::Option* lightOpt = app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights")
@@ -78,11 +78,9 @@ int run(int argc, char** argv) {
   s.lens.orthographic = ortho;
   const float aspect = float(w) / float(h);
   s.lens.orthoHalfHeight = orthoHeight > 0.0f ? orthoHeight : (aspect >= 1.0f ? 1.0f : 1.0f / aspect);
-  s.shading = shading == "pbr" ? Shading::Pbr : shading == "normals" ? Shading::Normals
-            : shading == "depth" ? Shading::Depth : Shading::Phong;
+  s.shading = cli::enumOption<Shading>("--shading", shading);
   s.shadows = shadows == "on";
-  s.intersect = intersectName == "halfplane" ? IntersectMethod::HalfPlane
-              : intersectName == "moller" ? IntersectMethod::MollerTrumbore : IntersectMethod::Watertight;
+  s.intersect = cli::enumOption<IntersectMethod>("--intersect", intersectName);
   if (!light.empty()) lightOptions.position = cli::parseVec3("--light", light);
   if (!lightColor.empty()) lightOptions.color = cli::parseColor("--light-color", lightColor);
   lightOptions.ambient = cli::parseColor("--ambient", ambient, true);

@@ -104,8 +104,8 @@ DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
   DeviceChoice c{o.shadingGiven ? o.settings.shading : d.shading, o.mipsGiven ? o.mips : d.mips};
   // No " on " in this line: scripts take the first line with one for the device line below.
   std::fprintf(stderr, "rtr-view: %s: %s shading (%s), %s mips (%s)", ctx.deviceName().c_str(),
-               render::toString(c.shading), o.shadingGiven ? "--shading-path" : "default",
-               render::toString(c.mips), o.mipsGiven ? "--mips" : "default");
+               enumName(c.shading), o.shadingGiven ? "--shading-path" : "default",
+               enumName(c.mips), o.mipsGiven ? "--mips" : "default");
   if (!o.shadingGiven || !o.mipsGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
   std::fprintf(stderr, "\n");
   if (const float max = render::maxAnisotropy(ctx); o.settings.sampler.anisotropy > max)
@@ -243,8 +243,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
                                                          : renderer.render(pose, lens, settings, std::max(1, o.frames));
     if (settings.lights.lights.empty() && allBlack(frame.image))
       std::fprintf(stderr, "rtr-view: warning: the image is all black (no lights: --no-default-light)\n");
-    // Compressed on all cores while the renderer, the scene and the device are torn down (10-15 ms on
-    // lavapipe, about a third of the PNG's time there).
+    // Compressed on all cores while the renderer, the scene and the device are torn down (on lavapipe
+    // a good part of the PNG's time).
     writing = std::async(std::launch::async, [&o, image = std::move(frame.image)] {
       saveImage(o.screenshot, image, {o.force ? Replace::Yes : Replace::No, true});
     });
@@ -283,11 +283,11 @@ int main(int argc, char** argv) {
                "T tracer shading phong/pbr/normals, Y shadows, U reflections, O orthographic, F frame the scene,\n"
                "Esc quit.",
                "rtr-view"};
-  std::string camera, size = "1280x720", mips = "compute", mosaic = "off", light, lightColor,
+  std::string camera, size = "1280x720", mips = enumName(o.mips), mosaic = "off", light, lightColor,
               ambient = "0.02", mtl,
-              filter = "trilinear";
+              filter = enumName(o.settings.sampler.filter);
   bool waitTextures = true;
-  std::string shadingPath = render::toString(o.settings.shading), raster = render::toString(o.settings.raster);
+  std::string shadingPath = enumName(o.settings.shading), raster = enumName(o.settings.raster);
   app.add_option("scene", o.scene, "scene file (.rtrscene, .comp5892mesh, .obj, .obj.zst)")->required();
   app.add_option("--mtl", mtl, "OBJ: take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
@@ -303,21 +303,23 @@ int main(int argc, char** argv) {
   app.add_flag("--force", o.force, "overwrite an existing screenshot");
   CLI::Option* mipsOpt = app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit | auto (per texture: compute "
                                         "when small, blit when large) "
-                                        "(default: the device's fastest, docs/startup.md)");
-  app.add_option("--mosaic", mosaic, "post process: off (the scene plainly) | compute | graphics (the brief's captures: compute)")->capture_default_str();
+                                        "(default: the device's fastest, docs/startup.md)")
+                         ->check(cli::oneOf<render::MipMode>());
+  app.add_option("--mosaic", mosaic, "post process: off (the scene plainly) | compute | graphics (the brief's captures: compute)")
+      ->check(cli::oneOf<render::MosaicMode>())->capture_default_str();
   CLI::Option* shadingOpt =
       app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward "
                      "(default: the device's fastest, docs/startup.md)")
-          ->check(CLI::IsMember({"visibility", "forward"}));
+          ->check(cli::oneOf<render::ShadingPath>());
   app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
-      ->check(CLI::IsMember({"auto", "hardware", "compute"}))->capture_default_str();
+      ->check(cli::oneOf<render::RasterPath>())->capture_default_str();
   std::string cull = "off";
   app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
       ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
   app.add_option("--filter", filter, "texture filter: trilinear | nearest-mip (nearest level, bilinear in it) | nearest "
                  "(nearest texel of the nearest level)")
-      ->check(CLI::IsMember({"trilinear", "nearest-mip", "nearest"}))->capture_default_str();
+      ->check(cli::oneOf<render::TextureFilter>())->capture_default_str();
   app.add_option("--anisotropy", o.settings.sampler.anisotropy,
                  "anisotropic filtering, 1 (off) up to the device's maxSamplerAnisotropy (more is clamped, with a note)")
       ->check(cli::number(1, 64))->capture_default_str();
@@ -356,25 +358,14 @@ int main(int argc, char** argv) {
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
-    const std::map<std::string, render::MipMode> mipModes{{"compute", render::MipMode::Compute},
-                                                          {"blit", render::MipMode::Blit},
-                                                          {"auto", render::MipMode::Auto}};
-    const std::map<std::string, render::MosaicMode> mosaicModes{
-        {"off", render::MosaicMode::Off}, {"compute", render::MosaicMode::Compute}, {"graphics", render::MosaicMode::Graphics}};
-    if (!mipModes.count(mips)) throw UsageError("--mips '" + mips + "': expected compute, blit or auto");
-    if (!mosaicModes.count(mosaic)) throw UsageError("--mosaic '" + mosaic + "': expected off, compute or graphics");
-    o.mips = mipModes.at(mips);
+    o.mips = cli::enumOption<render::MipMode>("--mips", mips);
     o.mipsGiven = mipsOpt->count() > 0;
     if (waitOpt->count()) o.waitTextures = waitTextures;
     o.shadingGiven = shadingOpt->count() > 0;
-    o.settings.mosaic = mosaicModes.at(mosaic);
-    o.settings.shading = shadingPath == "forward" ? render::ShadingPath::Forward : render::ShadingPath::Visibility;
-    o.settings.sampler.filter = filter == "nearest" ? render::TextureFilter::Nearest
-                                : filter == "nearest-mip" ? render::TextureFilter::NearestMip
-                                                          : render::TextureFilter::Trilinear;
-    o.settings.raster = raster == "hardware" ? render::RasterPath::Hardware
-                        : raster == "compute" ? render::RasterPath::Compute
-                                              : render::RasterPath::Auto;
+    o.settings.mosaic = cli::enumOption<render::MosaicMode>("--mosaic", mosaic);
+    o.settings.shading = cli::enumOption<render::ShadingPath>("--shading-path", shadingPath);
+    o.settings.sampler.filter = cli::enumOption<render::TextureFilter>("--filter", filter);
+    o.settings.raster = cli::enumOption<render::RasterPath>("--raster", raster);
     o.settings.cull = cull == "on";
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
   } catch (const std::exception& e) {

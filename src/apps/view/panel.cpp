@@ -192,7 +192,7 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::Text("filter:");
     for (auto f : {render::TextureFilter::Trilinear, render::TextureFilter::NearestMip, render::TextureFilter::Nearest}) {
       ImGui::SameLine();
-      radio(render::toString(f), sampler.filter, f);
+      radio(enumName(f), sampler.filter, f);
     }
     if (facts.maxAnisotropy > 1) {
       ImGui::SliderFloat("anisotropy", &sampler.anisotropy, 1.0f, facts.maxAnisotropy, sampler.anisotropy > 1 ? "%.0fx" : "off");
@@ -201,7 +201,7 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     } else {
       ImGui::TextDisabled("anisotropy: not supported by the device");
     }
-    ImGui::Text("shading path: %s", render::toString(s.settings.shading));
+    ImGui::Text("shading path: %s", enumName(s.settings.shading));
   }
   if (ImGui::CollapsingHeader("Lights")) lightsSection(s);
   if (ImGui::CollapsingHeader("Camera")) cameraSection(s);

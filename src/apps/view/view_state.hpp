@@ -23,7 +23,7 @@ struct ViewState {
   bool traceRequested = false, errorMapRequested = false, reframeRequested = false, homeRequested = false;
   bool screenshotRequested = false, remipRequested = false;
   std::vector<std::string> drops;  // files dropped on the window (the last one is loaded)
-  // Ray tracer (FORMATS.md §2's toggles, on keys that do not clash with the view modes).
+  // Ray tracer (docs/formats.md's toggles, on keys that do not clash with the view modes).
   trace::Shading traceShading = trace::Shading::Phong;
   bool traceShadows = true, traceReflections = true, traceOrtho = false;
   std::string message;             // the last load / screenshot outcome, shown in the panel

@@ -337,7 +337,7 @@ int runWindowed(const ViewOptions& opts) {
       }
       cur.build(ctx, surface, e, app.mips, waitTextures);
       if (cur.gpu->texturesReady())
-        std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), cur.gpu->stats().mipGpuMs);
+        std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", enumName(app.mips), cur.gpu->stats().mipGpuMs);
     }
     // Textures decode on worker threads, then upload and get their mips in a submission of their own, while
     // frames go on; then they are taken in between frames.
@@ -346,7 +346,7 @@ int runWindowed(const ViewOptions& opts) {
       if (texturesInAt == 0) texturesInAt = render::msSinceProcessStart();
       std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload and mips %.0f ms\n",
                    st.textures, st.decodeMs, st.textureUploadMs);
-      std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", render::toString(app.mips), st.mipGpuMs);
+      std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", enumName(app.mips), st.mipGpuMs);
     }
     ViewFrames& frames = *cur.frames;
     TraceOverlay& traced = *cur.traced;
@@ -485,8 +485,8 @@ int runWindowed(const ViewOptions& opts) {
       titleTimer = 0;
       char buf[160];
       std::snprintf(buf, sizeof buf, "rtr-view | mode %d | %s | mosaic %s | lod bias %.2f | %s x%g | %s | CPU frame %.2f ms",
-                    app.settings.mode, modeName(app.settings.mode), render::toString(app.settings.mosaic),
-                    app.settings.lodBias, render::toString(app.settings.sampler.filter), app.settings.sampler.anisotropy,
+                    app.settings.mode, modeName(app.settings.mode), enumName(app.settings.mosaic),
+                    app.settings.lodBias, enumName(app.settings.sampler.filter), app.settings.sampler.anisotropy,
                     app.camera.mode() == CameraMode::Orbit ? "orbit" : "fly", cpuFrameMs);
       std::string title = buf;
       for (const auto& [name, ms] : frames.gpuTimes()) {

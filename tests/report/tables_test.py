@@ -1,0 +1,33 @@
+#!/usr/bin/python3
+"""tools/report/tables.py reads every row of a tool's table, also where the tool's notes sit between rows."""
+import os
+import sys
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tools/report"))
+from tables import md_tables, num  # noqa: E402
+
+
+class MdTables(unittest.TestCase):
+    def test_notes_between_rows_do_not_end_the_table(self):
+        text = ("$ tool\n| case | ms |\n|---|---:|\n| a | 1.5 |\n"
+                "note: b.obj: no 'mtllib' line; using 'b.mtl' beside it\n| b | 2 |\n"
+                "warning: c: something\n| c | 3 |\n\nafter the table\n| x | y |\n|---|---|\n| 1 | 2 |\n")
+        tables = md_tables(text)
+        self.assertEqual(len(tables), 2)
+        self.assertEqual([r[0] for r in tables[0][1]], ["a", "b", "c"])
+        self.assertEqual(tables[1][1], [["1", "2"]])
+
+    def test_h200_frame_compare_has_every_case_of_poses_txt(self):
+        with open(os.path.join(ROOT, "docs/bench/data/h200/frame-compare.txt")) as f:
+            tables = md_tables(f.read())
+        with open(os.path.join(ROOT, "tests/reference/poses.txt")) as f:
+            cases = {line.split()[0] for line in f if line.strip() and not line.startswith("#")}
+        self.assertEqual(len(tables), 1)
+        self.assertEqual({r[0] for r in tables[0][1]}, cases)
+        self.assertTrue(all(num(r[2]) is not None for r in tables[0][1]))
+
+
+if __name__ == "__main__":
+    unittest.main()
