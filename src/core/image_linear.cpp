@@ -4,13 +4,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <string_view>
 
 #include <tinyexr.h>
 
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "core/input_file.hpp"
 
 namespace rtr {
 
@@ -19,15 +19,9 @@ namespace {
 constexpr uint64_t kMaxLinearBytes = uint64_t(1) << 31;  // 2 GiB of file: a 16k×8k float map is 1.5 GiB
 
 std::vector<unsigned char> readWhole(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw fileError(file.string(), "", "not a regular file (or missing)");
-  const uint64_t size = std::filesystem::file_size(file, ec);
-  if (ec) throw fileError(file.string(), "", "cannot tell the file's size");
-  if (size > kMaxLinearBytes) throw fileError(file.string(), "", "larger than 2 GiB");
-  std::ifstream in(file, std::ios::binary);
-  std::vector<unsigned char> bytes(size);
-  if (!in || !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size))) throw fileError(file.string(), "", "read error");
-  return bytes;
+  const MappedFile mapped(file, "environment map");  // a regular file, or refused without blocking
+  if (mapped.bytes().size() > kMaxLinearBytes) throw fileError(file.string(), "", "larger than 2 GiB");
+  return {mapped.bytes().begin(), mapped.bytes().end()};
 }
 
 // Radiance RGBE: a text header ending in an empty line, the resolution line "-Y H +X W" (rows top first),
