@@ -128,7 +128,9 @@ public:
     if (animated_) note("animations, skins and morph targets are not played: the meshes are shown at rest");
     if (skipped_)
       note(std::to_string(skipped_) + " primitive(s) of points or lines (or without POSITION) left out: rtr draws triangles");
-    if (scene_.instances.empty()) throw fileError(name_, "", "the scene has no triangles to draw");
+    if (scene_.instances.empty())
+      throw fileError(name_, "", "the scene has no triangles to draw" +
+                                     (skipped_ ? " (" + std::to_string(skipped_) + " primitive(s) of points or lines left out)" : std::string()));
     return std::move(scene_);
   }
 
