@@ -294,15 +294,20 @@ private:
       where.fail("index " + std::to_string(m.indices[i]) + " (element " + std::to_string(i) + ") is not below the vertex count " +
                  std::to_string(vertices));
     }
-    float sum = 0.0f;  // NaN or infinity anywhere makes the sum so
-    for (const glm::vec3& v : m.positions) {
-      sum += v.x + v.y + v.z;
-      m.bounds.extend(v);
-    }
-    if (!std::isfinite(sum))
-      for (size_t i = 0; i < vertices; ++i)
-        if (!std::isfinite(m.positions[i].x) || !std::isfinite(m.positions[i].y) || !std::isfinite(m.positions[i].z))
+    // Coordinates beyond ±1e9 (an Earth-centred frame is ±6.4e6 m) overflow the squared lengths that
+    // clustering and shading take; NaN and infinity are never geometry.
+    constexpr float kMaxCoordinate = 1e9f;
+    for (const glm::vec3& v : m.positions) m.bounds.extend(v);
+    const Bounds& bb = m.bounds;
+    if (!(std::max({-bb.min.x, -bb.min.y, -bb.min.z, bb.max.x, bb.max.y, bb.max.z}) <= kMaxCoordinate) ||
+        !std::all_of(m.positions.begin(), m.positions.end(), [](const glm::vec3& v) { return v == v; }))
+      for (size_t i = 0; i < vertices; ++i) {
+        const glm::vec3 v = m.positions[i];
+        if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
           attrs.fail("POSITION element " + std::to_string(i) + " is not finite");
+        if (std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}) > kMaxCoordinate)
+          attrs.fail("POSITION element " + std::to_string(i) + " has a coordinate beyond ±1e9, more than rtr handles");
+      }
     toTriangleList(m.indices, mode);
     if (m.indices.empty()) {
       ++skipped_;
