@@ -77,8 +77,13 @@ TEST(GltfReader, InterleavedStrideNormalizedAndQuantizedComponents) {
   const int8_t ns[3][3] = {{0, 0, 127}, {0, 0, 127}, {0, -127, 0}};
   const int nv = b.view(ns, sizeof ns);
   const int nrm = b.accessor(nv, 5120, 3, "VEC3", "\"normalized\":true");
+  // int8 and int16 normalized uvs (signed: max(c / 127, -1) and max(c / 32767, -1)).
+  const int8_t uv1[3][2] = {{-128, -127}, {127, 64}, {0, -64}};
+  const int uv1v = b.view(uv1, sizeof uv1);
+  const int uv1a = b.accessor(uv1v, 5120, 3, "VEC2", "\"normalized\":true");
   const Scene s = loadScene(b.writeGlb(dir, "q",
-                                       meshJson(pos, -1, ",\"TEXCOORD_0\":" + std::to_string(uv) + ",\"NORMAL\":" + std::to_string(nrm)) +
+                                       meshJson(pos, -1, ",\"TEXCOORD_0\":" + std::to_string(uv) + ",\"NORMAL\":" + std::to_string(nrm) +
+                                                             ",\"TEXCOORD_1\":" + std::to_string(uv1a)) +
                                            ",\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"]," + kOneNode));
   const Mesh& m = s.meshes.at(0);
   EXPECT_EQ(m.positions[1], glm::vec3(300, 0, 0));
@@ -87,6 +92,10 @@ TEST(GltfReader, InterleavedStrideNormalizedAndQuantizedComponents) {
   EXPECT_FLOAT_EQ(m.texcoords[1].x, 0.2f);
   EXPECT_FLOAT_EQ(m.texcoords[2].y, 0.4f);
   EXPECT_EQ(m.normals[2], glm::vec3(0, -1, 0));
+  EXPECT_EQ(m.texcoords1[0], glm::vec2(-1.0f, -1.0f));
+  EXPECT_EQ(m.texcoords1[1].x, 1.0f);
+  EXPECT_FLOAT_EQ(m.texcoords1[1].y, 64.0f / 127.0f);
+  EXPECT_FLOAT_EQ(m.texcoords1[2].y, -64.0f / 127.0f);
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));  // non-indexed: in order
 }
 
