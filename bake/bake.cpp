@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <set>
 #include <thread>
 
 #include "core/error.hpp"
@@ -12,6 +13,7 @@
 #include "scene/binio.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
+#include "scene/load.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
@@ -22,6 +24,12 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 bool endsWith(const std::string& s, std::string_view e) {
   return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
+}
+
+bool isGltf(const std::filesystem::path& p) {
+  std::string name = p.filename().string();
+  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return endsWith(name, ".gltf") || endsWith(name, ".glb");
 }
 
 // Removes what it tracked unless told the job succeeded, so a failed bake leaves nothing behind.
@@ -36,22 +44,29 @@ struct CreatedFiles {
 };
 
 // Decodes every source texture with the channel count of its slot, on a few threads.
-void verifyTextures(const TexturePlan& plan, unsigned threads) {
+void verifyTextures(const TexturePlan& plan, unsigned threads, const std::string& namedIn) {
   std::atomic<size_t> next{0};
   std::vector<std::string> errors(plan.sources.size());
   auto work = [&] {
     for (size_t i; (i = next.fetch_add(1)) < plan.sources.size();) {
       const auto& src = plan.sources[i];
+      if (plan.bytes[i]) {
+        try {
+          decodeImage(*plan.bytes[i], plan.scene.textures[i].path.string(), plan.scene.textures[i].channels);
+        } catch (const Error& e) {
+          errors[i] = std::string(e.what()) + " (an image embedded in the glTF is not readable)";
+        }
+      }
       if (src.empty()) continue;
       std::error_code ec;
       if (!std::filesystem::is_regular_file(src, ec)) {
-        errors[i] = src.string() + ": texture file named in the MTL does not exist";
+        errors[i] = src.string() + ": texture file named in the " + namedIn + " does not exist";
         continue;
       }
       try {
         loadImage(src, plan.scene.textures[i].channels);
       } catch (const Error& e) {
-        errors[i] = std::string(e.what()) + " (texture named in the MTL is not a readable image)";
+        errors[i] = std::string(e.what()) + " (texture named in the " + namedIn + " is not a readable image)";
       }
     }
   };
@@ -88,6 +103,10 @@ BakeReport bake(const BakeOptions& opt) {
   const bool course = endsWith(out, ".comp5892mesh");
   if (!course && !endsWith(out, ".rtrscene"))
     throw UsageError(opt.output.string() + ": unknown output format (expected .rtrscene or .comp5892mesh)");
+  const bool gltf = isGltf(opt.input);
+  if (gltf && course)
+    throw UsageError(opt.output.string() + ": a glTF bakes to .rtrscene only (the .comp5892mesh format has no instances, "
+                                           "samplers, uv transforms or glTF materials)");
   std::error_code ec;
   const Replace replace = opt.force ? Replace::Yes : Replace::No;
   if (std::filesystem::exists(opt.output, ec) && !opt.force)
@@ -102,16 +121,30 @@ BakeReport bake(const BakeOptions& opt) {
   if (!opt.lights.empty() && course && opt.warn) opt.warn("the .comp5892mesh format stores no lights; --light ignored");
   const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
 
-  // 1. Parse and weld.
-  ObjOptions oo;
-  oo.warn = opt.warn;
-  oo.threads = threads;
-  oo.mtl = opt.mtl;
-  if (opt.progress)
-    oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
-  Scene scene = loadObj(opt.input, oo, &rep.obj);
-  rep.parseSeconds = rep.obj.parseSeconds;
-  rep.weldSeconds = rep.obj.weldSeconds;
+  // 1. Parse and weld (OBJ), or read the glTF (instances kept, embedded images held in memory).
+  Scene scene;
+  if (gltf) {
+    if (opt.progress) opt.progress("reading", 0.0);
+    LoadOptions lo;
+    lo.warn = opt.warn;
+    lo.note = opt.note;
+    const auto t = Clock::now();
+    scene = loadScene(opt.input, lo);
+    rep.parseSeconds = since(t);
+    rep.gltf = true;
+  } else {
+    ObjOptions oo;
+    oo.warn = opt.warn;
+    oo.threads = threads;
+    oo.mtl = opt.mtl;
+    if (opt.progress)
+      oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
+    scene = loadObj(opt.input, oo, &rep.obj);
+    rep.parseSeconds = rep.obj.parseSeconds;
+    rep.weldSeconds = rep.obj.weldSeconds;
+  }
+  for (const Mesh& m : scene.meshes) rep.triangles += m.triangleCount();
+  rep.instances = scene.instances.size();
   if (opt.view) scene.defaultView = opt.view;
   if (!opt.lights.empty()) scene.lights = opt.lights;
 
@@ -122,20 +155,33 @@ BakeReport bake(const BakeOptions& opt) {
   TexturePlan plan = planTextures(scene, sceneName, course);
   scene = Scene{};
   if (opt.progress) opt.progress("checking textures", 0.0);
-  verifyTextures(plan, threads);
+  verifyTextures(plan, threads, gltf ? "glTF" : "MTL");
   const std::filesystem::path texDir = outDir / (sceneName + "-tex");
+  std::vector<bool> present(plan.scene.textures.size());  // an embedded image already there, byte for byte
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
     const auto dst = outDir / plan.scene.textures[i].path;
-    if (std::filesystem::exists(dst, ec) && !opt.force)
+    if (!std::filesystem::exists(dst, ec)) continue;
+    if (plan.bytes[i]) {  // named by its content: the same bytes are kept, other bytes are never replaced
+      present[i] = std::filesystem::is_regular_file(dst, ec) && readFileBytes(dst) == *plan.bytes[i];
+      if (!present[i])
+        throw OutputExists(dst.string() + ": a different file has the name of an embedded image; refusing to overwrite it");
+    } else if (!opt.force) {
       throw OutputExists(dst.string() + ": texture exists; refusing to overwrite it without --force");
+    }
   }
   if (!plan.scene.textures.empty()) createFolders(texDir, created);
+  std::set<std::filesystem::path> written;
   for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
     // Without --force a texture is only ever created, never replaced (FORMATS.md §1): AtomicFile's
     // link-based commit lets exactly one of two concurrent bakes create it; the other stops here.
     const auto dst = outDir / plan.scene.textures[i].path;
+    if (present[i] || !written.insert(dst).second) continue;  // one file for textures sampled two ways
     const bool existed = std::filesystem::exists(dst, ec);
-    if (plan.sources[i].empty()) {
+    if (plan.bytes[i]) {
+      const auto& b = *plan.bytes[i];
+      writeFileAtomic(dst, {reinterpret_cast<const char*>(b.data()), b.size()}, Replace::No);
+      ++rep.embeddedTextures;
+    } else if (plan.sources[i].empty()) {
       writeFallback(dst, dst.filename().string(), replace);
       ++rep.fallbackTextures;
     } else {

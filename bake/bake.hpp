@@ -1,6 +1,7 @@
 #pragma once
 // rtr-bake's work as a library (the executable, the tests and the benchmark share it):
-// OBJ in, .rtrscene or .comp5892mesh out, textures copied into "<scene>-tex/" beside the output.
+// OBJ or glTF in, .rtrscene or .comp5892mesh (OBJ only) out, textures copied into "<scene>-tex/" beside the
+// output (a glTF's embedded images written there as files).
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -20,13 +21,16 @@ struct BakeOptions {
   std::optional<std::filesystem::path> mtl;  // the OBJ's MTL instead of its mtllib lines (LoadOptions::mtl)
   std::vector<Light> lights;              // stored with the scene (.rtrscene only); empty: none stored
   std::function<void(const std::string&)> warn;
+  std::function<void(const std::string&)> note;  // glTF: what the reader chose on its own (LoadOptions::note)
   std::function<void(const char* phase, double fraction)> progress;
   unsigned threads = 0;
 };
 
 struct BakeReport {
   ObjStats obj;
-  size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0;
+  bool gltf = false;                      // read as glTF (obj stays empty)
+  size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0, embeddedTextures = 0;
+  size_t triangles = 0, instances = 0;
   uint64_t outputBytes = 0;
   double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, writeSeconds = 0, totalSeconds = 0;
 };
@@ -34,12 +38,15 @@ struct BakeReport {
 // Throws rtr::Error naming the file and place; on failure nothing it created is left behind.
 BakeReport bake(const BakeOptions& options);
 
-// The texture plan for an output named `sceneName`: paths become "<sceneName>-tex/<file name>", ids are
-// re-given at first appearance (materials in order, slots in course order), and with `courseFallbacks`
-// missing baseColor/roughness/metalness/emissive slots point at fallback textures (FORMATS.md §1).
+// The texture plan for an output named `sceneName`: paths become "<sceneName>-tex/<file name>" (an image
+// held in memory: "<sceneName>-tex/<hash of its bytes>.png|.jpg"); textures that share a file and are
+// sampled alike become one. Ids: .rtrscene in the input's order; with `courseFallbacks` at first appearance
+// (materials in order, slots in course order), missing baseColor/roughness/metalness/emissive slots
+// pointing at fallback textures (FORMATS.md §1).
 struct TexturePlan {
   Scene scene;                                       // the scene to encode (shares nothing with the input)
-  std::vector<std::filesystem::path> sources;        // per texture of `scene`: the file to copy; empty for fallbacks
+  std::vector<std::filesystem::path> sources;        // per texture of `scene`: the file to copy; empty otherwise
+  std::vector<std::shared_ptr<const std::vector<uint8_t>>> bytes;  // per texture: the image to write, or null
 };
 TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks);
 

@@ -1,4 +1,5 @@
-// rtr-bake INPUT OUTPUT [--force] [--view x,y,z,yaw,pitch] [--light x,y,z]: OBJ (plain or zstd) + MTL to .rtrscene / .comp5892mesh.
+// rtr-bake INPUT OUTPUT [--force] [--view x,y,z,yaw,pitch] [--light x,y,z]: OBJ (plain or zstd) + MTL to
+// .rtrscene / .comp5892mesh, glTF (.gltf, .glb) to .rtrscene.
 #include <unistd.h>
 
 #include <cstdio>
@@ -11,10 +12,12 @@
 #include "core/error.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh", "rtr-bake"};
+  CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh, or a glTF 2.0 "
+               "scene (.gltf, .glb) into .rtrscene",
+               "rtr-bake"};
   rtr::BakeOptions opt;
   std::string input, output, view, light, lightColor, mtl;
-  app.add_option("INPUT", input, "OBJ file")->required();
+  app.add_option("INPUT", input, "OBJ or glTF file")->required();
   app.add_option("OUTPUT", output, "output file (.rtrscene or .comp5892mesh); a missing folder is created")->required();
   app.add_option("--mtl", mtl, "take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--force", opt.force, "overwrite an existing output and textures");
@@ -27,6 +30,7 @@ int main(int argc, char** argv) {
   opt.input = input;
   opt.output = output;
   opt.warn = [](const std::string& w) { std::cerr << "\rwarning: " << w << "\n"; };
+  opt.note = [](const std::string& n) { std::cerr << "\rnote: " << n << "\n"; };
   const bool tty = ::isatty(2);
   if (tty)
     opt.progress = [](const char* phase, double f) {
@@ -47,6 +51,14 @@ int main(int argc, char** argv) {
     const auto& o = r.obj;
     const double mb = double(o.textBytes) / 1e6;
     std::printf("%s -> %s\n", input.c_str(), output.c_str());
+    if (r.gltf) {
+      std::printf("  meshes %zu, instances %zu, materials %zu, textures %zu (%zu images written from the glTF)\n", r.meshes,
+                  r.instances, r.materials, r.textures, r.embeddedTextures);
+      std::printf("  triangles %zu, output %.2f MB\n", r.triangles, double(r.outputBytes) / 1e6);
+      std::printf("  time: read %.3f s, textures %.3f s, clusters %.3f s, write %.3f s, total %.3f s\n", r.parseSeconds,
+                  r.textureSeconds, r.clusterSeconds, r.writeSeconds, r.totalSeconds);
+      return 0;
+    }
     std::printf("  meshes %zu, materials %zu, textures %zu (+%zu fallback)\n", r.meshes, r.materials, r.textures,
                 r.fallbackTextures);
     std::printf("  faces %zu, triangles %zu, degenerate skipped %zu\n", o.faces, o.triangles, o.degenerateSkipped);

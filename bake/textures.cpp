@@ -1,52 +1,89 @@
+#include <cstdio>
 #include <unordered_map>
 
 #include "bake.hpp"
 #include "core/error.hpp"
+#include "scene/binio.hpp"
 #include "scene/course.hpp"
 #include "scene/mtl.hpp"
 
 namespace rtr {
+namespace {
+
+// A name for an image held in memory, from its content: the same image gets the same file in every bake.
+std::string contentName(const std::vector<uint8_t>& bytes) {
+  const bool jpeg = bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+  char name[40];
+  std::snprintf(name, sizeof name, "%016llx%s", static_cast<unsigned long long>(checksum64(bytes)), jpeg ? ".jpg" : ".png");
+  return name;
+}
+
+// Textures that share a file but are sampled differently stay apart (glTF takes roughness and metalness
+// from two channels of one image).
+std::string key(const std::string& rel, const Texture& t) {
+  const SamplerDesc& s = t.sampler;
+  char k[64];
+  std::snprintf(k, sizeof k, "|%d%d%d|%d%d%d%d%d", t.srgb, t.channels, t.sourceChannel, int(s.wrapU), int(s.wrapV),
+                s.nearestMag, s.nearestMin, s.nearestMip);
+  return rel + k;
+}
+
+}  // namespace
 
 TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks) {
   TexturePlan plan;
   plan.scene.baseDir = in.baseDir;
   plan.scene.meshes = in.meshes;
+  plan.scene.instances = in.instances;
   plan.scene.defaultView = in.defaultView;
+  plan.scene.defaultFovYDeg = in.defaultFovYDeg;
   plan.scene.lights = in.lights;
-  std::unordered_map<std::string, uint32_t> ids;           // destination path -> new id
+  std::unordered_map<std::string, uint32_t> ids;           // destination path and sampling -> new id
   std::unordered_map<std::string, std::string> sourceOf;   // destination path -> source, to catch clashes
   const std::string folder = sceneName + "-tex/";
 
-  auto idFor = [&](const std::string& rel, const std::filesystem::path& src, TextureSlot slot) {
-    auto [it, added] = ids.try_emplace(rel, uint32_t(plan.scene.textures.size()));
-    if (added) {
-      const SlotFormat f = slotFormat(slot);
-      plan.scene.textures.push_back({rel, f.srgb, f.channels});
-      plan.sources.push_back(src);
-      sourceOf[rel] = src.string();
-    } else if (sourceOf[rel] != src.string()) {
-      throw Error("textures '" + sourceOf[rel] + "' and '" + src.string() + "' would both be copied to '" + rel +
+  auto idFor = [&](const std::string& rel, const std::filesystem::path& src, const Texture& t) {
+    auto [it, added] = ids.try_emplace(key(rel, t), uint32_t(plan.scene.textures.size()));
+    if (!added) return it->second;
+    Texture out = t;
+    out.path = rel;
+    out.bytes = nullptr;
+    plan.scene.textures.push_back(std::move(out));
+    plan.sources.push_back(src);
+    plan.bytes.push_back(t.bytes);
+    auto [known, first] = sourceOf.try_emplace(rel, t.bytes ? rel : src.string());
+    if (!first && known->second != (t.bytes ? rel : src.string()))
+      throw Error("textures '" + known->second + "' and '" + src.string() + "' would both be copied to '" + rel +
                   "'; rename one of them");
-    }
     return it->second;
   };
+  // An input texture's id in the plan: files keep their name, images in memory get one from their bytes.
+  auto planned = [&](uint32_t id, const std::string& material) {
+    if (id >= in.textures.size()) throw Error("material '" + material + "': texture id out of range");
+    const Texture& t = in.textures[id];
+    if (t.bytes) return idFor(folder + contentName(*t.bytes), {}, t);
+    if (isFallbackTexture(t.path)) throw Error("texture file name '" + t.path.filename().string() + "' is reserved");
+    const std::filesystem::path src = t.path.is_absolute() ? t.path : in.baseDir / t.path;
+    return idFor(folder + t.path.filename().string(), src, t);
+  };
 
+  // .rtrscene: the input's textures in their order (OBJ gives them in order of first use already).
+  std::vector<uint32_t> remap;
+  if (!courseFallbacks)
+    for (uint32_t i = 0; i < in.textures.size(); ++i) remap.push_back(planned(i, "?"));
   for (const Material& m : in.materials) {
     Material out = m;
     for (uint32_t s = 0; s < kTextureSlotCount; ++s) {
       const uint32_t id = m.textures[s];
       const TextureSlot slot = TextureSlot(s);
       if (id != kNoTexture) {
-        if (id >= in.textures.size()) throw Error("material '" + m.name + "': texture id out of range");
-        const Texture& t = in.textures[id];
-        if (isFallbackTexture(t.path)) throw Error("texture file name '" + t.path.filename().string() + "' is reserved");
-        const std::filesystem::path src = t.path.is_absolute() ? t.path : in.baseDir / t.path;
-        out.textures[s] = idFor(folder + t.path.filename().string(), src, slot);
+        out.textures[s] = courseFallbacks ? planned(id, m.name) : id < remap.size() ? remap[id] : planned(id, m.name);
       } else if (courseFallbacks && slot != TextureSlot::AlphaMask && slot != TextureSlot::NormalMap) {
         std::string_view name = slot == TextureSlot::BaseColor ? kFallbackBaseColor
                                 : slot == TextureSlot::Emissive ? kFallbackEmissive
                                                                 : kFallbackOne;
-        out.textures[s] = idFor(folder + std::string(name), {}, slot);
+        const SlotFormat f = slotFormat(slot);
+        out.textures[s] = idFor(folder + std::string(name), {}, Texture{{}, f.srgb, f.channels});
       }
     }
     plan.scene.materials.push_back(std::move(out));

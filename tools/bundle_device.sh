@@ -12,8 +12,13 @@ rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
 bins=()
 for b in rtr-view rtr-bench-gpu rtr-trace bench-trace rtr-bake scenegen rtr-frame-compare bench_bake rtr-reflect \
-         vk_test render_test view_test reference_test rtr-bench-cull; do
+         vk_test render_test view_test reference_test rtr-bench-cull bench-load; do
   [[ -x $B/bin/$b ]] && cp "$B/bin/$b" "$out/bin/" && bins+=("$B/bin/$b")
+done
+# Debian's tools the load benchmark makes its GLB inputs with and compares against, where this machine has them.
+for t in gltfpack assimp; do
+  p=$(command -v "$t" || true)
+  [[ -n $p ]] && cp "$p" "$out/bin/" && bins+=("$p")
 done
 cp -r "$B/shaders" "$out/shaders"
 cp -r "$B/assets" "$out/assets"

@@ -7,7 +7,7 @@
 #     --runner CMD  how to start a binary: "CMD NAME ARGS" (e.g. .device/run.sh on the GPU machine);
 #                   default: build/release/bin/NAME
 #     --quick       fewer frames and runs (lavapipe at 4K takes about a second a frame)
-#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake,startup
+#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake,startup,load
 # The rows and their exact arguments are fixed here, so a rerun measures the same thing (fixed seeds and
 # poses: tests/reference/poses.txt, the generated scenes).
 set -uo pipefail
@@ -30,6 +30,11 @@ bin() {  # bin NAME ARGS...
   if [[ -n $runner ]]; then "$runner" "$@"; else "$root/build/release/bin/$1" "${@:2}"; fi
 }
 skipped() { [[ ",$skip," == *",$1,"* ]]; }
+# tool NAME ARGS...: a program from outside this build (gltfpack): the bundle's copy, else this machine's.
+tool() {
+  if [[ -n $runner ]] && "$runner" "$@" 2>/dev/null; then return 0; fi
+  command -v "$1" >/dev/null && "$@"
+}
 # row ID NAME ARGS...: runs one command, its output to $out/ID.txt; a failure is recorded, not fatal.
 row() {
   local id=$1; shift
@@ -110,5 +115,21 @@ if ! skipped startup; then  # start-up phases (--timings) at 4K: the default tem
         --screenshot "$work/startup.png" --force
     done
   done
+fi
+if ! skipped load; then  # time to the scene in memory: the 1M-triangle temple as .rtrscene, OBJ, GLB and
+  # meshopt GLB (gltfpack -cc), the meshopt decode rate, and `assimp info` on the GLBs, in one run
+  ld=$work/load
+  if bin scenegen --out "$ld" --scale 100 --plain >/dev/null 2>&1 &&
+     bin rtr-bake "$ld/temple.obj" "$ld/temple.rtrscene" >/dev/null 2>&1; then
+    glbs=() note=""
+    if tool gltfpack -i "$ld/temple.obj" -o "$ld/temple.glb" >/dev/null 2>&1 &&
+       tool gltfpack -i "$ld/temple.obj" -o "$ld/temple-cc.glb" -cc >/dev/null 2>&1; then
+      glbs=("$ld/temple.glb" "$ld/temple-cc.glb")
+    else
+      note="# gltfpack is neither in the bundle nor on this machine: no GLB rows (tools/setup.sh installs it)"
+    fi
+    row load bench-load --runs $((quick ? 3 : 10)) "$ld/temple.rtrscene" "$ld/temple.obj" "${glbs[@]}"
+    [[ -z $note ]] || echo "$note" >>"$out/load.txt"
+  fi
 fi
 echo "collect: done -> $out" >&2
