@@ -66,17 +66,19 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
-  // Draw index in the high bits (just enough that no id is VIS_EMPTY), primitive index in the rest.
-  uint32_t draws = 0, maxTriangles = 0;
+  // Instance index in the high bits (just enough that no id is VIS_EMPTY), primitive index in the rest.
+  uint32_t maxTriangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& d : scene.draws(DrawKind(k))) ++draws, maxTriangles = std::max(maxTriangles, d.indexCount / 3);
-  primitiveBits_ = 32 - uint32_t(std::bit_width(draws));
-  for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& d : scene.draws(DrawKind(k))) triangles_ += d.indexCount / 3;
+    for (const DrawItem& d : scene.draws(DrawKind(k))) {
+      maxTriangles = std::max(maxTriangles, d.indexCount / 3);
+      triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
+    }
+  const uint32_t instances = scene.instanceCount();
+  primitiveBits_ = 32 - uint32_t(std::bit_width(instances));
   cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   canHardware_ = features.geometryShader;
   canCompute_ = ComputeRaster::supported(ctx);
-  canUseVisibility_ = (canHardware_ || canCompute_) && draws > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
+  canUseVisibility_ = (canHardware_ || canCompute_) && instances > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
 }
 
 ShadingPath Renderer::pathFor(const RenderSettings& s) const {
@@ -99,6 +101,7 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader(vert), vk::loadShader(frag)};
   d.cullMode = cull;
+  d.dynamicFrontFace = true;  // per draw: mirrored instances' front faces are clockwise
   d.colorFormats = {colorFormat};
   d.depthFormat = kDepthFormat;
   vk::LayoutOptions options;
@@ -111,7 +114,10 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
     if (layout.setCount() == 0) break;
     // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
-    if (hasBinding(layout, 0, 1)) vk::DescriptorWriter(ctx_, layout, 0, p.sets.get(0, frame)).buffer(1, scene_.materials()).commit();
+    vk::DescriptorWriter w(ctx_, layout, 0, p.sets.get(0, frame));
+    if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
+    if (hasBinding(layout, 0, 2)) w.buffer(2, scene_.instances());
+    w.commit();
     if (layout.setCount() > 1 && !textures.empty())
       vk::DescriptorWriter(ctx_, layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
   }
@@ -245,9 +251,9 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
         vkCmdBindIndexBuffer(cb, d.indexType == VK_INDEX_TYPE_UINT16 ? scene_.indices16() : scene_.indices32(), 0, d.indexType);
         bound = d.indexType;
       }
-      shader::DrawPush push{d.material, vis ? d.id << primitiveBits_ : 0u};
-      pl.push(cb, push);
-      vkCmdDrawIndexed(cb, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
+      pl.push(cb, shader::DrawPush{d.material, primitiveBits_});
+      vkCmdSetFrontFace(cb, d.mirrored ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE);
+      vkCmdDrawIndexed(cb, d.indexCount, d.instanceCount, d.firstIndex, d.vertexOffset, d.firstInstance);
     }
   }
 }
@@ -267,6 +273,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(4, scene_.normals())
       .buffer(5, i32)
       .buffer(6, i16)
+      .buffer(10, scene_.instances())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
   if (raster == RasterPath::Compute) w.buffer(7, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
@@ -351,19 +358,29 @@ void Renderer::frame(FrameContext& fc) {
     vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                       VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-    vk::require(cb, {{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
+  } else {
+    rasterPass(cb, frame, set, pose.position);
+    timer.mark(cb, visibility ? "visibility" : "scene");
+  }
+  if (visibility) {
+    const vk::Requirement out{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true};
+    if (compute) vk::require(cb, {out});
+    else vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT}, out});
     shadeVisibility(cb, raster);
     timer.mark(cb, "shade");
-    post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
-    timer.mark(cb, "post");
-    return;
   }
+  post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
+  timer.mark(cb, "post");
+}
+
+// The scene pass by the hardware: forward colour or visibility ids, with depth.
+void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye) {
+  const bool visibility = set == kVisibility;
   // Old contents are discarded; the tracker waits for the previous frame's readers (post or shading pass).
   const vk::Image& target0 = visibility ? vis_ : color_;
   vk::require(cb, {{target0.tracked(), vk::Use::ColorAttachment, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, true},
                    {depth_.tracked(), vk::Use::DepthAttachment,
                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, true}});
-
   VkRenderingAttachmentInfo colorAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   colorAtt.imageView = target0.view();
   colorAtt.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
@@ -378,25 +395,15 @@ void Renderer::frame(FrameContext& fc) {
   depthAtt.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
   depthAtt.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-  ri.renderArea = {{0, 0}, target.extent};
+  ri.renderArea = {{0, 0}, extent_};
   ri.layerCount = 1;
   ri.colorAttachmentCount = 1;
   ri.pColorAttachments = &colorAtt;
   ri.pDepthAttachment = &depthAtt;
   vkCmdBeginRendering(cb, &ri);
-  vk::setFullViewport(cb, target.extent);
-  drawScene(cb, frame, set, pose.position);
+  vk::setFullViewport(cb, extent_);
+  drawScene(cb, frame, set, eye);
   vkCmdEndRendering(cb);
-  timer.mark(cb, visibility ? "visibility" : "scene");
-
-  if (visibility) {
-    vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
-                     {color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
-    shadeVisibility(cb, raster);
-    timer.mark(cb, "shade");
-  }
-  post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
-  timer.mark(cb, "post");
 }
 
 }  // namespace rtr::render

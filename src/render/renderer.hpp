@@ -118,6 +118,7 @@ class Renderer {
   KindPipelines makePipelines(PipelineSet set) const;
   VisShade makeShade(bool fromBuffer) const;
   void ensurePipelines(PipelineSet set);
+  void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
   void shadeVisibility(VkCommandBuffer cb, RasterPath raster);
   void writeTextureSets();  // the texture array of every pipeline built, with sampler_
