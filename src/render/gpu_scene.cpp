@@ -107,7 +107,7 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
   const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
   std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
   for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
-  for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i]));
+  for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i])), samplers_.push_back(scene.textures[i].sampler);
   staged_.resize(used.size());
   stats_.textures = uint32_t(used.size());
   auto decode = [this, &scene, used] {
@@ -382,7 +382,6 @@ void GpuScene::createTextures() {
     textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
     hostMips_.push_back(!staged_[i].levels.empty());
   }
-  sampler_ = makeSampler(ctx_, {});
 }
 
 std::vector<const vk::Image*> GpuScene::gpuMipBatch() const {
@@ -462,12 +461,20 @@ float maxAnisotropy(const vk::Context& ctx) {
   return features.samplerAnisotropy ? ctx.properties().limits.maxSamplerAnisotropy : 1.0f;
 }
 
-vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings) {
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings, const SamplerDesc& desc) {
   VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   const bool nearest = settings.filter == TextureFilter::Nearest;
-  si.magFilter = si.minFilter = nearest ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
-  si.mipmapMode = settings.filter == TextureFilter::Trilinear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
-  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  si.magFilter = nearest || desc.nearestMag ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+  si.minFilter = nearest || desc.nearestMin ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+  si.mipmapMode = settings.filter == TextureFilter::Trilinear && !desc.nearestMip ? VK_SAMPLER_MIPMAP_MODE_LINEAR
+                                                                                 : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  auto wrap = [](Wrap w) {
+    return w == Wrap::ClampToEdge      ? VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
+           : w == Wrap::MirroredRepeat ? VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT
+                                       : VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  };
+  si.addressModeU = wrap(desc.wrapU);
+  si.addressModeV = si.addressModeW = wrap(desc.wrapV);
   si.maxLod = VK_LOD_CLAMP_NONE;
   // Off by default: the mip-level view must show what plain trilinear filtering picks.
   const float anisotropy = std::clamp(settings.anisotropy, 1.0f, maxAnisotropy(ctx));
@@ -478,11 +485,10 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings)
   return vk::Sampler(ctx.device(), raw);
 }
 
-std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors(VkSampler sampler) const {
-  std::vector<VkDescriptorImageInfo> out;
+std::vector<VkImageView> GpuScene::textureViews() const {
+  std::vector<VkImageView> out;
   if (!ready_) return out;  // a deferred load's images exist before their upload completed
-  for (const auto& t : textures_)
-    out.push_back({sampler ? sampler : sampler_.get(), t.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  for (const auto& t : textures_) out.push_back(t.view());
   return out;
 }
 

@@ -69,8 +69,11 @@ struct SamplerSettings {
 };
 // The largest anisotropy the device samples with: 1 without the samplerAnisotropy feature.
 float maxAnisotropy(const vk::Context& ctx);
-// A repeat-wrapping sampler for scene textures; the anisotropy is clamped to maxAnisotropy(ctx).
-vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings);
+// A sampler for a scene texture: wrap modes from `desc` (the texture's own, glTF samplers; OBJ textures
+// repeat), filters from `desc` under Trilinear (the texture's own; OBJ: trilinear), forced nearest-mip or
+// nearest by the other settings (the mip experiments apply to every texture); the anisotropy is clamped
+// to maxAnisotropy(ctx).
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings, const SamplerDesc& desc = {});
 
 // How the geometry reaches device memory: written in place where the host can map it (Auto), or always
 // through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
@@ -110,8 +113,9 @@ class GpuScene {
   VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), instance by instance
   uint32_t clusterCount() const { return clusterCount_; }
   uint32_t textureCount() const { return stats_.textures; }  // also while they load
-  // Every texture with `sampler` (none: the default trilinear one); none until texturesReady().
-  std::vector<VkDescriptorImageInfo> textureDescriptors(VkSampler sampler = VK_NULL_HANDLE) const;
+  // Every texture's view; none until texturesReady(). The renderer pairs them with samplers (TextureSet).
+  std::vector<VkImageView> textureViews() const;
+  const std::vector<SamplerDesc>& textureSamplers() const { return samplers_; }  // per texture, its own
   const Bounds& bounds() const { return bounds_; }
   const GpuSceneStats& stats() const { return stats_; }
 
@@ -145,7 +149,7 @@ class GpuScene {
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
   uint32_t clusterCount_ = 0;
   std::vector<vk::Image> textures_;
-  vk::Sampler sampler_;
+  std::vector<SamplerDesc> samplers_;  // of each texture (Texture::sampler)
   struct PendingUpload {  // alive until its submission completed
     explicit PendingUpload(const vk::Context& ctx) : mips(ctx), timer(ctx, 1) {}
     MipGenerator mips;

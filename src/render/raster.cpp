@@ -33,9 +33,7 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   vk::LayoutOptions options = push;
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene.textureCount());
   hardware_ = vk::makeGraphicsPipeline(ctx, d, options);
-  textures_ = vk::DescriptorSets(ctx, hardware_.layout, 1);
-  auto textures = scene.textureDescriptors();
-  if (!textures.empty()) vk::DescriptorWriter(ctx, hardware_.layout, 1, textures_.get(1)).images(0, textures).commit();
+  textures_ = vk::DescriptorSets(ctx, hardware_.layout, 1);  // written by the renderer (Renderer::writeTextures)
   // Every triangle at most once in the hand-off list, after its VkDrawIndirectCommand.
   uint64_t triangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)

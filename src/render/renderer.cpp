@@ -58,9 +58,9 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
     : ctx_(ctx),
       scene_(scene),
       framesInFlight_(framesInFlight),
-      sampler_(makeSampler(ctx, {})),
       texturesBound_(scene.texturesReady()),
       post_(ctx) {
+  makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 12);  // at most: ComputeRaster::record's nine passes, shade, post
   }
@@ -110,7 +110,6 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   p.pipeline.emplace(vk::makeGraphicsPipeline(ctx_, d, options));
   const vk::PipelineLayout& layout = p.pipeline->layout;
   p.sets = vk::DescriptorSets(ctx_, layout, framesInFlight_);
-  auto textures = scene_.textureDescriptors(sampler_);
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
     if (layout.setCount() == 0) break;
     // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
@@ -118,8 +117,7 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
     if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
     if (hasBinding(layout, 0, 2)) w.buffer(2, scene_.instances());
     w.commit();
-    if (layout.setCount() > 1 && !textures.empty())
-      vk::DescriptorWriter(ctx_, layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
+    if (layout.setCount() > 1) writeTextures(layout, p.sets.get(1, frame));
   }
   return p;
 }
@@ -156,8 +154,7 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
       vk::makeComputePipeline(ctx_, vk::loadShader(shader), options));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
-    auto textures = scene_.textureDescriptors(sampler_);
-    if (!textures.empty()) vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
+    writeTextures(v.pipeline->layout, v.textures.get(1));
   }
   return v;
 }
@@ -184,22 +181,37 @@ void Renderer::rebuildPipelines() {
     raster->resize(extent_);
     raster_.reset();
     raster_.emplace(std::move(*raster));
+    writeTextures(raster_->textureLayout(), raster_->textureSet());
   }
 }
 
+void Renderer::makeTextureInfos() {
+  samplers_.clear();
+  textureInfos_.clear();
+  const std::vector<VkImageView> views = scene_.textureViews();
+  const std::vector<SamplerDesc>& descs = scene_.textureSamplers();
+  std::vector<SamplerDesc> made;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const size_t k = std::find(made.begin(), made.end(), descs[i]) - made.begin();
+    if (k == made.size()) made.push_back(descs[i]), samplers_.push_back(makeSampler(ctx_, samplerSettings_, descs[i]));
+    textureInfos_.push_back({samplers_[k].get(), views[i], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  }
+}
+
+void Renderer::writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set) const {
+  if (set && !textureInfos_.empty()) vk::DescriptorWriter(ctx_, layout, 1, set).images(0, textureInfos_).commit();
+}
+
 void Renderer::writeTextureSets() {
-  const auto textures = scene_.textureDescriptors(sampler_);
-  if (textures.empty()) return;
   for (auto& set : pipelines_) {
     if (!set) continue;
     for (ScenePipelines& p : *set)
       if (p.pipeline && p.pipeline->layout.setCount() > 1)
-        for (uint32_t frame = 0; frame < framesInFlight_; ++frame)
-          vk::DescriptorWriter(ctx_, p.pipeline->layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
+        for (uint32_t frame = 0; frame < framesInFlight_; ++frame) writeTextures(p.pipeline->layout, p.sets.get(1, frame));
   }
   for (VisShade& v : shade_)
-    if (v.pipeline && v.pipeline->layout.setCount() > 1)
-      vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
+    if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1));
+  if (raster_) writeTextures(raster_->textureLayout(), raster_->textureSet());
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -292,14 +304,14 @@ void Renderer::frame(FrameContext& fc) {
   const Lens& lens = fc.lens;
   const RenderSettings& s = fc.settings;
   const RenderTarget& target = fc.target;
-  // The texture sets are written again once no frame uses them, for a new sampler (samplers are cheap; a
-  // user's change in the panel) or the textures of a deferred load arriving (the compute rasteriser, which
-  // samples alpha masks, is then rebuilt with them).
+  // Every texture set is written again once no frame uses them, for new samplers (samplers are cheap; a
+  // user's change in the panel) or the textures of a deferred load arriving.
   const bool arrived = scene_.texturesReady() && !texturesBound_;
   if (s.sampler != samplerSettings_ || arrived) {
     VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
-    if (s.sampler != samplerSettings_) sampler_ = makeSampler(ctx_, s.sampler), samplerSettings_ = s.sampler;
-    if (arrived) raster_.reset(), texturesBound_ = true;
+    samplerSettings_ = s.sampler;
+    texturesBound_ = scene_.texturesReady();
+    makeTextureInfos();
     writeTextureSets();
   }
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
@@ -312,6 +324,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute && !raster_) {
     raster_.emplace(ctx_, scene_, framesInFlight_);
     raster_->resize(extent_);
+    writeTextures(raster_->textureLayout(), raster_->textureSet());
   }
   if (!compute) ensurePipelines(set);
   if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);
