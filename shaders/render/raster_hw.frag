@@ -21,6 +21,7 @@ void main() {
     const uint t = materials[inMaterial].textures.w;
     if (t != NO_TEXTURE && texture(textures[nonuniformEXT(t)], inTexcoord, frame.params.y).a < 0.5) discard;
   }
-  if (!gl_FrontFacing && (inFlags & CLUSTER_DOUBLE_SIDED) == 0u) discard;
+  const bool front = gl_FrontFacing != ((inFlags & CLUSTER_MIRRORED) != 0u);  // the pipeline's front is counter-clockwise
+  if (!front && (inFlags & CLUSTER_DOUBLE_SIDED) == 0u) discard;
   atomicMin(vis[uint(gl_FragCoord.y) * pc.width + uint(gl_FragCoord.x)], packVis(gl_FragCoord.z, inId));
 }

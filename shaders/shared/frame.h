@@ -59,8 +59,20 @@ struct GpuMaterial {
 // Per-draw push constants.
 struct DrawPush {
   uint material;
-  uint idBase;        // visibility pass: draw index << VisShadePush.primitiveBits
+  uint primitiveBits; // visibility pass: id = gl_InstanceIndex << primitiveBits | gl_PrimitiveID
 };
+
+// One placement of a mesh (storage buffer, std430, 128 bytes), indexed by gl_InstanceIndex in the
+// hardware paths and named by the high bits of a visibility id. A scene without instances gets one
+// identity instance per draw, in draw order (instance i draws GpuDraw i).
+struct GpuInstance {
+  mat4 transform;     // object to scene space
+  vec4 normalX;       // columns of the inverse transpose of transform's upper 3x3 (normals)
+  vec4 normalY;
+  vec4 normalZ;
+  uvec4 info;         // x: its GpuDraw, y: INSTANCE_* flags
+};
+#define INSTANCE_MIRRORED 1u  // negative determinant: the winding flips (front = clockwise on screen)
 
 // One draw of the scene, for the visibility path's shading pass (storage buffer, std430, 16 bytes).
 struct GpuDraw {
@@ -72,8 +84,8 @@ struct GpuDraw {
 #define DRAW_INDEX16 1u   // 16-bit indices (two per 32-bit word)
 #define DRAW_TEXTURED 2u  // has texcoords: sample the material's textures
 
-// Visibility target (R32_UINT): draw index << primitiveBits | gl_PrimitiveID; VIS_EMPTY where nothing
-// was drawn. The renderer gives the draw index just enough bits that no id equals VIS_EMPTY.
+// Visibility target (R32_UINT): instance index << primitiveBits | gl_PrimitiveID; VIS_EMPTY where
+// nothing was drawn. The renderer gives the instance index just enough bits that no id equals VIS_EMPTY.
 #define VIS_EMPTY 0xFFFFFFFFu
 struct VisShadePush {
   uint primitiveBits;

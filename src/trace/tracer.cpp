@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "scene/framing.hpp"
 #include "scene/textures.hpp"
+#include "brdf.h"  // shaders/shared: BRDF_BECKMANN, BRDF_GGX
 #include "trace/shade.hpp"
 #include "trace/spawn.hpp"
 
@@ -36,6 +37,26 @@ Ray beyond(const Ray& seg, const Hit& h, const SurfacePoint& sp) {
 // A ray cone's width on the surface in texture-coordinate units: stretched by 1/|cos| of the incidence.
 float uvWidth(const SurfacePoint& sp, const Ray& r, float coneWidth) {
   return sp.uvScale * coneWidth / std::abs(glm::dot(sp.geomNormal, glm::normalize(r.direction)));
+}
+
+static_assert(unsigned(Light::Kind::Spot) == LIGHT_SPOT && unsigned(Light::Kind::Directional) == LIGHT_DIRECTIONAL);
+
+// Shadow sample i of n of a light as the shared light model (shaders/shared/lights.h) sees it from p, and
+// the shadow ray towards it: to the sample point (t in [0, 1]), or to infinity for a directional light.
+struct LightRay {
+  shader::LightSample ls;
+  Ray shadow;
+  bool valid;  // false: p is the light's own position
+};
+LightRay lightRay(const Light& light, int i, int n, const glm::vec3& p, const glm::vec3& ng) {
+  const glm::vec3 at = light.samplePoint(i, n);
+  const shader::LightSample ls = shader::lightSample(
+      shader::makeGpuLight(unsigned(light.kind), at, light.color, light.falloff, light.direction, light.innerConeCos,
+                           light.outerConeCos, light.range),
+      p);
+  if (light.kind == Light::Kind::Directional) return {ls, spawnRay(p, ng, ls.l), true};
+  const glm::vec3 toLight = at - p;
+  return {ls, spawnRay(p, ng, toLight, 1.0f), glm::dot(toLight, toLight) > 0.0f};
 }
 
 }  // namespace
@@ -166,6 +187,8 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
   const bool textured = f.tex && !scene_.meshes[sp.mesh].texcoords.empty() && (pbr || baseTextured);
   const SurfaceInputs in = textured ? f.tex->fetch(mat, sp.uv, uvWidth(sp, r, coneWidth)) : materialFactors(mat);
   const glm::vec3 kd = textured && baseTextured ? in.baseColor : mat.kd;
+  const bool ggx = s.brdf ? *s.brdf == Brdf::Ggx : (mat.flags & kMaterialGltf) != 0;
+  const int brdf = ggx ? BRDF_GGX : BRDF_BECKMANN;
   // Ambient and emission, then every light's direct term averaged over its shadow samples; with shadows
   // on, a sample behind the surface itself or blocked gives nothing (Phong keeps its ambient Ka x Lc).
   glm::vec3 color = pbr ? f.ambient * glm::clamp(in.baseColor, 0.0f, 1.0f) + in.emissive : mat.ke;
@@ -176,10 +199,10 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
     const int samples = light.kind == Light::Kind::Area ? n : 1;
     glm::vec3 direct(0.0f);
     for (int i = 0; i < samples; ++i, ++slot) {
-      const glm::vec3 toLight = light.samplePoint(i, samples) - sp.position;
-      if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
-      const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
-      const glm::vec3 d = pbr ? pbrDirect(sp.normal, v, ls.l, ls.radiance, in.baseColor, in.roughness, in.metalness)
+      const LightRay lr = lightRay(light, i, samples, sp.position, sp.geomNormal);
+      if (!lr.valid) continue;
+      const shader::LightSample& ls = lr.ls;
+      const glm::vec3 d = pbr ? pbrDirect(brdf, sp.normal, v, ls.l, ls.radiance, in.baseColor, in.roughness, in.metalness)
                               : blinnPhongDirect(mat, kd, sp.normal, v, ls.l, ls.radiance);
       if (d == glm::vec3(0.0f)) continue;
       if (s.shadows) {
@@ -187,7 +210,7 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
         if (pre && (pre->known[slot] >> pre->lane & 1)) {
           ++c.shadow;
           if (pre->blocked[slot] >> pre->lane & 1) continue;
-        } else if (shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c)) {
+        } else if (shadowed(lr.shadow, f, c)) {
           continue;
         }
       }
@@ -217,11 +240,9 @@ void Tracer::shadowPackets(const Visible* vis, int n, const Frame& f, std::vecto
       for (int k = 0; k < n; ++k) {
         const Visible& v = vis[k];
         if (!v.hit.hit() || (!pbr && isLightMaterial(*v.sp.material))) continue;
-        const glm::vec3 toLight = light.samplePoint(i, samples) - v.sp.position;
-        if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
-        const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
-        if (glm::dot(v.sp.geomNormal, ls.l) <= 0.0f) continue;
-        rays[m] = spawnRay(v.sp.position, v.sp.geomNormal, toLight, 1.0f);
+        const LightRay lr = lightRay(light, i, samples, v.sp.position, v.sp.geomNormal);
+        if (!lr.valid || lr.ls.radiance == glm::vec3(0.0f) || glm::dot(v.sp.geomNormal, lr.ls.l) <= 0.0f) continue;
+        rays[m] = lr.shadow;
         lanes[m++] = k;
       }
       const unsigned occ = m ? bvh_.occluded8(rays.data(), m, s.intersect) : 0u;

@@ -29,6 +29,8 @@ constexpr int N_BOUNCES = 5;  // the brief's default recursion depth for mirrors
 constexpr int kMaxAlphaLayers = 32;
 
 enum class Shading { Phong, Pbr, Normals, Depth };
+// pbr's BRDF (shaders/shared/brdf.h): the brief's Beckmann or glTF's GGX.
+enum class Brdf { Beckmann, Ggx };
 
 struct TraceSettings {
   uint32_t width = 1280, height = 720;
@@ -46,6 +48,7 @@ struct TraceSettings {
   // Phong's ambient is Ka x each light's colour, as the course's.
   std::optional<LightRig> lights;
   float lodBias = 0.0f;            // pbr: added to every texture's level of detail, as the GPU's bias
+  std::optional<Brdf> brdf;        // pbr; none: per material, GGX for glTF materials, Beckmann for the rest
   glm::vec3 background{0.0f};
 };
 

@@ -23,7 +23,8 @@ using namespace rtr::trace;
 int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)", "rtr-trace"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "phong", shadows = "on",
-                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath;
+                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath,
+                                  brdf;
   LightOptions lightOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
@@ -41,6 +42,8 @@ int run(int argc, char** argv) {
   app.add_option("--ortho-height", orthoHeight, "half height of the orthographic volume")->check(cli::number(0, 1e30, true));
   app.add_option("--shading", shading, "phong | pbr | normals | depth")
       ->capture_default_str()->check(CLI::IsMember({"phong", "pbr", "normals", "depth"}));
+  app.add_option("--brdf", brdf, "pbr: beckmann | ggx for every material (default: ggx for glTF materials, "
+                 "beckmann for the rest)")->check(CLI::IsMember({"beckmann", "ggx"}));
   app.add_option("--shadows", shadows, "on | off")->capture_default_str()->check(CLI::IsMember({"on", "off"}));
   app.add_option("--bounces", s.bounces, "mirror bounces (N_BOUNCES); 0 turns reflections off")
       ->capture_default_str()->check(cli::integer(0, 64));
@@ -71,6 +74,7 @@ int run(int argc, char** argv) {
   s.lens.orthoHalfHeight = orthoHeight > 0.0f ? orthoHeight : (aspect >= 1.0f ? 1.0f : 1.0f / aspect);
   s.shading = shading == "pbr" ? Shading::Pbr : shading == "normals" ? Shading::Normals
             : shading == "depth" ? Shading::Depth : Shading::Phong;
+  if (!brdf.empty()) s.brdf = brdf == "ggx" ? Brdf::Ggx : Brdf::Beckmann;
   s.shadows = shadows == "on";
   s.intersect = intersectName == "halfplane" ? IntersectMethod::HalfPlane
               : intersectName == "moller" ? IntersectMethod::MollerTrumbore : IntersectMethod::Watertight;
