@@ -62,6 +62,16 @@ LightRay lightRay(const Light& light, int i, int n, const glm::vec3& p, const gl
 }  // namespace
 
 Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
+  // With instances, only the meshes they place are drawn, each stored once however often it is placed.
+  instanced_ = !scene.instances.empty();
+  std::vector<uint32_t> objectOf(scene.meshes.size(), kNoHit);
+  std::vector<InstanceBvh::Object> objects;
+  for (size_t i = 0; i < scene.instances.size(); ++i)
+    if (scene.instances[i].mesh >= scene.meshes.size())
+      throw Error("instance " + std::to_string(i) + " places mesh " + std::to_string(scene.instances[i].mesh) +
+                  " of " + std::to_string(scene.meshes.size()));
+    else
+      objectOf[scene.instances[i].mesh] = 0;
   for (uint32_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     const bool light = m.material < scene.materials.size() && isLightMaterial(scene.materials[m.material]);
@@ -69,6 +79,11 @@ Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
     anyAlphaTested_ = anyAlphaTested_ || meshAlphaTested_.back();
     anyBaseTextured_ = anyBaseTextured_ || (m.material < scene.materials.size() && !m.texcoords.empty() &&
                                             scene.materials[m.material].texture(TextureSlot::BaseColor) != kNoTexture);
+    if (instanced_) {
+      if (objectOf[mi] == kNoHit) continue;  // placed nowhere
+      objectOf[mi] = uint32_t(objects.size());
+      objects.push_back({uint32_t(tris_.size()), m.triangleCount()});
+    }
     for (uint32_t t = 0; t < m.triangleCount(); ++t) {
       const uint32_t* idx = &m.indices[size_t(t) * 3];
       if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size())
@@ -79,12 +94,19 @@ Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
       castsShadow_.push_back(light ? 0 : 1);  // shadow rays pass through the lights' own geometry
     }
   }
+  if (instanced_) {
+    std::vector<InstanceBvh::Placement> placements;
+    for (const Instance& in : scene.instances) placements.push_back({objectOf[in.mesh], in.transform});
+    instances_ = InstanceBvh(tris_, castsShadow_, objects, placements, buildThreads);
+    return;
+  }
   useBvh_ = tris_.size() >= kBruteForceMax;
   if (useBvh_) bvh_ = Bvh(tris_, castsShadow_, buildThreads);
 }
 
 Hit Tracer::closestTriangle(const Ray& r, IntersectMethod m) const {
   if (useBvh_) return bvh_.closest(r, m);
+  if (instanced_) return instances_.closest(r, m);
   // The brief's loop: every triangle, keep the smallest positive t.
   Hit best;
   Ray q = r;
@@ -98,6 +120,7 @@ Hit Tracer::closestTriangle(const Ray& r, IntersectMethod m) const {
 
 bool Tracer::occluded(const Ray& r, IntersectMethod m) const {
   if (useBvh_) return bvh_.occluded(r, m);
+  if (instanced_) return instances_.occluded(r, m);
   for (uint32_t i = 0; i < tris_.size(); ++i) {
     float b1, b2;
     if (castsShadow_[i] && intersect(m, r, tris_[i], b1, b2) > 0.0f) return true;
@@ -107,7 +130,12 @@ bool Tracer::occluded(const Ray& r, IntersectMethod m) const {
 
 SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
   SurfacePoint sp;
-  const Triangle& tri = tris_[h.prim];
+  Triangle tri = tris_[h.prim];
+  if (instanced_) {  // into scene space: the vertices, as a flattened copy would hold them
+    const glm::mat4& M = instances_.toScene(h.instance);
+    tri = {glm::vec3(M * glm::vec4(tri.v0, 1.0f)), glm::vec3(M * glm::vec4(tri.v1, 1.0f)),
+           glm::vec3(M * glm::vec4(tri.v2, 1.0f))};
+  }
   const float b0 = 1.0f - h.b1 - h.b2;
   sp.position = b0 * tri.v0 + h.b1 * tri.v1 + h.b2 * tri.v2;
   glm::vec3 ng = glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
@@ -117,7 +145,8 @@ SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
   const uint32_t* idx = &m.indices[size_t(triLocal_[h.prim]) * 3];
   glm::vec3 ns = ng;
   if (m.normals.size() == m.positions.size()) {
-    const glm::vec3 n = b0 * m.normals[idx[0]] + h.b1 * m.normals[idx[1]] + h.b2 * m.normals[idx[2]];
+    glm::vec3 n = b0 * m.normals[idx[0]] + h.b1 * m.normals[idx[1]] + h.b2 * m.normals[idx[2]];
+    if (instanced_) n = instances_.normalToScene(h.instance) * n;
     const float nl = glm::length(n);
     if (nl > 0.0f && std::isfinite(nl)) ns = n / nl;
   }

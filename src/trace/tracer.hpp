@@ -18,6 +18,7 @@
 #include "scene/lights.hpp"
 #include "scene/scene.hpp"
 #include "trace/bvh.hpp"
+#include "trace/instances.hpp"
 #include "trace/intersect.hpp"
 #include "trace/ray.hpp"
 #include "trace/textures.hpp"
@@ -81,7 +82,8 @@ glm::mat4 modelview(const CameraPose& pose, const glm::mat4& model);
 class Tracer {
  public:
   // Keeps a reference to `scene`, which must outlive the tracer. Builds a BVH unless the scene is tiny
-  // (fewer than kBruteForceMax triangles: then every ray tests every triangle, as the brief's loop does).
+  // (fewer than kBruteForceMax triangles: then every ray tests every triangle, as the brief's loop does);
+  // a scene with instances gets the two-level InstanceBvh (each placed mesh's triangles stored once).
   explicit Tracer(const Scene& scene, unsigned buildThreads = 0);
   static constexpr size_t kBruteForceMax = 16;
 
@@ -108,8 +110,10 @@ class Tracer {
   // loads any. Thread-safe. Throws rtr::Error naming a texture file that is missing or undecodable.
   const SceneTextures& textures() const;
 
+  // Each drawn mesh's triangles once (object space where the scene has instances).
   const std::vector<Triangle>& triangles() const { return tris_; }
   bool usesBvh() const { return useBvh_; }
+  bool instanced() const { return instanced_; }
   const Bvh& bvh() const { return bvh_; }
   const Scene& scene() const { return scene_; }
 
@@ -169,6 +173,8 @@ class Tracer {
   bool anyBaseTextured_ = false;  // a mesh with texcoords whose material has a base colour texture
   Bvh bvh_;
   bool useBvh_ = false;
+  InstanceBvh instances_;
+  bool instanced_ = false;
   mutable std::mutex texturesMutex_;
   mutable std::unique_ptr<const SceneTextures> textures_;
 };

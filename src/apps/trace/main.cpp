@@ -111,7 +111,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
                  "(%llu primary, %llu shadow, %llu mirror), %.2f Mrays/s; pose %s -> %s\n",
-                 tracer.triangles().size(), s.lights->lights.size(), tracer.usesBvh() ? "BVH8" : "no BVH",
+                 tracer.triangles().size(), s.lights->lights.size(), tracer.usesBvh() ? "BVH8" : tracer.instanced() ? "two-level BVH8" : "no BVH",
                  tracer.usesBvh() ? tracer.bvh().stats().buildSeconds : 0.0, w, h, st.seconds,
                  (unsigned long long)rays, (unsigned long long)st.primaryRays, (unsigned long long)st.shadowRays,
                  (unsigned long long)st.reflectionRays, double(rays) / st.seconds * 1e-6,
