@@ -69,7 +69,8 @@ InstanceBvh::InstanceBvh(std::span<const Triangle> tris, std::span<const uint8_t
     const glm::dmat3 m3(m);
     if (glm::determinant(m3) == 0.0 || !std::isfinite(glm::determinant(m3)))
       throw Error("instance " + std::to_string(i) + ": its transform is singular or not finite");
-    inst_.push_back({p.object, p.toScene, glm::mat4(glm::inverse(m)), glm::mat3(glm::transpose(glm::inverse(m3)))});
+    inst_.push_back({p.object, p.toScene, glm::mat4(glm::inverse(m)), glm::mat3(glm::transpose(glm::inverse(m3))),
+                     glm::determinant(m3) < 0.0});
     lo.push_back(glm::vec3(INFINITY));
     hi.push_back(glm::vec3(-INFINITY));
     const glm::dvec3 a = objLo[p.object], b = objHi[p.object];

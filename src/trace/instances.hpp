@@ -37,6 +37,7 @@ class InstanceBvh {
   // Per placement: object to scene, and the normal matrix (inverse transpose of its 3×3 part).
   const glm::mat4& toScene(uint32_t instance) const { return inst_[instance].toScene; }
   const glm::mat3& normalToScene(uint32_t instance) const { return inst_[instance].normal; }
+  bool mirrored(uint32_t instance) const { return inst_[instance].mirrored; }  // negative determinant
   size_t objectCount() const { return bvhs_.size(); }
 
  private:
@@ -44,6 +45,7 @@ class InstanceBvh {
     uint32_t object;
     glm::mat4 toScene, toObject;
     glm::mat3 normal;
+    bool mirrored;
   };
   struct Node {
     glm::vec3 lo, hi;
