@@ -9,7 +9,9 @@ BOOKWORM_PKGS=(
   libvulkan-dev vulkan-validationlayers vulkan-tools glslang-tools glslang-dev spirv-tools spirv-headers
   libglm-dev libglfw3-dev libstb-dev libzstd-dev zstd zlib1g-dev libtinyexr-dev libjpeg62-turbo-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev libcli11-dev libtinyobjloader-dev libmeshoptimizer-dev
+  libdraco-dev gltfpack assimp-utils
   libimgui-dev xvfb xdotool x11-utils clang libclang-rt-14-dev python3 assimp-testmodels
+  libsimdjson-dev
 )
 # Not in bookworm: taken from later suites through a low apt pin (priority 100), by name only.
 PINNED_PKGS=(libspirv-reflect-dev/sid libvulkan-memory-allocator-dev/trixie)

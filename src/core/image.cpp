@@ -37,7 +37,7 @@ constexpr uint32_t kMaxImageSide = 32768;
 // is refused, not padded with grey: libjpeg calls that a warning, and a 650-byte file declaring 30000²
 // pixels then decoded into gigabytes of filler (found by fuzzing). The texels grow row by row, so such a
 // header costs no more than the rows its data really holds.
-bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData& out, std::string& error) {
+bool decodeJpeg(std::span<const uint8_t> bytes, int channels, TexelData& out, std::string& error) {
   jpeg_decompress_struct cinfo{};
   JpegError err{};
   cinfo.err = jpeg_std_error(&err.mgr);
@@ -88,7 +88,7 @@ bool decodeJpeg(const std::vector<unsigned char>& bytes, int channels, TexelData
 // to 8, gamma ignored; the channel count is then converted by stb's rules (convertChannels).
 
 struct PngReader {
-  const std::vector<unsigned char>& bytes;
+  std::span<const uint8_t> bytes;
   size_t at = 0;
   std::string error;
 };
@@ -114,7 +114,7 @@ void convertChannels(const std::vector<uint8_t>& in, uint32_t n, TexelData& out)
   }
 }
 
-bool decodePng(const std::vector<unsigned char>& bytes, int channels, TexelData& out, std::string& error) {
+bool decodePng(std::span<const uint8_t> bytes, int channels, TexelData& out, std::string& error) {
   PngReader reader{bytes};
   png_structp png = png_create_read_struct(
       PNG_LIBPNG_VER_STRING, &reader,
@@ -182,23 +182,27 @@ TexelData loadImage(const std::filesystem::path& file, int channels) {
   std::vector<unsigned char> bytes(static_cast<size_t>(size));
   in.seekg(0);
   if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) throw fileError(file.string(), "", "read error");
+  return decodeImage(bytes, file.string(), channels);
+}
+
+TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, int channels) {
   if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8) {  // a JPEG start-of-image marker
     TexelData out;
     std::string error;
-    if (!decodeJpeg(bytes, channels, out, error)) throw fileError(file.string(), "", "cannot decode JPEG: " + error);
+    if (!decodeJpeg(bytes, channels, out, error)) throw fileError(name, "", "cannot decode JPEG: " + error);
     return out;
   }
   if (bytes.size() >= 8 && png_sig_cmp(bytes.data(), 0, 8) == 0) {
     TexelData out;
     std::string error;
-    if (!decodePng(bytes, channels, out, error)) throw fileError(file.string(), "", "cannot decode PNG: " + error);
+    if (!decodePng(bytes, channels, out, error)) throw fileError(name, "", "cannot decode PNG: " + error);
     return out;
   }
   int w = 0, h = 0, n = 0;
   stbi_uc* data = stbi_load_from_memory(bytes.data(), int(std::min<size_t>(bytes.size(), INT32_MAX)), &w, &h, &n, channels);
   if (!data) {  // stb can fail without a reason
     const char* why = stbi_failure_reason();
-    throw fileError(file.string(), "", std::string("cannot decode image: ") + (why ? why : "not a supported image"));
+    throw fileError(name, "", std::string("cannot decode image: ") + (why ? why : "not a supported image"));
   }
   TexelData out{uint32_t(w), uint32_t(h), uint32_t(channels), {}};
   out.texels.assign(data, data + size_t(w) * h * channels);

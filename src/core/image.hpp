@@ -3,6 +3,8 @@
 // JPEG, Radiance HDR and OpenEXR, always atomically (core/atomic_file.hpp).
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -32,6 +34,8 @@ struct TexelData {
 };
 
 TexelData loadImage(const std::filesystem::path& file, int channels);  // throws rtr::Error naming the file
+// An encoded image (PNG, JPEG, or what stb reads) in memory; `name` names it in errors.
+TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, int channels);
 void savePng(const std::filesystem::path& file, const ImageRGBA8& image);  // PNG whatever the name says
 
 // Output format by extension; anything else is a UsageError that lists these.

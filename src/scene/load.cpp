@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
+#include "scene/gltf.hpp"
 #include "scene/obj.hpp"
 #include "scene/rtrscene.hpp"
 
@@ -22,7 +23,8 @@ Scene loadAny(const std::filesystem::path& file, const LoadOptions& options) {
     throw fileError(file.string(), "", "an MTL file ('" + options.mtl->string() + "') can only be given with an OBJ scene");
   if (ends(".comp5892mesh")) return loadCourseMesh(file);
   if (ends(".rtrscene")) return loadRtrScene(file);
-  throw fileError(file.string(), "", "unknown scene format (expected .obj, .obj.zst, .obj-zstd, .comp5892mesh, .rtrscene)");
+  if (ends(".gltf") || ends(".glb")) return loadGltf(file, options);
+  throw fileError(file.string(), "", "unknown scene format (expected .obj, .obj.zst, .obj-zstd, .gltf, .glb, .comp5892mesh, .rtrscene)");
 }
 
 }  // namespace

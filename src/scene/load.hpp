@@ -21,7 +21,7 @@ struct LoadOptions {
   std::function<void(const std::string&)> note;
 };
 
-// .obj / .obj.zst / .obj-zstd (with their MTL), .comp5892mesh, .rtrscene.
+// .obj / .obj.zst / .obj-zstd (with their MTL), .gltf / .glb (scene/gltf.hpp), .comp5892mesh, .rtrscene.
 // Throws rtr::Error naming the file and the place of the fault.
 Scene loadScene(const std::filesystem::path& file, const LoadOptions& options = {});
 

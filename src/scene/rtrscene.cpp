@@ -23,7 +23,13 @@ constexpr uint32_t kMaxString = 32768;
 constexpr uint32_t kHasView = 1u << 0;  // header flags
 constexpr uint32_t kLightFalloff = 1u << 0;  // light flags
 constexpr uint32_t kHasNormals = 1u << 0, kHasTexcoords = 1u << 1, kIndex16 = 1u << 2;  // mesh flags
-constexpr uint32_t kKnownMaterialFlags = kMaterialAlphaMasked | kMaterialDoubleSided | kMaterialLight;
+constexpr uint32_t kHasTexcoords1 = 1u << 3, kHasTangents = 1u << 4, kHasColors = 1u << 5;  // version 5
+constexpr uint32_t kKnownMaterialFlags4 = kMaterialAlphaMasked | kMaterialDoubleSided | kMaterialLight;
+constexpr uint32_t kKnownMaterialFlags = kKnownMaterialFlags4 | kMaterialBlend | kMaterialUnlit | kMaterialGltf;
+constexpr uint32_t kNearestMag = 1u << 0, kNearestMin = 1u << 1, kNearestMip = 1u << 2;  // texture filter bits
+// Minimum record sizes (a string is at least its length word), checked against the file before allocating.
+constexpr size_t kLightSize4 = 80, kLightSize5 = 104, kInstanceSize = 80;
+constexpr size_t kMaterialMin4 = 128, kMaterialMin5 = 4 + 4 + 28 * 4 + 7 * 4 + 7 * 24;
 
 void writeString(ByteWriter& w, const std::string& s) {
   if (s.size() >= kMaxString) throw Error("string longer than 32767 bytes: " + s.substr(0, 64));
@@ -58,11 +64,52 @@ glm::vec3 readVec(ByteReader& r, const char* what) {
   return v;
 }
 
+// What a scene holds that versions 1-4 cannot store (empty: nothing); writing it to one is refused, not dropped.
+std::string newerThan4(const Scene& s) {
+  if (!s.instances.empty()) return "instances";
+  if (s.defaultFovYDeg != 0.0f) return "a field of view";
+  for (const Light& l : s.lights)
+    if (l.kind > Light::Kind::Headlight || l.range != 0.0f) return "spot or directional lights or light ranges";
+  for (const Texture& t : s.textures)
+    if (t.sourceChannel != 0 || !(t.sampler == SamplerDesc{})) return "texture samplers or source channels";
+  for (const Material& m : s.materials) {
+    if ((m.flags & ~kKnownMaterialFlags4) || m.opacity != 1.0f || m.alphaCutoff != 0.5f || m.normalScale != 1.0f ||
+        m.occlusionStrength != 1.0f || m.texture(TextureSlot::Occlusion) != kNoTexture)
+      return "glTF material fields";
+    for (const UvTransform& u : m.uv)
+      if (!u.identity() || u.texCoord != 0) return "uv transforms";
+  }
+  for (const Mesh& m : s.meshes)
+    if (!m.texcoords1.empty() || !m.tangents.empty() || !m.colors.empty()) return "a second uv set, tangents or vertex colours";
+  return {};
+}
+
+// A light the renderers cannot use (the caller has checked that its numbers are finite); null: none.
+const char* lightFault(const Light& l) {
+  if (l.range < 0.0f) return "negative range";
+  if (l.innerConeCos < -1.0f || l.innerConeCos > 1.0f || l.outerConeCos < -1.0f || l.outerConeCos > 1.0f)
+    return "cone cosine outside -1..1";
+  if (l.kind == Light::Kind::Spot && l.outerConeCos > l.innerConeCos) return "outer cone narrower than the inner one";
+  if ((l.kind == Light::Kind::Spot || l.kind == Light::Kind::Directional) && std::abs(glm::length(l.direction) - 1.0f) > 1e-3f)
+    return "direction is not a unit vector";
+  return nullptr;
+}
+
 // Where a mesh's arrays and clusters lie in the file: found by the first pass over the records, copied out
 // and checked by the second, on all cores.
+enum Stream : uint8_t { kPositions, kNormals, kTexcoords, kTexcoords1, kTangents, kColors, kIndices, kClusters };
+constexpr size_t kVertexStreams = kIndices;  // the per-vertex arrays, in file order
+constexpr size_t kVertexSize[kVertexStreams] = {12, 12, 8, 8, 16, 16};
+constexpr uint32_t kStreamFlag[kVertexStreams] = {0, kHasNormals, kHasTexcoords, kHasTexcoords1, kHasTangents, kHasColors};
+constexpr const char* kStreamName[kVertexStreams] = {"positions", "normals", "texcoords", "texcoords1", "tangents", "colors"};
+
 struct MeshLayout {
   uint32_t flags = 0, vertices = 0, indices = 0, clusters = 0;
-  size_t posAt = 0, normalAt = 0, texcoordAt = 0, indexAt = 0, clusterHeaderAt = 0, clusterAt = 0;
+  size_t at[kVertexStreams] = {}, indexAt = 0, clusterHeaderAt = 0, clusterAt = 0;
+  size_t count(Stream s) const {
+    return s == kIndices ? indices : s == kPositions || (flags & kStreamFlag[s]) ? vertices : 0;
+  }
+  size_t elementSize(Stream s) const { return s == kIndices ? (flags & kIndex16 ? 2 : 4) : kVertexSize[s]; }
 };
 
 // A fault found by a worker. Of several, the one at the lowest offset is reported, so the message does
@@ -86,8 +133,6 @@ void checkFinite(const uint8_t* p, size_t at, int floats, const char* what) {
     if (!std::isfinite(load<float>(p + 4 * k))) throw Fault{at + 4 * size_t(k), std::string(what) + " is not finite"};
 }
 
-enum Stream : uint8_t { kPositions, kNormals, kTexcoords, kIndices, kClusters };
-
 // A piece of the second pass: copy one of a mesh's arrays out of the file, or check elements
 // [first, first + count) of one (the checks read the file's bytes, not the copies, so they need not wait).
 struct Job {
@@ -104,12 +149,18 @@ const T* as(const uint8_t* base, size_t at) {
 }
 
 // assign copies without first zeroing the vectors (a resize would write every byte twice).
+template <class T>
+void copyTo(std::vector<T>& v, const uint8_t* base, size_t at, size_t n) { v.assign(as<T>(base, at), as<T>(base, at) + n); }
+
 void copyStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base) {
   const size_t v = l.vertices, n = l.indices;
   switch (s) {
-    case kPositions: m.positions.assign(as<glm::vec3>(base, l.posAt), as<glm::vec3>(base, l.posAt) + v); break;
-    case kNormals: m.normals.assign(as<glm::vec3>(base, l.normalAt), as<glm::vec3>(base, l.normalAt) + v); break;
-    case kTexcoords: m.texcoords.assign(as<glm::vec2>(base, l.texcoordAt), as<glm::vec2>(base, l.texcoordAt) + v); break;
+    case kPositions: copyTo(m.positions, base, l.at[s], v); break;
+    case kNormals: copyTo(m.normals, base, l.at[s], v); break;
+    case kTexcoords: copyTo(m.texcoords, base, l.at[s], v); break;
+    case kTexcoords1: copyTo(m.texcoords1, base, l.at[s], v); break;
+    case kTangents: copyTo(m.tangents, base, l.at[s], v); break;
+    case kColors: copyTo(m.colors, base, l.at[s], v); break;
     case kIndices:
       if (l.flags & kIndex16)
         m.indices.assign(as<uint16_t>(base, l.indexAt), as<uint16_t>(base, l.indexAt) + n);
@@ -143,29 +194,39 @@ void checkIndices(const MeshLayout& l, const uint8_t* base, uint32_t i, size_t f
   });
 }
 
+// Finite when every component times 0 is 0 (an infinity or a NaN gives NaN): no branch, no overflow.
+template <int N>
+bool allFinite(glm::vec<N, float> v) {
+  float z = 0.0f;
+  for (int c = 0; c < N; ++c) z += v[c] * 0.0f;
+  return z == 0.0f;
+}
+
+template <int N>
+void checkFiniteArray(const uint8_t* base, size_t at, size_t first, size_t end, const std::string& what) {
+  using V = glm::vec<N, float>;
+  scan<V>(base + at, first, end, allFinite<N>, [&](size_t k, V v) {
+    if (!allFinite<N>(v)) throw Fault{at + k * sizeof(V), what + " is not finite"};
+  });
+}
+
 void checkArray(const Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i, Stream s, size_t first, size_t end) {
   const Bounds& b = m.bounds;  // finite (read as such): a NaN or an infinity is never inside
   auto inside = [&](glm::vec3 p) {
     return (p.x >= b.min.x) & (p.y >= b.min.y) & (p.z >= b.min.z) & (p.x <= b.max.x) & (p.y <= b.max.y) & (p.z <= b.max.z);
   };
-  auto finite = [](float sum) { return std::abs(sum) <= std::numeric_limits<float>::max(); };  // NaN compares false
+  const size_t at = s < kVertexStreams ? l.at[s] : 0;
   switch (s) {
     case kPositions:
-      return scan<glm::vec3>(base + l.posAt, first, end, inside, [&](size_t k, glm::vec3 p) {
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-          throw Fault{l.posAt + k * 12, meshName(i) + ": position " + std::to_string(k) + " is not finite"};
-        if (!inside(p)) throw Fault{l.posAt + k * 12, meshName(i) + ": position " + std::to_string(k) + " lies outside the mesh bounds"};
+      return scan<glm::vec3>(base + at, first, end, inside, [&](size_t k, glm::vec3 p) {
+        if (!allFinite<3>(p)) throw Fault{at + k * 12, meshName(i) + ": position " + std::to_string(k) + " is not finite"};
+        if (!inside(p)) throw Fault{at + k * 12, meshName(i) + ": position " + std::to_string(k) + " lies outside the mesh bounds"};
       });
-    case kNormals:
-      return scan<glm::vec3>(base + l.normalAt, first, end, [&](glm::vec3 n) { return finite(n.x + n.y + n.z); },
-                             [&](size_t k, glm::vec3 n) {
-                               if (!finite(n.x + n.y + n.z)) throw Fault{l.normalAt + k * 12, meshName(i) + ": a normal is not finite"};
-                             });
-    case kTexcoords:
-      return scan<glm::vec2>(base + l.texcoordAt, first, end, [&](glm::vec2 t) { return finite(t.x + t.y); },
-                             [&](size_t k, glm::vec2 t) {
-                               if (!finite(t.x + t.y)) throw Fault{l.texcoordAt + k * 8, meshName(i) + ": a texcoord is not finite"};
-                             });
+    case kNormals: return checkFiniteArray<3>(base, at, first, end, meshName(i) + ": a normal");
+    case kTexcoords: return checkFiniteArray<2>(base, at, first, end, meshName(i) + ": a texcoord");
+    case kTexcoords1: return checkFiniteArray<2>(base, at, first, end, meshName(i) + ": a second-set texcoord");
+    case kTangents: return checkFiniteArray<4>(base, at, first, end, meshName(i) + ": a tangent");
+    case kColors: return checkFiniteArray<4>(base, at, first, end, meshName(i) + ": a vertex colour");
     case kIndices:
       return l.flags & kIndex16 ? checkIndices<uint16_t>(l, base, i, first, end) : checkIndices<uint32_t>(l, base, i, first, end);
     case kClusters: return;
@@ -231,7 +292,7 @@ void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i
     }
     const float slack = c.radius * 1e-4f + 1e-6f * (std::abs(c.center.x) + std::abs(c.center.y) + std::abs(c.center.z));
     for (uint32_t j = 0; j < distinct; ++j)
-      if (!(glm::length(load<glm::vec3>(base + l.posAt + size_t(vertices[j]) * 12) - c.center) <= c.radius + slack))
+      if (!(glm::length(load<glm::vec3>(base + l.at[kPositions] + size_t(vertices[j]) * 12) - c.center) <= c.radius + slack))
         fault(cAt, k, "vertex " + std::to_string(vertices[j]) + " lies outside its bounding sphere");
   }
   if (end == l.clusters && next != triangles)
@@ -247,15 +308,13 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
   std::vector<Job> jobs;
   for (uint32_t i = 0; i < layout.size(); ++i) {
     const MeshLayout& l = layout[i];
-    const size_t counts[] = {l.vertices, l.flags & kHasNormals ? l.vertices : 0u, l.flags & kHasTexcoords ? l.vertices : 0u,
-                             l.indices};
-    const size_t sizes[] = {12, 12, 8, size_t(l.flags & kIndex16 ? 2 : 4)};
     for (uint8_t s = kPositions; s <= kIndices; ++s) {
-      if (counts[s] == 0) continue;
-      jobs.push_back({i, Stream(s), true, 0, counts[s], 2 * counts[s] * sizes[s]});  // writes cost more: fresh pages
-      for (size_t f = 0; f < counts[s]; f += kPiece) {
-        const size_t n = std::min(kPiece, counts[s] - f);
-        jobs.push_back({i, Stream(s), false, f, n, n * sizes[s]});
+      const size_t count = l.count(Stream(s)), size = l.elementSize(Stream(s));
+      if (count == 0) continue;
+      jobs.push_back({i, Stream(s), true, 0, count, 2 * count * size});  // writes cost more: fresh pages
+      for (size_t f = 0; f < count; f += kPiece) {
+        const size_t n = std::min(kPiece, count - f);
+        jobs.push_back({i, Stream(s), false, f, n, n * size});
       }
     }
     for (size_t f = 0; f < l.clusters; f += kClusterPiece) {
@@ -292,6 +351,12 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
 std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   if (version < 1 || version > kRtrSceneVersion || (version < 2 && !scene.lights.empty()))
     throw Error("cannot encode .rtrscene version " + std::to_string(version) + (scene.lights.empty() ? "" : " with lights"));
+  if (const std::string what = newerThan4(scene); version < 5 && !what.empty())
+    throw Error("cannot encode .rtrscene version " + std::to_string(version) + " with " + what);
+  for (const Light& l : scene.lights)
+    if (const char* f = lightFault(l)) throw Error(std::string("cannot encode a light: ") + f);
+  for (const Instance& i : scene.instances)
+    if (i.mesh >= scene.meshes.size()) throw Error("cannot encode an instance of mesh " + std::to_string(i.mesh) + ": no such mesh");
   ByteWriter w;
   w.bytes(kMagic, 8);
   w.u32(version);
@@ -306,16 +371,38 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   writeVec(w, view.position);
   w.f32(view.yawDeg);
   w.f32(view.pitchDeg);
+  if (version >= 5) {
+    w.u32(uint32_t(scene.instances.size()));
+    w.f32(scene.defaultFovYDeg);
+  }
   w.pad(kAlign);
 
-  for (const Light& l : scene.lights) {  // 80 bytes each
+  for (const Light& l : scene.lights) {  // 80 bytes each, 104 from version 5
     w.u32(uint32_t(l.kind));
     w.u32(l.falloff ? kLightFalloff : 0);
     for (const glm::vec3& v : {l.position, l.color, l.corner, l.edge1, l.edge2, l.normal}) writeVec(w, v);
+    if (version < 5) continue;
+    writeVec(w, l.direction);
+    w.f32(l.innerConeCos);
+    w.f32(l.outerConeCos);
+    w.f32(l.range);
+  }
+  if (version >= 5) w.pad(kAlign);
+  for (const Instance& i : scene.instances) {  // version 5: 80 bytes each (none before: refused above)
+    w.u32(i.mesh);
+    w.data().append(12, '\0');
+    w.pod(i.transform);  // column-major, as glm holds it
   }
   for (const Texture& t : scene.textures) {
+    if (t.bytes) throw Error("texture '" + t.path.string() + "' is held in memory: write it to a file first (rtr-bake does)");
     w.u8(t.srgb ? 1 : 0);
     w.u8(t.channels);
+    if (version >= 5) {
+      w.u8(t.sourceChannel);
+      w.u8(uint8_t(t.sampler.wrapU));
+      w.u8(uint8_t(t.sampler.wrapV));
+      w.u8((t.sampler.nearestMag ? kNearestMag : 0) | (t.sampler.nearestMin ? kNearestMin : 0) | (t.sampler.nearestMip ? kNearestMip : 0));
+    }
     w.pod(uint16_t(0));
     writeString(w, t.path.generic_string());
   }
@@ -335,16 +422,30 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     w.f32(m.mirror);
     w.f32(m.ior);
     w.f32(m.transparency);
-    for (uint32_t s = 0; s < kCourseSlotCount; ++s) w.u32(m.textures[s]);
+    if (version < 5) {
+      for (uint32_t s = 0; s < kCourseSlotCount; ++s) w.u32(m.textures[s]);
+      continue;
+    }
+    for (float f : {m.opacity, m.alphaCutoff, m.normalScale, m.occlusionStrength}) w.f32(f);
+    for (uint32_t id : m.textures) w.u32(id);
+    for (const UvTransform& u : m.uv) {
+      for (float f : {u.offset.x, u.offset.y, u.rotation, u.scale.x, u.scale.y}) w.f32(f);
+      w.u32(u.texCoord);
+    }
   }
   w.pad(kAlign);
   for (const Mesh& m : scene.meshes) {
     const size_t v = m.positions.size();
-    if ((!m.normals.empty() && m.normals.size() != v) || (!m.texcoords.empty() && m.texcoords.size() != v))
+    auto sized = [v](const auto& a) { return a.empty() || a.size() == v; };
+    if (!sized(m.normals) || !sized(m.texcoords) || !sized(m.texcoords1) || !sized(m.tangents) || !sized(m.colors))
       throw Error("mesh '" + m.name + "': attribute counts differ");
     const bool small = v <= 0x10000;
+    const uint32_t present[kVertexStreams] = {1, !m.normals.empty(), !m.texcoords.empty(), !m.texcoords1.empty(),
+                                              !m.tangents.empty(), !m.colors.empty()};
+    uint32_t flags = small ? kIndex16 : 0;
+    for (size_t s = 1; s < kVertexStreams; ++s) flags |= present[s] ? kStreamFlag[s] : 0;
     w.u32(m.material);
-    w.u32((m.normals.empty() ? 0 : kHasNormals) | (m.texcoords.empty() ? 0 : kHasTexcoords) | (small ? kIndex16 : 0));
+    w.u32(flags);
     w.u32(uint32_t(v));
     w.u32(uint32_t(m.indices.size()));
     writeVec(w, v ? m.bounds.min : glm::vec3(0.0f));  // an empty mesh's bounds are infinite: store zeros
@@ -357,6 +458,14 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     w.pad(kAlign);
     w.array(m.texcoords);
     w.pad(kAlign);
+    if (version >= 5) {  // empty before (refused above)
+      w.array(m.texcoords1);
+      w.pad(kAlign);
+      w.array(m.tangents);
+      w.pad(kAlign);
+      w.array(m.colors);
+      w.pad(kAlign);
+    }
     if (small)
       w.array(std::vector<uint16_t>(m.indices.begin(), m.indices.end()));
     else
@@ -412,6 +521,14 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
   view.yawDeg = readFinite(r, "the default view");
   view.pitchDeg = readFinite(r, "the default view");
   if (flags & kHasView) scene.defaultView = view;
+  uint32_t instanceCount = 0;
+  if (version >= 5) {
+    instanceCount = r.u32("the header");
+    scene.defaultFovYDeg = readFinite(r, "the field of view");
+    if (scene.defaultFovYDeg < 0.0f || scene.defaultFovYDeg >= 180.0f)
+      r.failAt(72, "field of view " + std::to_string(scene.defaultFovYDeg) + " not in 0..180 degrees");
+    if (r.u32("the header") != 0) r.failAt(76, "reserved field is not 0");
+  }
   r.align(kAlign, "the header");
   if (payload != bytes.size() - kHeaderSize)
     r.failAt(32, "payload size " + std::to_string(payload) + " does not match the file (" +
@@ -426,33 +543,68 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
 #endif
 
   // Each record has a minimum size; a count that cannot fit is refused before anything is allocated.
-  if (uint64_t(lightCount) * 80 > r.remaining()) r.failAt(28, "light count " + std::to_string(lightCount) + " cannot fit in the file");
-  if (uint64_t(texCount) * 8 > r.remaining()) r.failAt(16, "texture count " + std::to_string(texCount) + " cannot fit in the file");
-  if (uint64_t(matCount) * 128 > r.remaining()) r.failAt(20, "material count " + std::to_string(matCount) + " cannot fit in the file");
+  const bool v5 = version >= 5;
+  if (uint64_t(lightCount) * (v5 ? kLightSize5 : kLightSize4) > r.remaining())
+    r.failAt(28, "light count " + std::to_string(lightCount) + " cannot fit in the file");
+  if (uint64_t(instanceCount) * kInstanceSize > r.remaining())
+    r.failAt(68, "instance count " + std::to_string(instanceCount) + " cannot fit in the file");
+  if (uint64_t(texCount) * (v5 ? 12 : 8) > r.remaining()) r.failAt(16, "texture count " + std::to_string(texCount) + " cannot fit in the file");
+  if (uint64_t(matCount) * (v5 ? kMaterialMin5 : kMaterialMin4) > r.remaining())
+    r.failAt(20, "material count " + std::to_string(matCount) + " cannot fit in the file");
   if (uint64_t(meshCount) * 64 > r.remaining()) r.failAt(24, "mesh count " + std::to_string(meshCount) + " cannot fit in the file");
 
   scene.lights.resize(lightCount);
   for (Light& l : scene.lights) {
     const size_t at = r.pos();
     const uint32_t kind = r.u32("a light record"), lflags = r.u32("a light record");
-    if (kind > uint32_t(Light::Kind::Headlight)) r.failAt(at, "unknown light kind " + std::to_string(kind));
+    if (kind > uint32_t(v5 ? Light::Kind::Directional : Light::Kind::Headlight)) r.failAt(at, "unknown light kind " + std::to_string(kind));
     if (lflags & ~kLightFalloff) r.failAt(at + 4, "unknown light flags");
     l.kind = Light::Kind(kind);
     l.falloff = (lflags & kLightFalloff) != 0;
     for (glm::vec3* v : {&l.position, &l.color, &l.corner, &l.edge1, &l.edge2, &l.normal}) *v = readVec(r, "a light");
+    if (!v5) continue;
+    l.direction = readVec(r, "a light");
+    l.innerConeCos = readFinite(r, "a light");
+    l.outerConeCos = readFinite(r, "a light");
+    l.range = readFinite(r, "a light");
+    if (const char* f = lightFault(l)) r.failAt(at, std::string("light: ") + f);
+  }
+  if (v5) r.align(kAlign, "the light table");
+
+  scene.instances.resize(instanceCount);
+  for (Instance& inst : scene.instances) {
+    const size_t at = r.pos();
+    inst.mesh = r.u32("an instance record");
+    if (inst.mesh >= meshCount)
+      r.failAt(at, "instance of mesh " + std::to_string(inst.mesh) + ": out of range (" + std::to_string(meshCount) + " meshes)");
+    for (int k = 0; k < 3; ++k)
+      if (r.u32("an instance record") != 0) r.failAt(at + 4, "reserved instance field is not 0");
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k) inst.transform[c][k] = readFinite(r, "an instance transform");
   }
 
   scene.textures.resize(texCount);
   for (Texture& t : scene.textures) {
     const size_t at = r.pos();
     const uint8_t srgb = r.u8("a texture record"), ch = r.u8("a texture record");
-    r.skip(2, "a texture record");
     if (srgb > 1) r.failAt(at, "texture sRGB flag " + std::to_string(srgb) + " is neither 0 nor 1");
     if (ch < 1 || ch > 4) r.failAt(at + 1, "texture channel count " + std::to_string(ch) + " not in 1..4");
     t.srgb = srgb == 1;
     t.channels = ch;
+    if (v5) {
+      t.sourceChannel = r.u8("a texture record");
+      const uint8_t wrapU = r.u8("a texture record"), wrapV = r.u8("a texture record"), filter = r.u8("a texture record");
+      if (t.sourceChannel > (ch == 1 ? 3 : 0))
+        r.failAt(at + 2, "texture source channel " + std::to_string(t.sourceChannel) + " for " + std::to_string(ch) + " channels");
+      for (uint8_t wrap : {wrapU, wrapV})
+        if (wrap > uint8_t(Wrap::MirroredRepeat)) r.failAt(at + 3, "unknown texture wrap mode " + std::to_string(wrap));
+      if (filter & ~(kNearestMag | kNearestMin | kNearestMip)) r.failAt(at + 5, "unknown texture filter flags");
+      t.sampler = {Wrap(wrapU), Wrap(wrapV), (filter & kNearestMag) != 0, (filter & kNearestMin) != 0, (filter & kNearestMip) != 0};
+    }
+    const size_t reservedAt = r.pos();
+    if (r.pod<uint16_t>("a texture record") != 0 && v5) r.failAt(reservedAt, "reserved texture field is not 0");
     t.path = readString(r, "a texture path");
-    if (t.path.empty()) r.failAt(at + 4, "empty texture path");
+    if (t.path.empty()) r.failAt(reservedAt + 2, "empty texture path");
   }
   r.align(kAlign, "the texture table");
 
@@ -460,7 +612,7 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
   for (Material& m : scene.materials) {
     const size_t at = r.pos();
     m.flags = r.u32("a material record");
-    if (m.flags & ~kKnownMaterialFlags) r.failAt(at, "unknown material flags");
+    if (m.flags & ~(v5 ? kKnownMaterialFlags : kKnownMaterialFlags4)) r.failAt(at, "unknown material flags");
     m.name = readString(r, "a material name");
     m.baseColor = readVec(r, "a material factor");
     m.roughness = readFinite(r, "a material factor");
@@ -474,12 +626,21 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     m.mirror = readFinite(r, "a material factor");
     m.ior = readFinite(r, "a material factor");
     m.transparency = readFinite(r, "a material factor");
-    for (uint32_t s = 0; s < kCourseSlotCount; ++s) {
+    if (v5)
+      for (float* f : {&m.opacity, &m.alphaCutoff, &m.normalScale, &m.occlusionStrength}) *f = readFinite(r, "a material factor");
+    for (uint32_t s = 0; s < (v5 ? kTextureSlotCount : kCourseSlotCount); ++s) {
       uint32_t& id = m.textures[s];
       const size_t idAt = r.pos();
       id = r.u32("a material texture index");
       if (id != kNoTexture && id >= texCount)
         r.failAt(idAt, "texture index " + std::to_string(id) + " out of range (" + std::to_string(texCount) + " textures)");
+    }
+    if (!v5) continue;
+    for (UvTransform& u : m.uv) {
+      for (float* f : {&u.offset.x, &u.offset.y, &u.rotation, &u.scale.x, &u.scale.y}) *f = readFinite(r, "a uv transform");
+      const size_t setAt = r.pos();
+      u.texCoord = r.u32("a uv transform");
+      if (u.texCoord > 1) r.failAt(setAt, "uv set " + std::to_string(u.texCoord) + " is neither 0 nor 1");
     }
   }
   r.align(kAlign, "the material table");
@@ -495,12 +656,16 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     m.material = r.u32("a mesh record");
     if (m.material >= matCount) r.failAt(at, which + ": material index " + std::to_string(m.material) + " out of range");
     const uint32_t mf = r.u32("a mesh record");
-    if (mf & ~uint32_t(kHasNormals | kHasTexcoords | kIndex16)) r.failAt(at + 4, which + ": unknown mesh flags");
+    const uint32_t known = kHasNormals | kHasTexcoords | kIndex16 | (v5 ? kHasTexcoords1 | kHasTangents | kHasColors : 0);
+    if (mf & ~known) r.failAt(at + 4, which + ": unknown mesh flags");
     const uint32_t v = r.u32("a mesh record"), n = r.u32("a mesh record");
     if (n % 3 != 0) r.failAt(at + 12, which + ": index count " + std::to_string(n) + " is not a multiple of 3");
     if ((mf & kIndex16) && v > 0x10000) r.failAt(at + 4, which + ": 16-bit indices with more than 65536 vertices");
-    const uint64_t need = uint64_t(v) * (12 + (mf & kHasNormals ? 12 : 0) + (mf & kHasTexcoords ? 8 : 0)) +
-                          uint64_t(n) * (mf & kIndex16 ? 2 : 4);
+    l.flags = mf;
+    l.vertices = v;
+    l.indices = n;
+    uint64_t need = uint64_t(n) * l.elementSize(kIndices);
+    for (uint8_t s = kPositions; s < kVertexStreams; ++s) need += uint64_t(l.count(Stream(s))) * kVertexSize[s];
     if (need > r.remaining())
       r.failAt(at + 8, which + ": " + std::to_string(v) + " vertices and " + std::to_string(n) + " indices cannot fit in the " +
                            std::to_string(r.remaining()) + " bytes left");
@@ -509,15 +674,10 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     if (v == 0) m.bounds = Bounds{};
     m.name = readString(r, "a mesh name");
     r.align(kAlign, "a mesh record");
-    l.flags = mf;
-    l.vertices = v;
-    l.indices = n;
-    l.posAt = r.skipArray(v, 12, "positions");
-    r.align(kAlign, "positions");
-    l.normalAt = r.skipArray(mf & kHasNormals ? v : 0, 12, "normals");
-    r.align(kAlign, "normals");
-    l.texcoordAt = r.skipArray(mf & kHasTexcoords ? v : 0, 8, "texcoords");
-    r.align(kAlign, "texcoords");
+    for (uint8_t s = kPositions; s < kVertexStreams; ++s) {
+      l.at[s] = r.skipArray(l.count(Stream(s)), kVertexSize[s], kStreamName[s]);
+      r.align(kAlign, kStreamName[s]);
+    }
     l.indexAt = r.skipArray(n, mf & kIndex16 ? 2 : 4, "indices");
     r.align(kAlign, "indices");
     if (version < 3) continue;

@@ -9,11 +9,13 @@
 
 namespace rtr {
 
-// 2 added lights, 3 clusters, 4 a checksum summed on all cores (pieceChecksum64); versions 1-3 still load.
-constexpr uint32_t kRtrSceneVersion = 4;
+// 2 added lights, 3 clusters, 4 a checksum summed on all cores (pieceChecksum64), 5 what glTF brings
+// (instances, samplers, uv transforms, more attributes and light kinds); versions 1-4 still load.
+constexpr uint32_t kRtrSceneVersion = 5;
 
 // `version` below the current one writes an older layout (lights need 2, clusters 3, the checksum of
-// version 4), for tests of the reader.
+// version 4), for tests of the reader; a scene holding what only version 5 stores is refused in older
+// ones. Textures held in memory (Texture::bytes) are refused: the file names image files.
 std::string encodeRtrScene(const Scene& scene, uint32_t version = kRtrSceneVersion);
 // Validates everything (sizes, counts, strings, indices, texture ids, finite values, clusters, checksum).
 // The checksum (version 4), the arrays and their checks run on `threads` threads (0: one per core, or

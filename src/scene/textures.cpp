@@ -11,13 +11,19 @@
 
 namespace rtr {
 
+std::span<const TextureSlot> sampledSlots(const Material& material) {
+  if (material.flags & kMaterialGltf) return kGltfSampledSlots;
+  return kSampledSlots;
+}
+
 std::vector<uint32_t> sampledTextures(const Scene& scene) {
   std::vector<uint32_t> used;
   std::vector<uint8_t> seen(scene.textures.size(), 0);
   for (const Mesh& m : scene.meshes) {
     if (m.texcoords.empty() || m.indices.empty()) continue;
-    for (TextureSlot slot : kSampledSlots) {
-      const uint32_t t = scene.materials.at(m.material).texture(slot);
+    const Material& mat = scene.materials.at(m.material);
+    for (TextureSlot slot : sampledSlots(mat)) {
+      const uint32_t t = mat.texture(slot);
       if (t != kNoTexture && !seen.at(t)) {
         seen[t] = 1;
         used.push_back(t);
@@ -29,6 +35,21 @@ std::vector<uint32_t> sampledTextures(const Scene& scene) {
 
 int decodeChannels(const Texture& t) { return t.channels == 1 ? 1 : 4; }
 bool decodeSrgb(const Texture& t) { return t.srgb && decodeChannels(t) == 4; }
+
+TexelData decodeTexture(const Scene& scene, const Texture& t) {
+  const int channels = decodeChannels(t);
+  const bool pick = channels == 1 && t.sourceChannel > 0;  // one channel of a colour image
+  TexelData d = t.bytes ? decodeImage(*t.bytes, t.path.string(), pick ? 4 : channels)
+                        : loadImage(t.path.is_absolute() ? t.path : scene.baseDir / t.path, pick ? 4 : channels);
+  if (pick) {
+    const int c = std::min<int>(t.sourceChannel, 3);
+    for (size_t i = 0, n = size_t(d.width) * d.height; i < n; ++i) d.texels[i] = d.texels[i * 4 + c];
+    d.texels.resize(size_t(d.width) * d.height);
+    d.texels.shrink_to_fit();
+    d.channels = 1;
+  }
+  return d;
+}
 
 TexelData fallbackTexels(int channels) {
   constexpr uint32_t kSize = 64, kCell = 8;
@@ -48,14 +69,15 @@ void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
                     const std::function<void(const std::string&)>& warn) {
   std::mutex warnMutex;
   // A missing or broken texture must not stop a model from showing: warn, and show the checker instead.
-  auto load = [&](const std::filesystem::path& file, int channels) {
+  auto load = [&](const Texture& t) {
     std::string why;
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec)) {
+    const std::filesystem::path file = t.path.is_absolute() ? t.path : scene.baseDir / t.path;
+    if (!t.bytes && !std::filesystem::is_regular_file(file, ec)) {
       why = file.string() + ": texture file does not exist";
     } else {
       try {
-        return loadImage(file, channels);
+        return decodeTexture(scene, t);
       } catch (const Error& e) {
         why = e.what();
       }
@@ -64,7 +86,7 @@ void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
     const std::string msg = why + "; showing a magenta/black checker instead";
     if (warn) warn(msg);
     else std::cerr << "warning: " << msg << "\n";
-    return fallbackTexels(channels);
+    return fallbackTexels(decodeChannels(t));
   };
   std::atomic<size_t> next{0};
   std::vector<std::future<void>> workers;
@@ -72,8 +94,7 @@ void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
   for (unsigned w = 0; w < n; ++w)
     workers.push_back(std::async(std::launch::async, [&] {
       for (size_t i; (i = next++) < which.size();) {
-        const Texture& t = scene.textures.at(which[i]);
-        use(i, load(t.path.is_absolute() ? t.path : scene.baseDir / t.path, decodeChannels(t)));
+        use(i, load(scene.textures.at(which[i])));
       }
     }));
   for (auto& w : workers) w.get();  // rethrows the first error

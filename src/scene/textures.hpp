@@ -13,9 +13,14 @@
 
 namespace rtr {
 
-// Texture slots the renderers sample (the normal map is not part of the brief's shading model).
+// Texture slots the renderers sample for OBJ/MTL and course materials (the normal map is not part of the
+// brief's shading model), and for glTF materials (kMaterialGltf), which add the normal map and occlusion.
 constexpr TextureSlot kSampledSlots[] = {TextureSlot::BaseColor, TextureSlot::Roughness, TextureSlot::Metalness,
                                          TextureSlot::AlphaMask, TextureSlot::Emissive};
+constexpr TextureSlot kGltfSampledSlots[] = {TextureSlot::BaseColor, TextureSlot::Roughness, TextureSlot::Metalness,
+                                             TextureSlot::AlphaMask, TextureSlot::Emissive,  TextureSlot::NormalMap,
+                                             TextureSlot::Occlusion};
+std::span<const TextureSlot> sampledSlots(const Material& material);
 
 // Scene texture indices sampled by some slot of a material drawn by a mesh that has texcoords (a mesh
 // without texcoords samples nothing), each once, in order of first use.
@@ -29,6 +34,10 @@ bool decodeSrgb(const Texture& t);
 // The texels shown for a texture that is missing or cannot be decoded: a 64x64 magenta/black checker of
 // 8-texel cells (one channel: 255/0), so the fault is visible in every renderer.
 TexelData fallbackTexels(int channels);
+
+// One texture's texels: Texture::bytes when set (else the file), `sourceChannel` taken for one-channel
+// textures. Throws rtr::Error naming the file (or the image's name).
+TexelData decodeTexture(const Scene& scene, const Texture& t);
 
 // Decodes scene.textures[which[i]] for every i on all cores and hands the texels to use(i, texels) on the
 // thread that decoded them (so per-texture work after decoding runs in parallel too). A texture that is

@@ -50,7 +50,10 @@ inline void checkScene(const Scene& s) {
       next += c.triangleCount;
     }
     require(m.clusters.empty() || next == m.triangleCount(), "clusters do not cover the triangles");
+    for (size_t n : {m.texcoords1.size(), m.tangents.size(), m.colors.size()})
+      require(n == 0 || n == m.positions.size(), "attribute count differs from position count");
   }
+  for (const Instance& i : s.instances) require(i.mesh < s.meshes.size(), "instance mesh id out of range");
 }
 
 }  // namespace rtr::fuzz

@@ -195,7 +195,7 @@ TEST(Clusters, RtrSceneStoresThemAndOlderVersionsLoadWithout) {
   }
   // Version 2 has no clusters: it loads with none (loadScene then builds them).
   const std::string v2 = encodeRtrScene(gridScene(), 2);
-  EXPECT_EQ(v2.size() + 16, plain.size()) << "version 3 adds a 16-byte cluster header per mesh";
+  EXPECT_EQ(v2.size() + 16, encodeRtrScene(gridScene(), 3).size()) << "version 3 adds a 16-byte cluster header per mesh";
   const Scene old = decodeRtrScene({reinterpret_cast<const uint8_t*>(v2.data()), v2.size()}, "g.rtrscene");
   EXPECT_TRUE(old.meshes[0].clusters.empty());
   EXPECT_EQ(old.meshes[0].indices, gridScene().meshes[0].indices);

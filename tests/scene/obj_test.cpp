@@ -159,8 +159,8 @@ TEST(Obj, MaterialFieldsTexturesAndFlags) {
   EXPECT_EQ(ms[0].flags, 0u);
   // Ids at first appearance, de-duplicated: stone_col 0, stone_r 1, stone_m 2, stone_n 3, leaf 4, fire 5.
   ASSERT_EQ(p.scene.textures.size(), 6u);
-  EXPECT_EQ(ms[0].textures, (std::array<uint32_t, 6>{0, 1, 2, kNoTexture, 3, kNoTexture}));
-  EXPECT_EQ(ms[1].textures, (std::array<uint32_t, 6>{4, kNoTexture, kNoTexture, 4, kNoTexture, kNoTexture}));
+  EXPECT_EQ(ms[0].textures, (std::array<uint32_t, kTextureSlotCount>{0, 1, 2, kNoTexture, 3, kNoTexture, kNoTexture}));
+  EXPECT_EQ(ms[1].textures, (std::array<uint32_t, kTextureSlotCount>{4, kNoTexture, kNoTexture, 4, kNoTexture, kNoTexture, kNoTexture}));
   EXPECT_EQ(ms[1].flags, kMaterialAlphaMasked | kMaterialDoubleSided);
   EXPECT_EQ(ms[2].flags, kMaterialLight);
   EXPECT_EQ(ms[2].emissive, glm::vec3(2, 1, 0.5f));

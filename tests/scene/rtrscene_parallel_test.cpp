@@ -1,5 +1,5 @@
 // The .rtrscene decoder on several threads: the scene and any fault it reports are those of one thread;
-// version 4's piece checksum is its definition at any thread count; files of older versions still load.
+// the piece checksum (version 4 on) is its definition at any thread count; files of older versions still load.
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -202,7 +202,7 @@ TEST(RtrSceneParallel, Version4RefusesADamagedPieceAndOlderFilesStillLoad) {
   EXPECT_EQ(decodeError(v3, 1), "(no error)");
   v3[v3.size() - 20] ^= 1;
   EXPECT_THAT(decodeError(v3, 1), HasSubstr("at byte 40: checksum mismatch"));
-  std::string v5 = good;
-  v5[8] = 5;
-  EXPECT_THAT(decodeError(v5, 1), HasSubstr("at byte 8: unsupported version 5 (this build reads 4)"));
+  std::string v6 = good;
+  v6[8] = 6;
+  EXPECT_THAT(decodeError(v6, 1), HasSubstr("at byte 8: unsupported version 6 (this build reads 5)"));
 }
