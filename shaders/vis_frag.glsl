@@ -18,8 +18,11 @@ layout(location = 0) in vec2 inTexcoord;
 
 void main() {
 #if ALPHA_MASK
-  uint t = materials[draw.material].textures.w;  // uniform per draw
-  if (t != NO_TEXTURE && texture(textures[t], inTexcoord, frame.params.y).a < 0.5) discard;
+  const GpuMaterial m = materials[draw.material];  // uniform per draw
+  if (m.textures.w != NO_TEXTURE) {
+    const vec4 mask = texture(textures[m.textures.w], inTexcoord, frame.params.y);
+    if (m.baseColor.a * ((m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a) < m.roughMetal.z) discard;
+  }
 #endif
   outId = (inInstance << draw.primitiveBits) | uint(gl_PrimitiveID);
 }

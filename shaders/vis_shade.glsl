@@ -92,7 +92,7 @@ void main() {
 
   const GpuMaterial m = materials[d.material];
   vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
-  float roughness = m.roughMetal.x, metalness = m.roughMetal.y;
+  float roughness = m.roughMetal.x, metalness = m.roughMetal.y, occlusion = 1.0;
 #if HAS_TEXCOORDS
   if ((d.flags & DRAW_TEXTURED) != 0u) {
     const vec2 t0 = texcoords[tri.x], t1 = texcoords[tri.y], t2 = texcoords[tri.z];
@@ -109,15 +109,20 @@ void main() {
     roughness *= sampleOr(m.textures.y, uv, gx, gy, vec4(1.0)).r;
     metalness *= sampleOr(m.textures.z, uv, gx, gy, vec4(1.0)).r;
     emissive *= sampleOr(m.textures2.x, uv, gx, gy, vec4(1.0)).rgb;
+    if (m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m.textures2.y, uv, gx, gy, vec4(1.0)).r - 1.0);
   }
 #endif
+  if ((m.textures2.w & MATERIAL_UNLIT) != 0u) {
+    imageStore(sceneColor, p, vec4(min(baseColor, vec3(kMaxRadiance)), 1.0));
+    return;
+  }
 
   const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
-  vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) + emissive;
+  const int brdf = (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
+  vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) * occlusion + emissive;
   for (uint i = 0u; i < frame.lightCount.x; ++i) {
-    const LightSample ls = lightSample(frame.lights[i].position.xyz, frame.lights[i].color.rgb,
-                                       frame.lights[i].position.w > 0.5, worldPos);
-    c += pbrDirect(nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
+    const LightSample ls = lightSample(frame.lights[i], worldPos);  // point, spot or directional (lights.h)
+    c += pbrDirect(brdf, nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
   }
   imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
 }

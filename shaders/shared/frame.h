@@ -48,13 +48,18 @@ struct FrameUniforms {
 
 // Material factors (storage buffer, std430). Texture indices index the scene's texture array;
 // 0xFFFFFFFF: no texture (the factor alone is used).
+// OBJ/course materials: opacity 1, cutoff 0.5, no occlusion texture, no flags (today's shading exactly).
 struct GpuMaterial {
-  vec4 baseColor;     // rgb factor, a unused
+  vec4 baseColor;     // rgb factor, a opacity (glTF baseColorFactor's alpha; it multiplies the mask)
   vec4 emissive;      // rgb factor
-  vec4 roughMetal;    // x roughness, y metalness
+  vec4 roughMetal;    // x roughness, y metalness, z alpha cutoff (alpha below it is cut out),
+                      // w occlusion strength (glTF: ambient x (1 + strength (occlusion - 1)))
   uvec4 textures;     // x baseColor, y roughness, z metalness, w alphaMask
-  uvec4 textures2;    // x emissive
+  uvec4 textures2;    // x emissive, y occlusion (its red), z unused, w MATERIAL_* flags
 };
+#define MATERIAL_UNLIT 1u     // KHR_materials_unlit: the base colour is the result
+#define MATERIAL_MASK_RED 2u  // the alpha-mask texture is one channel (glTF: the base colour's alpha): read .r
+#define MATERIAL_GGX 4u       // glTF materials: brdf.h's BRDF_GGX (others: the brief's Beckmann)
 
 // Per-draw push constants.
 struct DrawPush {

@@ -92,7 +92,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
     texturedMaterials_ = materials;
-    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = NO_TEXTURE;
+    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = NO_TEXTURE;
   }
   uploadGeometry(plan, materials, upload);
   stats_.geometryMs = msSince(t);
@@ -203,13 +203,18 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
   std::vector<shader::GpuMaterial> materials;
   for (const Material& m : scene.materials) {
     shader::GpuMaterial g{};
-    g.baseColor = glm::vec4(m.baseColor, 1.0f);
+    // glTF factors only for glTF materials: OBJ/course ones keep opacity 1 and the cutoff 0.5.
+    const bool gltf = m.flags & kMaterialGltf;
+    g.baseColor = glm::vec4(m.baseColor, gltf ? m.opacity : 1.0f);
     g.emissive = glm::vec4(m.emissive, 0.0f);
-    g.roughMetal = glm::vec4(m.roughness, m.metalness, 0.0f, 0.0f);
+    g.roughMetal = glm::vec4(m.roughness, m.metalness, gltf ? m.alphaCutoff : 0.5f, m.occlusionStrength);
     auto tex = [&](TextureSlot s) { uint32_t t = m.texture(s); return t == kNoTexture ? NO_TEXTURE : gpuIndex[t]; };
     g.textures = glm::uvec4(tex(TextureSlot::BaseColor), tex(TextureSlot::Roughness), tex(TextureSlot::Metalness),
                             tex(TextureSlot::AlphaMask));
-    g.textures2 = glm::uvec4(tex(TextureSlot::Emissive), 0, 0, 0);
+    const uint32_t mask = m.texture(TextureSlot::AlphaMask);
+    const uint32_t flags = (m.flags & kMaterialUnlit ? MATERIAL_UNLIT : 0u) | (gltf ? MATERIAL_GGX : 0u) |
+                           (mask != kNoTexture && scene.textures.at(mask).channels == 1 ? MATERIAL_MASK_RED : 0u);
+    g.textures2 = glm::uvec4(tex(TextureSlot::Emissive), gltf ? tex(TextureSlot::Occlusion) : NO_TEXTURE, NO_TEXTURE, flags);
     materials.push_back(g);
   }
   if (materials.empty()) materials.push_back({});

@@ -342,7 +342,8 @@ void Renderer::frame(FrameContext& fc) {
   for (uint32_t i = 0; i < u.lightCount.x; ++i) {
     const Light& l = s.lights.lights[i];
     const glm::vec3 p = l.kind == Light::Kind::Headlight ? pose.position : l.position;
-    u.lights[i] = {glm::vec4(p, l.falloff ? 1.0f : 0.0f), glm::vec4(l.color, 0.0f)};
+    u.lights[i] = shader::makeGpuLight(unsigned(l.kind), p, l.color, l.falloff, l.direction, l.innerConeCos,
+                                       l.outerConeCos, l.range);
   }
   u.params = glm::vec4(float(s.mode), s.lodBias, lens.zNear, lens.zFar);
   {

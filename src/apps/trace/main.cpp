@@ -40,7 +40,7 @@ int run(int argc, char** argv) {
       ->capture_default_str()->check(cli::number(0, 180, true));
   app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, FORMATS.md §2)");
   app.add_option("--ortho-height", orthoHeight, "half height of the orthographic volume")->check(cli::number(0, 1e30, true));
-  app.add_option("--shading", shading, "phong | pbr | normals | depth")
+  app.add_option("--shading", shading, "phong | pbr | normals | depth (default: pbr for glTF materials, else phong)")
       ->capture_default_str()->check(CLI::IsMember({"phong", "pbr", "normals", "depth"}));
   app.add_option("--brdf", brdf, "pbr: beckmann | ggx for every material (default: ggx for glTF materials, "
                  "beckmann for the rest)")->check(CLI::IsMember({"beckmann", "ggx"}));
@@ -86,6 +86,10 @@ int run(int argc, char** argv) {
   LoadOptions load;
   if (!mtlPath.empty()) load.mtl = mtlPath;
   const Scene scene = loadScene(scenePath, load);
+  // glTF materials are physically based: without --shading they get pbr, not the course's Blinn-Phong.
+  if (app.count("--shading") == 0 &&
+      std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.flags & kMaterialGltf; }))
+    s.shading = Shading::Pbr;
   s.lights = resolveLights(scene, lightOptions);
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   const Tracer tracer(scene, s.threads);
@@ -111,7 +115,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
                  "(%llu primary, %llu shadow, %llu mirror), %.2f Mrays/s; pose %s -> %s\n",
-                 tracer.triangles().size(), s.lights->lights.size(), tracer.usesBvh() ? "BVH8" : "no BVH",
+                 tracer.triangles().size(), s.lights->lights.size(), tracer.usesBvh() ? "BVH8" : tracer.instanced() ? "two-level BVH8" : "no BVH",
                  tracer.usesBvh() ? tracer.bvh().stats().buildSeconds : 0.0, w, h, st.seconds,
                  (unsigned long long)rays, (unsigned long long)st.primaryRays, (unsigned long long)st.shadowRays,
                  (unsigned long long)st.reflectionRays, double(rays) / st.seconds * 1e-6,
