@@ -125,7 +125,7 @@ def main():
                 brightest, colours = image_stats(os.path.join(out, png))
                 if brightest < 16:
                     outcome = "BLACK image"
-                elif is_textured(obj) and colours < 24:
+                elif is_textured(obj) and colours < (20 if gltf else 24):
                     outcome = "NO TEXTURE (%d colours)" % colours
                 else:
                     outcome = "ok (max %d, %d colours)" % (brightest, colours)
