@@ -43,7 +43,8 @@ TEST(GltfReader, SameTriangleFromGltfBinDataUriAndGlb) {
   const int nrm = b.floats(std::vector<glm::vec3>(3, {0, 0, 1}), "VEC3");
   const int idx = b.indices({0, 1, 2});
   const std::string rest = meshJson(pos, idx, ",\"NORMAL\":" + std::to_string(nrm)) + "," + kOneNode;
-  for (const auto& file : {b.writeGltf(dir, "ext", rest), b.writeEmbedded(dir, "uri", rest), b.writeGlb(dir, "bin", rest)}) {
+  std::filesystem::copy_file(b.writeGlb(dir, "bin", rest), dir / "UPPER.GLB");  // the extension in any case
+  for (const auto& file : {b.writeGltf(dir, "ext", rest), b.writeEmbedded(dir, "uri", rest), b.writeGlb(dir, "bin", rest), dir / "UPPER.GLB"}) {
     SCOPED_TRACE(file.string());
     const Scene s = loadScene(file);
     ASSERT_EQ(s.meshes.size(), 1u);
