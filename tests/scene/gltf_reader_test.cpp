@@ -184,6 +184,23 @@ TEST(GltfReader, NodeHierarchyBecomesInstancesOfOneMesh) {
   EXPECT_EQ(s.bounds().max.x, 3.0f);
 }
 
+TEST(GltfReader, AtMostTenWarningsThenTheCount) {
+  const auto dir = test::tempFolder("warnings");
+  GltfBuilder b;
+  b.floats(kTri, "VEC3");
+  b.indices({0, 1, 2, 0});  // 4 indices: the last one is left out, with a warning
+  std::string meshes = "\"meshes\":[";
+  for (int i = 0; i < 12; ++i) meshes += std::string(i ? "," : "") + "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}";
+  std::string nodes = "],\"nodes\":[";
+  for (int i = 0; i < 12; ++i) nodes += std::string(i ? "," : "") + "{\"mesh\":" + std::to_string(i) + "}";
+  Notes n;
+  const Scene s = loadScene(b.writeGlb(dir, "w", meshes + nodes + "]"), n.options());
+  EXPECT_EQ(s.meshes.size(), 12u);
+  ASSERT_EQ(n.warnings.size(), 11u);
+  EXPECT_THAT(n.warnings[0], HasSubstr("not whole triangles"));
+  EXPECT_THAT(n.warnings[10], HasSubstr("w.glb: 12 warnings, first 10 shown"));
+}
+
 TEST(GltfReader, AnimationsSkinsAndMorphTargetsGetOneNote) {
   const auto dir = test::tempFolder("anim");
   GltfBuilder b;
