@@ -23,13 +23,15 @@ vec3 mipColor(float level) {
 void main() {
   Surface s = fetchSurface();
 #if ALPHA_MASK
-  if (s.alpha < 0.5) discard;
+  if (cutOut(s)) discard;
 #endif
   int mode = int(frame.params.x);
   vec3 n = brdfSafeNormal(shadingNormal());
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
   // The first light (a scene without lights: the view direction, as a headlight).
-  vec3 l = frame.lightCount.x > 0u ? normalize(frame.lights[0].position.xyz - inWorldPos) : v;
+  vec3 l = frame.lightCount.x == 0u              ? v
+           : frame.lights[0].color.w > 3.5 ? -frame.lights[0].direction.xyz  // LIGHT_DIRECTIONAL
+                                           : normalize(frame.lights[0].position.xyz - inWorldPos);
   float viewDepth = -(frame.view * vec4(inWorldPos, 1.0)).z;  // distance along the view axis
   float far = frame.params.w;
   vec3 c = vec3(0.0);
@@ -64,7 +66,7 @@ void main() {
     outColor = vec4(s.baseColor, 1.0);  // linear, like the shaded output
     return;
   } else {
-    BrdfTerms t = brdfTerms(n, v, l, s.baseColor, s.roughness, s.metalness);
+    BrdfTerms t = brdfTerms(brdfOf(), n, v, l, s.baseColor, s.roughness, s.metalness);
     if (mode == VIEW_BRDF_D) c = vec3(t.D / (1.0 + t.D));  // tone-mapped: D is unbounded
     else if (mode == VIEW_BRDF_F) c = t.F;
     else if (mode == VIEW_BRDF_G) c = vec3(t.G);

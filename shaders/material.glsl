@@ -3,6 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_nonuniform_qualifier : require
 #include "frame.h"
+#include "brdf.h"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1, std430) readonly buffer Materials { GpuMaterial materials[]; };
@@ -23,6 +24,7 @@ struct Surface {
   float metalness;
   vec3 emissive;
   float alpha;
+  float occlusion;  // multiplies the ambient term (1: none)
 };
 
 #if HAS_TEXCOORDS
@@ -39,16 +41,23 @@ Surface fetchSurface() {
   s.roughness = m.roughMetal.x;
   s.metalness = m.roughMetal.y;
   s.emissive = m.emissive.rgb;
-  s.alpha = 1.0;
+  s.alpha = m.baseColor.a;
+  s.occlusion = 1.0;
 #if HAS_TEXCOORDS
   s.baseColor *= sampleOr(m.textures.x, vec4(1.0)).rgb;
   s.roughness *= sampleOr(m.textures.y, vec4(1.0)).r;
   s.metalness *= sampleOr(m.textures.z, vec4(1.0)).r;
-  s.alpha = sampleOr(m.textures.w, vec4(1.0)).a;
+  const vec4 mask = sampleOr(m.textures.w, vec4(1.0));
+  s.alpha *= (m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a;
   s.emissive *= sampleOr(m.textures2.x, vec4(1.0)).rgb;
+  if (m.textures2.y != NO_TEXTURE) s.occlusion = 1.0 + m.roughMetal.w * (sampleOr(m.textures2.y, vec4(1.0)).r - 1.0);
 #endif
   return s;
 }
+
+bool cutOut(Surface s) { return s.alpha < materials[draw.material].roughMetal.z; }
+int brdfOf() { return (materials[draw.material].textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN; }
+bool unlit() { return (materials[draw.material].textures2.w & MATERIAL_UNLIT) != 0u; }
 
 // Two-sided materials light their back faces with the flipped normal.
 vec3 shadingNormal() { return gl_FrontFacing ? inNormal : -inNormal; }

@@ -12,15 +12,19 @@ const float kMaxRadiance = 60000.0;
 void main() {
   Surface s = fetchSurface();
 #if ALPHA_MASK
-  if (s.alpha < 0.5) discard;
+  if (cutOut(s)) discard;
 #endif
+  if (unlit()) {
+    outColor = vec4(min(s.baseColor, vec3(kMaxRadiance)), 1.0);
+    return;
+  }
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
   vec3 n = shadingNormal();
-  vec3 c = frame.ambient.rgb * clamp(s.baseColor, vec3(0.0), vec3(1.0)) + s.emissive;
+  const int brdf = brdfOf();
+  vec3 c = frame.ambient.rgb * clamp(s.baseColor, vec3(0.0), vec3(1.0)) * s.occlusion + s.emissive;
   for (uint i = 0u; i < frame.lightCount.x; ++i) {
-    LightSample ls = lightSample(frame.lights[i].position.xyz, frame.lights[i].color.rgb,
-                                 frame.lights[i].position.w > 0.5, inWorldPos);
-    c += pbrDirect(n, v, ls.l, ls.radiance, s.baseColor, s.roughness, s.metalness);
+    LightSample ls = lightSample(frame.lights[i], inWorldPos);  // point, spot or directional (lights.h)
+    c += pbrDirect(brdf, n, v, ls.l, ls.radiance, s.baseColor, s.roughness, s.metalness);
   }
   outColor = vec4(min(c, vec3(kMaxRadiance)), 1.0);
 }

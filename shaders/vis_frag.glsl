@@ -1,4 +1,4 @@
-// Visibility pass fragment stage: stores which triangle is visible (draw index and gl_PrimitiveID, which
+// Visibility pass fragment stage: stores which triangle is visible (instance index and gl_PrimitiveID, which
 // needs the geometryShader feature, in one uint); the compute pass vis_shade.glsl shades it. Alpha-masked materials
 // discard here exactly like pbr_frag.glsl (same texture, same implicit LOD and bias).
 #extension GL_GOOGLE_include_directive : require
@@ -7,6 +7,7 @@
 
 layout(push_constant) uniform Push { DrawPush draw; };
 layout(location = 0) out uint outId;
+layout(location = 1) flat in uint inInstance;
 
 #if ALPHA_MASK
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
@@ -17,8 +18,11 @@ layout(location = 0) in vec2 inTexcoord;
 
 void main() {
 #if ALPHA_MASK
-  uint t = materials[draw.material].textures.w;  // uniform per draw
-  if (t != NO_TEXTURE && texture(textures[t], inTexcoord, frame.params.y).a < 0.5) discard;
+  const GpuMaterial m = materials[draw.material];  // uniform per draw
+  if (m.textures.w != NO_TEXTURE) {
+    const vec4 mask = texture(textures[m.textures.w], inTexcoord, frame.params.y);
+    if (m.baseColor.a * ((m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a) < m.roughMetal.z) discard;
+  }
 #endif
-  outId = draw.idBase | uint(gl_PrimitiveID);
+  outId = (inInstance << draw.primitiveBits) | uint(gl_PrimitiveID);
 }

@@ -28,6 +28,7 @@ layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D sceneColor;
 layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
 layout(set = 1, binding = 0) uniform sampler2D textures[];
 #endif
+layout(set = 0, binding = 10, std430) readonly buffer Instances { GpuInstance instances[]; };
 layout(push_constant) uniform Push { VisShadePush pc; };
 
 const float kMaxRadiance = 60000.0;  // as pbr_frag.glsl: stay below the half-float maximum
@@ -69,10 +70,13 @@ void main() {
     imageStore(sceneColor, p, vec4(0.0, 0.0, 0.0, 1.0));  // the forward pass's clear colour
     return;
   }
-  const GpuDraw d = draws[packed >> pc.primitiveBits];
+  const GpuInstance inst = instances[packed >> pc.primitiveBits];
+  const GpuDraw d = draws[inst.info.x];
   const uint first = 3u * (packed & ((1u << pc.primitiveBits) - 1u));  // primitiveBits < 32
   const uvec3 tri = uvec3(vertexIndex(d, first), vertexIndex(d, first + 1u), vertexIndex(d, first + 2u)) + d.vertexOffset;
-  const vec3 p0 = position(tri.x), p1 = position(tri.y), p2 = position(tri.z);
+  // Scene space, computed as the vertex stages do.
+  const vec3 p0 = (inst.transform * vec4(position(tri.x), 1.0)).xyz, p1 = (inst.transform * vec4(position(tri.y), 1.0)).xyz,
+             p2 = (inst.transform * vec4(position(tri.z), 1.0)).xyz;
   const vec3 e1 = p1 - p0, e2 = p2 - p0, s = frame.cameraPos.xyz - p0;
   const vec3 n = cross(e1, e2), a = cross(e2, s), b = cross(s, e1);
 
@@ -80,13 +84,15 @@ void main() {
   const vec3 w = clamp(barycentrics(dir, a, b, n), 0.0, 1.0);  // the rasteriser covered this pixel centre
   const vec3 worldPos = p0 * w.x + p1 * w.y + p2 * w.z;
   // Two-sided materials light their back faces with the flipped normal (front: counter-clockwise seen
-  // from the camera, as the forward pipelines' VK_FRONT_FACE_COUNTER_CLOCKWISE).
-  vec3 nrm = normal(tri.x) * w.x + normal(tri.y) * w.y + normal(tri.z) * w.z;
-  if (dot(n, s) < 0.0) nrm = -nrm;
+  // from the camera, as the forward pipelines' VK_FRONT_FACE_COUNTER_CLOCKWISE; clockwise for a mirrored
+  // instance, whose draws set VK_FRONT_FACE_CLOCKWISE).
+  const mat3 normalMatrix = mat3(inst.normalX.xyz, inst.normalY.xyz, inst.normalZ.xyz);
+  vec3 nrm = normalMatrix * (normal(tri.x) * w.x + normal(tri.y) * w.y + normal(tri.z) * w.z);
+  if ((dot(n, s) < 0.0) != ((inst.info.y & INSTANCE_MIRRORED) != 0u)) nrm = -nrm;
 
   const GpuMaterial m = materials[d.material];
   vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
-  float roughness = m.roughMetal.x, metalness = m.roughMetal.y;
+  float roughness = m.roughMetal.x, metalness = m.roughMetal.y, occlusion = 1.0;
 #if HAS_TEXCOORDS
   if ((d.flags & DRAW_TEXTURED) != 0u) {
     const vec2 t0 = texcoords[tri.x], t1 = texcoords[tri.y], t2 = texcoords[tri.z];
@@ -103,15 +109,20 @@ void main() {
     roughness *= sampleOr(m.textures.y, uv, gx, gy, vec4(1.0)).r;
     metalness *= sampleOr(m.textures.z, uv, gx, gy, vec4(1.0)).r;
     emissive *= sampleOr(m.textures2.x, uv, gx, gy, vec4(1.0)).rgb;
+    if (m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m.textures2.y, uv, gx, gy, vec4(1.0)).r - 1.0);
   }
 #endif
+  if ((m.textures2.w & MATERIAL_UNLIT) != 0u) {
+    imageStore(sceneColor, p, vec4(min(baseColor, vec3(kMaxRadiance)), 1.0));
+    return;
+  }
 
   const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
-  vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) + emissive;
+  const int brdf = (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
+  vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) * occlusion + emissive;
   for (uint i = 0u; i < frame.lightCount.x; ++i) {
-    const LightSample ls = lightSample(frame.lights[i].position.xyz, frame.lights[i].color.rgb,
-                                       frame.lights[i].position.w > 0.5, worldPos);
-    c += pbrDirect(nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
+    const LightSample ls = lightSample(frame.lights[i], worldPos);  // point, spot or directional (lights.h)
+    c += pbrDirect(brdf, nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
   }
   imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
 }

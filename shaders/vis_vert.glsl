@@ -3,6 +3,8 @@
 #include "frame.h"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 2, std430) readonly buffer Instances { GpuInstance instances[]; };
+layout(location = 1) flat out uint outInstance;
 
 layout(location = 0) in vec3 inPosition;
 #if ALPHA_MASK
@@ -14,5 +16,6 @@ void main() {
 #if ALPHA_MASK
   outTexcoord = inTexcoord;
 #endif
-  gl_Position = frame.viewProj * vec4(inPosition, 1.0);
+  outInstance = gl_InstanceIndex;
+  gl_Position = frame.viewProj * (instances[gl_InstanceIndex].transform * vec4(inPosition, 1.0));
 }

@@ -1,5 +1,5 @@
-// Triangle fetch shared by the compute rasteriser and its hardware hand-off: cluster -> draw -> indices
-// -> positions, the same buffers the shading pass reads.
+// Triangle fetch shared by the compute rasteriser and its hardware hand-off: cluster -> instance -> draw
+// -> indices -> positions (placed by the instance's transform), the same buffers the shading pass reads.
 #extension GL_GOOGLE_include_directive : require
 #include "frame.h"
 #include "cluster.h"
@@ -30,6 +30,7 @@ layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
   uint largeCount, largeFirst, largePad1, largePad2;
   uvec2 largeTiles[];
 };
+layout(set = 0, binding = 13, std430) readonly buffer Instances { GpuInstance instances[]; };
 layout(push_constant) uniform Push { RasterPush pc; };
 
 vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
@@ -45,5 +46,8 @@ uvec3 triangleVertices(GpuCluster c, GpuDraw d, uint local) {
   const uint k = 3u * (c.firstTriangle + local);
   return uvec3(vertexIndex(d, k), vertexIndex(d, k + 1u), vertexIndex(d, k + 2u)) + d.vertexOffset;
 }
+
+// Clip-space position of vertex i placed by instance `inst`, computed as the vertex stages do.
+vec4 clipPosition(GpuInstance inst, uint i) { return frame.viewProj * (inst.transform * vec4(position(i), 1.0)); }
 
 uint64_t packVis(float depth, uint id) { return (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(id); }

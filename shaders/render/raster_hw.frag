@@ -18,9 +18,13 @@ layout(location = 3) in vec2 inTexcoord;
 
 void main() {
   if ((inFlags & CLUSTER_ALPHA_MASKED) != 0u) {
-    const uint t = materials[inMaterial].textures.w;
-    if (t != NO_TEXTURE && texture(textures[nonuniformEXT(t)], inTexcoord, frame.params.y).a < 0.5) discard;
+    const GpuMaterial m = materials[inMaterial];
+    if (m.textures.w != NO_TEXTURE) {
+      const vec4 mask = texture(textures[nonuniformEXT(m.textures.w)], inTexcoord, frame.params.y);
+      if (m.baseColor.a * ((m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a) < m.roughMetal.z) discard;
+    }
   }
-  if (!gl_FrontFacing && (inFlags & CLUSTER_DOUBLE_SIDED) == 0u) discard;
+  const bool front = gl_FrontFacing != ((inFlags & CLUSTER_MIRRORED) != 0u);  // the pipeline's front is counter-clockwise
+  if (!front && (inFlags & CLUSTER_DOUBLE_SIDED) == 0u) discard;
   atomicMin(vis[uint(gl_FragCoord.y) * pc.width + uint(gl_FragCoord.x)], packVis(gl_FragCoord.z, inId));
 }

@@ -17,12 +17,13 @@ layout(location = 3) out vec2 outTexcoord;
 void main() {
   const uint entry = hwTriangles[gl_VertexIndex / 3];
   const GpuCluster c = clusters[entry >> RASTER_LOCAL_BITS];
-  const GpuDraw d = draws[c.draw];
+  const GpuInstance inst = instances[c.instance];
+  const GpuDraw d = draws[inst.info.x];
   const uint local = entry & ((1u << RASTER_LOCAL_BITS) - 1u);
   const uint v = triangleVertices(c, d, local)[gl_VertexIndex % 3];
-  outId = (c.draw << pc.primitiveBits) | (c.firstTriangle + local);
+  outId = (c.instance << pc.primitiveBits) | (c.firstTriangle + local);
   outMaterial = d.material;
   outFlags = c.flags;
   outTexcoord = (c.flags & CLUSTER_ALPHA_MASKED) != 0u ? texcoords[v] : vec2(0.0);
-  gl_Position = frame.viewProj * vec4(position(v), 1.0);
+  gl_Position = clipPosition(inst, v);
 }

@@ -28,12 +28,12 @@ layout(constant_id = 0) const uint kSharedArea = RASTER_SHARED_AREA;
 
 uint setup(uint clusterIndex, uint local, out Tri t) {
   const GpuCluster c = clusters[clusterIndex];
-  const GpuDraw d = draws[c.draw];
-  t.id = (c.draw << pc.primitiveBits) | (c.firstTriangle + local);
+  const GpuInstance inst = instances[c.instance];
+  const GpuDraw d = draws[inst.info.x];
+  t.id = (c.instance << pc.primitiveBits) | (c.firstTriangle + local);
   if ((c.flags & CLUSTER_ALPHA_MASKED) != 0u) return kHardware;
   const uvec3 tri = triangleVertices(c, d, local);
-  const vec4 p[3] = vec4[3](frame.viewProj * vec4(position(tri.x), 1.0), frame.viewProj * vec4(position(tri.y), 1.0),
-                            frame.viewProj * vec4(position(tri.z), 1.0));
+  const vec4 p[3] = vec4[3](clipPosition(inst, tri.x), clipPosition(inst, tri.y), clipPosition(inst, tri.z));
   // Outside one plane of the view volume (behind the camera included): nothing to draw.
   for (int k = 0; k < 3; ++k) {
     if (p[0][k] > p[0].w && p[1][k] > p[1].w && p[2][k] > p[2].w) return kSkip;
@@ -49,9 +49,11 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
     v[i] = ivec2(floor(s * float(kOne) + 0.5));
     t.z[i] = p[i].z / p[i].w;
   }
-  // Vulkan's facing: counter-clockwise in framebuffer coordinates (y down) is front, i.e. area2 < 0 here.
+  // Vulkan's facing: counter-clockwise in framebuffer coordinates (y down) is front, i.e. area2 < 0 here;
+  // the other way round for a mirrored instance (its draws' VK_FRONT_FACE_CLOCKWISE).
   t.area2 = int64_t(v[1].x - v[0].x) * int64_t(v[2].y - v[0].y) - int64_t(v[1].y - v[0].y) * int64_t(v[2].x - v[0].x);
-  if (t.area2 == 0l || (t.area2 > 0l && (c.flags & CLUSTER_DOUBLE_SIDED) == 0u)) return kSkip;
+  const bool back = (t.area2 > 0l) != ((c.flags & CLUSTER_MIRRORED) != 0u);
+  if (t.area2 == 0l || (back && (c.flags & CLUSTER_DOUBLE_SIDED) == 0u)) return kSkip;
   if (t.area2 < 0l) {  // the other order: positive inside
     t.area2 = -t.area2;
     const ivec2 tv = v[1]; v[1] = v[2]; v[2] = tv;

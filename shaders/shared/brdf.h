@@ -1,5 +1,9 @@
-// The one BRDF of the project (brief part 2, §1.5): Lambertian diffuse + Cook-Torrance specular with the
-// Beckmann NDF, Cook-Torrance V-cavity masking and Schlick Fresnel. Not GGX, on purpose.
+// The project's two BRDFs, one material model (base colour, roughness, metalness; Schlick Fresnel):
+//   * BRDF_BECKMANN, the brief's (part 2, §1.5): Lambertian diffuse + Cook-Torrance specular with the
+//     Beckmann NDF and Cook-Torrance V-cavity masking. Course and OBJ scenes use it.
+//   * BRDF_GGX, glTF 2.0's (spec Appendix B): Trowbridge-Reitz NDF with the height-correlated Smith
+//     visibility, and the spec's metal-rough mix (diffuse weighted by the dielectric Fresnel). glTF
+//     materials use it.
 //
 // This file is both GLSL 4.60 (#include "brdf.h" with GL_GOOGLE_include_directive) and C++20 with GLM
 // (namespace rtr::shader), so the GPU renderer and the CPU reference ray tracer evaluate the same code.
@@ -8,9 +12,10 @@
 //
 // Every result is finite and >= 0 for every input (see docs/shading.md for why each guard is needed):
 //   * roughness 0 .. 1e-2: alpha = roughness^2 is clamped to BRDF_ALPHA_MIN;
-//   * D uses tan^2(theta_h) computed from the tangential part of the unnormalised half vector
-//     (no 1 - cos^2 cancellation), capped at BRDF_TAN2_MAX where D underflows to 0 anyway;
-//   * G / (4 n.v n.l) is cancelled algebraically (no division by n.v or n.l);
+//   * D uses tan^2(theta_h) (Beckmann) or sin^2(theta_h) (GGX) from the tangential part of the
+//     unnormalised half vector (no 1 - cos^2 cancellation); Beckmann's is capped at BRDF_TAN2_MAX where D
+//     underflows to 0 anyway;
+//   * G / (4 n.v n.l) is cancelled algebraically (Beckmann) or has a floored denominator (GGX);
 //   * |v + l|^2 is clamped to BRDF_HH_MIN inside the masking term only (v = -l, both grazing);
 //   * light below the shading normal: f = 0; view below it: specular = 0, diffuse kept;
 //   * n may be unnormalised or zero (zero n gives no direct light: ambient + emissive only).
@@ -37,16 +42,23 @@ RTR_CONST float BRDF_TAN2_MAX = 1e4f;
 RTR_CONST float BRDF_HH_MIN = 1e-6f;
 // Floor of |n|^2 before normalising: a zero normal stays zero instead of becoming NaN.
 RTR_CONST float BRDF_NN_MIN = 1e-30f;
+// Floor of the height-correlated Smith denominator n.l Lambda_v + n.v Lambda_l >= alpha (n.v + n.l): it
+// acts only with light and eye both within ~0.06 deg of the horizon, and bounds V_GGX <= 0.5 / 1e-6.
+RTR_CONST float BRDF_GGX_VDEN_MIN = 1e-6f;
+
+// Which BRDF (the first argument of brdfTerms, pbrDirect, shadePbr).
+#define BRDF_BECKMANN 0
+#define BRDF_GGX 1
 
 struct BrdfTerms {
-  float D;        // Beckmann NDF at h
+  float D;        // NDF at h (Beckmann or GGX)
   vec3 F;         // Schlick Fresnel
-  float G;        // Cook-Torrance masking, in [0, 1]
+  float G;        // masking-shadowing, in [0, 1] (Cook-Torrance; GGX: height-correlated Smith, 4 n.v n.l V)
   vec3 diffuse;   // BRDF value f_diffuse (before the cosine)
   vec3 specular;  // BRDF value f_spec = D F G / (4 n.v n.l) (before the cosine)
 };
 
-// Beckmann alpha from the texture roughness (brief: alpha = roughness^2), clamped to BRDF_ALPHA_MIN.
+// Alpha from the texture roughness (the brief and glTF: alpha = roughness^2), clamped to BRDF_ALPHA_MIN.
 RTR_FN float brdfAlpha(float roughness) {
   float r = clamp(roughness, 0.0f, 1.0f);
   return max(r * r, BRDF_ALPHA_MIN);
@@ -100,10 +112,38 @@ RTR_FN vec3 brdfFresnel(float vh, vec3 baseColor, float metalness) {
   return F0 + (vec3(1.0f) - F0) * (x2 * x2 * x);
 }
 
-// All terms for unit v, l and any n. f = 0 for light below the shading hemisphere (n.l <= 0); for the
-// view below it (back-facing interpolated normal) the specular is 0 (G = 0 by (n.v)_+) but the
-// Lambertian diffuse is kept, so silhouettes do not turn black.
-RTR_FN BrdfTerms brdfTerms(vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughness, float metalness) {
+// GGX (Trowbridge-Reitz) D = alpha^2 / (pi (cos^2 (alpha^2 - 1) + 1)^2) from the unnormalised half vector:
+// with cos^2 = (n.H)^2 / |H|^2 and sin^2 = |H_t|^2 / |H|^2, D = alpha^2 (|H|^2 / (alpha^2 (n.H)^2 + |H_t|^2))^2 / pi.
+// The ratio is <= 1/alpha^2 (alpha <= 1), so D <= 1/(pi alpha^2) with no cancellation near h = n.
+RTR_FN float brdfGgxD(vec3 n, vec3 H, float alpha) {
+  float nH = dot(n, H);
+  vec3 Ht = H - nH * n;
+  float ht2 = dot(Ht, Ht);
+  float a2 = alpha * alpha;
+  float ratio = (nH * nH + ht2) / max(a2 * nH * nH + ht2, 1e-30f);
+  float d = a2 * ratio * ratio / BRDF_PI;
+  return nH > 0.0f ? d : 0.0f;
+}
+
+// Height-correlated Smith visibility V = G2 / (4 n.v n.l) (glTF Appendix B):
+// V = 0.5 / (n.l sqrt((n.v)^2 (1 - a^2) + a^2) + n.v sqrt((n.l)^2 (1 - a^2) + a^2)); the denominator is
+// >= alpha (n.v + n.l) and floored at BRDF_GGX_VDEN_MIN.
+RTR_FN float brdfGgxVisibility(float nv, float nl, float alpha) {
+  if (nv <= 0.0f || nl <= 0.0f) return 0.0f;
+  float a2 = alpha * alpha;
+  float lv = nl * sqrt(nv * nv * (1.0f - a2) + a2);
+  float ll = nv * sqrt(nl * nl * (1.0f - a2) + a2);
+  return 0.5f / max(lv + ll, BRDF_GGX_VDEN_MIN);
+}
+
+// All terms of BRDF `brdf` (BRDF_BECKMANN or BRDF_GGX) for unit v, l and any n. f = 0 for light below the
+// shading hemisphere (n.l <= 0); for the view below it (back-facing interpolated normal) the specular is 0
+// (G = 0 by (n.v)_+) but the Lambertian diffuse is kept, so silhouettes do not turn black.
+// The diffuse: Beckmann (the brief) c/pi (1 - F)(1 - M) with the metal-tinted F; GGX (glTF Appendix B)
+// c/pi (1 - F_dielectric)(1 - M), F_dielectric = 0.04 + 0.96 (1 - v.h)^5 (the spec's fresnel_mix of the
+// dielectric, which metal has no diffuse to mix with). Both share F for the specular: the spec's metal
+// and dielectric specular mixed by M is exactly D V F with F0 = mix(0.04, c, M).
+RTR_FN BrdfTerms brdfTerms(int brdf, vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughness, float metalness) {
   vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
   float metal = clamp(metalness, 0.0f, 1.0f);
   vec3 nn = brdfSafeNormal(n);
@@ -115,28 +155,51 @@ RTR_FN BrdfTerms brdfTerms(vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughne
   float vh = 0.5f * sqrt(hh);  // v.h for unit v, l (exact, no division)
 
   BrdfTerms t;
-  t.D = brdfBeckmannD(nn, H, brdfAlpha(roughness));
   t.F = brdfFresnel(vh, c, metal);
-  t.G = brdfMaskingG(nv, nl, nH, hh);
   bool lit = nl > 0.0f;
+  if (brdf == BRDF_GGX) {
+    float alpha = brdfAlpha(roughness);
+    float V = brdfGgxVisibility(nv, nl, alpha);
+    t.D = brdfGgxD(nn, H, alpha);
+    t.G = min(1.0f, 4.0f * max(nv, 0.0f) * max(nl, 0.0f) * V);
+    float fd = brdfFresnel(vh, vec3(0.0f), 0.0f).x;  // the dielectric's Fresnel
+    t.diffuse = lit ? c * ((1.0f / BRDF_PI) * (1.0f - fd) * (1.0f - metal)) : vec3(0.0f);
+    t.specular = t.D * t.F * V;
+    return t;
+  }
+  t.D = brdfBeckmannD(nn, H, brdfAlpha(roughness));
+  t.G = brdfMaskingG(nv, nl, nH, hh);
   t.diffuse = lit ? c * (1.0f / BRDF_PI) * (vec3(1.0f) - t.F) * (1.0f - metal) : vec3(0.0f);
   t.specular = t.D * t.F * brdfVisibility(nv, nl, nH, hh);
   return t;
 }
 
 // What one light adds (brief eq. 1, its sum's term): (f_diffuse + f_spec) c_light (n.l)_+.
-RTR_FN vec3 pbrDirect(vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 baseColor, float roughness, float metalness) {
-  BrdfTerms t = brdfTerms(n, v, l, baseColor, roughness, metalness);
+RTR_FN vec3 pbrDirect(int brdf, vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 baseColor, float roughness,
+                      float metalness) {
+  BrdfTerms t = brdfTerms(brdf, n, v, l, baseColor, roughness, metalness);
   float nl = max(dot(brdfSafeNormal(n), l), 0.0f);
   return (t.diffuse + t.specular) * lightColor * nl;
 }
 
 // Outgoing radiance for one point light (brief eq. 1):
 // L = c_ambient c_mat + c_emit + (f_diffuse + f_spec) c_light (n.l)_+. More lights add more pbrDirect terms.
+RTR_FN vec3 shadePbr(int brdf, vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 ambient, vec3 baseColor,
+                     float roughness, float metalness, vec3 emissive) {
+  vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
+  return ambient * c + emissive + pbrDirect(brdf, n, v, l, lightColor, baseColor, roughness, metalness);
+}
+
+// The brief's Beckmann BRDF without the selector (the form the renderer's shaders called before GGX).
+RTR_FN BrdfTerms brdfTerms(vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughness, float metalness) {
+  return brdfTerms(BRDF_BECKMANN, n, v, l, baseColor, roughness, metalness);
+}
+RTR_FN vec3 pbrDirect(vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 baseColor, float roughness, float metalness) {
+  return pbrDirect(BRDF_BECKMANN, n, v, l, lightColor, baseColor, roughness, metalness);
+}
 RTR_FN vec3 shadePbr(vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 ambient, vec3 baseColor, float roughness,
                      float metalness, vec3 emissive) {
-  vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
-  return ambient * c + emissive + pbrDirect(n, v, l, lightColor, baseColor, roughness, metalness);
+  return shadePbr(BRDF_BECKMANN, n, v, l, lightColor, ambient, baseColor, roughness, metalness, emissive);
 }
 
 #ifdef __cplusplus

@@ -18,7 +18,7 @@ struct BrdfGridInput {
   vec4 v;           // xyz: unit direction towards the viewer
   vec4 l;           // xyz: unit direction towards the light
   vec4 baseColor;   // rgb
-  vec4 params;      // x: roughness, y: metalness
+  vec4 params;      // x: roughness, y: metalness, z: BRDF_BECKMANN or BRDF_GGX
   vec4 lightColor;  // rgb
   vec4 ambient;     // rgb
   vec4 emissive;    // rgb

@@ -1,6 +1,6 @@
 // Clusters: the unit of GPU-driven culling and of the compute rasteriser. A cluster is up to
 // CLUSTER_MAX_TRIANGLES triangles of one draw, contiguous in that draw's index range, so a triangle's id
-// (draw, firstTriangle + local index) is the same gl_PrimitiveID the hardware path sees. Built at bake time
+// (instance, firstTriangle + local index) is the same gl_PrimitiveID the hardware path sees. Built at bake time
 // (meshoptimizer, stored in .rtrscene) or at load; the mesh's index buffer is reordered cluster by cluster.
 #ifndef RTR_SHADERS_SHARED_CLUSTER_H
 #define RTR_SHADERS_SHARED_CLUSTER_H
@@ -16,18 +16,20 @@ typedef uint32_t uint;
 #define CLUSTER_MAX_VERTICES 64
 #define CLUSTER_MAX_TRIANGLES 124
 
-// Storage buffer, std430, 48 bytes. Bounds are in scene (world) space: the scene has no instancing.
+// Storage buffer, std430, 48 bytes. One record per (instance, cluster of its mesh); bounds are in scene
+// space, the mesh's cluster bounds transformed by the instance (render/cull.cpp).
 struct GpuCluster {
   vec4 sphere;         // xyz centre, w radius
   vec4 cone;           // xyz axis (unit), w cutoff: back-facing when dot(c - eye, axis) >= w |c - eye| + radius
                        // (c the sphere's centre; meshoptimizer's conservative test); w >= 1 never culls
-  uint draw;           // index of its GpuDraw (drawInfo buffer)
+  uint instance;       // its GpuInstance (frame.h), which names the GpuDraw
   uint firstTriangle;  // of the draw: the triangle's primitive id is firstTriangle + local index
   uint triangleCount;  // 1..CLUSTER_MAX_TRIANGLES
   uint flags;          // CLUSTER_* below
 };
 #define CLUSTER_ALPHA_MASKED 1u  // its material cuts out by texture alpha
 #define CLUSTER_DOUBLE_SIDED 2u  // never back-face culled (cone disabled)
+#define CLUSTER_MIRRORED 4u      // its instance's determinant is negative: front faces are clockwise on screen
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuCluster) == 48);

@@ -48,19 +48,36 @@ struct FrameUniforms {
 
 // Material factors (storage buffer, std430). Texture indices index the scene's texture array;
 // 0xFFFFFFFF: no texture (the factor alone is used).
+// OBJ/course materials: opacity 1, cutoff 0.5, no occlusion texture, no flags (today's shading exactly).
 struct GpuMaterial {
-  vec4 baseColor;     // rgb factor, a unused
+  vec4 baseColor;     // rgb factor, a opacity (glTF baseColorFactor's alpha; it multiplies the mask)
   vec4 emissive;      // rgb factor
-  vec4 roughMetal;    // x roughness, y metalness
+  vec4 roughMetal;    // x roughness, y metalness, z alpha cutoff (alpha below it is cut out),
+                      // w occlusion strength (glTF: ambient x (1 + strength (occlusion - 1)))
   uvec4 textures;     // x baseColor, y roughness, z metalness, w alphaMask
-  uvec4 textures2;    // x emissive
+  uvec4 textures2;    // x emissive, y occlusion (its red), z unused, w MATERIAL_* flags
 };
+#define MATERIAL_UNLIT 1u     // KHR_materials_unlit: the base colour is the result
+#define MATERIAL_MASK_RED 2u  // the alpha-mask texture is one channel (glTF: the base colour's alpha): read .r
+#define MATERIAL_GGX 4u       // glTF materials: brdf.h's BRDF_GGX (others: the brief's Beckmann)
 
 // Per-draw push constants.
 struct DrawPush {
   uint material;
-  uint idBase;        // visibility pass: draw index << VisShadePush.primitiveBits
+  uint primitiveBits; // visibility pass: id = gl_InstanceIndex << primitiveBits | gl_PrimitiveID
 };
+
+// One placement of a mesh (storage buffer, std430, 128 bytes), indexed by gl_InstanceIndex in the
+// hardware paths and named by the high bits of a visibility id. A scene without instances gets one
+// identity instance per draw, in draw order (instance i draws GpuDraw i).
+struct GpuInstance {
+  mat4 transform;     // object to scene space
+  vec4 normalX;       // columns of the inverse transpose of transform's upper 3x3 (normals)
+  vec4 normalY;
+  vec4 normalZ;
+  uvec4 info;         // x: its GpuDraw, y: INSTANCE_* flags
+};
+#define INSTANCE_MIRRORED 1u  // negative determinant: the winding flips (front = clockwise on screen)
 
 // One draw of the scene, for the visibility path's shading pass (storage buffer, std430, 16 bytes).
 struct GpuDraw {
@@ -72,8 +89,8 @@ struct GpuDraw {
 #define DRAW_INDEX16 1u   // 16-bit indices (two per 32-bit word)
 #define DRAW_TEXTURED 2u  // has texcoords: sample the material's textures
 
-// Visibility target (R32_UINT): draw index << primitiveBits | gl_PrimitiveID; VIS_EMPTY where nothing
-// was drawn. The renderer gives the draw index just enough bits that no id equals VIS_EMPTY.
+// Visibility target (R32_UINT): instance index << primitiveBits | gl_PrimitiveID; VIS_EMPTY where
+// nothing was drawn. The renderer gives the instance index just enough bits that no id equals VIS_EMPTY.
 #define VIS_EMPTY 0xFFFFFFFFu
 struct VisShadePush {
   uint primitiveBits;

@@ -14,8 +14,9 @@ void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= uint(gridIn.length())) return;
   BrdfGridInput a = gridIn[i];
-  BrdfTerms t = brdfTerms(a.n.xyz, a.v.xyz, a.l.xyz, a.baseColor.rgb, a.params.x, a.params.y);
-  vec3 L = shadePbr(a.n.xyz, a.v.xyz, a.l.xyz, a.lightColor.rgb, a.ambient.rgb, a.baseColor.rgb, a.params.x,
+  int brdf = int(a.params.z);
+  BrdfTerms t = brdfTerms(brdf, a.n.xyz, a.v.xyz, a.l.xyz, a.baseColor.rgb, a.params.x, a.params.y);
+  vec3 L = shadePbr(brdf, a.n.xyz, a.v.xyz, a.l.xyz, a.lightColor.rgb, a.ambient.rgb, a.baseColor.rgb, a.params.x,
                     a.params.y, a.emissive.rgb);
   BrdfGridOutput o;
   o.DG = vec4(t.D, t.G, 0.0, 0.0);

@@ -1,9 +1,14 @@
 #include "render/cull.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
+#include <string>
+
+#include <glm/glm.hpp>
 
 #include "core/error.hpp"
+#include "scene/textures.hpp"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
 
@@ -24,19 +29,74 @@ VkExtent2D DepthPyramid::pyramidExtent(VkExtent2D depth) {
   return {std::max(1u, depth.width / 2), std::max(1u, depth.height / 2)};
 }
 
+std::vector<Instance> gpuInstances(const Scene& scene) {
+  std::vector<Instance> out = scene.instances;
+  if (out.empty())
+    for (uint32_t i = 0; i < scene.meshes.size(); ++i) out.push_back({i, glm::mat4(1.0f)});
+  for (const Instance& in : out)
+    if (in.mesh >= scene.meshes.size())
+      throw Error("instance of mesh " + std::to_string(in.mesh) + ": the scene has " + std::to_string(scene.meshes.size()));
+  std::erase_if(out, [&](const Instance& in) { return scene.meshes[in.mesh].indices.empty(); });
+  std::stable_sort(out.begin(), out.end(), [](const Instance& a, const Instance& b) {
+    return a.mesh != b.mesh ? a.mesh < b.mesh : !mirrored(a.transform) && mirrored(b.transform);
+  });
+  return out;
+}
+
+bool mirrored(const glm::mat4& t) { return glm::determinant(glm::mat3(t)) < 0.0f; }
+
+uint32_t clusterFlags(const Mesh& m, const Material& mat) {
+  if (m.texcoords.empty() || !(alphaTested(m, mat) || (mat.flags & kMaterialDoubleSided))) return 0;
+  return CLUSTER_DOUBLE_SIDED | (mat.texture(TextureSlot::AlphaMask) != kNoTexture ? CLUSTER_ALPHA_MASKED : 0u);
+}
+
+void appendClusters(const Mesh& m, const glm::mat4& transform, uint32_t instance, uint32_t flags,
+                    std::vector<shader::GpuCluster>& out) {
+  const float noCone = 2.0f;
+  const size_t first = out.size();
+  for (const Cluster& c : m.clusters)
+    out.push_back({glm::vec4(c.center, c.radius),
+                   glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff), instance,
+                   c.firstTriangle, c.triangleCount, flags});
+  if (m.clusters.empty()) {
+    const uint32_t triangles = uint32_t(m.indices.size() / 3);
+    for (uint32_t f = 0; f < triangles; f += CLUSTER_MAX_TRIANGLES) {
+      const uint32_t count = std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - f);
+      Bounds b;
+      for (uint32_t i = 3 * f; i < 3 * (f + count); ++i) b.extend(m.positions[m.indices[i]]);
+      const glm::vec3 c = 0.5f * (b.min + b.max);
+      float r = 0.0f;
+      for (uint32_t i = 3 * f; i < 3 * (f + count); ++i) r = std::max(r, glm::length(m.positions[m.indices[i]] - c));
+      out.push_back({glm::vec4(c, r), glm::vec4(0, 0, 1, noCone), instance, f, count, flags});
+    }
+  }
+  if (transform == glm::mat4(1.0f)) return;
+  // The linear part's largest stretch bounds the radius: a column's length for a similarity, the
+  // Frobenius norm (>= the spectral norm) otherwise.
+  const glm::mat3 l(transform);
+  const glm::vec3 len(glm::length(l[0]), glm::length(l[1]), glm::length(l[2]));
+  const float s = std::max(len.x, std::max(len.y, len.z)), eps = 1e-5f * s * s;
+  const bool similarity = std::abs(len.x - len.y) <= 1e-5f * s && std::abs(len.x - len.z) <= 1e-5f * s &&
+                          std::abs(glm::dot(l[0], l[1])) <= eps && std::abs(glm::dot(l[0], l[2])) <= eps &&
+                          std::abs(glm::dot(l[1], l[2])) <= eps;
+  const float stretch = similarity ? s : std::sqrt(glm::dot(len, len));
+  for (size_t i = first; i < out.size(); ++i) {
+    shader::GpuCluster& c = out[i];
+    c.sphere = glm::vec4(glm::vec3(transform * glm::vec4(glm::vec3(c.sphere), 1.0f)), c.sphere.w * stretch);
+    // A mirror flips the winding and the front face with it (CLUSTER_MIRRORED), so the front normals
+    // turn with the linear part in every case (its inverse transpose, parallel to it for a similarity).
+    if (!similarity) c.cone = glm::vec4(0, 0, 1, noCone);
+    else if (c.cone.w < 1.0f) c.cone = glm::vec4(glm::normalize(l * glm::vec3(c.cone)), c.cone.w);
+  }
+}
+
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene) {
   std::vector<shader::GpuCluster> out;
-  uint32_t draw = 0;
-  for (const Mesh& m : scene.meshes) {
-    if (m.indices.empty()) continue;
-    if (m.clusters.empty()) throw Error("mesh '" + m.name + "' has no clusters (scene/clusters.hpp builds them)");
-    const uint32_t mf = scene.materials.at(m.material).flags;
-    const uint32_t flags = (mf & kMaterialAlphaMasked ? CLUSTER_ALPHA_MASKED : 0u) |
-                           (mf & kMaterialDoubleSided ? CLUSTER_DOUBLE_SIDED : 0u);
-    for (const Cluster& c : m.clusters)
-      out.push_back({glm::vec4(c.center, c.radius), glm::vec4(c.coneAxis, c.coneCutoff), draw, c.firstTriangle,
-                     c.triangleCount, flags});
-    ++draw;
+  const std::vector<Instance> instances = gpuInstances(scene);
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    const uint32_t flip = mirrored(instances[i].transform) ? CLUSTER_MIRRORED : 0u;
+    appendClusters(m, instances[i].transform, i, clusterFlags(m, scene.materials.at(m.material)) | flip, out);
   }
   return out;
 }

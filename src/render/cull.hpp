@@ -22,8 +22,26 @@ namespace rtr::vk { class Context; }
 
 namespace rtr::render {
 
-// The GpuCluster records of a scene whose meshes have clusters, numbered by draw as GpuScene numbers its
-// GpuDraws (the meshes that have triangles, in order).
+// The instances a scene draws, in the GPU's order (GpuScene's GpuInstance buffer, the high bits of a
+// visibility id): Scene::instances, or each mesh once untransformed; those of meshes without triangles
+// dropped; grouped by mesh, then mirrored ones after the others (stable), so that the instances one
+// instanced draw covers are one range.
+std::vector<Instance> gpuInstances(const Scene& scene);
+// Whether a transform flips the winding (negative determinant).
+bool mirrored(const glm::mat4& transform);
+
+// The CLUSTER_* flags of a mesh's clusters: the GPU's alpha-tested, two-sided draws are double-sided,
+// and alpha-masked where they have a mask texture (render/gpu_scene.cpp's draw kinds).
+uint32_t clusterFlags(const Mesh& mesh, const Material& material);
+// Appends the scene-space records of `mesh`'s clusters placed by `transform` (instance `instance`): the
+// mesh's own (meshoptimizer, scene/clusters.hpp) or, for a mesh built without them, runs of up to
+// CLUSTER_MAX_TRIANGLES triangles with a sphere around their box and no cone. The sphere's centre is
+// transformed and its radius scaled by the largest stretch; the cone's axis is rotated with it where the
+// transform is a similarity (rotation, uniform scale, mirror), else dropped (a non-uniform scale bends
+// the normals' cone). Double-sided clusters get no cone. Identity: the records as stored, bit for bit.
+void appendClusters(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags,
+                    std::vector<shader::GpuCluster>& out);
+// Every GpuCluster of a scene, numbered as GpuScene numbers its instances.
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
 
 // The farthest depth per texel of a depth image, level by level (level 0 half the image; which pixels a

@@ -6,10 +6,14 @@
 #include <cstring>
 #include <functional>
 #include <future>
+#include <optional>
+
+#include <glm/gtc/matrix_inverse.hpp>
 #include <mutex>
 #include <thread>
 
 #include "cluster.h"
+#include "render/cull.hpp"
 #include "core/image.hpp"
 #include "core/parallel.hpp"
 #include "scene/textures.hpp"
@@ -29,28 +33,7 @@ VkFormat textureFormat(const Texture& t) {
   return decodeSrgb(t) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
 }
 
-// The GPU records of one draw's clusters: the mesh's own (meshoptimizer, scene/clusters.hpp) or, for a
-// mesh built without them (tests), consecutive runs of up to CLUSTER_MAX_TRIANGLES triangles with a
-// bounding sphere around their vertices' box and no cone. A draw the hardware does not cull (double-sided,
-// alpha-masked) gets no cone either, whatever its material says.
-void appendClusters(const Mesh& m, uint32_t draw, uint32_t flags, std::vector<shader::GpuCluster>& out) {
-  const float noCone = 2.0f;
-  for (const Cluster& c : m.clusters)
-    out.push_back({glm::vec4(c.center, c.radius),
-                   glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff), draw,
-                   c.firstTriangle, c.triangleCount, flags});
-  if (!m.clusters.empty()) return;
-  const uint32_t triangles = uint32_t(m.indices.size() / 3);
-  for (uint32_t first = 0; first < triangles; first += CLUSTER_MAX_TRIANGLES) {
-    const uint32_t count = std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - first);
-    Bounds b;
-    for (uint32_t i = 3 * first; i < 3 * (first + count); ++i) b.extend(m.positions[m.indices[i]]);
-    const glm::vec3 c = 0.5f * (b.min + b.max);
-    float r = 0.0f;
-    for (uint32_t i = 3 * first; i < 3 * (first + count); ++i) r = std::max(r, glm::length(m.positions[m.indices[i]] - c));
-    out.push_back({glm::vec4(c, r), glm::vec4(0, 0, 1, noCone), draw, first, count, flags});
-  }
-}
+}  // namespace
 
 // Where one mesh's data goes in the scene-wide streams (counts of elements, not bytes).
 struct MeshSlot {
@@ -66,20 +49,54 @@ struct WriteTask {
   size_t begin, end;
 };
 
+// The CPU side of the geometry: where each mesh goes in the streams, and the GPU's draw, instance and
+// cluster records.
+struct GeometryPlan {
+  std::vector<MeshSlot> slots;
+  std::vector<shader::GpuDraw> draws;
+  std::vector<shader::GpuInstance> instances;
+  std::vector<shader::GpuCluster> clusters;
+  size_t vertices = 0, count16 = 0, count32 = 0;
+  bool anyTexcoords = false;
+};
+
+namespace {
+
+shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
+  // The identity stays exact (existing scenes' images do not move by a rounding).
+  const glm::mat3 n = t == glm::mat4(1.0f) ? glm::mat3(1.0f) : glm::inverseTranspose(glm::mat3(t));
+  return {t, glm::vec4(n[0], 0.0f), glm::vec4(n[1], 0.0f), glm::vec4(n[2], 0.0f),
+          glm::uvec4(draw, mirrored(t) ? INSTANCE_MIRRORED : 0u, 0u, 0u)};
+}
+
 }  // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
                    GeometryUpload upload, TextureLoad textureLoad)
     : ctx_(ctx), mipMode_(mipMode), progress_(progress) {
   bounds_ = scene.bounds();
+  const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
+  const auto t = Clock::now();
+  const GeometryPlan plan = planGeometry(scene);
+  std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
+  if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
+    texturedMaterials_ = materials;
+    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = NO_TEXTURE;
+  }
+  uploadGeometry(plan, materials, upload);
+  stats_.geometryMs = msSince(t);
+  if (!decoding_.valid()) finishTextures(), ready_ = true;
+}
 
-  // Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
-  // decoded straight into that texture's own staging buffer. Deferred: on a worker thread while the
-  // caller goes on (frames render with the materials' factors until updateTextures()).
+// Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
+// decoded straight into that texture's own staging buffer. Deferred: on a worker thread while the caller
+// goes on (frames render with the materials' factors until updateTextures()). Returns each scene
+// texture's index in the GPU's array (NO_TEXTURE: not sampled).
+std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad load) {
   const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
   std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
   for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
-  for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i]));
+  for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i])), samplers_.push_back(scene.textures[i].sampler);
   staged_.resize(used.size());
   stats_.textures = uint32_t(used.size());
   auto decode = [this, &scene, used] {
@@ -103,97 +120,132 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     });
     stats_.decodeMs = msSince(t);
   };
-  if (textureLoad == TextureLoad::Deferred && !used.empty()) decoding_ = std::async(std::launch::async, decode);
+  if (load == TextureLoad::Deferred && !used.empty()) decoding_ = std::async(std::launch::async, decode);
   else decode();
+  return gpuIndex;
+}
 
-  // Geometry: one stream per attribute for all meshes; indices 16-bit where the mesh has <= 65536 vertices.
-  auto t = Clock::now();
-  const bool anyTexcoords = std::any_of(scene.meshes.begin(), scene.meshes.end(),
-                                        [](const Mesh& m) { return !m.texcoords.empty() && !m.indices.empty(); });
-  std::vector<MeshSlot> slots;
-  std::vector<shader::GpuDraw> drawInfo;
-  std::vector<shader::GpuCluster> clusters;
-  size_t vertices = 0, count16 = 0, count32 = 0;
-  for (const Mesh& m : scene.meshes) {
+// Geometry: one stream per attribute for all meshes, each mesh once however many instances draw it;
+// indices 16-bit where the mesh has <= 65536 vertices. One DrawItem per mesh (two if some of its
+// instances are mirrored), drawn instanced over its range of the instance buffer.
+GeometryPlan GpuScene::planGeometry(const Scene& scene) {
+  GeometryPlan p;
+  p.anyTexcoords = std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                               [](const Mesh& m) { return !m.texcoords.empty() && !m.indices.empty(); });
+  struct MeshDraw { DrawItem item; DrawKind kind; uint32_t flags; };
+  std::vector<std::optional<MeshDraw>> meshDraw(scene.meshes.size());
+  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const Mesh& m = scene.meshes[mi];
     if (m.indices.empty()) continue;
     const Material& mat = scene.materials.at(m.material);
     const bool index16 = m.positions.size() <= 65536;
     DrawItem d;
     d.material = m.material;
-    if (!m.bounds.empty()) d.center = m.bounds.center();
     d.indexCount = uint32_t(m.indices.size());
-    d.vertexOffset = int32_t(vertices);
+    d.vertexOffset = int32_t(p.vertices);
     d.indexType = index16 ? VK_INDEX_TYPE_UINT16 : VK_INDEX_TYPE_UINT32;
-    d.firstIndex = uint32_t(index16 ? count16 : count32);
-    slots.push_back({&m, vertices, d.firstIndex, index16});
-    (index16 ? count16 : count32) += m.indices.size();
+    d.firstIndex = uint32_t(index16 ? p.count16 : p.count32);
+    p.slots.push_back({&m, p.vertices, d.firstIndex, index16});
+    (index16 ? p.count16 : p.count32) += m.indices.size();
     stats_.meshes16 += index16;
-    vertices += m.positions.size();
+    p.vertices += m.positions.size();
     const bool textured = !m.texcoords.empty();
     // Two-sided materials go to the alpha-tested pipeline, which does not cull (with no mask texture
-    // the alpha is 1 and nothing is discarded). alphaTested is the same rule the tracer cuts out by.
-    DrawKind kind = !textured                                                  ? DrawKind::Untextured
-                    : alphaTested(m, mat) || (mat.flags & kMaterialDoubleSided) ? DrawKind::AlphaMasked
-                                                                               : DrawKind::Opaque;
-    d.id = uint32_t(drawInfo.size());
-    drawInfo.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
-                        (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});
-    draws_[size_t(kind)].push_back(d);
-    const bool masked = kind == DrawKind::AlphaMasked && mat.texture(TextureSlot::AlphaMask) != kNoTexture;
-    appendClusters(m, d.id, (kind == DrawKind::AlphaMasked ? CLUSTER_DOUBLE_SIDED : 0u) | (masked ? CLUSTER_ALPHA_MASKED : 0u),
-                   clusters);
+    // the alpha is 1 and nothing is discarded): clusterFlags says double-sided.
+    const uint32_t flags = clusterFlags(m, mat);
+    const DrawKind kind = !textured ? DrawKind::Untextured : flags ? DrawKind::AlphaMasked : DrawKind::Opaque;
+    d.id = uint32_t(p.draws.size());
+    p.draws.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
+                       (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});
+    meshDraw[mi] = MeshDraw{d, kind, flags};
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
   }
-  stats_.vertices = uint32_t(vertices);
-  count16 += count16 % 2;  // keep the buffer size a multiple of 4
+  const std::vector<Instance> instances = gpuInstances(scene);
+  Bounds box;  // of the draw being extended
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    const Instance& in = instances[i];
+    const Mesh& m = scene.meshes[in.mesh];
+    const MeshDraw& md = *meshDraw[in.mesh];
+    const bool flip = mirrored(in.transform);
+    p.instances.push_back(gpuInstance(in.transform, md.item.id));
+    appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
+    // The identity keeps the box exact (the nearest-first order of existing scenes unchanged).
+    const Bounds b = in.transform == glm::mat4(1.0f) ? m.bounds : transformed(m.bounds, in.transform);
+    std::vector<DrawItem>& list = draws_[size_t(md.kind)];
+    if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
+      list.push_back(md.item);
+      list.back().firstInstance = i, list.back().instanceCount = 0, list.back().mirrored = flip;
+      box = {};
+    }
+    ++list.back().instanceCount;
+    box.extend(b);
+    if (!box.empty()) list.back().center = box.center();
+  }
+  stats_.instances = uint32_t(instances.size());
+  stats_.vertices = uint32_t(p.vertices);
+  p.count16 += p.count16 % 2;  // keep the buffer size a multiple of 4
+  return p;
+}
 
+std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const {
   std::vector<shader::GpuMaterial> materials;
   for (const Material& m : scene.materials) {
     shader::GpuMaterial g{};
-    g.baseColor = glm::vec4(m.baseColor, 1.0f);
+    // glTF factors only for glTF materials: OBJ/course ones keep opacity 1 and the cutoff 0.5.
+    const bool gltf = m.flags & kMaterialGltf;
+    g.baseColor = glm::vec4(m.baseColor, gltf ? m.opacity : 1.0f);
     g.emissive = glm::vec4(m.emissive, 0.0f);
-    g.roughMetal = glm::vec4(m.roughness, m.metalness, 0.0f, 0.0f);
+    g.roughMetal = glm::vec4(m.roughness, m.metalness, gltf ? m.alphaCutoff : 0.5f, m.occlusionStrength);
     auto tex = [&](TextureSlot s) { uint32_t t = m.texture(s); return t == kNoTexture ? NO_TEXTURE : gpuIndex[t]; };
     g.textures = glm::uvec4(tex(TextureSlot::BaseColor), tex(TextureSlot::Roughness), tex(TextureSlot::Metalness),
                             tex(TextureSlot::AlphaMask));
-    g.textures2 = glm::uvec4(tex(TextureSlot::Emissive), 0, 0, 0);
+    const uint32_t mask = m.texture(TextureSlot::AlphaMask);
+    const uint32_t flags = (m.flags & kMaterialUnlit ? MATERIAL_UNLIT : 0u) | (gltf ? MATERIAL_GGX : 0u) |
+                           (mask != kNoTexture && scene.textures.at(mask).channels == 1 ? MATERIAL_MASK_RED : 0u);
+    g.textures2 = glm::uvec4(tex(TextureSlot::Emissive), gltf ? tex(TextureSlot::Occlusion) : NO_TEXTURE, NO_TEXTURE, flags);
     materials.push_back(g);
   }
   if (materials.empty()) materials.push_back({});
-  if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
-    texturedMaterials_ = materials;
-    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = NO_TEXTURE;
-  }
+  return materials;
+}
 
-  // Each buffer is device-local. Where the device lets the host write such memory (lavapipe, a GPU with
-  // a large BAR) the data is written there directly; else into one staging buffer, then copied.
+// Each buffer is device-local. Where the device lets the host write such memory (lavapipe, a GPU with a
+// large BAR) the data is written there directly, on all cores; else into one staging buffer, then copied.
+void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
+                              GeometryUpload upload) {
   struct Target {
     vk::Buffer* buffer;
     size_t size;
+    const void* data = nullptr;  // records copied whole; null: the streams, written below
     uint8_t* dst = nullptr;
     size_t stagingOffset = 0;
   };
+  const size_t vertices = plan.vertices;
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kCluster, kTargets };
+  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kTargets };
+  auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
-                                        {&texcoords_, anyTexcoords ? vertices * 8 : 0},
-                                        {&indices16_, count16 * 2},
-                                        {&indices32_, count32 * 4},
-                                        {&materials_, materials.size() * sizeof(shader::GpuMaterial)},
-                                        {&drawInfo_, drawInfo.size() * sizeof(shader::GpuDraw)},
-                                        {&clusters_, clusters.size() * sizeof(shader::GpuCluster)}}};
-  constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex, kVertex, kVertex, kIndex, kIndex, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions", "normals", "texcoords", "indices16", "indices32", "materials", "draws", "clusters"};
-  clusterCount_ = uint32_t(clusters.size());
+                                        {&texcoords_, plan.anyTexcoords ? vertices * 8 : 0},
+                                        {&indices16_, plan.count16 * 2},
+                                        {&indices32_, plan.count32 * 4},
+                                        {&materials_, bytes(materials), materials.data()},
+                                        {&drawInfo_, bytes(plan.draws), plan.draws.data()},
+                                        {&instances_, bytes(plan.instances), plan.instances.data()},
+                                        {&clusters_, bytes(plan.clusters), plan.clusters.data()}}};
+  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex, kVertex, kVertex, kIndex, kIndex,
+                                                       kStorage, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions", "normals", "texcoords", "indices16", "indices32",
+                                 "materials", "draws", "instances", "clusters"};
+  clusterCount_ = uint32_t(plan.clusters.size());
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {
     Target& tg = targets[i];
     if (tg.size == 0) continue;
-    *tg.buffer = vk::Buffer(ctx, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+    *tg.buffer = vk::Buffer(ctx_, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                             upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
     tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
     if (!tg.dst) {
@@ -203,26 +255,25 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   vk::Buffer staging;
   if (stagingSize) {
-    staging = vk::Buffer(ctx, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
+    staging = vk::Buffer(ctx_, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
     for (Target& tg : targets)
       if (tg.size && !tg.dst) tg.dst = static_cast<uint8_t*>(staging.mapped()) + tg.stagingOffset;
   }
-  if (targets[kMat].size) std::memcpy(targets[kMat].dst, materials.data(), targets[kMat].size);
-  if (targets[kDraw].size) std::memcpy(targets[kDraw].dst, drawInfo.data(), targets[kDraw].size);
-  if (targets[kCluster].size) std::memcpy(targets[kCluster].dst, clusters.data(), targets[kCluster].size);
+  for (const Target& tg : targets)
+    if (tg.size && tg.data) std::memcpy(tg.dst, tg.data, tg.size);
 
   // Pieces of at most 256 Ki vertices or 1 Mi indices, written on all cores.
   constexpr size_t kVertexChunk = size_t(1) << 18, kIndexChunk = size_t(1) << 20;
   std::vector<WriteTask> tasks;
-  for (uint32_t s = 0; s < slots.size(); ++s) {
-    for (size_t b = 0, n = slots[s].mesh->positions.size(); b < n; b += kVertexChunk)
+  for (uint32_t s = 0; s < plan.slots.size(); ++s) {
+    for (size_t b = 0, n = plan.slots[s].mesh->positions.size(); b < n; b += kVertexChunk)
       tasks.push_back({s, false, b, std::min(n, b + kVertexChunk)});
-    for (size_t b = 0, n = slots[s].mesh->indices.size(); b < n; b += kIndexChunk)
+    for (size_t b = 0, n = plan.slots[s].mesh->indices.size(); b < n; b += kIndexChunk)
       tasks.push_back({s, true, b, std::min(n, b + kIndexChunk)});
   }
   parallelFor(tasks.size(), 0, [&](size_t i) {
     const WriteTask& task = tasks[i];
-    const MeshSlot& slot = slots[task.slot];
+    const MeshSlot& slot = plan.slots[task.slot];
     const Mesh& m = *slot.mesh;
     const size_t n = task.end - task.begin;
     if (task.indices) {
@@ -243,26 +294,22 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       if (have < n) std::memset(dst + (v + have) * stride, 0, (n - have) * stride);
     };
     stream(targets[kNrm].dst, m.normals, 12);
-    if (anyTexcoords) stream(targets[kUv].dst, m.texcoords, 8);
+    if (plan.anyTexcoords) stream(targets[kUv].dst, m.texcoords, 8);
   });
   for (const Target& tg : targets)
     if (tg.size) (tg.buffer->mapped() ? *tg.buffer : staging).flush();
   if (staging.handle())
-    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
       for (const Target& tg : targets)
         if (tg.size && !tg.buffer->mapped()) {
           VkBufferCopy region{tg.stagingOffset, 0, tg.size};
           vkCmdCopyBuffer(cb, staging.handle(), tg.buffer->handle(), 1, &region);
         }
       // Also orders the copies before the frames' reads, which come in later submissions.
-      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kVertexInput | vk::kFragmentRead | vk::kComputeRead);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
     });
-  staging = {};
-  stats_.geometryMs = msSince(t);
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
-
-  if (!decoding_.valid()) finishTextures(), ready_ = true;
 }
 
 GpuScene::~GpuScene() {
@@ -322,7 +369,6 @@ void GpuScene::createTextures() {
     textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
     hostMips_.push_back(!staged_[i].levels.empty());
   }
-  sampler_ = makeSampler(ctx_, {});
 }
 
 std::vector<const vk::Image*> GpuScene::gpuMipBatch() const {
@@ -398,12 +444,20 @@ float maxAnisotropy(const vk::Context& ctx) {
   return features.samplerAnisotropy ? ctx.properties().limits.maxSamplerAnisotropy : 1.0f;
 }
 
-vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings) {
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings, const SamplerDesc& desc) {
   VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   const bool nearest = settings.filter == TextureFilter::Nearest;
-  si.magFilter = si.minFilter = nearest ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
-  si.mipmapMode = settings.filter == TextureFilter::Trilinear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
-  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  si.magFilter = nearest || desc.nearestMag ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+  si.minFilter = nearest || desc.nearestMin ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+  si.mipmapMode = settings.filter == TextureFilter::Trilinear && !desc.nearestMip ? VK_SAMPLER_MIPMAP_MODE_LINEAR
+                                                                                 : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  auto wrap = [](Wrap w) {
+    return w == Wrap::ClampToEdge      ? VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
+           : w == Wrap::MirroredRepeat ? VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT
+                                       : VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  };
+  si.addressModeU = wrap(desc.wrapU);
+  si.addressModeV = si.addressModeW = wrap(desc.wrapV);
   si.maxLod = VK_LOD_CLAMP_NONE;
   // Off by default: the mip-level view must show what plain trilinear filtering picks.
   const float anisotropy = std::clamp(settings.anisotropy, 1.0f, maxAnisotropy(ctx));
@@ -414,11 +468,10 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings)
   return vk::Sampler(ctx.device(), raw);
 }
 
-std::vector<VkDescriptorImageInfo> GpuScene::textureDescriptors(VkSampler sampler) const {
-  std::vector<VkDescriptorImageInfo> out;
+std::vector<VkImageView> GpuScene::textureViews() const {
+  std::vector<VkImageView> out;
   if (!ready_) return out;  // a deferred load's images exist before their upload completed
-  for (const auto& t : textures_)
-    out.push_back({sampler ? sampler : sampler_.get(), t.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  for (const auto& t : textures_) out.push_back(t.view());
   return out;
 }
 

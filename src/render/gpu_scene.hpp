@@ -30,20 +30,25 @@ namespace rtr::render {
 enum class DrawKind { Opaque, Untextured, AlphaMasked, Count };
 constexpr size_t kDrawKindCount = size_t(DrawKind::Count);
 
+// One instanced draw: a mesh under a range of instances (all mirrored or none: the front face is per draw).
 struct DrawItem {
   uint32_t material = 0;
   uint32_t indexCount = 0;
   uint32_t firstIndex = 0;   // in the index buffer of its type
   int32_t vertexOffset = 0;
   VkIndexType indexType = VK_INDEX_TYPE_UINT32;
-  uint32_t id = 0;           // index of its GpuDraw in drawInfo() (visibility path)
-  glm::vec3 center{0.0f};    // of its mesh's bounding box (frames draw the nearest first)
+  uint32_t id = 0;           // index of its mesh's GpuDraw in drawInfo()
+  uint32_t firstInstance = 0, instanceCount = 1;  // range of the instance buffer (gl_InstanceIndex)
+  bool mirrored = false;     // its instances flip the winding: front faces are clockwise
+  glm::vec3 center{0.0f};    // of its instances' scene-space box (frames draw the nearest first)
 };
+struct GeometryPlan;
 
 // The loading phases, in order; they do not overlap, and together they are the constructor's time
 // (pipeline creation for the mips aside, which the context's pipeline cache counts).
 struct GpuSceneStats {
-  uint32_t meshes = 0, triangles = 0, vertices = 0, textures = 0, meshes16 = 0;
+  uint32_t meshes = 0, triangles = 0, vertices = 0, textures = 0, meshes16 = 0;  // stored once each
+  uint32_t instances = 0;       // placements drawn (GpuInstance records)
   double decodeMs = 0;          // texture files decoded on all cores, into staging memory
   double geometryMs = 0;        // vertex and index streams laid out, written and (where needed) copied
   double textureUploadMs = 0;   // staging memory to level 0 of each texture
@@ -67,8 +72,11 @@ struct SamplerSettings {
 };
 // The largest anisotropy the device samples with: 1 without the samplerAnisotropy feature.
 float maxAnisotropy(const vk::Context& ctx);
-// A repeat-wrapping sampler for scene textures; the anisotropy is clamped to maxAnisotropy(ctx).
-vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings);
+// A sampler for a scene texture: wrap modes from `desc` (the texture's own, glTF samplers; OBJ textures
+// repeat), filters from `desc` under Trilinear (the texture's own; OBJ: trilinear), forced nearest-mip or
+// nearest by the other settings (the mip experiments apply to every texture); the anisotropy is clamped
+// to maxAnisotropy(ctx).
+vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings, const SamplerDesc& desc = {});
 
 // How the geometry reaches device memory: written in place where the host can map it (Auto), or always
 // through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
@@ -103,15 +111,22 @@ class GpuScene {
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }
   VkBuffer drawInfo() const { return drawInfo_.handle(); }  // GpuDraw per draw, for shading in compute
-  VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), draw by draw
+  VkBuffer instances() const { return instances_.handle(); }  // GpuInstance (frame.h), gpuInstances() order
+  uint32_t instanceCount() const { return stats_.instances; }
+  VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), instance by instance
   uint32_t clusterCount() const { return clusterCount_; }
   uint32_t textureCount() const { return stats_.textures; }  // also while they load
-  // Every texture with `sampler` (none: the default trilinear one); none until texturesReady().
-  std::vector<VkDescriptorImageInfo> textureDescriptors(VkSampler sampler = VK_NULL_HANDLE) const;
+  // Every texture's view; none until texturesReady(). The renderer pairs them with samplers (TextureSet).
+  std::vector<VkImageView> textureViews() const;
+  const std::vector<SamplerDesc>& textureSamplers() const { return samplers_; }  // per texture, its own
   const Bounds& bounds() const { return bounds_; }
   const GpuSceneStats& stats() const { return stats_; }
 
  private:
+  std::vector<uint32_t> startTextures(const Scene& scene, TextureLoad load);  // decode (or start to)
+  GeometryPlan planGeometry(const Scene& scene);  // draws_, stats_ and the records
+  std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
+  void uploadGeometry(const GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials, GeometryUpload upload);
   void finishTextures();  // staging buffers to images, mips (a waited load)
   void startUpload();     // the same in one submission, not waited for (a deferred load)
   void createTextures();
@@ -134,10 +149,10 @@ class GpuScene {
   std::future<void> decoding_;     // a deferred load's decode, until taken in
   bool ready_ = false;             // the textures are on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
-  vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, clusters_;
+  vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
   uint32_t clusterCount_ = 0;
   std::vector<vk::Image> textures_;
-  vk::Sampler sampler_;
+  std::vector<SamplerDesc> samplers_;  // of each texture (Texture::sampler)
   struct PendingUpload {  // alive until its submission completed
     explicit PendingUpload(const vk::Context& ctx) : mips(ctx), timer(ctx, 1) {}
     MipGenerator mips;

@@ -31,13 +31,11 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   vk::LayoutOptions options = push;
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene.textureCount());
   hardware_ = vk::makeGraphicsPipeline(ctx, d, options);
-  textures_ = vk::DescriptorSets(ctx, hardware_.layout, 1);
-  auto textures = scene.textureDescriptors();
-  if (!textures.empty()) vk::DescriptorWriter(ctx, hardware_.layout, 1, textures_.get(1)).images(0, textures).commit();
+  textures_ = vk::DescriptorSets(ctx, hardware_.layout, 1);  // written by the renderer (Renderer::writeTextures)
   // Every triangle at most once in the hand-off list, after its VkDrawIndirectCommand.
   uint64_t triangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& di : scene.draws(DrawKind(k))) triangles += di.indexCount / 3;
+    for (const DrawItem& di : scene.draws(DrawKind(k))) triangles += uint64_t(di.indexCount / 3) * di.instanceCount;
   hwList_ = vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryUse::Device,
                        "raster hand-off");
@@ -84,7 +82,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
       const VkBuffer counts = culler_ ? culler_->counts() : scene_.clusters();
       const VkBuffer buffers[] = {uniforms.buffer, scene_.clusters(), scene_.drawInfo(), scene_.positions(),
                                   i32, i16, vis_.handle(), hwList_.handle(), scene_.materials(), uv,
-                                  largeList_.handle(), list, counts};
+                                  largeList_.handle(), list, counts, scene_.instances()};
       if (b.binding == 0) w.buffer(0, uniforms.buffer, uniforms.offset, sizeof(shader::FrameUniforms));
       else w.buffer(b.binding, buffers[b.binding]);
     }

@@ -31,6 +31,9 @@ class ComputeRaster {
   void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer,
               uint32_t frame, const CullCamera* cull);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
+  // The hand-off's texture array (set 1 of its layout), for the one writer of every texture set.
+  const vk::PipelineLayout& textureLayout() const { return hardware_.layout; }
+  VkDescriptorSet textureSet() const { return hardware_.layout.setCount() > 1 ? textures_.get(1) : VK_NULL_HANDLE; }
   // The culling counts of the last completed use of `frame` (none if it did not cull).
   struct CullStats {
     uint32_t clusters = 0, early = 0, late = 0;  // listed by each phase

@@ -53,25 +53,27 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
     : ctx_(ctx),
       scene_(scene),
       framesInFlight_(framesInFlight),
-      sampler_(makeSampler(ctx, {})),
       texturesBound_(scene.texturesReady()),
       post_(ctx) {
+  makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 12);  // at most: ComputeRaster::record's nine passes, shade, post
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
-  // Draw index in the high bits (just enough that no id is VIS_EMPTY), primitive index in the rest.
-  uint32_t draws = 0, maxTriangles = 0;
+  // Instance index in the high bits (just enough that no id is VIS_EMPTY), primitive index in the rest.
+  uint32_t maxTriangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& d : scene.draws(DrawKind(k))) ++draws, maxTriangles = std::max(maxTriangles, d.indexCount / 3);
-  primitiveBits_ = 32 - uint32_t(std::bit_width(draws));
-  for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& d : scene.draws(DrawKind(k))) triangles_ += d.indexCount / 3;
+    for (const DrawItem& d : scene.draws(DrawKind(k))) {
+      maxTriangles = std::max(maxTriangles, d.indexCount / 3);
+      triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
+    }
+  const uint32_t instances = scene.instanceCount();
+  primitiveBits_ = 32 - uint32_t(std::bit_width(instances));
   cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   canHardware_ = features.geometryShader;
   canCompute_ = ComputeRaster::supported(ctx);
-  canUseVisibility_ = (canHardware_ || canCompute_) && draws > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
+  canUseVisibility_ = (canHardware_ || canCompute_) && instances > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
 }
 
 ShadingPath Renderer::pathFor(const RenderSettings& s) const {
@@ -93,6 +95,7 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader(vert), vk::loadShader(frag)};
   d.cullMode = cull;
+  d.dynamicFrontFace = true;  // per draw: mirrored instances' front faces are clockwise
   d.colorFormats = {colorFormat};
   d.depthFormat = kDepthFormat;
   vk::LayoutOptions options;
@@ -101,13 +104,14 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   p.pipeline.emplace(vk::makeGraphicsPipeline(ctx_, d, options));
   const vk::PipelineLayout& layout = p.pipeline->layout;
   p.sets = vk::DescriptorSets(ctx_, layout, framesInFlight_);
-  auto textures = scene_.textureDescriptors(sampler_);
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
     if (layout.setCount() == 0) break;
     // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
-    if (hasBinding(layout, 0, 1)) vk::DescriptorWriter(ctx_, layout, 0, p.sets.get(0, frame)).buffer(1, scene_.materials()).commit();
-    if (layout.setCount() > 1 && !textures.empty())
-      vk::DescriptorWriter(ctx_, layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
+    vk::DescriptorWriter w(ctx_, layout, 0, p.sets.get(0, frame));
+    if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
+    if (hasBinding(layout, 0, 2)) w.buffer(2, scene_.instances());
+    w.commit();
+    if (layout.setCount() > 1) writeTextures(layout, p.sets.get(1, frame));
   }
   return p;
 }
@@ -144,8 +148,7 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
       vk::makeComputePipeline(ctx_, vk::loadShader(shader), options));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
-    auto textures = scene_.textureDescriptors(sampler_);
-    if (!textures.empty()) vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
+    writeTextures(v.pipeline->layout, v.textures.get(1));
   }
   return v;
 }
@@ -172,22 +175,37 @@ void Renderer::rebuildPipelines() {
     raster->resize(extent_);
     raster_.reset();
     raster_.emplace(std::move(*raster));
+    writeTextures(raster_->textureLayout(), raster_->textureSet());
   }
 }
 
+void Renderer::makeTextureInfos() {
+  samplers_.clear();
+  textureInfos_.clear();
+  const std::vector<VkImageView> views = scene_.textureViews();
+  const std::vector<SamplerDesc>& descs = scene_.textureSamplers();
+  std::vector<SamplerDesc> made;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const size_t k = std::find(made.begin(), made.end(), descs[i]) - made.begin();
+    if (k == made.size()) made.push_back(descs[i]), samplers_.push_back(makeSampler(ctx_, samplerSettings_, descs[i]));
+    textureInfos_.push_back({samplers_[k].get(), views[i], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  }
+}
+
+void Renderer::writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set) const {
+  if (set && !textureInfos_.empty()) vk::DescriptorWriter(ctx_, layout, 1, set).images(0, textureInfos_).commit();
+}
+
 void Renderer::writeTextureSets() {
-  const auto textures = scene_.textureDescriptors(sampler_);
-  if (textures.empty()) return;
   for (auto& set : pipelines_) {
     if (!set) continue;
     for (ScenePipelines& p : *set)
       if (p.pipeline && p.pipeline->layout.setCount() > 1)
-        for (uint32_t frame = 0; frame < framesInFlight_; ++frame)
-          vk::DescriptorWriter(ctx_, p.pipeline->layout, 1, p.sets.get(1, frame)).images(0, textures).commit();
+        for (uint32_t frame = 0; frame < framesInFlight_; ++frame) writeTextures(p.pipeline->layout, p.sets.get(1, frame));
   }
   for (VisShade& v : shade_)
-    if (v.pipeline && v.pipeline->layout.setCount() > 1)
-      vk::DescriptorWriter(ctx_, v.pipeline->layout, 1, v.textures.get(1)).images(0, textures).commit();
+    if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1));
+  if (raster_) writeTextures(raster_->textureLayout(), raster_->textureSet());
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -239,9 +257,9 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
         vkCmdBindIndexBuffer(cb, d.indexType == VK_INDEX_TYPE_UINT16 ? scene_.indices16() : scene_.indices32(), 0, d.indexType);
         bound = d.indexType;
       }
-      shader::DrawPush push{d.material, vis ? d.id << primitiveBits_ : 0u};
-      pl.push(cb, push);
-      vkCmdDrawIndexed(cb, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
+      pl.push(cb, shader::DrawPush{d.material, primitiveBits_});
+      vkCmdSetFrontFace(cb, d.mirrored ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE);
+      vkCmdDrawIndexed(cb, d.indexCount, d.instanceCount, d.firstIndex, d.vertexOffset, d.firstInstance);
     }
   }
 }
@@ -261,6 +279,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(4, scene_.normals())
       .buffer(5, i32)
       .buffer(6, i16)
+      .buffer(10, scene_.instances())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
   if (raster == RasterPath::Compute) w.buffer(7, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
@@ -278,14 +297,14 @@ void Renderer::frame(FrameContext& fc) {
   const Lens& lens = fc.lens;
   const RenderSettings& s = fc.settings;
   const RenderTarget& target = fc.target;
-  // The texture sets are written again once no frame uses them, for a new sampler (samplers are cheap; a
-  // user's change in the panel) or the textures of a deferred load arriving (the compute rasteriser, which
-  // samples alpha masks, is then rebuilt with them).
+  // Every texture set is written again once no frame uses them, for new samplers (samplers are cheap; a
+  // user's change in the panel) or the textures of a deferred load arriving.
   const bool arrived = scene_.texturesReady() && !texturesBound_;
   if (s.sampler != samplerSettings_ || arrived) {
     VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
-    if (s.sampler != samplerSettings_) sampler_ = makeSampler(ctx_, s.sampler), samplerSettings_ = s.sampler;
-    if (arrived) raster_.reset(), texturesBound_ = true;
+    samplerSettings_ = s.sampler;
+    texturesBound_ = scene_.texturesReady();
+    makeTextureInfos();
     writeTextureSets();
   }
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
@@ -298,6 +317,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute && !raster_) {
     raster_.emplace(ctx_, scene_, framesInFlight_);
     raster_->resize(extent_);
+    writeTextures(raster_->textureLayout(), raster_->textureSet());
   }
   if (!compute) ensurePipelines(set);
   if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);
@@ -315,7 +335,8 @@ void Renderer::frame(FrameContext& fc) {
   for (uint32_t i = 0; i < u.lightCount.x; ++i) {
     const Light& l = s.lights.lights[i];
     const glm::vec3 p = l.kind == Light::Kind::Headlight ? pose.position : l.position;
-    u.lights[i] = {glm::vec4(p, l.falloff ? 1.0f : 0.0f), glm::vec4(l.color, 0.0f)};
+    u.lights[i] = shader::makeGpuLight(unsigned(l.kind), p, l.color, l.falloff, l.direction, l.innerConeCos,
+                                       l.outerConeCos, l.range);
   }
   u.params = glm::vec4(float(s.mode), s.lodBias, lens.zNear, lens.zFar);
   {
@@ -342,19 +363,29 @@ void Renderer::frame(FrameContext& fc) {
     const CullCamera cam{u.viewProj, pose.position, lens.orthographic};
     raster_->record(cb, uniforms_, primitiveBits_, timer, frame, s.cull ? &cam : nullptr);
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
-    vk::require(cb, {{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
+  } else {
+    rasterPass(cb, frame, set, pose.position);
+    timer.mark(cb, visibility ? "visibility" : "scene");
+  }
+  if (visibility) {
+    const vk::Requirement out{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true};
+    if (compute) vk::require(cb, {out});
+    else vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT}, out});
     shadeVisibility(cb, raster);
     timer.mark(cb, "shade");
-    post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
-    timer.mark(cb, "post");
-    return;
   }
+  post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
+  timer.mark(cb, "post");
+}
+
+// The scene pass by the hardware: forward colour or visibility ids, with depth.
+void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye) {
+  const bool visibility = set == kVisibility;
   // Old contents are discarded; the tracker waits for the previous frame's readers (post or shading pass).
   const vk::Image& target0 = visibility ? vis_ : color_;
   vk::require(cb, {{target0.tracked(), vk::Use::ColorAttachment, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, true},
                    {depth_.tracked(), vk::Use::DepthAttachment,
                     VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, true}});
-
   VkRenderingAttachmentInfo colorAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   colorAtt.imageView = target0.view();
   colorAtt.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
@@ -369,25 +400,15 @@ void Renderer::frame(FrameContext& fc) {
   depthAtt.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
   depthAtt.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-  ri.renderArea = {{0, 0}, target.extent};
+  ri.renderArea = {{0, 0}, extent_};
   ri.layerCount = 1;
   ri.colorAttachmentCount = 1;
   ri.pColorAttachments = &colorAtt;
   ri.pDepthAttachment = &depthAtt;
   vkCmdBeginRendering(cb, &ri);
-  vk::setFullViewport(cb, target.extent);
-  drawScene(cb, frame, set, pose.position);
+  vk::setFullViewport(cb, extent_);
+  drawScene(cb, frame, set, eye);
   vkCmdEndRendering(cb);
-  timer.mark(cb, visibility ? "visibility" : "scene");
-
-  if (visibility) {
-    vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
-                     {color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true}});
-    shadeVisibility(cb, raster);
-    timer.mark(cb, "shade");
-  }
-  post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
-  timer.mark(cb, "post");
 }
 
 }  // namespace rtr::render

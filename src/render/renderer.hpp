@@ -123,15 +123,21 @@ class Renderer {
   KindPipelines makePipelines(PipelineSet set) const;
   VisShade makeShade(bool fromBuffer) const;
   void ensurePipelines(PipelineSet set);
+  void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
   void shadeVisibility(VkCommandBuffer cb, RasterPath raster);
-  void writeTextureSets();  // the texture array of every pipeline built, with sampler_
+  // The scene's texture array, as every pipeline that samples it binds it (set 1, binding 0): each
+  // texture with a sampler made from its own SamplerDesc and the settings (one per distinct pair).
+  void makeTextureInfos();
+  void writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set) const;  // the one writer
+  void writeTextureSets();  // every pipeline built: after a settings change or the textures' arrival
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
   uint32_t framesInFlight_;
   SamplerSettings samplerSettings_;
-  vk::Sampler sampler_;  // the texture descriptors' sampler, made from samplerSettings_
+  std::vector<vk::Sampler> samplers_;  // made from samplerSettings_, one per distinct SamplerDesc
+  std::vector<VkDescriptorImageInfo> textureInfos_;
   bool texturesBound_;   // the scene's textures were ready when the texture sets were written
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;

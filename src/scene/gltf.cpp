@@ -128,7 +128,11 @@ public:
     if (animated_) note("animations, skins and morph targets are not played: the meshes are shown at rest");
     if (skipped_)
       note(std::to_string(skipped_) + " primitive(s) of points or lines (or without POSITION) left out: rtr draws triangles");
-    if (scene_.instances.empty()) throw fileError(name_, "", "the scene has no triangles to draw");
+    if (warnings_ > kShownWarnings)
+      message(opt_.warn, "warning", std::to_string(warnings_) + " warnings, first " + std::to_string(kShownWarnings) + " shown");
+    if (scene_.instances.empty())
+      throw fileError(name_, "", "the scene has no triangles to draw" +
+                                     (skipped_ ? " (" + std::to_string(skipped_) + " primitive(s) of points or lines left out)" : std::string()));
     return std::move(scene_);
   }
 
@@ -140,7 +144,11 @@ private:
     else std::cerr << kind << ": " << line << "\n";
   }
   void note(const std::string& s) { message(opt_.note, "note", s); }
-  void warn(const std::string& s) { message(opt_.warn, "warning", s); }
+  // At most kShownWarnings are passed on, then one line with the total (as the OBJ reader does).
+  static constexpr size_t kShownWarnings = 10;
+  void warn(const std::string& s) {
+    if (++warnings_ <= kShownWarnings) message(opt_.warn, "warning", s);
+  }
 
   void checkExtensions(const Json& root) {
     auto supported = [](std::string_view e) { return std::find(std::begin(kSupported), std::end(kSupported), e) != std::end(kSupported); };
@@ -292,16 +300,21 @@ private:
       where.fail("index " + std::to_string(m.indices[i]) + " (element " + std::to_string(i) + ") is not below the vertex count " +
                  std::to_string(vertices));
     }
-    float sum = 0.0f;  // NaN or infinity anywhere makes the sum so
-    for (const glm::vec3& v : m.positions) {
-      sum += v.x + v.y + v.z;
-      m.bounds.extend(v);
-    }
-    if (!std::isfinite(sum))
-      for (size_t i = 0; i < vertices; ++i)
-        if (!std::isfinite(m.positions[i].x) || !std::isfinite(m.positions[i].y) || !std::isfinite(m.positions[i].z))
+    // Coordinates beyond ±1e9 (an Earth-centred frame is ±6.4e6 m) overflow the squared lengths that
+    // clustering and shading take; NaN and infinity are never geometry.
+    constexpr float kMaxCoordinate = 1e9f;
+    for (const glm::vec3& v : m.positions) m.bounds.extend(v);
+    const Bounds& bb = m.bounds;
+    if (!(std::max({-bb.min.x, -bb.min.y, -bb.min.z, bb.max.x, bb.max.y, bb.max.z}) <= kMaxCoordinate) ||
+        !std::all_of(m.positions.begin(), m.positions.end(), [](const glm::vec3& v) { return v == v; }))
+      for (size_t i = 0; i < vertices; ++i) {
+        const glm::vec3 v = m.positions[i];
+        if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
           attrs.fail("POSITION element " + std::to_string(i) + " is not finite");
-    toTriangleList(m.indices, mode);
+        if (std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}) > kMaxCoordinate)
+          attrs.fail("POSITION element " + std::to_string(i) + " has a coordinate beyond ±1e9, more than rtr handles");
+      }
+    toTriangleList(p, m.indices, mode);
     if (m.indices.empty()) {
       ++skipped_;
       return std::nullopt;
@@ -323,10 +336,10 @@ private:
   }
 
   // Strips and fans as triangle lists (their winding as the spec defines it); a list cut to whole triangles.
-  void toTriangleList(std::vector<uint32_t>& idx, uint64_t mode) {
+  void toTriangleList(const Json& p, std::vector<uint32_t>& idx, uint64_t mode) {
     if (mode == 4) {
       if (idx.size() % 3) {
-        warn(std::to_string(idx.size()) + " indices of a triangle list are not whole triangles: the last " +
+        warn(p.path() + ": " + std::to_string(idx.size()) + " indices of a triangle list are not whole triangles: the last " +
              std::to_string(idx.size() % 3) + " left out");
         idx.resize(idx.size() - idx.size() % 3);
       }
@@ -455,7 +468,7 @@ private:
   gltf::Materials* mats_ = nullptr;
   std::vector<std::optional<std::vector<uint32_t>>> meshes_;
   std::set<std::string> said_;
-  size_t skipped_ = 0;
+  size_t skipped_ = 0, warnings_ = 0;
   bool animated_ = false, cameraDone_ = false;
 };
 

@@ -48,13 +48,12 @@ public:
 
   // Reads accessor `a` as floats (normalized integers mapped to [0,1] / [-1,1], others converted) into
   // dst, `dstComponents` floats per element (extra components left as they are, missing ones not
-  // written). `allowed` lists the component counts the caller takes (e.g. "VEC3"); dst holds count elements.
+  // written). `allowedComponents` lists the component counts the caller takes; dst holds count elements.
   void readFloats(uint32_t accessor, float* dst, int dstComponents, std::initializer_list<int> allowedComponents);
   // Reads a SCALAR integer accessor (indices) as uint32.
   void readIndices(uint32_t accessor, std::vector<uint32_t>& out);
 
 private:
-  struct Buffer;
   std::span<const uint8_t> buffer(uint32_t i);
   // The checked byte range of an accessor's elements: element i at data[i * stride].
   struct Range { std::span<const uint8_t> data; size_t stride = 0; };

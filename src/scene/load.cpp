@@ -1,5 +1,7 @@
 #include "scene/load.hpp"
 
+#include <cctype>
+
 #include "core/error.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
@@ -23,7 +25,9 @@ Scene loadAny(const std::filesystem::path& file, const LoadOptions& options) {
     throw fileError(file.string(), "", "an MTL file ('" + options.mtl->string() + "') can only be given with an OBJ scene");
   if (ends(".comp5892mesh")) return loadCourseMesh(file);
   if (ends(".rtrscene")) return loadRtrScene(file);
-  if (ends(".gltf") || ends(".glb")) return loadGltf(file, options);
+  std::string lower = n;
+  for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (lower.ends_with(".gltf") || lower.ends_with(".glb")) return loadGltf(file, options);  // as rtr-bake: any case
   throw fileError(file.string(), "", "unknown scene format (expected .obj, .obj.zst, .obj-zstd, .gltf, .glb, .comp5892mesh, .rtrscene)");
 }
 

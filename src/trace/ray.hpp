@@ -29,11 +29,12 @@ struct FlushDenormals {
 constexpr uint32_t kNoHit = 0xFFFFFFFFu;
 
 // Closest hit: t along the ray, barycentric weights b1, b2 of vertices 1 and 2 (b0 = 1 - b1 - b2),
-// and the index of the triangle in the tracer's flattened triangle list.
+// the index of the triangle in the tracer's triangle list, and in a scene with instances which one.
 struct Hit {
   float t = std::numeric_limits<float>::infinity();
   float b1 = 0.0f, b2 = 0.0f;
   uint32_t prim = kNoHit;
+  uint32_t instance = 0;  // Scene::instances index (InstanceBvh); 0 without instances
   bool hit() const { return prim != kNoHit; }
 };
 

@@ -19,9 +19,9 @@ glm::vec3 blinnPhongDirect(const Material& m, const glm::vec3& kd, const glm::ve
 
 glm::vec3 blinnPhongAmbient(const Material& m, const glm::vec3& lightColor) { return m.ka * lightColor; }
 
-glm::vec3 pbrDirect(const glm::vec3& n, const glm::vec3& v, const glm::vec3& l, const glm::vec3& lightColor,
+glm::vec3 pbrDirect(int brdf, const glm::vec3& n, const glm::vec3& v, const glm::vec3& l, const glm::vec3& lightColor,
                     const glm::vec3& baseColor, float roughness, float metalness) {
-  return shader::pbrDirect(n, v, l, lightColor, baseColor, roughness, metalness);
+  return shader::pbrDirect(brdf, n, v, l, lightColor, baseColor, roughness, metalness);
 }
 
 }  // namespace rtr::trace

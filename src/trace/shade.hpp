@@ -16,8 +16,9 @@ glm::vec3 blinnPhongDirect(const Material& m, const glm::vec3& kd, const glm::ve
 // Ambient of one light: Ka ⊙ Lc. It is all a light gives to a point in its shadow (with Ke).
 glm::vec3 blinnPhongAmbient(const Material& m, const glm::vec3& lightColor);
 
-// The GPU renderer's BRDF for one light (shaders/shared/brdf.h's pbrDirect, compiled here as C++).
-glm::vec3 pbrDirect(const glm::vec3& n, const glm::vec3& v, const glm::vec3& l, const glm::vec3& lightColor,
+// The GPU renderer's BRDF for one light (shaders/shared/brdf.h's pbrDirect, compiled here as C++); brdf:
+// BRDF_BECKMANN or BRDF_GGX.
+glm::vec3 pbrDirect(int brdf, const glm::vec3& n, const glm::vec3& v, const glm::vec3& l, const glm::vec3& lightColor,
                     const glm::vec3& baseColor, float roughness, float metalness);
 
 }  // namespace rtr::trace

@@ -97,23 +97,42 @@ const MipTexture* SceneTextures::texture(const Material& m, TextureSlot slot) co
   return t < index_.size() && index_[t] != kNoTexture ? &textures_[index_[t]] : nullptr;
 }
 
-SurfaceInputs SceneTextures::fetch(const Material& m, glm::vec2 uv, float uvWidth) const {
-  auto sample = [&](TextureSlot slot) {
-    const MipTexture* t = texture(m, slot);
-    return t ? t->sample(uv, t->lod(uvWidth)) : glm::vec4(1.0f);
-  };
+glm::vec2 slotUv(const Material& m, TextureSlot slot, const SurfaceUv& uv, float* footprintScale) {
+  const UvTransform& x = m.uv[uint32_t(slot)];
+  const glm::vec2 in = x.texCoord == 1 ? uv.uv1 : uv.uv0;
+  if (footprintScale) *footprintScale = 1.0f;
+  if (x.identity()) return in;
+  if (footprintScale) *footprintScale = std::sqrt(std::abs(x.scale.x * x.scale.y));
+  const glm::vec2 p = x.scale * in;
+  const float c = std::cos(x.rotation), s = std::sin(x.rotation);
+  return x.offset + glm::vec2(c * p.x + s * p.y, -s * p.x + c * p.y);
+}
+
+glm::vec4 SceneTextures::sample(const Material& m, TextureSlot slot, const SurfaceUv& uv, float uvWidth,
+                                glm::vec4 none) const {
+  const MipTexture* t = texture(m, slot);
+  if (!t) return none;
+  float k;
+  const glm::vec2 st = slotUv(m, slot, uv, &k);
+  return t->sample(st, t->lod(uvWidth * k));
+}
+
+SurfaceInputs SceneTextures::fetch(const Material& m, const SurfaceUv& uv, float uvWidth) const {
+  auto sample = [&](TextureSlot slot) { return this->sample(m, slot, uv, uvWidth, glm::vec4(1.0f)); };
   SurfaceInputs s = materialFactors(m);
   s.baseColor *= glm::vec3(sample(TextureSlot::BaseColor));
   s.roughness *= sample(TextureSlot::Roughness).r;
   s.metalness *= sample(TextureSlot::Metalness).r;
-  s.alpha = sample(TextureSlot::AlphaMask).a;
+  s.alpha = alpha(m, uv, uvWidth);
   s.emissive *= glm::vec3(sample(TextureSlot::Emissive));
   return s;
 }
 
-float SceneTextures::alpha(const Material& m, glm::vec2 uv, float uvWidth) const {
+float SceneTextures::alpha(const Material& m, const SurfaceUv& uv, float uvWidth) const {
   const MipTexture* t = texture(m, TextureSlot::AlphaMask);
-  return t ? t->sample(uv, t->lod(uvWidth)).a : 1.0f;
+  if (!t) return 1.0f;
+  const glm::vec4 a = sample(m, TextureSlot::AlphaMask, uv, uvWidth, glm::vec4(1.0f));
+  return t->channels() == 1 ? a.r : a.a;
 }
 
 }  // namespace rtr::trace

@@ -29,6 +29,7 @@ class MipTexture {
   float lod(float uvWidth) const;
 
   uint32_t width() const { return levels_[0].width; }
+  uint32_t channels() const { return channels_; }
   uint32_t height() const { return levels_[0].height; }
   uint32_t levels() const { return uint32_t(levels_.size()); }
 
@@ -54,6 +55,15 @@ struct SurfaceInputs {
 };
 SurfaceInputs materialFactors(const Material& m);  // factors only (a mesh without texcoords)
 
+// The texture coordinates of a surface point: both sets (glTF TEXCOORD_0 and _1).
+struct SurfaceUv {
+  glm::vec2 uv0{0.0f}, uv1{0.0f};
+};
+// The uv a material's slot samples: its set, through its KHR_texture_transform
+// (uv' = offset + R · (scale ⊙ uv), R turning counter-clockwise in uv space, whose v points down), and
+// the factor its transform scales a footprint by. Identity: uv0 itself, factor 1.
+glm::vec2 slotUv(const Material& m, TextureSlot slot, const SurfaceUv& uv, float* footprintScale = nullptr);
+
 // The textures a scene's PBR shading samples (only those scene/textures.hpp's sampledTextures lists),
 // decoded and mip-mapped on all cores. Throws rtr::Error naming a file that is missing or undecodable.
 class SceneTextures {
@@ -62,8 +72,11 @@ class SceneTextures {
 
   // material.glsl's fetchSurface: factors × textures at uv. uvWidth: the ray cone's width at the hit in
   // texture-coordinate units (the level of detail follows from it and each texture's size).
-  SurfaceInputs fetch(const Material& m, glm::vec2 uv, float uvWidth) const;
-  float alpha(const Material& m, glm::vec2 uv, float uvWidth) const;  // the alpha-mask texture's alpha
+  SurfaceInputs fetch(const Material& m, const SurfaceUv& uv, float uvWidth) const;
+  // The alpha-mask texture's alpha (a one-channel mask, glTF's base colour alpha: its value), 1 without.
+  float alpha(const Material& m, const SurfaceUv& uv, float uvWidth) const;
+  // One slot's sample (one channel: (r, 0, 0, 1)), or `none` where the material has no texture there.
+  glm::vec4 sample(const Material& m, TextureSlot slot, const SurfaceUv& uv, float uvWidth, glm::vec4 none) const;
 
   size_t count() const { return textures_.size(); }
   double loadSeconds() const { return seconds_; }  // decoding and mip building, wall time

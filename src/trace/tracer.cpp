@@ -15,6 +15,7 @@
 #include "core/parallel.hpp"
 #include "scene/framing.hpp"
 #include "scene/textures.hpp"
+#include "brdf.h"  // shaders/shared: BRDF_BECKMANN, BRDF_GGX
 #include "trace/shade.hpp"
 #include "trace/spawn.hpp"
 
@@ -35,16 +36,70 @@ float uvWidth(const SurfacePoint& sp, const Ray& r, float coneWidth) {
   return sp.uvScale * coneWidth / std::abs(glm::dot(sp.geomNormal, glm::normalize(r.direction)));
 }
 
+// glTF's normal map: the texel's tangent-space normal (2·rgb − 1, xy times `scale`) on the frame of the
+// interpolated normal and tangent (bitangent = n × t · w). No texel (x < 0) or no tangent: sp.normal.
+glm::vec3 normalMapped(const SurfacePoint& sp, const glm::vec4& texel, float scale) {
+  if (texel.x < 0.0f || sp.tangent == glm::vec4(0.0f)) return sp.normal;
+  const glm::vec3 n = sp.flipped ? -sp.normal : sp.normal;  // the side the mesh's normals are on
+  glm::vec3 t = glm::vec3(sp.tangent) - n * glm::dot(n, glm::vec3(sp.tangent));
+  const float tl = glm::length(t);
+  if (!(tl > 0.0f)) return sp.normal;
+  t /= tl;
+  const glm::vec3 b = glm::cross(n, t) * sp.tangent.w;
+  const glm::vec3 ts = glm::vec3(texel) * 2.0f - 1.0f;
+  const glm::vec3 p = glm::normalize(t * (ts.x * scale) + b * (ts.y * scale) + n * ts.z);
+  if (!std::isfinite(p.x)) return sp.normal;
+  return sp.flipped ? -p : p;
+}
+
+static_assert(unsigned(Light::Kind::Spot) == LIGHT_SPOT && unsigned(Light::Kind::Directional) == LIGHT_DIRECTIONAL);
+
+// Shadow sample i of n of a light as the shared light model (shaders/shared/lights.h) sees it from p, and
+// the shadow ray towards it: to the sample point (t in [0, 1]), or to infinity for a directional light.
+struct LightRay {
+  shader::LightSample ls;
+  Ray shadow;
+  bool valid;  // false: p is the light's own position
+};
+LightRay lightRay(const Light& light, int i, int n, const glm::vec3& p, const glm::vec3& ng) {
+  const glm::vec3 at = light.samplePoint(i, n);
+  const shader::LightSample ls = shader::lightSample(
+      shader::makeGpuLight(unsigned(light.kind), at, light.color, light.falloff, light.direction, light.innerConeCos,
+                           light.outerConeCos, light.range),
+      p);
+  if (light.kind == Light::Kind::Directional) return {ls, spawnRay(p, ng, ls.l), true};
+  const glm::vec3 toLight = at - p;
+  return {ls, spawnRay(p, ng, toLight, 1.0f), glm::dot(toLight, toLight) > 0.0f};
+}
+
 }  // namespace
 
 Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
+  // With instances, only the meshes they place are drawn, each stored once however often it is placed.
+  instanced_ = !scene.instances.empty();
+  std::vector<uint32_t> objectOf(scene.meshes.size(), kNoHit);
+  std::vector<InstanceBvh::Object> objects;
+  for (size_t i = 0; i < scene.instances.size(); ++i)
+    if (scene.instances[i].mesh >= scene.meshes.size())
+      throw Error("instance " + std::to_string(i) + " places mesh " + std::to_string(scene.instances[i].mesh) +
+                  " of " + std::to_string(scene.meshes.size()));
+    else
+      objectOf[scene.instances[i].mesh] = 0;
   for (uint32_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     const bool light = m.material < scene.materials.size() && isLightMaterial(scene.materials[m.material]);
-    meshAlphaTested_.push_back(m.material < scene.materials.size() && alphaTested(m, scene.materials[m.material]));
+    // glTF MASK materials cut out by the alpha of factor, texture and vertex colour, textured or not.
+    const Material* mat = m.material < scene.materials.size() ? &scene.materials[m.material] : nullptr;
+    meshAlphaTested_.push_back(mat && ((mat->flags & kMaterialGltf) ? (mat->flags & kMaterialAlphaMasked) != 0
+                                                                    : alphaTested(m, *mat)));
     anyAlphaTested_ = anyAlphaTested_ || meshAlphaTested_.back();
     anyBaseTextured_ = anyBaseTextured_ || (m.material < scene.materials.size() && !m.texcoords.empty() &&
                                             scene.materials[m.material].texture(TextureSlot::BaseColor) != kNoTexture);
+    if (instanced_) {
+      if (objectOf[mi] == kNoHit) continue;  // placed nowhere
+      objectOf[mi] = uint32_t(objects.size());
+      objects.push_back({uint32_t(tris_.size()), m.triangleCount()});
+    }
     for (uint32_t t = 0; t < m.triangleCount(); ++t) {
       const uint32_t* idx = &m.indices[size_t(t) * 3];
       if (idx[0] >= m.positions.size() || idx[1] >= m.positions.size() || idx[2] >= m.positions.size())
@@ -55,12 +110,19 @@ Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
       castsShadow_.push_back(light ? 0 : 1);  // shadow rays pass through the lights' own geometry
     }
   }
+  if (instanced_) {
+    std::vector<InstanceBvh::Placement> placements;
+    for (const Instance& in : scene.instances) placements.push_back({objectOf[in.mesh], in.transform});
+    instances_ = InstanceBvh(tris_, castsShadow_, objects, placements, buildThreads);
+    return;
+  }
   useBvh_ = tris_.size() >= kBruteForceMax;
   if (useBvh_) bvh_ = Bvh(tris_, castsShadow_, buildThreads);
 }
 
 Hit Tracer::closestTriangle(const Ray& r, IntersectMethod m) const {
   if (useBvh_) return bvh_.closest(r, m);
+  if (instanced_) return instances_.closest(r, m);
   // The brief's loop: every triangle, keep the smallest positive t.
   Hit best;
   Ray q = r;
@@ -74,6 +136,7 @@ Hit Tracer::closestTriangle(const Ray& r, IntersectMethod m) const {
 
 bool Tracer::occluded(const Ray& r, IntersectMethod m) const {
   if (useBvh_) return bvh_.occluded(r, m);
+  if (instanced_) return instances_.occluded(r, m);
   for (uint32_t i = 0; i < tris_.size(); ++i) {
     float b1, b2;
     if (castsShadow_[i] && intersect(m, r, tris_[i], b1, b2) > 0.0f) return true;
@@ -83,7 +146,14 @@ bool Tracer::occluded(const Ray& r, IntersectMethod m) const {
 
 SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
   SurfacePoint sp;
-  const Triangle& tri = tris_[h.prim];
+  Triangle tri = tris_[h.prim];
+  bool mirrored = false;
+  if (instanced_) {  // into scene space: the vertices, as a flattened copy would hold them
+    const glm::mat4& M = instances_.toScene(h.instance);
+    mirrored = instances_.mirrored(h.instance);
+    tri = {glm::vec3(M * glm::vec4(tri.v0, 1.0f)), glm::vec3(M * glm::vec4(tri.v1, 1.0f)),
+           glm::vec3(M * glm::vec4(tri.v2, 1.0f))};
+  }
   const float b0 = 1.0f - h.b1 - h.b2;
   sp.position = b0 * tri.v0 + h.b1 * tri.v1 + h.b2 * tri.v2;
   glm::vec3 ng = glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
@@ -93,7 +163,8 @@ SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
   const uint32_t* idx = &m.indices[size_t(triLocal_[h.prim]) * 3];
   glm::vec3 ns = ng;
   if (m.normals.size() == m.positions.size()) {
-    const glm::vec3 n = b0 * m.normals[idx[0]] + h.b1 * m.normals[idx[1]] + h.b2 * m.normals[idx[2]];
+    glm::vec3 n = b0 * m.normals[idx[0]] + h.b1 * m.normals[idx[1]] + h.b2 * m.normals[idx[2]];
+    if (instanced_) n = instances_.normalToScene(h.instance) * n;
     const float nl = glm::length(n);
     if (nl > 0.0f && std::isfinite(nl)) ns = n / nl;
   }
@@ -102,9 +173,24 @@ SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
     sp.uv = t0 + h.b1 * e1 + h.b2 * e2;
     if (len > 0.0f) sp.uvScale = std::sqrt(std::abs(e1.x * e2.y - e1.y * e2.x) / len);  // both doubled areas
   }
+  if (m.texcoords1.size() == m.positions.size())
+    sp.uv1 = b0 * m.texcoords1[idx[0]] + h.b1 * m.texcoords1[idx[1]] + h.b2 * m.texcoords1[idx[2]];
+  if (m.colors.size() == m.positions.size())
+    sp.color = b0 * m.colors[idx[0]] + h.b1 * m.colors[idx[1]] + h.b2 * m.colors[idx[2]];
+  if (m.tangents.size() == m.positions.size()) {
+    glm::vec4 t = b0 * m.tangents[idx[0]] + h.b1 * m.tangents[idx[1]] + h.b2 * m.tangents[idx[2]];
+    glm::vec3 x(t);
+    if (instanced_) x = glm::mat3(instances_.toScene(h.instance)) * x;
+    const float tl = glm::length(x);
+    // A mirroring placement turns the bitangent's handedness.
+    if (tl > 0.0f && std::isfinite(tl)) sp.tangent = glm::vec4(x / tl, (t.w < 0.0f) != mirrored ? -1.0f : 1.0f);
+  }
+  // Front = counter-clockwise as seen (glTF; a mirroring placement turns it).
+  sp.backFace = (glm::dot(ng, r.direction) > 0.0f) != mirrored;
   // Two-sided: face the normals towards where the ray came from.
   if (glm::dot(ng, r.direction) > 0.0f) ng = -ng;
-  if (glm::dot(ns, ng) < 0.0f) ns = -ns;
+  sp.flipped = glm::dot(ns, ng) < 0.0f;
+  if (sp.flipped) ns = -ns;
   sp.geomNormal = ng;
   sp.normal = ns;
   static const Material kDefault{};
@@ -113,8 +199,19 @@ SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
   return sp;
 }
 
-bool Tracer::cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const {
-  return f.tex && meshAlphaTested_[sp.mesh] && f.tex->alpha(*sp.material, sp.uv, uvWidth(sp, r, coneWidth)) < 0.5f;
+float Tracer::gltfAlpha(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const {
+  const Material& m = *sp.material;
+  const bool textured = f.tex && !scene_.meshes[sp.mesh].texcoords.empty();
+  return m.opacity * sp.color.a * (textured ? f.tex->alpha(m, {sp.uv, sp.uv1}, uvWidth(sp, r, coneWidth)) : 1.0f);
+}
+
+bool Tracer::cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f, bool cull) const {
+  const Material& m = *sp.material;
+  if (m.flags & kMaterialGltf) {
+    if (cull && sp.backFace && !(m.flags & kMaterialDoubleSided)) return true;
+    return (m.flags & kMaterialAlphaMasked) && gltfAlpha(sp, r, coneWidth, f) < m.alphaCutoff;
+  }
+  return f.tex && meshAlphaTested_[sp.mesh] && f.tex->alpha(m, {sp.uv, sp.uv1}, uvWidth(sp, r, coneWidth)) < 0.5f;
 }
 
 Tracer::Visible Tracer::closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c,
@@ -125,7 +222,7 @@ Tracer::Visible Tracer::closestVisible(const Ray& r, const Cone& cone, const Fra
     v.sp = surface(v.ray, v.hit);
     if (layer > 0) v.t = glm::dot(v.sp.position - r.origin, r.direction) / glm::dot(r.direction, r.direction);
     if (f.tex) v.coneWidth = cone.width + cone.spread * glm::distance(r.origin, v.sp.position);
-    if (layer == kMaxAlphaLayers || !cutOut(v.sp, v.ray, v.coneWidth, f)) break;
+    if (layer == kMaxAlphaLayers || !cutOut(v.sp, v.ray, v.coneWidth, f, true)) break;
     v.ray = beyond(v.ray, v.hit, v.sp);
     v.hit = closestTriangle(v.ray, f.s->intersect);
     ++c.alpha;
@@ -144,7 +241,7 @@ bool Tracer::shadowed(const Ray& r, const Frame& f, Counters& c) const {
     if (!h.hit()) return false;
     const SurfacePoint sp = surface(seg, h);
     // A point light casts a sharp shadow: the mask at full resolution (a cone of width 0).
-    if (layer == kMaxAlphaLayers || (castsShadow_[h.prim] && !cutOut(sp, seg, 0.0f, f))) return true;
+    if (layer == kMaxAlphaLayers || (castsShadow_[h.prim] && !cutOut(sp, seg, 0.0f, f, false))) return true;
     seg = beyond(seg, h, sp);
     ++c.alpha;
   }
@@ -161,11 +258,28 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
   // Phong takes Kd from the base colour (Kd x map_Kd) where a model textures it.
   const bool baseTextured = mat.texture(TextureSlot::BaseColor) != kNoTexture;
   const bool textured = f.tex && !scene_.meshes[sp.mesh].texcoords.empty() && (pbr || baseTextured);
-  const SurfaceInputs in = textured ? f.tex->fetch(mat, sp.uv, uvWidth(sp, r, coneWidth)) : materialFactors(mat);
-  const glm::vec3 kd = textured && baseTextured ? in.baseColor : mat.kd;
-  // Ambient and emission, then every light's direct term averaged over its shadow samples; with shadows
-  // on, a sample behind the surface itself or blocked gives nothing (Phong keeps its ambient Ka x Lc).
-  glm::vec3 color = pbr ? f.ambient * glm::clamp(in.baseColor, 0.0f, 1.0f) + in.emissive : mat.ke;
+  const SurfaceUv uvs{sp.uv, sp.uv1};
+  const float width = textured ? uvWidth(sp, r, coneWidth) : 0.0f;
+  SurfaceInputs in = textured ? f.tex->fetch(mat, uvs, width) : materialFactors(mat);
+  const bool gltf = (mat.flags & kMaterialGltf) != 0;
+  glm::vec3 normal = sp.normal;
+  float occlusion = 1.0f;
+  if (gltf) {
+    in.baseColor *= glm::vec3(sp.color);
+    if (mat.flags & kMaterialUnlit) return in.baseColor;  // KHR_materials_unlit: the base colour is the result
+    if (textured) {
+      normal = normalMapped(sp, f.tex->sample(mat, TextureSlot::NormalMap, uvs, width, glm::vec4(-1.0f)), mat.normalScale);
+      occlusion = 1.0f + mat.occlusionStrength * (f.tex->sample(mat, TextureSlot::Occlusion, uvs, width, glm::vec4(1.0f)).r - 1.0f);
+    }
+  }
+  // glTF materials have no Kd: Phong takes their base colour.
+  const glm::vec3 kd = (textured && baseTextured) || gltf ? in.baseColor : mat.kd;
+  const bool ggx = s.brdf ? *s.brdf == Brdf::Ggx : gltf;
+  const int brdf = ggx ? BRDF_GGX : BRDF_BECKMANN;
+  // Ambient (times the occlusion texture's) and emission, then every light's direct term averaged over its
+  // shadow samples; with shadows on, a sample behind the surface itself or blocked gives nothing (Phong
+  // keeps its ambient Ka x Lc).
+  glm::vec3 color = pbr ? f.ambient * glm::clamp(in.baseColor, 0.0f, 1.0f) * occlusion + in.emissive : mat.ke;
   const int n = std::max(1, s.areaLightSamples);
   size_t slot = 0;
   for (const Light& light : f.lights) {
@@ -173,18 +287,18 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
     const int samples = light.kind == Light::Kind::Area ? n : 1;
     glm::vec3 direct(0.0f);
     for (int i = 0; i < samples; ++i, ++slot) {
-      const glm::vec3 toLight = light.samplePoint(i, samples) - sp.position;
-      if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
-      const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
-      const glm::vec3 d = pbr ? pbrDirect(sp.normal, v, ls.l, ls.radiance, in.baseColor, in.roughness, in.metalness)
-                              : blinnPhongDirect(mat, kd, sp.normal, v, ls.l, ls.radiance);
+      const LightRay lr = lightRay(light, i, samples, sp.position, sp.geomNormal);
+      if (!lr.valid) continue;
+      const shader::LightSample& ls = lr.ls;
+      const glm::vec3 d = pbr ? pbrDirect(brdf, normal, v, ls.l, ls.radiance, in.baseColor, in.roughness, in.metalness)
+                              : blinnPhongDirect(mat, kd, normal, v, ls.l, ls.radiance);
       if (d == glm::vec3(0.0f)) continue;
       if (s.shadows) {
         if (glm::dot(sp.geomNormal, ls.l) <= 0.0f) continue;
         if (pre && (pre->known[slot] >> pre->lane & 1)) {
           ++c.shadow;
           if (pre->blocked[slot] >> pre->lane & 1) continue;
-        } else if (shadowed(spawnRay(sp.position, sp.geomNormal, toLight, 1.0f), f, c)) {
+        } else if (shadowed(lr.shadow, f, c)) {
           continue;
         }
       }
@@ -214,11 +328,9 @@ void Tracer::shadowPackets(const Visible* vis, int n, const Frame& f, std::vecto
       for (int k = 0; k < n; ++k) {
         const Visible& v = vis[k];
         if (!v.hit.hit() || (!pbr && isLightMaterial(*v.sp.material))) continue;
-        const glm::vec3 toLight = light.samplePoint(i, samples) - v.sp.position;
-        if (!(glm::dot(toLight, toLight) > 0.0f)) continue;
-        const shader::LightSample ls = shader::lightSample(toLight, light.color, light.falloff, glm::vec3(0.0f));
-        if (glm::dot(v.sp.geomNormal, ls.l) <= 0.0f) continue;
-        rays[m] = spawnRay(v.sp.position, v.sp.geomNormal, toLight, 1.0f);
+        const LightRay lr = lightRay(light, i, samples, v.sp.position, v.sp.geomNormal);
+        if (!lr.valid || lr.ls.radiance == glm::vec3(0.0f) || glm::dot(v.sp.geomNormal, lr.ls.l) <= 0.0f) continue;
+        rays[m] = lr.shadow;
         lanes[m++] = k;
       }
       const unsigned occ = m ? bvh_.occluded8(rays.data(), m, s.intersect) : 0u;
@@ -234,7 +346,7 @@ void Tracer::shadowPackets(const Visible* vis, int n, const Frame& f, std::vecto
 }
 
 glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
-                        const Visible* first, const Shadows* pre) const {
+                        const Visible* first, const Shadows* pre, int blendDepth) const {
   const TraceSettings& s = *f.s;
   const Visible vis = first ? *first : closestVisible(r, cone, f, c, nullptr);
   if (s.shading == Shading::Depth) {
@@ -244,7 +356,17 @@ glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame
   if (!vis.hit.hit()) return s.background;
   const SurfacePoint& sp = vis.sp;
   if (s.shading == Shading::Normals) return glm::abs(sp.normal);  // the brief's "interpolation" view
-  const glm::vec3 col = local(vis.ray, sp, vis.coneWidth, f, c, pre);
+  glm::vec3 col = local(vis.ray, sp, vis.coneWidth, f, c, pre);
+  // glTF BLEND: alpha-composited over what the ray sees beyond (the GPU's "over" blending, in ray order).
+  if ((sp.material->flags & kMaterialGltf) && (sp.material->flags & kMaterialBlend) && blendDepth < kMaxAlphaLayers) {
+    const float a = std::clamp(gltfAlpha(sp, vis.ray, vis.coneWidth, f), 0.0f, 1.0f);
+    if (a < 1.0f) {
+      ++c.alpha;
+      const glm::vec3 behind = shade(beyond(vis.ray, vis.hit, sp), {vis.coneWidth, cone.spread}, bounces, f, c, nullptr,
+                                     nullptr, blendDepth + 1);
+      col = a * col + (1.0f - a) * behind;
+    }
+  }
   const float m = std::clamp(sp.material->mirror, 0.0f, 1.0f);
   if (m <= 0.0f || bounces <= 0) return col;  // out of bounces: the surface's own colour
   // Task 7: reflect about the shading normal (the geometric one if that would dive under the surface).

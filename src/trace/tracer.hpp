@@ -18,6 +18,7 @@
 #include "scene/lights.hpp"
 #include "scene/scene.hpp"
 #include "trace/bvh.hpp"
+#include "trace/instances.hpp"
 #include "trace/intersect.hpp"
 #include "trace/ray.hpp"
 #include "trace/textures.hpp"
@@ -32,6 +33,9 @@ enum class Shading { Phong, Pbr, Normals, Depth };
 constexpr std::array<EnumName<Shading>, 4> enumNames(Shading) {
   return {{{Shading::Phong, "phong"}, {Shading::Pbr, "pbr"}, {Shading::Normals, "normals"}, {Shading::Depth, "depth"}}};
 }
+// pbr's BRDF (shaders/shared/brdf.h): the brief's Beckmann or glTF's GGX.
+enum class Brdf { Beckmann, Ggx };
+constexpr std::array<EnumName<Brdf>, 2> enumNames(Brdf) { return {{{Brdf::Beckmann, "beckmann"}, {Brdf::Ggx, "ggx"}}}; }
 
 struct TraceSettings {
   uint32_t width = 1280, height = 720;
@@ -49,6 +53,7 @@ struct TraceSettings {
   // Phong's ambient is Ka x each light's colour, as the course's.
   std::optional<LightRig> lights;
   float lodBias = 0.0f;            // pbr: added to every texture's level of detail, as the GPU's bias
+  std::optional<Brdf> brdf;        // pbr; none: per material, GGX for glTF materials, Beckmann for the rest
   glm::vec3 background{0.0f};
 };
 
@@ -71,6 +76,11 @@ struct SurfacePoint {
   glm::vec3 normal;      // interpolated shading normal, unit, same side as geomNormal
   glm::vec2 uv{0.0f};
   float uvScale = 0.0f;  // √(uv area / area) of the triangle: texture-coordinate units per scene unit
+  glm::vec2 uv1{0.0f};   // the second uv set (glTF TEXCOORD_1), where the mesh has one
+  glm::vec4 color{1.0f}; // vertex colour (glTF COLOR_0), white without
+  glm::vec4 tangent{0.0f};  // xyz unit tangent in scene space, w the bitangent's sign; zero without
+  bool flipped = false;  // the normals were turned to face the ray (it hit the back of the interpolated side)
+  bool backFace = false; // the ray hit the triangle's back (clockwise as seen; glTF's culled side)
   const Material* material = nullptr;
   uint32_t mesh = 0;
 };
@@ -81,7 +91,8 @@ glm::mat4 modelview(const CameraPose& pose, const glm::mat4& model);
 class Tracer {
  public:
   // Keeps a reference to `scene`, which must outlive the tracer. Builds a BVH unless the scene is tiny
-  // (fewer than kBruteForceMax triangles: then every ray tests every triangle, as the brief's loop does).
+  // (fewer than kBruteForceMax triangles: then every ray tests every triangle, as the brief's loop does);
+  // a scene with instances gets the two-level InstanceBvh (each placed mesh's triangles stored once).
   explicit Tracer(const Scene& scene, unsigned buildThreads = 0);
   static constexpr size_t kBruteForceMax = 16;
 
@@ -108,8 +119,10 @@ class Tracer {
   // loads any. Thread-safe. Throws rtr::Error naming a texture file that is missing or undecodable.
   const SceneTextures& textures() const;
 
+  // Each drawn mesh's triangles once (object space where the scene has instances).
   const std::vector<Triangle>& triangles() const { return tris_; }
   bool usesBvh() const { return useBvh_; }
+  bool instanced() const { return instanced_; }
   const Bvh& bvh() const { return bvh_; }
   const Scene& scene() const { return scene_; }
 
@@ -148,15 +161,20 @@ class Tracer {
   Frame makeFrame(const TraceSettings& s) const;
   // `first`: what r sees when the caller has traced it already (the render loop traces primary rays in
   // packets), else null; `pre`: shadow rays traced ahead for it, else null.
+  // `blendDepth`: glTF BLEND surfaces composited in front of this ray already (at most kMaxAlphaLayers).
   glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
-                  const Visible* first = nullptr, const Shadows* pre = nullptr) const;
+                  const Visible* first = nullptr, const Shadows* pre = nullptr, int blendDepth = 0) const;
   glm::vec3 local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c,
                   const Shadows* pre = nullptr) const;
   // The shadow rays local() will ask for at these n ≤ 8 hits, traced as packets, one per light sample
   // (all go to the same point): known/blocked as in Shadows, left empty where local() must trace alone.
   void shadowPackets(const Visible* vis, int n, const Frame& f, std::vector<uint8_t>& known,
                      std::vector<uint8_t>& blocked) const;
-  bool cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const;
+  // Whether a ray passes this hit: a cut-out texel; for glTF materials MASK below the cutoff and, with
+  // `cull` (what the camera and mirrors see, not shadow rays), the back of a single-sided material.
+  bool cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f, bool cull) const;
+  // glTF materials: the alpha, opacity × base colour alpha × vertex alpha.
+  float gltfAlpha(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const;
   Visible closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c, const Hit* first) const;
   bool shadowed(const Ray& r, const Frame& f, Counters& c) const;
 
@@ -169,6 +187,8 @@ class Tracer {
   bool anyBaseTextured_ = false;  // a mesh with texcoords whose material has a base colour texture
   Bvh bvh_;
   bool useBvh_ = false;
+  InstanceBvh instances_;
+  bool instanced_ = false;
   mutable std::mutex texturesMutex_;
   mutable std::unique_ptr<const SceneTextures> textures_;
 };

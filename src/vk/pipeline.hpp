@@ -89,6 +89,7 @@ struct GraphicsDesc {
   // bound at the binding number equal to its location.
   VkCullModeFlags cullMode = VK_CULL_MODE_BACK_BIT;
   VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  bool dynamicFrontFace = false;  // set by vkCmdSetFrontFace before drawing (mirrored instances)
   bool depthTest = true, depthWrite = true;
   bool alphaBlend = false;  // colour = src.a * src + (1 - src.a) * dst (overlays such as the viewer's panel)
   VkCompareOp depthCompare = VK_COMPARE_OP_LESS;

@@ -1,4 +1,6 @@
 // The texture filter and anisotropy (the brief's mip experiments), switched between frames of one renderer.
+#include <cstdio>
+
 #include <gtest/gtest.h>
 
 #include "test_paths.hpp"
@@ -86,6 +88,43 @@ TEST_F(SamplerTest, FilterChangesTheShadedViewOnBothPathsAndSwitchesBack) {
     // The descriptors were rewritten, not added to: back to trilinear is the first frame again.
     EXPECT_EQ(differingPixels(trilinear, render(VIEW_SHADED, TextureFilter::Trilinear, path)), 0u);
   }
+}
+
+// --filter reaches every pipeline that samples the scene's textures (they share one writer): the
+// forward and visibility images change with it on both rasterisers, and so do the compute rasteriser's
+// ids, whose alpha-masked foliage its hardware hand-off tests with the same sampler as the others (so its
+// coverage stays the hardware rasteriser's).
+TEST_F(SamplerTest, FilterNearestChangesEveryPath) {
+  struct Path { render::ShadingPath shading; render::RasterPath raster; };
+  std::vector<Path> paths = {{render::ShadingPath::Forward, render::RasterPath::Auto},
+                             {render::ShadingPath::Visibility, render::RasterPath::Hardware}};
+  const bool compute = render::ComputeRaster::supported(*ctx);
+  if (compute) paths.push_back({render::ShadingPath::Visibility, render::RasterPath::Compute});
+  std::vector<uint32_t> ids[2][2];  // [raster hardware, compute][trilinear, nearest]
+  for (const Path& p : paths)
+    for (int nearest = 0; nearest < 2; ++nearest) {
+      RenderSettings s;
+      s.shading = p.shading;
+      s.raster = p.raster;
+      s.mosaic = render::MosaicMode::Off;
+      s.sampler.filter = nearest ? TextureFilter::Nearest : TextureFilter::Trilinear;
+      if (p.shading == render::ShadingPath::Visibility)
+        ids[p.raster == render::RasterPath::Compute][nearest] = renderer->ids(pose, lens, s);
+      if (nearest) continue;
+      SCOPED_TRACE(testing::Message() << render::toString(p.shading) << ", " << render::toString(p.raster));
+      const ImageRGBA8 a = renderer->render(pose, lens, s).image;
+      s.sampler.filter = TextureFilter::Nearest;
+      EXPECT_GT(differingPixels(a, renderer->render(pose, lens, s).image), size_t(kW * kH / 20));
+    }
+  if (!compute) return;
+  size_t moved = 0, disagree = 0;
+  for (size_t i = 0; i < ids[1][0].size(); ++i) {
+    moved += ids[1][0][i] != ids[1][1][i];
+    disagree += ids[0][1][i] != ids[1][1][i];
+  }
+  EXPECT_GT(moved, 50u) << "the compute rasteriser's alpha test ignored the filter";
+  EXPECT_LT(disagree, moved / 4) << "compute and hardware ids under the nearest filter";
+  std::printf("nearest filter: %zu compute ids moved, %zu differ from the hardware's\n", moved, disagree);
 }
 
 TEST_F(SamplerTest, AnisotropyChangesTheShadedViewWhereSupported) {

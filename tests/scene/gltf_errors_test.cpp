@@ -161,6 +161,13 @@ TEST_F(Errors, NonFinitePositions) {
   GltfBuilder b;
   b.floats(std::vector<glm::vec3>{{0, 0, 0}, {std::numeric_limits<float>::infinity(), 0, 0}, {0, 1, 0}}, "VEC3");
   EXPECT_THAT(errorOf(b.writeGlb(dir, "a", kMesh)), HasSubstr("a.glb: /meshes/0/primitives/0/attributes: POSITION element 1 is not finite"));
+  // Found by fuzz_gltf: a coordinate of 4.5e30 made clustering lose the triangle (squared lengths overflow).
+  GltfBuilder c;
+  c.floats(std::vector<glm::vec3>{{0, 0, 0}, {2, 0, 4.5e30f}, {0, 1, 0}}, "VEC3");
+  EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)), HasSubstr("b.glb: /meshes/0/primitives/0/attributes: POSITION element 1 has a coordinate beyond"));
+  GltfBuilder d;
+  d.floats(std::vector<glm::vec3>{{0, 0, 0}, {2, 0, std::nanf("")}, {0, 1, 0}}, "VEC3");
+  EXPECT_THAT(errorOf(d.writeGlb(dir, "c", kMesh)), HasSubstr("c.glb: /meshes/0/primitives/0/attributes: POSITION element 1 is not finite"));
 }
 
 }  // namespace

@@ -43,7 +43,8 @@ TEST(GltfReader, SameTriangleFromGltfBinDataUriAndGlb) {
   const int nrm = b.floats(std::vector<glm::vec3>(3, {0, 0, 1}), "VEC3");
   const int idx = b.indices({0, 1, 2});
   const std::string rest = meshJson(pos, idx, ",\"NORMAL\":" + std::to_string(nrm)) + "," + kOneNode;
-  for (const auto& file : {b.writeGltf(dir, "ext", rest), b.writeEmbedded(dir, "uri", rest), b.writeGlb(dir, "bin", rest)}) {
+  std::filesystem::copy_file(b.writeGlb(dir, "bin", rest), dir / "UPPER.GLB");  // the extension in any case
+  for (const auto& file : {b.writeGltf(dir, "ext", rest), b.writeEmbedded(dir, "uri", rest), b.writeGlb(dir, "bin", rest), dir / "UPPER.GLB"}) {
     SCOPED_TRACE(file.string());
     const Scene s = loadScene(file);
     ASSERT_EQ(s.meshes.size(), 1u);
@@ -77,8 +78,13 @@ TEST(GltfReader, InterleavedStrideNormalizedAndQuantizedComponents) {
   const int8_t ns[3][3] = {{0, 0, 127}, {0, 0, 127}, {0, -127, 0}};
   const int nv = b.view(ns, sizeof ns);
   const int nrm = b.accessor(nv, 5120, 3, "VEC3", "\"normalized\":true");
+  // int8 and int16 normalized uvs (signed: max(c / 127, -1) and max(c / 32767, -1)).
+  const int8_t uv1[3][2] = {{-128, -127}, {127, 64}, {0, -64}};
+  const int uv1v = b.view(uv1, sizeof uv1);
+  const int uv1a = b.accessor(uv1v, 5120, 3, "VEC2", "\"normalized\":true");
   const Scene s = loadScene(b.writeGlb(dir, "q",
-                                       meshJson(pos, -1, ",\"TEXCOORD_0\":" + std::to_string(uv) + ",\"NORMAL\":" + std::to_string(nrm)) +
+                                       meshJson(pos, -1, ",\"TEXCOORD_0\":" + std::to_string(uv) + ",\"NORMAL\":" + std::to_string(nrm) +
+                                                             ",\"TEXCOORD_1\":" + std::to_string(uv1a)) +
                                            ",\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"]," + kOneNode));
   const Mesh& m = s.meshes.at(0);
   EXPECT_EQ(m.positions[1], glm::vec3(300, 0, 0));
@@ -87,6 +93,10 @@ TEST(GltfReader, InterleavedStrideNormalizedAndQuantizedComponents) {
   EXPECT_FLOAT_EQ(m.texcoords[1].x, 0.2f);
   EXPECT_FLOAT_EQ(m.texcoords[2].y, 0.4f);
   EXPECT_EQ(m.normals[2], glm::vec3(0, -1, 0));
+  EXPECT_EQ(m.texcoords1[0], glm::vec2(-1.0f, -1.0f));
+  EXPECT_EQ(m.texcoords1[1].x, 1.0f);
+  EXPECT_FLOAT_EQ(m.texcoords1[1].y, 64.0f / 127.0f);
+  EXPECT_FLOAT_EQ(m.texcoords1[2].y, -64.0f / 127.0f);
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));  // non-indexed: in order
 }
 
@@ -172,6 +182,23 @@ TEST(GltfReader, NodeHierarchyBecomesInstancesOfOneMesh) {
   EXPECT_NEAR(r.x, 0, 1e-6);
   EXPECT_NEAR(r.z, -1, 1e-6);
   EXPECT_EQ(s.bounds().max.x, 3.0f);
+}
+
+TEST(GltfReader, AtMostTenWarningsThenTheCount) {
+  const auto dir = test::tempFolder("warnings");
+  GltfBuilder b;
+  b.floats(kTri, "VEC3");
+  b.indices({0, 1, 2, 0});  // 4 indices: the last one is left out, with a warning
+  std::string meshes = "\"meshes\":[";
+  for (int i = 0; i < 12; ++i) meshes += std::string(i ? "," : "") + "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}";
+  std::string nodes = "],\"nodes\":[";
+  for (int i = 0; i < 12; ++i) nodes += std::string(i ? "," : "") + "{\"mesh\":" + std::to_string(i) + "}";
+  Notes n;
+  const Scene s = loadScene(b.writeGlb(dir, "w", meshes + nodes + "]"), n.options());
+  EXPECT_EQ(s.meshes.size(), 12u);
+  ASSERT_EQ(n.warnings.size(), 11u);
+  EXPECT_THAT(n.warnings[0], HasSubstr("not whole triangles"));
+  EXPECT_THAT(n.warnings[10], HasSubstr("w.glb: 12 warnings, first 10 shown"));
 }
 
 TEST(GltfReader, AnimationsSkinsAndMorphTargetsGetOneNote) {

@@ -198,7 +198,7 @@ TEST(TracerTextures, FetchMultipliesEverySlotLikeTheGpu) {
   addMesh(s, facingQuad(0, addMaterial(s, m)));
   const SceneTextures tex(s);
   EXPECT_EQ(tex.count(), 5u);
-  const SurfaceInputs in = tex.fetch(s.materials[0], {0.3f, 0.6f}, 0.0f);
+  const SurfaceInputs in = tex.fetch(s.materials[0], {{0.3f, 0.6f}}, 0.0f);
   expectNear(in.baseColor, {0.5f * srgb(255), 0.25f * srgb(128), srgb(64)}, 1e-6f, "base");
   EXPECT_NEAR(in.roughness, 0.5f * 51 / 255.0f, 1e-6f);  // UNORM, not sRGB
   EXPECT_NEAR(in.metalness, 0.8f * 102 / 255.0f, 1e-6f);

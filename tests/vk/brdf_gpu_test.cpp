@@ -1,5 +1,5 @@
 // The shared BRDF header evaluated on the GPU (shaders/test/brdf_grid.comp) agrees with its C++ build and
-// stays finite and non-negative over a grid that includes the hard cases.
+// stays finite and non-negative over a grid that includes the hard cases, for both BRDFs.
 #include <cmath>
 #include <cstring>
 
@@ -30,23 +30,24 @@ std::vector<BrdfGridInput> makeGrid() {
   const std::vector<float> roughness = {0.0f, 1e-4f, 0.01f, 0.1f, 0.5f, 1.0f};
   const std::vector<float> metalness = {0.0f, 0.5f, 1.0f};
   std::vector<BrdfGridInput> grid;
-  for (const glm::vec3& n : normals)
-    for (float tv : thetas)
-      for (float tl : thetas)
-        for (float phi : {0.0f, 1.0f, 3.14159265f})  // phi = pi with tv = tl makes v = -l mirrored
-          for (float r : roughness)
-            for (float m : metalness) {
-              BrdfGridInput in{};
-              in.n = glm::vec4(n, 0);
-              in.v = glm::vec4(direction(tv, 0.0f), 0);
-              in.l = glm::vec4(direction(tl, phi), 0);
-              in.baseColor = glm::vec4(0.9f, 0.5f, 0.2f, 0);
-              in.params = glm::vec4(r, m, 0, 0);
-              in.lightColor = glm::vec4(1.0f);
-              in.ambient = glm::vec4(0.02f);
-              in.emissive = glm::vec4(0.0f);
-              grid.push_back(in);
-            }
+  for (int brdf : {BRDF_BECKMANN, BRDF_GGX})
+    for (const glm::vec3& n : normals)
+      for (float tv : thetas)
+        for (float tl : thetas)
+          for (float phi : {0.0f, 1.0f, 3.14159265f})  // phi = pi with tv = tl makes v = -l mirrored
+            for (float r : roughness)
+              for (float m : metalness) {
+                BrdfGridInput in{};
+                in.n = glm::vec4(n, 0);
+                in.v = glm::vec4(direction(tv, 0.0f), 0);
+                in.l = glm::vec4(direction(tl, phi), 0);
+                in.baseColor = glm::vec4(0.9f, 0.5f, 0.2f, 0);
+                in.params = glm::vec4(r, m, float(brdf), 0);
+                in.lightColor = glm::vec4(1.0f);
+                in.ambient = glm::vec4(0.02f);
+                in.emissive = glm::vec4(0.0f);
+                grid.push_back(in);
+              }
   return grid;
 }
 
@@ -77,11 +78,12 @@ TEST_F(VulkanTest, GpuBrdfIsFiniteNonNegativeAndMatchesCpu) {
   size_t worstAt = 0;
   for (size_t i = 0; i < grid.size(); ++i) {
     const BrdfGridInput& a = grid[i];
-    const shader::BrdfTerms t = shader::brdfTerms(glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l), glm::vec3(a.baseColor),
-                                                  a.params.x, a.params.y);
-    const glm::vec3 L = shader::shadePbr(glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l), glm::vec3(a.lightColor),
-                                         glm::vec3(a.ambient), glm::vec3(a.baseColor), a.params.x, a.params.y,
-                                         glm::vec3(a.emissive));
+    const int brdf = int(a.params.z);
+    const shader::BrdfTerms t = shader::brdfTerms(brdf, glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l),
+                                                  glm::vec3(a.baseColor), a.params.x, a.params.y);
+    const glm::vec3 L = shader::shadePbr(brdf, glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l),
+                                         glm::vec3(a.lightColor), glm::vec3(a.ambient), glm::vec3(a.baseColor),
+                                         a.params.x, a.params.y, glm::vec3(a.emissive));
     const float cpu[] = {t.D, t.G, t.F.x, t.F.y, t.F.z, t.diffuse.x, t.diffuse.y, t.diffuse.z,
                          t.specular.x, t.specular.y, t.specular.z, L.x, L.y, L.z};
     const BrdfGridOutput& g = gpu[i];

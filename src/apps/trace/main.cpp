@@ -27,7 +27,8 @@ std::string gStage = "starting";  // what was under way, for an out-of-memory me
 int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)", "rtr-trace"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "phong", shadows = "on",
-                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath;
+                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath,
+                                  brdf;
   LightOptions lightOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
@@ -45,8 +46,10 @@ int run(int argc, char** argv) {
       ->capture_default_str()->check(cli::number(0, 180, true));
   app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, docs/formats.md)");
   app.add_option("--ortho-height", orthoHeight, "half height of the orthographic volume")->check(cli::number(0, 1e30, true));
-  app.add_option("--shading", shading, "phong | pbr | normals | depth")
+  app.add_option("--shading", shading, "phong | pbr | normals | depth (default: pbr for glTF materials, else phong)")
       ->capture_default_str()->check(cli::oneOf<Shading>());
+  app.add_option("--brdf", brdf, "pbr: beckmann | ggx for every material (default: ggx for glTF materials, "
+                 "beckmann for the rest)")->check(cli::oneOf<Brdf>());
   app.add_option("--shadows", shadows, "on | off")->capture_default_str()->check(CLI::IsMember({"on", "off"}));
   app.add_option("--bounces", s.bounces, "mirror bounces (N_BOUNCES); 0 turns reflections off")
       ->capture_default_str()->check(cli::integer(0, 64));
@@ -79,6 +82,7 @@ int run(int argc, char** argv) {
   const float aspect = float(w) / float(h);
   s.lens.orthoHalfHeight = orthoHeight > 0.0f ? orthoHeight : (aspect >= 1.0f ? 1.0f : 1.0f / aspect);
   s.shading = cli::enumOption<Shading>("--shading", shading);
+  if (!brdf.empty()) s.brdf = cli::enumOption<Brdf>("--brdf", brdf);
   s.shadows = shadows == "on";
   s.intersect = cli::enumOption<IntersectMethod>("--intersect", intersectName);
   if (!light.empty()) lightOptions.position = cli::parseVec3("--light", light);
@@ -89,6 +93,10 @@ int run(int argc, char** argv) {
   LoadOptions load;
   if (!mtlPath.empty()) load.mtl = mtlPath;
   const Scene scene = loadScene(scenePath, load);
+  // glTF materials are physically based: without --shading they get pbr, not the course's Blinn-Phong.
+  if (app.count("--shading") == 0 &&
+      std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.flags & kMaterialGltf; }))
+    s.shading = Shading::Pbr;
   s.lights = resolveLights(scene, lightOptions);
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   gStage = "building the BVH of " + scenePath;
@@ -118,7 +126,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
                  "(%llu primary, %llu shadow, %llu mirror), %.2f Mrays/s; pose %s -> %s\n",
-                 tracer.triangles().size(), s.lights->lights.size(), tracer.usesBvh() ? "BVH8" : "no BVH",
+                 tracer.triangles().size(), s.lights->lights.size(), tracer.usesBvh() ? "BVH8" : tracer.instanced() ? "two-level BVH8" : "no BVH",
                  tracer.usesBvh() ? tracer.bvh().stats().buildSeconds : 0.0, w, h, st.seconds,
                  (unsigned long long)rays, (unsigned long long)st.primaryRays, (unsigned long long)st.shadowRays,
                  (unsigned long long)st.reflectionRays, double(rays) / st.seconds * 1e-6,

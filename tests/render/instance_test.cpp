@@ -1,0 +1,202 @@
+// Instances, not copies: a mesh placed by N instances renders exactly as the same scene flattened into N
+// transformed meshes (built here on the CPU), in every path: forward, visibility with hardware ids,
+// visibility with compute ids, with and without cluster culling; and it is drawn with one instanced draw
+// per mesh (and mirroring), not one per instance.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/bounds.hpp"
+#include "core/camera.hpp"
+#include "render/cull.hpp"
+#include "render/headless.hpp"
+#include "scene/clusters.hpp"
+#include "vk_fixture.hpp"
+
+namespace rtr {
+namespace {
+
+// A lumpy sphere (so the shading varies over it and its clusters have normal cones), radius about 1.
+Mesh lumpySphere() {
+  Mesh m;
+  m.name = "lump";
+  const int rings = 16, segments = 24;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s <= segments; ++s) {
+      const float th = float(M_PI) * float(r) / rings, ph = 2.0f * float(M_PI) * float(s) / segments;
+      const glm::vec3 d(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+      m.positions.push_back(d * (1.0f + 0.15f * std::sin(3.0f * ph) * std::sin(2.0f * th)));
+      m.normals.push_back(d);
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const uint32_t a = r * (segments + 1) + s, b = a + segments + 1;
+      m.indices.insert(m.indices.end(), {a, a + 1, b, a + 1, b + 1, b});  // counter-clockwise from outside
+    }
+  for (const glm::vec3& p : m.positions) m.bounds.extend(p);
+  buildClusters(m, true);
+  return m;
+}
+
+// 5 x 4 placements whose matrices have one entry per row of 0, ±0.5, ±1 or ±2 and integer translations,
+// so that a placed position is one exact product plus one rounded addition on the CPU and on the GPU
+// alike; rotations by 90°, uniform and non-uniform scales, and the last four mirrored.
+Scene instancedScene() {
+  Scene s;
+  Material mat;
+  mat.name = "lump";
+  mat.baseColor = glm::vec3(0.8f, 0.5f, 0.3f);
+  mat.roughness = 0.4f;
+  s.materials.push_back(mat);
+  s.meshes.push_back(lumpySphere());
+  for (int i = 0; i < 20; ++i) {
+    glm::mat4 t(1.0f);
+    t = glm::translate(t, glm::vec3(float(i % 5) * 3.0f - 6.0f, float(i / 5) * 3.0f - 4.5f, float(i % 3) - 1.0f));
+    if (i % 4 == 1) t = t * glm::mat4(glm::vec4(0, 0, -1, 0), glm::vec4(0, 1, 0, 0), glm::vec4(1, 0, 0, 0), glm::vec4(0, 0, 0, 1));
+    if (i % 4 == 2) t = glm::scale(t, glm::vec3(i % 8 == 2 ? 0.5f : 1.0f, 1.0f, 0.5f));  // uniform ones below
+    if (i % 7 == 3) t = glm::scale(t, glm::vec3(0.5f));
+    if (i % 6 == 5) t = t * glm::mat4(glm::vec4(0, 1, 0, 0), glm::vec4(-1, 0, 0, 0), glm::vec4(0, 0, 1, 0), glm::vec4(0, 0, 0, 1));
+    if (i >= 16) t = glm::scale(t, glm::vec3(i % 2 ? -1.0f : 1.0f, i % 2 ? 1.0f : -2.0f, 1.0f));  // mirrors
+    s.instances.push_back({0, t});
+  }
+  return s;
+}
+
+// The same scene with each instance's mesh transformed on the CPU: positions by the matrix, normals by
+// its inverse transpose, a mirrored one's triangles turned round (so counter-clockwise is front again).
+Scene flattened(const Scene& in) {
+  Scene s;
+  s.materials = in.materials;
+  for (const Instance& inst : in.instances) {
+    Mesh m = in.meshes[inst.mesh];
+    const glm::mat3 n = glm::inverseTranspose(glm::mat3(inst.transform));
+    m.bounds = {};
+    for (glm::vec3& p : m.positions) p = glm::vec3(inst.transform * glm::vec4(p, 1.0f)), m.bounds.extend(p);
+    for (glm::vec3& v : m.normals) v = n * v;
+    if (glm::determinant(glm::mat3(inst.transform)) < 0.0f)
+      for (size_t i = 0; i < m.indices.size(); i += 3) std::swap(m.indices[i + 1], m.indices[i + 2]);
+    m.clusters.clear();  // runs of triangles in order (GpuScene's fallback): the primitive ids stay
+    s.meshes.push_back(m);
+  }
+  return s;
+}
+
+class InstanceTest : public test::VulkanTest {};
+
+constexpr VkExtent2D kE{240, 160};
+
+std::vector<CameraPose> views(const Bounds& b) {
+  const float aspect = float(kE.width) / float(kE.height);
+  return {frameBounds(b, Lens{}, aspect), orbitFrame(b, Lens{}, aspect, 150.0f, -20.0f),
+          {glm::vec3(0.5f, 0.2f, 4.0f), 10.0f, 5.0f}};  // close, inside the grid: some instances off screen
+}
+
+TEST_F(InstanceTest, InstancesDrawLikeTheFlattenedScene) {
+  const Scene inst = instancedScene(), flat = flattened(inst);
+  render::GpuScene gi(*ctx, inst, render::MipMode::Compute), gf(*ctx, flat, render::MipMode::Compute);
+  // One mesh stored once; two instanced draws (plain and mirrored), not one per instance.
+  EXPECT_EQ(gi.stats().meshes, 1u);
+  EXPECT_EQ(gi.stats().instances, 20u);
+  ASSERT_EQ(gi.draws(render::DrawKind::Untextured).size(), 2u);
+  EXPECT_EQ(gi.draws(render::DrawKind::Untextured)[0].instanceCount, 16u);
+  EXPECT_TRUE(gi.draws(render::DrawKind::Untextured)[1].mirrored);
+  render::HeadlessRenderer ri(*ctx, gi, kE), rf(*ctx, gf, kE);
+  ASSERT_EQ(ri.renderer().primitiveBits(), rf.renderer().primitiveBits());
+
+  struct Path { render::ShadingPath shading; render::RasterPath raster; bool cull; };
+  std::vector<Path> paths = {{render::ShadingPath::Forward, render::RasterPath::Auto, false},
+                             {render::ShadingPath::Visibility, render::RasterPath::Hardware, false}};
+  if (render::ComputeRaster::supported(*ctx))
+    paths.insert(paths.end(), {{render::ShadingPath::Visibility, render::RasterPath::Compute, false},
+                               {render::ShadingPath::Visibility, render::RasterPath::Compute, true}});
+  const Bounds b = inst.bounds();
+  const std::vector<CameraPose> poses = views(b);
+  for (const CameraPose& pose : poses) {
+    const Lens lens = fitDepthRange(Lens{}, b, pose);
+    const bool first = &pose == &poses.front();
+    for (const Path& p : paths) {
+      SCOPED_TRACE(testing::Message() << "view at " << pose.position.x << ", " << render::toString(p.shading) << ", "
+                                      << render::toString(p.raster) << (p.cull ? ", culled" : ""));
+      render::RenderSettings s;
+      s.shading = p.shading;
+      s.raster = p.raster;
+      s.cull = p.cull;
+      s.mosaic = render::MosaicMode::Off;
+      for (int mode : {VIEW_SHADED, VIEW_NORMAL}) {
+        if (mode != VIEW_SHADED && p.shading == render::ShadingPath::Visibility) continue;  // debug views are forward
+        s.mode = mode;
+        const ImageRGBA8 a = ri.render(pose, lens, s, 2).image, c = rf.render(pose, lens, s, 2).image;
+        size_t covered = 0, differ = 0;
+        int worst = 0;
+        for (size_t i = 0; i < a.pixels.size(); ++i) {
+          const int d = std::abs(int(a.pixels[i]) - int(c.pixels[i]));
+          worst = std::max(worst, d);
+          differ += d > 1;
+          covered += i % 4 == 0 && (c.pixels[i] | c.pixels[i + 1] | c.pixels[i + 2]) != 0;
+        }
+        EXPECT_GT(covered, a.pixels.size() / 4 / 20) << "the view sees little";
+        // Only the rounding of interpolation in a mirrored triangle's other vertex order differs.
+        EXPECT_EQ(differ, 0u) << "mode " << mode << ", worst difference " << worst;
+      }
+      if (p.shading != render::ShadingPath::Visibility) continue;
+      s.mode = VIEW_SHADED;
+      const std::vector<uint32_t> a = ri.ids(pose, lens, s), c = rf.ids(pose, lens, s);
+      size_t differ = 0, mirroredSeen = 0;
+      const uint32_t bits = ri.renderer().primitiveBits();
+      for (size_t i = 0; i < a.size(); ++i) {
+        differ += a[i] != c[i];
+        mirroredSeen += a[i] != VIS_EMPTY && (a[i] >> bits) >= 16;
+      }
+      EXPECT_EQ(differ, 0u) << "visibility ids differ from the flattened scene's";
+      if (first) {
+        EXPECT_GT(mirroredSeen, 100u) << "the mirrored instances are not in view";
+      }
+    }
+  }
+}
+
+// The compute rasteriser's ids (with culling, which must not change them) against the hardware's, on
+// the instanced scene: the same up to pixel centres on an edge (tests/render/raster_test.cpp's rule,
+// here as a bound on how many pixels differ); culling must have culled something by frustum and cone.
+TEST_F(InstanceTest, ComputeIdsEqualHardwareIdsAndCullingChangesNothing) {
+  if (!render::ComputeRaster::supported(*ctx)) GTEST_SKIP() << "no 64-bit buffer atomics";
+  const Scene inst = instancedScene();
+  render::GpuScene g(*ctx, inst, render::MipMode::Compute);
+  render::HeadlessRenderer r(*ctx, g, kE), culled(*ctx, g, kE);
+  const Bounds b = inst.bounds();
+  uint32_t frustum = 0, cone = 0;
+  for (const CameraPose& pose : views(b)) {
+    const Lens lens = fitDepthRange(Lens{}, b, pose);
+    render::RenderSettings s;
+    s.mosaic = render::MosaicMode::Off;
+    s.raster = render::RasterPath::Hardware;
+    const std::vector<uint32_t> hw = r.ids(pose, lens, s);
+    s.raster = render::RasterPath::Compute;
+    const std::vector<uint32_t> cs = r.ids(pose, lens, s);
+    s.cull = true;
+    culled.ids(pose, lens, s);  // a first frame: history
+    const std::vector<uint32_t> cc = culled.ids(pose, lens, s);
+    const auto stats = culled.renderer().cullStats(0);
+    ASSERT_TRUE(stats.has_value());
+    frustum += stats->frustum, cone += stats->cone;
+    size_t covered = 0, differ = 0, cullDiffer = 0;
+    for (size_t i = 0; i < hw.size(); ++i) {
+      covered += hw[i] != VIS_EMPTY;
+      differ += hw[i] != cs[i];
+      cullDiffer += cc[i] != cs[i];
+    }
+    std::printf("view at (%.1f %.1f %.1f): %zu px covered, %zu differ hardware/compute; culled by frustum %u, cone %u\n",
+                pose.position.x, pose.position.y, pose.position.z, covered, differ, stats->frustum, stats->cone);
+    EXPECT_EQ(cullDiffer, 0u) << "culling changed the ids";
+    EXPECT_LE(differ, covered / 200) << "compute and hardware ids disagree beyond edge pixels";
+  }
+  EXPECT_GT(frustum, 0u);
+  EXPECT_GT(cone, 0u);
+}
+
+}  // namespace
+}  // namespace rtr
