@@ -243,6 +243,24 @@ TEST(GltfMaterial, TextureTransformAndSecondUvSet) {
   }
 }
 
+// glTF samplers' wrap modes address the texels (at texel centres: exactly one texel).
+TEST(GltfMaterial, SamplerWrapModes) {
+  struct Case { Wrap wrap; float u; uint32_t texel; };
+  for (const Case c : {Case{Wrap::Repeat, 1.375f, 1}, Case{Wrap::ClampToEdge, 1.375f, 3}, Case{Wrap::ClampToEdge, 1.875f, 3},
+                       Case{Wrap::MirroredRepeat, 1.125f, 3}, Case{Wrap::MirroredRepeat, 1.375f, 2}}) {
+    Scene s;
+    Material m = gltf(glm::vec3(1.0f));
+    m.textures[uint32_t(TextureSlot::BaseColor)] = addTexture(s, "pattern", 4, 4, pattern, true, 4);
+    s.textures.back().sampler.wrapU = c.wrap;
+    Mesh q = facing(2, addMaterial(s, m));
+    for (glm::vec2& t : q.texcoords) t *= 2.0f;  // uv = (x + 1, y + 1)
+    addMesh(s, std::move(q));
+    const Tracer t(s);
+    expectNear(at(t, baseView(), c.u - 1.0f, 0.375f - 1.0f), decoded(pattern(c.texel, 1)),
+               "wrap " + std::to_string(int(c.wrap)) + " u " + std::to_string(c.u));
+  }
+}
+
 float unorm(uint8_t b) { return float(decodeTexel(b, 0, TexelEncoding::Unorm)); }
 
 // A uniform normal map on a quad with tangent +x: the shading normal is T·x + B·y + N·z of the texel's
