@@ -1,5 +1,6 @@
 #include "trace/textures.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -28,9 +29,34 @@ const Table kSrgb = decodeTable(TexelEncoding::Srgb);
 // REPEAT for texel index i in [-1, n]: the neighbours of a bilinear footprint.
 uint32_t wrap(int i, uint32_t n) { return i < 0 ? n - 1 : uint32_t(i) >= n ? 0u : uint32_t(i); }
 
+// The texel coordinate (x - 0.5 in texel units, the footprint's first texel) and the two texels of a
+// bilinear footprint along one axis, by the sampler's wrap mode. REPEAT wraps uv into [0, 1] first.
+struct Axis {
+  float f;  // texel coordinate
+  uint32_t i0, i1;
+};
+Axis address(float u, uint32_t n, Wrap w) {
+  if (w == Wrap::Repeat) {
+    const float x = (u - std::floor(u)) * float(n) - 0.5f;
+    const int i = int(std::floor(x));
+    return {x, wrap(i, n), wrap(i + 1, n)};
+  }
+  const float x = std::clamp(u, -1e6f, 1e6f) * float(n) - 0.5f;
+  const int i = int(std::floor(x));
+  auto at = [&](int k) -> uint32_t {
+    if (w == Wrap::ClampToEdge) return uint32_t(std::clamp(k, 0, int(n) - 1));
+    const int p = 2 * int(n);
+    int m = k % p;
+    if (m < 0) m += p;
+    return uint32_t(m < int(n) ? m : p - 1 - m);  // mirrored
+  };
+  return {x, at(i), at(i + 1)};
+}
+
 }  // namespace
 
-MipTexture::MipTexture(const TexelData& image, bool srgb) : channels_(image.channels), srgb_(srgb) {
+MipTexture::MipTexture(const TexelData& image, bool srgb, const SamplerDesc& sampler)
+    : channels_(image.channels), srgb_(srgb), sampler_(sampler) {
   if (channels_ != 1 && channels_ != 4)
     throw Error("texture: " + std::to_string(channels_) + " channels; the tracer samples 1 or 4");
   const MipChain chain = buildMipReference(image, srgb ? TexelEncoding::Srgb : TexelEncoding::Unorm,
@@ -43,12 +69,11 @@ MipTexture::MipTexture(const TexelData& image, bool srgb) : channels_(image.chan
 }
 
 glm::vec4 MipTexture::bilinear(const Level& l, glm::vec2 uv) const {
-  // Texel centres sit at half-integers; REPEAT makes the image periodic, so wrap uv into [0, 1] first.
-  const float x = (uv.x - std::floor(uv.x)) * float(l.width) - 0.5f;
-  const float y = (uv.y - std::floor(uv.y)) * float(l.height) - 0.5f;
+  // Texel centres sit at half-integers.
+  const Axis ax_ = address(uv.x, l.width, sampler_.wrapU), ay_ = address(uv.y, l.height, sampler_.wrapV);
+  const float x = ax_.f, y = ay_.f;
   const float fx = std::floor(x), fy = std::floor(y);
-  const uint32_t x0 = wrap(int(fx), l.width), x1 = wrap(int(fx) + 1, l.width);
-  const uint32_t y0 = wrap(int(fy), l.height), y1 = wrap(int(fy) + 1, l.height);
+  const uint32_t x0 = ax_.i0, x1 = ax_.i1, y0 = ay_.i0, y1 = ay_.i1;
   const Table& colour = srgb_ ? kSrgb : kUnorm;
   auto texel = [&](uint32_t tx, uint32_t ty) {
     const uint8_t* p = &l.texels[(size_t(ty) * l.width + tx) * channels_];
@@ -80,7 +105,7 @@ SceneTextures::SceneTextures(const Scene& scene) : index_(scene.textures.size(),
   std::vector<std::optional<MipTexture>> built(used.size());
   decodeTextures(scene, used, [&](size_t i, TexelData&& t) {
     try {
-      built[i].emplace(t, decodeSrgb(scene.textures[used[i]]));
+      built[i].emplace(t, decodeSrgb(scene.textures[used[i]]), scene.textures[used[i]].sampler);
     } catch (const Error& e) {
       throw Error(scene.textures[used[i]].path.string() + ": " + e.what());
     }

@@ -20,9 +20,11 @@ namespace rtr::trace {
 // 8 bits like the GPU's image, and decoded to linear on read (sRGB before filtering, as Vulkan does).
 class MipTexture {
  public:
-  MipTexture(const TexelData& image, bool srgb);  // throws rtr::Error for an empty or malformed image
+  // Throws rtr::Error for an empty or malformed image. The sampler's wrap modes address texels (its
+  // nearest filters are not modelled: always trilinear).
+  MipTexture(const TexelData& image, bool srgb, const SamplerDesc& sampler = {});
 
-  // Trilinear sample at uv (REPEAT) at level of detail `lod` (clamped to the chain; NaN reads level 0).
+  // Trilinear sample at uv (the sampler's wrap modes) at level of detail `lod` (clamped to the chain; NaN reads level 0).
   // A one-channel texture reads (r, 0, 0, 1), as R8_UNORM does.
   glm::vec4 sample(glm::vec2 uv, float lod) const;
   // The level of detail of a footprint `uvWidth` wide in texture coordinates: log2(uvWidth · √(w·h)).
@@ -43,6 +45,7 @@ class MipTexture {
   std::vector<Level> levels_;
   uint32_t channels_;
   bool srgb_;
+  SamplerDesc sampler_;
   float halfLog2Area_;  // 0.5·log2(width·height)
 };
 

@@ -20,7 +20,10 @@ namespace {
 const char* const kCases[] = {"temple_nave",   "temple_aisle",  "cornell_box",   "cube_backplane",
                               "grazing_floor", "metal_sphere",  "rough0_patch",  "backface_quad",
                               "temple_nave_textured", "temple_aisle_textured", "cube_backplane_falloff",
-                              "two_lights", "two_lights_falloff", "headlight"};
+                              "two_lights", "two_lights_falloff", "headlight", "gltf_metal_rough", "gltf_emissive",
+                              "gltf_spot", "gltf_alpha_mask", "gltf_normal_map", "gltf_texture_transform"};
+// Cases whose GPU side is not built yet: run (and compared) once the renderer has them.
+const std::set<std::string> kGpuMissing = {"gltf_normal_map", "gltf_texture_transform"};
 
 // The shaded view runs once per visibility rasteriser (the debug views are forward: no ids).
 struct Param {
@@ -45,6 +48,9 @@ class ReferenceTest : public test::VulkanTest, public ::testing::WithParamInterf
 
 TEST_P(ReferenceTest, GpuMatchesCpu) {
   const Param& p = GetParam();
+  if (kGpuMissing.count(p.name))
+    GTEST_SKIP() << p.name << ": the renderer does not yet sample normal maps with tangents or apply "
+                 << "KHR_texture_transform / the second uv set (the tracer does: tests/trace/gltf_material_test.cpp)";
   const auto poses = loadPoses(posesFile());
   ASSERT_TRUE(poses.count(p.name)) << p.name << " has no pose in " << posesFile();
   const ReferenceScene rs = makeScene(p.name, outDir() / "work");

@@ -243,5 +243,67 @@ TEST(GltfMaterial, TextureTransformAndSecondUvSet) {
   }
 }
 
+// glTF samplers' wrap modes address the texels (at texel centres: exactly one texel).
+TEST(GltfMaterial, SamplerWrapModes) {
+  struct Case { Wrap wrap; float u; uint32_t texel; };
+  for (const Case c : {Case{Wrap::Repeat, 1.375f, 1}, Case{Wrap::ClampToEdge, 1.375f, 3}, Case{Wrap::ClampToEdge, 1.875f, 3},
+                       Case{Wrap::MirroredRepeat, 1.125f, 3}, Case{Wrap::MirroredRepeat, 1.375f, 2}}) {
+    Scene s;
+    Material m = gltf(glm::vec3(1.0f));
+    m.textures[uint32_t(TextureSlot::BaseColor)] = addTexture(s, "pattern", 4, 4, pattern, true, 4);
+    s.textures.back().sampler.wrapU = c.wrap;
+    Mesh q = facing(2, addMaterial(s, m));
+    for (glm::vec2& t : q.texcoords) t *= 2.0f;  // uv = (x + 1, y + 1)
+    addMesh(s, std::move(q));
+    const Tracer t(s);
+    expectNear(at(t, baseView(), c.u - 1.0f, 0.375f - 1.0f), decoded(pattern(c.texel, 1)),
+               "wrap " + std::to_string(int(c.wrap)) + " u " + std::to_string(c.u));
+  }
+}
+
+float unorm(uint8_t b) { return float(decodeTexel(b, 0, TexelEncoding::Unorm)); }
+
+// A uniform normal map on a quad with tangent +x: the shading normal is T·x + B·y + N·z of the texel's
+// 2·v − 1 (x, y times normalScale), B = N × T = +y; without tangents the interpolated normal stays.
+TEST(GltfMaterial, NormalMapTiltsTheShadingNormalOnTheTangentFrame) {
+  const Texel texel{204, 110, 230, 255};
+  for (int variant = 0; variant < 3; ++variant) {  // tangents; tangents with bitangent sign -1; none
+    Scene s;
+    Material m = gltf(glm::vec3(0.7f, 0.6f, 0.5f));
+    m.roughness = 0.5f;
+    m.normalScale = 0.7f;
+    m.textures[uint32_t(TextureSlot::NormalMap)] =
+        addTexture(s, "normal", 4, 4, [&](uint32_t, uint32_t) { return texel; }, false, 4);
+    Mesh q = facing(2, addMaterial(s, m));
+    if (variant < 2) q.tangents.assign(q.positions.size(), glm::vec4(1, 0, 0, variant == 0 ? 1.0f : -1.0f));
+    addMesh(s, std::move(q));
+    const Tracer t(s);
+    TraceSettings ts = baseView();
+    Light l;
+    l.position = {1.0f, 0.5f, 1.0f};
+    ts.lights = LightRig{{l}, glm::vec3(0.0f), {}};
+    const glm::vec3 p(0.1f, 0.2f, -2.0f);
+    const float sign = variant == 1 ? -1.0f : 1.0f;
+    const glm::vec3 n = variant == 2 ? glm::vec3(0, 0, 1)
+                                     : glm::normalize(glm::vec3((2 * unorm(texel[0]) - 1) * 0.7f,
+                                                                sign * (2 * unorm(texel[1]) - 1) * 0.7f, 2 * unorm(texel[2]) - 1));
+    const glm::vec3 want = shader::pbrDirect(BRDF_GGX, n, glm::vec3(0, 0, 1), glm::normalize(l.position - p), l.color,
+                                             m.baseColor, 0.5f, 0.0f);
+    expectNear(at(t, ts), want, "variant " + std::to_string(variant), 2e-5f);
+  }
+}
+
+TEST(GltfMaterial, OcclusionScalesTheAmbientTermByItsStrength) {
+  Scene s;
+  Material m = gltf(glm::vec3(0.8f, 0.5f, 0.25f));
+  m.occlusionStrength = 0.5f;
+  m.textures[uint32_t(TextureSlot::Occlusion)] =
+      addTexture(s, "occlusion", 4, 4, [](uint32_t, uint32_t) { return Texel{128, 128, 128, 255}; }, false, 1);
+  addMesh(s, facing(2, addMaterial(s, m)));
+  const Tracer t(s);
+  const float ao = 1.0f + 0.5f * (unorm(128) - 1.0f);
+  expectNear(at(t, baseView()), m.baseColor * ao, "ambient 1, no light");
+}
+
 }  // namespace
 }  // namespace rtr::trace
