@@ -166,12 +166,12 @@ uint32_t Materials::make(const Json& j) {
       texture(*t, TextureSlot::BaseColor, m, true, 4, 0);
       // The mask is the base colour's alpha: the slot the renderers alpha-test takes that channel.
       if ((m.flags & (kMaterialAlphaMasked | kMaterialBlend)) && m.texture(TextureSlot::BaseColor) != kNoTexture) {
-        texture(*t, TextureSlot::AlphaMask, m, false, 1, 3);
+        texture(*t, TextureSlot::AlphaMask, m, false, 1, 4);
       }
     }
     if (auto t = pbr->get("metallicRoughnessTexture")) {
-      texture(*t, TextureSlot::Roughness, m, false, 1, 1);
-      texture(*t, TextureSlot::Metalness, m, false, 1, 2);
+      texture(*t, TextureSlot::Roughness, m, false, 1, 2);
+      texture(*t, TextureSlot::Metalness, m, false, 1, 3);
     }
   }
   if (auto t = j.get("normalTexture")) {
@@ -179,7 +179,7 @@ uint32_t Materials::make(const Json& j) {
     m.normalScale = float(t->number("scale", 1.0));
   }
   if (auto t = j.get("occlusionTexture")) {
-    texture(*t, TextureSlot::Occlusion, m, false, 1, 0);
+    texture(*t, TextureSlot::Occlusion, m, false, 1, 1);
     m.occlusionStrength = float(t->number("strength", 1.0));
   }
   if (auto t = j.get("emissiveTexture")) texture(*t, TextureSlot::Emissive, m, true, 4, 0);

@@ -595,7 +595,7 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     if (v5) {
       t.sourceChannel = r.u8("a texture record");
       const uint8_t wrapU = r.u8("a texture record"), wrapV = r.u8("a texture record"), filter = r.u8("a texture record");
-      if (t.sourceChannel > (ch == 1 ? 3 : 0))
+      if (t.sourceChannel > (ch == 1 ? 4 : 0))
         r.failAt(at + 2, "texture source channel " + std::to_string(t.sourceChannel) + " for " + std::to_string(ch) + " channels");
       for (uint8_t wrap : {wrapU, wrapV})
         if (wrap > uint8_t(Wrap::MirroredRepeat)) r.failAt(at + 3, "unknown texture wrap mode " + std::to_string(wrap));

@@ -40,8 +40,8 @@ struct Texture {
   std::filesystem::path path;  // absolute, or relative to Scene::baseDir; with `bytes`: a name for messages
   bool srgb = false;
   uint8_t channels = 4;        // channel count the slot needs; loaders force it
-  // channels == 1: which channel of the decoded image it takes (glTF packs roughness in G, metalness
-  // in B, occlusion in R of its textures); 0 for a grey image.
+  // channels == 1: 0 takes the image as grey (its luminance: OBJ/MTL and course textures); 1-4 take its
+  // R, G, B or A (glTF packs occlusion in R, roughness in G, metalness in B; a mask is the alpha).
   uint8_t sourceChannel = 0;
   SamplerDesc sampler;
   // The encoded image (PNG, JPEG) held in memory: a glTF data URI or buffer view. Null: read `path`.

@@ -40,7 +40,7 @@ TexelData decodeTexture(const Scene& scene, const Texture& t) {
   TexelData d = t.bytes ? decodeImage(*t.bytes, t.path.string(), pick ? 4 : channels)
                         : loadImage(t.path.is_absolute() ? t.path : scene.baseDir / t.path, pick ? 4 : channels);
   if (pick) {
-    const int c = std::min<int>(t.sourceChannel, 3);
+    const int c = std::min<int>(t.sourceChannel - 1, 3);
     for (size_t i = 0, n = size_t(d.width) * d.height; i < n; ++i) d.texels[i] = d.texels[i * 4 + c];
     d.texels.resize(size_t(d.width) * d.height);
     d.texels.shrink_to_fit();

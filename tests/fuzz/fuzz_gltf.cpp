@@ -30,6 +30,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fuzz::require(m.colors.empty() || m.colors.size() == m.positions.size(), "colour count differs");
     fuzz::require(m.texcoords1.empty() || m.texcoords1.size() == m.positions.size(), "texcoord1 count differs");
   }
-  for (const Texture& t : s.textures) fuzz::require(t.sourceChannel < 4, "source channel");
+  for (const Texture& t : s.textures) fuzz::require(t.sourceChannel <= 4, "source channel");
   return 0;
 }

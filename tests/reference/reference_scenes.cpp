@@ -298,9 +298,9 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
       return glm::u8vec4(200 - 20 * x, 120 + 15 * y, 60 + 10 * (x + y), 255);
     }, true);
     auto packed = [](uint32_t x, uint32_t y) { return glm::u8vec4(255, 20 + 30 * x, y < 4 ? 255 : 0, 255); };
-    q.textures[uint32_t(TextureSlot::Roughness)] = addPng(s, workDir, "mr_packed", 8, 8, packed, false, 1, 1);
+    q.textures[uint32_t(TextureSlot::Roughness)] = addPng(s, workDir, "mr_packed", 8, 8, packed, false, 1, 2);
     Texture metal = s.textures.back();  // the same image, its blue channel
-    metal.sourceChannel = 2;
+    metal.sourceChannel = 3;
     s.textures.push_back(metal);
     q.textures[uint32_t(TextureSlot::Metalness)] = uint32_t(s.textures.size() - 1);
     s.materials.push_back(q);
@@ -355,7 +355,7 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
       return glm::u8vec4(180, 220, 120, dx * dx + dy * dy < 40.0f ? 255 : (x / 2 + y / 2) % 2 ? 130 : 0);
     };
     m.textures[uint32_t(TextureSlot::BaseColor)] = addPng(s, workDir, "leaf", 16, 16, texel, true);
-    m.textures[uint32_t(TextureSlot::AlphaMask)] = addPng(s, workDir, "leaf", 16, 16, texel, false, 1, 3);
+    m.textures[uint32_t(TextureSlot::AlphaMask)] = addPng(s, workDir, "leaf", 16, 16, texel, false, 1, 4);
     s.materials.push_back(m);
     s.meshes.push_back(grid("floor", 0, {-4, -1, 0}, {8, 0, 0}, {0, 0, -8}, 8, 8, false));
     s.meshes.push_back(grid("leaf", 1, {-1.2f, -0.9f, -3.5f}, {2.4f, 0, 0}, {0, 2.0f, 0}, 4, 4, true));

@@ -42,7 +42,7 @@ Scene gltfScene(const std::filesystem::path& dir, bool withOcclusion) {
   s.baseDir = dir;
   s.textures.push_back({"base.png", true, 4});
   Texture mask{"base.png", false, 1};
-  mask.sourceChannel = 3;  // glTF's mask: the base colour's alpha
+  mask.sourceChannel = 4;  // glTF's mask: the base colour's alpha
   s.textures.push_back(mask);
   Texture o{"occ.png", false, 1};
   s.textures.push_back(o);

@@ -72,14 +72,14 @@ TEST(GltfMaterials, MetallicRoughnessAllSlotsFactorsAndFlags) {
             (SamplerDesc{Wrap::ClampToEdge, Wrap::MirroredRepeat, true, false, true}));
   // The mask: the base colour image's alpha.
   EXPECT_EQ(tex(TextureSlot::AlphaMask).bytes, tex(TextureSlot::BaseColor).bytes);
-  EXPECT_EQ(tex(TextureSlot::AlphaMask).sourceChannel, 3);
+  EXPECT_EQ(tex(TextureSlot::AlphaMask).sourceChannel, 4);
   // The metal-rough texture: the same external image twice, G for roughness and B for metalness, linear.
   EXPECT_EQ(tex(TextureSlot::Roughness).path, "px.png");
-  EXPECT_EQ(tex(TextureSlot::Roughness).sourceChannel, 1);
-  EXPECT_EQ(tex(TextureSlot::Metalness).sourceChannel, 2);
+  EXPECT_EQ(tex(TextureSlot::Roughness).sourceChannel, 2);
+  EXPECT_EQ(tex(TextureSlot::Metalness).sourceChannel, 3);
   EXPECT_EQ(tex(TextureSlot::Metalness).channels, 1);
   EXPECT_FALSE(tex(TextureSlot::Roughness).srgb);
-  EXPECT_EQ(tex(TextureSlot::Occlusion).sourceChannel, 0);
+  EXPECT_EQ(tex(TextureSlot::Occlusion).sourceChannel, 1);
   EXPECT_EQ(tex(TextureSlot::NormalMap).channels, 4);
   EXPECT_FALSE(tex(TextureSlot::NormalMap).srgb);
   EXPECT_EQ(tex(TextureSlot::Emissive).sampler, tex(TextureSlot::BaseColor).sampler);
@@ -96,6 +96,8 @@ TEST(GltfMaterials, MetallicRoughnessAllSlotsFactorsAndFlags) {
   EXPECT_EQ(decodeTexture(s, tex(TextureSlot::Roughness)).texels, (std::vector<uint8_t>{20, 60}));
   EXPECT_EQ(decodeTexture(s, tex(TextureSlot::Metalness)).texels, (std::vector<uint8_t>{30, 70}));
   EXPECT_EQ(decodeTexture(s, tex(TextureSlot::AlphaMask)).texels, (std::vector<uint8_t>{40, 80}));
+  // Occlusion is the R channel, not the image's luminance (R 10/50, G 20/60, B 30/70).
+  EXPECT_EQ(decodeTexture(s, tex(TextureSlot::Occlusion)).texels, (std::vector<uint8_t>{10, 50}));
   // glTF materials sample the normal map and occlusion; an OBJ-style material with the same slots does not.
   const std::vector<uint32_t> used = sampledTextures(s);
   EXPECT_NE(std::find(used.begin(), used.end(), m.texture(TextureSlot::NormalMap)), used.end());

@@ -27,8 +27,8 @@ Scene rich() {
   Texture base{"tex/base.png", true, 4};
   base.sampler = {Wrap::ClampToEdge, Wrap::MirroredRepeat, true, false, true};
   Texture rough{"tex/mr.png", false, 1}, metal{"tex/mr.png", false, 1};
-  rough.sourceChannel = 1;
-  metal.sourceChannel = 2;
+  rough.sourceChannel = 2;
+  metal.sourceChannel = 3;
   metal.sampler.nearestMin = true;
   s.textures = {base, rough, metal};
   Material m;
