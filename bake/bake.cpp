@@ -12,6 +12,7 @@
 #include "scene/binio.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
+#include "scene/first_look.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
@@ -107,9 +108,11 @@ BakeReport bake(const BakeOptions& opt) {
   oo.warn = opt.warn;
   oo.threads = threads;
   oo.mtl = opt.mtl;
+  oo.creaseDeg = opt.creaseDeg;
   if (opt.progress)
     oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
   Scene scene = loadObj(opt.input, oo, &rep.obj);
+  turnScene(scene, opt.up);
   rep.parseSeconds = rep.obj.parseSeconds;
   rep.weldSeconds = rep.obj.weldSeconds;
   if (opt.view) scene.defaultView = opt.view;

@@ -9,6 +9,7 @@
 #include "bake.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
+#include "scene/first_look.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh", "rtr-bake"};
@@ -22,6 +23,11 @@ int main(int argc, char** argv) {
   app.add_option("--light", light, "store a point light at x,y,z with the scene (.rtrscene); it replaces the scene's own");
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b");
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
+  std::string up = "+Y";
+  app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
+      ->capture_default_str();
+  app.add_option("--crease", opt.creaseDeg, "faces without normals: normals split where faces meet at more than DEG "
+                 "degrees (0 flat, 180 smooth)")->capture_default_str()->check(rtr::cli::number(0, 180));
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   opt.input = input;
@@ -36,6 +42,7 @@ int main(int argc, char** argv) {
   try {
     if (!view.empty()) opt.view = rtr::cli::parsePose("--view", view);
     if (!mtl.empty()) opt.mtl = mtl;
+    opt.up = rtr::upRotation(up);
     if (!light.empty()) {
       rtr::Light l;
       l.position = rtr::cli::parseVec3("--light", light);

@@ -2,8 +2,8 @@
 """The windowed viewer's settings panel, orbit camera and dropped files, under its own Xvfb (xdotool).
 
 Usage: panel_test.py RTR_VIEW SCENE_DIR   (SCENE_DIR holds temple.rtrscene and its temple-tex folder)
-Exit 0: pass, 1: fail, 77: Xvfb or xdotool missing. The viewer runs with RTR_VIEW_TEST_UI=1, which prints
-each panel widget's rectangle ("ui ID x0 y0 x1 y1"), and RTR_VIEW_TEST_DROP=FILE: paths written to FILE
+Exit 0: pass, 1: fail, 77: Xvfb or xdotool missing. The viewer runs with the test-only options --test-ui,
+which prints each panel widget's rectangle ("ui ID x0 y0 x1 y1"), and --test-drop FILE: paths written to FILE
 are handed to the window's drop callback (xdotool cannot drag files).
 """
 import math
@@ -44,8 +44,7 @@ def main():
     config = os.path.join(tmp.name, "config")
     drop_file = os.path.join(tmp.name, "drop.txt")
     xvfb, display = start_xvfb(fbdir)
-    env = dict(os.environ, DISPLAY=display, RTR_VALIDATION="1", XDG_CONFIG_HOME=config, RTR_VIEW_TEST_UI="1",
-               RTR_VIEW_TEST_DROP=drop_file)
+    env = dict(os.environ, DISPLAY=display, RTR_VALIDATION="1", XDG_CONFIG_HOME=config)
     viewer = None
     try:
         def xdo(*args):
@@ -55,7 +54,8 @@ def main():
             return subprocess.run(["xdotool", *map(str, args)], env=env, check=True, capture_output=True, text=True,
                                   timeout=30).stdout.strip()
 
-        viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--timings", "--size", f"{SIZE[0]}x{SIZE[1]}"], env)
+        viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--timings", "--size", f"{SIZE[0]}x{SIZE[1]}",
+                         "--test-ui", "--test-drop", drop_file], env)
         viewer.wait_line("err", r"move speed")
         # The textures load while frames go on (the materials show their factors meanwhile): every frame this
         # test compares comes after they are in.
@@ -124,7 +124,16 @@ def main():
             return [float(v) for v in p.split(",")], [float(v) for v in t.group(1).split(",")], float(t.group(2))
 
         wait_title("CPU")
+        # The panel starts collapsed to its title bar, the view free; its arrow opens it.
+        bar = latest_rect("panel")
+        h = bar[3] - bar[1]
+        check(h < 40 and bar[2] - bar[0] < SIZE[0], f"the panel starts as a title bar only ({bar})")
+        xdo("mousemove", "--window", win, bar[0] + h // 2, bar[1] + h // 2)
+        time.sleep(0.3)
+        xdo("click", "1")
+        time.sleep(0.5)
         panel = latest_rect("lodbias")
+        check(latest_rect("panel")[3] > bar[3] + 100, "a click on its arrow opens it")
         right = panel[2] + 20  # the view right of the panel
         check(right < SIZE[0] - 40, f"the panel leaves the right of the window free (widgets end at x={panel[2]})")
         # The panel's start-up section (scrolled into view) opens on the phases; closed and scrolled back after.
