@@ -26,19 +26,21 @@ std::string windowTitle(const ViewState& s, const std::vector<std::pair<std::str
 }
 
 const std::vector<std::pair<const char*, const char*>>& keyList() {
+  // The labels are those of docs/viewer.md's key table (tests/first_minute/docs_test.py compares them).
   static const std::vector<std::pair<const char*, const char*>> keys{
-      {"W/S/A/D", "move forward/back/left/right"}, {"E/Q", "move up/down"},
-      {"Shift, Ctrl (held)", "move faster, slower"}, {"right mouse button", "mouse-look on/off (fly)"},
-      {"left/middle drag, wheel", "turn, pan, zoom (orbit)"},
-      {"1-7", "views: shaded, mip level, linear depth, depth derivatives, normal, view dir, light dir"},
-      {"8/9/0", "BRDF terms D, F, G"}, {"- / =", "diffuse, specular terms"},
-      {"M", "mosaic off/compute/graphics"}, {"[ ]", "LOD bias -/+ 0.5"},
-      {"F", "frame the scene"}, {"Home", "back to the start pose"}, {"C", "print the camera pose"},
+      {"W / S", "move forward / back"}, {"A / D", "move left / right"}, {"E / Q", "move up / down"},
+      {"Shift, Ctrl (held)", "move faster (x5), slower (x0.05)"},
+      {"right mouse button", "mouse-look on/off (fly mode)"},
+      {"left / middle drag, scroll", "orbit mode: turn about the target, pan, zoom"},
+      {"1-7", "views: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, 5 normal, 6 view dir, 7 light dir"},
+      {"8 / 9 / 0", "views 8-10: BRDF terms D, F, G"}, {"- / =", "views 11-12: diffuse, specular term"},
+      {"M", "mosaic post-process off / compute / graphics"}, {"[ / ]", "LOD bias -/+ 0.5"},
+      {"F", "frame the scene"}, {"Home", "back to the start pose"}, {"C", "print the camera pose (--camera)"},
+      {"Left / Right", "previous / next file of the command line or folder"}, {"F5", "read the scene file again"},
       {"R", "ray-trace this view on the CPU (again: hide)"},
+      {"T / Y / U / O", "CPU trace: shading phong/pbr/normals, shadows, reflections, orthographic"},
       {"X", "error map: this frame against a CPU trace (again: hide)"},
-      {"T/Y/U/O", "tracer shading, shadows, reflections, orthographic"},
-      {"Left/Right", "previous/next file of the command line or folder"}, {"F5", "read the scene file again"},
-      {"F1 or H", "this panel on/off"}, {"Esc", "quit"}};
+      {"F1 or H", "settings panel and legend on / off"}, {"Esc", "quit"}};
   return keys;
 }
 

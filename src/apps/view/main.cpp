@@ -14,6 +14,7 @@
 #include "core/cli.hpp"
 #include "core/error.hpp"
 #include "options.hpp"
+#include "view_state.hpp"
 #include "render/headless.hpp"
 #include "render/startup.hpp"
 #include "scene/first_look.hpp"
@@ -253,15 +254,11 @@ int runHeadless(const ViewOptions& o) {
 int main(int argc, char** argv) {
   using namespace rtr;
   view::ViewOptions o;
-  CLI::App app{"rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
-               "Keys in the window (docs/viewer.md):\n"
-               "  W/S/A/D/E/Q move, Shift faster, Ctrl slower, right mouse button toggles mouse-look\n"
-               "  1-7 views: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, 5 normal, 6 view dir, 7 light dir\n"
-               "  8/9/0 BRDF D/F/G, - diffuse, = specular (views 8-12; view 13, albedo, from the panel or --mode 13)\n"
-               "  M mosaic off/compute/graphics, [ ] LOD bias, F frame the scene, Home start pose, C print the camera pose\n"
-               "  R ray-trace the view on the CPU (again: hide), X error map of this frame against a CPU trace (again: hide)\n"
-               "  T tracer shading phong/pbr/normals, Y tracer shadows, U tracer reflections, O tracer orthographic\n"
-               "  F1 or H settings panel and key list, Esc quit",
+  std::string description = "rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
+                            "Keys in the window (the panel's Keys section; docs/viewer.md):\n";
+  for (const auto& [key, what] : view::keyList()) description += "  " + std::string(key) + ": " + what + "\n";
+  description += "View 13 (albedo) has no key: --mode 13 or the panel.";
+  CLI::App app{description,
                "rtr-view"};
   std::string camera, size = "1280x720", mips = "compute", mosaic = "off", light, lightColor,
               ambient = "0.02", mtl,
