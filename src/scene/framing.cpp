@@ -1,5 +1,6 @@
 #include "scene/framing.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -11,7 +12,7 @@
 
 namespace rtr {
 
-std::vector<double> frontAreas(const Scene& scene, std::span<const glm::vec3> toViewer) {
+std::vector<double> frontAreas(const Scene& scene, std::span<const glm::vec3> toViewer, bool windingOnly) {
   // One pass for every direction: the triangle's gathers and cross product are the cost, not the dots
   // (framing a 10M-triangle scene took 0.6 s as one pass per direction). The pass runs on all cores in
   // pieces of a fixed size whose sums are added in piece order, so the result does not depend on the
@@ -24,7 +25,8 @@ std::vector<double> frontAreas(const Scene& scene, std::span<const glm::vec3> to
   std::vector<double> sums(pieces.size() * toViewer.size(), 0.0);
   parallelFor(pieces.size(), 0, [&](size_t p) {
     const Mesh& m = *pieces[p].mesh;
-    const bool twoSided = m.material < scene.materials.size() && (scene.materials[m.material].flags & kMaterialDoubleSided);
+    const bool twoSided = !windingOnly && m.material < scene.materials.size() &&
+                          (scene.materials[m.material].flags & kMaterialDoubleSided);
     double* area = &sums[p * toViewer.size()];
     for (size_t t = pieces[p].first; t < pieces[p].end; ++t) {
       const glm::vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
@@ -43,7 +45,7 @@ std::vector<double> frontAreas(const Scene& scene, std::span<const glm::vec3> to
   return area;
 }
 
-double frontArea(const Scene& scene, const glm::vec3& toViewer) { return frontAreas(scene, {&toViewer, 1})[0]; }
+double frontArea(const Scene& scene, const glm::vec3& toViewer) { return frontAreas(scene, {&toViewer, 1}, false)[0]; }
 
 namespace {
 
@@ -111,15 +113,22 @@ CameraPose framingPose(const Scene& scene, const Lens& lens, float aspect, const
   // The preferred view keeps its place unless another sees 1.5x its front area (a solid looks alike from
   // every side; a sheet does not).
   const glm::mat3 toScene = glm::inverse(glm::mat3(model));
-  // From above only: a model seen from below its horizon looks wrong way up (--camera can ask for it).
-  const float pitches[] = {-25.0f}, yaws[] = {35.0f, 125.0f, -145.0f, -55.0f};
-  std::vector<glm::vec3> dirs;  // the preferred view first, then every candidate
+  // From above: a model seen from below its horizon looks wrong way up (--camera can ask for it). Only a
+  // model no face of which is wound towards any view from above (a sheet that faces down) is seen from
+  // below, as the GPU culls the back of one-sided faces (and, for now, of untextured two-sided ones).
+  const float yaws[] = {35.0f, 125.0f, -145.0f, -55.0f};
   auto dir = [&](float yaw, float pitch) { return glm::normalize(toScene * -basis(CameraPose{{}, yaw, pitch}).forward); };
-  float bestYaw = 35.0f, bestPitch = -25.0f;
+  std::vector<glm::vec3> above;
+  for (float yaw : yaws) above.push_back(dir(yaw, -25.0f));
+  const std::vector<double> wound = frontAreas(scene, above, true);
+  const bool facesDown = std::all_of(wound.begin(), wound.end(), [](double a) { return a == 0.0; });
+  const float pitches[] = {facesDown ? 25.0f : -25.0f};
+  std::vector<glm::vec3> dirs;  // the preferred view first, then every candidate
+  float bestYaw = 35.0f, bestPitch = pitches[0];
   dirs.push_back(dir(bestYaw, bestPitch));
   for (float pitch : pitches)
     for (float yaw : yaws) dirs.push_back(dir(yaw, pitch));
-  const std::vector<double> areas = frontAreas(scene, dirs);
+  const std::vector<double> areas = frontAreas(scene, dirs, true);  // faces as wound: the GPU culls some backs
   double best = areas[0] * 1.5;
   size_t k = 1;
   for (float pitch : pitches)
