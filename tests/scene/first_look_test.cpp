@@ -91,6 +91,9 @@ TEST_F(FirstLook, IndicesThatPointNowhereAreDroppedForTheFace) {
   for (const glm::vec3& n : s.meshes[0].normals) EXPECT_NEAR(n.z, 1.0f, 1e-6f);  // computed
   ASSERT_EQ(warnings.size(), 1u) << "one warning for all such faces";
   EXPECT_THAT(warnings[0], HasSubstr("t.obj:6: face normal index 1 points nowhere"));
+  // One corner's normal points nowhere: the whole face's normals are computed, not a mix.
+  const Scene mixed = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 1 0 0\nf 1//1 2//1 3//7\n");
+  for (const glm::vec3& n : mixed.meshes[0].normals) EXPECT_NEAR(n.z, 1.0f, 1e-6f);
 }
 
 TEST_F(FirstLook, VertexColoursAreRead) {
