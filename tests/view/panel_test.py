@@ -319,6 +319,18 @@ def main():
         dist = math.sqrt(sum(v * v for v in to))
         cos = sum(a * b for a, b in zip(fwd, to)) / dist
         check(cos > 0.999 and dist < 20, f"F frames the far triangle (distance {dist:.2f}, cos {cos:.5f})")
+        # F5 reads the file again: an edited triangle (now far to the other side) replaces the old one.
+        with open(tri, "w") as f:
+            f.write("".join(f"v {-far[0] + x} {far[1] + y} {far[2]}\n" for x, y in ((-1, -1), (1, -1), (0, 1))) + "f 1 2 3\n")
+        n_err = len(viewer.lines("err"))
+        xdo("key", "F5")
+        viewer.wait_line("err", r"rtr-view: loaded .*tri\.obj", start=n_err)
+        viewer.wait_line("err", r"move speed", start=n_err)
+        time.sleep(0.5)
+        xdo("key", "f")
+        time.sleep(0.5)
+        (cr, _, _) = pose()
+        check(cr[0] < -900, f"F5 reloads the edited file (the camera frames it at x {cr[0]:.0f})")
     except Fail as e:
         print("FAIL:", e, flush=True)
         return finish(viewer, xvfb, ok=False, t0=t0, xdo=None)
