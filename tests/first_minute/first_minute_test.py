@@ -112,6 +112,10 @@ def main():
         d = mean_diff(flat_rgb, read_png(smooth)[2])
         check(d > 0.5, f"torus: rtr-{tool} --crease 0 and 180 differ (mean difference {d:.2f})")
 
+    # A folder on the command line stands for its scene files: --headless takes one, and says how many it got.
+    r = run([f"{bins}/rtr-view", OWN, "--headless", "-o", os.path.join(out, "x.png")])
+    check(r.returncode == 2 and "3 given" in r.stderr, f"a folder gives its 3 scene files ({r.stderr.strip()[-120:]})")
+
     # rtr-bake takes --up and --crease as the renderers do: the baked Z-up house renders as the OBJ does.
     baked = os.path.join(out, "regr01", "regr01.rtrscene")
     r = run([f"{bins}/rtr-bake", f"{ASSIMP}/regr01.obj", baked, "--up", "+Z", "--crease", "0", "--force"])

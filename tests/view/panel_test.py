@@ -43,6 +43,10 @@ def main():
     scene = os.path.join(scenes, "temple.rtrscene")
     config = os.path.join(tmp.name, "config")
     drop_file = os.path.join(tmp.name, "drop.txt")
+    # A second file on the command line, for Right (the next file).
+    second = os.path.join(tmp.name, "second.obj")
+    with open(second, "w") as f:
+        f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     xvfb, display = start_xvfb(fbdir)
     env = dict(os.environ, DISPLAY=display, RTR_VALIDATION="1", XDG_CONFIG_HOME=config)
     viewer = None
@@ -55,7 +59,7 @@ def main():
                                   timeout=30).stdout.strip()
 
         viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--timings", "--size", f"{SIZE[0]}x{SIZE[1]}",
-                         "--test-ui", "--test-drop", drop_file], env)
+                         "--test-ui", "--test-drop", drop_file, second], env)
         viewer.wait_line("err", r"move speed")
         # The textures load while frames go on (the materials show their factors meanwhile): every frame this
         # test compares comes after they are in.
@@ -331,6 +335,11 @@ def main():
         time.sleep(0.5)
         (cr, _, _) = pose()
         check(cr[0] < -900, f"F5 reloads the edited file (the camera frames it at x {cr[0]:.0f})")
+        # Right: the next file of the command line.
+        n_err = len(viewer.lines("err"))
+        xdo("key", "Right")
+        viewer.wait_line("err", r"rtr-view: loaded .*second\.obj", start=n_err)
+        check(True, "Right loads the next file of the command line")
     except Fail as e:
         print("FAIL:", e, flush=True)
         return finish(viewer, xvfb, ok=False, t0=t0, xdo=None)
