@@ -182,6 +182,9 @@ def main():
         wait_title("| mip level |")
         xdo("key", "F1")
         settle()
+        legend = latest_rect("legend")  # with the panel shown (F1 hides both); settled
+        check(legend[0] < 20 and SIZE[1] - 40 < legend[3] <= SIZE[1] and legend[2] > legend[0] + 100,
+              f"the mip-level view shows its legend at the bottom left ({legend})")
         before_view = screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1])
         p0 = pose()
         x0, y0, x1, y1 = latest_rect("lodbias")

@@ -57,6 +57,16 @@ void drawLegend(const ViewState& s, const PanelFacts& facts) {
     ImGui::SameLine();
     ImGui::Text("%s", label);
   };
+  if (panelTracking()) {  // the legend's rectangle for the window test, when it appears or moves
+    static ImVec2 last{-1, -1};
+    const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize(), sc = ImGui::GetIO().DisplayFramebufferScale;
+    if (pos.x != last.x || pos.y != last.y) {
+      std::printf("ui legend %d %d %d %d\n", int(pos.x * sc.x), int(pos.y * sc.y), int((pos.x + size.x) * sc.x),
+                  int((pos.y + size.y) * sc.y));
+      std::fflush(stdout);
+      last = pos;
+    }
+  }
   if (facts.errorMap) {  // core/compare.hpp's map: grey by the largest channel error, red past the threshold
     ImGui::Text("error map, per pixel: the largest channel error in 8-bit steps");
     swatch(ImVec4(0, 0, 0, 1), "0: black");

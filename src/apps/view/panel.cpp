@@ -117,6 +117,7 @@ void tracerSection(ViewState& s, const PanelFacts& facts) {
 }  // namespace
 
 void setPanelTracking(bool on) { tracking = on; }
+bool panelTracking() { return tracking; }
 
 const char* modeName(int m) {
   static const char* names[] = {"", "shaded", "mip level", "linear depth", "depth derivatives", "normal", "view dir",

@@ -68,6 +68,7 @@ const std::vector<std::pair<const char*, const char*>>& keyList();
 // Test-only: each widget's rectangle (framebuffer pixels) on stdout when it changes, "ui ID x0 y0 x1 y1",
 // so the window test can click and drag the panel with xdotool.
 void setPanelTracking(bool on);
+bool panelTracking();
 
 // The window title: mode, settings, timings, the tracer's status and a shader error (the window test reads it).
 std::string windowTitle(const ViewState& s, const std::vector<std::pair<std::string, double>>& gpuTimes,
