@@ -16,8 +16,9 @@
 #include "scene/binio.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
-#include "scene/load.hpp"
 #include "core/parallel.hpp"
+#include "scene/first_look.hpp"
+#include "scene/load.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
@@ -125,6 +126,7 @@ BakeReport bake(const BakeOptions& opt) {
     LoadOptions lo;
     lo.warn = opt.warn;
     lo.note = opt.note;
+    lo.creaseDeg = opt.creaseDeg;
     const auto t = Clock::now();
     scene = stage("reading " + opt.input.string(), [&] { return loadScene(opt.input, lo); });
     rep.parseSeconds = since(t);
@@ -134,12 +136,14 @@ BakeReport bake(const BakeOptions& opt) {
     oo.warn = opt.warn;
     oo.threads = threads;
     oo.mtl = opt.mtl;
+    oo.creaseDeg = opt.creaseDeg;
     if (opt.progress)
       oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
     scene = stage("reading " + opt.input.string(), [&] { return loadObj(opt.input, oo, &rep.obj); });
     rep.parseSeconds = rep.obj.parseSeconds;
     rep.weldSeconds = rep.obj.weldSeconds;
   }
+  turnScene(scene, opt.up);
   for (const Mesh& m : scene.meshes) rep.triangles += m.triangleCount();
   rep.instances = scene.instances.size();
   if (opt.view) scene.defaultView = opt.view;

@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
+
 #include "core/camera.hpp"
+#include "scene/load.hpp"
 #include "scene/obj.hpp"
 #include "scene/scene.hpp"
 
@@ -20,6 +23,8 @@ struct BakeOptions {
   std::optional<CameraPose> view;         // stored as the default view (.rtrscene only)
   std::optional<std::filesystem::path> mtl;  // the OBJ's MTL instead of its mtllib lines (LoadOptions::mtl)
   std::vector<Light> lights;              // stored with the scene (.rtrscene only); empty: none stored
+  float creaseDeg = LoadOptions{}.creaseDeg;  // --crease: normals made for faces without them split at this angle
+  glm::mat3 up{1.0f};                     // --up: the rotation that turns the model's up axis to +Y
   std::function<void(const std::string&)> warn;
   std::function<void(const std::string&)> note;  // glTF: what the reader chose on its own (LoadOptions::note)
   std::function<void(const char* phase, double fraction)> progress;

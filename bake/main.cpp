@@ -10,6 +10,7 @@
 #include "bake.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
+#include "scene/first_look.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh, or a glTF 2.0 "
@@ -30,6 +31,11 @@ int main(int argc, char** argv) {
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
       ->needs(lightOpt)->check(checked([](const std::string& t) { rtr::cli::parseColor("--light-color", t); }, "R,G,B"));
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
+  std::string up = "+Y";
+  app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
+      ->capture_default_str();
+  app.add_option("--crease", opt.creaseDeg, "faces without normals: normals split where faces meet at more than DEG "
+                 "degrees (0 flat, 180 smooth)")->capture_default_str()->check(rtr::cli::number(0, 180));
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   opt.input = input;
@@ -45,6 +51,7 @@ int main(int argc, char** argv) {
   try {
     if (!view.empty()) opt.view = rtr::cli::parsePose("--view", view);
     if (!mtl.empty()) opt.mtl = mtl;
+    opt.up = rtr::upRotation(up);
     if (!light.empty()) {
       rtr::Light l;
       l.position = rtr::cli::parseVec3("--light", light);

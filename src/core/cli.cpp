@@ -17,9 +17,13 @@
 namespace rtr::cli {
 namespace {
 
-constexpr const char* kFooter =
-    "Exit status: 0 success; 1 failure while working (unreadable input, I/O error); 2 usage error (bad option "
-    "value, unknown output format, an output that exists without --force).";
+// The usage errors a tool can make: an existing output only where it has --force.
+std::string footer(const CLI::App& app) {
+  return std::string("Exit status: 0 success; 1 failure while working (unreadable input, I/O error); 2 usage error "
+                     "(bad option value") +
+         (app.get_option_no_throw("--force") ? ", unknown output format, an output that exists without --force)."
+                                             : ").");
+}
 
 std::string fmt(double v) {
   char buf[32];
@@ -45,7 +49,7 @@ std::string version(const std::string& tool) {
 int parse(CLI::App& app, int argc, char** argv) {
   const std::string tool = app.get_name();
   app.set_version_flag("--version", version(tool), "print the version and exit");
-  app.footer(kFooter);
+  app.footer(footer(app));
   try {
     app.parse(argc, argv);
     return -1;

@@ -56,6 +56,9 @@ Light areaLight(const Mesh& m, glm::vec3 color) {
 
 }  // namespace
 
+// A light material's colour: its Ke, or its Kd when it has no Ke (exporters often write the colour there).
+glm::vec3 lightColor(const Material& m) { return m.ke != glm::vec3(0.0f) ? m.ke : m.kd; }
+
 std::vector<Light> lightsFromGeometry(const Scene& scene) {
   std::vector<Light> lights;
   for (const Mesh& m : scene.meshes) {
@@ -63,14 +66,14 @@ std::vector<Light> lightsFromGeometry(const Scene& scene) {
     const Material& mat = scene.materials[m.material];
     if (!isLightMaterial(mat)) continue;
     if (m.triangleCount() == 2) {
-      lights.push_back(areaLight(m, mat.ke));
+      lights.push_back(areaLight(m, lightColor(mat)));
       continue;
     }
     Light l;
     glm::dvec3 sum(0.0);
     for (const glm::vec3& p : m.positions) sum += glm::dvec3(p);
     l.position = glm::vec3(sum / double(m.positions.size()));
-    l.color = mat.ke;
+    l.color = lightColor(mat);
     lights.push_back(l);
   }
   return lights;
@@ -96,11 +99,17 @@ LightRig resolveLights(const Scene& scene, const LightOptions& o) {
     rig.lights.resize(kMaxLights);
   }
   for (Light& l : rig.lights) l.falloff = l.falloff || o.falloff;
+  // Lights that are all black would give a black image: the headlight instead, said why.
+  const bool allBlack = !o.position && !rig.lights.empty() &&
+                        std::all_of(rig.lights.begin(), rig.lights.end(), [](const Light& l) { return l.color == glm::vec3(0.0f); });
+  if (allBlack && o.defaultLight) rig.lights.clear();
   if (rig.lights.empty() && o.defaultLight) {
     Light h;
     h.kind = Light::Kind::Headlight;
     rig.lights = {h};
-    rig.note = "the scene has no lights: lit by a headlight at the camera (--no-default-light: none)";
+    rig.note = allBlack ? "the scene's lights are all black (zero colour): lit by a headlight at the camera instead "
+                          "(--no-default-light: none)"
+                        : "the scene has no lights: lit by a headlight at the camera (--no-default-light: none)";
   } else if (rig.lights.empty()) {
     rig.note = "the scene has no lights and --no-default-light is set: only ambient and emission light it";
   }

@@ -2,8 +2,9 @@
 // Which lights light a scene, one rule for every tool (docs/lights.md):
 // 1. --light on the command line replaces the scene's lights with one point light;
 // 2. else the lights stored with the scene (.rtrscene; the course format's standard light);
-// 3. else its light geometry (docs/formats.md): every object whose material name contains "light" lights
-//    the scene with its Ke; two triangles make an area light (a parallelogram), anything else a point
+// 3. else its light geometry (the course's convention, docs/formats.md): every object whose material name
+//    contains "light" lights the scene with its Ke (its Kd when it has no Ke); two triangles make an area
+//    light (a parallelogram), anything else a point
 //    light at the centroid of its vertices;
 // 4. else, unless switched off, a headlight at the camera, announced once.
 // At most kMaxLights are kept (the GPU's frame uniforms hold that many); the rest are dropped with a note.
@@ -19,7 +20,7 @@ namespace rtr {
 
 constexpr size_t kMaxLights = 8;  // MAX_LIGHTS in shaders/shared/lights.h
 
-// The brief's standard light of the Vulkan part (docs/formats.md).
+// The course's standard light of the Vulkan part (docs/formats.md).
 Light briefLight();
 
 bool isLightMaterial(const Material& m);  // flag set, or "light" in the name

@@ -14,6 +14,9 @@ struct LoadOptions {
   // framework is started as `program NAME.obj NAME.mtl`). Without it, an OBJ that has no `mtllib` line
   // uses NAME.mtl beside it when that file exists.
   std::optional<std::filesystem::path> mtl;
+  // OBJ only: where a face has no normals, they are split at this angle between faces (degrees; 0 flat,
+  // 180 smooth): --crease.
+  float creaseDeg = 40.0f;
   // Non-fatal findings ("file:line: what"); at most 10 are passed on, then one line with the total.
   // Default: "warning: ..." on stderr.
   std::function<void(const std::string&)> warn;

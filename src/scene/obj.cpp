@@ -145,6 +145,25 @@ private:
     out.push_back(v);
   }
 
+  // `v x y z`, or `v x y z r g b` (vertex colours, as other readers take them; a lone 4th number is w).
+  // What follows the third number is read only as colour: anything else there is ignored, as before.
+  void vertex(std::string_view rest) {
+    float f[6] = {};
+    int n = 0;
+    for (; n < 6; ++n) {
+      const text::NumResult r = text::nextFloat(rest, f[n]);
+      if (r == text::NumResult::Ok) continue;
+      if (n >= 3) break;
+      if (r == text::NumResult::Missing) throw error("'v' needs 3 numbers");
+      if (r == text::NumResult::NotFinite) throw error("'v' coordinate is NaN or infinite");
+      throw error("'v' coordinate is not a number");
+    }
+    positions_.push_back({f[0], f[1], f[2]});
+    const bool coloured = n == 6;
+    if (coloured && colors_.size() < positions_.size() - 1) colors_.assign(positions_.size() - 1, glm::vec4(1.0f));
+    if (coloured || !colors_.empty()) colors_.push_back(coloured ? glm::vec4(f[3], f[4], f[5], 1.0f) : glm::vec4(1.0f));
+  }
+
   void onLine(std::string_view l) {
     if (line_ == 1 && l.substr(0, 3) == "\xEF\xBB\xBF") l.remove_prefix(3);  // UTF-8 byte order mark
     size_t i = 0;
@@ -153,7 +172,7 @@ private:
     const char c0 = l[i];
     const char c1 = i + 1 < l.size() ? l[i + 1] : '\0';
     const bool sep1 = c1 == '\0' || text::isSpace(c1);
-    if (c0 == 'v' && sep1) return vec<3>(l.substr(i + 1), positions_, "v", 3);
+    if (c0 == 'v' && sep1) return vertex(l.substr(i + 1));
     if (c0 == 'f' && sep1) return face(l.substr(i + 1));
     if (c0 == 'v' && c1 == 'n' && (i + 2 == l.size() || text::isSpace(l[i + 2]))) return vec<3>(l.substr(i + 2), normals_, "vn", 3);
     if (c0 == 'v' && c1 == 't' && (i + 2 == l.size() || text::isSpace(l[i + 2]))) return vec<2>(l.substr(i + 2), texcoords_, "vt", 1);
@@ -253,6 +272,18 @@ private:
     return true;
   }
 
+  // A texcoord or normal index that points nowhere: kAbsent (the face loses that attribute; one warning).
+  uint32_t resolveLenient(int64_t idx, size_t count, const char* what, bool& dropped) {
+    const int64_t r = idx > 0 ? idx - 1 : int64_t(count) + idx;
+    if (idx != 0 && r >= 0 && r < int64_t(count)) return uint32_t(r);
+    if (!dropped && ++danglingFaces_ == 1)
+      warn(std::string("face ") + what + " index " + std::to_string(idx) + " points nowhere (" + std::to_string(count) +
+           " " + what + "s defined so far): the face's " + what + "s are dropped" +
+           (std::string(what) == "normal" ? " and computed" : "") + " (so for every such face; no more warnings)");
+    dropped = true;
+    return kAbsent;
+  }
+
   uint32_t resolve(int64_t idx, size_t count, const char* what) {
     if (idx == 0) throw error(std::string("face ") + what + " index 0 is invalid (OBJ indices start at 1)");
     int64_t r = idx > 0 ? idx - 1 : int64_t(count) + idx;
@@ -264,6 +295,7 @@ private:
 
   void face(std::string_view rest) {
     poly_.clear();
+    bool dropT = false, dropN = false;
     const char* p = rest.data();
     const char* e = p + rest.size();
     for (;;) {
@@ -277,16 +309,20 @@ private:
         ++p;
         if (p < e && *p != '/') {
           if (!parseIndex(p, e, v)) throw error("face texture coordinate index is not a number");
-          c.t = resolve(v, texcoords_.size(), "texcoord");
+          c.t = resolveLenient(v, texcoords_.size(), "texcoord", dropT);
         }
         if (p < e && *p == '/') {
           ++p;
           if (!parseIndex(p, e, v)) throw error("face normal index is not a number");
-          c.n = resolve(v, normals_.size(), "normal");
+          c.n = resolveLenient(v, normals_.size(), "normal", dropN);
         }
       }
       if (p < e && !text::isSpace(*p)) throw error("unexpected character in face corner");
       poly_.push_back(c);
+    }
+    for (Corner& c : poly_) {
+      if (dropT) c.t = kAbsent;
+      if (dropN) c.n = kAbsent;
     }
     ++stats_.faces;
     if (poly_.size() < 3) {
@@ -326,6 +362,7 @@ private:
   size_t line_ = 0;
 
   std::vector<glm::vec3> positions_, normals_;
+  std::vector<glm::vec4> colors_;  // one per position once a `v` line has a colour; empty before
   std::vector<glm::vec2> texcoords_;
   std::vector<Corner> poly_;
   std::vector<glm::vec3> polyPos_;
@@ -340,7 +377,7 @@ private:
   std::string besideMtl_;
   uint32_t object_ = kAbsent, material_ = kAbsent, mesh_ = kAbsent;
   bool groupsSeen_ = false, mtlSeen_ = false, mtllibIgnored_ = false;
-  size_t pointsAndLines_ = 0;
+  size_t pointsAndLines_ = 0, danglingFaces_ = 0;
 };
 
 Scene ObjParser::finish() {
@@ -369,7 +406,7 @@ Scene ObjParser::finish() {
   std::vector<Mesh> meshes(builds_.size());
   std::vector<WeldCounts> counts(builds_.size());
   parallelFor(builds_.size(), opt_.threads, [&](size_t i) {
-    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i]);
+    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_);
     std::vector<Corner>().swap(builds_[i].corners);
   });
 

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 namespace rtr {
 namespace {
@@ -35,18 +36,20 @@ inline uint64_t cellHash(int64_t x, int64_t y, int64_t z) {
 struct Vertex {
   glm::vec3 p, n;
   glm::vec2 t;
+  glm::vec4 c;  // vertex colour; 0 when the file has none
 };
 
 inline bool near(const Vertex& a, const Vertex& b) {
   auto c = [](float x, float y) { return std::fabs(x - y) <= kWeldTolerance; };
   return c(a.p.x, b.p.x) && c(a.p.y, b.p.y) && c(a.p.z, b.p.z) && c(a.n.x, b.n.x) && c(a.n.y, b.n.y) &&
-         c(a.n.z, b.n.z) && c(a.t.x, b.t.x) && c(a.t.y, b.t.y);
+         c(a.n.z, b.n.z) && c(a.t.x, b.t.x) && c(a.t.y, b.t.y) && a.c == b.c;
 }
 
 }  // namespace
 
 WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions,
-                    std::span<const glm::vec3> normals, std::span<const glm::vec2> texcoords, Mesh& out) {
+                    std::span<const glm::vec3> normals, std::span<const glm::vec2> texcoords, Mesh& out,
+                    float creaseDeg, std::span<const glm::vec4> colors) {
   WeldCounts counts;
   const size_t triCount = corners.size() / 3;
 
@@ -70,34 +73,68 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     }
   }
 
-  // 2. Area-weighted normals per position: the unnormalised cross product is twice the area times the normal.
+  // 2. Normals where a corner has none: the area-weighted sum of the faces around its position whose normals
+  // lie within `creaseDeg` of its own face's (180: every face, one smooth normal per position; 0: its own
+  // face only, flat). The unnormalised cross product is twice the area times the normal. Such corners get
+  // the id normals.size() + k of generated normal k; equal sums at a position share an id.
   // Per-thread tables over all positions, reset after each mesh: neighbouring faces share nearby
   // positions, so direct indexing stays in cache where a hash table would not.
   thread_local std::vector<uint32_t> headByPos, normalOfPos;
   if (headByPos.size() < positions.size()) headByPos.assign(positions.size(), kAbsent);
   if (needNormals && normalOfPos.size() < positions.size()) normalOfPos.assign(positions.size(), kAbsent);
-  std::vector<glm::vec3> accum;
-  std::vector<uint32_t> accumPos;
+  std::vector<glm::vec3> gen;
+  std::vector<uint32_t> accumPos;  // positions with an entry in normalOfPos (a local id)
+  std::vector<Corner> filled;
   if (needNormals) {
+    std::vector<glm::vec3> cross(triCount);
+    std::vector<uint32_t> start(1, 0);  // faces around local position i: around[start[i], start[i + 1])
     for (size_t t = 0; t < triCount; ++t) {
       if (!keep[t]) continue;
       const Corner* c = &corners[t * 3];
       const glm::vec3 a = positions[c[0].p];
-      const glm::vec3 x = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
+      cross[t] = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
       for (int k = 0; k < 3; ++k) {
         uint32_t& id = normalOfPos[c[k].p];
-        if (id == kAbsent) {
-          id = uint32_t(accum.size());
-          accum.emplace_back(0.0f);
-          accumPos.push_back(c[k].p);
-        }
-        accum[id] += x;
+        if (id == kAbsent) id = uint32_t(accumPos.size()), accumPos.push_back(c[k].p), start.push_back(0);
+        ++start[id + 1];
       }
     }
-    for (glm::vec3& n : accum) {
-      float l = glm::length(n);
-      n = l > 0.0f && std::isfinite(l) ? n / l : glm::vec3(0, 0, 1);
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    std::vector<uint32_t> around(start.back()), fill(start.begin(), start.end() - 1);
+    for (size_t t = 0; t < triCount; ++t)
+      if (keep[t])
+        for (int k = 0; k < 3; ++k) around[fill[normalOfPos[corners[t * 3 + k].p]]++] = uint32_t(t);
+    const float cosCrease = creaseDeg >= 180.0f ? -2.0f : std::cos(glm::radians(std::max(creaseDeg, 0.0f))) - 1e-6f;
+    auto unit = [](glm::vec3 n) {
+      const float l = glm::length(n);
+      return l > 0.0f && std::isfinite(l) ? n / l : glm::vec3(0, 0, 1);
+    };
+    std::vector<uint32_t> firstGen(accumPos.size(), kAbsent), nextGen;  // generated normals per position
+    filled.assign(corners.begin(), corners.end());
+    for (size_t t = 0; t < triCount; ++t) {
+      if (!keep[t]) continue;
+      const glm::vec3 own = unit(cross[t]);
+      for (int k = 0; k < 3; ++k) {
+        Corner& c = filled[t * 3 + k];
+        if (c.n != kAbsent) continue;
+        const uint32_t lp = normalOfPos[c.p];
+        glm::vec3 sum(0.0f);
+        for (uint32_t i = start[lp]; i < start[lp + 1]; ++i)
+          if (around[i] == t || (creaseDeg > 0.0f && glm::dot(own, unit(cross[around[i]])) >= cosCrease))
+            sum += cross[around[i]];
+        const glm::vec3 n = unit(sum);
+        uint32_t g = firstGen[lp];
+        while (g != kAbsent && gen[g] != n) g = nextGen[g];
+        if (g == kAbsent) {
+          g = uint32_t(gen.size());
+          gen.push_back(n);
+          nextGen.push_back(firstGen[lp]);
+          firstGen[lp] = g;
+        }
+        c.n = uint32_t(normals.size()) + g;
+      }
     }
+    corners = filled;
   }
 
   // 3. Identical corners become one vertex; 4. vertices within the tolerance are merged (greedy,
@@ -142,8 +179,9 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     const Corner& c = uniq[u];
     Vertex v;
     v.p = positions[c.p];
-    v.n = c.n != kAbsent ? normals[c.n] : accum[normalOfPos[c.p]];
+    v.n = c.n < normals.size() ? normals[c.n] : gen[c.n - normals.size()];
     v.t = c.t != kAbsent ? texcoords[c.t] : glm::vec2(0.0f);
+    v.c = colors.empty() ? glm::vec4(0.0f) : colors[c.p];
     int64_t cell[3], lo[3], hi[3];
     for (int d = 0; d < 3; ++d) {
       cell[d] = cellOf(v.p[d]);
@@ -173,11 +211,13 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   out.positions.resize(reps.size());
   out.normals.resize(reps.size());
   out.texcoords.resize(hasTex ? reps.size() : 0);
+  out.colors.resize(colors.empty() ? 0 : reps.size());
   out.bounds = Bounds{};
   for (size_t r = 0; r < reps.size(); ++r) {
     out.positions[r] = reps[r].p;
     out.normals[r] = reps[r].n;
     if (hasTex) out.texcoords[r] = reps[r].t;
+    if (!colors.empty()) out.colors[r] = reps[r].c;
     out.bounds.extend(reps[r].p);
   }
   // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.

@@ -1,6 +1,7 @@
 #pragma once
 // Triangle soup (corners indexing shared attribute arrays) to an indexed mesh: degenerate triangles
-// dropped, area-weighted normals generated where a corner has none, vertices welded within 1e-5.
+// dropped, area-weighted normals generated where a corner has none (split at a crease angle), vertices
+// welded within 1e-5.
 #include <cstdint>
 #include <span>
 
@@ -23,8 +24,13 @@ struct WeldCounts {
   size_t vertices = 0;    // vertices after welding
 };
 
-// `corners` holds 3 per triangle. Fills out.positions/normals/texcoords/indices/bounds (not name or material).
+constexpr float kDefaultCreaseDeg = 40.0f;
+
+// `corners` holds 3 per triangle. Fills out.positions/normals/texcoords/colors/indices/bounds (not name or
+// material). A generated normal averages the faces at its position within `creaseDeg` of its own face (0:
+// flat, 180: smooth). `colors`: one per position, or empty.
 WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions,
-                    std::span<const glm::vec3> normals, std::span<const glm::vec2> texcoords, Mesh& out);
+                    std::span<const glm::vec3> normals, std::span<const glm::vec2> texcoords, Mesh& out,
+                    float creaseDeg = kDefaultCreaseDeg, std::span<const glm::vec4> colors = {});
 
 }  // namespace rtr

@@ -343,19 +343,26 @@ TEST_F(Cli, NoLightsIsNeverBlackInSilence) {
   Result r = run("rtr-trace", {obj.string(), "-o", png, "--size", "32x24"});
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("headlight"));
-  EXPECT_THAT(r.err, Not(HasSubstr("all black")));
-  r = run("rtr-trace", {obj.string(), "-o", png, "--size", "32x24", "--force", "--no-default-light"});
+  EXPECT_THAT(r.err, Not(HasSubstr("no lit pixel")));
+  // The ambient alone would light it a little: without ambient it is black.
+  r = run("rtr-trace", {obj.string(), "-o", png, "--size", "32x24", "--force", "--no-default-light", "--ambient", "0"});
   EXPECT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_THAT(r.err, HasSubstr("all black"));
-  // The viewer's ambient alone would light it a little: without ambient it is black too.
+  EXPECT_THAT(r.err, HasSubstr("warning: the image has no lit pixel: the scene has no lights"));
   r = run("rtr-view", {obj.string(), "--headless", "--screenshot", vpng, "--size", "32x24", "--no-default-light",
                        "--ambient", "0"});
   EXPECT_EQ(r.exitCode, 0) << r.err;
-  EXPECT_THAT(r.err, HasSubstr("all black"));
+  EXPECT_THAT(r.err, HasSubstr("warning: the image has no lit pixel: the scene has no lights"));
   r = run("rtr-view", {obj.string(), "--headless", "--screenshot", vpng, "--size", "32x24", "--force"});
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("headlight"));
-  EXPECT_THAT(r.err, Not(HasSubstr("all black")));
+  EXPECT_THAT(r.err, Not(HasSubstr("warning")));
+  // A camera that looks away: the scene is outside the view, said in both tools.
+  r = run("rtr-trace", {obj.string(), "-o", png, "--size", "32x24", "--force", "--camera", "0.3,0.3,3,180,0"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("warning: the scene lies wholly outside the view"));
+  r = run("rtr-view", {obj.string(), "--headless", "-o", vpng, "--size", "32x24", "--force", "--camera", "0.3,0.3,3,180,0"});
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("warning: the scene lies wholly outside the view"));
 }
 
 }  // namespace

@@ -54,16 +54,27 @@ TEST(Framing, AStagedSceneIsSeenFromTheFront) {
   EXPECT_EQ(p.pitchDeg, 0.0f);
 }
 
-// One-sided sheets are seen from their front: a triangle facing back-left, and one facing down.
-TEST(Framing, ASheetIsSeenFromItsFront) {
+// One-sided sheets are seen from their front: a triangle facing back-left; one facing only down is the one
+// model seen from below. A box wound inwards (faces towards its inside) is seen from above.
+TEST(Framing, ASheetIsSeenFromItsFrontAndOnlyADownwardSheetFromBelow) {
   const Scene backLeft = sceneOf(triangle({0, 0, 0}, {0, 1, 0}, {1, 0, 1}));  // normal (1, 0, -1)
   ASSERT_EQ(frontArea(backLeft, toViewer(CameraPose{{}, 35.0f, -25.0f})), 0.0) << "the preferred view sees its back";
   CameraPose p = framingPose(backLeft, Lens{}, 1.0f);
   EXPECT_GT(frontArea(backLeft, toViewer(p)), 0.0) << p.yawDeg << " " << p.pitchDeg;
-  const Scene down = sceneOf(triangle({0, 0, 0}, {1, 0, 0}, {0, 0, 1}));  // normal -y: only seen from below
+  const Scene down = sceneOf(triangle({0, 0, 0}, {1, 0, 0}, {0, 0, 1}));  // normal -y: its front only from below
   p = framingPose(down, Lens{}, 1.0f);
   EXPECT_EQ(p.pitchDeg, 25.0f);
-  EXPECT_GT(frontArea(down, toViewer(p)), 0.0);
+  // Facing down and sideways: seen better from below, but a view from above sees its front too.
+  const Scene slanted = sceneOf(triangle({0, 0, 0}, {1, 1, 0}, {0, 0, 1}));  // normal (1, -1, 0)
+  ASSERT_GT(glm::dot(glm::cross(glm::vec3(1, 1, 0), glm::vec3(0, 0, 1)), glm::vec3(1, -1, 0)), 0.0f);
+  p = framingPose(slanted, Lens{}, 1.0f);
+  EXPECT_EQ(p.pitchDeg, -25.0f) << "never from below while a view from above sees its front";
+  EXPECT_GT(frontArea(slanted, toViewer(p)), 0.0);
+  Mesh inward = cube();
+  for (size_t i = 0; i < inward.indices.size(); i += 3) std::swap(inward.indices[i + 1], inward.indices[i + 2]);
+  const Scene box = sceneOf(inward);
+  p = framingPose(box, Lens{}, 1.0f);
+  EXPECT_EQ(p.pitchDeg, -25.0f) << "from above, its floor's inside in view, not from below (yaw " << p.yawDeg << ")";
 }
 
 TEST(Framing, TwoSidedFacesCountFromBothSides) {

@@ -2,8 +2,8 @@
 """The windowed viewer's settings panel, orbit camera and dropped files, under its own Xvfb (xdotool).
 
 Usage: panel_test.py RTR_VIEW SCENE_DIR   (SCENE_DIR holds temple.rtrscene and its temple-tex folder)
-Exit 0: pass, 1: fail, 77: Xvfb or xdotool missing. The viewer runs with RTR_VIEW_TEST_UI=1, which prints
-each panel widget's rectangle ("ui ID x0 y0 x1 y1"), and RTR_VIEW_TEST_DROP=FILE: paths written to FILE
+Exit 0: pass, 1: fail, 77: Xvfb or xdotool missing. The viewer runs with the test-only options --test-ui,
+which prints each panel widget's rectangle ("ui ID x0 y0 x1 y1"), and --test-drop FILE: paths written to FILE
 are handed to the window's drop callback (xdotool cannot drag files).
 """
 import math
@@ -43,9 +43,12 @@ def main():
     scene = os.path.join(scenes, "temple.rtrscene")
     config = os.path.join(tmp.name, "config")
     drop_file = os.path.join(tmp.name, "drop.txt")
+    # A second file on the command line, for Right (the next file).
+    second = os.path.join(tmp.name, "second.obj")
+    with open(second, "w") as f:
+        f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     xvfb, display = start_xvfb(fbdir)
-    env = dict(os.environ, DISPLAY=display, RTR_VALIDATION="1", XDG_CONFIG_HOME=config, RTR_VIEW_TEST_UI="1",
-               RTR_VIEW_TEST_DROP=drop_file)
+    env = dict(os.environ, DISPLAY=display, RTR_VALIDATION="1", XDG_CONFIG_HOME=config)
     viewer = None
     try:
         def xdo(*args):
@@ -55,7 +58,8 @@ def main():
             return subprocess.run(["xdotool", *map(str, args)], env=env, check=True, capture_output=True, text=True,
                                   timeout=30).stdout.strip()
 
-        viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--timings", "--size", f"{SIZE[0]}x{SIZE[1]}"], env)
+        viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--timings", "--size", f"{SIZE[0]}x{SIZE[1]}",
+                         "--test-ui", "--test-drop", drop_file, second], env)
         viewer.wait_line("err", r"move speed")
         # The textures load while frames go on (the materials show their factors meanwhile): every frame this
         # test compares comes after they are in.
@@ -124,7 +128,16 @@ def main():
             return [float(v) for v in p.split(",")], [float(v) for v in t.group(1).split(",")], float(t.group(2))
 
         wait_title("CPU")
+        # The panel starts collapsed to its title bar, the view free; its arrow opens it.
+        bar = latest_rect("panel")
+        h = bar[3] - bar[1]
+        check(h < 40 and bar[2] - bar[0] < SIZE[0], f"the panel starts as a title bar only ({bar})")
+        xdo("mousemove", "--window", win, bar[0] + h // 2, bar[1] + h // 2)
+        time.sleep(0.3)
+        xdo("click", "1")
+        time.sleep(0.5)
         panel = latest_rect("lodbias")
+        check(latest_rect("panel")[3] > bar[3] + 100, "a click on its arrow opens it")
         right = panel[2] + 20  # the view right of the panel
         check(right < SIZE[0] - 40, f"the panel leaves the right of the window free (widgets end at x={panel[2]})")
         # The panel's start-up section (scrolled into view) opens on the phases; closed and scrolled back after.
@@ -169,6 +182,9 @@ def main():
         wait_title("| mip level |")
         xdo("key", "F1")
         settle()
+        legend = latest_rect("legend")  # with the panel shown (F1 hides both); settled
+        check(legend[0] < 20 and SIZE[1] - 40 < legend[3] <= SIZE[1] and legend[2] > legend[0] + 100,
+              f"the mip-level view shows its legend at the bottom left ({legend})")
         before_view = screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1])
         p0 = pose()
         x0, y0, x1, y1 = latest_rect("lodbias")
@@ -310,6 +326,23 @@ def main():
         dist = math.sqrt(sum(v * v for v in to))
         cos = sum(a * b for a, b in zip(fwd, to)) / dist
         check(cos > 0.999 and dist < 20, f"F frames the far triangle (distance {dist:.2f}, cos {cos:.5f})")
+        # F5 reads the file again: an edited triangle (now far to the other side) replaces the old one.
+        with open(tri, "w") as f:
+            f.write("".join(f"v {-far[0] + x} {far[1] + y} {far[2]}\n" for x, y in ((-1, -1), (1, -1), (0, 1))) + "f 1 2 3\n")
+        n_err = len(viewer.lines("err"))
+        xdo("key", "F5")
+        viewer.wait_line("err", r"rtr-view: loaded .*tri\.obj", start=n_err)
+        viewer.wait_line("err", r"move speed", start=n_err)
+        time.sleep(0.5)
+        xdo("key", "f")
+        time.sleep(0.5)
+        (cr, _, _) = pose()
+        check(cr[0] < -900, f"F5 reloads the edited file (the camera frames it at x {cr[0]:.0f})")
+        # Right: the next file of the command line.
+        n_err = len(viewer.lines("err"))
+        xdo("key", "Right")
+        viewer.wait_line("err", r"rtr-view: loaded .*second\.obj", start=n_err)
+        check(True, "Right loads the next file of the command line")
     except Fail as e:
         print("FAIL:", e, flush=True)
         return finish(viewer, xvfb, ok=False, t0=t0, xdo=None)

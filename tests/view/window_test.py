@@ -266,15 +266,16 @@ def main():
 
         # F1: the settings panel is drawn over the frame (top-left); F1 again removes it, pixel for pixel.
         # The window sits at the screen's origin (no window manager).
-        before = screen_pixels(fbdir, 0, 0, 120, 40)
+        # It starts collapsed: its title bar, from (8, 8), about 19 pixels high.
+        before = screen_pixels(fbdir, 10, 10, 120, 24)
         xdo("key", "F1")
         time.sleep(1.0)
-        shown = screen_pixels(fbdir, 0, 0, 120, 40)
+        shown = screen_pixels(fbdir, 10, 10, 120, 24)
         changed = sum(1 for a, b in zip(before, shown) if a != b)
         check(changed > 0.5 * len(before), f"F1 draws the panel into the frame ({changed} of {len(before)} pixels changed)")
         xdo("key", "F1")
         time.sleep(1.0)
-        check(screen_pixels(fbdir, 0, 0, 120, 40) == before, "F1 again removes it: the same pixels as before (the camera is still)")
+        check(screen_pixels(fbdir, 10, 10, 120, 24) == before, "F1 again removes it: the same pixels as before (the camera is still)")
 
         # X: trace the view with the renderer's model and show the error map; the title gives mean and max.
         frame = screen_pixels(fbdir, 0, 0, SIZE[0], SIZE[1])

@@ -1,4 +1,4 @@
-// rtr-trace: ray-trace a scene file into an image (brief Part 1; issue 6).
+// rtr-trace: ray-trace a scene file into an image (the course's ray-tracing part; docs/tracer.md).
 #include <algorithm>
 #include <cstdio>
 #include <cstdint>
@@ -14,6 +14,7 @@
 #include "core/cli.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
+#include "scene/first_look.hpp"
 #include "scene/load.hpp"
 #include "trace/tracer.hpp"
 
@@ -25,18 +26,21 @@ using namespace rtr::trace;
 std::string gStage = "starting";  // what was under way, for an out-of-memory message
 
 int run(int argc, char** argv) {
-  CLI::App app{"rtr-trace: CPU ray tracer (Blinn-Phong with shadows and mirrors, or the GPU's PBR BRDF)", "rtr-trace"};
-  std::string scenePath, outPath, size = "1280x720", camera, shading = "phong", shadows = "on",
-                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath,
+  CLI::App app{"rtr-trace: CPU ray tracer (the GPU's PBR BRDF for models; the course's Blinn-Phong with shadows and "
+               "mirrors for the course's scenes)", "rtr-trace"};
+  std::string scenePath, outPath, size = "1280x720", camera, shading = "auto", shadows = "on",
+                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath, up = "+Y",
                                   brdf;
   LightOptions lightOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
-  bool ortho = false, quiet = false, force = false;
+  bool ortho = false, quiet = false, force = false, noDefaultLight = false;
+  float crease = LoadOptions{}.creaseDeg;
   app.add_option("scene", scenePath, "scene file (.obj, .obj.zst, .comp5892mesh, .rtrscene)")->required();
   app.add_option("mtl,--mtl", mtlPath, "OBJ: its MTL, as the course runs `program NAME.obj NAME.mtl` (default: the "
                  "OBJ's mtllib, else NAME.mtl beside it)");
-  app.add_option("-o,--output", outPath, "output image: .png or .jpg (sRGB), .exr or .hdr (linear radiance)")->required();
+  app.add_option("-o,--output,--screenshot", outPath, "output image: .png or .jpg (sRGB), .exr or .hdr (linear radiance)")
+      ->required();
   app.add_flag("--force", force, "overwrite an existing output");
   app.add_option("--size", size, "image size WxH")->capture_default_str()
       ->check(cli::checked([](const std::string& t) { cli::parseSize("--size", t); }, "WxH"));
@@ -44,14 +48,17 @@ int run(int argc, char** argv) {
       ->check(cli::checked([](const std::string& t) { cli::parsePose("--camera", t); }, "X,Y,Z,YAW,PITCH"));
   app.add_option("--fov", fov, "vertical field of view in degrees (the viewer's default; the course uses 80)")
       ->capture_default_str()->check(cli::number(0, 180, true));
-  app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, docs/formats.md)");
+  app.add_flag("--ortho", ortho, "orthographic projection (volume ±aspect × ±1, as the course's framework; docs/formats.md)");
   app.add_option("--ortho-height", orthoHeight, "half height of the orthographic volume")->check(cli::number(0, 1e30, true));
-  app.add_option("--shading", shading, "phong | pbr | normals | depth (default: pbr for glTF materials, else phong)")
-      ->capture_default_str()->check(cli::oneOf<Shading>());
+  app.add_option("--shading", shading, "auto | phong | pbr | normals | depth; auto (the default): the course's "
+                 "Blinn-Phong for the course's own scenes (lit by *light* materials, or using N_mirr/N_ior), else PBR "
+                 "as rtr-view shades (docs/viewer.md)")
+      ->check(CLI::IsMember({"auto", "phong", "pbr", "normals", "depth"}));
   app.add_option("--brdf", brdf, "pbr: beckmann | ggx for every material (default: ggx for glTF materials, "
                  "beckmann for the rest)")->check(cli::oneOf<Brdf>());
   app.add_option("--shadows", shadows, "on | off")->capture_default_str()->check(CLI::IsMember({"on", "off"}));
-  app.add_option("--bounces", s.bounces, "mirror bounces (N_BOUNCES); 0 turns reflections off")
+  app.add_option("--bounces", s.bounces, "mirror bounces, the recursion depth of reflections (the course's N_BOUNCES); "
+                 "0 turns reflections off")
       ->capture_default_str()->check(cli::integer(0, 64));
   app.add_option("--threads", s.threads, "worker threads, 0 = every core")->capture_default_str()->check(cli::integer(0, 1024));
   app.add_option("--intersect", intersectName, "halfplane | watertight | moller")
@@ -65,8 +72,12 @@ int run(int argc, char** argv) {
   app.add_flag("--falloff", lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
   app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str()
       ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
-  app.add_flag("!--no-default-light", lightOptions.defaultLight,
-               "a scene without lights gets no headlight (the brief's strict behaviour)");
+  app.add_flag("--no-default-light", noDefaultLight,
+               "a scene without lights gets no headlight (the assignment's strict behaviour: ambient and emission only)");
+  app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
+      ->capture_default_str();
+  app.add_option("--crease", crease, "OBJ faces without normals: normals split where faces meet at more than DEG "
+                 "degrees (0 flat, 180 smooth)")->capture_default_str()->check(cli::number(0, 180));
   app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
       ->capture_default_str()->check(cli::number(-16, 16));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
@@ -81,7 +92,8 @@ int run(int argc, char** argv) {
   s.lens.orthographic = ortho;
   const float aspect = float(w) / float(h);
   s.lens.orthoHalfHeight = orthoHeight > 0.0f ? orthoHeight : (aspect >= 1.0f ? 1.0f : 1.0f / aspect);
-  s.shading = cli::enumOption<Shading>("--shading", shading);
+  lightOptions.defaultLight = !noDefaultLight;
+  const glm::mat3 upTurn = upRotation(up);
   if (!brdf.empty()) s.brdf = cli::enumOption<Brdf>("--brdf", brdf);
   s.shadows = shadows == "on";
   s.intersect = cli::enumOption<IntersectMethod>("--intersect", intersectName);
@@ -92,11 +104,16 @@ int run(int argc, char** argv) {
 
   LoadOptions load;
   if (!mtlPath.empty()) load.mtl = mtlPath;
-  const Scene scene = loadScene(scenePath, load);
-  // glTF materials are physically based: without --shading they get pbr, not the course's Blinn-Phong.
-  if (app.count("--shading") == 0 &&
-      std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.flags & kMaterialGltf; }))
-    s.shading = Shading::Pbr;
+  load.creaseDeg = crease;
+  Scene scene = loadScene(scenePath, load);
+  turnScene(scene, upTurn);
+  drawBothSides(scene);
+  s.shading = shading == "pbr" ? Shading::Pbr : shading == "normals" ? Shading::Normals
+            : shading == "depth" ? Shading::Depth : shading == "phong" ? Shading::Phong
+            : isCourseScene(scene) ? Shading::Phong : Shading::Pbr;
+  if (!quiet && shading == "auto")
+    std::fprintf(stderr, "rtr-trace: note: %s shading: %s (--shading)\n", s.shading == Shading::Phong ? "Blinn-Phong" : "PBR",
+                 s.shading == Shading::Phong ? "one of the course's scenes" : "a model, shaded as rtr-view shades it");
   s.lights = resolveLights(scene, lightOptions);
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   gStage = "building the BVH of " + scenePath;
@@ -112,9 +129,10 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "\rrtr-trace: tracing %3u%%", unsigned(100.0 * done / ((w + s.tileSize - 1) / s.tileSize * ((h + s.tileSize - 1) / s.tileSize))));
   });
   if (tty) std::fprintf(stderr, "\r\033[K");
-  if (s.lights->lights.empty() && s.shading != Shading::Normals && s.shading != Shading::Depth &&
-      std::all_of(image.pixels.begin(), image.pixels.end(), [](const glm::vec4& p) { return glm::vec3(p) == glm::vec3(0.0f); }))
-    std::fprintf(stderr, "rtr-trace: warning: the image is all black (no lights: --no-default-light)\n");
+  const bool lit = std::any_of(image.pixels.begin(), image.pixels.end(),
+                               [&](const glm::vec4& p) { return glm::vec3(p) != s.background; });
+  const std::string empty = emptyImageWarning(scene, tracer.resolvePose(s), s.lens, aspect, lit, s.lights->lights.size());
+  if (!empty.empty()) std::fprintf(stderr, "rtr-trace: warning: %s\n", empty.c_str());
   gStage = "writing " + outPath;
   saveImage(outPath, image, {force ? Replace::Yes : Replace::No, !quiet});
   if (!quiet) {

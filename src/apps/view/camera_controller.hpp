@@ -1,5 +1,5 @@
 #pragma once
-// Camera motion (brief 1.3, docs/formats.md). Fly: first-person keys and mouse-look. Orbit (model viewers):
+// Camera motion (the course's task 1.3, docs/formats.md). Fly: first-person keys and mouse-look. Orbit (model viewers):
 // left-drag turns the camera about a target on its view axis, scroll moves it to and from the target,
 // middle-drag pans both. Key state comes from press/release events (GLFW callbacks), never from polling;
 // motion is scaled by the frame time so speed does not depend on the frame rate.

@@ -2,6 +2,9 @@
 // Command-line options of rtr-view, shared by the headless and the windowed paths.
 #include <optional>
 #include <string>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
 
 #include "core/camera.hpp"
 #include "render/mips.hpp"
@@ -14,8 +17,10 @@
 namespace rtr::view {
 
 struct ViewOptions {
-  std::string scene;
-  LoadOptions load;                // --mtl
+  std::string scene;               // the first of `files`
+  std::vector<std::string> files;  // the command line's files, folders expanded (the window steps through them)
+  LoadOptions load;                // --mtl, --crease
+  glm::mat3 up{1.0f};              // --up: turns the model's up axis to +Y
   bool headless = false;
   uint32_t width = 1280, height = 720;
   std::optional<CameraPose> camera;
@@ -37,11 +42,22 @@ struct ViewOptions {
   // The first frame waits for the textures (deterministic captures); unless given, on for --headless
   // (--screenshot, --bench), off in the window, whose frames show the factors until the textures are in.
   std::optional<bool> waitTextures;
+  bool panel = true;               // the window's settings panel shown at start
+  // Test-only seams of the window (hidden options): each panel widget's rectangle on stdout when it
+  // changes (--test-ui), and a file whose lines are taken as dropped paths once it appears (--test-drop).
+  bool testUi = false;
+  std::string testDropFile;
 };
 
 constexpr uint32_t kMaxSize = 32768;  // the largest image side any Vulkan device offers today
 // --size within the device's maxImageDimension2D; throws rtr::UsageError naming the limit.
 void checkSizeFits(const ViewOptions& o, const vk::Context& ctx);
+
+// The files given on the command line, each folder replaced by the scene files in it (sorted by name).
+std::vector<std::string> sceneFiles(const std::vector<std::string>& given);
+// The scene file as every path of the viewer loads it: --mtl, --crease, --up, both sides drawn for models
+// (scene/first_look.hpp).
+Scene loadForView(const ViewOptions& o, const std::string& path);
 
 // The start pose: --camera, else the scene's own view, else framing the scene (framingPose), as rtr-trace.
 CameraPose startPose(const ViewOptions& o, const Scene& scene);

@@ -1,9 +1,9 @@
 // The windowed viewer's settings panel: every setting that has a key, the lights, the camera, the tracer,
 // scene facts and the frame-time graphs.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <map>
 
 #include <imgui.h>
@@ -14,11 +14,10 @@
 namespace rtr::view {
 namespace {
 
-// RTR_VIEW_TEST_UI=1: each widget's rectangle (framebuffer pixels) on stdout when it changes, so the
-// window test can click and drag the panel with xdotool.
+bool tracking = false;  // setPanelTracking
+
 void track(const std::string& id) {
-  static const bool enabled = std::getenv("RTR_VIEW_TEST_UI") != nullptr;
-  if (!enabled) return;
+  if (!tracking) return;
   static std::map<std::string, std::array<int, 4>> last;
   const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax(), s = ImGui::GetIO().DisplayFramebufferScale;
   const std::array<int, 4> r{int(a.x * s.x), int(a.y * s.y), int(b.x * s.x), int(b.y * s.y)};
@@ -117,6 +116,9 @@ void tracerSection(ViewState& s, const PanelFacts& facts) {
 
 }  // namespace
 
+void setPanelTracking(bool on) { tracking = on; }
+bool panelTracking() { return tracking; }
+
 const char* modeName(int m) {
   static const char* names[] = {"", "shaded", "mip level", "linear depth", "depth derivatives", "normal", "view dir",
                                 "light dir", "BRDF D", "BRDF F", "BRDF G", "diffuse", "specular", "albedo"};
@@ -136,7 +138,18 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
   ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowSize(ImVec2(std::min(display.x - 16, 420.0f), std::min(display.y - 16, 640.0f)), ImGuiCond_FirstUseEver);
-  ImGui::Begin("rtr-view (F1 hides)");
+  ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);  // the title bar only, until clicked
+  const bool open = ImGui::Begin("rtr-view settings and keys (F1 hides)");
+  if (tracking) {  // the window's rectangle, open or collapsed
+    const ImVec2 a = ImGui::GetWindowPos(), b = ImGui::GetWindowSize(), sc = ImGui::GetIO().DisplayFramebufferScale;
+    static std::array<int, 4> last{};
+    const std::array<int, 4> r{int(a.x * sc.x), int(a.y * sc.y), int((a.x + b.x) * sc.x), int((a.y + b.y) * sc.y)};
+    if (r != last) std::printf("ui panel %d %d %d %d\n", r[0], r[1], r[2], r[3]), std::fflush(stdout), last = r;
+  }
+  if (!open) {
+    ImGui::End();
+    return;
+  }
   if (!s.message.empty()) {
     ImGui::TextColored(s.messageIsError ? ImVec4(1, 0.35f, 0.3f, 1) : ImVec4(0.6f, 1, 0.6f, 1), "%s", s.message.c_str());
     track("message");
@@ -210,7 +223,8 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::TextWrapped("%s", facts.scenePath.c_str());
     ImGui::Text("%u meshes, %u materials, %u textures, %u triangles", facts.meshes, facts.materials, facts.textures,
                 facts.triangles);
-    ImGui::TextDisabled("drop an .obj, .obj.zst, .rtrscene or .comp5892mesh on the window to load it");
+    ImGui::TextDisabled("drop an .obj, .obj.zst, .rtrscene or .comp5892mesh on the window to load it; Left/Right: the "
+                        "other files of the command line or folder; F5 reads the file again");
   }
   if (ImGui::CollapsingHeader("Timing", ImGuiTreeNodeFlags_DefaultOpen)) {
     graph("CPU frame", history.cpuMs);
@@ -218,6 +232,13 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
       ImGui::PushID(name.c_str());
       graph(name.c_str(), values);
       ImGui::PopID();
+    }
+  }
+  if (ImGui::CollapsingHeader("Keys (as rtr-view --help lists them)")) {
+    for (const auto& [key, what] : keyList()) {
+      ImGui::Text("%-22s", key);
+      ImGui::SameLine();
+      ImGui::TextWrapped("%s", what);
     }
   }
   const bool startupOpen = ImGui::CollapsingHeader("Start-up");  // the phases --timings prints

@@ -14,12 +14,10 @@
 
 namespace rtr::view {
 
-// The reference tests' per-channel threshold (docs/reference-tests.md): an error of 3 steps shows white.
-constexpr int kErrorThreshold = 3;
-
 void TraceOverlay::start(const trace::TraceSettings& settings, std::optional<ImageRGBA8> raster) {
   stop();
   showError_ = false;
+  errorMapShown_ = false;
   if (!tracer_) tracer_ = std::make_unique<trace::Tracer>(scene_);
   {
     std::lock_guard lock(mutex_);
@@ -51,6 +49,7 @@ void TraceOverlay::start(const trace::TraceSettings& settings, std::optional<Ima
                     "%.2f%% of pixels > %d steps beyond 3x3 edge tolerance (red); trace %.2f s",
                     r.meanAbsError, r.maxAbsError, 100.0 * r.failingFraction, kErrorThreshold, st.seconds);
       errorText_ = text;
+      errorMapShown_ = true;
       showError_ = true;
     }
     dirty_ = true;

@@ -29,6 +29,10 @@ class TraceOverlay {
   void start(const trace::TraceSettings& settings, std::optional<ImageRGBA8> raster = std::nullopt);
   void stop();  // cancels and hides
   bool visible() const { return visible_; }
+  bool errorMapShown() const { return visible_ && errorMapShown_; }  // the error map, not a trace or its failure
+  // The error map's scale: grey = the largest channel error, white at this many 8-bit steps; red beyond it
+  // (the reference tests' threshold, docs/reference-tests.md).
+  static constexpr int kErrorThreshold = 3;
   std::string status() const;
 
   // Records a copy of the traced image over `image` (in TRANSFER_DST_OPTIMAL, `format` BGRA or RGBA UNORM,
@@ -49,7 +53,7 @@ class TraceOverlay {
   std::thread worker_;
   std::atomic<bool> cancel_{false}, dirty_{false}, visible_{false};
   std::atomic<uint32_t> tilesDone_{0}, tilesTotal_{0};
-  std::atomic<bool> showError_{false};  // errorMap_ and errorText_ are final once this is set
+  std::atomic<bool> showError_{false}, errorMapShown_{false};  // errorMap_ and errorText_ are final once this is set
   std::mutex mutex_;  // guards image_ against a concurrent restart
   ImageF image_;
   ImageRGBA8 errorMap_;

@@ -23,7 +23,9 @@ struct ViewState {
   bool traceRequested = false, errorMapRequested = false, reframeRequested = false, homeRequested = false;
   bool screenshotRequested = false, remipRequested = false;
   std::vector<std::string> drops;  // files dropped on the window (the last one is loaded)
-  // Ray tracer (docs/formats.md's toggles, on keys that do not clash with the view modes).
+  int fileStep = 0;                // Left/Right: the previous/next file of the command line or folder
+  bool reloadRequested = false;    // F5: the scene file read again
+  // Ray tracer (the course framework's toggles, docs/formats.md, on keys that do not clash with the view modes).
   trace::Shading traceShading = trace::Shading::Phong;
   bool traceShadows = true, traceReflections = true, traceOrtho = false;
   std::string message;             // the last load / screenshot outcome, shown in the panel
@@ -41,6 +43,8 @@ struct PanelFacts {
   bool texturesLoading = false;   // not all in yet: materials show their factors
   const std::vector<std::pair<std::string, double>>* startup = nullptr;  // phases in ms; empty before the first frame
   double startupTotalMs = 0, texturesInAtMs = 0;                         // from process start; 0: not yet
+  float depthFar = 0;             // the linear depth view's white (its far plane)
+  bool errorMap = false;          // the error map is on screen: its scale is shown
 };
 
 // The last kFrames frames' CPU time and per-pass GPU times, for the panel's graphs.
@@ -53,7 +57,21 @@ struct FrameHistory {
 
 const char* modeName(int mode);  // "shaded", "mip level", ... (1..VIEW_COUNT)
 
-// The settings panel (Dear ImGui): one window, between ImGui::NewFrame and ImGui::Render.
+// The settings panel (Dear ImGui): one window, between ImGui::NewFrame and ImGui::Render. It starts
+// collapsed to its title bar (a click opens it); its "Keys" section lists every key.
 void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& history);
+// The legend of what is on screen (between NewFrame and Render, shown with or without the panel): the mip
+// level colours, the linear depth range, the error map's scale.
+void drawLegend(const ViewState& s, const PanelFacts& facts);
+// Every key of the window, as "key", "what it does" pairs (the panel's Keys section; rtr-view --help says the same).
+const std::vector<std::pair<const char*, const char*>>& keyList();
+// Test-only: each widget's rectangle (framebuffer pixels) on stdout when it changes, "ui ID x0 y0 x1 y1",
+// so the window test can click and drag the panel with xdotool.
+void setPanelTracking(bool on);
+bool panelTracking();
+
+// The window title: mode, settings, timings, the tracer's status and a shader error (the window test reads it).
+std::string windowTitle(const ViewState& s, const std::vector<std::pair<std::string, double>>& gpuTimes,
+                        const std::string& traceStatus, const std::string& shaderError, double cpuFrameMs);
 
 }  // namespace rtr::view

@@ -1,0 +1,221 @@
+// rtr-view --headless: the scene rendered offscreen (no window, no display) to a screenshot or timed.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <future>
+#include <map>
+#include <optional>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "options.hpp"
+#include "render/headless.hpp"
+#include "render/startup.hpp"
+#include "scene/first_look.hpp"
+#include "scene/framing.hpp"
+#include "vk/context.hpp"
+#include "vk/pipeline_cache.hpp"
+#include "vk/resources.hpp"
+
+namespace rtr::view {
+namespace {
+
+bool anyLit(const ImageRGBA8& img) {  // the background is black
+  for (size_t i = 0; i < img.pixels.size(); i += 4)
+    if (img.pixels[i] | img.pixels[i + 1] | img.pixels[i + 2]) return true;
+  return false;
+}
+
+void printBench(const std::vector<std::vector<std::pair<std::string, double>>>& frames, const std::string& device) {
+  std::map<std::string, std::vector<double>> perPass;
+  std::vector<std::string> order;
+  for (const auto& f : frames) {
+    double total = 0;
+    for (const auto& [name, ms] : f) {
+      if (!perPass.count(name)) order.push_back(name);
+      perPass[name].push_back(ms);
+      total += ms;
+    }
+    if (!perPass.count("total")) order.push_back("total");
+    perPass["total"].push_back(total);
+  }
+  std::printf("| pass | min ms | median ms |  (%zu frames, %s)\n|---|---|---|\n", frames.size(), device.c_str());
+  std::string csv;
+  for (const auto& name : order) {
+    auto v = perPass[name];
+    std::sort(v.begin(), v.end());
+    std::printf("| %s | %.4f | %.4f |\n", name.c_str(), v.front(), v[v.size() / 2]);
+    csv += "csv," + name + "," + std::to_string(v.front()) + "," + std::to_string(v[v.size() / 2]) + "\n";
+  }
+  std::printf("%s", csv.c_str());
+}
+
+std::string mb(uint64_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MB"; }
+
+// What the address space limit (ulimit -v) leaves this process: a CPU device's memory is the process's own.
+uint64_t addressSpaceLeft() {
+  rlimit r{};
+  if (::getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return UINT64_MAX;
+  unsigned long pages = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%lu", &pages) != 1) pages = 0;
+    std::fclose(f);
+  }
+  const uint64_t used = uint64_t(pages) * uint64_t(::sysconf(_SC_PAGESIZE));
+  return r.rlim_cur > used ? r.rlim_cur - used : 0;
+}
+
+// Before the scene is allocated on the device: its geometry and the frame's targets (about 24 bytes a
+// pixel: colour, depth, ids, read-back) against the largest device heap and the address space left,
+// and what would fit when they do not.
+void checkMemoryFits(const ViewOptions& o, const vk::Context& ctx, const Scene& scene) {
+  uint64_t geometry = 0;
+  for (const Mesh& m : scene.meshes)
+    geometry += m.positions.size() * (12 + 12 + (m.texcoords.empty() ? 0 : 8)) + m.indices.size() * 4 +
+                m.clusters.size() * sizeof(Cluster);
+  constexpr uint64_t kTargetBytesPerPixel = 24;
+  const uint64_t targets = uint64_t(o.width) * o.height * kTargetBytesPerPixel;
+  const bool cpu = ctx.deviceType() == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const uint64_t heap = ctx.deviceHeapBytes(), left = cpu ? std::min<uint64_t>(heap, addressSpaceLeft()) : heap;
+  if (geometry + targets <= left) return;
+  std::string fits = "the geometry alone does not fit";
+  if (geometry < left) {
+    const uint32_t side = uint32_t(std::sqrt(double(left - geometry) / kTargetBytesPerPixel));
+    fits = side ? "a frame of up to " + std::to_string(side) + "x" + std::to_string(side) + " would fit"
+                : "no frame fits beside the geometry";
+  }
+  throw Error("out of memory before uploading " + o.scene + ": needs about " + mb(geometry) + " for its geometry and " +
+              mb(targets) + " for the " + std::to_string(o.width) + "x" + std::to_string(o.height) + " frame; " +
+              ctx.deviceName() + " has " + mb(left) + (left < heap ? " (the address space left under ulimit -v)" : "") +
+              ": " + fits);
+}
+
+}  // namespace
+
+namespace {
+
+// Renders; a screenshot is left to `writing`, which writes it while the caller's Vulkan objects go.
+int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
+  // The phases tile the time: each runs from the end of the one before (those of the scene upload are
+  // timed inside it), so their sum against the total, measured on its own, shows any time left out.
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  render::StartupTimeline timeline;
+  timeline.add("process start to Vulkan (exec, libraries, options)", render::msSinceProcessStart());
+  auto last = Clock::now();
+  const auto phase = [&](const std::string& name, double lessMs = 0) {
+    timeline.add(name, since(last) - lessMs);
+    last = Clock::now();
+  };
+  vk::Context ctx(contextOptions(o));
+  checkSizeFits(o, ctx);
+  const DeviceChoice choice = chooseForDevice(o, ctx);
+  phase("instance and device");
+  Scene scene = loadForView(o, o.scene);
+  checkMemoryFits(o, ctx, scene);
+  phase("scene file read");
+  // A load that takes over half a second says how far it is: one line rewritten on a terminal, else a
+  // line a second.
+  const auto loadStart = Clock::now();
+  auto lastShown = loadStart;
+  const bool terminal = ::isatty(2);
+  const render::LoadProgress progress = [&](const char* what, size_t done, size_t total) {
+    if (since(loadStart) < 500 || (done < total && since(lastShown) < (terminal ? 250 : 1000))) return;
+    std::fprintf(stderr, "%srtr-view: %s %zu/%zu%s", terminal ? "\r" : "", what, done, total,
+                 terminal && done < total ? "" : "\n");
+    lastShown = Clock::now();
+  };
+  const bool wait = o.waitTextures.value_or(true);
+  render::GpuScene gpuScene(ctx, scene, choice.mips, progress, render::GeometryUpload::Auto,
+                            wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred);
+  const auto& st = gpuScene.stats();  // the texture phases: once they are in
+  if (wait) timeline.add("texture decode", st.decodeMs);
+  timeline.add("geometry upload", st.geometryMs);
+  if (wait) timeline.add("texture upload", st.textureUploadMs), timeline.add("mips", st.mipsMs);
+  last = Clock::now();
+  const double pipelineMsBefore = ctx.pipelineCache().stats().ms;
+  std::fprintf(stderr, "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
+               "geometry %.0f ms (%.2f GB/s)",
+               o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16,
+               st.triangles, st.textures, st.geometryMs,
+               st.geometryMs > 0 ? double(st.geometryBytes) / st.geometryMs * 1e-6 : 0.0);
+  if (wait)
+    std::fprintf(stderr, ", decode %.0f ms, texture upload %.0f ms, mips %.3f ms GPU", st.decodeMs, st.textureUploadMs,
+                 st.mipGpuMs);
+  else if (st.textures)
+    std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
+  std::fprintf(stderr, "\n");
+  const CameraPose pose = startPose(o, scene);
+  const Lens lens = fitDepthRange(o.lens, scene.bounds(), pose);
+  render::RenderSettings settings = sceneSettings(o, scene);
+  settings.shading = choice.shading;
+  render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
+  phase("renderer setup (start pose, targets)", setupPipelineMs);
+  std::optional<render::HeadlessFrame> first;
+  // --no-wait-textures: the first frame is rendered before the textures are in (the materials' factors);
+  // they are taken in after it, for the frames that follow.
+  if (o.timings || !wait) first = renderer.render(pose, lens, settings, 1);
+  if (o.timings) {
+    const double totalMs = render::msSinceProcessStart();
+    const vk::PipelineStats ps = ctx.pipelineCache().stats();
+    char name[120];
+    if (ps.reported == ps.created)
+      std::snprintf(name, sizeof name, "pipeline creation (%u, %u from the cache)", ps.created, ps.cacheHits);
+    else
+      std::snprintf(name, sizeof name, "pipeline creation (%u, cache hits not reported)", ps.created);
+    timeline.add(name, ps.ms);
+    phase("first frame complete (record, GPU, read-back)", ps.ms - pipelineMsBefore - setupPipelineMs);
+    std::fprintf(stderr, "rtr-view: %s", timeline.format(totalMs).c_str());
+  }
+  if (gpuScene.updateTextures(true) && o.timings)  // how long the textures took, after the first frame
+    std::fprintf(stderr, "rtr-view: textures in at %.0f ms from process start: decode %.0f ms (worker threads), "
+                 "upload and mips %.0f ms (mips %.3f ms GPU)\n", render::msSinceProcessStart(), st.decodeMs,
+                 st.textureUploadMs, st.mipGpuMs);
+  if (o.bench > 0) {
+    renderer.bench(pose, lens, settings, 10);  // warm-up
+    printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
+    if (const auto c = renderer.renderer().cullStats(0)) {
+      const double n = std::max(1u, c->clusters);
+      std::printf("cull: %u clusters; listed early %u, late %u; culled by frustum %u (%.1f %%), cone %u (%.1f %%), "
+                  "occlusion %u (%.1f %%)\n", c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone,
+                  100 * c->cone / n, c->occlusion, 100 * c->occlusion / n);
+    }
+  }
+  if (!o.screenshot.empty()) {
+    render::HeadlessFrame frame = first && o.frames <= 1 ? std::move(*first)
+                                                         : renderer.render(pose, lens, settings, std::max(1, o.frames));
+    const std::string empty = emptyImageWarning(scene, pose, lens, float(o.width) / float(o.height), anyLit(frame.image),
+                                                settings.lights.lights.size());
+    if (!empty.empty()) std::fprintf(stderr, "rtr-view: warning: %s\n", empty.c_str());
+    // Compressed on all cores while the renderer, the scene and the device are torn down (10-15 ms on
+    // lavapipe, about a third of the PNG's time there).
+    writing = std::async(std::launch::async, [&o, image = std::move(frame.image)] {
+      saveImage(o.screenshot, image, {o.force ? Replace::Yes : Replace::No, true});
+    });
+    for (const auto& [name, ms] : frame.gpuTimes) std::fprintf(stderr, "  %s: %.3f ms GPU\n", name.c_str(), ms);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int runHeadless(const ViewOptions& o) {
+  std::future<void> writing;
+  int status = 0;
+  try {
+    status = stage("uploading or rendering " + o.scene, [&] { return renderHeadless(o, writing); });
+  } catch (const vk::OutOfMemory& e) {
+    throw Error("out of memory while uploading or rendering " + o.scene + ": " + e.what());
+  }
+  if (writing.valid()) {
+    writing.get();  // rethrows a write error
+    std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());
+  }
+  return status;
+}
+
+}  // namespace rtr::view
