@@ -300,9 +300,8 @@ private:
       where.fail("index " + std::to_string(m.indices[i]) + " (element " + std::to_string(i) + ") is not below the vertex count " +
                  std::to_string(vertices));
     }
-    // Coordinates beyond ±1e9 (an Earth-centred frame is ±6.4e6 m) overflow the squared lengths that
-    // clustering and shading take; NaN and infinity are never geometry.
-    constexpr float kMaxCoordinate = 1e9f;
+    // The one coordinate limit of every reader (core/bounds.hpp): beyond it the squared lengths that
+    // clustering and shading take overflow; NaN and infinity are never geometry.
     for (const glm::vec3& v : m.positions) m.bounds.extend(v);
     const Bounds& bb = m.bounds;
     if (!(std::max({-bb.min.x, -bb.min.y, -bb.min.z, bb.max.x, bb.max.y, bb.max.z}) <= kMaxCoordinate) ||
@@ -312,7 +311,8 @@ private:
         if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
           attrs.fail("POSITION element " + std::to_string(i) + " is not finite");
         if (std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}) > kMaxCoordinate)
-          attrs.fail("POSITION element " + std::to_string(i) + " has a coordinate beyond ±1e9, more than rtr handles");
+          attrs.fail("POSITION element " + std::to_string(i) +
+                     " has a coordinate beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
       }
     toTriangleList(p, m.indices, mode);
     if (m.indices.empty()) {
