@@ -115,8 +115,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
 
     down.bind(cb);
     for (uint32_t l = 1; l < sourceLevels; ++l) {  // each level reads the one just written
-      vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kCompute,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+      vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite);  // a global barrier: images in GENERAL too
       pc.size = s.sourceSize >> l;
       vk::DescriptorWriter(ctx, down.layout, 0, VK_NULL_HANDLE)
           .image(0, sourceLevelViews[l - 1], VK_IMAGE_LAYOUT_GENERAL)
@@ -168,7 +167,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     // Ready for shading in compute or fragment shaders.
     constexpr VkPipelineStageFlags2 kShading = kCompute | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
     vk::require(cb, {{specular_.tracked(), vk::Use::Sampled, kShading}, {lut_.tracked(), vk::Use::Sampled, kShading}});
-    vk::memoryBarrier(cb, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, kShading, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead | vk::kFragmentRead);  // the sh buffer
   });
   times_ = timer.results();
 }

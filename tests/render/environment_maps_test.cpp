@@ -43,8 +43,7 @@ class EnvironmentMapsTest : public VulkanTest {
       r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, layers};
       r.imageExtent = {size, size, 1};
       vkCmdCopyImageToBuffer(cb, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, out.handle(), 1, &r);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     });
     out.invalidate();
     const auto* h = static_cast<const uint16_t*>(out.mapped());
@@ -56,12 +55,10 @@ class EnvironmentMapsTest : public VulkanTest {
   std::array<glm::vec3, 9> readSh(const EnvironmentMaps& maps) {
     vk::Buffer out(*ctx, 9 * sizeof(glm::vec4), VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                        VK_ACCESS_2_TRANSFER_READ_BIT);
+      vk::bufferBarrier(cb, vk::kComputeWrite, vk::kCopyRead);
       const VkBufferCopy r{0, 0, 9 * sizeof(glm::vec4)};
       vkCmdCopyBuffer(cb, maps.sh(), out.handle(), 1, &r);
-      vk::memoryBarrier(cb, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                        VK_ACCESS_2_HOST_READ_BIT);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     });
     out.invalidate();
     std::array<glm::vec3, 9> sh;
