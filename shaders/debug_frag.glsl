@@ -26,7 +26,7 @@ void main() {
   if (cutOut(s)) discard;
 #endif
   int mode = int(frame.params.x);
-  vec3 n = brdfSafeNormal(shadingNormal());
+  vec3 n = brdfSafeNormal(shadingNormal(s));
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
   // The first light (a scene without lights: the view direction, as a headlight).
   vec3 l = frame.lightCount.x == 0u              ? v

@@ -19,7 +19,7 @@ void main() {
     return;
   }
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
-  vec3 n = shadingNormal();
+  vec3 n = shadingNormal(s);
   const int brdf = brdfOf();
   vec3 c = frame.ambient.rgb * clamp(s.baseColor, vec3(0.0), vec3(1.0)) * s.occlusion + s.emissive;
   for (uint i = 0u; i < frame.lightCount.x; ++i) {

@@ -20,7 +20,8 @@ void main() {
 #if ALPHA_MASK
   const GpuMaterial m = materials[draw.material];  // uniform per draw
   if (m.textures.w != NO_TEXTURE) {
-    const vec4 mask = texture(textures[m.textures.w], inTexcoord, frame.params.y);
+    const vec4 r0 = m.uvTransform[2 * SLOT_MASK], r1 = m.uvTransform[2 * SLOT_MASK + 1];  // set 0's texcoords
+    const vec4 mask = texture(textures[m.textures.w], vec2(dot(r0.xy, inTexcoord) + r0.z, dot(r1.xy, inTexcoord) + r1.z), frame.params.y);
     if (m.baseColor.a * ((m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a) < m.roughMetal.z) discard;
   }
 #endif

@@ -29,6 +29,10 @@ layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[
 layout(set = 1, binding = 0) uniform sampler2D textures[];
 #endif
 layout(set = 0, binding = 10, std430) readonly buffer Instances { GpuInstance instances[]; };
+// glTF's streams where the draw has them (GpuDraw flags); scenes without bind any buffer.
+layout(set = 0, binding = 11, std430) readonly buffer Texcoords1 { vec2 texcoords1[]; };
+layout(set = 0, binding = 12, std430) readonly buffer Tangents { vec4 tangents[]; };
+layout(set = 0, binding = 13, std430) readonly buffer Colors { vec4 colors[]; };
 layout(push_constant) uniform Push { VisShadePush pc; };
 
 const float kMaxRadiance = 60000.0;  // as pbr_frag.glsl: stay below the half-float maximum
@@ -53,8 +57,13 @@ vec3 barycentrics(vec3 dir, vec3 a, vec3 b, vec3 n) {
 }
 
 #if HAS_TEXCOORDS
-vec4 sampleOr(uint index, vec2 uv, vec2 gx, vec2 gy, vec4 fallback) {
-  return index == NO_TEXTURE ? fallback : textureGrad(textures[nonuniformEXT(index)], uv, gx, gy);
+// Texcoords of both sets and their differences to the quad neighbours (x, y): uv[0..2] set 0, uv[3..5] set 1.
+vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec2 uv[6], vec4 fallback) {
+  if (index == NO_TEXTURE) return fallback;
+  const vec4 r0 = m.uvTransform[2 * slot], r1 = m.uvTransform[2 * slot + 1];
+  const int k = r0.w > 0.5 ? 3 : 0;
+  const mat2 a = mat2(r0.x, r1.x, r0.y, r1.y);  // the transform's linear part (columns)
+  return textureGrad(textures[nonuniformEXT(index)], a * uv[k] + vec2(r0.z, r1.z), a * uv[k + 1], a * uv[k + 2]);
 }
 #endif
 
@@ -88,11 +97,13 @@ void main() {
   // instance, whose draws set VK_FRONT_FACE_CLOCKWISE).
   const mat3 normalMatrix = mat3(inst.normalX.xyz, inst.normalY.xyz, inst.normalZ.xyz);
   vec3 nrm = normalMatrix * (normal(tri.x) * w.x + normal(tri.y) * w.y + normal(tri.z) * w.z);
-  if ((dot(n, s) < 0.0) != ((inst.info.y & INSTANCE_MIRRORED) != 0u)) nrm = -nrm;
+  const bool back = (dot(n, s) < 0.0) != ((inst.info.y & INSTANCE_MIRRORED) != 0u);
+  if (back) nrm = -nrm;
 
   const GpuMaterial m = materials[d.material];
   vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
   float roughness = m.roughMetal.x, metalness = m.roughMetal.y, occlusion = 1.0;
+  if ((d.flags & DRAW_COLORS) != 0u) baseColor *= (colors[tri.x] * w.x + colors[tri.y] * w.y + colors[tri.z] * w.z).rgb;
 #if HAS_TEXCOORDS
   if ((d.flags & DRAW_TEXTURED) != 0u) {
     const vec2 t0 = texcoords[tri.x], t1 = texcoords[tri.y], t2 = texcoords[tri.z];
@@ -105,11 +116,29 @@ void main() {
     const float scale = exp2(frame.params.y);
     const vec2 gx = (t0 * wx.x + t1 * wx.y + t2 * wx.z - uv) * (side.x * scale);
     const vec2 gy = (t0 * wy.x + t1 * wy.y + t2 * wy.z - uv) * (side.y * scale);
-    baseColor *= sampleOr(m.textures.x, uv, gx, gy, vec4(1.0)).rgb;
-    roughness *= sampleOr(m.textures.y, uv, gx, gy, vec4(1.0)).r;
-    metalness *= sampleOr(m.textures.z, uv, gx, gy, vec4(1.0)).r;
-    emissive *= sampleOr(m.textures2.x, uv, gx, gy, vec4(1.0)).rgb;
-    if (m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m.textures2.y, uv, gx, gy, vec4(1.0)).r - 1.0);
+    vec2 uvs[6] = vec2[6](uv, gx, gy, uv, gx, gy);
+    if ((d.flags & DRAW_UV1) != 0u) {
+      const vec2 s0 = texcoords1[tri.x], s1 = texcoords1[tri.y], s2 = texcoords1[tri.z];
+      uvs[3] = s0 * w.x + s1 * w.y + s2 * w.z;
+      uvs[4] = (s0 * wx.x + s1 * wx.y + s2 * wx.z - uvs[3]) * (side.x * scale);
+      uvs[5] = (s0 * wy.x + s1 * wy.y + s2 * wy.z - uvs[3]) * (side.y * scale);
+    }
+    baseColor *= sampleOr(m, m.textures.x, SLOT_BASE, uvs, vec4(1.0)).rgb;
+    roughness *= sampleOr(m, m.textures.y, SLOT_ROUGHNESS, uvs, vec4(1.0)).r;
+    metalness *= sampleOr(m, m.textures.z, SLOT_METALNESS, uvs, vec4(1.0)).r;
+    emissive *= sampleOr(m, m.textures2.x, SLOT_EMISSIVE, uvs, vec4(1.0)).rgb;
+    if (m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m, m.textures2.y, SLOT_OCCLUSION, uvs, vec4(1.0)).r - 1.0);
+    if (m.textures2.z != NO_TEXTURE && (d.flags & DRAW_TANGENTS) != 0u) {
+      // As material.glsl: t, b = w (n x t), n; the map's xy scaled by normalScale.
+      const vec4 tg = tangents[tri.x] * w.x + tangents[tri.y] * w.y + tangents[tri.z] * w.z;
+      const vec3 tn = (sampleOr(m, m.textures2.z, SLOT_NORMAL, uvs, vec4(0.5, 0.5, 1.0, 1.0)).xyz * 2.0 - 1.0) *
+                      vec3(m.emissive.w, m.emissive.w, 1.0);
+      const vec3 nn = normalize(back ? -nrm : nrm), t3 = mat3(inst.transform) * tg.xyz;
+      const vec3 t = normalize(t3 - nn * dot(nn, t3));
+      const float sgn = (inst.info.y & INSTANCE_MIRRORED) != 0u ? -tg.w : tg.w;
+      nrm = t * tn.x + cross(nn, t) * (sgn * tn.y) + nn * tn.z;
+      if (back) nrm = -nrm;
+    }
   }
 #endif
   if ((m.textures2.w & MATERIAL_UNLIT) != 0u) {

@@ -51,12 +51,23 @@ struct FrameUniforms {
 // OBJ/course materials: opacity 1, cutoff 0.5, no occlusion texture, no flags (today's shading exactly).
 struct GpuMaterial {
   vec4 baseColor;     // rgb factor, a opacity (glTF baseColorFactor's alpha; it multiplies the mask)
-  vec4 emissive;      // rgb factor
+  vec4 emissive;      // rgb factor, w normal scale (glTF normalTexture.scale)
   vec4 roughMetal;    // x roughness, y metalness, z alpha cutoff (alpha below it is cut out),
                       // w occlusion strength (glTF: ambient x (1 + strength (occlusion - 1)))
   uvec4 textures;     // x baseColor, y roughness, z metalness, w alphaMask
-  uvec4 textures2;    // x emissive, y occlusion (its red), z unused, w MATERIAL_* flags
+  uvec4 textures2;    // x emissive, y occlusion (its red), z normal map, w MATERIAL_* flags
+  // Per texture slot s (scene.hpp's TextureSlot order): uv' = (dot(r0.xy, uv) + r0.z, dot(r1.xy, uv) + r1.z)
+  // with r0 = uvTransform[2 s], r1 = uvTransform[2 s + 1], uv the texcoord set r0.w (0 or 1); the
+  // identity for OBJ (exact). KHR_texture_transform.
+  vec4 uvTransform[14];
 };
+#define SLOT_BASE 0
+#define SLOT_ROUGHNESS 1
+#define SLOT_METALNESS 2
+#define SLOT_MASK 3
+#define SLOT_NORMAL 4
+#define SLOT_EMISSIVE 5
+#define SLOT_OCCLUSION 6
 #define MATERIAL_UNLIT 1u     // KHR_materials_unlit: the base colour is the result
 #define MATERIAL_MASK_RED 2u  // the alpha-mask texture is one channel (glTF: the base colour's alpha): read .r
 #define MATERIAL_GGX 4u       // glTF materials: brdf.h's BRDF_GGX (others: the brief's Beckmann)
@@ -88,6 +99,9 @@ struct GpuDraw {
 };
 #define DRAW_INDEX16 1u   // 16-bit indices (two per 32-bit word)
 #define DRAW_TEXTURED 2u  // has texcoords: sample the material's textures
+#define DRAW_COLORS 4u    // has vertex colours (glTF COLOR_0): they multiply the base colour and alpha
+#define DRAW_TANGENTS 8u  // has tangents (xyz, w the bitangent's sign): normal maps apply
+#define DRAW_UV1 16u      // has a second texcoord set
 
 // Visibility target (R32_UINT): instance index << primitiveBits | gl_PrimitiveID; VIS_EMPTY where
 // nothing was drawn. The renderer gives the instance index just enough bits that no id equals VIS_EMPTY.

@@ -57,7 +57,7 @@ struct GeometryPlan {
   std::vector<shader::GpuInstance> instances;
   std::vector<shader::GpuCluster> clusters;
   size_t vertices = 0, count16 = 0, count32 = 0;
-  bool anyTexcoords = false;
+  bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
 };
 
 namespace {
@@ -81,7 +81,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
     texturedMaterials_ = materials;
-    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = NO_TEXTURE;
+    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
   }
   uploadGeometry(plan, materials, upload);
   stats_.geometryMs = msSince(t);
@@ -130,8 +130,13 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
 // instances are mirrored), drawn instanced over its range of the instance buffer.
 GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   GeometryPlan p;
-  p.anyTexcoords = std::any_of(scene.meshes.begin(), scene.meshes.end(),
-                               [](const Mesh& m) { return !m.texcoords.empty() && !m.indices.empty(); });
+  auto any = [&](auto has) {
+    return std::any_of(scene.meshes.begin(), scene.meshes.end(), [&](const Mesh& m) { return !m.indices.empty() && has(m); });
+  };
+  p.anyTexcoords = any([](const Mesh& m) { return !m.texcoords.empty(); });
+  p.anyUv1 = any([](const Mesh& m) { return !m.texcoords1.empty(); });
+  p.anyTangents = any([](const Mesh& m) { return !m.tangents.empty(); });
+  p.anyColors = any([](const Mesh& m) { return !m.colors.empty(); });
   struct MeshDraw { DrawItem item; DrawKind kind; uint32_t flags; };
   std::vector<std::optional<MeshDraw>> meshDraw(scene.meshes.size());
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
@@ -156,7 +161,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     const DrawKind kind = !textured ? DrawKind::Untextured : flags ? DrawKind::AlphaMasked : DrawKind::Opaque;
     d.id = uint32_t(p.draws.size());
     p.draws.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
-                       (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u)});
+                       (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u) |
+                           (m.colors.empty() ? 0u : DRAW_COLORS) | (m.tangents.empty() ? 0u : DRAW_TANGENTS) |
+                           (m.texcoords1.empty() ? 0u : DRAW_UV1)});
     meshDraw[mi] = MeshDraw{d, kind, flags};
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
@@ -195,15 +202,24 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
     // glTF factors only for glTF materials: OBJ/course ones keep opacity 1 and the cutoff 0.5.
     const bool gltf = m.flags & kMaterialGltf;
     g.baseColor = glm::vec4(m.baseColor, gltf ? m.opacity : 1.0f);
-    g.emissive = glm::vec4(m.emissive, 0.0f);
+    g.emissive = glm::vec4(m.emissive, m.normalScale);
     g.roughMetal = glm::vec4(m.roughness, m.metalness, gltf ? m.alphaCutoff : 0.5f, m.occlusionStrength);
+    for (uint32_t s = 0; s < kTextureSlotCount; ++s) {
+      const UvTransform& u = m.uv[s];
+      // KHR_texture_transform: offset + R(rotation) (scale * uv), R turning counter-clockwise in uv space.
+      const float c = std::cos(u.rotation), sn = std::sin(u.rotation);
+      g.uvTransform[2 * s] = u.identity() ? glm::vec4(1, 0, 0, float(u.texCoord))
+                                          : glm::vec4(c * u.scale.x, sn * u.scale.y, u.offset.x, float(u.texCoord));
+      g.uvTransform[2 * s + 1] = u.identity() ? glm::vec4(0, 1, 0, 0) : glm::vec4(-sn * u.scale.x, c * u.scale.y, u.offset.y, 0);
+    }
     auto tex = [&](TextureSlot s) { uint32_t t = m.texture(s); return t == kNoTexture ? NO_TEXTURE : gpuIndex[t]; };
     g.textures = glm::uvec4(tex(TextureSlot::BaseColor), tex(TextureSlot::Roughness), tex(TextureSlot::Metalness),
                             tex(TextureSlot::AlphaMask));
     const uint32_t mask = m.texture(TextureSlot::AlphaMask);
     const uint32_t flags = (m.flags & kMaterialUnlit ? MATERIAL_UNLIT : 0u) | (gltf ? MATERIAL_GGX : 0u) |
                            (mask != kNoTexture && scene.textures.at(mask).channels == 1 ? MATERIAL_MASK_RED : 0u);
-    g.textures2 = glm::uvec4(tex(TextureSlot::Emissive), gltf ? tex(TextureSlot::Occlusion) : NO_TEXTURE, NO_TEXTURE, flags);
+    g.textures2 = glm::uvec4(tex(TextureSlot::Emissive), gltf ? tex(TextureSlot::Occlusion) : NO_TEXTURE,
+                             gltf ? tex(TextureSlot::NormalMap) : NO_TEXTURE, flags);
     materials.push_back(g);
   }
   if (materials.empty()) materials.push_back({});
@@ -225,7 +241,7 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kTargets };
+  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kTargets };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
@@ -235,11 +251,16 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&materials_, bytes(materials), materials.data()},
                                         {&drawInfo_, bytes(plan.draws), plan.draws.data()},
                                         {&instances_, bytes(plan.instances), plan.instances.data()},
-                                        {&clusters_, bytes(plan.clusters), plan.clusters.data()}}};
-  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex, kVertex, kVertex, kIndex, kIndex,
-                                                       kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions", "normals", "texcoords", "indices16", "indices32",
-                                 "materials", "draws", "instances", "clusters"};
+                                        {&clusters_, bytes(plan.clusters), plan.clusters.data()},
+                                        {&texcoords1_, plan.anyUv1 ? vertices * 8 : 0},
+                                        {&tangents_, plan.anyTangents ? vertices * 16 : 0},
+                                        {&colors_, plan.anyColors ? vertices * 16 : 0}}};
+  // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
+  // vertex streams: OBJ scenes' pipelines stay as they were.
+  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex, kVertex, kVertex, kIndex, kIndex, kStorage, kStorage,
+                                                       kStorage, kStorage, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions", "normals", "texcoords", "indices16", "indices32", "materials",
+                                 "draws", "instances", "clusters", "texcoords1", "tangents", "colours"};
   clusterCount_ = uint32_t(plan.clusters.size());
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {
@@ -295,6 +316,9 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     };
     stream(targets[kNrm].dst, m.normals, 12);
     if (plan.anyTexcoords) stream(targets[kUv].dst, m.texcoords, 8);
+    if (plan.anyUv1) stream(targets[kUv1].dst, m.texcoords1, 8);
+    if (plan.anyTangents) stream(targets[kTan].dst, m.tangents, 16);
+    if (plan.anyColors) stream(targets[kCol].dst, m.colors, 16);
   });
   for (const Target& tg : targets)
     if (tg.size) (tg.buffer->mapped() ? *tg.buffer : staging).flush();

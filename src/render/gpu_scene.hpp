@@ -107,6 +107,10 @@ class GpuScene {
   VkBuffer positions() const { return positions_.handle(); }
   VkBuffer normals() const { return normals_.handle(); }
   VkBuffer texcoords() const { return texcoords_.handle(); }  // null when no mesh has texcoords
+  // glTF's streams, read as storage buffers by gl_VertexIndex; null where no mesh has them.
+  VkBuffer texcoords1() const { return texcoords1_.handle(); }
+  VkBuffer tangents() const { return tangents_.handle(); }
+  VkBuffer colors() const { return colors_.handle(); }
   VkBuffer indices16() const { return indices16_.handle(); }
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }
@@ -150,6 +154,7 @@ class GpuScene {
   bool ready_ = false;             // the textures are on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
+  vk::Buffer texcoords1_, tangents_, colors_;
   uint32_t clusterCount_ = 0;
   std::vector<vk::Image> textures_;
   std::vector<SamplerDesc> samplers_;  // of each texture (Texture::sampler)

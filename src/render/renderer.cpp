@@ -110,6 +110,10 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
     vk::DescriptorWriter w(ctx_, layout, 0, p.sets.get(0, frame));
     if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
     if (hasBinding(layout, 0, 2)) w.buffer(2, scene_.instances());
+    // glTF's streams (a scene without one: any buffer fills the binding; the draw's flags say none).
+    const VkBuffer streams[] = {scene_.drawInfo(), scene_.texcoords1(), scene_.tangents(), scene_.colors()};
+    for (uint32_t b = 3; b <= 6; ++b)
+      if (hasBinding(layout, 0, b)) w.buffer(b, streams[b - 3] ? streams[b - 3] : scene_.positions());
     w.commit();
     if (layout.setCount() > 1) writeTextures(layout, p.sets.get(1, frame));
   }
@@ -280,6 +284,9 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(5, i32)
       .buffer(6, i16)
       .buffer(10, scene_.instances())
+      .buffer(11, scene_.texcoords1() ? scene_.texcoords1() : scene_.positions())
+      .buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions())
+      .buffer(13, scene_.colors() ? scene_.colors() : scene_.positions())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
   if (raster == RasterPath::Compute) w.buffer(7, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);

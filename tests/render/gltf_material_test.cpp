@@ -173,5 +173,72 @@ TEST_F(VulkanTest, SpotAndDirectionalLightsInEveryPath) {
       ASSERT_NEAR(images[0].pixels[k], images[i].pixels[k], 2) << "paths disagree at byte " << k;
 }
 
+// glTF's per-vertex streams and texture transforms, read from storage buffers by every path: vertex
+// colours multiply the base colour, KHR_texture_transform moves a texture, a normal map (with tangents)
+// bends the normal.
+TEST_F(VulkanTest, VertexColoursTextureTransformAndNormalMapInEveryPath) {
+  const auto dir = std::filesystem::temp_directory_path() / "rtr_gltf_stream_test";
+  std::filesystem::create_directories(dir);
+  ImageRGBA8 halves{2, 1, {255, 0, 0, 255, 0, 0, 255, 255}};  // left red, right blue
+  savePng(dir / "halves.png", halves);
+  ImageRGBA8 bent{1, 1, {218, 128, 218, 255}};  // tangent-space normal (0.71, 0, 0.71): 45° towards +t
+  savePng(dir / "bent.png", bent);
+  Scene scene;
+  scene.baseDir = dir;
+  Texture h{"halves.png", false, 4};
+  h.sampler.nearestMag = h.sampler.nearestMin = true;
+  scene.textures = {h, Texture{"bent.png", false, 4}};
+  Material coloured, shifted, bumpy, flat;
+  coloured.flags = shifted.flags = kMaterialGltf | kMaterialUnlit;
+  shifted.textures[uint32_t(TextureSlot::BaseColor)] = 0;
+  shifted.uv[uint32_t(TextureSlot::BaseColor)].offset = {0.5f, 0.0f};
+  bumpy.flags = flat.flags = kMaterialGltf;
+  bumpy.baseColor = flat.baseColor = glm::vec3(0.8f);
+  bumpy.textures[uint32_t(TextureSlot::NormalMap)] = 1;
+  scene.materials = {coloured, shifted, bumpy, flat};
+  Mesh a = quad(-1.6f, 0), b = quad(-0.5f, 1), c = quad(0.6f, 2);
+  a.colors.assign(4, glm::vec4(0.2f, 0.9f, 0.3f, 1.0f));
+  c.tangents.assign(4, glm::vec4(1, 0, 0, 1));
+  scene.meshes = {a, b, c};
+  Scene plain = scene;
+  plain.meshes[2].material = 3;
+  {
+    render::GpuScene gpu(*ctx, scene, render::MipMode::Compute), gpuFlat(*ctx, plain, render::MipMode::Compute);
+    render::HeadlessRenderer r(*ctx, gpu, {kSize, kSize}), rFlat(*ctx, gpuFlat, {kSize, kSize});
+    render::RenderSettings s;
+    s.mosaic = render::MosaicMode::Off;
+    s.lights.ambient = glm::vec3(0.0f);
+    Light sun;
+    sun.kind = Light::Kind::Directional;
+    sun.direction = {0, 0, -1};  // straight onto the quads
+    s.lights.lights = {sun};
+    Lens lens;
+    lens.fovYDeg = 60.0f;
+    const CameraPose pose{{0, 0, 3.0f}, 0.0f, 0.0f};
+    auto column = [](float x) { return uint32_t(std::lround((0.5f + 0.5f * x / (3.0f * std::tan(glm::radians(30.0f)))) * kSize)); };
+    const uint32_t y = kSize / 2;
+    for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
+                                {render::ShadingPath::Visibility, render::RasterPath::Hardware},
+                                {render::ShadingPath::Visibility, render::RasterPath::Compute}}) {
+      SCOPED_TRACE(testing::Message() << render::toString(path) << ", " << render::toString(raster));
+      s.shading = path;
+      s.raster = raster;
+      const render::HeadlessFrame f = r.render(pose, lens, s, 1, true), g = rFlat.render(pose, lens, s, 1, true);
+      const glm::vec4 col = f.sceneColor.pixels[y * kSize + column(-1.1f)];
+      EXPECT_NEAR(col.r, 0.2f, 1e-3f);
+      EXPECT_NEAR(col.g, 0.9f, 1e-3f) << "vertex colours";
+      // Offset 0.5: the quad's left half (u < 0.5) samples the right texel, blue.
+      const glm::vec4 left = f.sceneColor.pixels[y * kSize + column(-0.25f)];
+      EXPECT_GT(left.b, 0.9f) << "the texture transform's offset was not applied";
+      EXPECT_LT(left.r, 0.1f);
+      // Lambert under a light along the flat normal: the bent one (45°) gets cos 45° of it.
+      const float bentR = f.sceneColor.pixels[y * kSize + column(1.1f)].r, flatR = g.sceneColor.pixels[y * kSize + column(1.1f)].r;
+      EXPECT_GT(flatR, 0.1f);
+      EXPECT_NEAR(bentR / flatR, 0.707f, 0.08f) << "the normal map did not bend the normal";
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rtr
