@@ -89,7 +89,7 @@ TEST_F(VulkanTest, GltfCutoffUnlitAndOcclusionInEveryPath) {
     for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
                                 {render::ShadingPath::Visibility, render::RasterPath::Hardware},
                                 {render::ShadingPath::Visibility, render::RasterPath::Compute}}) {
-      SCOPED_TRACE(testing::Message() << render::toString(path) << ", " << render::toString(raster));
+      SCOPED_TRACE(testing::Message() << enumName(path) << ", " << enumName(raster));
       s.shading = path;
       s.raster = raster;
       const ImageRGBA8 img = r.render(pose, lens, s).image, ref = rPlain.render(pose, lens, s).image;
@@ -153,7 +153,7 @@ TEST_F(VulkanTest, SpotAndDirectionalLightsInEveryPath) {
   for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
                               {render::ShadingPath::Visibility, render::RasterPath::Hardware},
                               {render::ShadingPath::Visibility, render::RasterPath::Compute}}) {
-    SCOPED_TRACE(testing::Message() << render::toString(path) << ", " << render::toString(raster));
+    SCOPED_TRACE(testing::Message() << enumName(path) << ", " << enumName(raster));
     s.shading = path;
     s.raster = raster;
     s.lights.lights = {spot};
@@ -220,7 +220,7 @@ TEST_F(VulkanTest, VertexColoursTextureTransformAndNormalMapInEveryPath) {
     for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
                                 {render::ShadingPath::Visibility, render::RasterPath::Hardware},
                                 {render::ShadingPath::Visibility, render::RasterPath::Compute}}) {
-      SCOPED_TRACE(testing::Message() << render::toString(path) << ", " << render::toString(raster));
+      SCOPED_TRACE(testing::Message() << enumName(path) << ", " << enumName(raster));
       s.shading = path;
       s.raster = raster;
       const render::HeadlessFrame f = r.render(pose, lens, s, 1, true), g = rFlat.render(pose, lens, s, 1, true);

@@ -119,8 +119,8 @@ TEST_F(InstanceTest, InstancesDrawLikeTheFlattenedScene) {
     const Lens lens = fitDepthRange(Lens{}, b, pose);
     const bool first = &pose == &poses.front();
     for (const Path& p : paths) {
-      SCOPED_TRACE(testing::Message() << "view at " << pose.position.x << ", " << render::toString(p.shading) << ", "
-                                      << render::toString(p.raster) << (p.cull ? ", culled" : ""));
+      SCOPED_TRACE(testing::Message() << "view at " << pose.position.x << ", " << enumName(p.shading) << ", "
+                                      << enumName(p.raster) << (p.cull ? ", culled" : ""));
       render::RenderSettings s;
       s.shading = p.shading;
       s.raster = p.raster;

@@ -111,7 +111,7 @@ TEST_F(SamplerTest, FilterNearestChangesEveryPath) {
       if (p.shading == render::ShadingPath::Visibility)
         ids[p.raster == render::RasterPath::Compute][nearest] = renderer->ids(pose, lens, s);
       if (nearest) continue;
-      SCOPED_TRACE(testing::Message() << render::toString(p.shading) << ", " << render::toString(p.raster));
+      SCOPED_TRACE(testing::Message() << enumName(p.shading) << ", " << enumName(p.raster));
       const ImageRGBA8 a = renderer->render(pose, lens, s).image;
       s.sampler.filter = TextureFilter::Nearest;
       EXPECT_GT(differingPixels(a, renderer->render(pose, lens, s).image), size_t(kW * kH / 20));
