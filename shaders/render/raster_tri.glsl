@@ -74,7 +74,10 @@ void rasterPixel(Tri t, ivec2 px) {
   const int64_t e0 = edge(t.v[1], t.v[2], c), e1 = edge(t.v[2], t.v[0], c), e2 = edge(t.v[0], t.v[1], c);
   if (e0 < 0l || e1 < 0l || e2 < 0l) return;
   // The bias is at most 1 of area2 (>= 1): barycentrics from the unbiased edges are not worth the cost.
-  const float z = (float(e0) * t.z[0] + float(e1) * t.z[1] + float(e2) * t.z[2]) / float(t.area2);
+  // Depth as z0 plus the weighted differences: depths crowd just below 1 (z/w of a far-away model), and
+  // the sum of the three weighted depths lost the few units in the last place that separate a shell from
+  // the parts inside it (2CylinderEngine showed its inner parts); the differences keep them.
+  const float z = t.z[0] + (float(e1) * (t.z[1] - t.z[0]) + float(e2) * (t.z[2] - t.z[0])) / float(t.area2);
   if (z < 0.0 || z > 1.0) return;  // the hardware's near and far clipping (w > 0 everywhere here)
   atomicMin(vis[px.y * int(pc.width) + px.x], packVis(z, t.id));
 }

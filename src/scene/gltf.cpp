@@ -41,7 +41,7 @@ uint32_t le32(std::span<const uint8_t> d, size_t at) {
 
 // The GLB container: a 12-byte header, a JSON chunk, then optionally a BIN chunk (others are skipped).
 Glb splitGlb(std::span<const uint8_t> d, const std::string& name) {
-  auto fail = [&](size_t at, const std::string& what) { throw fileError(name, "at byte " + std::to_string(at), what); };
+  auto fail = [&](size_t at, const std::string& what) { throw fileError(name, "byte " + std::to_string(at), what); };
   if (d.size() < 12) fail(0, "a GLB header needs 12 bytes, the file has " + std::to_string(d.size()));
   if (const uint32_t v = le32(d, 4); v != 2) fail(4, "GLB version " + std::to_string(v) + " (rtr reads version 2)");
   const uint32_t length = le32(d, 8);

@@ -158,6 +158,8 @@ private:
       if (r == text::NumResult::NotFinite) throw error("'v' coordinate is NaN or infinite");
       throw error("'v' coordinate is not a number");
     }
+    if (!coordinateOk(glm::vec3(f[0], f[1], f[2])))  // the limit every reader applies
+      throw error("vertex coordinate beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
     positions_.push_back({f[0], f[1], f[2]});
     const bool coloured = n == 6;
     if (coloured && colors_.size() < positions_.size() - 1) colors_.assign(positions_.size() - 1, glm::vec4(1.0f));

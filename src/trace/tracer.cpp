@@ -264,8 +264,8 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
   const bool gltf = (mat.flags & kMaterialGltf) != 0;
   glm::vec3 normal = sp.normal;
   float occlusion = 1.0f;
+  in.baseColor *= glm::vec3(sp.color);  // vertex colours (glTF COLOR_0, OBJ `v x y z r g b`), as the GPU
   if (gltf) {
-    in.baseColor *= glm::vec3(sp.color);
     if (mat.flags & kMaterialUnlit) return in.baseColor;  // KHR_materials_unlit: the base colour is the result
     if (textured) {
       normal = normalMapped(sp, f.tex->sample(mat, TextureSlot::NormalMap, uvs, width, glm::vec4(-1.0f)), mat.normalScale);

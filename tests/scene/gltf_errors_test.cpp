@@ -105,20 +105,20 @@ TEST_F(Errors, BadGlbContainer) {
   std::string longChunk = good;
   const uint32_t huge = 1u << 30;
   std::memcpy(&longChunk[12], &huge, 4);
-  EXPECT_THAT(errorOfGlb(longChunk), HasSubstr("bad.glb:at byte 12: chunk 0's length 1073741824 runs past the end of the GLB"));
+  EXPECT_THAT(errorOfGlb(longChunk), HasSubstr("bad.glb: byte 12: chunk 0's length 1073741824 runs past the end of the GLB"));
   std::string longFile = good;
   const uint32_t more = uint32_t(good.size() + 1);
   std::memcpy(&longFile[8], &more, 4);
-  EXPECT_THAT(errorOfGlb(longFile), HasSubstr("bad.glb:at byte 8: the GLB header's length"));
+  EXPECT_THAT(errorOfGlb(longFile), HasSubstr("bad.glb: byte 8: the GLB header's length"));
   std::string v1 = good;
   v1[4] = 1;
-  EXPECT_THAT(errorOfGlb(v1), HasSubstr("bad.glb:at byte 4: GLB version 1"));
-  EXPECT_THAT(errorOfGlb(good.substr(0, 10)), HasSubstr("bad.glb:at byte 0: a GLB header needs 12 bytes"));
+  EXPECT_THAT(errorOfGlb(v1), HasSubstr("bad.glb: byte 4: GLB version 1"));
+  EXPECT_THAT(errorOfGlb(good.substr(0, 10)), HasSubstr("bad.glb: byte 0: a GLB header needs 12 bytes"));
   // The BIN chunk cut short: the header length still says the whole size.
   std::string cut = good.substr(0, good.size() - 8);
   const uint32_t cutLen = uint32_t(cut.size());
   std::memcpy(&cut[8], &cutLen, 4);
-  EXPECT_THAT(errorOfGlb(cut), HasSubstr("bad.glb:at byte"));
+  EXPECT_THAT(errorOfGlb(cut), HasSubstr("bad.glb: byte"));
   EXPECT_THAT(errorOfGlb(cut), HasSubstr("runs past the end of the GLB"));
 }
 

@@ -193,7 +193,7 @@ TEST(RtrSceneV5, OlderVersionsRefuseWhatOnlyVersion5Stores) {
   Scene one;
   one.lights.push_back(Light{});
   const std::string v4 = patched(encodeRtrScene(one, 4), 80, uint32_t(Light::Kind::Spot));
-  EXPECT_THAT(decodeError(v4), HasSubstr("v5.rtrscene:at byte 80: unknown light kind 3"));
+  EXPECT_THAT(decodeError(v4), HasSubstr("v5.rtrscene: byte 80: unknown light kind 3"));
   // Textures still in memory are never silently dropped.
   s.textures[0].bytes = std::make_shared<std::vector<uint8_t>>(8, 0);
   EXPECT_THROW(encodeRtrScene(s), Error);
@@ -208,18 +208,18 @@ TEST(RtrSceneV5, RefusesDamageInTheNewRecords) {
     std::string bytes, message;
   };
   const Case cases[] = {
-      {patched(good, 68, uint32_t(1) << 28), "at byte 68: instance count 268435456 cannot fit in the file"},
-      {patched(good, 72, 200.0f), "at byte 72: field of view 200"},
-      {patched(good, 76, uint32_t(1)), "at byte 76: reserved field is not 0"},
-      {patched(good, spot, uint32_t(5)), "at byte 184: unknown light kind 5"},
-      {patched(good, spot + 92, 1.5f), "at byte 184: light: cone cosine outside -1..1"},
-      {patched(good, spot + 96, 0.95f), "at byte 184: light: outer cone narrower than the inner one"},
-      {patched(good, spot + 80, 3.0f), "at byte 184: light: direction is not a unit vector"},
-      {patched(good, spot + 100, -1.0f), "at byte 184: light: negative range"},
-      {patched(good, spot + 100, std::numeric_limits<float>::infinity()), "at byte 284: a light is not finite"},
-      {patched(good, instances + 80, uint32_t(2)), "at byte 576: instance of mesh 2: out of range (2 meshes)"},
-      {patched(good, instances + 84, uint32_t(1)), "at byte 580: reserved instance field is not 0"},
-      {patched(good, instances + 80 + 16 + 4 * 13, std::nanf("")), "at byte 644: an instance transform is not finite"},
+      {patched(good, 68, uint32_t(1) << 28), "byte 68: instance count 268435456 cannot fit in the file"},
+      {patched(good, 72, 200.0f), "byte 72: field of view 200"},
+      {patched(good, 76, uint32_t(1)), "byte 76: reserved field is not 0"},
+      {patched(good, spot, uint32_t(5)), "byte 184: unknown light kind 5"},
+      {patched(good, spot + 92, 1.5f), "byte 184: light: cone cosine outside -1..1"},
+      {patched(good, spot + 96, 0.95f), "byte 184: light: outer cone narrower than the inner one"},
+      {patched(good, spot + 80, 3.0f), "byte 184: light: direction is not a unit vector"},
+      {patched(good, spot + 100, -1.0f), "byte 184: light: negative range"},
+      {patched(good, spot + 100, std::numeric_limits<float>::infinity()), "byte 284: a light is not finite"},
+      {patched(good, instances + 80, uint32_t(2)), "byte 576: instance of mesh 2: out of range (2 meshes)"},
+      {patched(good, instances + 84, uint32_t(1)), "byte 580: reserved instance field is not 0"},
+      {patched(good, instances + 80 + 16 + 4 * 13, std::nanf("")), "byte 644: an instance transform is not finite"},
       {patched(good, textures + 2, uint8_t(1)), "texture source channel 1 for 4 channels"},
       {patched(good, textures + 3, uint8_t(3)), "unknown texture wrap mode 3"},
       {patched(good, textures + 5, uint8_t(8)), "unknown texture filter flags"},

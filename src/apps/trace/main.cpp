@@ -53,7 +53,9 @@ int run(int argc, char** argv) {
   app.add_option("--shading", shading, "auto | phong | pbr | normals | depth; auto (the default): the course's "
                  "Blinn-Phong for the course's own scenes (lit by *light* materials, or using N_mirr/N_ior), else PBR "
                  "as rtr-view shades (docs/viewer.md)")
-      ->check(CLI::IsMember({"auto", "phong", "pbr", "normals", "depth"}));
+      ->check(cli::checked([](const std::string& t) { if (t != "auto") cli::enumOption<Shading>("--shading", t); },
+                           "{auto|" + enumChoices<Shading>("|") + "}"))
+      ->capture_default_str();
   app.add_option("--brdf", brdf, "pbr: beckmann | ggx for every material (default: ggx for glTF materials, "
                  "beckmann for the rest)")->check(cli::oneOf<Brdf>());
   app.add_option("--shadows", shadows, "on | off")->capture_default_str()->check(CLI::IsMember({"on", "off"}));
@@ -108,8 +110,10 @@ int run(int argc, char** argv) {
   Scene scene = loadScene(scenePath, load);
   turnScene(scene, upTurn);
   drawBothSides(scene);
-  s.shading = shading == "pbr" ? Shading::Pbr : shading == "normals" ? Shading::Normals
-            : shading == "depth" ? Shading::Depth : shading == "phong" ? Shading::Phong
+  // The stored view's field of view (a glTF camera) goes with it, as in rtr-view.
+  if (app.count("--fov") == 0 && camera.empty() && scene.defaultView && scene.defaultFovYDeg > 0.0f)
+    s.lens.fovYDeg = scene.defaultFovYDeg;
+  s.shading = shading != "auto" ? cli::enumOption<Shading>("--shading", shading)
             : isCourseScene(scene) ? Shading::Phong : Shading::Pbr;
   if (!quiet && shading == "auto")
     std::fprintf(stderr, "rtr-trace: note: %s shading: %s (--shading)\n", s.shading == Shading::Phong ? "Blinn-Phong" : "PBR",

@@ -149,7 +149,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
   std::fprintf(stderr, "\n");
   const CameraPose pose = startPose(o, scene);
-  const Lens lens = fitDepthRange(o.lens, scene.bounds(), pose);
+  const Lens lens = fitDepthRange(startLens(o, scene), scene.bounds(), pose);
   render::RenderSettings settings = sceneSettings(o, scene);
   settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});

@@ -30,6 +30,12 @@ CameraPose startPose(const ViewOptions& o, const Scene& scene) {
   return framingPose(scene, o.lens, float(o.width) / float(o.height));
 }
 
+Lens startLens(const ViewOptions& o, const Scene& scene) {
+  Lens lens = o.lens;
+  if (!o.fovGiven && !o.camera && scene.defaultView && scene.defaultFovYDeg > 0.0f) lens.fovYDeg = scene.defaultFovYDeg;
+  return lens;
+}
+
 void checkSizeFits(const ViewOptions& o, const vk::Context& ctx) {
   const uint32_t max = ctx.properties().limits.maxImageDimension2D;
   if (o.width > max || o.height > max)
@@ -115,7 +121,7 @@ int main(int argc, char** argv) {
       ->check(cli::checked([](const std::string& t) { cli::parseSize("--size", t, view::kMaxSize); }, "WxH"));
   app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)")
       ->check(cli::checked([](const std::string& t) { cli::parsePose("--camera", t); }, "X,Y,Z,YAW,PITCH"));
-  app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str()
+  CLI::Option* fovOpt = app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str()
       ->check(cli::number(0, 180, true));
   app.add_option("--mode", o.settings.mode, "view mode 1-13: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, "
                  "5 normal, 6 view dir, 7 light dir, 8 BRDF D, 9 BRDF F, 10 BRDF G, 11 diffuse, 12 specular, 13 albedo")
@@ -202,6 +208,7 @@ int main(int argc, char** argv) {
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
     o.mips = cli::enumOption<render::MipMode>("--mips", mips);
     o.mipsGiven = mipsOpt->count() > 0;
+    o.fovGiven = fovOpt->count() > 0;
     if (waitOpt->count()) o.waitTextures = true;
     if (noWaitTextures) o.waitTextures = false;
     o.shadingGiven = shadingOpt->count() > 0;

@@ -24,6 +24,7 @@ struct ViewOptions {
   bool headless = false;
   uint32_t width = 1280, height = 720;
   std::optional<CameraPose> camera;
+  bool fovGiven = false;           // --fov
   Lens lens;
   render::RenderSettings settings;  // settings.lights: resolved from lightOptions once the scene is loaded
   LightOptions lightOptions;
@@ -61,6 +62,9 @@ Scene loadForView(const ViewOptions& o, const std::string& path);
 
 // The start pose: --camera, else the scene's own view, else framing the scene (framingPose), as rtr-trace.
 CameraPose startPose(const ViewOptions& o, const Scene& scene);
+// The start lens: --fov, else the field of view stored with the scene's own view (a glTF camera) when
+// that view is the start pose, else the default.
+Lens startLens(const ViewOptions& o, const Scene& scene);
 // The render settings for `scene`: o.settings with the scene's lights (scene/lights.hpp), the choice
 // said once on stderr when it is not simply the scene's own lights.
 render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene);

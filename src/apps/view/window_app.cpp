@@ -70,7 +70,7 @@ int runWindowed(const ViewOptions& opts) {
   auto scene = std::make_unique<Scene>(loadForView(o, o.scene));
   clock.phase("scene file read");
   app.settings = sceneSettings(o, *scene);
-  app.lens = o.lens;
+  app.lens = startLens(o, *scene);
   app.panel = o.panel;
   if (o.orbit) app.camera.setMode(CameraMode::Orbit);
 
