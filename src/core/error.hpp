@@ -2,8 +2,8 @@
 // One error type for every user-facing failure: the message names the file and the place.
 #include <new>
 #include <stdexcept>
-#include <system_error>
 #include <string>
+#include <system_error>
 
 namespace rtr {
 
@@ -35,9 +35,7 @@ template <class Fn>
 auto stage(const std::string& what, Fn&& fn) -> decltype(fn()) {
   try {
     return fn();
-  } catch (const std::bad_alloc&) {
-    throw Error("out of memory while " + what);
-  } catch (const std::system_error& e) {
+  } catch (const std::bad_alloc&) { throw Error("out of memory while " + what); } catch (const std::system_error& e) {
     throw Error("while " + what + ": " + e.what());
   }
 }

@@ -100,8 +100,9 @@ LightRig resolveLights(const Scene& scene, const LightOptions& o) {
   }
   for (Light& l : rig.lights) l.falloff = l.falloff || o.falloff;
   // Lights that are all black would give a black image: the headlight instead, said why.
-  const bool allBlack = !o.position && !rig.lights.empty() &&
-                        std::all_of(rig.lights.begin(), rig.lights.end(), [](const Light& l) { return l.color == glm::vec3(0.0f); });
+  const bool allBlack =
+      !o.position && !rig.lights.empty() &&
+      std::all_of(rig.lights.begin(), rig.lights.end(), [](const Light& l) { return l.color == glm::vec3(0.0f); });
   if (allBlack && o.defaultLight) rig.lights.clear();
   if (rig.lights.empty() && o.defaultLight) {
     Light h;

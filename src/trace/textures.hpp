@@ -24,8 +24,8 @@ class MipTexture {
   // nearest filters are not modelled: always trilinear).
   MipTexture(const TexelData& image, bool srgb, const SamplerDesc& sampler = {});
 
-  // Trilinear sample at uv (the sampler's wrap modes) at level of detail `lod` (clamped to the chain; NaN reads level 0).
-  // A one-channel texture reads (r, 0, 0, 1), as R8_UNORM does.
+  // Trilinear sample at uv (the sampler's wrap modes) at level of detail `lod` (clamped to the chain; NaN reads level
+  // 0). A one-channel texture reads (r, 0, 0, 1), as R8_UNORM does.
   glm::vec4 sample(glm::vec2 uv, float lod) const;
   // The level of detail of a footprint `uvWidth` wide in texture coordinates: log2(uvWidth · √(w·h)).
   float lod(float uvWidth) const;

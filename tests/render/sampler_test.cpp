@@ -95,7 +95,10 @@ TEST_F(SamplerTest, FilterChangesTheShadedViewOnBothPathsAndSwitchesBack) {
 // ids, whose alpha-masked foliage its hardware hand-off tests with the same sampler as the others (so its
 // coverage stays the hardware rasteriser's).
 TEST_F(SamplerTest, FilterNearestChangesEveryPath) {
-  struct Path { render::ShadingPath shading; render::RasterPath raster; };
+  struct Path {
+    render::ShadingPath shading;
+    render::RasterPath raster;
+  };
   std::vector<Path> paths = {{render::ShadingPath::Forward, render::RasterPath::Auto},
                              {render::ShadingPath::Visibility, render::RasterPath::Hardware}};
   const bool compute = render::ComputeRaster::supported(*ctx);
