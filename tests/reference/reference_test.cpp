@@ -22,8 +22,6 @@ const char* const kCases[] = {"temple_nave",   "temple_aisle",  "cornell_box",  
                               "temple_nave_textured", "temple_aisle_textured", "cube_backplane_falloff",
                               "two_lights", "two_lights_falloff", "headlight", "gltf_metal_rough", "gltf_emissive",
                               "gltf_spot", "gltf_alpha_mask", "gltf_normal_map", "gltf_texture_transform"};
-// Cases whose GPU side is not built yet: run (and compared) once the renderer has them.
-const std::set<std::string> kGpuMissing = {"gltf_normal_map", "gltf_texture_transform"};
 
 // The shaded view runs once per visibility rasteriser (the debug views are forward: no ids).
 struct Param {
@@ -48,9 +46,9 @@ class ReferenceTest : public test::VulkanTest, public ::testing::WithParamInterf
 
 TEST_P(ReferenceTest, GpuMatchesCpu) {
   const Param& p = GetParam();
-  if (kGpuMissing.count(p.name))
-    GTEST_SKIP() << p.name << ": the renderer does not yet sample normal maps with tangents or apply "
-                 << "KHR_texture_transform / the second uv set (the tracer does: tests/trace/gltf_material_test.cpp)";
+  if (p.name == "gltf_normal_map" && p.view == View::Normals)
+    GTEST_SKIP() << "the normals views disagree on a normal-mapped surface: the GPU's mode 5 shows the mapped "
+                    "normal, the tracer's normals view the interpolated one (the shaded views agree)";
   const auto poses = loadPoses(posesFile());
   ASSERT_TRUE(poses.count(p.name)) << p.name << " has no pose in " << posesFile();
   const ReferenceScene rs = makeScene(p.name, outDir() / "work");
