@@ -102,7 +102,8 @@ void expectNear(glm::vec3 a, glm::vec3 b, const std::string& what, float tol = 1
   EXPECT_NEAR(a.z, b.z, tol) << what;
 }
 
-TEST(GltfMaterial, VertexColourMultipliesTheBaseColourOfGltfMaterialsOnly) {
+// Vertex colours (glTF COLOR_0, OBJ `v x y z r g b`) multiply the base colour of every material, as on the GPU.
+TEST(GltfMaterial, VertexColourMultipliesTheBaseColourOfEveryMaterial) {
   for (bool isGltf : {true, false}) {
     Scene s;
     Material m = gltf({0.5f, 1.0f, 0.8f});
@@ -111,8 +112,7 @@ TEST(GltfMaterial, VertexColourMultipliesTheBaseColourOfGltfMaterialsOnly) {
     q.colors.assign(q.positions.size(), glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));
     addMesh(s, std::move(q));
     const Tracer t(s);
-    expectNear(at(t, baseView()), isGltf ? glm::vec3(0.25f, 0.25f, 0.8f) : glm::vec3(0.5f, 1.0f, 0.8f),
-               isGltf ? "glTF" : "OBJ (colours unused, as before)");
+    expectNear(at(t, baseView()), glm::vec3(0.25f, 0.25f, 0.8f), isGltf ? "glTF" : "OBJ");
   }
 }
 
