@@ -39,16 +39,6 @@ share() {
   case $1 in fuzz_spirv) echo 6 ;; fuzz_obj) echo 3 ;; fuzz_rtrscene | fuzz_texture) echo 2 ;; *) echo 1 ;; esac
 }
 
-# The draco library allocates by the counts a stream declares (a 159-byte input asked for 5.2 GB, finding 11 in
-# docs/fuzzing.md); our decoder turns a failed allocation into an error. Its target lets such an allocation fail
-# (allocator_may_return_null) instead of stopping on it, so it fuzzes on past the library's known behaviour.
-limits() {  # limits TARGET: extra libFuzzer flags
-  case $1 in fuzz_gltf_compress) echo "-malloc_limit_mb=65536" ;; *) echo "" ;; esac
-}
-asan() {  # asan TARGET: its ASAN_OPTIONS
-  case $1 in fuzz_gltf_compress) echo "${ASAN_OPTIONS:+$ASAN_OPTIONS:}allocator_may_return_null=1" ;; *) echo "${ASAN_OPTIONS:-}" ;; esac
-}
-
 fuzz() {  # fuzz TARGET: fuzzes it for $seconds, leaving its log in $art/TARGET.log and its exit code beside it
   t=$1
   seeds=tests/fuzz/corpus/$t
@@ -61,15 +51,14 @@ fuzz() {  # fuzz TARGET: fuzzes it for $seconds, leaving its log in $art/TARGET.
   fi
   rc=0
   # shellcheck disable=SC2086
-  ASAN_OPTIONS=$(asan "$t") $wrap "$bin/$t" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=10 $opts $(limits "$t") \
+  $wrap "$bin/$t" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=10 $opts \
     -artifact_prefix="$art/$t-" "build/fuzz/corpus/$t" "$seeds" >"$art/$t.log" 2>&1 || rc=$?
   echo $rc >"$art/$t.rc"
 }
 
 failed=
 for t in $targets; do
-  # shellcheck disable=SC2046
-  if [ -d "tests/fuzz/crashes/$t" ] && ! ASAN_OPTIONS=$(asan "$t") $wrap "$bin/$t" $(limits "$t") tests/fuzz/crashes/$t/* >"$art/$t.replay.log" 2>&1; then
+  if [ -d "tests/fuzz/crashes/$t" ] && ! $wrap "$bin/$t" tests/fuzz/crashes/$t/* >"$art/$t.replay.log" 2>&1; then
     echo "$t: a known crash input still fails (tests/fuzz/crashes/$t, log $art/$t.replay.log)"
     failed="$failed $t"
   fi
@@ -92,7 +81,7 @@ for t in $targets; do
   if [ -n "$cores" ]; then  # -fork counts coverage its own way: load the corpus in one process to compare
     seeds=tests/fuzz/corpus/$t
     [ "$t" = fuzz_spirv ] && seeds=$spirv_seeds
-    ASAN_OPTIONS=$(asan "$t") $wrap "$bin/$t" -runs=0 -max_len=65536 -rss_limit_mb=2048 $(limits "$t") "build/fuzz/corpus/$t" "$seeds" >"$art/$t.final.log" 2>&1 || true
+    $wrap "$bin/$t" -runs=0 -max_len=65536 -rss_limit_mb=2048 "build/fuzz/corpus/$t" "$seeds" >"$art/$t.final.log" 2>&1 || true
     last=$(grep -E '^#[0-9]+[[:space:]]+INITED' "$art/$t.final.log" | tail -1)
   fi
   cov=$(echo "$last" | sed -n 's/.* cov: \([0-9]*\).*/\1/p')
