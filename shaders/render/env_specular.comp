@@ -17,10 +17,10 @@ void main() {
   const uvec3 id = gl_GlobalInvocationID;
   if (id.x >= pc.size || id.y >= pc.size) return;
   const vec3 n = envCubeDir(id.z, (vec2(id.xy) + 0.5) / float(pc.size) * 2.0 - 1.0);
-  const float alpha = max(pc.roughness * pc.roughness, ENV_ALPHA_MIN);
+  const float alpha = max(pc.roughness * pc.roughness, BRDF_ALPHA_MIN);
   const vec3 t = envTangent(n), b = cross(n, t);
   // Never finer than this level's own texels: a texel averages its footprint (roughness 0 too).
-  const float lodMin = 0.5 * log2(4.0 * ENVP_PI / (6.0 * float(pc.size * pc.size)) / pc.srcTexelSolidAngle);
+  const float lodMin = 0.5 * log2(4.0 * BRDF_PI / (6.0 * float(pc.size * pc.size)) / pc.srcTexelSolidAngle);
   vec3 sum = vec3(0.0);
   float weight = 0.0;
   for (uint i = 0u; i < pc.samples; ++i) {
@@ -30,7 +30,7 @@ void main() {
     const float nl = dot(n, l);
     if (nl <= 0.0) continue;
     // pdf(l) = D n.h / (4 v.h) = D / 4 with v = n; the sample stands for 1 / (N pdf) steradians.
-    const float pdf = envGgxD(hl.z, alpha) * 0.25;
+    const float pdf = brdfGgxD(vec3(0.0, 0.0, 1.0), hl, alpha) * 0.25;
     const float omega = 1.0 / (float(pc.samples) * pdf + 1e-20);
     const float lod = clamp(max(0.5 * log2(omega / pc.srcTexelSolidAngle), lodMin), 0.0, float(pc.srcLevels - 1u));
     sum += textureLod(src, l, lod).rgb * nl;

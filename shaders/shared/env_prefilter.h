@@ -4,13 +4,11 @@
 #ifndef RTR_SHADERS_SHARED_ENV_PREFILTER_H
 #define RTR_SHADERS_SHARED_ENV_PREFILTER_H
 
-#include "shared.h"
+#include "brdf.h"
 #ifdef __cplusplus
 namespace rtr::shader {
 using namespace glm;
 #endif
-
-RTR_CONST float ENVP_PI = 3.14159265358979f;
 
 // The direction through (s, t) in [-1,1]² of cube face f, in Vulkan's order +X, -X, +Y, -Y, +Z, -Z and
 // orientation (the texel a cube sampler reads for that direction).
@@ -47,15 +45,10 @@ RTR_FN vec2 envHammersley(uint i, uint n) {
   return vec2(float(i) / float(n), float(b) * 2.3283064365386963e-10f);
 }
 
-// GGX (Trowbridge-Reitz) with alpha = roughness²: the normal distribution D(n.h), and a half vector drawn
-// in proportion to D(h) (h.n), in the frame whose z is n; its density per solid angle of h is D · n.h.
-RTR_FN float envGgxD(float nh, float alpha) {
-  float a2 = alpha * alpha;
-  float d = nh * nh * (a2 - 1.0f) + 1.0f;
-  return a2 / (ENVP_PI * d * d);
-}
+// A GGX half vector (alpha = roughness²) drawn in proportion to D(h) (h.n), in the frame whose z is n; its
+// density per solid angle of h is D · n.h, with brdf.h's brdfGgxD.
 RTR_FN vec3 envGgxHalf(vec2 u, float alpha) {
-  float phi = 2.0f * ENVP_PI * u.x;
+  float phi = 2.0f * BRDF_PI * u.x;
   float cos2 = (1.0f - u.y) / (1.0f + (alpha * alpha - 1.0f) * u.y);
   float c = sqrt(cos2), s = sqrt(max(1.0f - cos2, 0.0f));
   return vec3(s * cos(phi), s * sin(phi), c);
@@ -67,23 +60,11 @@ RTR_FN vec3 envTangent(vec3 n) {
   return normalize(cross(up, n));
 }
 
-// The smallest alpha prefiltering uses: below it the lobe is narrower than a texel of the base level.
-RTR_CONST float ENV_ALPHA_MIN = 1e-3f;
-
-// Height-correlated Smith visibility V = G / (4 n.l n.v) for GGX (the glTF BRDF's).
-RTR_FN float envGgxVis(float nl, float nv, float alpha) {
-  float a2 = alpha * alpha;
-  float gv = nl * sqrt(nv * nv * (1.0f - a2) + a2);
-  float gl = nv * sqrt(nl * nl * (1.0f - a2) + a2);
-  float s = gv + gl;
-  return s > 0.0f ? 0.5f / s : 0.0f;
-}
-
 // One row of the split-sum table: for view angle n.v and roughness, the scale A and bias B such that the
 // GGX specular's hemispherical integral under uniform white light is F0 A + B (Schlick Fresnel), by
 // `samples` half vectors drawn from D. Evaluated the same way on the GPU (env_brdf_lut.comp) and the CPU.
 RTR_FN vec2 envBrdfLut(float nv, float roughness, uint samples) {
-  float alpha = max(roughness * roughness, ENV_ALPHA_MIN);
+  float alpha = max(roughness * roughness, BRDF_ALPHA_MIN);
   nv = max(nv, 1e-4f);
   vec3 v = vec3(sqrt(max(1.0f - nv * nv, 0.0f)), 0.0f, nv);
   float a = 0.0f, b = 0.0f;
@@ -94,7 +75,7 @@ RTR_FN vec2 envBrdfLut(float nv, float roughness, uint samples) {
     float nl = l.z, nh = h.z;
     if (nl > 0.0f && vh > 0.0f) {
       // f cos / pdf with pdf(l) = D n.h / (4 v.h):  F · V · 4 · nl · vh / nh.
-      float w = envGgxVis(nl, nv, alpha) * 4.0f * nl * vh / nh;
+      float w = brdfGgxVisibility(nv, nl, alpha) * 4.0f * nl * vh / nh;
       float fc = pow(1.0f - vh, 5.0f);
       a += (1.0f - fc) * w;
       b += fc * w;

@@ -131,7 +131,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     spec.bind(cb);
     pc.samples = s.samples;
     pc.srcLevels = sourceLevels;
-    pc.srcTexelSolidAngle = 4.0f * shader::ENVP_PI / (6.0f * float(s.sourceSize) * float(s.sourceSize));
+    pc.srcTexelSolidAngle = 4.0f * shader::BRDF_PI / (6.0f * float(s.sourceSize) * float(s.sourceSize));
     for (uint32_t l = 0; l < s.specularLevels; ++l) {
       pc.size = s.specularSize >> l;
       pc.roughness = float(l) / float(s.specularLevels - 1);

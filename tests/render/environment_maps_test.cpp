@@ -133,7 +133,7 @@ TEST_F(EnvironmentMapsTest, SpecularMatchesCpuIntegrationOfASmoothMap) {
   for (uint32_t l = 1; l < s.specularLevels; ++l) {
     const uint32_t size = s.specularSize >> l;
     const auto texels = readLevel(maps.specular(), l);
-    const float alpha = std::max(std::pow(float(l) / float(s.specularLevels - 1), 2.0f), shader::ENV_ALPHA_MIN);
+    const float alpha = std::max(std::pow(float(l) / float(s.specularLevels - 1), 2.0f), shader::BRDF_ALPHA_MIN);
     for (uint32_t f = 0; f < 6; ++f) {
       const uint32_t x = size / 3, y = size / 2;
       const glm::vec3 n = shader::envCubeDir(f, (glm::vec2(x, y) + 0.5f) / float(size) * 2.0f - 1.0f);
