@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <span>
 #include <string_view>
 
 #include <tinyexr.h>
@@ -18,15 +19,9 @@ namespace {
 
 constexpr uint64_t kMaxLinearBytes = uint64_t(1) << 31;  // 2 GiB of file: a 16k×8k float map is 1.5 GiB
 
-std::vector<unsigned char> readWhole(const std::filesystem::path& file) {
-  const MappedFile mapped(file, "environment map");  // a regular file, or refused without blocking
-  if (mapped.bytes().size() > kMaxLinearBytes) throw fileError(file.string(), "", "larger than 2 GiB");
-  return {mapped.bytes().begin(), mapped.bytes().end()};
-}
-
 // Radiance RGBE: a text header ending in an empty line, the resolution line "-Y H +X W" (rows top first),
 // then each row flat (4 bytes a pixel) or run-length coded per channel (a row starts 2 2 W/256 W%256).
-ImageF decodeHdr(const std::vector<unsigned char>& b, const std::string& file) {
+ImageF decodeHdr(std::span<const uint8_t> b, const std::string& file) {
   size_t pos = 0;
   auto line = [&]() -> std::string_view {
     const size_t start = pos;
@@ -84,7 +79,9 @@ ImageF decodeHdr(const std::vector<unsigned char>& b, const std::string& file) {
 ImageF loadLinearImage(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  const std::vector<unsigned char> bytes = readWhole(file);
+  const MappedFile mapped(file, "environment map");  // a regular file, or refused without blocking
+  const std::span<const uint8_t> bytes = mapped.bytes();  // decoded in place, not copied
+  if (bytes.size() > kMaxLinearBytes) throw fileError(file.string(), "", "larger than 2 GiB");
   ImageF out;
   if (ext == ".exr") {
     float* rgba = nullptr;
