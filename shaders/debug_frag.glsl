@@ -22,9 +22,9 @@ vec3 mipColor(float level) {
 
 void main() {
   Surface s = fetchSurface();
-#if ALPHA_MASK
-  if (cutOut(s)) discard;
-#endif
+  if (ALPHA_MASK) {  // a branch on the constant alone, which specialization folds
+    if (cutOut(s)) discard;
+  }
   int mode = int(frame.params.x);
   vec3 n = brdfSafeNormal(shadingNormal(s));
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
@@ -36,9 +36,10 @@ void main() {
   float far = frame.params.w;
   vec3 c = vec3(0.0);
   if (mode == VIEW_MIP_LEVEL) {
-#if HAS_TEXCOORDS
     uint t = materials[draw.material].textures.x;
-    if (t == NO_TEXTURE) {
+    if (!HAS_TEXCOORDS) {
+      c = vec3(0.5);  // no texture coordinates: no mip level
+    } else if (t == NO_TEXTURE) {
       c = vec3(0.5);
     } else {
       vec2 q = textureQueryLod(textures[t], inTexcoord);
@@ -48,9 +49,6 @@ void main() {
         level = ceil(clamp(q.y + frame.params.y, 0.0, float(textureQueryLevels(textures[t]) - 1)) + 0.5) - 1.0;
       c = mipColor(level);
     }
-#else
-    c = vec3(0.5);  // no texture coordinates: no mip level
-#endif
   } else if (mode == VIEW_LINEAR_DEPTH) {
     c = vec3(viewDepth / far);
   } else if (mode == VIEW_DEPTH_DERIVATIVES) {

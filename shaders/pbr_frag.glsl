@@ -11,9 +11,9 @@ const float kMaxRadiance = 60000.0;
 
 void main() {
   Surface s = fetchSurface();
-#if ALPHA_MASK
-  if (cutOut(s)) discard;
-#endif
+  if (ALPHA_MASK) {  // a branch on the constant alone, which specialization folds
+    if (cutOut(s)) discard;
+  }
   if (unlit()) {
     outColor = vec4(min(s.baseColor, vec3(kMaxRadiance)), 1.0);
     return;

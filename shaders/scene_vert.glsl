@@ -2,6 +2,7 @@
 // the textured variant (a scene without texcoords binds none).
 #extension GL_GOOGLE_include_directive : require
 #include "frame.h"
+#include "variants.h"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2, std430) readonly buffer Instances { GpuInstance instances[]; };
@@ -16,10 +17,8 @@ layout(location = 5) out vec4 outColor;
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
-#if HAS_TEXCOORDS
-layout(location = 2) in vec2 inTexcoord;
+layout(location = 2) in vec2 inTexcoord;  // HAS_TEXCOORDS only
 layout(location = 2) out vec2 outTexcoord;
-#endif
 layout(location = 0) out vec3 outWorldPos;
 layout(location = 1) out vec3 outNormal;
 
@@ -37,8 +36,6 @@ void main() {
     const vec4 t = tangents[v];
     outTangent = vec4(mat3(inst.transform) * t.xyz, (inst.info.y & INSTANCE_MIRRORED) != 0u ? -t.w : t.w);
   }
-#if HAS_TEXCOORDS
-  outTexcoord = inTexcoord;
-#endif
+  if (HAS_TEXCOORDS) outTexcoord = inTexcoord;
   gl_Position = frame.viewProj * world;
 }

@@ -1,4 +1,3 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#define HAS_TEXCOORDS 1
 #include "vis_shade.glsl"

@@ -8,6 +8,7 @@
 #extension GL_EXT_samplerless_texture_functions : require
 #include "frame.h"
 #include "brdf.h"
+#include "variants.h"
 
 layout(local_size_x = VIS_GROUP_X, local_size_y = VIS_GROUP_Y) in;
 
@@ -18,16 +19,14 @@ layout(set = 0, binding = 3, std430) readonly buffer Positions { float positions
 layout(set = 0, binding = 4, std430) readonly buffer Normals { float normals[]; };
 layout(set = 0, binding = 5, std430) readonly buffer Indices32 { uint indices32[]; };
 layout(set = 0, binding = 6, std430) readonly buffer Indices16 { uint indices16[]; };  // two per word
-#ifdef VIS_BUFFER  // the compute rasteriser's: (depth << 32 | id) per pixel, row by row (raster.h)
-layout(set = 0, binding = 7, std430) readonly buffer Visibility { uvec2 visibility[]; };  // x: the low half
-#else
-layout(set = 0, binding = 7) uniform utexture2D visibility;
-#endif
+// The ids, by VIS_BUFFER: the hardware rasteriser's image, or the compute rasteriser's (depth << 32 | id)
+// per pixel, row by row (raster.h).
+layout(set = 0, binding = 7) uniform utexture2D visibilityImage;
+layout(set = 0, binding = 14, std430) readonly buffer Visibility { uvec2 visibilityBuffer[]; };  // x: the low half
 layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D sceneColor;
-#if HAS_TEXCOORDS
+// HAS_TEXCOORDS only:
 layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
 layout(set = 1, binding = 0) uniform sampler2D textures[];
-#endif
 layout(set = 0, binding = 10, std430) readonly buffer Instances { GpuInstance instances[]; };
 // glTF's streams where the draw has them (GpuDraw flags); scenes without bind any buffer.
 layout(set = 0, binding = 11, std430) readonly buffer Texcoords1 { vec2 texcoords1[]; };
@@ -56,7 +55,6 @@ vec3 barycentrics(vec3 dir, vec3 a, vec3 b, vec3 n) {
   return vec3(1.0 - uv.x - uv.y, uv);
 }
 
-#if HAS_TEXCOORDS
 // Texcoords of both sets and their differences to the quad neighbours (x, y): uv[0..2] set 0, uv[3..5] set 1.
 vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec2 uv[6], vec4 fallback) {
   if (index == NO_TEXTURE) return fallback;
@@ -65,16 +63,13 @@ vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec2 uv[6], vec4 fallback) {
   const mat2 a = mat2(r0.x, r1.x, r0.y, r1.y);  // the transform's linear part (columns)
   return textureGrad(textures[nonuniformEXT(index)], a * uv[k] + vec2(r0.z, r1.z), a * uv[k + 1], a * uv[k + 2]);
 }
-#endif
 
 void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(p, imageSize(sceneColor)))) return;
-#ifdef VIS_BUFFER
-  const uint packed = visibility[p.y * imageSize(sceneColor).x + p.x].x;
-#else
-  const uint packed = texelFetch(visibility, p, 0).x;
-#endif
+  uint packed;
+  if (VIS_BUFFER) packed = visibilityBuffer[p.y * imageSize(sceneColor).x + p.x].x;
+  else packed = texelFetch(visibilityImage, p, 0).x;
   if (packed == VIS_EMPTY) {
     imageStore(sceneColor, p, vec4(0.0, 0.0, 0.0, 1.0));  // the forward pass's clear colour
     return;
@@ -104,8 +99,7 @@ void main() {
   vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
   float roughness = m.roughMetal.x, metalness = m.roughMetal.y, occlusion = 1.0;
   if ((d.flags & DRAW_COLORS) != 0u) baseColor *= (colors[tri.x] * w.x + colors[tri.y] * w.y + colors[tri.z] * w.z).rgb;
-#if HAS_TEXCOORDS
-  if ((d.flags & DRAW_TEXTURED) != 0u) {
+  if (HAS_TEXCOORDS && (d.flags & DRAW_TEXTURED) != 0u) {
     const vec2 t0 = texcoords[tri.x], t1 = texcoords[tri.y], t2 = texcoords[tri.z];
     const vec2 uv = t0 * w.x + t1 * w.y + t2 * w.z;
     // Differences to the other pixel of the 2x2 quad in x and in y (what fine dFdx/dFdy give), scaled
@@ -140,7 +134,6 @@ void main() {
       if (back) nrm = -nrm;
     }
   }
-#endif
   if ((m.textures2.w & MATERIAL_UNLIT) != 0u) {
     imageStore(sceneColor, p, vec4(min(baseColor, vec3(kMaxRadiance)), 1.0));
     return;
