@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/common/light_options.hpp"
 #include "core/camera.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
@@ -29,12 +30,12 @@ int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (the GPU's PBR BRDF for models; the course's Blinn-Phong with shadows and "
                "mirrors for the course's scenes)", "rtr-trace"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "auto", shadows = "on",
-                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath, up = "+Y",
+                                  intersectName = "watertight", mtlPath, up = "+Y",
                                   brdf;
   LightOptions lightOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
-  bool ortho = false, quiet = false, force = false, noDefaultLight = false;
+  bool ortho = false, quiet = false, force = false;
   float crease = LoadOptions{}.creaseDeg;
   app.add_option("scene", scenePath, "scene file (.obj, .obj.zst, .comp5892mesh, .rtrscene)")->required();
   app.add_option("mtl,--mtl", mtlPath, "OBJ: its MTL, as the course runs `program NAME.obj NAME.mtl` (default: the "
@@ -67,15 +68,7 @@ int run(int argc, char** argv) {
       ->capture_default_str()->check(cli::oneOf<IntersectMethod>());
   app.add_option("--area-samples", s.areaLightSamples, "shadow rays per area light (1: its centre)")
       ->capture_default_str()->check(cli::integer(1, 1024));
-  CLI::Option* lightOpt = app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights")
-      ->check(cli::checked([](const std::string& t) { cli::parseVec3("--light", t); }, "X,Y,Z"));
-  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
-      ->needs(lightOpt)->check(cli::checked([](const std::string& t) { cli::parseColor("--light-color", t); }, "R,G,B"));
-  app.add_flag("--falloff", lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
-  app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str()
-      ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
-  app.add_flag("--no-default-light", noDefaultLight,
-               "a scene without lights gets no headlight (the assignment's strict behaviour: ambient and emission only)");
+  cli::addLightOptions(app, lightOptions);
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
       ->capture_default_str();
   app.add_option("--crease", crease, "OBJ faces without normals: normals split where faces meet at more than DEG "
@@ -94,14 +87,10 @@ int run(int argc, char** argv) {
   s.lens.orthographic = ortho;
   const float aspect = float(w) / float(h);
   s.lens.orthoHalfHeight = orthoHeight > 0.0f ? orthoHeight : (aspect >= 1.0f ? 1.0f : 1.0f / aspect);
-  lightOptions.defaultLight = !noDefaultLight;
   const glm::mat3 upTurn = upRotation(up);
   if (!brdf.empty()) s.brdf = cli::enumOption<Brdf>("--brdf", brdf);
   s.shadows = shadows == "on";
   s.intersect = cli::enumOption<IntersectMethod>("--intersect", intersectName);
-  if (!light.empty()) lightOptions.position = cli::parseVec3("--light", light);
-  if (!lightColor.empty()) lightOptions.color = cli::parseColor("--light-color", lightColor);
-  lightOptions.ambient = cli::parseColor("--ambient", ambient, true);
   cli::checkImageOutput("-o", outPath, force);  // before tracing, not after
 
   LoadOptions load;
