@@ -104,7 +104,8 @@ TEST_F(SamplerTest, FilterNearestChangesEveryPath) {
                              {render::ShadingPath::Forward, render::RasterPath::Auto, render::MosaicMode::Graphics},
                              {render::ShadingPath::Visibility, render::RasterPath::Hardware}};
   const bool compute = render::ComputeRaster::supported(*ctx);
-  if (compute) paths.push_back({render::ShadingPath::Visibility, render::RasterPath::Compute, render::MosaicMode::Compute});
+  if (compute)
+    paths.push_back({render::ShadingPath::Visibility, render::RasterPath::Compute, render::MosaicMode::Compute});
   std::vector<uint32_t> ids[2][2];  // [raster hardware, compute][trilinear, nearest]
   for (const Path& p : paths)
     for (int nearest = 0; nearest < 2; ++nearest) {
@@ -116,7 +117,8 @@ TEST_F(SamplerTest, FilterNearestChangesEveryPath) {
       if (p.shading == render::ShadingPath::Visibility)
         ids[p.raster == render::RasterPath::Compute][nearest] = renderer->ids(pose, lens, s);
       if (nearest) continue;
-      SCOPED_TRACE(testing::Message() << enumName(p.shading) << ", " << enumName(p.raster) << ", mosaic " << enumName(p.mosaic));
+      SCOPED_TRACE(testing::Message() << enumName(p.shading) << ", " << enumName(p.raster) << ", mosaic "
+                                      << enumName(p.mosaic));
       const ImageRGBA8 a = renderer->render(pose, lens, s).image;
       s.sampler.filter = TextureFilter::Nearest;
       EXPECT_GT(differingPixels(a, renderer->render(pose, lens, s).image), size_t(kW * kH / 20));
