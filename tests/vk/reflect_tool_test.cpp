@@ -84,9 +84,12 @@ TEST(Specialization, EachVariantHasOnlyTheInterfaceItUses) {
     EXPECT_EQ(vis.stages[0].inputs.size(), alpha ? 2u : 1u);  // positions (, texcoords)
     EXPECT_EQ(hasBinding(vis, 1, 0), bool(alpha));
   }
-  // No constants: the module as compiled.
+  // No constants: the module as compiled. The same constants: the same module, so the driver's pipeline
+  // cache (keyed on the module's code) hits on the next start.
   const vk::SpirvModule pbr = vk::loadShader("pbr.frag");
   EXPECT_EQ(vk::specialize(pbr, {}).code, pbr.code);
+  EXPECT_EQ(vk::specialize(pbr, {{VARIANT_TEXCOORDS, 0}}).code, vk::specialize(pbr, {{VARIANT_TEXCOORDS, 0}}).code);
+  EXPECT_NE(vk::specialize(pbr, {{VARIANT_TEXCOORDS, 0}}).code, vk::specialize(pbr, {{VARIANT_TEXCOORDS, 1}}).code);
 }
 
 TEST(ReflectTool, ConflictAndBadInputExitNonZero) {
