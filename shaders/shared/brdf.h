@@ -245,8 +245,8 @@ RTR_FN vec3 brdfToFrame(vec3 local, vec3 n) {
 }
 
 // The probability of drawing from the specular lobe: its Fresnel weight seen from v against the diffuse
-// weight, at least 1/4 while there is a diffuse lobe (a bright environment's reflection of a dielectric
-// is still found), and 1 without one (metal). View below the surface: the specular is 0, so 0.
+// weight (about each lobe's share of the albedo, which keeps f cos / pdf nearly constant), 1 without a
+// diffuse lobe (metal). View below the surface: the specular is 0, so 0.
 RTR_FN float brdfSpecularChance(float nv, vec3 baseColor, float metalness) {
   vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
   float metal = clamp(metalness, 0.0f, 1.0f);
@@ -254,7 +254,7 @@ RTR_FN float brdfSpecularChance(float nv, vec3 baseColor, float metalness) {
   if (nv <= 0.0f) return diff > 0.0f ? 0.0f : 1.0f;
   if (!(diff > 0.0f)) return 1.0f;
   float spec = brdfLuminance(brdfFresnel(nv, c, metal));
-  return clamp(spec / (spec + diff), 0.25f, 1.0f);
+  return spec / (spec + diff);
 }
 
 // Draws l for BRDF `brdf` at unit v and any n from three uniform numbers (u.x picks the lobe). The

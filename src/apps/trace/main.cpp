@@ -137,6 +137,8 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "rtr-trace: note: the environment lights PBR shading only; %s shading sees it where rays "
                  "leave the scene\n", enumName(s.shading));
   s.lights = resolveLights(scene, lightOptions);
+  if (envOptions.hasEnvironment() && s.lights->lights.empty() && !noDefaultLight)
+    s.lights->note = "lit by the environment (--env: no default headlight, no ambient unless --ambient)";
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   gStage = "building the BVH of " + scenePath;
   const Tracer tracer(scene, s.threads);
