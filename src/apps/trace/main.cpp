@@ -154,7 +154,7 @@ int run(int argc, char** argv) {
   });
   if (tty) std::fprintf(stderr, "\r\033[K");
   const bool lit = std::any_of(image.pixels.begin(), image.pixels.end(),
-                               [&](const glm::vec4& p) { return glm::vec3(p) != s.background; });
+                               [&](const glm::vec4& p) { return glm::vec3(p) != s.background && glm::vec3(p) != glm::vec3(0.0f); });
   const std::string empty = emptyImageWarning(scene, tracer.resolvePose(s), s.lens, aspect, lit, s.lights->lights.size());
   if (!empty.empty()) std::fprintf(stderr, "rtr-trace: warning: %s\n", empty.c_str());
   gStage = "writing " + outPath;
