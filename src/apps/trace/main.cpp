@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <cstdint>
 #include <exception>
-#include <new>
 #include <memory>
+#include <new>
 #include <string>
 
 #include <unistd.h>
