@@ -10,12 +10,22 @@
 
 #include <glm/mat3x3.hpp>
 
+#include "core/enum_names.hpp"
+
 #include "core/camera.hpp"
+#include "core/image.hpp"
 #include "scene/load.hpp"
 #include "scene/obj.hpp"
 #include "scene/scene.hpp"
 
 namespace rtr {
+
+// How an .rtrscene carries its textures: image files in "<scene>-tex/" (decoded and filtered at every
+// load), or their whole mip chains as the GPU samples them inside the file (version 6's TEXS chunk).
+enum class TextureStore { Files, Lossless };
+constexpr std::array<EnumName<TextureStore>, 2> enumNames(TextureStore) {
+  return {{{TextureStore::Files, "files"}, {TextureStore::Lossless, "lossless"}}};
+}
 
 struct BakeOptions {
   std::filesystem::path input, output;
@@ -29,6 +39,7 @@ struct BakeOptions {
   std::function<void(const std::string&)> note;  // glTF: what the reader chose on its own (LoadOptions::note)
   std::function<void(const char* phase, double fraction)> progress;
   unsigned threads = 0;
+  TextureStore textures = TextureStore::Files;  // .rtrscene only
 };
 
 struct BakeReport {
@@ -37,6 +48,7 @@ struct BakeReport {
   size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0, embeddedTextures = 0;
   size_t triangles = 0, instances = 0;
   uint64_t outputBytes = 0;
+  uint64_t texelBytes = 0, storedTexelBytes = 0;  // baked textures: their chains, and as stored (zstd)
   double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, writeSeconds = 0, totalSeconds = 0;
 };
 
@@ -54,5 +66,14 @@ struct TexturePlan {
   std::vector<std::shared_ptr<const std::vector<uint8_t>>> bytes;  // per texture: the image to write, or null
 };
 TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks);
+
+// Decodes every texture of the plan (its sources or bytes; errors as a bake's, naming the file and where it
+// is named: `namedIn`), filters its full mip chain with the reference filter (core/mip_reference.hpp,
+// linear light, each level from the one before) and sets Texture::baked; sources and bytes are cleared.
+// Textures on all cores. `progress` gets the fraction done.
+void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn,
+                const std::function<void(double)>& progress = {});
+// One texture's chain as bakeTexels makes it, from decoded texels (channels 1 or 4).
+std::vector<uint8_t> referenceChain(const TexelData& level0, bool srgb);
 
 }  // namespace rtr

@@ -36,7 +36,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--crease", opt.creaseDeg, "faces without normals: normals split where faces meet at more than DEG "
                  "degrees (0 flat, 180 smooth)")->capture_default_str()->check(rtr::cli::number(0, 180));
+  std::string textures = "files";
+  app.add_option("--textures", textures, "how an .rtrscene carries its textures: files (image files in NAME-tex/, "
+                 "decoded at load) | lossless (the mip chains as the GPU samples them, zstd, in the file)")
+      ->check(rtr::cli::oneOf<rtr::TextureStore>())->capture_default_str();
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
+  opt.textures = rtr::cli::enumOption<rtr::TextureStore>("--textures", textures);
 
   opt.input = input;
   opt.output = output;
@@ -63,6 +68,9 @@ int main(int argc, char** argv) {
     const auto& o = r.obj;
     const double mb = double(o.textBytes) / 1e6;
     std::printf("%s -> %s\n", input.c_str(), output.c_str());
+    if (r.texelBytes)
+      std::printf("  textures baked: %.2f MB of mip chains, %.2f MB stored\n", double(r.texelBytes) / 1e6,
+                  double(r.storedTexelBytes) / 1e6);
     if (r.gltf) {
       std::printf("  meshes %zu, instances %zu, materials %zu, textures %zu (%zu images written from the glTF)\n", r.meshes,
                   r.instances, r.materials, r.textures, r.embeddedTextures);

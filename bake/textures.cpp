@@ -1,11 +1,17 @@
+#include <atomic>
 #include <cstdio>
+#include <mutex>
 #include <unordered_map>
 
 #include "bake.hpp"
 #include "core/error.hpp"
+#include "core/mip_reference.hpp"
+#include "core/parallel.hpp"
+#include "scene/baked_texels.hpp"
 #include "scene/binio.hpp"
 #include "scene/course.hpp"
 #include "scene/mtl.hpp"
+#include "scene/textures.hpp"
 
 namespace rtr {
 namespace {
@@ -89,6 +95,56 @@ TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool cou
     plan.scene.materials.push_back(std::move(out));
   }
   return plan;
+}
+
+std::vector<uint8_t> referenceChain(const TexelData& level0, bool srgb) {
+  const MipChain chain = buildMipReference(level0, srgb ? TexelEncoding::Srgb : TexelEncoding::Unorm, MipSource::PreviousLevel);
+  BakedTexels layout;
+  layout.format = level0.channels == 1 ? BakedFormat::R8 : BakedFormat::Rgba8;
+  layout.width = level0.width;
+  layout.height = level0.height;
+  const std::vector<uint64_t> at = layout.levelOffsets();
+  std::vector<uint8_t> out(at.back());
+  for (uint32_t l = 0; l < chain.levels.size(); ++l) {
+    const std::vector<uint8_t> q = l == 0 ? level0.texels : quantizeMipLevel(chain, l);
+    std::copy(q.begin(), q.end(), out.begin() + ptrdiff_t(at[l]));
+  }
+  return out;
+}
+
+void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn, const std::function<void(double)>& progress) {
+  std::vector<std::string> errors(plan.scene.textures.size());
+  std::atomic<size_t> done{0};
+  std::mutex progressMutex;
+  parallelFor(plan.scene.textures.size(), threads, [&](size_t i) {
+    Texture& t = plan.scene.textures[i];
+    Texture src = t;  // the image it comes from: a file, bytes held in memory, or a course fallback (none here)
+    src.path = plan.sources[i];
+    src.bytes = plan.bytes[i];
+    std::error_code ec;
+    if (!src.bytes && !std::filesystem::exists(src.path, ec)) {
+      errors[i] = src.path.string() + ": texture file named in the " + namedIn + " does not exist";
+      return;
+    }
+    TexelData texels;
+    try {
+      texels = decodeTexture(Scene{}, src);
+    } catch (const Error& e) {
+      errors[i] = std::string(e.what()) + (src.bytes ? " (an image embedded in the glTF is not readable)"
+                                                     : " (texture named in the " + namedIn + " is not a readable image)");
+      return;
+    }
+    const BakedFormat format = texels.channels == 1 ? BakedFormat::R8 : BakedFormat::Rgba8;
+    const uint32_t w = texels.width, h = texels.height;
+    t.baked = packBakedTexels(format, w, h, referenceChain(texels, decodeSrgb(t)), 1);
+    if (progress) {
+      const std::lock_guard lock(progressMutex);
+      progress(double(++done) / double(plan.scene.textures.size()));
+    }
+  });
+  for (const std::string& e : errors)
+    if (!e.empty()) throw Error(e);
+  for (size_t i = 0; i < plan.sources.size(); ++i) plan.sources[i].clear(), plan.bytes[i] = nullptr;
 }
 
 }  // namespace rtr

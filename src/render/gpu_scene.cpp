@@ -16,6 +16,7 @@
 #include "render/cull.hpp"
 #include "core/image.hpp"
 #include "core/parallel.hpp"
+#include "scene/baked_texels.hpp"
 #include "scene/textures.hpp"
 #include "vk/check.hpp"
 #include "vk/commands.hpp"
@@ -102,7 +103,39 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
   auto decode = [this, &scene, used] {
     const auto t = Clock::now();
     std::mutex progressMutex;
-    decodeTextures(scene, used, [&](size_t i, TexelData&& texels) {
+    auto done = [&] {
+      const std::lock_guard lock(progressMutex);
+      const size_t n = ++decoded_;
+      if (progress_) progress_("decoding textures", n, staged_.size());
+    };
+    // Baked texels (.rtrscene version 6): every chain unpacked piece by piece on all cores straight into
+    // its staging buffer, whole (no decode, no mip pass); the others decoded from their images.
+    std::vector<uint32_t> images;
+    std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (GPU texture, piece)
+    for (uint32_t i = 0; i < used.size(); ++i) {
+      const BakedTexels* b = scene.textures[used[i]].baked.get();
+      if (!b) {
+        images.push_back(i);
+        continue;
+      }
+      Staged& s = staged_[i];
+      s.extent = {b->width, b->height};
+      s.levels = b->levelOffsets();
+      s.buffer = vk::Buffer(ctx_, s.levels.back(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
+      s.levels.pop_back();
+      for (uint32_t k = 0; k < b->pieces.size(); ++k) pieces.emplace_back(i, k);
+    }
+    std::vector<std::atomic<uint32_t>> left(used.size());
+    for (const auto& [i, k] : pieces) ++left[i];
+    parallelFor(pieces.size(), 0, [&](size_t p) {
+      const auto [i, k] = pieces[p];
+      unpackBakedPiece(*scene.textures[used[i]].baked, k, static_cast<uint8_t*>(staged_[i].buffer.mapped()));
+      if (--left[i] == 0) staged_[i].buffer.flush(), done();
+    });
+    std::vector<uint32_t> decodeOnly;
+    for (uint32_t i : images) decodeOnly.push_back(used[i]);
+    decodeTextures(scene, decodeOnly, [&](size_t j, TexelData&& texels) {
+      const size_t i = images[j];
       Staged& s = staged_[i];
       s.extent = {texels.width, texels.height};
       // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
@@ -114,9 +147,7 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
                             vk::MemoryUse::Upload);
       std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
       s.buffer.flush();
-      const std::lock_guard lock(progressMutex);
-      const size_t done = ++decoded_;
-      if (progress_) progress_("decoding textures", done, staged_.size());
+      done();
     });
     stats_.decodeMs = msSince(t);
   };
