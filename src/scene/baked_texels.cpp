@@ -43,7 +43,13 @@ std::shared_ptr<const BakedTexels> packBakedTexels(BakedFormat format, uint32_t 
     const uint8_t* src = chain.data() + k * kBakedPiece;
     std::vector<uint8_t>& out = packed[k];
     out.resize(ZSTD_compressBound(n));
-    const size_t z = ZSTD_compress(out.data(), out.size(), src, n, 3);
+    // Each frame carries its content checksum: a damaged piece is found when it is unpacked, even where
+    // the file's checksum was not checked (fuzz builds).
+    thread_local std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> ctx(ZSTD_createCCtx(), ZSTD_freeCCtx);
+    ZSTD_CCtx_reset(ctx.get(), ZSTD_reset_session_and_parameters);
+    ZSTD_CCtx_setParameter(ctx.get(), ZSTD_c_compressionLevel, 3);
+    ZSTD_CCtx_setParameter(ctx.get(), ZSTD_c_checksumFlag, 1);
+    const size_t z = ZSTD_compress2(ctx.get(), out.data(), out.size(), src, n);
     if (ZSTD_isError(z) || z >= n) out.assign(src, src + n);  // incompressible: stored as it is
     else out.resize(z);
   });
