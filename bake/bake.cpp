@@ -162,13 +162,13 @@ BakeReport bake(const BakeOptions& opt) {
   sceneName = sceneName.substr(0, sceneName.rfind('.'));
   TexturePlan plan = planTextures(scene, sceneName, course);
   scene = Scene{};
-  const bool baked = opt.textures == TextureStore::Lossless;
+  const bool baked = opt.textures != TextureStore::Files;
   if (baked) {  // into the file: no texture file is written
     if (opt.progress) opt.progress("baking textures", 0.0);
     stage("baking the textures of " + input, [&] {
       bakeTexels(plan, threads, gltf ? "glTF" : "MTL", [&](double f) {
         if (opt.progress) opt.progress("baking textures", f);
-      });
+      }, opt.textures == TextureStore::Bc, &rep.bcError);
     });
     for (const Texture& t : plan.scene.textures) {
       rep.texelBytes += t.baked->bytes();

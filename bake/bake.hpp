@@ -22,10 +22,19 @@ namespace rtr {
 
 // How an .rtrscene carries its textures: image files in "<scene>-tex/" (decoded and filtered at every
 // load), or their whole mip chains as the GPU samples them inside the file (version 6's TEXS chunk).
-enum class TextureStore { Files, Lossless };
-constexpr std::array<EnumName<TextureStore>, 2> enumNames(TextureStore) {
-  return {{{TextureStore::Files, "files"}, {TextureStore::Lossless, "lossless"}}};
+// Bc: the same chains block-compressed (BC1 opaque colour, BC3 colour with alpha, BC4 one channel).
+enum class TextureStore { Files, Lossless, Bc };
+constexpr std::array<EnumName<TextureStore>, 3> enumNames(TextureStore) {
+  return {{{TextureStore::Files, "files"}, {TextureStore::Lossless, "lossless"}, {TextureStore::Bc, "bc"}}};
 }
+
+// Block compression's error against the lossless texels, per mip level over every texture, every channel
+// (8-bit LSB).
+struct LevelError {
+  double sumAbs = 0;
+  uint64_t samples = 0;
+  int max = 0;
+};
 
 struct BakeOptions {
   std::filesystem::path input, output;
@@ -49,6 +58,7 @@ struct BakeReport {
   size_t triangles = 0, instances = 0;
   uint64_t outputBytes = 0;
   uint64_t texelBytes = 0, storedTexelBytes = 0;  // baked textures: their chains, and as stored (zstd)
+  std::vector<LevelError> bcError;                // --textures bc: per level
   double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, writeSeconds = 0, totalSeconds = 0;
 };
 
@@ -71,8 +81,10 @@ TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool cou
 // is named: `namedIn`), filters its full mip chain with the reference filter (core/mip_reference.hpp,
 // linear light, each level from the one before) and sets Texture::baked; sources and bytes are cleared.
 // Textures on all cores. `progress` gets the fraction done.
+// `blocks`: block-compressed, with the error per level added to `bcError`.
 void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn,
-                const std::function<void(double)>& progress = {});
+                const std::function<void(double)>& progress = {}, bool blocks = false,
+                std::vector<LevelError>* bcError = nullptr);
 // One texture's chain as bakeTexels makes it, from decoded texels (channels 1 or 4).
 std::vector<uint8_t> referenceChain(const TexelData& level0, bool srgb);
 

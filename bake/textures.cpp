@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <cstdio>
 #include <mutex>
 #include <unordered_map>
@@ -112,7 +114,36 @@ std::vector<uint8_t> referenceChain(const TexelData& level0, bool srgb) {
   return out;
 }
 
-void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn, const std::function<void(double)>& progress) {
+// The chain in `format` (lossless, or each level block-compressed), its error per level added to `error`.
+std::vector<uint8_t> encodeChain(const std::vector<uint8_t>& lossless, BakedFormat format, uint32_t w, uint32_t h,
+                                 std::vector<LevelError>& error) {
+  if (format == BakedFormat::Rgba8 || format == BakedFormat::R8) return lossless;
+  BakedTexels from, to;
+  from.format = bakedChannels(format) == 1 ? BakedFormat::R8 : BakedFormat::Rgba8;
+  to.format = format;
+  from.width = to.width = w;
+  from.height = to.height = h;
+  const std::vector<uint64_t> src = from.levelOffsets(), dst = to.levelOffsets();
+  std::vector<uint8_t> out(dst.back());
+  error.resize(std::max<size_t>(error.size(), from.levels()));
+  for (uint32_t l = 0; l < from.levels(); ++l) {
+    const uint32_t lw = mipLevelSize(w, l), lh = mipLevelSize(h, l);
+    const std::vector<uint8_t> blocks = encodeBakedLevel(format, lw, lh, lossless.data() + src[l]);
+    std::copy(blocks.begin(), blocks.end(), out.begin() + ptrdiff_t(dst[l]));
+    const std::vector<uint8_t> back = decodeBakedLevel(format, lw, lh, blocks.data());
+    LevelError& e = error[l];
+    for (size_t i = 0; i < back.size(); ++i) {
+      const int d = std::abs(int(back[i]) - int(lossless[src[l] + i]));
+      e.sumAbs += d;
+      e.max = std::max(e.max, d);
+    }
+    e.samples += back.size();
+  }
+  return out;
+}
+
+void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn, const std::function<void(double)>& progress,
+                bool blocks, std::vector<LevelError>* bcError) {
   std::vector<std::string> errors(plan.scene.textures.size());
   std::atomic<size_t> done{0};
   std::mutex progressMutex;
@@ -134,13 +165,26 @@ void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn,
                                                      : " (texture named in the " + namedIn + " is not a readable image)");
       return;
     }
-    const BakedFormat format = texels.channels == 1 ? BakedFormat::R8 : BakedFormat::Rgba8;
-    const uint32_t w = texels.width, h = texels.height;
-    t.baked = packBakedTexels(format, w, h, referenceChain(texels, decodeSrgb(t)), 1);
-    if (progress) {
-      const std::lock_guard lock(progressMutex);
-      progress(double(++done) / double(plan.scene.textures.size()));
+    BakedFormat format = texels.channels == 1 ? BakedFormat::R8 : BakedFormat::Rgba8;
+    if (blocks && format == BakedFormat::R8) format = BakedFormat::Bc4;
+    if (blocks && format == BakedFormat::Rgba8) {
+      bool opaque = true;
+      for (size_t k = 3; k < texels.texels.size(); k += 4) opaque &= texels.texels[k] == 255;
+      format = opaque ? BakedFormat::Bc1 : BakedFormat::Bc3;
     }
+    const uint32_t w = texels.width, h = texels.height;
+    std::vector<LevelError> error;
+    t.baked = packBakedTexels(format, w, h, encodeChain(referenceChain(texels, decodeSrgb(t)), format, w, h, error), 1);
+    const std::lock_guard lock(progressMutex);
+    if (bcError) {
+      bcError->resize(std::max(bcError->size(), error.size()));
+      for (size_t l = 0; l < error.size(); ++l) {
+        (*bcError)[l].sumAbs += error[l].sumAbs;
+        (*bcError)[l].samples += error[l].samples;
+        (*bcError)[l].max = std::max((*bcError)[l].max, error[l].max);
+      }
+    }
+    if (progress) progress(double(++done) / double(plan.scene.textures.size()));
   });
   for (const std::string& e : errors)
     if (!e.empty()) throw Error(e);

@@ -14,6 +14,7 @@
 
 #include "cluster.h"
 #include "render/cull.hpp"
+#include "core/error.hpp"
 #include "core/image.hpp"
 #include "core/parallel.hpp"
 #include "scene/baked_texels.hpp"
@@ -30,9 +31,15 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 VkFormat textureFormat(const Texture& t) {
+  const bool srgb = decodeSrgb(t);
+  if (t.baked && t.baked->format == BakedFormat::Bc1) return srgb ? VK_FORMAT_BC1_RGB_SRGB_BLOCK : VK_FORMAT_BC1_RGB_UNORM_BLOCK;
+  if (t.baked && t.baked->format == BakedFormat::Bc3) return srgb ? VK_FORMAT_BC3_SRGB_BLOCK : VK_FORMAT_BC3_UNORM_BLOCK;
+  if (t.baked && t.baked->format == BakedFormat::Bc4) return VK_FORMAT_BC4_UNORM_BLOCK;
   if (decodeChannels(t) == 1) return VK_FORMAT_R8_UNORM;
-  return decodeSrgb(t) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+  return srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
 }
+
+bool blockCompressed(VkFormat f) { return f >= VK_FORMAT_BC1_RGB_UNORM_BLOCK && f <= VK_FORMAT_BC7_SRGB_BLOCK; }
 
 }  // namespace
 
@@ -100,6 +107,11 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
   for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i])), samplers_.push_back(scene.textures[i].sampler);
   staged_.resize(used.size());
   stats_.textures = uint32_t(used.size());
+  VkPhysicalDeviceFeatures features{};
+  vkGetPhysicalDeviceFeatures(ctx_.physicalDevice(), &features);
+  for (VkFormat f : formats_)
+    if (blockCompressed(f) && !features.textureCompressionBC)
+      throw Error("this device samples no BC textures (textureCompressionBC); bake the scene with --textures lossless");
   auto decode = [this, &scene, used] {
     const auto t = Clock::now();
     std::mutex progressMutex;
@@ -421,7 +433,10 @@ void GpuScene::startUpload() {
 
 void GpuScene::createTextures() {
   for (size_t i = 0; i < staged_.size(); ++i) {
-    textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
+    vk::ImageDesc desc = textureDesc(staged_[i].extent, formats_[i]);
+    if (blockCompressed(formats_[i]))  // baked with its chain: copied into, sampled, nothing else
+      desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, desc.flags = 0, desc.viewUsage = 0;
+    textures_.emplace_back(ctx_, desc);
     hostMips_.push_back(!staged_[i].levels.empty());
   }
 }

@@ -1,8 +1,10 @@
 #include "scene/baked_texels.hpp"
 
+#include <squish.h>
 #include <zstd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include "core/error.hpp"
@@ -11,14 +13,106 @@
 
 namespace rtr {
 
-uint32_t bakedTexelBytes(BakedFormat f) { return f == BakedFormat::R8 ? 1 : 4; }
+bool bakedKnown(uint32_t f) { return f >= uint32_t(BakedFormat::Rgba8) && f <= uint32_t(BakedFormat::Bc4); }
+uint32_t bakedChannels(BakedFormat f) { return f == BakedFormat::R8 || f == BakedFormat::Bc4 ? 1 : 4; }
+bool bakedBlocks(BakedFormat f) { return f == BakedFormat::Bc1 || f == BakedFormat::Bc3 || f == BakedFormat::Bc4; }
+
+uint64_t bakedLevelBytes(BakedFormat f, uint32_t w, uint32_t h) {
+  if (!bakedBlocks(f)) return uint64_t(w) * h * bakedChannels(f);
+  return uint64_t((w + 3) / 4) * ((h + 3) / 4) * (f == BakedFormat::Bc3 ? 16 : 8);
+}
+
+namespace {
+
+int squishFlags(BakedFormat f) { return f == BakedFormat::Bc1 ? squish::kDxt1 : squish::kDxt5; }
+
+// BC4 is ours: bookworm's libsquish 1.15 encodes and decodes its kBc4 as BC1 colour. A block: red_0, red_1,
+// then a 3-bit index per texel (row-major, little-endian from bit 0). red_0 > red_1: eight values from
+// red_0 to red_1 in sevenths; else six in fifths, then 0 and 255 (Vulkan's data format specification).
+void bc4Palette(const uint8_t* block, int v[8]) {
+  const int r0 = block[0], r1 = block[1];
+  v[0] = r0;
+  v[1] = r1;
+  if (r0 > r1)
+    for (int i = 1; i < 7; ++i) v[i + 1] = ((7 - i) * r0 + i * r1 + 3) / 7;
+  else {
+    for (int i = 1; i < 5; ++i) v[i + 1] = ((5 - i) * r0 + i * r1 + 2) / 5;
+    v[6] = 0;
+    v[7] = 255;
+  }
+}
+
+// Endpoints the block's extremes (eight-value mode), each texel the nearest value: the error is at most
+// (max − min) / 14 plus rounding.
+void bc4Encode(const uint8_t* texels, uint32_t w, uint32_t h, uint32_t bx, uint32_t by, uint8_t* block) {
+  uint8_t t[16];
+  int lo = 255, hi = 0;
+  for (uint32_t i = 0; i < 16; ++i) {
+    const uint32_t x = std::min(bx * 4 + i % 4, w - 1), y = std::min(by * 4 + i / 4, h - 1);  // edges repeat
+    t[i] = texels[size_t(y) * w + x];
+    lo = std::min<int>(lo, t[i]);
+    hi = std::max<int>(hi, t[i]);
+  }
+  block[0] = uint8_t(hi);
+  block[1] = uint8_t(lo);
+  int v[8];
+  bc4Palette(block, v);
+  uint64_t bits = 0;
+  for (uint32_t i = 0; i < 16; ++i) {
+    int best = 0;
+    for (int k = 1; k < 8; ++k)
+      if (std::abs(v[k] - t[i]) < std::abs(v[best] - t[i])) best = k;
+    bits |= uint64_t(best) << (3 * i);
+  }
+  for (int b = 0; b < 6; ++b) block[2 + b] = uint8_t(bits >> (8 * b));
+}
+
+void bc4Decode(const uint8_t* block, uint32_t w, uint32_t h, uint32_t bx, uint32_t by, uint8_t* texels) {
+  int v[8];
+  bc4Palette(block, v);
+  uint64_t bits = 0;
+  for (int b = 0; b < 6; ++b) bits |= uint64_t(block[2 + b]) << (8 * b);
+  for (uint32_t i = 0; i < 16; ++i) {
+    const uint32_t x = bx * 4 + i % 4, y = by * 4 + i / 4;
+    if (x < w && y < h) texels[size_t(y) * w + x] = uint8_t(v[(bits >> (3 * i)) & 7]);
+  }
+}
+
+}  // namespace
+
+std::vector<uint8_t> decodeBakedLevel(BakedFormat f, uint32_t w, uint32_t h, const uint8_t* data) {
+  const size_t n = size_t(w) * h;
+  if (!bakedBlocks(f)) return std::vector<uint8_t>(data, data + n * bakedChannels(f));
+  if (f == BakedFormat::Bc4) {
+    std::vector<uint8_t> r(n);
+    for (uint32_t by = 0, bw = (w + 3) / 4; by < (h + 3) / 4; ++by)
+      for (uint32_t bx = 0; bx < bw; ++bx) bc4Decode(data + (size_t(by) * bw + bx) * 8, w, h, bx, by, r.data());
+    return r;
+  }
+  std::vector<uint8_t> rgba(n * 4);
+  squish::DecompressImage(rgba.data(), int(w), int(h), data, squishFlags(f));
+  return rgba;
+}
+
+std::vector<uint8_t> encodeBakedLevel(BakedFormat f, uint32_t w, uint32_t h, const uint8_t* texels) {
+  const size_t n = size_t(w) * h;
+  if (!bakedBlocks(f)) return std::vector<uint8_t>(texels, texels + n * bakedChannels(f));
+  std::vector<uint8_t> out(bakedLevelBytes(f, w, h));
+  if (f == BakedFormat::Bc4) {
+    for (uint32_t by = 0, bw = (w + 3) / 4; by < (h + 3) / 4; ++by)
+      for (uint32_t bx = 0; bx < bw; ++bx) bc4Encode(texels, w, h, bx, by, out.data() + (size_t(by) * bw + bx) * 8);
+    return out;
+  }
+  squish::CompressImage(texels, int(w), int(h), out.data(), squishFlags(f) | squish::kColourClusterFit);
+  return out;
+}
 
 uint32_t BakedTexels::levels() const { return mipLevelCount(width, height); }
 
 std::vector<uint64_t> BakedTexels::levelOffsets() const {
   std::vector<uint64_t> at{0};
   for (uint32_t l = 0; l < levels(); ++l) {
-    const uint64_t n = uint64_t(mipLevelSize(width, l)) * mipLevelSize(height, l) * bakedTexelBytes(format);
+    const uint64_t n = bakedLevelBytes(format, mipLevelSize(width, l), mipLevelSize(height, l));
     at.push_back((at.back() + n + 15) & ~uint64_t(15));
   }
   return at;
@@ -82,12 +176,13 @@ void unpackBakedPiece(const BakedTexels& t, size_t k, uint8_t* chain) {
 }
 
 TexelData unpackBakedLevel0(const BakedTexels& t) {
-  const uint32_t ch = bakedTexelBytes(t.format);
-  const size_t n = size_t(t.width) * t.height * ch;
+  const uint32_t ch = bakedChannels(t.format);
+  const size_t n = bakedLevelBytes(t.format, t.width, t.height);
   // The pieces that cover level 0, unpacked into a buffer of whole pieces, then cut to the level.
   const size_t pieces = (n + kBakedPiece - 1) / kBakedPiece;
   std::vector<uint8_t> chain(std::min<uint64_t>(t.bytes(), pieces * kBakedPiece));
   for (size_t k = 0; k < pieces; ++k) unpackBakedPiece(t, k, chain.data());
+  if (bakedBlocks(t.format)) return {t.width, t.height, ch, decodeBakedLevel(t.format, t.width, t.height, chain.data())};
   chain.resize(n);
   return {t.width, t.height, ch, std::move(chain)};
 }

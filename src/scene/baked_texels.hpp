@@ -13,9 +13,18 @@
 
 namespace rtr {
 
-// Texel formats: what decodeChannels() gives a slot (4: RGBA8, sRGB or not as the texture; 1: R8).
-enum class BakedFormat : uint32_t { Rgba8 = 1, R8 = 2 };
-uint32_t bakedTexelBytes(BakedFormat f);
+// Texel formats. Lossless: what decodeChannels() gives a slot (4: RGBA8, sRGB or not as the texture; 1: R8).
+// Block-compressed (4x4 blocks): BC1 for opaque colour (its alpha reads 1), BC3 for colour with alpha, BC4
+// for one channel.
+enum class BakedFormat : uint32_t { Rgba8 = 1, R8 = 2, Bc1 = 3, Bc3 = 4, Bc4 = 5 };
+bool bakedKnown(uint32_t format);
+uint32_t bakedChannels(BakedFormat f);  // of the decoded texels: 1 or 4
+bool bakedBlocks(BakedFormat f);        // block-compressed
+uint64_t bakedLevelBytes(BakedFormat f, uint32_t width, uint32_t height);
+// Decodes one level of `f` to 8-bit texels of bakedChannels(f) channels (BC: libsquish's decoder).
+std::vector<uint8_t> decodeBakedLevel(BakedFormat f, uint32_t width, uint32_t height, const uint8_t* data);
+// Encodes one level of 8-bit texels (bakedChannels(f) channels) to `f` (BC: libsquish, cluster fit).
+std::vector<uint8_t> encodeBakedLevel(BakedFormat f, uint32_t width, uint32_t height, const uint8_t* texels);
 
 constexpr size_t kBakedPiece = size_t(1) << 18;  // bytes of texels per piece (the last one of a texture shorter)
 
@@ -47,7 +56,8 @@ std::shared_ptr<const BakedTexels> packBakedTexels(BakedFormat format, uint32_t 
 // Unpacks piece k into `chain` (which holds bytes() bytes) at k * kBakedPiece. Throws rtr::Error naming the
 // file and the byte offset of a piece that does not unpack to its size.
 void unpackBakedPiece(const BakedTexels& t, size_t k, uint8_t* chain);
-// Level 0 alone, as decoded texels (the CPU tracer's input); pieces unpacked on the calling thread.
+// Level 0 alone, as decoded texels (the CPU tracer's input; block-compressed levels decoded); pieces
+// unpacked on the calling thread.
 TexelData unpackBakedLevel0(const BakedTexels& t);
 
 }  // namespace rtr

@@ -10,7 +10,8 @@ namespace {
 constexpr size_t kTexsHeader = 16, kTexsRecord = 32, kTexsPiece = 16;
 constexpr uint32_t kMaxSide = 32768;  // as the image decoders (core/image.cpp)
 
-BakedFormat formatFor(const Texture& t) { return decodeChannels(t) == 1 ? BakedFormat::R8 : BakedFormat::Rgba8; }
+// A baked format fits a texture whose slot decodes to its channel count.
+bool fits(BakedFormat f, const Texture& t) { return int(bakedChannels(f)) == decodeChannels(t); }
 
 }  // namespace
 
@@ -27,7 +28,7 @@ void writeTexs(ByteWriter& w, const Scene& scene) {
   for (const Texture& t : scene.textures) {
     if (!t.baked) throw Error("texture '" + t.path.string() + "' is not baked: a file's textures are all baked or none");
     const BakedTexels& b = *t.baked;
-    if (b.format != formatFor(t)) throw Error("texture '" + t.path.string() + "': baked format does not match its channels");
+    if (!fits(b.format, t)) throw Error("texture '" + t.path.string() + "': baked format does not match its channels");
     w.u32(uint32_t(b.format));
     w.u32(b.width);
     w.u32(b.height);
@@ -83,10 +84,9 @@ void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& 
     const uint32_t n = r.u32("a TEXS record");
     if (r.u32("a TEXS record") != 0) r.failAt(at + 28, which + ": reserved field is not 0");
     const Texture& t = scene.textures[i];
-    if (format != uint32_t(BakedFormat::Rgba8) && format != uint32_t(BakedFormat::R8))
-      r.failAt(at, which + ": unknown texel format " + std::to_string(format));
+    if (!bakedKnown(format)) r.failAt(at, which + ": unknown texel format " + std::to_string(format));
     b->format = BakedFormat(format);
-    if (b->format != formatFor(t))
+    if (!fits(b->format, t))
       r.failAt(at, which + ": texel format " + std::to_string(format) + " does not match the texture's " +
                        std::to_string(t.channels) + " channels");
     if (b->width < 1 || b->width > kMaxSide || b->height < 1 || b->height > kMaxSide)
