@@ -25,7 +25,7 @@ namespace {
 std::span<const uint8_t> span(const std::string& b) { return {reinterpret_cast<const uint8_t*>(b.data()), b.size()}; }
 
 // A chain of the right size: smooth (zstd shrinks it) or noise (stored as it is).
-std::vector<uint8_t> chainBytes(BakedFormat f, uint32_t w, uint32_t h, bool noise) {
+std::vector<uint8_t> chainBytes(BakedFormat f, uint32_t w, uint32_t h, bool noise) {  // any format: bytes
   BakedTexels layout;
   layout.format = f;
   layout.width = w;
@@ -165,4 +165,57 @@ TEST(RtrSceneTexs, DamagedChunksAreRefusedWithTheByteOffset) {
   reseal(frame);
   EXPECT_THAT(decodeError(frame), HasSubstr("t.rtrscene: byte " + std::to_string(body + firstPiece) +
                                             ": baked texture piece 0 does not unpack"));
+}
+
+// BC4 as Vulkan's data format specification decodes it (values written out here from its formulas), and
+// the encoder within its bound on smooth texels; BC1/BC3/BC4 chains round-trip through the file.
+TEST(RtrSceneTexs, BlockCompressedLevelsDecodeAsSpecifiedAndRoundTrip) {
+  // red_0 200 > red_1 100: eight values 200, 100, then (6·200+100)/7 … (200+6·100)/7.
+  uint8_t block[8] = {200, 100};
+  const int want8[8] = {200, 100, 186, 171, 157, 143, 129, 114};
+  uint64_t bits = 0;
+  for (int i = 0; i < 16; ++i) bits |= uint64_t(i % 8) << (3 * i);
+  for (int b = 0; b < 6; ++b) block[2 + b] = uint8_t(bits >> (8 * b));
+  std::vector<uint8_t> t = decodeBakedLevel(BakedFormat::Bc4, 4, 4, block);
+  for (int i = 0; i < 16; ++i) EXPECT_EQ(t[i], want8[i % 8]) << "texel " << i;
+  // red_0 50 <= red_1 150: six values 50, 150, (4·50+150)/5 … (50+4·150)/5, then 0 and 255.
+  block[0] = 50;
+  block[1] = 150;
+  const int want6[8] = {50, 150, 70, 90, 110, 130, 0, 255};
+  t = decodeBakedLevel(BakedFormat::Bc4, 3, 2, block);  // a partial block: the texels inside the level
+  ASSERT_EQ(t.size(), 6u);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x) EXPECT_EQ(t[y * 3 + x], want6[(y * 4 + x) % 8]);
+  // Smooth texels: within (max − min) / 14 of the block, plus rounding.
+  std::vector<uint8_t> smooth(21 * 10);
+  for (size_t i = 0; i < smooth.size(); ++i) smooth[i] = uint8_t(40 + (i % 21) * 5 + (i / 21) * 3);
+  const std::vector<uint8_t> back = decodeBakedLevel(BakedFormat::Bc4, 21, 10, encodeBakedLevel(BakedFormat::Bc4, 21, 10, smooth.data()).data());
+  for (size_t i = 0; i < smooth.size(); ++i) EXPECT_LE(std::abs(int(back[i]) - int(smooth[i])), 2) << i;
+
+  Scene s = bakedScene();
+  const uint32_t w = 19, h = 11;
+  for (auto [i, f] : {std::pair{0, BakedFormat::Bc3}, std::pair{1, BakedFormat::Bc4}, std::pair{2, BakedFormat::Bc1}}) {
+    BakedTexels layout;
+    layout.format = f;
+    layout.width = w;
+    layout.height = h;
+    EXPECT_EQ(layout.levelOffsets()[1], ((w + 3) / 4) * ((h + 3) / 4) * (f == BakedFormat::Bc3 ? 16u : 8u) + 15 & ~15u);
+    s.textures[i].baked = packBakedTexels(f, w, h, chainBytes(f, w, h, i == 2));
+  }
+  const std::string bytes = encodeRtrScene(s);
+  const Scene got = decodeRtrScene(span(bytes), "bc.rtrscene", 1);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(got.textures[i].baked->format, s.textures[i].baked->format);
+    EXPECT_EQ(unpackAll(*got.textures[i].baked), unpackAll(*s.textures[i].baked));
+  }
+  const TexelData l0 = decodeTexture(got, got.textures[1]);  // the tracer's level 0: BC4 decoded
+  EXPECT_EQ(l0.channels, 1u);
+  EXPECT_EQ(l0.texels.size(), size_t(w) * h);
+  // A BC4 chain given to a four-channel texture is refused where it is named.
+  std::string wrong = bytes;
+  const size_t body = wrong.find("TEXS") + 16;
+  const uint32_t bc4 = uint32_t(BakedFormat::Bc4);
+  std::memcpy(wrong.data() + body + 16, &bc4, 4);
+  reseal(wrong);
+  EXPECT_THAT(decodeError(wrong), HasSubstr("byte " + std::to_string(body + 16) + ": baked texture 0: texel format 5"));
 }
