@@ -78,3 +78,44 @@ TEST_F(VulkanTest, BakedTexturesDrawWhatTheImagePathDraws) {
 
 }  // namespace
 }  // namespace rtr
+
+namespace rtr {
+namespace {
+
+// --textures bc: BC1/BC3/BC4 images sampled by the GPU from the chains as baked (no mip pass); frames stay
+// near the lossless ones (mean error of the texels a few LSB: rtr-bake prints it per level) and sample the
+// same levels.
+TEST_F(VulkanTest, BlockCompressedTexturesDrawNearTheLosslessOnes) {
+  const Scene files = loadScene(test::assetDir() / "temple.rtrscene");
+  TexturePlan plan = planTextures(files, "t", false), bcPlan = plan;
+  bakeTexels(plan, 0, "MTL");
+  std::vector<LevelError> error;
+  bakeTexels(bcPlan, 0, "MTL", {}, true, &error);
+  size_t bc = 0;
+  for (const Texture& t : bcPlan.scene.textures) bc += bakedBlocks(t.baked->format);
+  EXPECT_EQ(bc, bcPlan.scene.textures.size());
+  ASSERT_FALSE(error.empty());
+  EXPECT_GT(error[0].sumAbs, 0.0) << "BC is lossy";
+  const CameraPose pose = *files.defaultView;
+  const Lens lens = fitDepthRange(Lens{}, files.bounds(), pose);
+  const render::GpuScene lossless(*ctx, plan.scene, render::MipMode::Compute), blocks(*ctx, bcPlan.scene, render::MipMode::Compute);
+  EXPECT_EQ(blocks.stats().mipGpuMs, 0.0) << "a mip pass ran";
+  render::HeadlessRenderer a(*ctx, lossless, {kW, kH}), b(*ctx, blocks, {kW, kH});
+  for (int mode : {VIEW_ALBEDO, VIEW_SHADED, VIEW_MIP_LEVEL}) {
+    const ImageRGBA8 x = a.render(pose, lens, settings(mode)).image, y = b.render(pose, lens, settings(mode)).image;
+    double sum = 0;
+    size_t differ = 0;
+    for (size_t i = 0; i < x.pixels.size(); ++i) {
+      sum += std::abs(int(x.pixels[i]) - int(y.pixels[i]));
+      differ += x.pixels[i] != y.pixels[i];
+    }
+    std::printf("bc vs lossless, view %d: %zu of %zu bytes differ, mean %.3f LSB\n", mode, differ, x.pixels.size(), sum / double(x.pixels.size()));
+    // The same levels are sampled, but where BC3's alpha moves an alpha-tested edge (a few pixels).
+    if (mode == VIEW_MIP_LEVEL) EXPECT_LT(differ, x.pixels.size() / 1000);
+    else EXPECT_GT(differ, 0u) << "mode " << mode << ": BC textures were not used";
+    EXPECT_LT(sum / double(x.pixels.size()), 2.0) << "mode " << mode;
+  }
+}
+
+}  // namespace
+}  // namespace rtr
