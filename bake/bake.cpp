@@ -19,6 +19,7 @@
 #include "core/parallel.hpp"
 #include "scene/first_look.hpp"
 #include "scene/load.hpp"
+#include "scene/baked_texels.hpp"
 #include "scene/rtrscene.hpp"
 
 namespace rtr {
@@ -102,6 +103,8 @@ BakeReport bake(const BakeOptions& opt) {
   if (!course && !endsWith(out, ".rtrscene"))
     throw UsageError(opt.output.string() + ": unknown output format (expected .rtrscene or .comp5892mesh)");
   const bool gltf = isGltf(opt.input);
+  if (course && opt.textures != TextureStore::Files)
+    throw UsageError(opt.output.string() + ": the .comp5892mesh format stores texture files only (--textures files)");
   if (gltf && course)
     throw UsageError(opt.output.string() + ": a glTF bakes to .rtrscene only (the .comp5892mesh format has no instances, "
                                            "samplers, uv transforms or glTF materials)");
@@ -159,11 +162,25 @@ BakeReport bake(const BakeOptions& opt) {
   sceneName = sceneName.substr(0, sceneName.rfind('.'));
   TexturePlan plan = planTextures(scene, sceneName, course);
   scene = Scene{};
-  if (opt.progress) opt.progress("checking textures", 0.0);
-  stage("checking the textures of " + input, [&] { verifyTextures(plan, threads, gltf ? "glTF" : "MTL"); });
+  const bool baked = opt.textures != TextureStore::Files;
+  if (baked) {  // into the file: no texture file is written
+    if (opt.progress) opt.progress("baking textures", 0.0);
+    stage("baking the textures of " + input, [&] {
+      bakeTexels(plan, threads, gltf ? "glTF" : "MTL", [&](double f) {
+        if (opt.progress) opt.progress("baking textures", f);
+      }, opt.textures == TextureStore::Bc, &rep.bcError);
+    });
+    for (const Texture& t : plan.scene.textures) {
+      rep.texelBytes += t.baked->bytes();
+      for (const BakedPiece& p : t.baked->pieces) rep.storedTexelBytes += p.stored;
+    }
+  } else {
+    if (opt.progress) opt.progress("checking textures", 0.0);
+    stage("checking the textures of " + input, [&] { verifyTextures(plan, threads, gltf ? "glTF" : "MTL"); });
+  }
   const std::filesystem::path texDir = outDir / (sceneName + "-tex");
   std::vector<bool> present(plan.scene.textures.size());  // an embedded image already there, byte for byte
-  for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
+  for (size_t i = 0; i < plan.scene.textures.size() && !baked; ++i) {
     const auto dst = outDir / plan.scene.textures[i].path;
     if (!std::filesystem::exists(dst, ec)) continue;
     if (plan.bytes[i]) {  // named by its content: the same bytes are kept, other bytes are never replaced
@@ -174,11 +191,11 @@ BakeReport bake(const BakeOptions& opt) {
       throw OutputExists(dst.string() + ": texture exists; refusing to overwrite it without --force");
     }
   }
-  if (!plan.scene.textures.empty()) createFolders(texDir, created);
+  if (!plan.scene.textures.empty() && !baked) createFolders(texDir, created);
   std::set<std::filesystem::path> written;
   std::vector<std::unique_ptr<AtomicFile>> textures;
   std::vector<Replace> textureReplace;
-  for (size_t i = 0; i < plan.scene.textures.size(); ++i) {
+  for (size_t i = 0; i < plan.scene.textures.size() && !baked; ++i) {
     const auto dst = outDir / plan.scene.textures[i].path;
     if (present[i] || !written.insert(dst).second) continue;  // one file for textures sampled two ways
     textures.push_back(std::make_unique<AtomicFile>(dst));

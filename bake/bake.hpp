@@ -10,12 +10,31 @@
 
 #include <glm/mat3x3.hpp>
 
+#include "core/enum_names.hpp"
+
 #include "core/camera.hpp"
+#include "core/image.hpp"
 #include "scene/load.hpp"
 #include "scene/obj.hpp"
 #include "scene/scene.hpp"
 
 namespace rtr {
+
+// How an .rtrscene carries its textures: image files in "<scene>-tex/" (decoded and filtered at every
+// load), or their whole mip chains as the GPU samples them inside the file (version 6's TEXS chunk).
+// Bc: the same chains block-compressed (BC1 opaque colour, BC3 colour with alpha, BC4 one channel).
+enum class TextureStore { Files, Lossless, Bc };
+constexpr std::array<EnumName<TextureStore>, 3> enumNames(TextureStore) {
+  return {{{TextureStore::Files, "files"}, {TextureStore::Lossless, "lossless"}, {TextureStore::Bc, "bc"}}};
+}
+
+// Block compression's error against the lossless texels, per mip level over every texture, every channel
+// (8-bit LSB).
+struct LevelError {
+  double sumAbs = 0;
+  uint64_t samples = 0;
+  int max = 0;
+};
 
 struct BakeOptions {
   std::filesystem::path input, output;
@@ -29,6 +48,7 @@ struct BakeOptions {
   std::function<void(const std::string&)> note;  // glTF: what the reader chose on its own (LoadOptions::note)
   std::function<void(const char* phase, double fraction)> progress;
   unsigned threads = 0;
+  TextureStore textures = TextureStore::Files;  // .rtrscene only
 };
 
 struct BakeReport {
@@ -37,6 +57,8 @@ struct BakeReport {
   size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0, embeddedTextures = 0;
   size_t triangles = 0, instances = 0;
   uint64_t outputBytes = 0;
+  uint64_t texelBytes = 0, storedTexelBytes = 0;  // baked textures: their chains, and as stored (zstd)
+  std::vector<LevelError> bcError;                // --textures bc: per level
   double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, writeSeconds = 0, totalSeconds = 0;
 };
 
@@ -54,5 +76,16 @@ struct TexturePlan {
   std::vector<std::shared_ptr<const std::vector<uint8_t>>> bytes;  // per texture: the image to write, or null
 };
 TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks);
+
+// Decodes every texture of the plan (its sources or bytes; errors as a bake's, naming the file and where it
+// is named: `namedIn`), filters its full mip chain with the reference filter (core/mip_reference.hpp,
+// linear light, each level from the one before) and sets Texture::baked; sources and bytes are cleared.
+// Textures on all cores. `progress` gets the fraction done.
+// `blocks`: block-compressed, with the error per level added to `bcError`.
+void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn,
+                const std::function<void(double)>& progress = {}, bool blocks = false,
+                std::vector<LevelError>* bcError = nullptr);
+// One texture's chain as bakeTexels makes it, from decoded texels (channels 1 or 4).
+std::vector<uint8_t> referenceChain(const TexelData& level0, bool srgb);
 
 }  // namespace rtr

@@ -36,7 +36,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--crease", opt.creaseDeg, "faces without normals: normals split where faces meet at more than DEG "
                  "degrees (0 flat, 180 smooth)")->capture_default_str()->check(rtr::cli::number(0, 180));
+  std::string textures = "files";
+  app.add_option("--textures", textures, "how an .rtrscene carries its textures: files (image files in NAME-tex/, "
+                 "decoded at load) | lossless (the mip chains as the GPU samples them, zstd, in the file) | bc (the same, "
+                 "block-compressed: BC1/BC3/BC4; prints the error against lossless per level)")
+      ->check(rtr::cli::oneOf<rtr::TextureStore>())->capture_default_str();
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
+  opt.textures = rtr::cli::enumOption<rtr::TextureStore>("--textures", textures);
 
   opt.input = input;
   opt.output = output;
@@ -63,6 +69,13 @@ int main(int argc, char** argv) {
     const auto& o = r.obj;
     const double mb = double(o.textBytes) / 1e6;
     std::printf("%s -> %s\n", input.c_str(), output.c_str());
+    if (r.texelBytes)
+      std::printf("  textures baked: %.2f MB of mip chains, %.2f MB stored\n", double(r.texelBytes) / 1e6,
+                  double(r.storedTexelBytes) / 1e6);
+    for (size_t l = 0; l < r.bcError.size(); ++l)
+      std::printf("  BC error vs lossless, level %2zu: mean %.3f LSB, max %d LSB (%llu samples)\n", l,
+                  r.bcError[l].samples ? r.bcError[l].sumAbs / double(r.bcError[l].samples) : 0.0, r.bcError[l].max,
+                  static_cast<unsigned long long>(r.bcError[l].samples));
     if (r.gltf) {
       std::printf("  meshes %zu, instances %zu, materials %zu, textures %zu (%zu images written from the glTF)\n", r.meshes,
                   r.instances, r.materials, r.textures, r.embeddedTextures);

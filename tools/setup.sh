@@ -7,7 +7,7 @@ set -euo pipefail
 BOOKWORM_PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates
   libvulkan-dev vulkan-validationlayers vulkan-tools glslang-tools glslang-dev spirv-tools spirv-headers
-  libglm-dev libglfw3-dev libstb-dev libzstd-dev zstd zlib1g-dev libtinyexr-dev libjpeg62-turbo-dev libpng-dev
+  libglm-dev libglfw3-dev libstb-dev libzstd-dev zstd libsquish-dev zlib1g-dev libtinyexr-dev libjpeg62-turbo-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev libcli11-dev libtinyobjloader-dev libmeshoptimizer-dev
   libdraco-dev gltfpack assimp-utils
   libimgui-dev xvfb xdotool x11-utils clang libclang-rt-14-dev clang-format python3 assimp-testmodels

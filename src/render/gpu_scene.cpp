@@ -14,8 +14,10 @@
 
 #include "cluster.h"
 #include "render/cull.hpp"
+#include "core/error.hpp"
 #include "core/image.hpp"
 #include "core/parallel.hpp"
+#include "scene/baked_texels.hpp"
 #include "scene/textures.hpp"
 #include "vk/check.hpp"
 #include "vk/commands.hpp"
@@ -29,9 +31,15 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 VkFormat textureFormat(const Texture& t) {
+  const bool srgb = decodeSrgb(t);
+  if (t.baked && t.baked->format == BakedFormat::Bc1) return srgb ? VK_FORMAT_BC1_RGB_SRGB_BLOCK : VK_FORMAT_BC1_RGB_UNORM_BLOCK;
+  if (t.baked && t.baked->format == BakedFormat::Bc3) return srgb ? VK_FORMAT_BC3_SRGB_BLOCK : VK_FORMAT_BC3_UNORM_BLOCK;
+  if (t.baked && t.baked->format == BakedFormat::Bc4) return VK_FORMAT_BC4_UNORM_BLOCK;
   if (decodeChannels(t) == 1) return VK_FORMAT_R8_UNORM;
-  return decodeSrgb(t) ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+  return srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
 }
+
+bool blockCompressed(VkFormat f) { return f >= VK_FORMAT_BC1_RGB_UNORM_BLOCK && f <= VK_FORMAT_BC7_SRGB_BLOCK; }
 
 }  // namespace
 
@@ -99,10 +107,47 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
   for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i])), samplers_.push_back(scene.textures[i].sampler);
   staged_.resize(used.size());
   stats_.textures = uint32_t(used.size());
+  VkPhysicalDeviceFeatures features{};
+  vkGetPhysicalDeviceFeatures(ctx_.physicalDevice(), &features);
+  for (VkFormat f : formats_)
+    if (blockCompressed(f) && !features.textureCompressionBC)
+      throw Error("this device samples no BC textures (textureCompressionBC); bake the scene with --textures lossless");
   auto decode = [this, &scene, used] {
     const auto t = Clock::now();
     std::mutex progressMutex;
-    decodeTextures(scene, used, [&](size_t i, TexelData&& texels) {
+    auto done = [&] {
+      const std::lock_guard lock(progressMutex);
+      const size_t n = ++decoded_;
+      if (progress_) progress_("decoding textures", n, staged_.size());
+    };
+    // Baked texels (.rtrscene version 6): every chain unpacked piece by piece on all cores straight into
+    // its staging buffer, whole (no decode, no mip pass); the others decoded from their images.
+    std::vector<uint32_t> images;
+    std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (GPU texture, piece)
+    for (uint32_t i = 0; i < used.size(); ++i) {
+      const BakedTexels* b = scene.textures[used[i]].baked.get();
+      if (!b) {
+        images.push_back(i);
+        continue;
+      }
+      Staged& s = staged_[i];
+      s.extent = {b->width, b->height};
+      s.levels = b->levelOffsets();
+      s.buffer = vk::Buffer(ctx_, s.levels.back(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
+      s.levels.pop_back();
+      for (uint32_t k = 0; k < b->pieces.size(); ++k) pieces.emplace_back(i, k);
+    }
+    std::vector<std::atomic<uint32_t>> left(used.size());
+    for (const auto& [i, k] : pieces) ++left[i];
+    parallelFor(pieces.size(), 0, [&](size_t p) {
+      const auto [i, k] = pieces[p];
+      unpackBakedPiece(*scene.textures[used[i]].baked, k, static_cast<uint8_t*>(staged_[i].buffer.mapped()));
+      if (--left[i] == 0) staged_[i].buffer.flush(), done();
+    });
+    std::vector<uint32_t> decodeOnly;
+    for (uint32_t i : images) decodeOnly.push_back(used[i]);
+    decodeTextures(scene, decodeOnly, [&](size_t j, TexelData&& texels) {
+      const size_t i = images[j];
       Staged& s = staged_[i];
       s.extent = {texels.width, texels.height};
       // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
@@ -114,9 +159,7 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
                             vk::MemoryUse::Upload);
       std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
       s.buffer.flush();
-      const std::lock_guard lock(progressMutex);
-      const size_t done = ++decoded_;
-      if (progress_) progress_("decoding textures", done, staged_.size());
+      done();
     });
     stats_.decodeMs = msSince(t);
   };
@@ -390,7 +433,10 @@ void GpuScene::startUpload() {
 
 void GpuScene::createTextures() {
   for (size_t i = 0; i < staged_.size(); ++i) {
-    textures_.emplace_back(ctx_, textureDesc(staged_[i].extent, formats_[i]));
+    vk::ImageDesc desc = textureDesc(staged_[i].extent, formats_[i]);
+    if (blockCompressed(formats_[i]))  // baked with its chain: copied into, sampled, nothing else
+      desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, desc.flags = 0, desc.viewUsage = 0;
+    textures_.emplace_back(ctx_, desc);
     hostMips_.push_back(!staged_[i].levels.empty());
   }
 }

@@ -12,6 +12,7 @@
 #include "core/bounds.hpp"
 #include "scene/binio.hpp"
 #include "core/parallel.hpp"
+#include "scene/rtrscene_texs.hpp"
 
 namespace rtr {
 namespace {
@@ -347,6 +348,29 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
   if (first.at != SIZE_MAX) r.failAt(first.at, first.what);
 }
 
+// Version 6: chunks to the end of the payload. An unknown or repeated tag is refused, named with its offset.
+void readChunks(ByteReader& r, std::span<const uint8_t> bytes, Scene& scene, const std::shared_ptr<const void>& owner,
+                const std::string& file) {
+  bool texs = false;
+  while (r.remaining() != 0) {
+    const size_t at = r.pos();
+    char tag[4];
+    r.raw(tag, 4, "a chunk header");
+    std::string name(tag, 4);
+    for (char& c : name) c = c >= 0x20 && c < 0x7F ? c : '?';
+    if (r.u32("a chunk header") != 0) r.failAt(at + 4, "chunk '" + name + "': reserved field is not 0");
+    const uint64_t size = r.pod<uint64_t>("a chunk header");
+    if (size > r.remaining())
+      r.failAt(at + 8, "chunk '" + name + "' of " + std::to_string(size) + " bytes: the file ends after " +
+                           std::to_string(r.remaining()));
+    if (name != "TEXS") r.failAt(at, "unknown chunk '" + name + "'");
+    if (texs) r.failAt(at, "chunk '" + name + "' repeated");
+    texs = true;
+    readTexs(r, r.pos() + size, bytes, scene, owner, file);
+    r.align(kAlign, "a chunk's padding");
+  }
+}
+
 }  // namespace
 
 std::string encodeRtrScene(const Scene& scene, uint32_t version) {
@@ -354,6 +378,8 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     throw Error("cannot encode .rtrscene version " + std::to_string(version) + (scene.lights.empty() ? "" : " with lights"));
   if (const std::string what = newerThan4(scene); version < 5 && !what.empty())
     throw Error("cannot encode .rtrscene version " + std::to_string(version) + " with " + what);
+  if (version < 6 && hasBakedTextures(scene))
+    throw Error("cannot encode .rtrscene version " + std::to_string(version) + " with baked textures");
   for (const Light& l : scene.lights)
     if (const char* f = lightFault(l)) throw Error(std::string("cannot encode a light: ") + f);
   for (const Instance& i : scene.instances)
@@ -486,6 +512,17 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     }
     w.pad(kAlign);
   }
+  // Version 6: chunks, each a 16-byte header {tag, 0, body size}, the body, pad16.
+  if (hasBakedTextures(scene)) {
+    w.bytes("TEXS", 4);
+    w.u32(0);
+    const size_t sizeAt = w.size();
+    w.pod(uint64_t(0));
+    writeTexs(w, scene);
+    const uint64_t body = w.size() - sizeAt - 8;
+    std::memcpy(w.data().data() + sizeAt, &body, 8);
+    w.pad(kAlign);
+  }
   std::string& out = w.data();
   const uint64_t payload = out.size() - kHeaderSize;
   const std::span<const uint8_t> payloadBytes{reinterpret_cast<const uint8_t*>(out.data()) + kHeaderSize, payload};
@@ -495,11 +532,12 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   return std::move(out);
 }
 
-Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, unsigned threads) {
+Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, unsigned threads,
+                     const std::shared_ptr<const void>& owner) {
   if (!bytes.empty() && reinterpret_cast<uintptr_t>(bytes.data()) % alignof(uint32_t) != 0) {  // arrays read in place
     std::vector<uint32_t> aligned((bytes.size() + 3) / 4);
     std::memcpy(aligned.data(), bytes.data(), bytes.size());
-    return decodeRtrScene({reinterpret_cast<const uint8_t*>(aligned.data()), bytes.size()}, file, threads);
+    return decodeRtrScene({reinterpret_cast<const uint8_t*>(aligned.data()), bytes.size()}, file, threads, nullptr);
   }
   if (threads == 0 && bytes.size() < (size_t(4) << 20)) threads = 1;  // a small file: starting threads costs more
   ByteReader r(bytes, file);
@@ -695,14 +733,16 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     r.align(kAlign, "clusters");
     m.clusters.resize(l.clusters);
   }
-  if (r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
+  if (version < 6 && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
+  readChunks(r, bytes, scene, owner, file);
   readArrays(bytes, scene, layout, threads, r);
   return scene;
 }
 
 Scene loadRtrScene(const std::filesystem::path& file) {
-  const MappedFile mapped(file);
-  Scene s = decodeRtrScene(mapped.bytes(), file.string());
+  // Kept mapped while baked texels point into it (until the scene's last texture goes).
+  const auto mapped = std::make_shared<const MappedFile>(file);
+  Scene s = decodeRtrScene(mapped->bytes(), file.string(), 0, mapped);
   s.baseDir = file.parent_path();
   return s;
 }

@@ -2,6 +2,7 @@
 // Our baked format (.rtrscene): versioned, scalar factors instead of fallback textures, 16-bit indices where
 // a mesh allows, 16-byte aligned arrays, a checksum over the payload. Byte table: docs/rtrscene-format.md.
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 
@@ -10,17 +11,22 @@
 namespace rtr {
 
 // 2 added lights, 3 clusters, 4 a checksum summed on all cores (pieceChecksum64), 5 what glTF brings
-// (instances, samplers, uv transforms, more attributes and light kinds); versions 1-4 still load.
-constexpr uint32_t kRtrSceneVersion = 5;
+// (instances, samplers, uv transforms, more attributes and light kinds), 6 chunks after the version-5
+// layout (TEXS: textures baked as the GPU samples them); versions 1-5 still load.
+constexpr uint32_t kRtrSceneVersion = 6;
 
 // `version` below the current one writes an older layout (lights need 2, clusters 3, the checksum of
 // version 4), for tests of the reader; a scene holding what only version 5 stores is refused in older
-// ones. Textures held in memory (Texture::bytes) are refused: the file names image files.
+// ones. Textures held in memory (Texture::bytes) are refused: the file names image files, or holds baked
+// texels (Texture::baked: all of a scene's textures or none; version 6).
 std::string encodeRtrScene(const Scene& scene, uint32_t version = kRtrSceneVersion);
 // Validates everything (sizes, counts, strings, indices, texture ids, finite values, clusters, checksum).
 // The checksum (version 4), the arrays and their checks run on `threads` threads (0: one per core, or
-// one for a file under 4 MiB); the scene and any fault reported do not depend on the count.
-Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, unsigned threads = 0);
+// one for a file under 4 MiB); the scene and any fault reported do not depend on the count. Baked texels
+// are checked for layout here and unpacked by their user (scene/baked_texels.hpp); they point into `bytes`
+// kept alive by `owner`, or without one into a copy of the TEXS chunk.
+Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, unsigned threads = 0,
+                     const std::shared_ptr<const void>& owner = {});
 Scene loadRtrScene(const std::filesystem::path& file);
 
 }  // namespace rtr

@@ -20,6 +20,8 @@
 
 namespace rtr {
 
+struct BakedTexels;  // scene/baked_texels.hpp
+
 // Texture slots: the course format's six in its order (docs/formats.md), then glTF's occlusion, which
 // the course format does not store.
 enum class TextureSlot : uint32_t { BaseColor, Roughness, Metalness, AlphaMask, NormalMap, Emissive, Occlusion, Count };
@@ -46,6 +48,9 @@ struct Texture {
   SamplerDesc sampler;
   // The encoded image (PNG, JPEG) held in memory: a glTF data URI or buffer view. Null: read `path`.
   std::shared_ptr<const std::vector<uint8_t>> bytes;
+  // The full mip chain as the GPU samples it (.rtrscene version 6, scene/baked_texels.hpp): when set, it is
+  // used instead of decoding, and `path` only names the texture's source image in messages.
+  std::shared_ptr<const BakedTexels> baked;
 };
 
 // KHR_texture_transform: uv' = offset + R(rotation) · (scale ⊙ uv), taken from texcoord set `texCoord`.

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "scene/baked_texels.hpp"
 
 namespace rtr {
 
@@ -35,6 +36,7 @@ int decodeChannels(const Texture& t) { return t.channels == 1 ? 1 : 4; }
 bool decodeSrgb(const Texture& t) { return t.srgb && decodeChannels(t) == 4; }
 
 TexelData decodeTexture(const Scene& scene, const Texture& t) {
+  if (t.baked) return unpackBakedLevel0(*t.baked);  // its channel already picked at bake time
   const int channels = decodeChannels(t);
   const bool pick = channels == 1 && t.sourceChannel > 0;  // one channel of a colour image
   TexelData d = t.bytes ? decodeImage(*t.bytes, t.path.string(), pick ? 4 : channels)
@@ -71,7 +73,7 @@ void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
     std::string why;
     std::error_code ec;
     const std::filesystem::path file = t.path.is_absolute() ? t.path : scene.baseDir / t.path;
-    if (!t.bytes && !std::filesystem::is_regular_file(file, ec)) {
+    if (!t.bytes && !t.baked && !std::filesystem::is_regular_file(file, ec)) {
       why = file.string() + ": texture file does not exist";
     } else {
       try {

@@ -35,8 +35,8 @@ bool decodeSrgb(const Texture& t);
 // 8-texel cells (one channel: 255/0), so the fault is visible in every renderer.
 TexelData fallbackTexels(int channels);
 
-// One texture's texels: Texture::bytes when set (else the file), `sourceChannel` taken for one-channel
-// textures. Throws rtr::Error naming the file (or the image's name).
+// One texture's texels: level 0 of Texture::baked when set, else Texture::bytes when set, else the file;
+// `sourceChannel` taken for one-channel textures. Throws rtr::Error naming the file (or the image's name).
 TexelData decodeTexture(const Scene& scene, const Texture& t);
 
 // Decodes scene.textures[which[i]] for every i on all cores and hands the texels to use(i, texels) on the

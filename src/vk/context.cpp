@@ -211,6 +211,7 @@ Context::Context(const ContextOptions& options) {
     vkGetPhysicalDeviceFeatures(physical_, &supported);
     f2.features.geometryShader = supported.geometryShader;
     f2.features.samplerAnisotropy = supported.samplerAnisotropy;  // the viewer's --anisotropy; optional
+    f2.features.textureCompressionBC = supported.textureCompressionBC;  // textures baked as BC; optional
     // The compute rasteriser (render/raster.hpp): 64-bit atomicMin on a storage buffer, also from the
     // fragment stage for the triangles it hands to the hardware; optional, enabled where all are supported.
     VkPhysicalDeviceVulkan12Features s12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};

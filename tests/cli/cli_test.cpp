@@ -180,6 +180,8 @@ TEST_F(Cli, BadOptionValuesAreUsageErrorsNamingTheOption) {
       {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light", "0,1,0", "--light-color", "-1,1,1"}, "--light-color"},
       {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--light", ""}, "--light"},
       {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--view", ""}, "--view"},
+      {"rtr-bake", {c, (dir / "x.rtrscene").string(), "--textures", "png"}, "--textures"},
+      {"rtr-bake", {c, (dir / "x.comp5892mesh").string(), "--textures", "bc"}, "--textures files"},
       {"rtr-trace", {c, "-o", png, "--light", "0,1,0", "--light-color", ""}, "--light-color"},
       {"rtr-trace", {c, "-o", png, "--light", "0,1,0", "--light-color", "-1,0,0"}, "--light-color"},
       {"rtr-trace", {c, "-o", png, "--ambient", "-0.5"}, "--ambient"},

@@ -8,7 +8,10 @@
 
 #include "bake.hpp"
 #include "core/error.hpp"
+#include "core/mip_reference.hpp"
+#include "scene/baked_texels.hpp"
 #include "scene/course.hpp"
+#include "scene/textures.hpp"
 #include "scene/load.hpp"
 #include "scene/rtrscene.hpp"
 #include "test_paths.hpp"
@@ -171,4 +174,46 @@ TEST(RoundTrip, MappedFileLoadsWhatTheBytesDecodeTo) {
     }
   }
   std::filesystem::remove_all(dir);
+}
+
+// --textures lossless: no texture file is written; each texture's chain in the file is its source image
+// (level 0, the slot's channel taken) and the reference filter's levels below it, in linear light for sRGB
+// colour (core/mip_reference.hpp), laid out as BakedTexels::levelOffsets says.
+TEST(RoundTrip, LosslessTexturesAreTheReferenceChainsInTheFile) {
+  const Scene want = planned(false);
+  const Scene source = loadScene(rtr::test::sourceDir() / "assets-src/temple/temple.obj.zst");
+  const fs::path dir = tempDir("rt_lossless");
+  BakeOptions o{rtr::test::sourceDir() / "assets-src/temple/temple.obj.zst", dir / "temple.rtrscene"};
+  o.textures = TextureStore::Lossless;
+  o.threads = 2;
+  const BakeReport rep = bake(o);
+  EXPECT_FALSE(fs::exists(dir / "temple-tex")) << "no texture file is written";
+  EXPECT_GT(rep.texelBytes, rep.storedTexelBytes);
+  const Scene got = loadScene(o.output);
+  expectSameMeshes(want, got);
+  expectSameTextures(want, got);
+  ASSERT_EQ(got.textures.size(), source.textures.size());
+  bool srgbSeen = false, greySeen = false;
+  for (size_t i = 0; i < got.textures.size(); ++i) {
+    const Texture& t = got.textures[i];
+    ASSERT_TRUE(t.baked) << t.path;
+    const BakedTexels& b = *t.baked;
+    std::vector<uint8_t> chain(b.bytes());
+    for (size_t k = 0; k < b.pieces.size(); ++k) unpackBakedPiece(b, k, chain.data());
+    const int channels = t.channels == 1 ? 1 : 4;
+    const TexelData level0 = decodeTexture(source, source.textures[i]);
+    ASSERT_EQ(int(level0.channels), channels);
+    const bool srgb = t.srgb && channels == 4;
+    srgbSeen |= srgb;
+    greySeen |= channels == 1;
+    const MipChain ref = buildMipReference(level0, srgb ? TexelEncoding::Srgb : TexelEncoding::Unorm, MipSource::PreviousLevel);
+    const std::vector<uint64_t> at = b.levelOffsets();
+    ASSERT_EQ(b.levels(), ref.levels.size());
+    for (uint32_t l = 0; l < b.levels(); ++l) {
+      const std::vector<uint8_t> expect = l == 0 ? level0.texels : quantizeMipLevel(ref, l);
+      EXPECT_TRUE(std::equal(expect.begin(), expect.end(), chain.begin() + ptrdiff_t(at[l]))) << t.path << " level " << l;
+    }
+  }
+  EXPECT_TRUE(srgbSeen && greySeen) << "both kinds of texture are covered";
+  fs::remove_all(dir);
 }
