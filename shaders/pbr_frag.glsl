@@ -1,7 +1,10 @@
-// The shaded view (mode 1): the brief's Beckmann / Cook-Torrance model summed over the frame's lights, per fragment,
-// in world space. The BRDF itself lives in brdf.h, shared with the CPU reference.
+// The shaded view (mode 1): the material's BRDF (brdf.h) summed over the frame's lights, per fragment, in
+// world space, plus the environment's split sum in the HAS_ENV variants (env_light.glsl). The BRDF itself lives in brdf.h, shared with the CPU reference.
 #include "material.glsl"
 #include "brdf.h"
+#ifdef HAS_ENV
+#include "env_light.glsl"
+#endif
 
 layout(location = 0) out vec4 outColor;
 
@@ -26,5 +29,8 @@ void main() {
     LightSample ls = lightSample(frame.lights[i], inWorldPos);  // point, spot or directional (lights.h)
     c += pbrDirect(brdf, n, v, ls.l, ls.radiance, s.baseColor, s.roughness, s.metalness);
   }
+#ifdef HAS_ENV
+  c += envLight(brdf, n, v, s.baseColor, s.roughness, s.metalness, s.occlusion);
+#endif
   outColor = vec4(min(c, vec3(kMaxRadiance)), 1.0);
 }

@@ -1,6 +1,7 @@
 // Visibility path, shading in compute (ShadingPath::Visibility, mode 1): one thread per pixel reads the
 // visible triangle's ids, rebuilds the triangle from the index and vertex buffers, intersects the pixel's
-// ray with it for perspective-correct barycentrics, and shades with the same brdf.h as pbr_frag.glsl.
+// ray with it for perspective-correct barycentrics, and shades with the same brdf.h as pbr_frag.glsl (and
+// env_light.glsl's environment in the HAS_ENV variants). Empty pixels get the backdrop.
 // Texture LOD: the texcoord differences to the quad neighbour, like the rasteriser's fine derivatives
 // (docs/shading.md, "Visibility path").
 #extension GL_GOOGLE_include_directive : require
@@ -34,6 +35,9 @@ layout(set = 0, binding = 11, std430) readonly buffer Texcoords1 { vec2 texcoord
 layout(set = 0, binding = 12, std430) readonly buffer Tangents { vec4 tangents[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Colors { vec4 colors[]; };
 layout(push_constant) uniform Push { VisShadePush pc; };
+#ifdef HAS_ENV
+#include "env_light.glsl"
+#endif
 
 const float kMaxRadiance = 60000.0;  // as pbr_frag.glsl: stay below the half-float maximum
 
@@ -75,8 +79,13 @@ void main() {
 #else
   const uint packed = texelFetch(visibility, p, 0).x;
 #endif
-  if (packed == VIS_EMPTY) {
-    imageStore(sceneColor, p, vec4(0.0, 0.0, 0.0, 1.0));  // the forward pass's clear colour
+  const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
+  if (packed == VIS_EMPTY) {  // the backdrop: the forward pass's clear colour, or the environment
+#ifdef HAS_ENV
+    imageStore(sceneColor, p, vec4(min(envBackdrop(dir), vec3(kMaxRadiance)), 1.0));
+#else
+    imageStore(sceneColor, p, vec4(frame.background.rgb, 1.0));
+#endif
     return;
   }
   const GpuInstance inst = instances[packed >> pc.primitiveBits];
@@ -89,7 +98,6 @@ void main() {
   const vec3 e1 = p1 - p0, e2 = p2 - p0, s = frame.cameraPos.xyz - p0;
   const vec3 n = cross(e1, e2), a = cross(e2, s), b = cross(s, e1);
 
-  const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
   const vec3 w = clamp(barycentrics(dir, a, b, n), 0.0, 1.0);  // the rasteriser covered this pixel centre
   const vec3 worldPos = p0 * w.x + p1 * w.y + p2 * w.z;
   // Two-sided materials light their back faces with the flipped normal (front: counter-clockwise seen
@@ -147,11 +155,14 @@ void main() {
   }
 
   const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
-  const int brdf = (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
+  const int brdf = frame.options.x != 0u ? int(frame.options.x) - 1 : (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
   vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) * occlusion + emissive;
   for (uint i = 0u; i < frame.lightCount.x; ++i) {
     const LightSample ls = lightSample(frame.lights[i], worldPos);  // point, spot or directional (lights.h)
     c += pbrDirect(brdf, nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
   }
+#ifdef HAS_ENV
+  c += envLight(brdf, nrm, v, baseColor, roughness, metalness, occlusion);
+#endif
   imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
 }

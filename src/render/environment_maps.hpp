@@ -31,7 +31,8 @@ class EnvironmentMaps {
 
   const vk::Image& source() const { return source_; }      // RGBA32F cube with mips
   const vk::Image& specular() const { return specular_; }  // RGBA16F cube, roughness per mip
-  const vk::Image& brdfLut() const { return lut_; }        // RG16F (A, B)
+  // RGBA16F (A, B, C, 0), lutSize wide and 2 lutSize high: Beckmann's rows, then GGX's (envLutUv).
+  const vk::Image& brdfLut() const { return lut_; }
   VkBuffer sh() const { return sh_.handle(); }             // 9 vec4: rgb coefficients
   VkSampler sampler() const { return sampler_; }           // linear, mips, clamped
   const EnvironmentMapSettings& settings() const { return settings_; }

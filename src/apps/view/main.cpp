@@ -11,6 +11,8 @@
 #include "view_state.hpp"
 #include "render/startup.hpp"
 #include "scene/first_look.hpp"
+#include "trace/tracer.hpp"
+#include "brdf.h"
 #include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "vk/context.hpp"
@@ -46,8 +48,20 @@ void checkSizeFits(const ViewOptions& o, const vk::Context& ctx) {
 render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
   render::RenderSettings s = o.settings;
   s.lights = resolveLights(scene, o.lightOptions);
+  const cli::Backdrop b = cli::backdrop(o.env);
+  s.background = b.color;
+  s.backdropBlur = b.blur;
   if (!s.lights.note.empty()) std::fprintf(stderr, "rtr-view: note: %s\n", s.lights.note.c_str());
   return s;
+}
+
+std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx) {
+  if (!cli::hasEnvironment(o.env)) return nullptr;
+  auto maps = std::make_shared<const render::EnvironmentMaps>(ctx, Environment::load(o.env.env));
+  std::fprintf(stderr, "rtr-view: environment %s prefiltered:", o.env.env.source.c_str());
+  for (const auto& [name, ms] : maps->times()) std::fprintf(stderr, " %s %.3f ms", name.c_str(), ms);
+  std::fprintf(stderr, " GPU\n");
+  return maps;
 }
 
 vk::ContextOptions contextOptions(const ViewOptions& o) {
@@ -158,10 +172,14 @@ int main(int argc, char** argv) {
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
       ->needs(lightOpt)->check(cli::checked([](const std::string& t) { cli::parseColor("--light-color", t); }, "R,G,B"));
   app.add_flag("--falloff", o.lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
-  app.add_option("--ambient", ambient, "ambient colour r,g,b (or one grey value)")->capture_default_str()
+  CLI::Option* ambientOpt = app.add_option("--ambient", ambient, "ambient colour r,g,b (or one grey value); 0 with --env")->capture_default_str()
       ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
   bool noDefaultLight = false, noPipelineCache = false, noWaitTextures = false;
   std::string up = "+Y";
+  cli::addEnvOptions(app, o.env);
+  std::string brdf;
+  app.add_option("--brdf", brdf, "beckmann | ggx for every material (default: ggx for glTF materials, beckmann for the "
+                 "rest), as rtr-trace's")->check(cli::oneOf<trace::Brdf>());
   app.add_flag("--no-default-light", noDefaultLight,
                "a scene without lights gets no headlight (only ambient and emission light it)");
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
@@ -202,7 +220,8 @@ int main(int argc, char** argv) {
     o.pipelineCache = !noPipelineCache;
     if (!light.empty()) o.lightOptions.position = cli::parseVec3("--light", light);
     if (!lightColor.empty()) o.lightOptions.color = cli::parseColor("--light-color", lightColor);
-    o.lightOptions.ambient = cli::parseColor("--ambient", ambient, true);
+    o.lightOptions.ambient = cli::hasEnvironment(o.env) && !ambientOpt->count() ? glm::vec3(0.0f) : cli::parseColor("--ambient", ambient, true);
+    if (!brdf.empty()) o.settings.brdf = cli::enumOption<trace::Brdf>("--brdf", brdf) == trace::Brdf::Ggx ? BRDF_GGX : BRDF_BECKMANN;
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);

@@ -97,6 +97,7 @@ int runWindowed(const ViewOptions& opts) {
   SceneSlot slot(ctx, window.surface(), std::move(scene), o.files, waitTextures,
                  [dropped](const std::string& path) { return loadForView(dropped, path); });
   slot.build({o.width, o.height}, app.mips);
+  slot.setEnvironment(loadEnvironment(o, ctx));
   clock.phase(waitTextures ? "scene to the GPU (geometry, textures, mips), swapchain" : "geometry to the GPU, swapchain");
 
   ShaderReload shaders(o.watch);
