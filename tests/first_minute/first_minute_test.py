@@ -41,7 +41,8 @@ def run(cmd):
 def render(bins, out, model, extra, tool):
     png = os.path.join(out, f"{os.path.basename(model)}.{tool}.png")
     size = f"{SIZE[0]}x{SIZE[1]}"
-    cmd = ([f"{bins}/rtr-view", model, "--headless", "-o", png, "--size", size, "--force"] if tool == "view" else
+    # rtr-view's backdrop is mid grey, rtr-trace's black: the pictures are compared on the same backdrop.
+    cmd = ([f"{bins}/rtr-view", model, "--headless", "-o", png, "--size", size, "--force", "--background", "0"] if tool == "view" else
            [f"{bins}/rtr-trace", model, "-o", png, "--size", size, "--force"]) + extra
     r = run(cmd)
     return r, png

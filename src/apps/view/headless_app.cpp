@@ -23,14 +23,17 @@
 namespace rtr::view {
 namespace {
 
-// Whether any pixel differs from a plain colour backdrop (an environment backdrop: taken as lit).
+// Whether any pixel is neither black nor the plain colour backdrop (an environment backdrop: taken as lit).
 bool anyLit(const ImageRGBA8& img, const render::RenderSettings& s) {
   if (s.backdropBlur >= 0.0f) return true;
-  uint8_t bg[3];
-  for (int c = 0; c < 3; ++c) bg[c] = uint8_t(std::lround(255.0f * linearToSrgb(std::clamp(s.background[c], 0.0f, 1.0f))));
-  for (size_t i = 0; i < img.pixels.size(); i += 4)
-    for (int c = 0; c < 3; ++c)
-      if (std::abs(int(img.pixels[i + c]) - int(bg[c])) > 1) return true;
+  int bg[3];
+  for (int c = 0; c < 3; ++c) bg[c] = int(std::lround(255.0f * linearToSrgb(std::clamp(s.background[c], 0.0f, 1.0f))));
+  for (size_t i = 0; i < img.pixels.size(); i += 4) {
+    const uint8_t* p = &img.pixels[i];
+    const bool black = !(p[0] | p[1] | p[2]);
+    const bool backdrop = std::abs(p[0] - bg[0]) <= 1 && std::abs(p[1] - bg[1]) <= 1 && std::abs(p[2] - bg[2]) <= 1;
+    if (!black && !backdrop) return true;
+  }
   return false;
 }
 

@@ -57,6 +57,7 @@ void startErrorMap(ViewState& app, SceneSlot& slot, const Lens& lens, ImageRGBA8
   ts.shadows = false;
   ts.bounces = 0;
   ts.lens.orthographic = false;
+  ts.background = app.settings.background;  // the raster's backdrop colour (the tracer has no environment here)
   slot.traced().start(ts, std::move(raster));  // traced on the CPU's cores while frames go on
 }
 
