@@ -129,12 +129,14 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kCompute}, {specular_.tracked(), vk::Use::Storage, kCompute, true},
                      {lut_.tracked(), vk::Use::Storage, kCompute, true}});
     spec.bind(cb);
-    pc.samples = s.samples;
     pc.srcLevels = sourceLevels;
     pc.srcTexelSolidAngle = 4.0f * shader::BRDF_PI / (6.0f * float(s.sourceSize) * float(s.sourceSize));
     for (uint32_t l = 0; l < s.specularLevels; ++l) {
       pc.size = s.specularSize >> l;
       pc.roughness = float(l) / float(s.specularLevels - 1);
+      // Roughness 0's lobe is narrower than its texel: one sample. Rougher levels have 4 times fewer
+      // texels each and wider lobes over a bright sun: twice the samples of the level before.
+      pc.samples = l == 0 ? 1u : s.samples << (l - 1);
       vk::DescriptorWriter(ctx, spec.layout, 0, VK_NULL_HANDLE)
           .image(0, sourceCube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler_)
           .image(1, specularLevelViews[l], VK_IMAGE_LAYOUT_GENERAL)
