@@ -9,6 +9,7 @@
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 
+#include "brdf.h"
 #include "options.hpp"
 #include "scene_camera.hpp"
 #include "scene_slot.hpp"
@@ -32,6 +33,8 @@ trace::TraceSettings traceSettings(const ViewState& app, VkExtent2D e, const Len
   ts.bounces = app.traceReflections ? trace::N_BOUNCES : 0;
   ts.lights = app.settings.lights;
   ts.lodBias = app.settings.lodBias;
+  ts.background = app.settings.background;  // the backdrop colour (the tracer has no environment here)
+  if (app.settings.brdf) ts.brdf = *app.settings.brdf == BRDF_GGX ? trace::Brdf::Ggx : trace::Brdf::Beckmann;
   return ts;
 }
 
@@ -57,7 +60,6 @@ void startErrorMap(ViewState& app, SceneSlot& slot, const Lens& lens, ImageRGBA8
   ts.shadows = false;
   ts.bounces = 0;
   ts.lens.orthographic = false;
-  ts.background = app.settings.background;  // the raster's backdrop colour (the tracer has no environment here)
   slot.traced().start(ts, std::move(raster));  // traced on the CPU's cores while frames go on
 }
 
