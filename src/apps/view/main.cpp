@@ -216,7 +216,8 @@ int main(int argc, char** argv) {
     if (!camera.empty()) o.camera = cli::parsePose("--camera", camera);
     if (!mtl.empty()) o.load.mtl = mtl;
     o.up = upRotation(up);
-    o.lightOptions.defaultLight = !noDefaultLight;
+    // The environment is the light: no headlight stands in for it (as rtr-trace).
+    o.lightOptions.defaultLight = !noDefaultLight && !cli::hasEnvironment(o.env);
     o.pipelineCache = !noPipelineCache;
     if (!light.empty()) o.lightOptions.position = cli::parseVec3("--light", light);
     if (!lightColor.empty()) o.lightOptions.color = cli::parseColor("--light-color", lightColor);
