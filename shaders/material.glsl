@@ -69,7 +69,11 @@ Surface fetchSurface() {
 }
 
 bool cutOut(Surface s) { return s.alpha < materials[draw.material].roughMetal.z; }
-int brdfOf() { return (materials[draw.material].textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN; }
+// The frame's --brdf where given, else the material's own.
+int brdfOf() {
+  if (frame.options.x != 0u) return int(frame.options.x) - 1;
+  return (materials[draw.material].textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
+}
 bool unlit() { return (materials[draw.material].textures2.w & MATERIAL_UNLIT) != 0u; }
 
 // Two-sided materials light their back faces with the flipped normal.

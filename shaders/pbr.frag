@@ -1,9 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The shaded view (mode 1): the brief's Beckmann / Cook-Torrance model summed over the frame's lights, per fragment,
-// in world space. The BRDF itself lives in brdf.h, shared with the CPU reference.
+// The shaded view (mode 1): the material's BRDF (brdf.h, shared with the CPU reference) summed over the
+// frame's lights, per fragment, in world space, plus the environment's split sum in the HAS_ENV variant.
 #include "material.glsl"
 #include "brdf.h"
+#include "env_light.glsl"
 
 layout(location = 0) out vec4 outColor;
 
@@ -28,5 +29,6 @@ void main() {
     LightSample ls = lightSample(frame.lights[i], inWorldPos);  // point, spot or directional (lights.h)
     c += pbrDirect(brdf, n, v, ls.l, ls.radiance, s.baseColor, s.roughness, s.metalness);
   }
+  if (HAS_ENV) c += envLight(brdf, n, v, s.baseColor, s.roughness, s.metalness, s.occlusion);
   outColor = vec4(min(c, vec3(kMaxRadiance)), 1.0);
 }

@@ -34,6 +34,7 @@ layout(set = 0, binding = 11, std430) readonly buffer Texcoords1 { vec2 texcoord
 layout(set = 0, binding = 12, std430) readonly buffer Tangents { vec4 tangents[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Colors { vec4 colors[]; };
 layout(push_constant) uniform Push { VisShadePush pc; };
+#include "env_light.glsl"
 
 const float kMaxRadiance = 60000.0;  // as pbr.frag: stay below the half-float maximum
 
@@ -71,8 +72,9 @@ void main() {
   uint packed;
   if (VIS_BUFFER) packed = visibilityBuffer[p.y * imageSize(sceneColor).x + p.x].x;
   else packed = texelFetch(visibilityImage, p, 0).x;
-  if (packed == VIS_EMPTY) {
-    imageStore(sceneColor, p, vec4(0.0, 0.0, 0.0, 1.0));  // the forward pass's clear colour
+  const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
+  if (packed == VIS_EMPTY) {  // the backdrop: the forward pass's clear colour, or the environment
+    imageStore(sceneColor, p, vec4(HAS_ENV ? min(envBackdrop(dir), vec3(kMaxRadiance)) : frame.background.rgb, 1.0));
     return;
   }
   const GpuInstance inst = instances[packed >> pc.primitiveBits];
@@ -85,7 +87,6 @@ void main() {
   const vec3 e1 = p1 - p0, e2 = p2 - p0, s = frame.cameraPos.xyz - p0;
   const vec3 n = cross(e1, e2), a = cross(e2, s), b = cross(s, e1);
 
-  const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
   const vec3 w = clamp(barycentrics(dir, a, b, n), 0.0, 1.0);  // the rasteriser covered this pixel centre
   const vec3 worldPos = p0 * w.x + p1 * w.y + p2 * w.z;
   // Two-sided materials light their back faces with the flipped normal (front: counter-clockwise seen
@@ -141,11 +142,12 @@ void main() {
   }
 
   const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
-  const int brdf = (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
+  const int brdf = frame.options.x != 0u ? int(frame.options.x) - 1 : (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
   vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) * occlusion + emissive;
   for (uint i = 0u; i < frame.lightCount.x; ++i) {
     const LightSample ls = lightSample(frame.lights[i], worldPos);  // point, spot or directional (lights.h)
     c += pbrDirect(brdf, nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
   }
+  if (HAS_ENV) c += envLight(brdf, nrm, v, baseColor, roughness, metalness, occlusion);
   imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
 }

@@ -21,6 +21,9 @@ void main() {
   const vec3 t = envTangent(n), b = cross(n, t);
   // Never finer than this level's own texels: a texel averages its footprint (roughness 0 too).
   const float lodMin = 0.5 * log2(4.0 * BRDF_PI / (6.0 * float(pc.size * pc.size)) / pc.srcTexelSolidAngle);
+  // Never coarser than faces of 8² texels: a cube's coarsest levels (1², 2², 4² a face) are bilinear
+  // within each face only, and a bright texel there paints the lobe with the faces' outlines.
+  const float lodMax = max(float(pc.srcLevels) - 4.0, 0.0);
   vec3 sum = vec3(0.0);
   float weight = 0.0;
   for (uint i = 0u; i < pc.samples; ++i) {
@@ -32,7 +35,7 @@ void main() {
     // pdf(l) = D n.h / (4 v.h) = D / 4 with v = n; the sample stands for 1 / (N pdf) steradians.
     const float pdf = brdfGgxD(vec3(0.0, 0.0, 1.0), hl, alpha) * 0.25;
     const float omega = 1.0 / (float(pc.samples) * pdf + 1e-20);
-    const float lod = clamp(max(0.5 * log2(omega / pc.srcTexelSolidAngle), lodMin), 0.0, float(pc.srcLevels - 1u));
+    const float lod = clamp(max(0.5 * log2(omega / pc.srcTexelSolidAngle), lodMin), 0.0, lodMax);
     sum += textureLod(src, l, lod).rgb * nl;
     weight += nl;
   }

@@ -60,28 +60,72 @@ RTR_FN vec3 envTangent(vec3 n) {
   return normalize(cross(up, n));
 }
 
-// One row of the split-sum table: for view angle n.v and roughness, the scale A and bias B such that the
-// GGX specular's hemispherical integral under uniform white light is F0 A + B (Schlick Fresnel), by
-// `samples` half vectors drawn from D. Evaluated the same way on the GPU (env_brdf_lut.comp) and the CPU.
-RTR_FN vec2 envBrdfLut(float nv, float roughness, uint samples) {
+// A Beckmann half vector (alpha = roughness²) drawn in proportion to D(h) (h.n): tan²θ = -alpha² ln(1 - u).
+RTR_FN vec3 envBeckmannHalf(vec2 u, float alpha) {
+  float phi = 2.0f * BRDF_PI * u.x;
+  float t2 = -alpha * alpha * log(max(1.0f - u.y, 1e-30f));
+  float c = 1.0f / sqrt(1.0f + t2), s = sqrt(max(1.0f - c * c, 0.0f));
+  return vec3(s * cos(phi), s * sin(phi), c);
+}
+
+// One texel of the split-sum table for BRDF `brdf` (brdf.h's BRDF_BECKMANN or BRDF_GGX): for view angle
+// n.v and roughness, (A, B, C) such that under uniform white light
+//   * the specular's hemispherical integral is F0 A + B (Schlick Fresnel; A, B by `samples` half vectors
+//     drawn from the BRDF's own D, f cos / pdf = F V 4 n.l v.h / n.h);
+//   * the diffuse's is c (1 - M)(1 - F0d)(1 - C), with C the cosine-weighted mean of (1 - v.h)^5 over the
+//     hemisphere (the Fresnel weight both diffuse terms of brdf.h carry; F0d = 0.04 for GGX, F0 for
+//     Beckmann), by `samples` cosine-distributed light directions. C depends on n.v only.
+// Evaluated the same way on the GPU (env_brdf_lut.comp) and the CPU.
+RTR_FN vec3 envBrdfLut(int brdf, float nv, float roughness, uint samples) {
   float alpha = max(roughness * roughness, BRDF_ALPHA_MIN);
   nv = max(nv, 1e-4f);
   vec3 v = vec3(sqrt(max(1.0f - nv * nv, 0.0f)), 0.0f, nv);
-  float a = 0.0f, b = 0.0f;
+  float a = 0.0f, b = 0.0f, cw = 0.0f;
   for (uint i = 0u; i < samples; ++i) {
-    vec3 h = envGgxHalf(envHammersley(i, samples), alpha);
+    vec2 u = envHammersley(i, samples);
+    vec3 h = brdf == BRDF_GGX ? envGgxHalf(u, alpha) : envBeckmannHalf(u, alpha);
     float vh = dot(v, h);
     vec3 l = 2.0f * vh * h - v;
     float nl = l.z, nh = h.z;
     if (nl > 0.0f && vh > 0.0f) {
-      // f cos / pdf with pdf(l) = D n.h / (4 v.h):  F · V · 4 · nl · vh / nh.
-      float w = brdfGgxVisibility(nv, nl, alpha) * 4.0f * nl * vh / nh;
+      vec3 H = v + l;
+      float V = brdf == BRDF_GGX ? brdfGgxVisibility(nv, nl, alpha) : brdfVisibility(nv, nl, H.z, dot(H, H));
+      float w = V * 4.0f * nl * vh / nh;
       float fc = pow(1.0f - vh, 5.0f);
       a += (1.0f - fc) * w;
       b += fc * w;
     }
+    // Cosine-distributed l: the diffuse's Fresnel weight.
+    float r = sqrt(u.y), phi = 2.0f * BRDF_PI * u.x;
+    vec3 ld = vec3(r * cos(phi), r * sin(phi), sqrt(max(1.0f - u.y, 0.0f)));
+    vec3 hd = v + ld;
+    float vhd = 0.5f * sqrt(dot(hd, hd));  // v.h for unit v, l
+    cw += pow(1.0f - vhd, 5.0f);
   }
-  return vec2(a, b) / float(samples);
+  return vec3(a, b, cw) / float(samples);
+}
+
+// Where the shading passes read the table: block `brdf` of rows (the table is `size` wide, 2 size high:
+// BRDF_BECKMANN's rows, then BRDF_GGX's), clamped to texel centres so bilinear filtering never mixes them.
+RTR_FN vec2 envLutUv(int brdf, float nv, float roughness, float size) {
+  float lo = 0.5f / size, hi = 1.0f - 0.5f / size;
+  vec2 t = clamp(vec2(nv, roughness), vec2(lo), vec2(hi));
+  return vec2(t.x, (t.y + float(brdf)) * 0.5f);
+}
+
+// The split sum (docs/environment.md): what the environment adds to a surface, from the diffuse
+// irradiance E(n) (spherical harmonics), the specular cube's radiance along the mirror direction at the
+// surface's roughness, and the table's (A, B, C) at (n.v, roughness) for the same BRDF as brdf.h's:
+//   diffuse  = E/pi c (1 - M)(1 - F0d)(1 - C)   (exact for uniform light: brdf.h's diffuse integrated)
+//   specular = prefiltered (F0 A + B)           (F0 = mix(0.04, c, M))
+// For uniform radiance 1 (E = pi, prefiltered = 1) this is the BRDF's directional albedo, <= 1.
+RTR_FN vec3 envSplitSum(int brdf, vec3 irradiance, vec3 prefiltered, vec3 abc, vec3 baseColor, float metalness) {
+  vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
+  float m = clamp(metalness, 0.0f, 1.0f);
+  vec3 F0 = mix(vec3(0.04f), c, m);
+  vec3 F0d = brdf == BRDF_GGX ? vec3(0.04f) : F0;
+  vec3 diffuse = irradiance * (1.0f / BRDF_PI) * c * (1.0f - m) * (vec3(1.0f) - F0d) * (1.0f - abc.z);
+  return diffuse + prefiltered * (F0 * abc.x + vec3(abc.y));
 }
 
 // Push constants of the prefiltering passes.

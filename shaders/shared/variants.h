@@ -7,10 +7,12 @@
 #define VARIANT_TEXCOORDS 0   // the scene has texture coordinates: materials' textures are sampled
 #define VARIANT_ALPHA_MASK 1  // the fragment stage cuts out by the material's alpha (foliage)
 #define VARIANT_VIS_BUFFER 2  // vis_shade reads the compute rasteriser's 64-bit buffer, not the id image
+#define VARIANT_ENV 3         // the shaded view adds an environment's light (env_light.glsl) and shows its backdrop
 
 #ifndef __cplusplus
 layout(constant_id = VARIANT_TEXCOORDS) const bool HAS_TEXCOORDS = true;
 layout(constant_id = VARIANT_ALPHA_MASK) const bool ALPHA_MASK = false;
 layout(constant_id = VARIANT_VIS_BUFFER) const bool VIS_BUFFER = false;
+layout(constant_id = VARIANT_ENV) const bool HAS_ENV = false;
 #endif
 #endif

@@ -62,7 +62,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
   source_ = vk::Image(ctx, {{s.sourceSize, s.sourceSize}, kSourceFormat, sourceLevels, kRw, 0, 0, "environment source cube", true});
   specular_ = vk::Image(ctx, {{s.specularSize, s.specularSize}, VK_FORMAT_R16G16B16A16_SFLOAT, s.specularLevels, kRw, 0, 0,
                               "environment specular cube", true});
-  lut_ = vk::Image(ctx, {{s.lutSize, s.lutSize}, VK_FORMAT_R16G16_SFLOAT, 1, kRw, 0, 0, "split-sum table"});
+  lut_ = vk::Image(ctx, {{s.lutSize, 2 * s.lutSize}, VK_FORMAT_R16G16B16A16_SFLOAT, 1, kRw, 0, 0, "split-sum table"});
   sh_ = vk::Buffer(ctx, 9 * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                    vk::MemoryUse::Device, "environment sh");
   sampler_ = makeEnvSampler(ctx);
@@ -129,12 +129,14 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kCompute}, {specular_.tracked(), vk::Use::Storage, kCompute, true},
                      {lut_.tracked(), vk::Use::Storage, kCompute, true}});
     spec.bind(cb);
-    pc.samples = s.samples;
     pc.srcLevels = sourceLevels;
     pc.srcTexelSolidAngle = 4.0f * shader::BRDF_PI / (6.0f * float(s.sourceSize) * float(s.sourceSize));
     for (uint32_t l = 0; l < s.specularLevels; ++l) {
       pc.size = s.specularSize >> l;
       pc.roughness = float(l) / float(s.specularLevels - 1);
+      // Roughness 0's lobe is narrower than its texel: one sample. Rougher levels have 4 times fewer
+      // texels each and wider lobes over a bright sun: twice the samples of the level before.
+      pc.samples = l == 0 ? 1u : s.samples << (l - 1);
       vk::DescriptorWriter(ctx, spec.layout, 0, VK_NULL_HANDLE)
           .image(0, sourceCube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler_)
           .image(1, specularLevelViews[l], VK_IMAGE_LAYOUT_GENERAL)
@@ -161,12 +163,13 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     lut.bind(cb);
     vk::DescriptorWriter(ctx, lut.layout, 0, VK_NULL_HANDLE).image(0, lut_.view(), VK_IMAGE_LAYOUT_GENERAL).push(cb, lut);
     lut.push(cb, pc);
-    vkCmdDispatch(cb, groups(pc.size), groups(pc.size), 1);
+    vkCmdDispatch(cb, groups(pc.size), groups(2 * pc.size), 1);
     timer.mark(cb, "env lut");
 
     // Ready for shading in compute or fragment shaders.
     constexpr VkPipelineStageFlags2 kShading = kCompute | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-    vk::require(cb, {{specular_.tracked(), vk::Use::Sampled, kShading}, {lut_.tracked(), vk::Use::Sampled, kShading}});
+    vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kShading}, {specular_.tracked(), vk::Use::Sampled, kShading},
+                     {lut_.tracked(), vk::Use::Sampled, kShading}});
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead | vk::kFragmentRead);  // the sh buffer
   });
   times_ = timer.results();

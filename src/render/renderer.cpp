@@ -112,6 +112,7 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
     const VkBuffer streams[] = {scene_.drawInfo(), scene_.texcoords1(), scene_.tangents(), scene_.colors()};
     for (uint32_t b = 3; b <= 6; ++b)
       if (hasBinding(layout, 0, b)) w.buffer(b, streams[b - 3] ? streams[b - 3] : scene_.positions());
+    writeEnvironment(w, layout);
     w.commit();
     if (layout.setCount() > 1) writeTextures(layout, p.sets.get(1, frame));
   }
@@ -134,7 +135,9 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
       slot = set == kVisibility
                  ? makePipeline("vis.vert", "vis.frag", kVisFormat, info.cull, {{VARIANT_ALPHA_MASK, info.alphaMasked}})
                  : makePipeline(kSceneVert, kFrag[set], kColorFormat, info.cull,
-                                {{VARIANT_TEXCOORDS, info.textured}, {VARIANT_ALPHA_MASK, info.alphaMasked}});
+                                {{VARIANT_TEXCOORDS, info.textured},
+                                 {VARIANT_ALPHA_MASK, info.alphaMasked},
+                                 {VARIANT_ENV, set == kShaded && env_}});
     });
   }
   vk::inParallel(jobs);
@@ -147,12 +150,41 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
   VisShade v;
   v.pipeline.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
-                                             {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}}));
+                                             {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}, {VARIANT_ENV, env_}}));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
   }
   return v;
+}
+
+void Renderer::writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout) const {
+  if (!env_ || !hasBinding(layout, 0, 20)) return;
+  constexpr VkImageLayout kRead = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  w.image(20, env_->specular().view(), kRead, env_->sampler())
+      .image(21, env_->brdfLut().view(), kRead, env_->sampler())
+      .buffer(22, env_->sh())
+      .image(23, env_->source().view(), kRead, env_->sampler());
+}
+
+void Renderer::setEnvironment(std::shared_ptr<const EnvironmentMaps> env) {
+  VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+  env_ = std::move(env);
+  pipelines_[kShaded].reset();
+  shade_ = {};
+  backdrop_.reset();
+}
+
+void Renderer::backdropPass(VkCommandBuffer cb) {
+  if (!backdrop_)
+    backdrop_.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
+  vk::require(cb, color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
+  backdrop_->bind(cb);
+  vk::DescriptorWriter w(ctx_, backdrop_->layout, 0, VK_NULL_HANDLE);
+  w.buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms)).image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
+  writeEnvironment(w, backdrop_->layout);
+  w.push(cb, *backdrop_);
+  backdrop_->dispatch(cb, extent_.width, extent_.height);
 }
 
 void Renderer::ensurePipelines(PipelineSet set) {
@@ -170,9 +202,12 @@ void Renderer::rebuildPipelines() {
   for (RasterPath r : {RasterPath::Hardware, RasterPath::Compute})
     if (shade_[size_t(r)].pipeline) shade[size_t(r)] = makeShade(r == RasterPath::Compute);
   if (raster_) raster.emplace(ctx_, scene_, framesInFlight_);
+  std::optional<vk::Pipeline> backdrop;
+  if (backdrop_) backdrop.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
   vkDeviceWaitIdle(ctx_.device());
   pipelines_ = std::move(fresh);
   shade_ = std::move(shade);
+  backdrop_ = std::move(backdrop);
   if (raster) {
     raster->resize(extent_);
     raster_.reset();
@@ -284,6 +319,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(10, scene_.instances())
       .buffer(13, scene_.colors() ? scene_.colors() : scene_.positions())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
+  writeEnvironment(w, c.layout);
   if (raster == RasterPath::Compute) w.buffer(14, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   if (hasBinding(c.layout, 0, 9)) {  // the textured variant's
@@ -330,6 +366,8 @@ void Renderer::frame(FrameContext& fc) {
   if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);
   lastRaster_ = raster;
   const float aspect = float(target.extent.width) / float(target.extent.height);
+  // The forward shaded view shows the environment behind the scene in a pass of its own.
+  const bool backdrop = env_ && set == kShaded && s.backdropBlur >= 0.0f;
 
   shader::FrameUniforms u{};
   u.view = viewMatrix(pose);
@@ -346,6 +384,13 @@ void Renderer::frame(FrameContext& fc) {
                                        l.outerConeCos, l.range);
   }
   u.params = glm::vec4(float(s.mode), s.lodBias, lens.zNear, lens.zFar);
+  if (env_) {
+    const EnvironmentMapSettings& es = env_->settings();
+    u.environment = glm::vec4(float(es.specularLevels - 1), s.backdropBlur < 0.0f ? ENV_BACKDROP_COLOR : std::min(s.backdropBlur, 1.0f),
+                              float(es.lutSize), 0.0f);
+  }
+  u.background = glm::vec4(s.background, 0.0f);
+  u.options.x = s.brdf ? uint32_t(*s.brdf) + 1u : 0u;
   {
     // Pixel rays from the inverse projection: h = M^-1 (ndc, 0.5, 1) is linear in the pixel, and
     // h.xyz - h.w cameraPos = h.w (point - cameraPos) points along the pixel's ray (scaled).
@@ -363,6 +408,11 @@ void Renderer::frame(FrameContext& fc) {
   uniforms_ = fc.frame.upload(sizeof u, ctx_.properties().limits.minUniformBufferOffsetAlignment);
   std::memcpy(uniforms_.data, &u, sizeof u);
 
+  if (env_) {  // left sampled by their build; a read-back (tests) may have moved them since
+    constexpr VkPipelineStageFlags2 kShading = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+    vk::require(cb, {{env_->source().tracked(), vk::Use::Sampled, kShading}, {env_->specular().tracked(), vk::Use::Sampled, kShading},
+                     {env_->brdfLut().tracked(), vk::Use::Sampled, kShading}});
+  }
   vk::GpuTimer& timer = timers_[frame];
   timer.reset(cb);
   timer.begin(cb);
@@ -371,8 +421,12 @@ void Renderer::frame(FrameContext& fc) {
     raster_->record(cb, uniforms_, primitiveBits_, timer, frame, s.cull ? &cam : nullptr);
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
   } else {
-    rasterPass(cb, frame, set, pose.position);
+    rasterPass(cb, frame, set, pose.position, s.background, backdrop);
     timer.mark(cb, visibility ? "visibility" : "scene");
+    if (backdrop) {
+      backdropPass(cb);
+      timer.mark(cb, "backdrop");
+    }
   }
   if (visibility) {
     const vk::Requirement out{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true};
@@ -386,7 +440,8 @@ void Renderer::frame(FrameContext& fc) {
 }
 
 // The scene pass by the hardware: forward colour or visibility ids, with depth.
-void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye) {
+void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye,
+                          const glm::vec3& background, bool backdrop) {
   const bool visibility = set == kVisibility;
   // Old contents are discarded; the tracker waits for the previous frame's readers (post or shading pass).
   const vk::Image& target0 = visibility ? vis_ : color_;
@@ -399,7 +454,7 @@ void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, c
   colorAtt.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
   colorAtt.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
   if (visibility) colorAtt.clearValue.color.uint32[0] = VIS_EMPTY;
-  else colorAtt.clearValue.color = {{0.0f, 0.0f, 0.0f, 1.0f}};
+  else colorAtt.clearValue.color = {{background.r, background.g, background.b, backdrop ? 0.0f : 1.0f}};  // 0: backdropPass's
   VkRenderingAttachmentInfo depthAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   depthAtt.imageView = depth_.view();
   depthAtt.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;

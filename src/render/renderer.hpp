@@ -3,6 +3,7 @@
 // linear-light image, then the post pass (mosaic or copy) into the target (a swapchain image or an
 // offscreen image). Knows no window.
 #include <array>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -11,6 +12,7 @@
 #include "core/enum_names.hpp"
 #include "core/camera.hpp"
 #include "frame.h"
+#include "render/environment_maps.hpp"
 #include "render/gpu_scene.hpp"
 #include "render/post.hpp"
 #include "render/raster.hpp"
@@ -50,6 +52,12 @@ struct RenderSettings {
   // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;
   // the apps resolve them once from the scene and the command line (scene/lights.hpp).
   LightRig lights{{briefLight()}, glm::vec3(0.02f), {}};
+  // What pixels nothing covers show: the environment (Renderer::setEnvironment) at this blur (0: sharp;
+  // (0, 1]: the specular cube at that roughness; < 0: not at all), else `background` (linear). The
+  // library's default is black, the image of every release before environments; rtr-view's is grey.
+  glm::vec3 background{0.0f};
+  float backdropBlur = 0.0f;
+  std::optional<int> brdf;  // BRDF_BECKMANN or BRDF_GGX (brdf.h) for every material; none: each material's
 };
 
 // The frame leaves the target written by the post pass (its state tracked); the caller requires what
@@ -83,6 +91,12 @@ class Renderer {
   static constexpr VkFormat kVisFormat = VK_FORMAT_R32_UINT;  // draw index, primitive index (frame.h)
 
   Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight);
+
+  // Light from an environment, added to the lights by the shaded view of both paths, and the backdrop;
+  // null: none (no environment pipeline, descriptor or texture). Waits for the device; the shaded
+  // pipelines are made again on their next use.
+  void setEnvironment(std::shared_ptr<const EnvironmentMaps> env);
+  const EnvironmentMaps* environment() const { return env_.get(); }
 
   // Records the whole frame into fc.frame's command buffer; its index picks the uniforms and timer.
   void frame(FrameContext& fc);
@@ -123,8 +137,11 @@ class Renderer {
                               std::vector<vk::SpecializationConstant> variant) const;
   KindPipelines makePipelines(PipelineSet set) const;
   VisShade makeShade(bool fromBuffer) const;
+  void writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout) const;  // bindings 20-23
+  void backdropPass(VkCommandBuffer cb);
   void ensurePipelines(PipelineSet set);
-  void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
+  void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye, const glm::vec3& background,
+                  bool backdrop);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
   void shadeVisibility(VkCommandBuffer cb, RasterPath raster);
   // The scene's texture array, as every pipeline that samples it binds it (set 1, binding 0): each
@@ -144,6 +161,8 @@ class Renderer {
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   std::array<VisShade, 3> shade_;  // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
   std::optional<ComputeRaster> raster_;  // built on first use
+  std::shared_ptr<const EnvironmentMaps> env_;
+  std::optional<vk::Pipeline> backdrop_;  // the forward path's environment backdrop, on first use
   RasterPath lastRaster_ = RasterPath::Auto;
   bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
   uint64_t triangles_ = 0;

@@ -203,6 +203,12 @@ TEST_F(Cli, BadOptionValuesAreUsageErrorsNamingTheOption) {
       {"rtr-view", {c, "--headless", "--screenshot", png, "--light-color", "1,1,1"}, "--light"},
       {"rtr-view", {c, "--headless", "--screenshot", png, "--mode", " 5"}, "--mode"},
       {"rtr-view", {c, "--headless", "--screenshot", png, "--device", "no-such-device"}, "--device"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--background", "0.5,nan,0"}, "--background"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--background", "-1"}, "--background"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--env-intensity", "-1"}, "--env-intensity"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--env-rotation", "inf"}, "--env-rotation"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--env-blur", "2"}, "--env-blur"},
+      {"rtr-view", {c, "--headless", "--screenshot", png, "--brdf", "phong"}, "expected beckmann or ggx"},
       {"scenegen", {"--scale", "nan"}, "--scale"},
       {"scenegen", {"--scale", "1e9"}, "--scale"},
       {"scenegen", {"--textures", "abc"}, "--textures"},
@@ -216,6 +222,30 @@ TEST_F(Cli, BadOptionValuesAreUsageErrorsNamingTheOption) {
   }
   EXPECT_FALSE(fs::exists(dir / "x.png"));
   EXPECT_FALSE(fs::exists(dir / "x.rtrscene"));
+}
+
+// --env none is the image without the option, byte for byte; an environment changes it; a missing
+// environment file is a failure naming it (exit 1), and no image is written.
+TEST_F(Cli, EnvironmentOptions) {
+  const std::string c = kCornell.string(), a = (dir / "a.png").string(), b = (dir / "b.png").string(),
+                    e = (dir / "e.png").string();
+  const std::vector<std::string> common = {c, "--headless", "--size", "48x32", "--validation"};
+  auto with = [&](std::vector<std::string> extra) { extra.insert(extra.begin(), common.begin(), common.end()); return extra; };
+  Result r = run("rtr-view", with({"-o", a}));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = run("rtr-view", with({"-o", b, "--env", "none"}));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(readAll(a), readAll(b));
+  r = run("rtr-view", with({"-o", e, "--env", "sky", "--env-rotation", "30"}));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("environment sky prefiltered"));
+  EXPECT_THAT(r.err, Not(HasSubstr("[vulkan ")));
+  EXPECT_NE(readAll(a), readAll(e));
+  const std::string missing = (dir / "no-such.hdr").string();
+  r = run("rtr-view", with({"-o", (dir / "m.png").string(), "--env", missing}));
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr(missing));
+  EXPECT_FALSE(fs::exists(dir / "m.png"));
 }
 
 TEST_F(Cli, VersionAndExitStatusInHelp) {

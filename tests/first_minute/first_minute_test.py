@@ -41,8 +41,8 @@ def run(cmd):
 def render(bins, out, model, extra, tool):
     png = os.path.join(out, f"{os.path.basename(model)}.{tool}.png")
     size = f"{SIZE[0]}x{SIZE[1]}"
-    cmd = ([f"{bins}/rtr-view", model, "--headless", "-o", png, "--size", size, "--force"] if tool == "view" else
-           # A black backdrop: the checks count lit pixels against black (rtr-trace's default is mid-grey).
+    # A black backdrop: the checks count lit pixels against black (both tools' default is mid-grey).
+    cmd = ([f"{bins}/rtr-view", model, "--headless", "-o", png, "--size", size, "--force", "--background", "0"] if tool == "view" else
            [f"{bins}/rtr-trace", model, "-o", png, "--size", size, "--force", "--background", "0"]) + extra
     r = run(cmd)
     return r, png

@@ -72,6 +72,9 @@ frame_rows() {  # frame_rows TAG SCENE SIZES...
   for size in "$@"; do
     row "frame-$tag-$size-pbr" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic compute --shading-path visibility
     row "frame-$tag-$size-pbr-forward" rtr-view "$scene" --headless --size "$size" --bench $frames --shading-path forward --mosaic compute
+    # The same with light from the generated sky (--env: split-sum shading and the backdrop; its
+    # prefiltering is said on stderr, outside the frame).
+    row "frame-$tag-$size-pbr-env" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic compute --shading-path visibility --env sky
     row "frame-$tag-$size-pbr-graphics" rtr-view "$scene" --headless --size "$size" --bench $frames --mosaic graphics --shading-path visibility
     row "frame-$tag-$size-textured" rtr-view "$scene" --headless --size "$size" --bench $frames --mode 13 --mosaic compute
   done

@@ -2,7 +2,8 @@
 // The environment options rtr-view and rtr-trace share, with one meaning (docs/files-and-cli.md):
 //   --env FILE|sky|none, --env-intensity K, --env-rotation DEG: where the light comes from;
 //   --background R,G,B (linear): what camera rays that miss see; without it, the environment where there
-//   is one, else a neutral mid-grey backdrop (kDefaultBackground) on which a black model is visible.
+//   is one, else a neutral mid-grey backdrop (kDefaultBackground) on which a black model is visible;
+//   --env-blur B (rtr-view): the backdrop's environment from sharp (0) to the roughest prefiltered level (1).
 #include <optional>
 #include <string>
 
@@ -19,6 +20,7 @@ constexpr float kDefaultBackground = 0.18f;
 struct EnvironmentOptions {
   EnvironmentSettings settings;
   std::string background;  // as given; empty: not given
+  float blur = 0.0f;       // --env-blur
   // Resolved by resolve(): the colour camera misses see, and whether they see the environment instead.
   glm::vec3 backgroundColor{kDefaultBackground};
   bool showEnvironment = false;
@@ -27,6 +29,7 @@ struct EnvironmentOptions {
   void resolve();
 };
 
-void addEnvironmentOptions(CLI::App& app, EnvironmentOptions& o);
+// `blur`: also --env-blur (only rtr-view blurs its backdrop).
+void addEnvironmentOptions(CLI::App& app, EnvironmentOptions& o, bool blur = false);
 
 }  // namespace rtr::cli

@@ -23,9 +23,17 @@
 namespace rtr::view {
 namespace {
 
-bool anyLit(const ImageRGBA8& img) {  // the background is black
-  for (size_t i = 0; i < img.pixels.size(); i += 4)
-    if (img.pixels[i] | img.pixels[i + 1] | img.pixels[i + 2]) return true;
+// Whether any pixel is neither black nor the plain colour backdrop (an environment backdrop: taken as lit).
+bool anyLit(const ImageRGBA8& img, const render::RenderSettings& s) {
+  if (s.backdropBlur >= 0.0f) return true;
+  int bg[3];
+  for (int c = 0; c < 3; ++c) bg[c] = int(std::lround(255.0f * linearToSrgb(std::clamp(s.background[c], 0.0f, 1.0f))));
+  for (size_t i = 0; i < img.pixels.size(); i += 4) {
+    const uint8_t* p = &img.pixels[i];
+    const bool black = !(p[0] | p[1] | p[2]);
+    const bool backdrop = std::abs(p[0] - bg[0]) <= 1 && std::abs(p[1] - bg[1]) <= 1 && std::abs(p[2] - bg[2]) <= 1;
+    if (!black && !backdrop) return true;
+  }
   return false;
 }
 
@@ -153,6 +161,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   render::RenderSettings settings = sceneSettings(o, scene);
   settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  const auto env = loadEnvironment(o, ctx);
+  renderer.renderer().setEnvironment(env);
   const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
   phase("renderer setup (start pose, targets)", setupPipelineMs);
   std::optional<render::HeadlessFrame> first;
@@ -188,7 +198,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   if (!o.screenshot.empty()) {
     render::HeadlessFrame frame = first && o.frames <= 1 ? std::move(*first)
                                                          : renderer.render(pose, lens, settings, std::max(1, o.frames));
-    const std::string empty = emptyImageWarning(scene, pose, lens, float(o.width) / float(o.height), anyLit(frame.image),
+    const std::string empty = emptyImageWarning(scene, pose, lens, float(o.width) / float(o.height), anyLit(frame.image, settings),
                                                 settings.lights.lights.size());
     if (!empty.empty()) std::fprintf(stderr, "rtr-view: warning: %s\n", empty.c_str());
     // Compressed on all cores while the renderer, the scene and the device are torn down: the two overlap.

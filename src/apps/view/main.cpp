@@ -12,6 +12,8 @@
 #include "view_state.hpp"
 #include "render/startup.hpp"
 #include "scene/first_look.hpp"
+#include "trace/tracer.hpp"
+#include "brdf.h"
 #include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "vk/context.hpp"
@@ -47,8 +49,19 @@ void checkSizeFits(const ViewOptions& o, const vk::Context& ctx) {
 render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
   render::RenderSettings s = o.settings;
   s.lights = resolveLights(scene, o.lightOptions);
+  s.background = o.env.backgroundColor;
+  s.backdropBlur = o.env.showEnvironment ? o.env.blur : -1.0f;  // < 0: the colour even with an environment
   if (!s.lights.note.empty()) std::fprintf(stderr, "rtr-view: note: %s\n", s.lights.note.c_str());
   return s;
+}
+
+std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx) {
+  if (!o.env.hasEnvironment()) return nullptr;
+  auto maps = std::make_shared<const render::EnvironmentMaps>(ctx, Environment::load(o.env.settings));
+  std::fprintf(stderr, "rtr-view: environment %s prefiltered:", o.env.settings.source.c_str());
+  for (const auto& [name, ms] : maps->times()) std::fprintf(stderr, " %s %.3f ms", name.c_str(), ms);
+  std::fprintf(stderr, " GPU\n");
+  return maps;
 }
 
 vk::ContextOptions contextOptions(const ViewOptions& o) {
@@ -156,6 +169,10 @@ int main(int argc, char** argv) {
   cli::addLightOptions(app, o.lightOptions);
   bool noPipelineCache = false, noWaitTextures = false;
   std::string up = "+Y";
+  cli::addEnvironmentOptions(app, o.env, true);
+  std::string brdf;
+  app.add_option("--brdf", brdf, "beckmann | ggx for every material (default: ggx for glTF materials, beckmann for the "
+                 "rest), as rtr-trace's")->check(cli::oneOf<trace::Brdf>());
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
       ->capture_default_str();
   app.add_option("--crease", o.load.creaseDeg, "OBJ faces without normals: normals split where faces meet at more "
@@ -191,6 +208,11 @@ int main(int argc, char** argv) {
     if (!mtl.empty()) o.load.mtl = mtl;
     o.up = upRotation(up);
     o.pipelineCache = !noPipelineCache;
+    o.env.resolve();
+    // The environment is the light: no headlight and no flat ambient stand in for it unless asked for (as rtr-trace).
+    if (o.env.hasEnvironment()) o.lightOptions.defaultLight = false;
+    if (o.env.hasEnvironment() && app.count("--ambient") == 0) o.lightOptions.ambient = glm::vec3(0.0f);
+    if (!brdf.empty()) o.settings.brdf = cli::enumOption<trace::Brdf>("--brdf", brdf) == trace::Brdf::Ggx ? BRDF_GGX : BRDF_BECKMANN;
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);

@@ -7,6 +7,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "core/camera.hpp"
+#include "apps/common/environment_options.hpp"
 #include "render/mips.hpp"
 #include "render/renderer.hpp"
 #include "scene/lights.hpp"
@@ -28,6 +29,7 @@ struct ViewOptions {
   Lens lens;
   render::RenderSettings settings;  // settings.lights: resolved from lightOptions once the scene is loaded
   LightOptions lightOptions;
+  cli::EnvironmentOptions env;             // --env, --env-intensity, --env-rotation, --env-blur, --background
   render::MipMode mips = render::MipMode::Compute;
   int frames = 1;                  // frames to render before the screenshot
   std::string screenshot;          // image path (.png, .jpg, .exr, .hdr); empty: none
@@ -78,6 +80,10 @@ struct DeviceChoice {
   render::MipMode mips;
 };
 DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx);
+
+// The environment's maps (--env), prefiltered on `ctx`'s device, their build times said on stderr; null
+// for --env none.
+std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx);
 
 int runHeadless(const ViewOptions& o);
 int runWindowed(const ViewOptions& o);

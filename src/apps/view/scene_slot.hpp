@@ -26,6 +26,11 @@ class SceneSlot {
   ~SceneSlot() { release(); }  // the device idle, children first; before the surface and the device go
 
   void build(VkExtent2D extent, render::MipMode mips);
+  // The environment every scene of the slot is lit by (kept across drops); null: none.
+  void setEnvironment(std::shared_ptr<const render::EnvironmentMaps> env) {
+    env_ = std::move(env);
+    if (frames_) frames_->renderer().setEnvironment(env_);
+  }
   // Serves drops, Left/Right, F5 and mip changes: starts loading the last dropped (or chosen) file, takes a finished load (the panel's
   // message says how it went) and rebuilds. True when a new scene came in (its camera is to be set).
   bool update(ViewState& app);
@@ -48,6 +53,7 @@ class SceneSlot {
   size_t fileIndex_ = 0;
   std::string path_;
   std::unique_ptr<render::GpuScene> gpu_;
+  std::shared_ptr<const render::EnvironmentMaps> env_;
   std::unique_ptr<ViewFrames> frames_;
   std::unique_ptr<TraceOverlay> traced_;
   std::future<Scene> loading_;

@@ -9,6 +9,7 @@
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 
+#include "brdf.h"
 #include "options.hpp"
 #include "scene_camera.hpp"
 #include "scene_slot.hpp"
@@ -32,6 +33,8 @@ trace::TraceSettings traceSettings(const ViewState& app, VkExtent2D e, const Len
   ts.bounces = app.traceReflections ? trace::N_BOUNCES : 0;
   ts.lights = app.settings.lights;
   ts.lodBias = app.settings.lodBias;
+  ts.background = app.settings.background;  // the backdrop colour (the tracer has no environment here)
+  if (app.settings.brdf) ts.brdf = *app.settings.brdf == BRDF_GGX ? trace::Brdf::Ggx : trace::Brdf::Beckmann;
   return ts;
 }
 
@@ -97,6 +100,7 @@ int runWindowed(const ViewOptions& opts) {
   SceneSlot slot(ctx, window.surface(), std::move(scene), o.files, waitTextures,
                  [dropped](const std::string& path) { return loadForView(dropped, path); });
   slot.build({o.width, o.height}, app.mips);
+  slot.setEnvironment(loadEnvironment(o, ctx));
   clock.phase(waitTextures ? "scene to the GPU (geometry, textures, mips), swapchain" : "geometry to the GPU, swapchain");
 
   ShaderReload shaders(o.watch);
