@@ -137,7 +137,7 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
                  : makePipeline(kSceneVert, kFrag[set], kColorFormat, info.cull,
                                 {{VARIANT_TEXCOORDS, info.textured},
                                  {VARIANT_ALPHA_MASK, info.alphaMasked},
-                                 {VARIANT_ENV, set == kShaded && env_}});
+                                 {VARIANT_ENV, set == kShaded && env_ != nullptr}});
     });
   }
   vk::inParallel(jobs);
@@ -150,7 +150,7 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
   VisShade v;
   v.pipeline.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
-                                             {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}, {VARIANT_ENV, env_}}));
+                                             {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}, {VARIANT_ENV, env_ != nullptr}}));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
