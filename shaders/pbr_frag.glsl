@@ -5,17 +5,38 @@
 
 layout(location = 0) out vec4 outColor;
 
+#ifndef BLEND
+#define BLEND 0
+#endif
+#if BLEND
+// The transparency pass (glTF BLEND, render/transparency.cpp): "over" blending by the surface's alpha. Where
+// the compute rasteriser drew the opaque surfaces, their depth is the high half of its per-pixel word
+// (draw.opaqueWidth its row length); the hardware paths test against the depth attachment instead (0).
+layout(set = 0, binding = 7, std430) readonly buffer OpaqueIds { uvec2 opaqueIds[]; };
+bool behindOpaque() {
+  if (draw.opaqueWidth == 0u) return false;
+  const uvec2 p = uvec2(gl_FragCoord.xy);
+  return gl_FragCoord.z >= uintBitsToFloat(opaqueIds[p.y * draw.opaqueWidth + p.x].y);  // empty: NaN, false
+}
+float outAlpha(Surface s) { return clamp(s.alpha, 0.0, 1.0); }
+#else
+float outAlpha(Surface s) { return 1.0; }
+#endif
+
 // Largest value written to the half-float target (max 65504): a white metal at roughness 0 peaks near
 // 8e4 x the light colour; the display clamps at 1 anyway.
 const float kMaxRadiance = 60000.0;
 
 void main() {
+#if BLEND
+  if (behindOpaque()) discard;
+#endif
   Surface s = fetchSurface();
 #if ALPHA_MASK
   if (cutOut(s)) discard;
 #endif
   if (unlit()) {
-    outColor = vec4(min(s.baseColor, vec3(kMaxRadiance)), 1.0);
+    outColor = vec4(min(s.baseColor, vec3(kMaxRadiance)), outAlpha(s));
     return;
   }
   vec3 v = normalize(frame.cameraPos.xyz - inWorldPos);
@@ -26,5 +47,5 @@ void main() {
     LightSample ls = lightSample(frame.lights[i], inWorldPos);  // point, spot or directional (lights.h)
     c += pbrDirect(brdf, n, v, ls.l, ls.radiance, s.baseColor, s.roughness, s.metalness);
   }
-  outColor = vec4(min(c, vec3(kMaxRadiance)), 1.0);
+  outColor = vec4(min(c, vec3(kMaxRadiance)), outAlpha(s));
 }

@@ -14,6 +14,7 @@
 #include "render/gpu_scene.hpp"
 #include "render/post.hpp"
 #include "render/raster.hpp"
+#include "render/transparency.hpp"
 #include "scene/lights.hpp"
 #include "vk/commands.hpp"
 #include "vk/frame_ring.hpp"
@@ -143,6 +144,7 @@ class Renderer {
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   std::array<VisShade, 3> shade_;  // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
   std::optional<ComputeRaster> raster_;  // built on first use
+  std::optional<TransparencyPass> transparency_;  // a scene with blended draws only
   RasterPath lastRaster_ = RasterPath::Auto;
   bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
   uint64_t triangles_ = 0;
