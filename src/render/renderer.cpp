@@ -73,7 +73,10 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
   cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   canHardware_ = features.geometryShader;
   canCompute_ = ComputeRaster::supported(ctx);
-  if (!scene.blendDraws().empty()) transparency_.emplace(ctx, scene), writeTextureSets();
+  if (!scene.blendDraws().empty()) {
+    transparency_.emplace(ctx, scene);
+    writeTextureSets();
+  }
   canUseVisibility_ = (canHardware_ || canCompute_) && instances > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
 }
 
