@@ -4,22 +4,19 @@
 #extension GL_EXT_nonuniform_qualifier : require
 #include "frame.h"
 #include "brdf.h"
+#include "variants.h"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1, std430) readonly buffer Materials { GpuMaterial materials[]; };
 layout(push_constant) uniform Push { DrawPush draw; };
-#if HAS_TEXCOORDS
-layout(set = 1, binding = 0) uniform sampler2D textures[];
-#endif
+layout(set = 1, binding = 0) uniform sampler2D textures[];  // HAS_TEXCOORDS only
 
 layout(location = 0) in vec3 inWorldPos;
 layout(location = 1) in vec3 inNormal;
 layout(location = 3) in vec2 inTexcoord1;
 layout(location = 4) in vec4 inTangent;
 layout(location = 5) in vec4 inColor;
-#if HAS_TEXCOORDS
-layout(location = 2) in vec2 inTexcoord;
-#endif
+layout(location = 2) in vec2 inTexcoord;  // HAS_TEXCOORDS only
 
 struct Surface {
   vec3 baseColor;
@@ -31,7 +28,6 @@ struct Surface {
   vec3 normal;      // the interpolated normal, bent by the normal map where there is one
 };
 
-#if HAS_TEXCOORDS
 // Slot `slot`'s texcoords: its set, its transform (the identity for OBJ materials).
 vec2 slotUv(GpuMaterial m, uint slot) {
   const vec4 r0 = m.uvTransform[2 * slot], r1 = m.uvTransform[2 * slot + 1];
@@ -42,7 +38,6 @@ vec2 slotUv(GpuMaterial m, uint slot) {
 vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec4 fallback) {
   return index == NO_TEXTURE ? fallback : texture(textures[index], slotUv(m, slot), frame.params.y);
 }
-#endif
 
 Surface fetchSurface() {
   GpuMaterial m = materials[draw.material];
@@ -56,7 +51,7 @@ Surface fetchSurface() {
   s.normal = inNormal;
   s.baseColor *= inColor.rgb;  // 1 without vertex colours
   s.alpha *= inColor.a;
-#if HAS_TEXCOORDS
+  if (!HAS_TEXCOORDS) return s;
   s.baseColor *= sampleOr(m, m.textures.x, SLOT_BASE, vec4(1.0)).rgb;
   s.roughness *= sampleOr(m, m.textures.y, SLOT_ROUGHNESS, vec4(1.0)).r;
   s.metalness *= sampleOr(m, m.textures.z, SLOT_METALNESS, vec4(1.0)).r;
@@ -70,7 +65,6 @@ Surface fetchSurface() {
     const vec3 n = normalize(inNormal), t = normalize(inTangent.xyz - n * dot(n, inTangent.xyz));
     s.normal = t * tn.x + cross(n, t) * (inTangent.w * tn.y) + n * tn.z;
   }
-#endif
   return s;
 }
 

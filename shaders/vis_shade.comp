@@ -1,4 +1,151 @@
 #version 460
+// Visibility path, shading in compute (ShadingPath::Visibility, mode 1): one thread per pixel reads the
+// visible triangle's ids, rebuilds the triangle from the index and vertex buffers, intersects the pixel's
+// ray with it for perspective-correct barycentrics, and shades with the same brdf.h as pbr.frag.
+// Texture LOD: the texcoord differences to the quad neighbour, like the rasteriser's fine derivatives
+// (docs/shading.md, "Visibility path").
 #extension GL_GOOGLE_include_directive : require
-#define HAS_TEXCOORDS 1
-#include "vis_shade.glsl"
+#extension GL_EXT_nonuniform_qualifier : require
+#extension GL_EXT_samplerless_texture_functions : require
+#include "frame.h"
+#include "brdf.h"
+#include "variants.h"
+
+layout(local_size_x = VIS_GROUP_X, local_size_y = VIS_GROUP_Y) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 1, std430) readonly buffer Materials { GpuMaterial materials[]; };
+layout(set = 0, binding = 2, std430) readonly buffer Draws { GpuDraw draws[]; };
+layout(set = 0, binding = 3, std430) readonly buffer Positions { float positions[]; };
+layout(set = 0, binding = 4, std430) readonly buffer Normals { float normals[]; };
+layout(set = 0, binding = 5, std430) readonly buffer Indices32 { uint indices32[]; };
+layout(set = 0, binding = 6, std430) readonly buffer Indices16 { uint indices16[]; };  // two per word
+// The ids, by VIS_BUFFER: the hardware rasteriser's image, or the compute rasteriser's (depth << 32 | id)
+// per pixel, row by row (raster.h).
+layout(set = 0, binding = 7) uniform utexture2D visibilityImage;
+layout(set = 0, binding = 14, std430) readonly buffer Visibility { uvec2 visibilityBuffer[]; };  // x: the low half
+layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D sceneColor;
+// HAS_TEXCOORDS only:
+layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
+layout(set = 1, binding = 0) uniform sampler2D textures[];
+layout(set = 0, binding = 10, std430) readonly buffer Instances { GpuInstance instances[]; };
+// glTF's streams where the draw has them (GpuDraw flags); scenes without bind any buffer.
+layout(set = 0, binding = 11, std430) readonly buffer Texcoords1 { vec2 texcoords1[]; };
+layout(set = 0, binding = 12, std430) readonly buffer Tangents { vec4 tangents[]; };
+layout(set = 0, binding = 13, std430) readonly buffer Colors { vec4 colors[]; };
+layout(push_constant) uniform Push { VisShadePush pc; };
+
+const float kMaxRadiance = 60000.0;  // as pbr.frag: stay below the half-float maximum
+
+vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
+vec3 normal(uint i) { return vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]); }
+
+uint vertexIndex(GpuDraw d, uint i) {
+  if ((d.flags & DRAW_INDEX16) == 0u) return indices32[d.firstIndex + i];
+  uint k = d.firstIndex + i;
+  return (indices16[k >> 1] >> ((k & 1u) * 16u)) & 0xFFFFu;  // little-endian halves
+}
+
+// Barycentrics (of vertices 0, 1, 2) where the ray o + t dir meets the triangle's plane. With
+// s = o - p0: u = dir.(e2 x s) / det, v = dir.(s x e1) / det, det = -dir.(e1 x e2); any scale of dir
+// gives the same result. The guard keeps a ray parallel to the plane finite.
+vec3 barycentrics(vec3 dir, vec3 a, vec3 b, vec3 n) {
+  float det = -dot(dir, n);
+  float inv = 1.0 / (abs(det) > 1e-30 ? det : 1e-30);
+  vec2 uv = clamp(vec2(dot(dir, a), dot(dir, b)) * inv, -1e4, 1e4);
+  return vec3(1.0 - uv.x - uv.y, uv);
+}
+
+// Texcoords of both sets and their differences to the quad neighbours (x, y): uv[0..2] set 0, uv[3..5] set 1.
+vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec2 uv[6], vec4 fallback) {
+  if (index == NO_TEXTURE) return fallback;
+  const vec4 r0 = m.uvTransform[2 * slot], r1 = m.uvTransform[2 * slot + 1];
+  const int k = r0.w > 0.5 ? 3 : 0;
+  const mat2 a = mat2(r0.x, r1.x, r0.y, r1.y);  // the transform's linear part (columns)
+  return textureGrad(textures[nonuniformEXT(index)], a * uv[k] + vec2(r0.z, r1.z), a * uv[k + 1], a * uv[k + 2]);
+}
+
+void main() {
+  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(p, imageSize(sceneColor)))) return;
+  uint packed;
+  if (VIS_BUFFER) packed = visibilityBuffer[p.y * imageSize(sceneColor).x + p.x].x;
+  else packed = texelFetch(visibilityImage, p, 0).x;
+  if (packed == VIS_EMPTY) {
+    imageStore(sceneColor, p, vec4(0.0, 0.0, 0.0, 1.0));  // the forward pass's clear colour
+    return;
+  }
+  const GpuInstance inst = instances[packed >> pc.primitiveBits];
+  const GpuDraw d = draws[inst.info.x];
+  const uint first = 3u * (packed & ((1u << pc.primitiveBits) - 1u));  // primitiveBits < 32
+  const uvec3 tri = uvec3(vertexIndex(d, first), vertexIndex(d, first + 1u), vertexIndex(d, first + 2u)) + d.vertexOffset;
+  // Scene space, computed as the vertex stages do.
+  const vec3 p0 = (inst.transform * vec4(position(tri.x), 1.0)).xyz, p1 = (inst.transform * vec4(position(tri.y), 1.0)).xyz,
+             p2 = (inst.transform * vec4(position(tri.z), 1.0)).xyz;
+  const vec3 e1 = p1 - p0, e2 = p2 - p0, s = frame.cameraPos.xyz - p0;
+  const vec3 n = cross(e1, e2), a = cross(e2, s), b = cross(s, e1);
+
+  const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
+  const vec3 w = clamp(barycentrics(dir, a, b, n), 0.0, 1.0);  // the rasteriser covered this pixel centre
+  const vec3 worldPos = p0 * w.x + p1 * w.y + p2 * w.z;
+  // Two-sided materials light their back faces with the flipped normal (front: counter-clockwise seen
+  // from the camera, as the forward pipelines' VK_FRONT_FACE_COUNTER_CLOCKWISE; clockwise for a mirrored
+  // instance, whose draws set VK_FRONT_FACE_CLOCKWISE).
+  const mat3 normalMatrix = mat3(inst.normalX.xyz, inst.normalY.xyz, inst.normalZ.xyz);
+  vec3 nrm = normalMatrix * (normal(tri.x) * w.x + normal(tri.y) * w.y + normal(tri.z) * w.z);
+  const bool back = (dot(n, s) < 0.0) != ((inst.info.y & INSTANCE_MIRRORED) != 0u);
+  if (back) nrm = -nrm;
+
+  const GpuMaterial m = materials[d.material];
+  vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
+  float roughness = m.roughMetal.x, metalness = m.roughMetal.y, occlusion = 1.0;
+  if ((d.flags & DRAW_COLORS) != 0u) baseColor *= (colors[tri.x] * w.x + colors[tri.y] * w.y + colors[tri.z] * w.z).rgb;
+  if (HAS_TEXCOORDS && (d.flags & DRAW_TEXTURED) != 0u) {
+    const vec2 t0 = texcoords[tri.x], t1 = texcoords[tri.y], t2 = texcoords[tri.z];
+    const vec2 uv = t0 * w.x + t1 * w.y + t2 * w.z;
+    // Differences to the other pixel of the 2x2 quad in x and in y (what fine dFdx/dFdy give), scaled
+    // by 2^bias: textureGrad has no bias argument, and the LOD is log2 of the gradient's length.
+    const vec2 side = vec2(1 - 2 * (p & 1));
+    const vec3 wx = barycentrics(dir + side.x * frame.rayDx.xyz, a, b, n);
+    const vec3 wy = barycentrics(dir + side.y * frame.rayDy.xyz, a, b, n);
+    const float scale = exp2(frame.params.y);
+    const vec2 gx = (t0 * wx.x + t1 * wx.y + t2 * wx.z - uv) * (side.x * scale);
+    const vec2 gy = (t0 * wy.x + t1 * wy.y + t2 * wy.z - uv) * (side.y * scale);
+    vec2 uvs[6] = vec2[6](uv, gx, gy, uv, gx, gy);
+    if ((d.flags & DRAW_UV1) != 0u) {
+      const vec2 s0 = texcoords1[tri.x], s1 = texcoords1[tri.y], s2 = texcoords1[tri.z];
+      uvs[3] = s0 * w.x + s1 * w.y + s2 * w.z;
+      uvs[4] = (s0 * wx.x + s1 * wx.y + s2 * wx.z - uvs[3]) * (side.x * scale);
+      uvs[5] = (s0 * wy.x + s1 * wy.y + s2 * wy.z - uvs[3]) * (side.y * scale);
+    }
+    baseColor *= sampleOr(m, m.textures.x, SLOT_BASE, uvs, vec4(1.0)).rgb;
+    roughness *= sampleOr(m, m.textures.y, SLOT_ROUGHNESS, uvs, vec4(1.0)).r;
+    metalness *= sampleOr(m, m.textures.z, SLOT_METALNESS, uvs, vec4(1.0)).r;
+    emissive *= sampleOr(m, m.textures2.x, SLOT_EMISSIVE, uvs, vec4(1.0)).rgb;
+    if (m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m, m.textures2.y, SLOT_OCCLUSION, uvs, vec4(1.0)).r - 1.0);
+    if (m.textures2.z != NO_TEXTURE && (d.flags & DRAW_TANGENTS) != 0u) {
+      // As material.glsl: t, b = w (n x t), n; the map's xy scaled by normalScale.
+      const vec4 tg = tangents[tri.x] * w.x + tangents[tri.y] * w.y + tangents[tri.z] * w.z;
+      const vec3 tn = (sampleOr(m, m.textures2.z, SLOT_NORMAL, uvs, vec4(0.5, 0.5, 1.0, 1.0)).xyz * 2.0 - 1.0) *
+                      vec3(m.emissive.w, m.emissive.w, 1.0);
+      const vec3 nn = normalize(back ? -nrm : nrm), t3 = mat3(inst.transform) * tg.xyz;
+      const vec3 t = normalize(t3 - nn * dot(nn, t3));
+      const float sgn = (inst.info.y & INSTANCE_MIRRORED) != 0u ? -tg.w : tg.w;
+      nrm = t * tn.x + cross(nn, t) * (sgn * tn.y) + nn * tn.z;
+      if (back) nrm = -nrm;
+    }
+  }
+  if ((m.textures2.w & MATERIAL_UNLIT) != 0u) {
+    imageStore(sceneColor, p, vec4(min(baseColor, vec3(kMaxRadiance)), 1.0));
+    return;
+  }
+
+  const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
+  const int brdf = (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
+  vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) * occlusion + emissive;
+  for (uint i = 0u; i < frame.lightCount.x; ++i) {
+    const LightSample ls = lightSample(frame.lights[i], worldPos);  // point, spot or directional (lights.h)
+    c += pbrDirect(brdf, nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
+  }
+  imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
+}

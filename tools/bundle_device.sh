@@ -58,7 +58,7 @@ cat > "$out/run-tests.sh" <<'RUN'
 # Runs every Vulkan test binary with validation (core + synchronization: any message fails a test).
 # Prints each binary's gtest summary and, at the end, tests run / passed / validation messages.
 here=$(cd "$(dirname "$0")" && pwd)
-export RTR_VALIDATION=1 RTR_TEST=1
+export RTR_VALIDATION=1 RTR_PIPELINE_CACHE=off
 run=0 passed=0 messages=0 status=0
 for t in vk_test render_test view_test reference_test; do
   log=$(mktemp)

@@ -1,5 +1,5 @@
 #version 460
-// The compute rasteriser's hand-off, fragment stage: the same alpha test as vis_frag.glsl, the same
+// The compute rasteriser's hand-off, fragment stage: the same alpha test as vis.frag, the same
 // back-face rule as the visibility pipelines, then the same 64-bit atomicMin as raster.comp.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_nonuniform_qualifier : require

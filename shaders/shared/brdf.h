@@ -190,6 +190,102 @@ RTR_FN vec3 shadePbr(int brdf, vec3 n, vec3 v, vec3 l, vec3 lightColor, vec3 amb
   return ambient * c + emissive + pbrDirect(brdf, n, v, l, lightColor, baseColor, roughness, metalness);
 }
 
+// ---- Importance sampling of the BRDF (the tracer's Monte Carlo; docs/environment.md) ----
+// A direction l is drawn from a mixture: with probability brdfSpecularChance a half vector h in
+// proportion to D(h) (n.h) of the BRDF's own NDF, reflected about h (density D (n.h) / (4 v.h) per unit
+// solid angle of l); otherwise the cosine-weighted hemisphere (density n.l / pi). brdfPdf is the
+// mixture's density, which multiple importance sampling needs for directions drawn by anything else.
+// Uniform numbers in [0, 1); 1 itself is clamped just below.
+
+RTR_CONST float BRDF_U_MAX = 0.99999994f;  // the largest float below 1
+
+// Luminance weights (Rec. 709), for the mixture's lobe probability.
+RTR_FN float brdfLuminance(vec3 c) { return dot(c, vec3(0.2126f, 0.7152f, 0.0722f)); }
+
+// A half vector about +z drawn in proportion to D(h) cos(theta_h). sin^2 and cos^2 are computed apart (no
+// 1 - cos^2 cancellation), so alpha = 1e-3 keeps its narrow lobe:
+//   Beckmann: tan^2 = -alpha^2 ln(1 - u), the inverse of its CDF 1 - exp(-tan^2 / alpha^2);
+//   GGX:      cos^2 = (1 - u) / (1 + (alpha^2 - 1) u), sin^2 = alpha^2 u / (1 + (alpha^2 - 1) u).
+RTR_FN vec3 brdfSampleHalfLocal(int brdf, vec2 u, float alpha) {
+  float ux = min(max(u.x, 0.0f), BRDF_U_MAX);
+  float a2 = alpha * alpha;
+  float cos2;
+  float sin2;
+  if (brdf == BRDF_GGX) {
+    float den = 1.0f + (a2 - 1.0f) * ux;  // >= alpha^2 > 0
+    cos2 = (1.0f - ux) / den;
+    sin2 = a2 * ux / den;
+  } else {
+    float t2 = -a2 * log(1.0f - ux);
+    cos2 = 1.0f / (1.0f + t2);
+    sin2 = t2 / (1.0f + t2);
+  }
+  float phi = 2.0f * BRDF_PI * u.y;
+  float st = sqrt(max(sin2, 0.0f));
+  return vec3(st * cos(phi), st * sin(phi), sqrt(max(cos2, 0.0f)));
+}
+
+// A cosine-weighted direction about +z (density cos(theta) / pi).
+RTR_FN vec3 brdfSampleCosineLocal(vec2 u) {
+  float ux = min(max(u.x, 0.0f), BRDF_U_MAX);
+  float r = sqrt(ux);
+  float phi = 2.0f * BRDF_PI * u.y;
+  return vec3(r * cos(phi), r * sin(phi), sqrt(1.0f - ux));
+}
+
+// `local` (about +z) turned into the frame of unit n: a branch-free orthonormal basis that stays
+// accurate for every n (Duff et al. 2017's construction).
+RTR_FN vec3 brdfToFrame(vec3 local, vec3 n) {
+  float sgn = n.z >= 0.0f ? 1.0f : -1.0f;
+  float a = -1.0f / (sgn + n.z);
+  float b = n.x * n.y * a;
+  vec3 t = vec3(1.0f + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+  vec3 bt = vec3(b, sgn + n.y * n.y * a, -n.y);
+  return local.x * t + local.y * bt + local.z * n;
+}
+
+// The probability of drawing from the specular lobe: its Fresnel weight seen from v against the diffuse
+// weight (about each lobe's share of the albedo, which keeps f cos / pdf nearly constant), 1 without a
+// diffuse lobe (metal). View below the surface: the specular is 0, so 0.
+RTR_FN float brdfSpecularChance(float nv, vec3 baseColor, float metalness) {
+  vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
+  float metal = clamp(metalness, 0.0f, 1.0f);
+  float diff = brdfLuminance(c) * (1.0f - metal);
+  if (nv <= 0.0f) return diff > 0.0f ? 0.0f : 1.0f;
+  if (!(diff > 0.0f)) return 1.0f;
+  float spec = brdfLuminance(brdfFresnel(nv, c, metal));
+  return spec / (spec + diff);
+}
+
+// Draws l for BRDF `brdf` at unit v and any n from three uniform numbers (u.x picks the lobe). The
+// result is unit; it may lie below n (f = 0 there).
+RTR_FN vec3 brdfSampleDirection(int brdf, vec3 n, vec3 v, vec3 u, vec3 baseColor, float roughness, float metalness) {
+  vec3 nn = brdfSafeNormal(n);
+  if (dot(nn, nn) == 0.0f) return v;  // zero normal: no light arrives, any direction will do
+  float p = brdfSpecularChance(dot(nn, v), baseColor, metalness);
+  if (u.x < p) {
+    vec3 h = brdfToFrame(brdfSampleHalfLocal(brdf, vec2(u.y, u.z), brdfAlpha(roughness)), nn);
+    return brdfSafeNormal(2.0f * dot(v, h) * h - v);
+  }
+  return brdfSafeNormal(brdfToFrame(brdfSampleCosineLocal(vec2(u.y, u.z)), nn));
+}
+
+// The density (per unit solid angle) brdfSampleDirection draws unit l with; 0 below the hemisphere of n,
+// where f = 0. The specular part D (n.h) / (4 v.h) from H = v + l: n.h = n.H / |H|, v.h = |H| / 2, so
+// D n.H / (2 |H|^2), |H|^2 floored as in the masking term.
+RTR_FN float brdfPdf(int brdf, vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughness, float metalness) {
+  vec3 nn = brdfSafeNormal(n);
+  float nl = dot(nn, l);
+  if (!(nl > 0.0f)) return 0.0f;
+  float p = brdfSpecularChance(dot(nn, v), baseColor, metalness);
+  vec3 H = v + l;
+  float hh = max(dot(H, H), BRDF_HH_MIN);
+  float alpha = brdfAlpha(roughness);
+  float D = brdf == BRDF_GGX ? brdfGgxD(nn, H, alpha) : brdfBeckmannD(nn, H, alpha);
+  float spec = D * max(dot(nn, H), 0.0f) / (2.0f * hh);
+  return p * spec + (1.0f - p) * nl * (1.0f / BRDF_PI);
+}
+
 // The brief's Beckmann BRDF without the selector (the form the renderer's shaders called before GGX).
 RTR_FN BrdfTerms brdfTerms(vec3 n, vec3 v, vec3 l, vec3 baseColor, float roughness, float metalness) {
   return brdfTerms(BRDF_BECKMANN, n, v, l, baseColor, roughness, metalness);

@@ -30,8 +30,8 @@ class MosaicPass {
   void setBlock(VkExtent2D block);  // 5x3 by default
   VkExtent2D block() const { return block_; }
 
-  void record(VkCommandBuffer cb, vk::TrackedImage input, VkImageView inputView, vk::TrackedImage output,
-              VkImageView outputView, VkFormat outputFormat, VkExtent2D extent, MosaicMode mode);
+  void record(VkCommandBuffer cb, vk::TrackedImage input, VkImageView inputView, vk::TrackedImage output, VkImageView outputView,
+              VkFormat outputFormat, VkExtent2D extent, MosaicMode mode);
 
  private:
   const vk::Pipeline& graphics(VkFormat format);

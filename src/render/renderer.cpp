@@ -6,32 +6,29 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "variants.h"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
 
 namespace rtr::render {
 namespace {
 
-// Every draw kind in one place: its shaders per pipeline set, its cull mode, and the vertex streams its
-// vertex shaders read (a prefix of {positions, normals, texcoords} forward, of {positions, texcoords} in
-// the visibility pass). Rows are in draw order: opaque geometry first, alpha-masked last (brief 1.6).
+// Every draw kind in one place: its variant of the scene shaders (specialization constants, variants.h),
+// whose visibility pipeline draws it, and its cull mode. The vertex streams bound are the variant's
+// reflected inputs. Rows are in draw order: opaque geometry first, alpha-masked last (brief 1.6).
 struct KindInfo {
-  const char* vert;    // forward and debug sets
-  const char* shaded;  // fragment stage of the shaded (forward) set
-  const char* debug;   // fragment stage of the debug set
-  DrawKind visAs;      // whose visibility pipeline draws this kind (untextured: the opaque one, positions only)
-  const char* visVert;
-  const char* visFrag;
+  bool textured, alphaMasked;
+  DrawKind visAs;        // whose visibility pipeline draws this kind (untextured: the opaque one, positions only)
   VkCullModeFlags cull;  // foliage (alpha-masked, two-sided) is not culled
-  uint32_t streams, visStreams;
 };
 constexpr KindInfo kKinds[kDrawKindCount] = {
-    {"scene.vert", "pbr.frag", "debug.frag", DrawKind::Opaque, "vis.vert", "vis.frag", VK_CULL_MODE_BACK_BIT, 3, 1},
-    {"scene_untextured.vert", "pbr_untextured.frag", "debug_untextured.frag", DrawKind::Opaque, nullptr, nullptr,
-     VK_CULL_MODE_BACK_BIT, 2, 1},
-    {"scene.vert", "pbr_alpha.frag", "debug_alpha.frag", DrawKind::AlphaMasked, "vis_alpha.vert", "vis_alpha.frag",
-     VK_CULL_MODE_NONE, 3, 2},
+    {true, false, DrawKind::Opaque, VK_CULL_MODE_BACK_BIT},
+    {false, false, DrawKind::Opaque, VK_CULL_MODE_BACK_BIT},
+    {true, true, DrawKind::AlphaMasked, VK_CULL_MODE_NONE},
 };
+// The scene passes' sources, one per pass (shaders/*.vert, *.frag, *.comp); variants by constants.
+constexpr const char* kSceneVert = "scene.vert";
+constexpr const char* kFrag[] = {"pbr.frag", "debug.frag"};  // by PipelineSet: kShaded, kDebug
 
 bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding) {
   for (const vk::ReflectedBinding& b : layout.interface().bindings)
@@ -95,9 +92,10 @@ RasterPath Renderer::rasterFor(const RenderSettings& s) const {
 }
 
 Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* frag, VkFormat colorFormat,
-                                                VkCullModeFlags cull) const {
+                                                VkCullModeFlags cull, std::vector<vk::SpecializationConstant> variant) const {
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader(vert), vk::loadShader(frag)};
+  d.specialization = std::move(variant);
   d.cullMode = cull;
   d.dynamicFrontFace = true;  // per draw: mirrored instances' front faces are clockwise
   d.colorFormats = {colorFormat};
@@ -137,8 +135,10 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
     }
     if (!needed) continue;
     jobs.push_back([this, set, &info, &slot = out[k]] {
-      slot = set == kVisibility ? makePipeline(info.visVert, info.visFrag, kVisFormat, info.cull)
-                                : makePipeline(info.vert, set == kDebug ? info.debug : info.shaded, kColorFormat, info.cull);
+      slot = set == kVisibility
+                 ? makePipeline("vis.vert", "vis.frag", kVisFormat, info.cull, {{VARIANT_ALPHA_MASK, info.alphaMasked}})
+                 : makePipeline(kSceneVert, kFrag[set], kColorFormat, info.cull,
+                                {{VARIANT_TEXCOORDS, info.textured}, {VARIANT_ALPHA_MASK, info.alphaMasked}});
     });
   }
   vk::inParallel(jobs);
@@ -147,13 +147,11 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
 
 Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
   const bool textured = scene_.texcoords() != VK_NULL_HANDLE;
-  const char* shader = fromBuffer ? (textured ? "vis_shade_buffer.comp" : "vis_shade_buffer_untextured.comp")
-                                  : (textured ? "vis_shade.comp" : "vis_shade_untextured.comp");
   vk::LayoutOptions options{.pushDescriptorSets = {0}};
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
   VisShade v;
-  v.pipeline.emplace(
-      vk::makeComputePipeline(ctx_, vk::loadShader(shader), options));
+  v.pipeline.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
+                                             {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}}));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
@@ -261,12 +259,12 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
     const vk::Pipeline& pl = *p.pipeline;
     pl.bind(cb);
     for (uint32_t s = 0; s < pl.layout.setCount(); ++s) pl.bindSet(cb, s, p.sets.get(s, frame));
-    // Streams in the order of the vertex shader's input locations.
+    // Streams by the vertex shader's input locations: the variant's reflected inputs are a prefix.
     const VkBuffer forward[3] = {scene_.positions(), scene_.normals(), scene_.texcoords()};
     const VkBuffer visStreams[2] = {scene_.positions(), scene_.texcoords()};
     const VkDeviceSize offsets[3] = {0, 0, 0};
-    if (vis) vkCmdBindVertexBuffers(cb, 0, kKinds[size_t(info.visAs)].visStreams, visStreams, offsets);
-    else vkCmdBindVertexBuffers(cb, 0, info.streams, forward, offsets);
+    const uint32_t inputs = uint32_t(pl.layout.interface().stages[0].inputs.size());  // stage 0: the vertex stage
+    vkCmdBindVertexBuffers(cb, 0, inputs, vis ? visStreams : forward, offsets);
     VkIndexType bound = VK_INDEX_TYPE_MAX_ENUM;
     for (const DrawItem* dp : nearestFirst(scene_.draws(kind), eye)) {
       const DrawItem& d = *dp;
@@ -297,13 +295,15 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(5, i32)
       .buffer(6, i16)
       .buffer(10, scene_.instances())
-      .buffer(11, scene_.texcoords1() ? scene_.texcoords1() : scene_.positions())
-      .buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions())
       .buffer(13, scene_.colors() ? scene_.colors() : scene_.positions())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
-  if (raster == RasterPath::Compute) w.buffer(7, raster_->ids());
+  if (raster == RasterPath::Compute) w.buffer(14, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  if (hasBinding(c.layout, 0, 9)) w.buffer(9, scene_.texcoords());
+  if (hasBinding(c.layout, 0, 9)) {  // the textured variant's
+    w.buffer(9, scene_.texcoords());
+    w.buffer(11, scene_.texcoords1() ? scene_.texcoords1() : scene_.positions());
+    w.buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions());
+  }
   w.push(cb, c);
   c.push(cb, shader::VisShadePush{primitiveBits_});
   if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade.textures.get(1));

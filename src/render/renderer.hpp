@@ -120,7 +120,8 @@ class Renderer {
     vk::DescriptorSets textures;  // set 1; set 0 is pushed per frame
   };
   void createTargets(VkExtent2D extent, bool visibility);
-  ScenePipelines makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull) const;
+  ScenePipelines makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull,
+                              std::vector<vk::SpecializationConstant> variant) const;
   KindPipelines makePipelines(PipelineSet set) const;
   VisShade makeShade(bool fromBuffer) const;
   void ensurePipelines(PipelineSet set);

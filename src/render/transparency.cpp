@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "renderer.hpp"
+#include "variants.h"
 
 namespace rtr::render {
 namespace {
@@ -27,8 +28,8 @@ TransparencyPass::TransparencyPass(const vk::Context& ctx, const GpuScene& scene
       continue;
     jobs.push_back([this, textured, doubleSided, &slot = variants_[v]] {
       vk::GraphicsDesc d;
-      d.modules = {vk::loadShader(textured ? "scene.vert" : "scene_untextured.vert"),
-                   vk::loadShader(textured ? "transparent.frag" : "transparent_untextured.frag")};
+      d.modules = {vk::loadShader("scene.vert"), vk::loadShader("pbr.frag")};  // the forward shading, BLEND variant
+      d.specialization = {{VARIANT_TEXCOORDS, textured}, {VARIANT_BLEND, 1}};
       d.cullMode = doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
       d.dynamicFrontFace = true;  // mirrored instances' front faces are clockwise
       d.depthWrite = false;

@@ -139,9 +139,16 @@ EnvSample Environment::sample(glm::vec2 u) const {
   const glm::vec2 uv{(float(tx) + std::min(u.y, 0x1.fffffep-1f)) / float(w), (float(ty) + std::min(frac, 0x1.fffffep-1f)) / float(h)};
   EnvSample s;
   s.direction = shader::envUvToDir(uv, rotation_);
-  s.radiance = lookup(s.direction);
+  s.radiance = glm::vec3(map_.at(tx, ty));
   s.pdf = density_[texel] / (2.0f * kPi * kPi * std::max(std::sin(uv.y * kPi), 1e-6f));
   return s;
+}
+
+glm::vec3 Environment::texel(const glm::vec3& d) const {
+  if (empty()) return glm::vec3(0.0f);
+  const glm::vec2 uv = shader::envDirToUv(d, rotation_);
+  const uint32_t w = map_.width, h = map_.height;
+  return glm::vec3(map_.at(std::min(uint32_t(uv.x * float(w)), w - 1), std::min(uint32_t(uv.y * float(h)), h - 1)));
 }
 
 float Environment::pdf(const glm::vec3& d) const {

@@ -38,7 +38,7 @@ glm::vec3 skySunDirection(const SkySettings& s);  // unit, from the ground towar
 
 struct EnvSample {
   glm::vec3 direction;  // unit, world space, towards where the light comes from
-  glm::vec3 radiance;   // as lookup(direction)
+  glm::vec3 radiance;   // as texel(direction)
   float pdf = 0.0f;     // per unit solid angle
 };
 
@@ -56,6 +56,10 @@ class Environment {
 
   // Bilinear radiance towards `direction` (unit, world space).
   glm::vec3 lookup(const glm::vec3& direction) const;
+  // The radiance of the texel that holds `direction`: the map as a piecewise-constant function, the one
+  // the tracer integrates (and the SH projection). Sampled in exact proportion to luminance, a texel's
+  // radiance / pdf is constant within it, so a sun in one texel adds no variance of its own.
+  glm::vec3 texel(const glm::vec3& direction) const;
   // A direction drawn in proportion to luminance (per unit solid angle) from two uniform numbers in [0,1).
   EnvSample sample(glm::vec2 u) const;
   // The density sample() draws `direction` with, per unit solid angle.

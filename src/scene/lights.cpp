@@ -13,9 +13,7 @@ Light briefLight() {
   return l;
 }
 
-bool isLightMaterial(const Material& m) {
-  return (m.flags & kMaterialLight) != 0 || m.name.find("light") != std::string::npos;
-}
+bool isLightMaterial(const Material& m) { return (m.flags & kMaterialLight) != 0 || m.name.find("light") != std::string::npos; }
 
 glm::vec3 Light::samplePoint(int i, int n) const {
   if (kind != Kind::Area || n <= 1) return position;
@@ -94,8 +92,8 @@ LightRig resolveLights(const Scene& scene, const LightOptions& o) {
     rig.lights = scene.lights.empty() ? lightsFromGeometry(scene) : scene.lights;
   }
   if (rig.lights.size() > kMaxLights) {
-    rig.note = "the scene has " + std::to_string(rig.lights.size()) + " lights; the first " +
-               std::to_string(kMaxLights) + " are used";
+    rig.note =
+        "the scene has " + std::to_string(rig.lights.size()) + " lights; the first " + std::to_string(kMaxLights) + " are used";
     rig.lights.resize(kMaxLights);
   }
   for (Light& l : rig.lights) l.falloff = l.falloff || o.falloff;

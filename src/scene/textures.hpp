@@ -43,8 +43,7 @@ TexelData decodeTexture(const Scene& scene, const Texture& t);
 // thread that decoded them (so per-texture work after decoding runs in parallel too). A texture that is
 // missing or cannot be decoded gets fallbackTexels() and one message naming its file to `warn` (default:
 // "warning: ..." on stderr; calls are serialised).
-void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
-                    const std::function<void(size_t, TexelData&&)>& use,
+void decodeTextures(const Scene& scene, std::span<const uint32_t> which, const std::function<void(size_t, TexelData&&)>& use,
                     const std::function<void(const std::string&)>& warn = {});
 
 // Whether a mesh's fragments are alpha-tested (discarded where the mask's alpha < 0.5), as on the GPU: it

@@ -306,6 +306,7 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
     }
     color += direct / float(samples);
   }
+  if (f.env) color += occlusion * environmentLight(sp, normal, v, in, brdf, f, c);
   return color;
 }
 
@@ -353,7 +354,8 @@ glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame
     if (!vis.hit.hit()) return glm::vec3(1.0f);
     return glm::vec3(std::clamp(vis.t * glm::dot(r.direction, f.depthAxis) / f.depthFar, 0.0f, 1.0f));
   }
-  if (!vis.hit.hit()) return s.background;
+  // bounces == s.bounces: a camera ray, or one continuing it past a blended surface (mirrors take one off).
+  if (!vis.hit.hit()) return s.shading == Shading::Normals ? s.background : missed(r.direction, bounces == s.bounces, f);
   const SurfacePoint& sp = vis.sp;
   if (s.shading == Shading::Normals) return glm::abs(sp.normal);  // the brief's "interpolation" view
   glm::vec3 col = local(vis.ray, sp, vis.coneWidth, f, c, pre);
@@ -404,6 +406,9 @@ Tracer::Frame Tracer::makeFrame(const TraceSettings& s) const {
   // A cone 2^bias times as wide: every LOD goes up by the bias.
   f.camera.width *= std::exp2(s.lodBias);
   f.camera.spread *= std::exp2(s.lodBias);
+  if (s.shading == Shading::Pbr && s.environment && !s.environment->empty()) f.env = s.environment.get();
+  f.dirToWorld = glm::mat3(s.model);
+  f.dirToScene = glm::mat3(f.toScene);
   return f;
 }
 
@@ -443,6 +448,7 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
   if (s.width == 0 || s.height == 0 || s.width > 32768 || s.height > 32768)
     throw Error("image size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " is out of range");
   if (s.bounces < 0 || s.bounces > 64) throw Error("bounces must be in 0..64, got " + std::to_string(s.bounces));
+  if (s.spp < 1 || s.spp > 65536) throw Error("samples per pixel must be in 1..65536, got " + std::to_string(s.spp));
   const Frame frame = makeFrame(s);  // loads the textures on the first pbr render: not part of its time
   const auto start = std::chrono::steady_clock::now();
   out.width = s.width;
@@ -486,6 +492,7 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
         shadowPackets(vis.data(), int(n), frame, known, blocked);
         for (uint32_t k = 0; k < n; ++k) {
           const Shadows pre{known.data(), blocked.data(), int(k)};
+          c.rng = Rng::forPixel(x + k, y);
           glm::vec3 col = shade(rays[k], frame.camera, s.bounces, frame, c, &vis[k], known.empty() ? nullptr : &pre);
           // Debug views hold their value as displayed: encode so that sRGB output shows it unchanged.
           if (debugView) col = {srgbToLinear(col.x), srgbToLinear(col.y), srgbToLinear(col.z)};
@@ -499,6 +506,7 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
     stats.shadowRays += c.shadow;
     stats.reflectionRays += c.reflection;
     stats.alphaRays += c.alpha;
+    stats.environmentRays += c.environment;
     if (onTile) onTile(rect);
   });
   stats.cancelled = stats.tilesDone < stats.tilesTotal;

@@ -10,17 +10,20 @@
 #include <optional>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/camera.hpp"
 #include "core/image.hpp"
+#include "scene/environment.hpp"
 #include "scene/lights.hpp"
 #include "scene/scene.hpp"
 #include "trace/bvh.hpp"
 #include "trace/instances.hpp"
 #include "trace/intersect.hpp"
 #include "trace/ray.hpp"
+#include "trace/sampling.hpp"
 #include "trace/textures.hpp"
 
 namespace rtr::trace {
@@ -54,6 +57,12 @@ struct TraceSettings {
   std::optional<LightRig> lights;
   float lodBias = 0.0f;            // pbr: added to every texture's level of detail, as the GPU's bias
   std::optional<Brdf> brdf;        // pbr; none: per material, GGX for glTF materials, Beckmann for the rest
+  // Light from an environment (pbr): integrated at every shaded point by multiple importance sampling of
+  // the environment and the BRDF, `spp` sample pairs a pixel, each with its shadow ray; rays that miss
+  // the scene see it. None: no environment light, misses see `background`.
+  std::shared_ptr<const Environment> environment;
+  int spp = 16;
+  bool environmentVisible = true;  // false: camera rays that miss see `background` even with an environment
   glm::vec3 background{0.0f};
 };
 
@@ -65,6 +74,7 @@ struct RenderStats {
   double seconds = 0.0;
   uint64_t primaryRays = 0, shadowRays = 0, reflectionRays = 0;
   uint64_t alphaRays = 0;  // rays continued beyond a cut-out texel (pbr with alpha-tested materials)
+  uint64_t environmentRays = 0;  // shadow rays of environment light samples (also counted in shadowRays)
   uint32_t tilesDone = 0, tilesTotal = 0;
   bool cancelled = false;
 };
@@ -127,7 +137,10 @@ class Tracer {
   const Scene& scene() const { return scene_; }
 
  private:
-  struct Counters { uint64_t shadow = 0, reflection = 0, alpha = 0; };
+  struct Counters {
+    uint64_t shadow = 0, reflection = 0, alpha = 0, environment = 0;
+    Rng rng;  // the pixel's own (Rng::forPixel), reset by the render loop before each pixel
+  };
   // A ray cone (Akenine-Möller et al., Ray Tracing Gems ch. 20) for texture LOD: width at the ray's
   // origin, growing by `spread` (radians) per unit of distance.
   struct Cone { float width = 0.0f, spread = 0.0f; };
@@ -141,6 +154,8 @@ class Tracer {
     float depthFar;
     const SceneTextures* tex = nullptr;  // pbr only
     Cone camera;                         // a primary ray's cone
+    const Environment* env = nullptr;    // pbr with a non-empty environment
+    glm::mat3 dirToWorld{1.0f}, dirToScene{1.0f};  // directions between scene space and the environment's
   };
   // A hit with its surface and the cone's width there; `ray` is the segment it was found on, t the hit's
   // parameter along the first ray (past cut-outs, of the hit point projected onto it).
@@ -175,6 +190,13 @@ class Tracer {
   bool cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f, bool cull) const;
   // glTF materials: the alpha, opacity × base colour alpha × vertex alpha.
   float gltfAlpha(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const;
+  // The environment's light reflected towards v at sp (f.env set): the MIS estimate, s.spp pairs of one
+  // environment sample and one BRDF sample, power heuristic, each with a shadow ray (env_light.cpp).
+  glm::vec3 environmentLight(const SurfacePoint& sp, const glm::vec3& n, const glm::vec3& v, const SurfaceInputs& in,
+                             int brdf, const Frame& f, Counters& c) const;
+  // What a ray that leaves the scene in (scene-space) direction d sees; camera: a camera ray (or one
+  // continuing it through a cut-out or a blended surface), not a mirror's.
+  glm::vec3 missed(const glm::vec3& d, bool camera, const Frame& f) const;
   Visible closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c, const Hit* first) const;
   bool shadowed(const Ray& r, const Frame& f, Counters& c) const;
 

@@ -121,7 +121,7 @@ ContextOptions optionsFromEnvironment() {
   if (const char* d = std::getenv("RTR_DEVICE")) o.device = d;
   if (const char* c = std::getenv("RTR_PIPELINE_CACHE")) {
     if (std::strcmp(c, "0") != 0 && std::strcmp(c, "off") != 0) o.pipelineCacheDir = c;
-  } else if (!std::getenv("RTR_TEST")) {
+  } else {
     o.pipelineCacheDir = defaultPipelineCacheDir();
   }
   return o;

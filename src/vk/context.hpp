@@ -27,8 +27,8 @@ struct ContextOptions {
 
 // Options from the environment: RTR_VALIDATION=1 enables validation (+ sync validation),
 // RTR_DEVICE picks the device. Debug builds validate by default. RTR_PIPELINE_CACHE=DIR keeps the
-// pipeline cache in DIR, =0 or =off keeps none; unset, the user's cache folder, except under tests
-// (RTR_TEST set), which never touch it unless they name a folder.
+// pipeline cache in DIR, =0 or =off keeps none; unset, the user's cache folder (the tests' environment
+// sets it off: they never touch it unless they name a folder).
 ContextOptions optionsFromEnvironment();
 
 class Context {

@@ -6,6 +6,9 @@
 #include <cstdlib>
 #include <mutex>
 #include <unistd.h>
+#include <unordered_map>
+
+#include <spirv-tools/optimizer.hpp>
 
 #include "core/parallel.hpp"
 #include "vk/check.hpp"
@@ -39,6 +42,34 @@ SpirvModule loadShader(const std::string& name) {
     if (auto it = g_overrides.find(name); it != g_overrides.end()) return it->second;
   }
   return readSpirv(shaderDir() / (name + ".spv"));
+}
+
+SpirvModule specialize(const SpirvModule& module, const std::vector<SpecializationConstant>& constants) {
+  if (constants.empty()) return module;
+  std::unordered_map<uint32_t, std::vector<uint32_t>> values;
+  for (const SpecializationConstant& c : constants) values[c.id] = {c.value};
+  // What a driver does with VkSpecializationInfo, done here so that reflection sees the variant: the
+  // constants become plain ones, branches on them fold, and what no branch left reaches goes, with the
+  // inputs, outputs and descriptors only it used.
+  spvtools::Optimizer opt(SPV_ENV_VULKAN_1_3);
+  std::string log;
+  opt.SetMessageConsumer([&](spv_message_level_t, const char*, const spv_position_t& at, const char* message) {
+    log += (log.empty() ? "" : "; ") + std::string(message) + " (word " + std::to_string(at.index) + ")";
+  });
+  opt.RegisterPass(spvtools::CreateSetSpecConstantDefaultValuePass(values))
+      .RegisterPass(spvtools::CreateFreezeSpecConstantValuePass())
+      .RegisterPass(spvtools::CreateFoldSpecConstantOpAndCompositePass())
+      .RegisterPass(spvtools::CreateCCPPass())  // `CONSTANT && x` in a condition, too
+      .RegisterPass(spvtools::CreateDeadBranchElimPass())
+      .RegisterPass(spvtools::CreateAggressiveDCEPass())
+      .RegisterPass(spvtools::CreateRemoveUnusedInterfaceVariablesPass())
+      .RegisterPass(spvtools::CreateEliminateDeadConstantPass());
+  spvtools::OptimizerOptions options;
+  options.set_run_validator(false);  // the build checked every module with spirv-val
+  SpirvModule out{module.name, {}};
+  if (!opt.Run(module.code.data(), module.code.size(), &out.code, options))
+    throw Error(module.name + ": cannot apply its specialization constants: " + log);
+  return out;
 }
 
 PipelineLayout::PipelineLayout(const Context& ctx, PipelineInterface interface, const LayoutOptions& options)
@@ -113,20 +144,6 @@ ShaderModuleHandle createModule(VkDevice device, const SpirvModule& m) {
   return ShaderModuleHandle(device, raw);
 }
 
-struct Specialization {
-  std::vector<VkSpecializationMapEntry> entries;
-  std::vector<uint32_t> data;
-  VkSpecializationInfo info{};
-  explicit Specialization(const std::vector<SpecializationConstant>& cs) {
-    for (const auto& c : cs) {
-      entries.push_back({c.id, uint32_t(data.size() * 4), 4});
-      data.push_back(c.value);
-    }
-    info = {uint32_t(entries.size()), entries.data(), data.size() * 4, data.data()};
-  }
-  const VkSpecializationInfo* get() const { return entries.empty() ? nullptr : &info; }
-};
-
 uint32_t formatSize(VkFormat f) {
   switch (f) {
     case VK_FORMAT_R32_SFLOAT: case VK_FORMAT_R32_UINT: case VK_FORMAT_R32_SINT: return 4;
@@ -163,15 +180,14 @@ Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, cons
   Feedback feedback(ctx, 1);
   Pipeline p;
   p.bindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
-  p.layout = PipelineLayout(ctx, reflectPipeline({shader}), options);
-  ShaderModuleHandle module = createModule(ctx.device(), shader);
-  Specialization spec(specialization);
+  const SpirvModule variant = specialize(shader, specialization);
+  p.layout = PipelineLayout(ctx, reflectPipeline({variant}), options);
+  ShaderModuleHandle module = createModule(ctx.device(), variant);
   VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO, &feedback.info};
   ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
   ci.stage.pName = p.layout.interface().stages[0].entryPoint.c_str();
-  ci.stage.pSpecializationInfo = spec.get();
   ci.layout = p.layout.handle();
   VkPipeline raw;
   VK_CHECK(vkCreateComputePipelines(ctx.device(), ctx.pipelineCache().handle(), 1, &ci, nullptr, &raw));
@@ -185,21 +201,21 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   Feedback feedback(ctx, d.modules.size());
   Pipeline p;
   p.bindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
-  p.layout = PipelineLayout(ctx, reflectPipeline(d.modules), options);
+  std::vector<SpirvModule> variants;
+  for (const SpirvModule& m : d.modules) variants.push_back(specialize(m, d.specialization));
+  p.layout = PipelineLayout(ctx, reflectPipeline(variants), options);
   const PipelineInterface& iface = p.layout.interface();
   // Stage i is module i's only entry point; a module with several would shift them.
   if (iface.stages.size() != d.modules.size()) throw Error("graphics pipeline: a module with several entry points");
 
   std::vector<ShaderModuleHandle> modules;
   std::vector<VkPipelineShaderStageCreateInfo> stages;
-  Specialization spec(d.specialization);
-  for (size_t i = 0; i < d.modules.size(); ++i) {
-    modules.push_back(createModule(ctx.device(), d.modules[i]));
+  for (size_t i = 0; i < variants.size(); ++i) {
+    modules.push_back(createModule(ctx.device(), variants[i]));
     VkPipelineShaderStageCreateInfo si{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     si.stage = iface.stages[i].stage;
     si.module = modules.back();
     si.pName = iface.stages[i].entryPoint.c_str();
-    si.pSpecializationInfo = spec.get();
     stages.push_back(si);
   }
 

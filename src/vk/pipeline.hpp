@@ -24,6 +24,14 @@ SpirvModule loadShader(const std::string& name);  // "mosaic.comp" -> <shaderDir
 // Shader hot reload: a module compiled at run time replaces the build's <name>.spv for later loadShader calls.
 void setShaderOverride(const std::string& name, SpirvModule module);
 
+// A shader's variant: the value (32 bits; a bool is 0 or 1) of its `layout(constant_id = id)` constant.
+struct SpecializationConstant { uint32_t id; uint32_t value; };
+// The module with its specialization constants set and folded, and the code, inputs, outputs and
+// descriptors that only the branches not taken used removed, so that reflection derives the variant's own
+// layout and vertex streams. Both pipeline makers specialize through it; the driver gets the result (no
+// VkSpecializationInfo). No constants: the module as it is.
+SpirvModule specialize(const SpirvModule& module, const std::vector<SpecializationConstant>& constants);
+
 struct LayoutOptions {
   // Size of each runtime-sized array binding, keyed by (set, binding). Such bindings are made
   // partially bound with a variable count, so a scene's texture count decides the size.
@@ -78,7 +86,6 @@ struct Pipeline {
 // workgroup size: the one rounding every dispatch uses, so no size is written twice.
 VkExtent3D groupCount(const PipelineInterface& p, uint32_t x, uint32_t y = 1, uint32_t z = 1);
 
-struct SpecializationConstant { uint32_t id; uint32_t value; };
 
 Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, const LayoutOptions& options = {},
                              const std::vector<SpecializationConstant>& specialization = {});

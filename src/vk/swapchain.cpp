@@ -31,8 +31,7 @@ void Swapchain::recreate(VkExtent2D windowExtent) {
 }
 
 std::optional<uint32_t> Swapchain::acquire(VkSemaphore acquired, VkExtent2D windowExtent) {
-  if (stale_ || windowExtent.width != windowExtent_.width || windowExtent.height != windowExtent_.height)
-    recreate(windowExtent);
+  if (stale_ || windowExtent.width != windowExtent_.width || windowExtent.height != windowExtent_.height) recreate(windowExtent);
   uint32_t i = 0;
   const VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, UINT64_MAX, acquired, VK_NULL_HANDLE, &i);
   if (r == VK_ERROR_OUT_OF_DATE_KHR) {

@@ -118,7 +118,8 @@ def main():
                 ("view", [view, "--headless", "--mosaic", "off", "--size", SIZE, "--screenshot", os.path.join(out, "view.png"), obj], "view.png"),
                 # Textured models in the tracer's pbr mode, the viewer's model: its default Blinn-Phong (the
                 # course's) samples map_Kd too, but Ka + Kd of these MTLs saturate it to near white.
-                ("trace", [trace, "-q", "--size", SIZE, obj, "-o", os.path.join(out, "trace.png")] +
+                # A black backdrop: "BLACK image" is judged against black (the default is mid-grey).
+                ("trace", [trace, "-q", "--size", SIZE, obj, "-o", os.path.join(out, "trace.png"), "--background", "0"] +
                  (["--shading", "pbr"] if is_textured(obj) else []), "trace.png")):
             outcome, msg = run(cmd, obj, timeout)
             if outcome == "ok":

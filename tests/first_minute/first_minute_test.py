@@ -42,7 +42,8 @@ def render(bins, out, model, extra, tool):
     png = os.path.join(out, f"{os.path.basename(model)}.{tool}.png")
     size = f"{SIZE[0]}x{SIZE[1]}"
     cmd = ([f"{bins}/rtr-view", model, "--headless", "-o", png, "--size", size, "--force"] if tool == "view" else
-           [f"{bins}/rtr-trace", model, "-o", png, "--size", size, "--force"]) + extra
+           # A black backdrop: the checks count lit pixels against black (rtr-trace's default is mid-grey).
+           [f"{bins}/rtr-trace", model, "-o", png, "--size", size, "--force", "--background", "0"]) + extra
     r = run(cmd)
     return r, png
 

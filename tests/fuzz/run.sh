@@ -29,7 +29,7 @@ spirv_seeds=build/fuzz/corpus/spirv-seeds
 if [ -d build/fuzz/shaders ]; then
   mkdir -p "$spirv_seeds"
   for f in build/fuzz/shaders/*.spv; do [ "$(wc -c <"$f")" -le 8192 ] && cp "$f" "$spirv_seeds/"; done
-  for p in vis vis_alpha mosaic imgui; do
+  for p in vis mosaic imgui; do
     cat "build/fuzz/shaders/$p.vert.spv" "build/fuzz/shaders/$p.frag.spv" >"$spirv_seeds/$p.pipeline"
   done
 fi

@@ -58,9 +58,7 @@ std::filesystem::path shaderFolderWith(const Edit& edit) {
   // The shaded view's shaders of both paths (forward fragment, visibility compute, from either rasteriser's
   // ids) include "brdf.h":
   // not found next to them (shaders/), so the edited copy comes first.
-  for (const char* shader :
-       {"pbr.frag", "pbr_untextured.frag", "pbr_alpha.frag", "vis_shade.comp", "vis_shade_untextured.comp",
-        "vis_shade_buffer.comp", "vis_shade_buffer_untextured.comp"}) {
+  for (const char* shader : {"pbr.frag", "vis_shade.comp"}) {  // every variant of each (variants.h)
     const vk::SpirvModule m = vk::compileGlsl(src / shader, {inc, src, src / "shared"});
     std::ofstream out(dir / (std::string(shader) + ".spv"), std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(m.code.data()), std::streamsize(m.code.size() * sizeof(uint32_t)));

@@ -59,8 +59,7 @@ TEST_F(VulkanTest, AlphaMaskedQuadDiscardsAndLightsBothFaces) {
       s.shading = path;
       s.raster = raster;
       for (bool back : {false, true}) {
-        SCOPED_TRACE(testing::Message() << rtr::enumName(path) << ", " << rtr::enumName(raster)
-                                        << (back ? " back" : " front"));
+        SCOPED_TRACE(testing::Message() << rtr::enumName(path) << ", " << rtr::enumName(raster) << (back ? " back" : " front"));
         CameraPose pose{{0, 0, back ? -2.5f : 2.5f}, back ? 180.0f : 0.0f, 0.0f};
         s.lights.lights = {Light{}};
         s.lights.lights[0].position = pose.position;

@@ -91,30 +91,32 @@ TEST_F(SamplerTest, FilterChangesTheShadedViewOnBothPathsAndSwitchesBack) {
 }
 
 // --filter reaches every pipeline that samples the scene's textures (they share one writer): the
-// forward and visibility images change with it on both rasterisers, and so do the compute rasteriser's
-// ids, whose alpha-masked foliage its hardware hand-off tests with the same sampler as the others (so its
-// coverage stays the hardware rasteriser's).
+// forward image (through either mosaic pass, compute or graphics) and the visibility images change with it
+// on both rasterisers, and so do the compute rasteriser's ids, whose alpha-masked foliage its hardware
+// hand-off tests with the same sampler as the others (so its coverage stays the hardware rasteriser's).
 TEST_F(SamplerTest, FilterNearestChangesEveryPath) {
   struct Path {
     render::ShadingPath shading;
     render::RasterPath raster;
+    render::MosaicMode mosaic = render::MosaicMode::Off;
   };
   std::vector<Path> paths = {{render::ShadingPath::Forward, render::RasterPath::Auto},
+                             {render::ShadingPath::Forward, render::RasterPath::Auto, render::MosaicMode::Graphics},
                              {render::ShadingPath::Visibility, render::RasterPath::Hardware}};
   const bool compute = render::ComputeRaster::supported(*ctx);
-  if (compute) paths.push_back({render::ShadingPath::Visibility, render::RasterPath::Compute});
+  if (compute) paths.push_back({render::ShadingPath::Visibility, render::RasterPath::Compute, render::MosaicMode::Compute});
   std::vector<uint32_t> ids[2][2];  // [raster hardware, compute][trilinear, nearest]
   for (const Path& p : paths)
     for (int nearest = 0; nearest < 2; ++nearest) {
       RenderSettings s;
       s.shading = p.shading;
       s.raster = p.raster;
-      s.mosaic = render::MosaicMode::Off;
+      s.mosaic = p.mosaic;
       s.sampler.filter = nearest ? TextureFilter::Nearest : TextureFilter::Trilinear;
       if (p.shading == render::ShadingPath::Visibility)
         ids[p.raster == render::RasterPath::Compute][nearest] = renderer->ids(pose, lens, s);
       if (nearest) continue;
-      SCOPED_TRACE(testing::Message() << enumName(p.shading) << ", " << enumName(p.raster));
+      SCOPED_TRACE(testing::Message() << enumName(p.shading) << ", " << enumName(p.raster) << ", mosaic " << enumName(p.mosaic));
       const ImageRGBA8 a = renderer->render(pose, lens, s).image;
       s.sampler.filter = TextureFilter::Nearest;
       EXPECT_GT(differingPixels(a, renderer->render(pose, lens, s).image), size_t(kW * kH / 20));
@@ -137,10 +139,9 @@ TEST_F(SamplerTest, AnisotropyChangesTheShadedViewWhereSupported) {
   // lavapipe filters anisotropically only where the footprint is long (the far floor): a few hundred pixels.
   EXPECT_GT(differingPixels(off, on), size_t(kW * kH / 1000));
   // More than the device offers is clamped, not an error (validation checks the sampler).
-  EXPECT_EQ(differingPixels(render(VIEW_SHADED, TextureFilter::Trilinear, render::ShadingPath::Visibility,
-                                   render::maxAnisotropy(*ctx) * 4),
-                            render(VIEW_SHADED, TextureFilter::Trilinear, render::ShadingPath::Visibility,
-                                   render::maxAnisotropy(*ctx))),
+  EXPECT_EQ(differingPixels(
+                render(VIEW_SHADED, TextureFilter::Trilinear, render::ShadingPath::Visibility, render::maxAnisotropy(*ctx) * 4),
+                render(VIEW_SHADED, TextureFilter::Trilinear, render::ShadingPath::Visibility, render::maxAnisotropy(*ctx))),
             0u);
 }
 

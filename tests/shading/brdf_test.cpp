@@ -1,7 +1,9 @@
 // CPU tests of the shared BRDF header (shaders/shared/brdf.h), compiled here as C++ with GLM.
 #include "brdf.h"
+#include "brdf_quadrature.hpp"
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -90,6 +92,17 @@ TEST(Brdf, DenseGridIsFiniteAndNonNegative) {
                   << " G " << t.G << " spec " << t.specular.x << " L " << L.x;
               ASSERT_LE(t.G, 1.0f);
               ASSERT_LE(t.F.x, 1.0f);
+              // The sampling side on the same grid: the density of any l, and draws at extreme numbers.
+              const float pdf = brdfPdf(brdf, n, v, l, base, r, m);
+              ASSERT_TRUE(finiteNonNeg(pdf)) << "pdf " << pdf << " r " << r << " m " << m << " brdf " << brdf;
+              if (j == 0)
+                for (float u0 : {0.0f, 0.3f, 0.9f})
+                  for (float u1 : {0.0f, 1e-7f, 0.5f, BRDF_U_MAX, 1.0f}) {
+                    const glm::vec3 d = brdfSampleDirection(brdf, n, v, glm::vec3(u0, u1, 1.0f - u1), base, r, m);
+                    ASSERT_TRUE(std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z));
+                    ASSERT_NEAR(glm::length(d), 1.0f, 1e-5f) << "r " << r << " m " << m << " u " << u0 << ' ' << u1;
+                    ASSERT_TRUE(finiteNonNeg(brdfPdf(brdf, n, v, d, base, r, m)));
+                  }
             }
       }
     }
@@ -438,6 +451,81 @@ TEST(BrdfGgx, SelectorPicksTheModel) {
   EXPECT_NE(g.D, a.D);
   EXPECT_EQ(g.F, a.F);  // one Fresnel
   EXPECT_NE(g.diffuse, a.diffuse);  // glTF weights the diffuse by the dielectric's Fresnel
+}
+
+}  // namespace
+}  // namespace rtr::shader
+
+namespace rtr::shader {
+namespace {
+
+// Importance sampling (brdfSampleDirection / brdfPdf): the estimator f cos / pdf over its own draws
+// gives the directional albedo found by quadrature, within four standard errors: this holds only if
+// brdfPdf is the density the draws really have, on every lobe and roughness down to the clamped alpha.
+TEST(BrdfSampling, EstimatorGivesTheDirectionalAlbedo) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const glm::vec3 n(0, 0, 1), base(0.9f, 0.6f, 0.3f);
+  int checked = 0;
+  for (int brdf : {BRDF_BECKMANN, BRDF_GGX})
+    for (float rough : {0.0f, 0.2f, 0.5f, 1.0f})
+      for (float metal : {0.0f, 1.0f})
+        for (double tv : {0.3, 1.2, 1.5}) {
+          const glm::vec3 v(float(std::sin(tv)), 0.0f, float(std::cos(tv)));
+          const quadrature::Estimate ref = quadrature::directionalAlbedo(brdf, tv, base, rough, metal);
+          const int N = 100000;
+          double sum = 0, sum2 = 0;
+          for (int i = 0; i < N; ++i) {
+            const glm::vec3 l = brdfSampleDirection(brdf, n, v, glm::vec3(uni(rng), uni(rng), uni(rng)), base, rough, metal);
+            const float pdf = brdfPdf(brdf, n, v, l, base, rough, metal);
+            if (!(pdf > 0.0f)) continue;
+            const BrdfTerms t = brdfTerms(brdf, n, v, l, base, rough, metal);
+            const double x = double(t.diffuse.x + t.specular.x) * std::max(l.z, 0.0f) / pdf;
+            sum += x;
+            sum2 += x * x;
+          }
+          const double mean = sum / N, se = std::sqrt(std::max(sum2 / N - mean * mean, 0.0) / N);
+          EXPECT_NEAR(mean, ref.value, 4 * se + ref.error + 1e-4)
+              << "brdf " << brdf << " roughness " << rough << " metal " << metal << " view " << tv << " se " << se;
+          ++checked;
+        }
+  EXPECT_EQ(checked, 48);
+}
+
+// The draws fall into bins of the hemisphere as often as brdfPdf integrated over each bin says (a
+// binomial count within 5 sigma), for rough lobes whose density a bin grid resolves.
+TEST(BrdfSampling, DrawsFollowThePdf) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  const glm::vec3 n(0, 0, 1), base(0.8f, 0.8f, 0.8f);
+  constexpr int kT = 8, kP = 8, kSub = 24;
+  for (int brdf : {BRDF_BECKMANN, BRDF_GGX})
+    for (float rough : {0.5f, 1.0f})
+      for (float metal : {0.0f, 1.0f}) {
+        const glm::vec3 v(float(std::sin(0.8)), 0.0f, float(std::cos(0.8)));
+        const int N = 200000;
+        std::vector<int> count(kT * kP, 0);
+        for (int i = 0; i < N; ++i) {
+          const glm::vec3 l = brdfSampleDirection(brdf, n, v, glm::vec3(uni(rng), uni(rng), uni(rng)), base, rough, metal);
+          if (l.z <= 0.0f) continue;
+          const double th = std::acos(std::min(double(l.z), 1.0)), ph = std::atan2(double(l.y), double(l.x)) + kPi;
+          count[std::min(int(th / (kPi / 2) * kT), kT - 1) * kP + std::min(int(ph / (2 * kPi) * kP), kP - 1)]++;
+        }
+        for (int bt = 0; bt < kT; ++bt)
+          for (int bp = 0; bp < kP; ++bp) {
+            double prob = 0;
+            for (int a = 0; a < kSub; ++a)
+              for (int b = 0; b < kSub; ++b) {
+                const double th = (bt + (a + 0.5) / kSub) * (kPi / 2) / kT, ph = (bp + (b + 0.5) / kSub) * 2 * kPi / kP - kPi;
+                const glm::vec3 l = dir(th, ph);
+                prob += double(brdfPdf(brdf, n, v, l, base, rough, metal)) * std::sin(th) * (kPi / 2 / kT / kSub) *
+                        (2 * kPi / kP / kSub);
+              }
+            const double expect = prob * N, sigma = std::sqrt(std::max(expect * (1 - prob), 1.0));
+            EXPECT_NEAR(count[bt * kP + bp], expect, 5 * sigma + 0.01 * expect)
+                << "brdf " << brdf << " roughness " << rough << " metal " << metal << " bin " << bt << ',' << bp;
+          }
+      }
 }
 
 }  // namespace

@@ -109,11 +109,11 @@ TEST_F(StartupTest, PipelineCacheGoesWhereItIsToldAndNowhereWhenOff) {
   EXPECT_EQ(files, 1);
 
   const fs::path home = dir / "home";
-  const ViewRun off = view("--no-pipeline-cache", "-u RTR_TEST -u XDG_CACHE_HOME HOME=" + home.string());
+  const ViewRun off = view("--no-pipeline-cache", "-u RTR_PIPELINE_CACHE -u XDG_CACHE_HOME HOME=" + home.string());
   ASSERT_EQ(off.status, 0) << off.out;
   EXPECT_FALSE(fs::exists(home / ".cache/rtr")) << off.out;
   // Without the flag the same run keeps it in the user's cache folder.
-  const ViewRun on = view("", "-u RTR_TEST -u XDG_CACHE_HOME HOME=" + home.string());
+  const ViewRun on = view("", "-u RTR_PIPELINE_CACHE -u XDG_CACHE_HOME HOME=" + home.string());
   ASSERT_EQ(on.status, 0) << on.out;
   EXPECT_TRUE(fs::is_directory(home / ".cache/rtr")) << on.out;
 }

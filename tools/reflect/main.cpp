@@ -13,6 +13,7 @@
 #include "core/cli.hpp"
 #include "core/error.hpp"
 #include "vk/glsl.hpp"
+#include "vk/pipeline.hpp"
 #include "vk/reflect.hpp"
 
 namespace {
@@ -27,8 +28,27 @@ std::string joined(const std::vector<std::string>& files) {
   return names;
 }
 
+// "ID=VALUE", both whole numbers that fit 32 bits; a usage error naming --spec otherwise.
+rtr::vk::SpecializationConstant parseSpec(const std::string& text) {
+  const size_t eq = text.find('=');
+  auto part = [&](const std::string& t) {
+    size_t used = 0;
+    unsigned long long v = 0;
+    try {
+      v = std::stoull(t, &used, 0);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (t.empty() || used != t.size() || t[0] == '-' || v > UINT32_MAX)
+      throw rtr::UsageError("--spec '" + text + "': expected ID=VALUE, whole numbers of 32 bits (a bool: 0 or 1)");
+    return uint32_t(v);
+  };
+  if (eq == std::string::npos) part("");
+  return {part(text.substr(0, eq)), part(text.substr(eq + 1))};
+}
+
 int reflectAll(const std::vector<std::string>& files, const std::vector<std::string>& includes, bool json,
-               bool noValidate, bool strict) {
+               bool noValidate, bool strict, const std::vector<rtr::vk::SpecializationConstant>& specs) {
   try {
     return rtr::stage("reflecting " + joined(files), [&] {
     std::vector<std::filesystem::path> dirs(includes.begin(), includes.end());
@@ -43,6 +63,7 @@ int reflectAll(const std::vector<std::string>& files, const std::vector<std::str
         std::fprintf(stderr, "rtr-reflect: warning: %s\n  (reflecting it anyway; --strict makes this an error)\n", e.what());
       }
     }
+    for (auto& m : modules) m = rtr::vk::specialize(m, specs);
     const auto iface = rtr::vk::reflectPipeline(modules);
     std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
     return 0;
@@ -69,6 +90,7 @@ int main(int argc, char** argv) {
       "rtr-reflect"};
   std::vector<std::string> files;
   std::vector<std::string> includes;
+  std::vector<std::string> specTexts;
   bool json = false, noValidate = false, strict = false;
   app.add_option("shaders", files, "SPIR-V or GLSL files of one pipeline")->required()->check(CLI::ExistingFile);
   app.add_flag("--json", json, "machine-readable JSON output");
@@ -76,7 +98,14 @@ int main(int argc, char** argv) {
   app.add_option("-I,--include", includes, "include folder for GLSL inputs (repeatable)")->allow_extra_args(false);
   app.add_flag("--no-validate", noValidate, "skip spirv-val style validation of SPIR-V inputs");
   app.add_flag("--strict", strict, "a module spirv-val rejects is an error (exit 1), not a warning");
+  app.add_option("--spec", specTexts,
+                 "ID=VALUE: a specialization constant's value (a bool: 0 or 1), applied before reflecting as the "
+                 "renderer applies it for a variant (repeatable)")
+      ->allow_extra_args(false)
+      ->check(rtr::cli::checked([](const std::string& t) { parseSpec(t); }, "ID=VALUE"));
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
+  std::vector<rtr::vk::SpecializationConstant> specs;
+  for (const std::string& t : specTexts) specs.push_back(parseSpec(t));
 
   // SPIRV-Reflect (third party) asserts or crashes on some modules, even ones spirv-val accepts (found
   // by fuzzing, docs/fuzzing.md). The work runs in a child process so that the tool reports such a module
@@ -95,13 +124,13 @@ int main(int argc, char** argv) {
       ::setrlimit(RLIMIT_AS, &limit);
     }
 #endif
-    const int rc = reflectAll(files, includes, json, noValidate, strict);
+    const int rc = reflectAll(files, includes, json, noValidate, strict, specs);
     std::cout.flush();
     std::fflush(nullptr);
     _exit(rc);
   }
   int status = 0;
-  if (pid < 0 || waitpid(pid, &status, 0) != pid) return reflectAll(files, includes, json, noValidate, strict);
+  if (pid < 0 || waitpid(pid, &status, 0) != pid) return reflectAll(files, includes, json, noValidate, strict, specs);
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   std::fprintf(stderr, "rtr-reflect: error: %s: SPIRV-Reflect crashed reading it (signal %d); the module is "
                "malformed in a way SPIRV-Reflect does not check\n", joined(files).c_str(), WTERMSIG(status));

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <new>
 #include <string>
 
@@ -10,6 +11,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/common/environment_options.hpp"
+#include "apps/common/light_options.hpp"
 #include "core/camera.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
@@ -29,12 +32,13 @@ int run(int argc, char** argv) {
   CLI::App app{"rtr-trace: CPU ray tracer (the GPU's PBR BRDF for models; the course's Blinn-Phong with shadows and "
                "mirrors for the course's scenes)", "rtr-trace"};
   std::string scenePath, outPath, size = "1280x720", camera, shading = "auto", shadows = "on",
-                                  intersectName = "watertight", light, lightColor, ambient = "0.02", mtlPath, up = "+Y",
+                                  intersectName = "watertight", mtlPath, up = "+Y",
                                   brdf;
   LightOptions lightOptions;
+  cli::EnvironmentOptions envOptions;
   TraceSettings s;
   float fov = s.lens.fovYDeg, orthoHeight = 0.0f;
-  bool ortho = false, quiet = false, force = false, noDefaultLight = false;
+  bool ortho = false, quiet = false, force = false;
   float crease = LoadOptions{}.creaseDeg;
   app.add_option("scene", scenePath, "scene file (.obj, .obj.zst, .comp5892mesh, .rtrscene)")->required();
   app.add_option("mtl,--mtl", mtlPath, "OBJ: its MTL, as the course runs `program NAME.obj NAME.mtl` (default: the "
@@ -67,19 +71,15 @@ int run(int argc, char** argv) {
       ->capture_default_str()->check(cli::oneOf<IntersectMethod>());
   app.add_option("--area-samples", s.areaLightSamples, "shadow rays per area light (1: its centre)")
       ->capture_default_str()->check(cli::integer(1, 1024));
-  CLI::Option* lightOpt = app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights")
-      ->check(cli::checked([](const std::string& t) { cli::parseVec3("--light", t); }, "X,Y,Z"));
-  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
-      ->needs(lightOpt)->check(cli::checked([](const std::string& t) { cli::parseColor("--light-color", t); }, "R,G,B"));
-  app.add_flag("--falloff", lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
-  app.add_option("--ambient", ambient, "pbr: ambient colour r,g,b (or one grey value)")->capture_default_str()
-      ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
-  app.add_flag("--no-default-light", noDefaultLight,
-               "a scene without lights gets no headlight (the assignment's strict behaviour: ambient and emission only)");
+  cli::addLightOptions(app, lightOptions);
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
       ->capture_default_str();
   app.add_option("--crease", crease, "OBJ faces without normals: normals split where faces meet at more than DEG "
                  "degrees (0 flat, 180 smooth)")->capture_default_str()->check(cli::number(0, 180));
+  cli::addEnvironmentOptions(app, envOptions);
+  app.add_option("--spp", s.spp, "pbr with --env: samples per pixel of the environment's light (each a pair: one "
+                 "from the environment, one from the BRDF, with a shadow ray each)")
+      ->capture_default_str()->check(cli::integer(1, 65536));
   app.add_option("--lod-bias", s.lodBias, "pbr: mipmap LOD bias (as rtr-view's)")
       ->capture_default_str()->check(cli::number(-16, 16));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
@@ -94,15 +94,20 @@ int run(int argc, char** argv) {
   s.lens.orthographic = ortho;
   const float aspect = float(w) / float(h);
   s.lens.orthoHalfHeight = orthoHeight > 0.0f ? orthoHeight : (aspect >= 1.0f ? 1.0f : 1.0f / aspect);
-  lightOptions.defaultLight = !noDefaultLight;
+  envOptions.resolve();
+  // The environment is the light: no headlight and no flat ambient stand in for it unless asked for.
+  if (envOptions.hasEnvironment()) lightOptions.defaultLight = false;
+  if (envOptions.hasEnvironment() && app.count("--ambient") == 0) lightOptions.ambient = glm::vec3(0.0f);
+  s.background = envOptions.backgroundColor;
+  s.environmentVisible = envOptions.showEnvironment;
   const glm::mat3 upTurn = upRotation(up);
   if (!brdf.empty()) s.brdf = cli::enumOption<Brdf>("--brdf", brdf);
   s.shadows = shadows == "on";
   s.intersect = cli::enumOption<IntersectMethod>("--intersect", intersectName);
-  if (!light.empty()) lightOptions.position = cli::parseVec3("--light", light);
-  if (!lightColor.empty()) lightOptions.color = cli::parseColor("--light-color", lightColor);
-  lightOptions.ambient = cli::parseColor("--ambient", ambient, true);
   cli::checkImageOutput("-o", outPath, force);  // before tracing, not after
+
+  gStage = "loading the environment " + envOptions.settings.source;
+  s.environment = std::make_shared<const Environment>(Environment::load(envOptions.settings));
 
   LoadOptions load;
   if (!mtlPath.empty()) load.mtl = mtlPath;
@@ -118,7 +123,12 @@ int run(int argc, char** argv) {
   if (!quiet && shading == "auto")
     std::fprintf(stderr, "rtr-trace: note: %s shading: %s (--shading)\n", s.shading == Shading::Phong ? "Blinn-Phong" : "PBR",
                  s.shading == Shading::Phong ? "one of the course's scenes" : "a model, shaded as rtr-view shades it");
+  if (!quiet && s.environment && !s.environment->empty() && s.shading != Shading::Pbr)
+    std::fprintf(stderr, "rtr-trace: note: the environment lights PBR shading only; %s shading sees it where rays "
+                 "leave the scene\n", enumName(s.shading));
   s.lights = resolveLights(scene, lightOptions);
+  if (envOptions.hasEnvironment() && s.lights->lights.empty() && app.count("--no-default-light") == 0)
+    s.lights->note = "lit by the environment (--env: no default headlight, no ambient unless --ambient)";
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   gStage = "building the BVH of " + scenePath;
   const Tracer tracer(scene, s.threads);
@@ -134,7 +144,7 @@ int run(int argc, char** argv) {
   });
   if (tty) std::fprintf(stderr, "\r\033[K");
   const bool lit = std::any_of(image.pixels.begin(), image.pixels.end(),
-                               [&](const glm::vec4& p) { return glm::vec3(p) != s.background; });
+                               [&](const glm::vec4& p) { return glm::vec3(p) != s.background && glm::vec3(p) != glm::vec3(0.0f); });
   const std::string empty = emptyImageWarning(scene, tracer.resolvePose(s), s.lens, aspect, lit, s.lights->lights.size());
   if (!empty.empty()) std::fprintf(stderr, "rtr-trace: warning: %s\n", empty.c_str());
   gStage = "writing " + outPath;
@@ -145,6 +155,9 @@ int run(int argc, char** argv) {
                    "cut-out texels\n", tracer.textures().count(), tracer.textures().loadSeconds(),
                    (unsigned long long)st.alphaRays);
     const uint64_t rays = st.primaryRays + st.shadowRays + st.reflectionRays + st.alphaRays;
+    if (st.environmentRays)
+      std::fprintf(stderr, "rtr-trace: environment light: %d samples per pixel, %llu shadow rays\n", s.spp,
+                   (unsigned long long)st.environmentRays);
     std::fprintf(stderr,
                  "rtr-trace: %zu triangles, %zu lights, %s (build %.3f s); %ux%u in %.3f s: %llu rays "
                  "(%llu primary, %llu shadow, %llu mirror), %.2f Mrays/s; pose %s -> %s\n",

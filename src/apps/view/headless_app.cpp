@@ -191,8 +191,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     const std::string empty = emptyImageWarning(scene, pose, lens, float(o.width) / float(o.height), anyLit(frame.image),
                                                 settings.lights.lights.size());
     if (!empty.empty()) std::fprintf(stderr, "rtr-view: warning: %s\n", empty.c_str());
-    // Compressed on all cores while the renderer, the scene and the device are torn down (10-15 ms on
-    // lavapipe, about a third of the PNG's time there).
+    // Compressed on all cores while the renderer, the scene and the device are torn down: the two overlap.
     writing = std::async(std::launch::async, [&o, image = std::move(frame.image)] {
       saveImage(o.screenshot, image, {o.force ? Replace::Yes : Replace::No, true});
     });

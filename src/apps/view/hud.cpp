@@ -74,7 +74,7 @@ void drawLegend(const ViewState& s, const PanelFacts& facts) {
     swatch(ImVec4(1, 1, 1, 1), "white: 3 steps");
     ImGui::SameLine();
     swatch(ImVec4(1, 0, 0, 1), "red: more, beyond a 3x3 neighbourhood");
-  } else if (mode == VIEW_MIP_LEVEL) {  // shaders/debug_frag.glsl's mipColor
+  } else if (mode == VIEW_MIP_LEVEL) {  // shaders/debug.frag's mipColor
     static const ImVec4 k[] = {{0, 0, 1, 1}, {0, 1, 1, 1}, {0, 1, 0, 1}, {1, 1, 0, 1},
                                {1, 0.5f, 0, 1}, {1, 0, 0, 1}, {1, 0, 1, 1}, {1, 1, 1, 1}};
     static const char* names[] = {"0", "1", "2", "3", "4", "5", "6", "7+"};

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/common/light_options.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
 #include "options.hpp"
@@ -107,8 +108,7 @@ int main(int argc, char** argv) {
   description += "View 13 (albedo) has no key: --mode 13 or the panel.";
   CLI::App app{description,
                "rtr-view"};
-  std::string camera, size = "1280x720", mips = enumName(o.mips), mosaic = "off", light, lightColor,
-              ambient = "0.02", mtl,
+  std::string camera, size = "1280x720", mips = enumName(o.mips), mosaic = "off", mtl,
               filter = enumName(o.settings.sampler.filter);
   bool waitTextures = true;
   std::string shadingPath = enumName(o.settings.shading), raster = enumName(o.settings.raster);
@@ -153,17 +153,9 @@ int main(int argc, char** argv) {
   app.add_option("--anisotropy", o.settings.sampler.anisotropy,
                  "anisotropic filtering, 1 (off) up to the device's maxSamplerAnisotropy (more is clamped, with a note)")
       ->check(cli::number(1, 64))->capture_default_str();
-  CLI::Option* lightOpt = app.add_option("--light", light, "one point light at x,y,z instead of the scene's lights")
-      ->check(cli::checked([](const std::string& t) { cli::parseVec3("--light", t); }, "X,Y,Z"));
-  app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
-      ->needs(lightOpt)->check(cli::checked([](const std::string& t) { cli::parseColor("--light-color", t); }, "R,G,B"));
-  app.add_flag("--falloff", o.lightOptions.falloff, "inverse-square falloff on every light (not the default headlight)");
-  app.add_option("--ambient", ambient, "ambient colour r,g,b (or one grey value)")->capture_default_str()
-      ->check(cli::checked([](const std::string& t) { cli::parseColor("--ambient", t, true); }, "R,G,B"));
-  bool noDefaultLight = false, noPipelineCache = false, noWaitTextures = false;
+  cli::addLightOptions(app, o.lightOptions);
+  bool noPipelineCache = false, noWaitTextures = false;
   std::string up = "+Y";
-  app.add_flag("--no-default-light", noDefaultLight,
-               "a scene without lights gets no headlight (only ambient and emission light it)");
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
       ->capture_default_str();
   app.add_option("--crease", o.load.creaseDeg, "OBJ faces without normals: normals split where faces meet at more "
@@ -198,11 +190,7 @@ int main(int argc, char** argv) {
     if (!camera.empty()) o.camera = cli::parsePose("--camera", camera);
     if (!mtl.empty()) o.load.mtl = mtl;
     o.up = upRotation(up);
-    o.lightOptions.defaultLight = !noDefaultLight;
     o.pipelineCache = !noPipelineCache;
-    if (!light.empty()) o.lightOptions.position = cli::parseVec3("--light", light);
-    if (!lightColor.empty()) o.lightOptions.color = cli::parseColor("--light-color", lightColor);
-    o.lightOptions.ambient = cli::parseColor("--ambient", ambient, true);
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);

@@ -26,8 +26,7 @@ bool ShaderWatcher::poll(std::string& error) {
   std::vector<std::pair<std::string, vk::SpirvModule>> compiled;
   try {
     for (const auto& [path, time] : now)
-      if (vk::isGlslPath(path))
-        compiled.emplace_back(path.filename().string(), vk::compileGlsl(path, {dir_, dir_ / "shared"}));
+      if (vk::isGlslPath(path)) compiled.emplace_back(path.filename().string(), vk::compileGlsl(path, {dir_, dir_ / "shared"}));
   } catch (const Error& e) {
     error = e.what();
     return false;

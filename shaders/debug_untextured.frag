@@ -1,5 +1,0 @@
-#version 460
-#extension GL_GOOGLE_include_directive : require
-#define HAS_TEXCOORDS 0
-#define ALPHA_MASK 0
-#include "debug_frag.glsl"

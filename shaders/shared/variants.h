@@ -1,0 +1,18 @@
+// The scene passes' variants: one source per pass, each variant a value of these specialization constants
+// (renderer.cpp sets them; vk::specialize folds them away with the code, inputs and descriptors that the
+// variant does not use, so reflection gives each variant its own layout and vertex streams).
+#ifndef RTR_SHADERS_SHARED_VARIANTS_H
+#define RTR_SHADERS_SHARED_VARIANTS_H
+
+#define VARIANT_TEXCOORDS 0   // the scene has texture coordinates: materials' textures are sampled
+#define VARIANT_ALPHA_MASK 1  // the fragment stage cuts out by the material's alpha (foliage)
+#define VARIANT_VIS_BUFFER 2  // vis_shade reads the compute rasteriser's 64-bit buffer, not the id image
+#define VARIANT_BLEND 3       // pbr.frag in the transparency pass: alpha out, the compute raster's depth tested
+
+#ifndef __cplusplus
+layout(constant_id = VARIANT_TEXCOORDS) const bool HAS_TEXCOORDS = true;
+layout(constant_id = VARIANT_ALPHA_MASK) const bool ALPHA_MASK = false;
+layout(constant_id = VARIANT_VIS_BUFFER) const bool VIS_BUFFER = false;
+layout(constant_id = VARIANT_BLEND) const bool BLEND = false;
+#endif
+#endif

@@ -1,5 +1,0 @@
-#version 460
-#extension GL_GOOGLE_include_directive : require
-#define HAS_TEXCOORDS 1
-#define VIS_BUFFER 1
-#include "vis_shade.glsl"

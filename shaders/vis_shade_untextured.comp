@@ -1,4 +1,0 @@
-#version 460
-#extension GL_GOOGLE_include_directive : require
-#define HAS_TEXCOORDS 0
-#include "vis_shade.glsl"
