@@ -84,6 +84,7 @@ struct GpuMaterial {
 struct DrawPush {
   uint material;
   uint primitiveBits; // visibility pass: id = gl_InstanceIndex << primitiveBits | gl_PrimitiveID
+  uint opaqueWidth;   // transparency pass: the compute rasteriser's row length (its depth tests), else 0
 };
 
 // One placement of a mesh (storage buffer, std430, 128 bytes), indexed by gl_InstanceIndex in the

@@ -8,11 +8,13 @@
 #define VARIANT_ALPHA_MASK 1  // the fragment stage cuts out by the material's alpha (foliage)
 #define VARIANT_VIS_BUFFER 2  // vis_shade reads the compute rasteriser's 64-bit buffer, not the id image
 #define VARIANT_ENV 3         // the shaded view adds an environment's light (env_light.glsl) and shows its backdrop
+#define VARIANT_BLEND 4       // pbr.frag in the transparency pass: alpha out, the compute raster's depth tested
 
 #ifndef __cplusplus
 layout(constant_id = VARIANT_TEXCOORDS) const bool HAS_TEXCOORDS = true;
 layout(constant_id = VARIANT_ALPHA_MASK) const bool ALPHA_MASK = false;
 layout(constant_id = VARIANT_VIS_BUFFER) const bool VIS_BUFFER = false;
 layout(constant_id = VARIANT_ENV) const bool HAS_ENV = false;
+layout(constant_id = VARIANT_BLEND) const bool BLEND = false;
 #endif
 #endif

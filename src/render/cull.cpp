@@ -95,6 +95,7 @@ std::vector<shader::GpuCluster> gpuClusters(const Scene& scene) {
   const std::vector<Instance> instances = gpuInstances(scene);
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Mesh& m = scene.meshes[instances[i].mesh];
+    if (scene.materials.at(m.material).blended()) continue;  // the transparency pass draws it (GpuScene)
     const uint32_t flip = mirrored(instances[i].transform) ? CLUSTER_MIRRORED : 0u;
     appendClusters(m, instances[i].transform, i, clusterFlags(m, scene.materials.at(m.material)) | flip, out);
   }

@@ -219,9 +219,15 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     const MeshDraw& md = *meshDraw[in.mesh];
     const bool flip = mirrored(in.transform);
     p.instances.push_back(gpuInstance(in.transform, md.item.id));
-    appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
     // The identity keeps the box exact (the nearest-first order of existing scenes unchanged).
     const Bounds b = in.transform == glm::mat4(1.0f) ? m.bounds : transformed(m.bounds, in.transform);
+    if (const Material& mat = scene.materials.at(m.material); mat.blended()) {
+      BlendDraw bd{md.item, !m.texcoords.empty(), (mat.flags & kMaterialDoubleSided) != 0};
+      bd.item.firstInstance = i, bd.item.mirrored = flip, bd.item.center = b.empty() ? glm::vec3(0.0f) : b.center();
+      blendDraws_.push_back(bd);
+      continue;
+    }
+    appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
     std::vector<DrawItem>& list = draws_[size_t(md.kind)];
     if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
       list.push_back(md.item);

@@ -42,6 +42,12 @@ struct DrawItem {
   bool mirrored = false;     // its instances flip the winding: front faces are clockwise
   glm::vec3 center{0.0f};    // of its instances' scene-space box (frames draw the nearest first)
 };
+// A draw of a glTF BLEND material: one instance each (the transparency pass sorts them per frame), in
+// neither draws() nor the clusters (they write no visibility id or depth).
+struct BlendDraw {
+  DrawItem item;
+  bool textured = false, doubleSided = false;
+};
 struct GeometryPlan;
 
 // The loading phases, in order; they do not overlap, and together they are the constructor's time
@@ -104,6 +110,7 @@ class GpuScene {
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
   bool hasDraws(DrawKind k) const { return !draws_[size_t(k)].empty(); }
+  const std::vector<BlendDraw>& blendDraws() const { return blendDraws_; }
   VkBuffer positions() const { return positions_.handle(); }
   VkBuffer normals() const { return normals_.handle(); }
   VkBuffer texcoords() const { return texcoords_.handle(); }  // null when no mesh has texcoords
@@ -153,6 +160,7 @@ class GpuScene {
   std::future<void> decoding_;     // a deferred load's decode, until taken in
   bool ready_ = false;             // the textures are on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
+  std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
   vk::Buffer texcoords1_, tangents_, colors_;
   uint32_t clusterCount_ = 0;

@@ -54,7 +54,7 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
       post_(ctx) {
   makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    timers_.emplace_back(ctx, 12);  // at most: ComputeRaster::record's nine passes, shade, post
+    timers_.emplace_back(ctx, 13);  // at most: ComputeRaster::record's nine passes, shade, transparent, post
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
@@ -70,6 +70,10 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
   cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   canHardware_ = features.geometryShader;
   canCompute_ = ComputeRaster::supported(ctx);
+  if (!scene.blendDraws().empty()) {
+    transparency_.emplace(ctx, scene);
+    writeTextureSets();
+  }
   canUseVisibility_ = (canHardware_ || canCompute_) && instances > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
 }
 
@@ -204,10 +208,17 @@ void Renderer::rebuildPipelines() {
   if (raster_) raster.emplace(ctx_, scene_, framesInFlight_);
   std::optional<vk::Pipeline> backdrop;
   if (backdrop_) backdrop.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
+  std::optional<TransparencyPass> transparency;
+  if (transparency_) transparency.emplace(ctx_, scene_);
   vkDeviceWaitIdle(ctx_.device());
   pipelines_ = std::move(fresh);
   shade_ = std::move(shade);
   backdrop_ = std::move(backdrop);
+  if (transparency) {
+    transparency_.reset();
+    transparency_.emplace(std::move(*transparency));
+    writeTextureSets();
+  }
   if (raster) {
     raster->resize(extent_);
     raster_.reset();
@@ -243,6 +254,8 @@ void Renderer::writeTextureSets() {
   for (VisShade& v : shade_)
     if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1));
   if (raster_) writeTextures(raster_->textureLayout(), raster_->textureSet());
+  if (transparency_)
+    for (const auto& [layout, set] : transparency_->textureSets()) writeTextures(*layout, set);
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -435,6 +448,10 @@ void Renderer::frame(FrameContext& fc) {
     shadeVisibility(cb, raster);
     timer.mark(cb, "shade");
   }
+  if (transparency_ && s.mode == VIEW_SHADED) {  // debug views show the opaque surfaces only
+    transparency_->record(cb, uniforms_, color_, depth_, extent_, pose.position, compute ? raster_->ids() : VK_NULL_HANDLE);
+    timer.mark(cb, "transparent");
+  }
   post_.record(cb, color_.tracked(), color_.view(), target.image, target.view, target.format, target.extent, s.mosaic);
   timer.mark(cb, "post");
 }
@@ -459,7 +476,7 @@ void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, c
   depthAtt.imageView = depth_.view();
   depthAtt.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
   depthAtt.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-  depthAtt.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  depthAtt.storeOp = transparency_ ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;  // it tests
   depthAtt.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
   ri.renderArea = {{0, 0}, extent_};

@@ -16,6 +16,7 @@
 #include "render/gpu_scene.hpp"
 #include "render/post.hpp"
 #include "render/raster.hpp"
+#include "render/transparency.hpp"
 #include "scene/lights.hpp"
 #include "vk/commands.hpp"
 #include "vk/frame_ring.hpp"
@@ -163,6 +164,7 @@ class Renderer {
   std::optional<ComputeRaster> raster_;  // built on first use
   std::shared_ptr<const EnvironmentMaps> env_;
   std::optional<vk::Pipeline> backdrop_;  // the forward path's environment backdrop, on first use
+  std::optional<TransparencyPass> transparency_;  // a scene with blended draws only
   RasterPath lastRaster_ = RasterPath::Auto;
   bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
   uint64_t triangles_ = 0;

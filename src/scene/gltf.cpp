@@ -12,6 +12,7 @@
 #include <simdjson.h>
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "scene/binio.hpp"
 #include "scene/gltf_accessors.hpp"
 #include "scene/gltf_compress.hpp"
@@ -124,6 +125,7 @@ public:
     acc_ = &acc;
     mats_ = &mats;
     traverse(root);
+    readDeferred();
     if (root.count("animations") || root.count("skins")) animated_ = true;
     if (animated_) note("animations, skins and morph targets are not played: the meshes are shown at rest");
     if (skipped_)
@@ -277,22 +279,101 @@ private:
       }
       const uint32_t pos = attrs.index("POSITION", acc_->accessorCount(), "accessors");
       const uint32_t count = acc_->info(pos).count;
-      attribute(attrs, "POSITION", m.positions, count, {3});
-      attribute(attrs, "NORMAL", m.normals, count, {3});
-      attribute(attrs, "TANGENT", m.tangents, count, {4});
-      attribute(attrs, "TEXCOORD_0", m.texcoords, count, {2});
-      attribute(attrs, "TEXCOORD_1", m.texcoords1, count, {2});
-      m.colors.assign(attrs.get("COLOR_0") ? count : 0, glm::vec4(1.0f));
-      if (!m.colors.empty()) attribute(attrs, "COLOR_0", m.colors, count, {3, 4});
-      if (indicesJ) {
-        acc_->readIndices(p.index("indices", acc_->accessorCount(), "accessors"), m.indices);
-      } else {
-        m.indices.resize(count);
-        std::iota(m.indices.begin(), m.indices.end(), 0u);
+      if (mode == 4 && deferable(p, attrs, indicesJ, count)) {  // its arrays are read after the walk, on all cores
+        scene_.meshes.push_back(std::move(m));
+        deferred_.push_back({uint32_t(scene_.meshes.size() - 1), p, attrs, indicesJ, count});
+        return deferred_.back().mesh;
       }
+      for (int stream = 0; stream < kStreams; ++stream) readStream(m, p, attrs, indicesJ, count, stream, false);
     }
-    const Json where = indicesJ ? *indicesJ : p;
-    const size_t vertices = m.positions.size();
+    checkIndices(indicesJ ? *indicesJ : p, m);
+    checkPositions(attrs, m);
+    toTriangleList(p, m.indices, mode);
+    if (m.indices.empty()) {
+      ++skipped_;
+      return std::nullopt;
+    }
+    if (!m.normals.empty()) unitNormals(m);
+    finishMesh(m);
+    scene_.meshes.push_back(std::move(m));
+    return uint32_t(scene_.meshes.size() - 1);
+  }
+
+  // A triangle list read after the scene's nodes are walked (docs/gltf.md: a GLB's read): what needs no
+  // array is checked now, in the walk's order; the arrays then, every stream of every mesh on all cores.
+  struct Deferred {
+    uint32_t mesh;
+    Json p, attrs;
+    std::optional<Json> indices;  // none: 0 .. count - 1
+    uint32_t count;               // vertices
+  };
+  static constexpr const char* kAttributes[] = {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0"};
+  static constexpr int kStreams = 7;  // the attributes, then the indices
+
+  // Checks what can be checked before reading (each attribute's accessor and count, the whole triangles)
+  // and resolves the views; false for a list of fewer than 3 indices (read now: it is left out).
+  bool deferable(const Json& p, const Json& attrs, const std::optional<Json>& indicesJ, uint32_t count) {
+    uint64_t n = count;
+    if (indicesJ) {
+      const uint32_t a = p.index("indices", acc_->accessorCount(), "accessors");
+      n = acc_->info(a).count;
+      acc_->prepare(a);
+    }
+    if (n < 3) return false;
+    for (const char* key : kAttributes) {
+      if (!attrs.get(key)) continue;
+      const uint32_t a = attrs.index(key, acc_->accessorCount(), "accessors");
+      if (acc_->info(a).count != count)
+        attrs.at(key).fail("accessor " + std::to_string(a) + " has " + std::to_string(acc_->info(a).count) +
+                           " elements, POSITION has " + std::to_string(count));
+      acc_->prepare(a);
+    }
+    wholeTriangles(p, n);
+    return true;
+  }
+
+  // Stream `stream` of a mesh: read, and (deferred) checked on its own.
+  void readStream(Mesh& m, const Json& p, const Json& attrs, const std::optional<Json>& indicesJ, uint32_t count,
+                  int stream, bool deferred) {
+    switch (stream) {
+      case 0:
+        attribute(attrs, "POSITION", m.positions, count, {3});
+        if (deferred) checkPositions(attrs, m);
+        break;
+      case 1:
+        if (attribute(attrs, "NORMAL", m.normals, count, {3}) && deferred) unitNormals(m);
+        break;
+      case 2: attribute(attrs, "TANGENT", m.tangents, count, {4}); break;
+      case 3: attribute(attrs, "TEXCOORD_0", m.texcoords, count, {2}); break;
+      case 4: attribute(attrs, "TEXCOORD_1", m.texcoords1, count, {2}); break;
+      case 5:
+        m.colors.assign(attrs.get("COLOR_0") ? count : 0, glm::vec4(1.0f));
+        if (!m.colors.empty()) attribute(attrs, "COLOR_0", m.colors, count, {3, 4});
+        break;
+      default:
+        if (indicesJ) {
+          acc_->readIndices(p.index("indices", acc_->accessorCount(), "accessors"), m.indices);
+        } else {
+          m.indices.resize(count);
+          std::iota(m.indices.begin(), m.indices.end(), 0u);
+        }
+        if (!deferred) break;
+        checkIndices(indicesJ ? *indicesJ : p, m, count);
+        m.indices.resize(m.indices.size() - m.indices.size() % 3);  // wholeTriangles warned
+    }
+  }
+
+  void readDeferred() {
+    // Jobs in the order one thread would run them, so the fault reported is the one it would meet first.
+    parallelFor(deferred_.size() * kStreams, 0, [&](size_t j) {
+      const Deferred& d = deferred_[j / kStreams];
+      readStream(scene_.meshes[d.mesh], d.p, d.attrs, d.indices, d.count, int(j % kStreams), true);
+    });
+    parallelFor(deferred_.size(), 0, [&](size_t i) { finishMesh(scene_.meshes[deferred_[i].mesh]); });
+  }
+
+  void checkIndices(const Json& where, const Mesh& m, std::optional<size_t> vertexCount = std::nullopt) {
+    const size_t vertices = vertexCount ? *vertexCount : m.positions.size();
     uint32_t maxIndex = 0;
     for (uint32_t i : m.indices) maxIndex = std::max(maxIndex, i);
     if (maxIndex >= vertices && !m.indices.empty()) {
@@ -300,13 +381,16 @@ private:
       where.fail("index " + std::to_string(m.indices[i]) + " (element " + std::to_string(i) + ") is not below the vertex count " +
                  std::to_string(vertices));
     }
-    // The one coordinate limit of every reader (core/bounds.hpp): beyond it the squared lengths that
-    // clustering and shading take overflow; NaN and infinity are never geometry.
+  }
+
+  // The one coordinate limit of every reader (core/bounds.hpp): beyond it the squared lengths that
+  // clustering and shading take overflow; NaN and infinity are never geometry. Sets the bounds.
+  static void checkPositions(const Json& attrs, Mesh& m) {
     for (const glm::vec3& v : m.positions) m.bounds.extend(v);
     const Bounds& bb = m.bounds;
     if (!(std::max({-bb.min.x, -bb.min.y, -bb.min.z, bb.max.x, bb.max.y, bb.max.z}) <= kMaxCoordinate) ||
         !std::all_of(m.positions.begin(), m.positions.end(), [](const glm::vec3& v) { return v == v; }))
-      for (size_t i = 0; i < vertices; ++i) {
+      for (size_t i = 0; i < m.positions.size(); ++i) {
         const glm::vec3 v = m.positions[i];
         if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
           attrs.fail("POSITION element " + std::to_string(i) + " is not finite");
@@ -314,35 +398,35 @@ private:
           attrs.fail("POSITION element " + std::to_string(i) +
                      " has a coordinate beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
       }
-    toTriangleList(p, m.indices, mode);
-    if (m.indices.empty()) {
-      ++skipped_;
-      return std::nullopt;
+  }
+
+  static void unitNormals(Mesh& m) {  // quantized (or careless) normals are not unit length
+    for (glm::vec3& nrm : m.normals) {
+      const float l = glm::length(nrm);
+      if (l > 0 && std::isfinite(l)) nrm /= l;
+      else nrm = glm::vec3(0, 0, 1);
     }
-    if (m.normals.empty()) {
-      flatNormals(m);
-    } else {  // quantized (or careless) normals are not unit length
-      for (glm::vec3& nrm : m.normals) {
-        const float l = glm::length(nrm);
-        if (l > 0 && std::isfinite(l)) nrm /= l;
-        else nrm = glm::vec3(0, 0, 1);
-      }
-    }
+  }
+
+  // What needs several streams: flat normals where there are none, tangents for a normal map.
+  void finishMesh(Mesh& m) const {
+    if (m.normals.empty()) flatNormals(m);
     const Material& mat = scene_.materials[m.material];
     const std::vector<glm::vec2>& uv = mat.uv[uint32_t(TextureSlot::NormalMap)].texCoord ? m.texcoords1 : m.texcoords;
     if (m.tangents.empty() && mat.texture(TextureSlot::NormalMap) != kNoTexture && !uv.empty()) generateTangents(m, uv);
-    scene_.meshes.push_back(std::move(m));
-    return uint32_t(scene_.meshes.size() - 1);
+  }
+
+  void wholeTriangles(const Json& p, size_t n) {
+    if (n % 3)
+      warn(p.path() + ": " + std::to_string(n) + " indices of a triangle list are not whole triangles: the last " +
+           std::to_string(n % 3) + " left out");
   }
 
   // Strips and fans as triangle lists (their winding as the spec defines it); a list cut to whole triangles.
   void toTriangleList(const Json& p, std::vector<uint32_t>& idx, uint64_t mode) {
     if (mode == 4) {
-      if (idx.size() % 3) {
-        warn(p.path() + ": " + std::to_string(idx.size()) + " indices of a triangle list are not whole triangles: the last " +
-             std::to_string(idx.size() % 3) + " left out");
-        idx.resize(idx.size() - idx.size() % 3);
-      }
+      wholeTriangles(p, idx.size());
+      idx.resize(idx.size() - idx.size() % 3);
       return;
     }
     std::vector<uint32_t> out;
@@ -467,6 +551,7 @@ private:
   gltf::Accessors* acc_ = nullptr;
   gltf::Materials* mats_ = nullptr;
   std::vector<std::optional<std::vector<uint32_t>>> meshes_;
+  std::vector<Deferred> deferred_;
   std::set<std::string> said_;
   size_t skipped_ = 0, warnings_ = 0;
   bool animated_ = false, cameraDone_ = false;

@@ -297,6 +297,16 @@ void Accessors::forEach(uint32_t accessor, const Info& in, Write&& write) {
   }
 }
 
+void Accessors::prepare(uint32_t accessor) {
+  const Json& a = accessors_[accessor];
+  if (a.get("bufferView")) view(a.index("bufferView", views_.size(), "bufferViews"));
+  if (auto sparse = a.get("sparse"))
+    for (const char* part : {"indices", "values"}) {
+      const Json j = sparse->at(part);
+      view(j.index("bufferView", views_.size(), "bufferViews"));
+    }
+}
+
 void Accessors::readFloats(uint32_t accessor, float* dst, int dstComponents, std::initializer_list<int> allowed) {
   const Info in = info(accessor);
   if (std::find(allowed.begin(), allowed.end(), in.components) == allowed.end()) {

@@ -46,6 +46,9 @@ public:
   Info info(uint32_t accessor) const;
   Json json(uint32_t accessor) const { return accessors_[accessor]; }
 
+  // Resolves (maps, decodes) every view accessor `a` reads, so that readFloats and readIndices of it
+  // may then run on several threads at once: they only read what is resolved.
+  void prepare(uint32_t accessor);
   // Reads accessor `a` as floats (normalized integers mapped to [0,1] / [-1,1], others converted) into
   // dst, `dstComponents` floats per element (extra components left as they are, missing ones not
   // written). `allowedComponents` lists the component counts the caller takes; dst holds count elements.

@@ -94,6 +94,7 @@ struct Material {
   float transparency = 0.0f;
 
   uint32_t texture(TextureSlot s) const { return textures[uint32_t(s)]; }
+  bool blended() const { return (flags & kMaterialGltf) && (flags & kMaterialBlend); }  // glTF alphaMode BLEND
 };
 
 // A run of at most 124 triangles of one mesh (scene/clusters.hpp), with the bounds culling tests it by.

@@ -362,6 +362,30 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
     r.lights = pointLights({{{1.0f, 3.0f, 0.0f}, glm::vec3(1.8f)}});
     return r;
   }
+  if (name == "gltf_blend") {
+    // BLEND over an opaque sphere and the floor: a panel whose base colour alpha ramps across (× opacity),
+    // and in front of it one without texcoords (opacity alone); both renderers composite "over", the GPU
+    // farthest first (its transparency pass), the tracer along the ray.
+    s.materials.push_back(gltfMaterial("floor", {0.6f, 0.6f, 0.6f}, 0.6f, 0.0f));
+    s.materials.push_back(gltfMaterial("ball", {0.9f, 0.4f, 0.2f}, 0.4f, 0.0f));
+    Material glass = gltfMaterial("glass", {0.3f, 0.6f, 0.9f}, 0.3f, 0.0f);
+    glass.flags |= kMaterialBlend;
+    glass.opacity = 0.8f;
+    auto texel = [](uint32_t x, uint32_t y) { return glm::u8vec4(200, 220, 255, uint8_t(40 + 26 * x + 2 * y)); };
+    glass.textures[uint32_t(TextureSlot::BaseColor)] = addPng(s, workDir, "glass", 8, 8, texel, true);
+    glass.textures[uint32_t(TextureSlot::AlphaMask)] = addPng(s, workDir, "glass", 8, 8, texel, false, 1, 4);
+    s.materials.push_back(glass);
+    Material tint = gltfMaterial("tint", {0.9f, 0.8f, 0.2f}, 0.5f, 0.0f);
+    tint.flags |= kMaterialBlend;
+    tint.opacity = 0.45f;
+    s.materials.push_back(tint);
+    s.meshes.push_back(grid("floor", 0, {-4, -1, 0}, {8, 0, 0}, {0, 0, -8}, 8, 8, false));
+    s.meshes.push_back(sphere("ball", 1, {0.3f, -0.2f, -4.6f}, 0.7f, 64, 32));
+    s.meshes.push_back(grid("glass", 2, {-1.6f, -0.8f, -3.6f}, {2.6f, 0, 0}, {0, 1.8f, 0}, 4, 4, true));
+    s.meshes.push_back(grid("tint", 3, {-0.3f, -0.6f, -2.9f}, {1.6f, 0, 0}, {0, 1.1f, 0}, 2, 2, false));
+    r.lights = pointLights({{{1.0f, 3.0f, 0.0f}, glm::vec3(1.8f)}});
+    return r;
+  }
   if (name == "gltf_normal_map" || name == "gltf_texture_transform") {
     // A normal-mapped quad with tangents, and a base colour texture under KHR_texture_transform on the
     // second uv set: built for both renderers; the GPU side is not there yet (reference_test skips them).
