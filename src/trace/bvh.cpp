@@ -614,7 +614,7 @@ template class HugeArray<TriPack>;
   unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
   unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
   unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
-  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, uint32_t*); \
+  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
   }
 RTR_DECLARE_TRAVERSAL(sse)
 RTR_DECLARE_TRAVERSAL(avx2)
@@ -630,7 +630,7 @@ struct Traversal {
   unsigned (*closestPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
   unsigned (*occludedPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
   unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
-  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, uint32_t*);
+  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
 };
 #define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket}
 constexpr Traversal kTraversals[] = {RTR_TRAVERSAL(sse), RTR_TRAVERSAL(avx2), RTR_TRAVERSAL(avx512)};
@@ -728,15 +728,12 @@ void Bvh::closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method) co
   }
 }
 
-unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method, uint32_t* lastOccluder) const {
+unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method) const {
   if (root_ == kEmpty || n <= 0) return 0;
   if (n == 1) return unsigned(occluded(rays[0], method));
   Hit scratch[8];
-  uint32_t none = kNoOccluder;
-  if (!lastOccluder) lastOccluder = &none;
-  else if (*lastOccluder / 8 >= packs_.size()) *lastOccluder = kNoOccluder;  // another BVH's, or none
   return traversal().occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch,
-                                      packetLeafRays.load(std::memory_order_relaxed), lastOccluder);
+                                      packetLeafRays.load(std::memory_order_relaxed));
 }
 
 }  // namespace rtr::trace

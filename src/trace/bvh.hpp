@@ -44,8 +44,6 @@ struct BvhCounters {
   // alone, rays traced again (near-ties).
   uint64_t packets = 0, packetNodes = 0, packetNodeRays = 0, intervalTests = 0, childTests = 0, childTestRays = 0;
   uint64_t packetLeaves = 0, packetLeafRays = 0, triangleTests = 0, packetTriangles = 0, lone = 0, retries = 0;
-  // Any hit with a last occluder (occluded8): packets that tested it first, and the rays it occluded.
-  uint64_t occluderTests = 0, occluderRays = 0;
 };
 
 // A fixed-size array in memory the kernel is asked to back with 2 MB pages (transparent huge pages):
@@ -97,13 +95,8 @@ class Bvh {
   // a ray left alone in a subtree walks on as a single ray (bvh_packet.inl). Rays that run parallel to
   // different axes, or another method than Watertight, go one at a time. n > 8 is taken as 8.
   void closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method = IntersectMethod::Watertight) const;
-  // Bit i set: ray i is occluded. lastOccluder (may be null; in and out, kNoOccluder: none): the triangle
-  // that occluded a ray of an earlier packet of this thread (its place in the packs, not its index), tested
-  // against all rays first: neighbouring shadow rays often have the same occluder, and an any-hit answer
-  // does not depend on the order of the tests (docs/bench/trace.md, round 11). Any value is safe.
-  static constexpr uint32_t kNoOccluder = 0xFFFFFFFFu;
-  unsigned occluded8(const Ray* rays, int n, IntersectMethod method = IntersectMethod::Watertight,
-                     uint32_t* lastOccluder = nullptr) const;
+  // Bit i set: ray i is occluded.
+  unsigned occluded8(const Ray* rays, int n, IntersectMethod method = IntersectMethod::Watertight) const;
 
   // A packet tests a leaf with lanes = rays (each triangle against all its live rays at once) when at
   // least this many rays are live there and all share the watertight test's axis order; else ray by ray

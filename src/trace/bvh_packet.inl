@@ -115,7 +115,6 @@ struct PacketWalker {
   alignas(W) unsigned char walkers[8][sizeof(W)];  // each ray's single-ray walk, for leaves and lone rays
 
   IntersectMethod method;
-  uint32_t occluder = Bvh::kNoOccluder;  // any hit: the last triangle found to occlude a ray (pack · 8 + lane)
   unsigned built = 0;  // the walkers constructed so far: only rays that need one pay its set-up
   // (on the temple most packets miss after a node or two, and eight set-ups cost more than the walk)
   RTR_INLINE const W& walker(int i) {
@@ -430,7 +429,6 @@ struct PacketWalker {
           const unsigned occ = occludedBy(pk, lane, active, tLimit);
           if (!occ) continue;
           occluded |= occ;
-          occluder = p * 8 + uint32_t(lane);
           active &= ~occ;
           if (!active) return occluded;
           continue;
@@ -479,9 +477,7 @@ struct PacketWalker {
     if constexpr (AnyHit) {
       Cursor at{0, ref, tMax[i], false};
       Hit scratch;
-      if (!w.run(stack, at, scratch)) return false;
-      occluder = scratch.prim;
-      return true;
+      return w.run(stack, at, scratch);
     } else {
       Cursor at{0, ref, cull[i], false};
       while (aloneStep(i, w, stack, at)) {}
@@ -506,7 +502,6 @@ struct PacketWalker {
       }
       if (moreA) wa.run(stackA, atA, scratch);
       if (moreB) wb.run(stackB, atB, scratch);
-      if (atA.found || atB.found) occluder = scratch.prim;
       return unsigned(atA.found) << a | unsigned(atB.found) << b;
     } else {
       Cursor atA{0, ref, cull[a], false}, atB{0, ref, cull[b], false};
@@ -554,7 +549,7 @@ struct PacketWalker {
             if constexpr (AnyHit) {
               Cursor at{0, ref, tMax[i], false};
               Hit scratch;
-              if (walker(i).testLeaf(at, scratch, set1(tMax[i]))) { done |= 1u << i; occluder = scratch.prim; }
+              if (walker(i).testLeaf(at, scratch, set1(tMax[i]))) done |= 1u << i;
             } else {
               leafCandidates(i, ref);
             }
@@ -581,29 +576,12 @@ struct PacketWalker {
   }
 };
 
-// Any hit with a last occluder (*occluder, kNoOccluder: none): that triangle first, against all rays at
-// once (when they share the watertight test's axis order); the rays it occludes are done. The packet's own
-// last occluder found, if any, goes back into *occluder.
 template <bool AnyHit, unsigned Parallel>
 unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, const PacketRays& pr, IntersectMethod method, Hit* hits,
-                    int leafRays, uint32_t* occluder) {
+                    int leafRays) {
   RTR_COUNT(c.packets += 1);
   PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays);
-  const unsigned all = (1u << n) - 1;
-  if constexpr (AnyHit) {
-    unsigned done = 0;
-    const uint32_t last = *occluder;
-    if (last != Bvh::kNoOccluder && !(bvh.packs[last / 8].prim[last % 8] & Bvh::kNoShadowBit) && p.shear()) {
-      done = p.occludedBy(bvh.packs[last / 8], int(last % 8), all, load(p.tMax));
-      RTR_COUNT(c.occluderTests += 1; c.occluderRays += unsigned(__builtin_popcount(done)));
-      if (done == all) return done;
-    }
-    done |= p.run(all & ~done);
-    if (p.occluder != Bvh::kNoOccluder) *occluder = p.occluder;
-    return done;
-  } else {
-    return p.run(all);
-  }
+  return p.run((1u << n) - 1);
 }
 
 #undef RTR_INLINE

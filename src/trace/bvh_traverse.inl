@@ -302,7 +302,7 @@ struct Walker {
   }
 
   // Tests the leaf at.ref's triangles, keeping the closest in at.tHit and hit; true when an any-hit query
-  // has found its hit (the walk is over; hit.prim is then the occluder's place: pack · 8 + lane).
+  // has found its hit (the walk is over).
   RTR_INLINE bool testLeaf(Cursor& at, Hit& hit, F tHitV) const {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
     const uint32_t first = at.ref & 0x0FFFFFFFu, np = ((at.ref >> 28) & 7u) + 1;
@@ -319,7 +319,7 @@ struct Walker {
           float b1, b2;
           const float t = intersect(method, r, laneTriangle(pk, lane), b1, b2);
           if (t > 0.0f) {
-            if constexpr (AnyHit) { hit.prim = p * 8 + uint32_t(lane); return true; }
+            if constexpr (AnyHit) return true;
             at.tHit = t; hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit}; at.found = true;
           }
         }
@@ -345,7 +345,7 @@ struct Walker {
       m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tHitV * (det ^ detSign)));
       if constexpr (AnyHit) {
         const unsigned casters = ~topBits(pk.prim);
-        if (m & casters) { hit.prim = p * 8 + uint32_t(ctz(m & casters)); return true; }
+        if (m & casters) return true;
         edge &= casters;
       } else if (m) {
         const F inv = set1(1.0f) / det;
@@ -368,7 +368,7 @@ struct Walker {
         float b1, b2;
         const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
         if (t > 0.0f) {
-          if constexpr (AnyHit) { hit.prim = p * 8 + uint32_t(lane); return true; }
+          if constexpr (AnyHit) return true;
           at.tHit = t; hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit}; at.found = true;
         }
       }
@@ -488,8 +488,7 @@ unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
 // use the watertight test; others go ray by ray. Closest hit: returns the rays the caller must trace
 // again alone (ties, see bvh_packet.inl). Any hit: returns the occluded rays.
 template <bool AnyHit>
-unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays,
-                        uint32_t* occluder) {
+unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
   bool same = method == IntersectMethod::Watertight && n > 1;
   const PacketRays pr = gatherRays(rays, n);
   unsigned p = 0;  // the axes every ray runs parallel to; same: no ray is parallel to another
@@ -499,13 +498,13 @@ unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectM
     else if (zero) same = false;
   }
   switch (same ? p : 8u) {
-    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, pr, method, hits, leafRays, occluder);
-    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, pr, method, hits, leafRays, occluder);
-    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, pr, method, hits, leafRays, occluder);
-    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, pr, method, hits, leafRays, occluder);
-    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, pr, method, hits, leafRays, occluder);
-    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, pr, method, hits, leafRays, occluder);
-    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, pr, method, hits, leafRays, occluder);
+    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, pr, method, hits, leafRays);
+    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, pr, method, hits, leafRays);
+    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, pr, method, hits, leafRays);
+    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, pr, method, hits, leafRays);
+    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, pr, method, hits, leafRays);
+    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, pr, method, hits, leafRays);
+    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, pr, method, hits, leafRays);
     case 7: return 0;
     default: {
       unsigned m = 0;
@@ -528,11 +527,10 @@ unsigned occludedPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
   return dispatchPair<true>(bvh, rays, method, scratch);
 }
 unsigned closestPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays) {
-  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays, nullptr);
+  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays);
 }
-unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch, int leafRays,
-                        uint32_t* occluder) {
-  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays, occluder);
+unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch, int leafRays) {
+  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays);
 }
 
 }  // namespace rtr::trace::RTR_BVH_ISA

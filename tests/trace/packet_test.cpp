@@ -34,14 +34,11 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
     Bvh::setIsa(isa);
     Bvh::setPacketLeafRays(leafRays);
     hits = 0;
-    uint32_t last = Bvh::kNoOccluder;  // every other pass: each packet tests the last one's occluder first
     for (size_t i = 0; i < rays.size(); i += width) {
       const int n = int(std::min<size_t>(width, rays.size() - i));
       Hit h[8];
       bvh.closest8(&rays[i], n, h);
-      // Pass 5: an arbitrary triangle as the last occluder (any value is safe, some out of range).
-      if (pass == 5) last = uint32_t(i * 7919 % (9 * size_t(std::max(1u, bvh.stats().packs))));
-      const unsigned occ = bvh.occluded8(&rays[i], n, IntersectMethod::Watertight, pass % 2 ? &last : nullptr);
+      const unsigned occ = bvh.occluded8(&rays[i], n);
       for (int k = 0; k < n; ++k) {
         const Hit one = bvh.closest(rays[i + k]);
         const bool occ1 = bvh.occluded(rays[i + k]);

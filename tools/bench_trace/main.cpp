@@ -218,9 +218,8 @@ void printCounters(const Bvh& bvh, const std::vector<RaySet>& sets) {
               "or lanes = rays for a packet; `live`: the share of a packet's 8 lanes with a ray):\n\n"
               "| rays | single: node visits | packs | triangles | packets: node visits a packet | box tests a node visit | "
               "live at box tests | leaf visits a packet | live at leaves | box passes a ray: single / packets | "
-              "triangle passes a ray: single / packets (of them lanes = rays) | walks alone a ray | retried | "
-              "rays occluded by the last occluder |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "triangle passes a ray: single / packets (of them lanes = rays) | walks alone a ray | retried |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const RaySet& s : sets) {
     const std::vector<Ray>& rays = *s.rays;
     const double n = double(std::max<size_t>(1, rays.size()));
@@ -228,22 +227,21 @@ void printCounters(const Bvh& bvh, const std::vector<RaySet>& sets) {
     for (const Ray& r : rays) s.any ? void(bvh.occluded(r)) : void(bvh.closest(r));
     const BvhCounters one = Bvh::counters();
     Bvh::counters() = {};
-    uint32_t last = Bvh::kNoOccluder;
     for (size_t i = 0; i < rays.size(); i += 8) {
       const int k = int(std::min<size_t>(8, rays.size() - i));
       Hit h[8];
-      if (s.any) bvh.occluded8(&rays[i], k, IntersectMethod::Watertight, &last); else bvh.closest8(&rays[i], k, h);
+      if (s.any) bvh.occluded8(&rays[i], k); else bvh.closest8(&rays[i], k, h);
     }
     const BvhCounters p = Bvh::counters();
     auto share = [](uint64_t live, uint64_t visits) { return visits ? double(live) / (8.0 * double(visits)) : 0.0; };
     // Packets' passes: their box and triangle tests plus the single-ray work of rays walking alone, retried,
     // or testing a leaf ray by ray.
-    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.2f | %.0f %% | %.2f / %.2f | %.2f / %.2f (%.2f) | %.3f | %.4f | %.1f %% |\n",
+    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.2f | %.0f %% | %.2f / %.2f | %.2f / %.2f (%.2f) | %.3f | %.4f |\n",
                 s.name, one.nodes / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
                 p.packetNodes ? double(p.childTests) / double(p.packetNodes) : 0.0, 100.0 * share(p.childTestRays, p.childTests),
                 8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), one.nodes / n,
                 (p.intervalTests + p.childTests + p.nodes) / n, one.packs / n, (p.triangleTests + p.packs) / n, p.triangleTests / n, p.lone / n,
-                p.retries / n, 100.0 * double(p.occluderRays) / n);
+                p.retries / n);
   }
   Bvh::counters() = {};
   Bvh::setCounting(false);
@@ -400,13 +398,12 @@ void printPacketAgreement(const Bvh& bvh, const Embree& em, const Rays& rays, in
   for (int lr : {2, leafRays}) {
     Bvh::setPacketLeafRays(lr);
     size_t differ = 0, total = 0;
-    uint32_t last = Bvh::kNoOccluder;  // shadow packets with the last occluder, as timed
     for (auto* set : {&primary, &ortho, &shadow, &mirror})
       for (size_t i = 0; i < set->size(); i += 8) {
         const int n = int(std::min<size_t>(8, set->size() - i));
         Hit h[8];
         if (set != &shadow) bvh.closest8(&(*set)[i], n, h);
-        const unsigned occ = set == &shadow ? bvh.occluded8(&(*set)[i], n, IntersectMethod::Watertight, &last) : 0u;
+        const unsigned occ = set == &shadow ? bvh.occluded8(&(*set)[i], n) : 0u;
         for (int k = 0; k < n; ++k, ++total) {
           if (set == &shadow) { differ += ((occ >> k) & 1) != unsigned(bvh.occluded((*set)[i + k])); continue; }
           const Hit one = bvh.closest((*set)[i + k]);
@@ -451,8 +448,7 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
         }));
         auto packets8 = [&](size_t i) {
           const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
-          static thread_local uint32_t last = Bvh::kNoOccluder;  // the thread's packets in order (a tracer's tile)
-          if (s.any) return uint32_t(__builtin_popcount(bvh.occluded8(&rays[8 * i], n, IntersectMethod::Watertight, &last)));
+          if (s.any) return uint32_t(__builtin_popcount(bvh.occluded8(&rays[8 * i], n)));
           Hit h[8];
           bvh.closest8(&rays[8 * i], n, h);
           uint32_t acc = 0;
