@@ -114,7 +114,7 @@ struct BvhBuilder {
   ThreadPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
   static constexpr uint32_t kSubtreeTask = 4096;  // triangles from which a subtree is a task of its own
-  static constexpr uint32_t kParallelChunk = 64 * 1024;  // refs per thread below which binning stays serial
+  static constexpr uint32_t kParallelChunk = 16 * 1024;  // refs a chunk at least, when binned by many threads
   static constexpr uint32_t kSmallRange = 24;  // ranges up to this size: findSplitSmall
 
   struct Split {
@@ -156,17 +156,24 @@ struct BvhBuilder {
     }
   }
 
+  // How many threads bin and partition a range of a node at `level` (the root: 0): while a level of the
+  // tree has fewer nodes than there are threads, there are not yet subtrees enough to run side by side,
+  // so each node's splits are shared out (chunks of at least kParallelChunk references).
+  uint32_t chunksFor(const Range& r, uint32_t level) const {
+    if (level < 10 && (1u << (3 * level)) >= threads) return 1;
+    return std::min(threads, r.size() / kParallelChunk);
+  }
+
   // Binned SAH over all three axes in one pass. Cost counts packs of eight, since a leaf's price is the
-  // number of 8-wide triangle tests it takes. Ranges near the root are binned by all threads: there the
-  // build has no subtrees yet to run side by side.
-  Split findSplit(const Range& r) const {
+  // number of 8-wide triangle tests it takes.
+  Split findSplit(const Range& r, uint32_t level) const {
     alignas(16) float ext[4], sc[4] = {};
     _mm_store_ps(ext, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
     for (int a = 0; a < 3; ++a) sc[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
     const __m128 scale = _mm_load_ps(sc);
     if (r.size() <= kSmallRange) return findSplitSmall(r, scale, ext);
     Bins all;
-    const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
+    const uint32_t chunks = chunksFor(r, level);
     if (chunks > 1) {
       std::vector<Bins> part(chunks);
       const auto cut = [&](uint32_t c) { return r.begin + uint32_t(uint64_t(r.size()) * c / chunks); };
@@ -311,7 +318,7 @@ struct BvhBuilder {
   // k-th misplaced one from the back (Hoare's scheme, as std::partition does it), whether one thread or
   // many do it: the tree does not depend on the thread count.
   // And sets the two sides' centroid bounds (cb[0]: left, cb[1]: right, of every ref looked at).
-  void partition(Split& s, const Range& r) {
+  void partition(Split& s, const Range& r, uint32_t level) {
     const int a = s.axis;
     // findSplit's bin of axis a (lane a; the other lanes are not looked at).
     const __m128 scale = _mm_set1_ps(float(kBins) * 0.99999f / (lane(r.cbounds.hi, a) - lane(r.cbounds.lo, a)));
@@ -325,7 +332,7 @@ struct BvhBuilder {
       cb[!l].grow(c);
       return l;
     };
-    const uint32_t chunks = std::min(threads, r.size() / kParallelChunk);
+    const uint32_t chunks = chunksFor(r, level);
     if (chunks <= 1) {
       Box cl, cr;  // in registers: each loop knows which side it adds to
       uint32_t i = r.begin, j = r.end;
@@ -380,17 +387,17 @@ struct BvhBuilder {
 
   // Split a range in two: SAH when it pays, by count when the centroids coincide or the tree is too deep.
   // Returns false when the range should stay a leaf.
-  bool split(const Range& r, Range& a, Range& b) {
+  bool split(const Range& r, Range& a, Range& b, uint32_t level) {
     const uint32_t n = r.size();
     if (n <= 1) return false;
     const bool tooDeep = r.depth > 48;
     if (!tooDeep) {
-      Split s = findSplit(r);
+      Split s = findSplit(r, level);
       if (s.axis >= 0) {
         const float leafCost = r.bounds.halfArea() * float(packsFor(n));
         const float splitCost = kNodeCost * r.bounds.halfArea() + s.cost;
         if (n <= Bvh::kMaxLeafTriangles && leafCost <= splitCost) return false;
-        partition(s, r);
+        partition(s, r, level);
         a = s.left;
         b = s.right;
         return true;
@@ -453,7 +460,7 @@ struct BvhBuilder {
     bvh.nodes_[node] = n;
   }
 
-  uint32_t build(const Range& r) {
+  uint32_t build(const Range& r, uint32_t level = 0) {
     uint32_t d = maxDepth.load();
     while (r.depth > d && !maxDepth.compare_exchange_weak(d, r.depth)) {}
     struct Child { Range r; bool leaf = false; };
@@ -461,7 +468,7 @@ struct BvhBuilder {
     int count = 1;
     c[0].r = r;
     Range a, b;
-    if (!split(r, a, b)) return makeLeaf(r);
+    if (!split(r, a, b, level)) return makeLeaf(r);
     c[0].r = a;
     c[1].r = b;
     count = 2;
@@ -471,7 +478,7 @@ struct BvhBuilder {
       for (int i = 0; i < count; ++i)
         if (!c[i].leaf && c[i].r.bounds.halfArea() > area) { area = c[i].r.bounds.halfArea(); pick = i; }
       if (pick < 0) break;
-      if (!split(c[pick].r, a, b)) { c[pick].leaf = true; continue; }
+      if (!split(c[pick].r, a, b, level)) { c[pick].leaf = true; continue; }
       c[pick].r = a;
       c[count++].r = b;
     }
@@ -491,8 +498,8 @@ struct BvhBuilder {
     while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < kSubtreeTask)) --last;
     for (int k = 0; k < count; ++k) {
       if (c[k].leaf) node.child[k] = makeLeaf(c[k].r);
-      else if (pool && k != last && c[k].r.size() >= kSubtreeTask) pool->run(g, [this, &node, k, rr = c[k].r] { node.child[k] = build(rr); });
-      else node.child[k] = build(c[k].r);
+      else if (pool && k != last && c[k].r.size() >= kSubtreeTask) pool->run(g, [this, &node, k, rr = c[k].r, level] { node.child[k] = build(rr, level + 1); });
+      else node.child[k] = build(c[k].r, level + 1);
     }
     if (pool) pool->wait(g);
     nodes[index] = node;

@@ -2,8 +2,8 @@
 // same rules: inline, no glm or std function templates). Lanes are rays here: a node's children are
 // tested one after another against all rays of the packet at once, each ray with exactly the slab
 // arithmetic of its single-ray walk. Leaves are tested all rays at once (lanes = rays) where enough rays
-// reach them, else ray by ray with the single-ray 8-wide triangle test. A ray left alone in a subtree
-// walks it as a single ray (any hit: four rays or fewer, two at a time). See docs/tracer.md.
+// reach them, else ray by ray with the single-ray 8-wide triangle test. Four rays or fewer left in a
+// subtree walk it as single rays, two at a time. See docs/tracer.md.
 //
 // Why the results equal the single-ray ones bit for bit:
 // * Any hit: a ray's tMax never changes, so each box and each triangle gets the same answer for a ray
@@ -68,10 +68,10 @@ RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
 }
 
 constexpr float kTieWindow = 0x1p-10f;
-// Any hit: a packet with this many live rays or fewer walks on as single rays, two at a time
-// (alonePair): two interleaved single walks beat a packet of few live lanes. Shadow packets lose their
-// coherence on the temple (63 % of lanes live at box tests, 93 % with this): its shadow rays +9-14 %,
-// the sphere's unchanged (VM, docs/bench/trace.md round 10).
+// A packet with this many live rays or fewer walks on as single rays, two at a time (alonePair): two
+// interleaved single walks beat a packet of few live lanes. Shadow and mirror packets lose their
+// coherence on the temple (shadow: 63 % of lanes live at box tests, 93 % with this, +9-14 %, round 10;
+// mirror: 68 → 93 %, box passes a ray 5.18 → 4.23, round 11 of docs/bench/trace.md).
 constexpr int kAloneRays = 4;
 
 struct PacketEntry {
@@ -374,11 +374,47 @@ struct PacketWalker {
     }
   }
 
-  // Leaf `ref` with lanes = rays: each real triangle against all `active` rays at once, each lane with
-  // exactly Walker::testLeaf's operations for its ray (closest hit: leafCandidates' rules). Any hit:
-  // returns the rays found occluded.
-  RTR_INLINE unsigned leafAllRays(uint32_t ref, unsigned active) {
+  // Triangle `lane` of pk against the `active` rays at once, each lane with exactly Walker::testLeaf's
+  // operations for its ray: m, the rays that meet it in (0, tLimit); edge, those exactly on an edge in
+  // float (for the scalar test); det, T, V, W3 for t and the barycentrics. False: neither.
+  struct Lanes { unsigned m, edge; F det, T, V, W3; };
+  RTR_INLINE bool triangleRays(const TriPack& pk, int lane, unsigned active, F tLimit, Lanes& o) const {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
+    const F Az = set1(pk.v[0][kz][lane]) - shO[2], Bz = set1(pk.v[1][kz][lane]) - shO[2], Cz = set1(pk.v[2][kz][lane]) - shO[2];
+    const F ax = (set1(pk.v[0][kx][lane]) - shO[0]) - shS[0] * Az, ay = (set1(pk.v[0][ky][lane]) - shO[1]) - shS[1] * Az;
+    const F bx = (set1(pk.v[1][kx][lane]) - shO[0]) - shS[0] * Bz, by = (set1(pk.v[1][ky][lane]) - shO[1]) - shS[1] * Bz;
+    const F cx = (set1(pk.v[2][kx][lane]) - shO[0]) - shS[0] * Cz, cy = (set1(pk.v[2][ky][lane]) - shO[1]) - shS[1] * Cz;
+    const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W3 = bx * ay - by * ax;
+    o.edge = bits(eq(U, zero) | eq(V, zero) | eq(W3, zero)) & active;
+    o.m = ~bits((U ^ V) | (V ^ W3)) & active & ~o.edge;
+    if ((o.m | o.edge) == 0) return false;
+    o.det = U + V + W3;
+    o.T = U * (shS[2] * Az) + V * (shS[2] * Bz) + W3 * (shS[2] * Cz);
+    const F detSign = o.det & signBit;
+    const F Ts = o.T ^ detSign;
+    o.m &= bits(neq(o.det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (o.det ^ detSign)));
+    o.V = V;
+    o.W3 = W3;
+    return true;
+  }
+
+  // Any hit: the rays of `active` that triangle `lane` of pk occludes (tLimit: their tMax).
+  RTR_INLINE unsigned occludedBy(const TriPack& pk, int lane, unsigned active, F tLimit) const {
+    Lanes l;
+    if (!triangleRays(pk, lane, active, tLimit, l)) return 0;
+    unsigned occluded = l.m;
+    for (unsigned edge = l.edge; edge; edge &= edge - 1) {
+      const int i = ctz(edge);
+      WatertightRay r(rays[i]);
+      float b1, b2;
+      if (intersectWatertight(r, laneTriangle(pk, lane), b1, b2) > 0.0f) occluded |= 1u << i;
+    }
+    return occluded;
+  }
+
+  // Leaf `ref` with lanes = rays: each real triangle against all `active` rays at once (triangleRays;
+  // closest hit: leafCandidates' rules). Any hit: returns the rays found occluded.
+  RTR_INLINE unsigned leafAllRays(uint32_t ref, unsigned active) {
     const uint32_t first = ref & 0x0FFFFFFFu, np = ((ref >> 28) & 7u) + 1;
     unsigned occluded = 0;
     for (uint32_t p = first; p < first + np; ++p) {
@@ -389,42 +425,27 @@ struct PacketWalker {
       for (; tris; tris &= tris - 1) {
         const int lane = ctz(tris);
         RTR_COUNT(c.triangleTests += 1; c.packetTriangles += unsigned(__builtin_popcount(active)));
-        const F Az = set1(pk.v[0][kz][lane]) - shO[2], Bz = set1(pk.v[1][kz][lane]) - shO[2], Cz = set1(pk.v[2][kz][lane]) - shO[2];
-        const F ax = (set1(pk.v[0][kx][lane]) - shO[0]) - shS[0] * Az, ay = (set1(pk.v[0][ky][lane]) - shO[1]) - shS[1] * Az;
-        const F bx = (set1(pk.v[1][kx][lane]) - shO[0]) - shS[0] * Bz, by = (set1(pk.v[1][ky][lane]) - shO[1]) - shS[1] * Bz;
-        const F cx = (set1(pk.v[2][kx][lane]) - shO[0]) - shS[0] * Cz, cy = (set1(pk.v[2][ky][lane]) - shO[1]) - shS[1] * Cz;
-        const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W3 = bx * ay - by * ax;
-        unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W3, zero)) & active;
-        unsigned m = ~bits((U ^ V) | (V ^ W3)) & active & ~edge;
-        if ((m | edge) == 0) continue;
-        const F det = U + V + W3;
-        const F T = U * (shS[2] * Az) + V * (shS[2] * Bz) + W3 * (shS[2] * Cz);
-        const F detSign = det & signBit;
-        const F Ts = T ^ detSign;
-        m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));
         if constexpr (AnyHit) {
-          occluded |= m;
-          for (edge &= ~m; edge; edge &= edge - 1) {
-            const int i = ctz(edge);
-            WatertightRay r(rays[i]);
-            float b1, b2;
-            if (intersectWatertight(r, laneTriangle(pk, lane), b1, b2) > 0.0f) occluded |= 1u << i;
-          }
-          active &= ~occluded;
+          const unsigned occ = occludedBy(pk, lane, active, tLimit);
+          if (!occ) continue;
+          occluded |= occ;
+          active &= ~occ;
           if (!active) return occluded;
           continue;
         }
-        if (m) {
-          const F inv = set1(1.0f) / det;
+        Lanes l;
+        if (!triangleRays(pk, lane, active, tLimit, l)) continue;
+        if (l.m) {
+          const F inv = set1(1.0f) / l.det;
           alignas(32) float tv[8], iv[8], vv[8], wv[8];
-          store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W3);
-          for (; m; m &= m - 1) {
+          store(tv, l.T * inv); store(iv, inv); store(vv, l.V); store(wv, l.W3);
+          for (unsigned m = l.m; m; m &= m - 1) {
             const int i = ctz(m);
             const float t = tv[i];
             if (t > 0.0f && t < tMax[i]) offer(i, t, vv[i] * iv[i], wv[i] * iv[i], pk.prim[lane]);
           }
         }
-        for (; edge; edge &= edge - 1) {
+        for (unsigned edge = l.edge; edge; edge &= edge - 1) {
           const int i = ctz(edge);
           WatertightRay r(rays[i]);
           float b1, b2;
@@ -434,6 +455,18 @@ struct PacketWalker {
       }
     }
     return occluded;
+  }
+
+  // Closest hit, ray i alone: one node or one leaf of its walk (every candidate of a leaf offered, the
+  // cull distance then its new one); false when the walk is over.
+  RTR_INLINE bool aloneStep(int i, const W& w, uint64_t* stack, Cursor& at) {
+    if (!(at.ref & Bvh::kLeafBit)) {
+      if (w.visitNode(stack, at, set1(at.tHit))) return true;
+    } else {
+      leafCandidates(i, at.ref);
+      at.tHit = cull[i];
+    }
+    return W::pop(stack, at);
   }
 
   // Ray i alone from node or leaf `ref` on: its single-ray walk; returns whether it is occluded (any hit).
@@ -447,35 +480,40 @@ struct PacketWalker {
       return w.run(stack, at, scratch);
     } else {
       Cursor at{0, ref, cull[i], false};
-      for (;;) {
-        const F tHitV = set1(at.tHit);
-        while (!(at.ref & Bvh::kLeafBit))
-          if (!w.visitNode(stack, at, tHitV)) goto next;
-        leafCandidates(i, at.ref);
-        at.tHit = cull[i];
-      next:
-        if (!W::pop(stack, at)) return false;
-      }
+      while (aloneStep(i, w, stack, at)) {}
+      return false;
     }
   }
 
-  // Any hit: rays a and b alone from node or leaf `ref` on, one node or leaf of each in turn, as
-  // Bvh::occludedPair: while one waits for memory the other works. Returns the rays found occluded.
+  // Rays a and b alone from node or leaf `ref` on, one node or leaf of each in turn, as
+  // Bvh::occludedPair: while one waits for memory the other works. Any hit: returns the rays found occluded.
   RTR_INLINE unsigned alonePair(int a, int b, uint32_t ref) {
     RTR_COUNT(c.lone += 2);
     const W& wa = walker(a);
     const W& wb = walker(b);
     uint64_t stackA[kStackSize], stackB[kStackSize];
-    Cursor atA{0, ref, tMax[a], false}, atB{0, ref, tMax[b], false};
-    Hit scratch;
-    bool moreA = true, moreB = true;
-    while (moreA && moreB) {
-      moreA = wa.step(stackA, atA, scratch);
-      moreB = wb.step(stackB, atB, scratch);
+    if constexpr (AnyHit) {
+      Cursor atA{0, ref, tMax[a], false}, atB{0, ref, tMax[b], false};
+      Hit scratch;
+      bool moreA = true, moreB = true;
+      while (moreA && moreB) {
+        moreA = wa.step(stackA, atA, scratch);
+        moreB = wb.step(stackB, atB, scratch);
+      }
+      if (moreA) wa.run(stackA, atA, scratch);
+      if (moreB) wb.run(stackB, atB, scratch);
+      return unsigned(atA.found) << a | unsigned(atB.found) << b;
+    } else {
+      Cursor atA{0, ref, cull[a], false}, atB{0, ref, cull[b], false};
+      bool moreA = true, moreB = true;
+      while (moreA && moreB) {
+        moreA = aloneStep(a, wa, stackA, atA);
+        moreB = aloneStep(b, wb, stackB, atB);
+      }
+      while (moreA) moreA = aloneStep(a, wa, stackA, atA);
+      while (moreB) moreB = aloneStep(b, wb, stackB, atB);
+      return 0;
     }
-    if (moreA) wa.run(stackA, atA, scratch);
-    if (moreB) wb.run(stackB, atB, scratch);
-    return unsigned(atA.found) << a | unsigned(atB.found) << b;
   }
 
   // Walks the packet; any hit: returns the occluded rays; closest hit: the rays to trace again alone.
@@ -486,11 +524,11 @@ struct PacketWalker {
     unsigned done = 0;  // any hit: the rays already occluded
     for (;;) {
       for (;;) {
-        if (__builtin_popcount(active) <= (AnyHit ? kAloneRays : 1)) {  // too few rays to share the work
+        if (__builtin_popcount(active) <= kAloneRays) {  // too few rays to share the work
           while (active) {
             const int i = ctz(active);
             active &= active - 1;
-            if (AnyHit && active) {
+            if (active) {
               const int j = ctz(active);
               active &= active - 1;
               done |= alonePair(i, j, ref);

@@ -187,7 +187,7 @@ TEST(Bvh, EmptyAndDegenerateInputs) {
   EXPECT_EQ(Bvh(bad).closest({{0, 0, 0}, {0, 0, -1}}).prim, 1u);
 }
 
-// The parallel build (ranges near the root binned and partitioned by all threads, subtrees side by side)
+// The parallel build (ranges near the root binned and partitioned by many threads, subtrees side by side)
 // makes the very tree one thread makes: nodes and packs bit for bit. And that tree is sound: child
 // boxes inside their parent's, each leaf's triangles inside its box, every triangle in exactly one leaf.
 TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
@@ -204,20 +204,25 @@ TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
     tris[i].v1.y = i % 2 ? NAN : INFINITY;
     bad.push_back(i);
   }
-  const Bvh one(tris, {}, 1), many(tris, {}, 8);
+  // 8 threads: the root's splits by all threads; 16: its children's too (a level of fewer nodes than threads).
+  const Bvh one(tris, {}, 1), many(tris, {}, 8), more(tris, {}, 16);
   ASSERT_GT(tris.size(), 300000u);
-  ASSERT_EQ(one.stats().nodes, many.stats().nodes);
-  ASSERT_EQ(one.stats().packs, many.stats().packs);
-  EXPECT_EQ(one.stats().sahCost, many.stats().sahCost);
+  const Bvh::View a = one.view();
+  for (const Bvh* other : {&many, &more}) {
+    ASSERT_EQ(one.stats().nodes, other->stats().nodes);
+    ASSERT_EQ(one.stats().packs, other->stats().packs);
+    EXPECT_EQ(one.stats().sahCost, other->stats().sahCost);
+    const Bvh::View b = other->view();
+    EXPECT_EQ(a.root, b.root);
+    for (uint32_t i = 0; i < one.stats().nodes; ++i)  // field by field: a Node has padding
+      ASSERT_TRUE(!std::memcmp(a.nodes[i].box, b.nodes[i].box, sizeof a.nodes[i].box) &&
+                  !std::memcmp(a.nodes[i].child, b.nodes[i].child, sizeof a.nodes[i].child)) << "node " << i;
+    for (uint32_t i = 0; i < one.stats().packs; ++i)
+      ASSERT_TRUE(!std::memcmp(a.packs[i].v, b.packs[i].v, sizeof a.packs[i].v) &&
+                  !std::memcmp(a.packs[i].prim, b.packs[i].prim, sizeof a.packs[i].prim)) << "pack " << i;
+  }
   EXPECT_GT(one.stats().sahCost, 1.0);
-  const Bvh::View a = one.view(), b = many.view();
-  EXPECT_EQ(a.root, b.root);
-  for (uint32_t i = 0; i < one.stats().nodes; ++i)  // field by field: a Node has padding
-    ASSERT_TRUE(!std::memcmp(a.nodes[i].box, b.nodes[i].box, sizeof a.nodes[i].box) &&
-                !std::memcmp(a.nodes[i].child, b.nodes[i].child, sizeof a.nodes[i].child)) << "node " << i;
-  for (uint32_t i = 0; i < one.stats().packs; ++i)
-    ASSERT_TRUE(!std::memcmp(a.packs[i].v, b.packs[i].v, sizeof a.packs[i].v) &&
-                !std::memcmp(a.packs[i].prim, b.packs[i].prim, sizeof a.packs[i].prim)) << "pack " << i;
+  const Bvh::View b = many.view();
 
   std::vector<int> seen(tris.size(), 0);
   size_t leaves = 0;
