@@ -29,6 +29,7 @@ struct BakeOptions {
   std::function<void(const std::string&)> note;  // glTF: what the reader chose on its own (LoadOptions::note)
   std::function<void(const char* phase, double fraction)> progress;
   unsigned threads = 0;
+  bool lod = true;                        // --no-lod: no cluster hierarchy (.rtrscene's CLOD chunk)
 };
 
 struct BakeReport {
@@ -37,7 +38,7 @@ struct BakeReport {
   size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0, embeddedTextures = 0;
   size_t triangles = 0, instances = 0;
   uint64_t outputBytes = 0;
-  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, writeSeconds = 0, totalSeconds = 0;
+  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, lodSeconds = 0, writeSeconds = 0, totalSeconds = 0;
 };
 
 // Throws rtr::Error naming the file and place; on failure nothing it created is left behind.

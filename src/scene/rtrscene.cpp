@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -11,6 +12,7 @@
 #include "cluster.h"
 #include "core/bounds.hpp"
 #include "scene/binio.hpp"
+#include "scene/rtrscene_lod.hpp"
 #include "core/parallel.hpp"
 
 namespace rtr {
@@ -486,6 +488,17 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     }
     w.pad(kAlign);
   }
+  // Version 6: chunks to the end of the payload, each {tag, 0, u64 body size}, the body, pad16.
+  if (version >= 6 && hasClusterLods(scene)) {
+    const size_t at = w.size();
+    w.bytes("CLOD", 4);
+    w.u32(0);
+    w.pod(uint64_t(0));
+    writeClusterLods(w, scene);
+    const uint64_t body = w.size() - at - 16;
+    std::memcpy(w.data().data() + at + 8, &body, 8);
+    w.pad(kAlign);
+  }
   std::string& out = w.data();
   const uint64_t payload = out.size() - kHeaderSize;
   const std::span<const uint8_t> payloadBytes{reinterpret_cast<const uint8_t*>(out.data()) + kHeaderSize, payload};
@@ -695,8 +708,31 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     r.align(kAlign, "clusters");
     m.clusters.resize(l.clusters);
   }
+  // Version 6's chunks: framed here, their bodies read once the meshes are (they refer to them).
+  struct Chunk { size_t at, body; uint64_t size; };
+  std::optional<Chunk> clod;
+  while (version >= 6 && r.remaining() != 0) {
+    const size_t at = r.pos();
+    char tag[4];
+    r.raw(tag, 4, "a chunk header");
+    const std::string name(tag, 4);
+    if (r.u32("a chunk header") != 0) r.failAt(at + 4, "chunk '" + name + "': reserved field is not 0");
+    const uint64_t size = r.pod<uint64_t>("a chunk header");
+    if (size > r.remaining()) r.failAt(at + 8, "chunk '" + name + "': " + std::to_string(size) + " bytes, " +
+                                                   std::to_string(r.remaining()) + " left in the file");
+    if (name != "CLOD") r.failAt(at, "unknown chunk '" + name + "'");
+    if (clod) r.failAt(at, "chunk '" + name + "' repeated (first at byte " + std::to_string(clod->at) + ")");
+    clod = Chunk{at, r.pos(), size};
+    r.skip(size, "a chunk");
+    r.align(kAlign, "a chunk");
+  }
   if (r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
   readArrays(bytes, scene, layout, threads, r);
+  if (clod) {
+    ByteReader body(bytes.first(clod->body + clod->size), file);
+    body.skip(clod->body, "a chunk");
+    readClusterLods(body, clod->size, scene);
+  }
   return scene;
 }
 

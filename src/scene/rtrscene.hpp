@@ -10,8 +10,9 @@
 namespace rtr {
 
 // 2 added lights, 3 clusters, 4 a checksum summed on all cores (pieceChecksum64), 5 what glTF brings
-// (instances, samplers, uv transforms, more attributes and light kinds); versions 1-4 still load.
-constexpr uint32_t kRtrSceneVersion = 5;
+// (instances, samplers, uv transforms, more attributes and light kinds), 6 chunks after the meshes
+// (CLOD: the cluster hierarchies); versions 1-5 still load (older writers drop the chunks).
+constexpr uint32_t kRtrSceneVersion = 6;
 
 // `version` below the current one writes an older layout (lights need 2, clusters 3, the checksum of
 // version 4), for tests of the reader; a scene holding what only version 5 stores is refused in older
