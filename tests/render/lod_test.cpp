@@ -110,8 +110,10 @@ TEST_F(LodTest, ImageErrorAgainstFullDetailIsSmall) {
       }
       std::printf("lod %.0f px: %u triangles listed, mean error %.3f, %.3f %% of pixels off by > 64\n", threshold,
                   c->triangles, sum / double(n), 100.0 * double(large) / double(n));
-      EXPECT_LT(sum / double(n), threshold * 1.0);
-      EXPECT_LT(double(large) / double(n), threshold * 0.005);
+      // Bounds from lavapipe's measurement (worst view: 0.094 and 0.018 % at 1 px, 0.28 and 0.077 % at 4 px)
+      // with room for another device's rounding; projected errors 20 times too small fail the 1 px bounds.
+      EXPECT_LT(sum / double(n), threshold <= 1.0f ? 0.15 : 0.5);
+      EXPECT_LT(double(large) / double(n), threshold <= 1.0f ? 0.0005 : 0.002);
     }
   }
 }
