@@ -202,7 +202,7 @@ TEST(RtrSceneParallel, Version4RefusesADamagedPieceAndOlderFilesStillLoad) {
   EXPECT_EQ(decodeError(v3, 1), "(no error)");
   v3[v3.size() - 20] ^= 1;
   EXPECT_THAT(decodeError(v3, 1), HasSubstr("byte 40: checksum mismatch"));
-  std::string v6 = good;
-  v6[8] = 6;
-  EXPECT_THAT(decodeError(v6, 1), HasSubstr("byte 8: unsupported version 6 (this build reads 5)"));
+  std::string v7 = good;
+  v7[8] = 7;
+  EXPECT_THAT(decodeError(v7, 1), HasSubstr("byte 8: unsupported version 7 (this build reads 6)"));
 }
