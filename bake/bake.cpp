@@ -14,6 +14,7 @@
 #include "core/image.hpp"
 #include "core/parallel.hpp"
 #include "scene/binio.hpp"
+#include "scene/cluster_lod.hpp"
 #include "scene/clusters.hpp"
 #include "scene/course.hpp"
 #include "core/parallel.hpp"
@@ -227,6 +228,17 @@ BakeReport bake(const BakeOptions& opt) {
       throw fileError(input, "", e.what());
     }
     rep.clusterSeconds = since(t0);
+    // The level-of-detail hierarchy over those clusters (docs/virtual-geometry.md), on all cores.
+    if (opt.lod) {
+      t0 = Clock::now();
+      if (opt.progress) opt.progress("cluster hierarchy", 0.0);
+      try {
+        stage("cluster hierarchy of " + input, [&] { buildMissingClusterLods(plan.scene, threads); });
+      } catch (const Error& e) {
+        throw fileError(input, "", e.what());
+      }
+      rep.lodSeconds = since(t0);
+    }
   }
 
   // 4. Encode and write the scene to its temporary, then put the textures and the scene in place. Without

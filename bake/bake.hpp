@@ -49,6 +49,7 @@ struct BakeOptions {
   std::function<void(const char* phase, double fraction)> progress;
   unsigned threads = 0;
   TextureStore textures = TextureStore::Files;  // .rtrscene only
+  bool lod = true;                        // --no-lod: no cluster hierarchy (.rtrscene's CLOD chunk)
 };
 
 struct BakeReport {
@@ -59,7 +60,7 @@ struct BakeReport {
   uint64_t outputBytes = 0;
   uint64_t texelBytes = 0, storedTexelBytes = 0;  // baked textures: their chains, and as stored (zstd)
   std::vector<LevelError> bcError;                // --textures bc: per level
-  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, writeSeconds = 0, totalSeconds = 0;
+  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, lodSeconds = 0, writeSeconds = 0, totalSeconds = 0;
 };
 
 // Throws rtr::Error naming the file and place; on failure nothing it created is left behind.

@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
           ->check(checked([](const std::string& t) { rtr::cli::parseVec3("--light", t); }, "X,Y,Z"));
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
       ->needs(lightOpt)->check(checked([](const std::string& t) { rtr::cli::parseColor("--light-color", t); }, "R,G,B"));
+  bool noLod = false;
+  app.add_flag("--no-lod", noLod, "store no cluster hierarchy (level of detail; docs/virtual-geometry.md)");
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
   std::string up = "+Y";
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
@@ -43,6 +45,7 @@ int main(int argc, char** argv) {
       ->check(rtr::cli::oneOf<rtr::TextureStore>())->capture_default_str();
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
   opt.textures = rtr::cli::enumOption<rtr::TextureStore>("--textures", textures);
+  opt.lod = !noLod;
 
   opt.input = input;
   opt.output = output;
@@ -80,8 +83,8 @@ int main(int argc, char** argv) {
       std::printf("  meshes %zu, instances %zu, materials %zu, textures %zu (%zu images written from the glTF)\n", r.meshes,
                   r.instances, r.materials, r.textures, r.embeddedTextures);
       std::printf("  triangles %zu, output %.2f MB\n", r.triangles, double(r.outputBytes) / 1e6);
-      std::printf("  time: read %.3f s, textures %.3f s, clusters %.3f s, write %.3f s, total %.3f s\n", r.parseSeconds,
-                  r.textureSeconds, r.clusterSeconds, r.writeSeconds, r.totalSeconds);
+      std::printf("  time: read %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n", r.parseSeconds,
+                  r.textureSeconds, r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.totalSeconds);
       return 0;
     }
     std::printf("  meshes %zu, materials %zu, textures %zu (+%zu fallback)\n", r.meshes, r.materials, r.textures,
@@ -89,9 +92,9 @@ int main(int argc, char** argv) {
     std::printf("  faces %zu, triangles %zu, degenerate skipped %zu\n", o.faces, o.triangles, o.degenerateSkipped);
     std::printf("  vertices %zu before welding, %zu after\n", o.verticesBeforeWeld, o.verticesAfterWeld);
     std::printf("  warnings %zu, output %.2f MB\n", o.warnings, double(r.outputBytes) / 1e6);
-    std::printf("  time: parse %.3f s (%.0f MB/s of OBJ text), weld %.3f s, textures %.3f s, clusters %.3f s, write %.3f s, total %.3f s\n",
+    std::printf("  time: parse %.3f s (%.0f MB/s of OBJ text), weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n",
                 r.parseSeconds, r.parseSeconds > 0 ? mb / r.parseSeconds : 0.0, r.weldSeconds, r.textureSeconds,
-                r.clusterSeconds, r.writeSeconds, r.totalSeconds);
+                r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.totalSeconds);
     return 0;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");

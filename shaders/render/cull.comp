@@ -1,6 +1,6 @@
 #version 460
-// Cluster culling: one thread per cluster; frustum, back-face cone, then occlusion against the depth
-// pyramid (shaders/shared/cull.h has the tests and the phases). Visible clusters are appended to a compact list whose
+// Cluster culling: one thread per cluster; the level-of-detail cut, frustum, back-face cone, then
+// occlusion against the depth pyramid (shaders/shared/cull.h has the tests and the phases). Visible clusters are appended to a compact list whose
 // length is the size of an indirect dispatch (one workgroup per visible cluster; cull.h); culled ones are counted by
 // reason. The caller zeroes the counts (x = 0, y = z = 1) before the pass.
 #extension GL_GOOGLE_include_directive : require
@@ -14,6 +14,7 @@ layout(set = 0, binding = 1, std430) buffer Counts { CullCounts counts; };
 layout(set = 0, binding = 2, std430) writeonly buffer Visible { uint visible[]; };
 layout(set = 0, binding = 3) uniform texture2D pyramid;  // R32F, farthest depth per texel (hiz.comp)
 layout(set = 0, binding = 4, std430) buffer History { uint history[]; };  // 1: visible in the last LATE pass
+layout(set = 0, binding = 5, std430) readonly buffer Lods { GpuClusterLod lods[]; };  // read with CULL_LOD
 
 layout(push_constant) uniform Push { CullPush pc; };
 
@@ -36,7 +37,11 @@ void main() {
   if (pc.phase == CULL_EARLY && !wasVisible) return;
   const GpuCluster c = clusters[i];
   uint reason = CULL_VISIBLE;
-  if ((pc.flags & CULL_FRUSTUM) != 0u && frustumCulls(c.sphere, pc.viewProj)) reason = CULL_BY_FRUSTUM;
+  if ((pc.flags & CULL_LOD) != 0u && !lodSelected(lods[i].sphere, lods[i].error.x, lods[i].parentSphere,
+                                                  lods[i].error.y, pc.eye.xyz, pc.pixelsPerUnit, pc.zNear,
+                                                  pc.lodThreshold))
+    reason = CULL_BY_LOD;
+  else if ((pc.flags & CULL_FRUSTUM) != 0u && frustumCulls(c.sphere, pc.viewProj)) reason = CULL_BY_FRUSTUM;
   else if ((pc.flags & CULL_CONE) != 0u && coneCulls(c.sphere, c.cone, pc.eye.xyz)) reason = CULL_BY_CONE;
   else if ((pc.flags & CULL_OCCLUSION) != 0u && pc.phase != CULL_EARLY && occluded(c.sphere)) reason = CULL_BY_OCCLUSION;
   if (pc.phase == CULL_LATE) history[i] = reason == CULL_VISIBLE ? 1u : 0u;
@@ -44,6 +49,7 @@ void main() {
   else if (!(pc.phase == CULL_LATE && wasVisible)) {
     const uint n = atomicAdd(counts.listed, 1u), maxX = max(pc.maxGroupsX, 1u);
     visible[n] = i;
+    atomicAdd(counts.triangles, c.triangleCount);
     if (n < maxX) atomicMax(counts.dispatch[0], n + 1u);
     if (n % maxX == 0u) atomicMax(counts.dispatch[1], n / maxX + 1u);
   }

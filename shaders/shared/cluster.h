@@ -31,8 +31,16 @@ struct GpuCluster {
 #define CLUSTER_DOUBLE_SIDED 2u  // never back-face culled (cone disabled)
 #define CLUSTER_MIRRORED 4u      // its instance's determinant is negative: front faces are clockwise on screen
 
+// Storage buffer, std430, 48 bytes, parallel to the GpuClusters (only for a scene with a cluster
+// hierarchy, docs/virtual-geometry.md): the level-of-detail choice's spheres and errors, in scene space.
+struct GpuClusterLod {
+  vec4 sphere;        // where `error` applies (the simplification that made the cluster)
+  vec4 parentSphere;  // where `parentError` applies (the one that replaced it)
+  vec4 error;         // x its error, y its parent's (LOD_ERROR_INFINITE: a root), zw 0
+};
+
 #ifdef __cplusplus
-static_assert(sizeof(GpuCluster) == 48);
+static_assert(sizeof(GpuCluster) == 48 && sizeof(GpuClusterLod) == 48);
 }  // namespace rtr::shader
 #endif
 #endif

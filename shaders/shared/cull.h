@@ -5,6 +5,7 @@
 #define RTR_SHADERS_SHARED_CULL_H
 
 #include "cluster.h"
+#include "cluster_lod.h"
 #include "shared.h"
 
 #ifdef __cplusplus
@@ -18,6 +19,7 @@ namespace rtr::shader {
 #define CULL_FRUSTUM 1u
 #define CULL_CONE 2u       // perspective cameras only: the test assumes rays from the eye
 #define CULL_OCCLUSION 4u  // against the depth pyramid bound to the pass
+#define CULL_LOD 8u        // the level-of-detail cut (cluster_lod.h's lodSelected) over the GpuClusterLods
 
 // CullPush::phase. Two-phase occlusion culling (docs/culling.md): EARLY passes the clusters visible last
 // frame (per the history buffer) through frustum and cone only; once they are drawn and the pyramid built
@@ -32,18 +34,20 @@ namespace rtr::shader {
 #define CULL_BY_FRUSTUM 1u
 #define CULL_BY_CONE 2u
 #define CULL_BY_OCCLUSION 3u
+#define CULL_BY_LOD 4u  // not in the cut at this view and threshold (tested first)
 
 // The counts buffer: VkDispatchIndirectCommand {visible clusters, 1, 1}, then the culled counts by reason.
 // Over CullPush::maxGroupsX visible clusters the dispatch is two-dimensional, {maxGroupsX, rows, 1}: a
 // workgroup's list entry is then gl_WorkGroupID.y * maxGroupsX + gl_WorkGroupID.x (below `listed`).
 struct CullCounts {
   uint dispatch[3];
-  uint culled[3];  // frustum, cone (back-facing), occlusion
+  uint culled[4];  // frustum, cone (back-facing), occlusion, level of detail
   uint listed;     // entries in the visible list
-  uint pad;
+  uint triangles;  // of the listed clusters
+  uint pad[3];
 };
 
-struct CullPush {  // 112 bytes
+struct CullPush {  // 128 bytes
   mat4 viewProj;
   vec4 eye;          // xyz
   uint count;        // clusters in the input buffer
@@ -53,7 +57,10 @@ struct CullPush {  // 112 bytes
   uint pyramidLevels;
   uint phase;        // CULL_SINGLE, CULL_EARLY or CULL_LATE
   uint maxGroupsX;   // the device's maxComputeWorkGroupCount[0] (at most 65535): wider lists go 2D
-  uint pad1;
+  float lodThreshold;   // CULL_LOD: pixels of projected error
+  float pixelsPerUnit;  // image height / (2 tan(fovY / 2))
+  float zNear;
+  uint pad1, pad2;
 };
 
 RTR_FN vec4 matrixRow(mat4 m, int i) { return vec4(m[0][i], m[1][i], m[2][i], m[3][i]); }
@@ -136,7 +143,7 @@ RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {
 }
 
 #ifdef __cplusplus
-static_assert(sizeof(CullPush) == 112 && sizeof(CullCounts) == 32);
+static_assert(sizeof(CullPush) == 128 && sizeof(CullCounts) == 48);
 }  // namespace rtr::shader
 #endif
 #endif

@@ -50,6 +50,38 @@ uint32_t clusterFlags(const Mesh& m, const Material& mat) {
   return CLUSTER_DOUBLE_SIDED | (mat.texture(TextureSlot::AlphaMask) != kNoTexture ? CLUSTER_ALPHA_MASKED : 0u);
 }
 
+namespace {
+
+// The linear part's largest stretch, and whether it is a similarity.
+std::pair<float, bool> largestStretch(const glm::mat4& transform) {
+  // A column's length for a similarity, the Frobenius norm (>= the spectral norm) otherwise.
+  const glm::mat3 l(transform);
+  const glm::vec3 len(glm::length(l[0]), glm::length(l[1]), glm::length(l[2]));
+  const float s = std::max(len.x, std::max(len.y, len.z)), eps = 1e-5f * s * s;
+  const bool similarity = std::abs(len.x - len.y) <= 1e-5f * s && std::abs(len.x - len.z) <= 1e-5f * s &&
+                          std::abs(glm::dot(l[0], l[1])) <= eps && std::abs(glm::dot(l[0], l[2])) <= eps &&
+                          std::abs(glm::dot(l[1], l[2])) <= eps;
+  return {similarity ? s : std::sqrt(glm::dot(len, len)), similarity};
+}
+
+// Records [first, end) of `out` placed by `transform`.
+void place(const glm::mat4& transform, size_t first, std::vector<shader::GpuCluster>& out) {
+  const float noCone = 2.0f;
+  if (transform == glm::mat4(1.0f)) return;
+  const glm::mat3 l(transform);
+  const auto [stretch, similarity] = largestStretch(transform);
+  for (size_t i = first; i < out.size(); ++i) {
+    shader::GpuCluster& c = out[i];
+    c.sphere = glm::vec4(glm::vec3(transform * glm::vec4(glm::vec3(c.sphere), 1.0f)), c.sphere.w * stretch);
+    // A mirror flips the winding and the front face with it (CLUSTER_MIRRORED), so the front normals
+    // turn with the linear part in every case (its inverse transpose, parallel to it for a similarity).
+    if (!similarity) c.cone = glm::vec4(0, 0, 1, noCone);
+    else if (c.cone.w < 1.0f) c.cone = glm::vec4(glm::normalize(l * glm::vec3(c.cone)), c.cone.w);
+  }
+}
+
+}  // namespace
+
 void appendClusters(const Mesh& m, const glm::mat4& transform, uint32_t instance, uint32_t flags,
                     std::vector<shader::GpuCluster>& out) {
   const float noCone = 2.0f;
@@ -70,23 +102,34 @@ void appendClusters(const Mesh& m, const glm::mat4& transform, uint32_t instance
       out.push_back({glm::vec4(c, r), glm::vec4(0, 0, 1, noCone), instance, f, count, flags});
     }
   }
+  place(transform, first, out);
+}
+
+void appendClusterLods(const Mesh& m, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above,
+                       size_t first, std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods) {
+  const float noCone = 2.0f;
+  const size_t firstOut = out.size(), firstLod = lods.size();
+  if (!above && m.lod.levels == 0) {  // always in the cut: its own error 0, no parent
+    for (size_t i = first; i < out.size(); ++i)
+      lods.push_back({out[i].sphere, out[i].sphere, glm::vec4(0.0f, shader::LOD_ERROR_INFINITE, 0.0f, 0.0f)});
+    return;
+  }
+  for (const LodCluster& c : m.lod.clusters) {
+    if ((c.level > 0) != above) continue;
+    lods.push_back({c.sphere, c.parentSphere, glm::vec4(c.error, c.parentError, 0.0f, 0.0f)});
+    if (above)
+      out.push_back({glm::vec4(c.center, c.radius),
+                     glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff), instance,
+                     c.firstTriangle, c.triangleCount, flags});
+  }
+  if (above) place(transform, firstOut, out);
   if (transform == glm::mat4(1.0f)) return;
-  // The linear part's largest stretch bounds the radius: a column's length for a similarity, the
-  // Frobenius norm (>= the spectral norm) otherwise.
-  const glm::mat3 l(transform);
-  const glm::vec3 len(glm::length(l[0]), glm::length(l[1]), glm::length(l[2]));
-  const float s = std::max(len.x, std::max(len.y, len.z)), eps = 1e-5f * s * s;
-  const bool similarity = std::abs(len.x - len.y) <= 1e-5f * s && std::abs(len.x - len.z) <= 1e-5f * s &&
-                          std::abs(glm::dot(l[0], l[1])) <= eps && std::abs(glm::dot(l[0], l[2])) <= eps &&
-                          std::abs(glm::dot(l[1], l[2])) <= eps;
-  const float stretch = similarity ? s : std::sqrt(glm::dot(len, len));
-  for (size_t i = first; i < out.size(); ++i) {
-    shader::GpuCluster& c = out[i];
-    c.sphere = glm::vec4(glm::vec3(transform * glm::vec4(glm::vec3(c.sphere), 1.0f)), c.sphere.w * stretch);
-    // A mirror flips the winding and the front face with it (CLUSTER_MIRRORED), so the front normals
-    // turn with the linear part in every case (its inverse transpose, parallel to it for a similarity).
-    if (!similarity) c.cone = glm::vec4(0, 0, 1, noCone);
-    else if (c.cone.w < 1.0f) c.cone = glm::vec4(glm::normalize(l * glm::vec3(c.cone)), c.cone.w);
+  const float stretch = largestStretch(transform).first;
+  auto move = [&](glm::vec4 s) { return glm::vec4(glm::vec3(transform * glm::vec4(glm::vec3(s), 1.0f)), s.w * stretch); };
+  auto scale = [&](float e) { return e >= shader::LOD_ERROR_INFINITE ? e : e * stretch; };
+  for (size_t i = firstLod; i < lods.size(); ++i) {
+    shader::GpuClusterLod& l = lods[i];
+    l = {move(l.sphere), move(l.parentSphere), glm::vec4(scale(l.error.x), scale(l.error.y), 0.0f, 0.0f)};
   }
 }
 
@@ -194,12 +237,12 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
 }
 
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
-                           const DepthPyramid* pyramid, CullTests tests, CullPhase phase) {
+                           const DepthPyramid* pyramid, CullTests tests, CullPhase phase, VkBuffer lods) {
   if (count > maxClusters_) throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
   vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);
-  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0}, 0, 0};  // the indirect dispatch's y and z are 1
+  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, {0, 0, 0}};  // the indirect dispatch's y and z are 1
   vkCmdUpdateBuffer(cb, counts_.handle(), 0, sizeof(zero), &zero);
   vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
 
@@ -208,7 +251,11 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
   push.eye = glm::vec4(camera.eye, 1.0f);
   push.count = count;
   push.flags = (tests.frustum ? CULL_FRUSTUM : 0u) | (tests.cone && !camera.orthographic ? CULL_CONE : 0u) |
-               (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u);
+               (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u) |
+               (tests.lod && lods && camera.lodThreshold > 0.0f && !camera.orthographic ? CULL_LOD : 0u);
+  push.lodThreshold = camera.lodThreshold;
+  push.pixelsPerUnit = camera.pixelsPerUnit;
+  push.zNear = camera.zNear;
   push.phase = uint32_t(phase);
   push.maxGroupsX = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0], 65535u);
   if (pyramid) {
@@ -223,6 +270,7 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
       .buffer(2, visible_.handle())
       .image(3, pyramid ? pyramid->view() : noPyramid_.view(), VK_IMAGE_LAYOUT_GENERAL)
       .buffer(4, history_.handle())
+      .buffer(5, lods ? lods : clusters)  // not read without CULL_LOD
       .push(cb, pipeline_);
   pipeline_.push(cb, push);
   pipeline_.dispatch(cb, count);

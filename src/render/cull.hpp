@@ -41,6 +41,12 @@ uint32_t clusterFlags(const Mesh& mesh, const Material& material);
 // the normals' cone). Double-sided clusters get no cone. Identity: the records as stored, bit for bit.
 void appendClusters(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags,
                     std::vector<shader::GpuCluster>& out);
+// The level-of-detail records (docs/virtual-geometry.md) of the clusters appendClusters appended from
+// `first` on (a mesh without a hierarchy: always in the cut), or, with `above`, the records of its
+// hierarchy's clusters above level 0 appended to `out` and their level-of-detail records to `lods`; all
+// placed by `transform` as appendClusters places them, errors scaled by its largest stretch.
+void appendClusterLods(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above,
+                       size_t first, std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods);
 // Every GpuCluster of a scene, numbered as GpuScene numbers its instances.
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
 
@@ -76,10 +82,15 @@ struct CullCamera {
   glm::mat4 viewProj{1.0f};  // projectionMatrix * viewMatrix (src/core/camera.hpp)
   glm::vec3 eye{0.0f};
   bool orthographic = false;  // no cone test (it assumes rays from the eye)
+  // The level-of-detail cut (with a GpuClusterLod buffer): pixels of projected error allowed, the image's
+  // height / (2 tan(fovY / 2)), the near plane. A threshold of 0 or an orthographic camera: no cut
+  // (the caller then passes only the full-detail clusters).
+  float lodThreshold = 0.0f, pixelsPerUnit = 0.0f, zNear = 0.0f;
 };
 
 struct CullTests {
   bool frustum = true, cone = true, occlusion = true;  // occlusion only when a pyramid is given
+  bool lod = true;  // only with a GpuClusterLod buffer and a camera's threshold above 0
 };
 
 // Single: every cluster tested once (occlusion conservative only for the view the pyramid was built from).
@@ -95,8 +106,10 @@ class ClusterCuller {
   // frame for Early/Late). With a pyramid (not used by Early), clusters hidden behind its depths are culled
   // too: a cluster whose every point lies behind that depth image there cannot be seen above it. Ends with
   // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
+  // `lods`: the clusters' GpuClusterLod records (cluster.h), for the level-of-detail cut, tested first.
   void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
-              const DepthPyramid* pyramid, CullTests tests = {}, CullPhase phase = CullPhase::Single);
+              const DepthPyramid* pyramid, CullTests tests = {}, CullPhase phase = CullPhase::Single,
+              VkBuffer lods = VK_NULL_HANDLE);
   VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
   VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
   uint32_t maxClusters() const { return maxClusters_; }

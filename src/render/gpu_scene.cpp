@@ -64,6 +64,8 @@ struct GeometryPlan {
   std::vector<shader::GpuDraw> draws;
   std::vector<shader::GpuInstance> instances;
   std::vector<shader::GpuCluster> clusters;
+  std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
+  size_t baseClusters = 0;
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
 };
@@ -190,11 +192,12 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     DrawItem d;
     d.material = m.material;
     d.indexCount = uint32_t(m.indices.size());
+    d.primitives = uint32_t((m.indices.size() + m.lod.indices.size()) / 3);
     d.vertexOffset = int32_t(p.vertices);
     d.indexType = index16 ? VK_INDEX_TYPE_UINT16 : VK_INDEX_TYPE_UINT32;
     d.firstIndex = uint32_t(index16 ? p.count16 : p.count32);
     p.slots.push_back({&m, p.vertices, d.firstIndex, index16});
-    (index16 ? p.count16 : p.count32) += m.indices.size();
+    (index16 ? p.count16 : p.count32) += m.indices.size() + m.lod.indices.size();  // the hierarchy's after
     stats_.meshes16 += index16;
     p.vertices += m.positions.size();
     const bool textured = !m.texcoords.empty();
@@ -212,6 +215,7 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     stats_.triangles += m.triangleCount();
   }
   const std::vector<Instance> instances = gpuInstances(scene);
+  const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
   Bounds box;  // of the draw being extended
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
@@ -227,7 +231,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
       blendDraws_.push_back(bd);
       continue;
     }
+    const size_t first = p.clusters.size();
     appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
+    if (lods) appendClusterLods(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), false, first, p.clusters, p.lods);
     std::vector<DrawItem>& list = draws_[size_t(md.kind)];
     if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
       list.push_back(md.item);
@@ -237,6 +243,13 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     ++list.back().instanceCount;
     box.extend(b);
     if (!box.empty()) list.back().center = box.center();
+  }
+  p.baseClusters = p.clusters.size();
+  for (uint32_t i = 0; lods && i < instances.size(); ++i) {  // the hierarchies' clusters after all full-detail ones
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    if (scene.materials.at(m.material).blended()) continue;  // drawn by the transparency pass, no clusters
+    const uint32_t flags = meshDraw[instances[i].mesh]->flags | (mirrored(instances[i].transform) ? CLUSTER_MIRRORED : 0u);
+    appendClusterLods(m, instances[i].transform, i, flags, true, 0, p.clusters, p.lods);
   }
   stats_.instances = uint32_t(instances.size());
   stats_.vertices = uint32_t(p.vertices);
@@ -290,7 +303,7 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kTargets };
+  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kLod, kTargets };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
@@ -303,14 +316,16 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&clusters_, bytes(plan.clusters), plan.clusters.data()},
                                         {&texcoords1_, plan.anyUv1 ? vertices * 8 : 0},
                                         {&tangents_, plan.anyTangents ? vertices * 16 : 0},
-                                        {&colors_, plan.anyColors ? vertices * 16 : 0}}};
+                                        {&colors_, plan.anyColors ? vertices * 16 : 0},
+                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
   const std::array<VkBufferUsageFlags, kTargets> usage{kVertex, kVertex, kVertex, kIndex, kIndex, kStorage, kStorage,
-                                                       kStorage, kStorage, kStorage, kStorage, kStorage};
+                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage};
   const char* names[kTargets] = {"positions", "normals", "texcoords", "indices16", "indices32", "materials",
-                                 "draws", "instances", "clusters", "texcoords1", "tangents", "colours"};
+                                 "draws", "instances", "clusters", "texcoords1", "tangents", "colours", "cluster lods"};
   clusterCount_ = uint32_t(plan.clusters.size());
+  baseClusterCount_ = uint32_t(plan.baseClusters);
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {
     Target& tg = targets[i];
@@ -338,7 +353,7 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   for (uint32_t s = 0; s < plan.slots.size(); ++s) {
     for (size_t b = 0, n = plan.slots[s].mesh->positions.size(); b < n; b += kVertexChunk)
       tasks.push_back({s, false, b, std::min(n, b + kVertexChunk)});
-    for (size_t b = 0, n = plan.slots[s].mesh->indices.size(); b < n; b += kIndexChunk)
+    for (size_t b = 0, n = plan.slots[s].mesh->indices.size() + plan.slots[s].mesh->lod.indices.size(); b < n; b += kIndexChunk)
       tasks.push_back({s, true, b, std::min(n, b + kIndexChunk)});
   }
   parallelFor(tasks.size(), 0, [&](size_t i) {
@@ -346,12 +361,19 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     const MeshSlot& slot = plan.slots[task.slot];
     const Mesh& m = *slot.mesh;
     const size_t n = task.end - task.begin;
-    if (task.indices) {
-      if (slot.index16) {
-        auto* dst = reinterpret_cast<uint16_t*>(targets[kI16].dst) + slot.index + task.begin;
-        for (size_t k = 0; k < n; ++k) dst[k] = uint16_t(m.indices[task.begin + k]);
-      } else {
-        std::memcpy(targets[kI32].dst + (slot.index + task.begin) * 4, &m.indices[task.begin], n * 4);
+    if (task.indices) {  // the mesh's indices, then its hierarchy's
+      const size_t own = m.indices.size();
+      for (size_t b = task.begin; b < task.end;) {
+        const bool lod = b >= own;
+        const uint32_t* src = lod ? &m.lod.indices[b - own] : &m.indices[b];
+        const size_t run = std::min(task.end, lod ? task.end : own) - b;
+        if (slot.index16) {
+          auto* dst = reinterpret_cast<uint16_t*>(targets[kI16].dst) + slot.index + b;
+          for (size_t k = 0; k < run; ++k) dst[k] = uint16_t(src[k]);
+        } else {
+          std::memcpy(targets[kI32].dst + (slot.index + b) * 4, src, run * 4);
+        }
+        b += run;
       }
       return;
     }

@@ -33,7 +33,8 @@ constexpr size_t kDrawKindCount = size_t(DrawKind::Count);
 // One instanced draw: a mesh under a range of instances (all mirrored or none: the front face is per draw).
 struct DrawItem {
   uint32_t material = 0;
-  uint32_t indexCount = 0;
+  uint32_t indexCount = 0;   // the mesh's own triangles (what a hardware draw draws)
+  uint32_t primitives = 0;   // triangles its ids may name: the mesh's, then its hierarchy's (Mesh::lod)
   uint32_t firstIndex = 0;   // in the index buffer of its type
   int32_t vertexOffset = 0;
   VkIndexType indexType = VK_INDEX_TYPE_UINT32;
@@ -124,8 +125,13 @@ class GpuScene {
   VkBuffer drawInfo() const { return drawInfo_.handle(); }  // GpuDraw per draw, for shading in compute
   VkBuffer instances() const { return instances_.handle(); }  // GpuInstance (frame.h), gpuInstances() order
   uint32_t instanceCount() const { return stats_.instances; }
-  VkBuffer clusters() const { return clusters_.handle(); }  // GpuCluster (cluster.h), instance by instance
+  // GpuCluster (cluster.h): every instance's full-detail clusters (the first baseClusterCount(), instance by
+  // instance), then those of the meshes' hierarchies above level 0, instance by instance.
+  VkBuffer clusters() const { return clusters_.handle(); }
   uint32_t clusterCount() const { return clusterCount_; }
+  uint32_t baseClusterCount() const { return baseClusterCount_; }
+  // GpuClusterLod per GpuCluster where some mesh has a hierarchy (docs/virtual-geometry.md); else null.
+  VkBuffer clusterLods() const { return clusterLods_.handle(); }
   uint32_t textureCount() const { return stats_.textures; }  // also while they load
   // Every texture's view; none until texturesReady(). The renderer pairs them with samplers (TextureSet).
   std::vector<VkImageView> textureViews() const;
@@ -162,8 +168,8 @@ class GpuScene {
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
-  vk::Buffer texcoords1_, tangents_, colors_;
-  uint32_t clusterCount_ = 0;
+  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_;
+  uint32_t clusterCount_ = 0, baseClusterCount_ = 0;
   std::vector<vk::Image> textures_;
   std::vector<SamplerDesc> samplers_;  // of each texture (Texture::sampler)
   struct PendingUpload {  // alive until its submission completed

@@ -19,7 +19,7 @@ bool ComputeRaster::supported(const vk::Context& ctx) {
 }
 
 ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), culled_(framesInFlight, false) {
+    : ctx_(ctx), scene_(scene), culled_(framesInFlight, false), twoPhase_(framesInFlight, false) {
   const vk::LayoutOptions push{.pushDescriptorSets = {0}};
   clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
   raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), push, {{0, RASTER_SHARED_AREA}});
@@ -35,7 +35,7 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   // Every triangle at most once in the hand-off list, after its VkDrawIndirectCommand.
   uint64_t triangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& di : scene.draws(DrawKind(k))) triangles += uint64_t(di.indexCount / 3) * di.instanceCount;
+    for (const DrawItem& di : scene.draws(DrawKind(k))) triangles += uint64_t(di.primitives) * di.instanceCount;
   hwList_ = vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryUse::Device,
                        "raster hand-off");
@@ -51,7 +51,9 @@ std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame)
   cullReadback_.invalidate();
   shader::CullCounts c[2];
   std::memcpy(c, static_cast<const char*>(cullReadback_.mapped()) + sizeof c * frame, sizeof c);
-  return CullStats{scene_.clusterCount(), c[0].listed, c[1].listed, c[1].culled[0], c[1].culled[1], c[1].culled[2]};
+  const uint32_t early = twoPhase_.at(frame) ? c[0].listed : 0, earlyTriangles = twoPhase_.at(frame) ? c[0].triangles : 0;
+  return CullStats{scene_.clusterCount(), early, c[1].listed, c[1].culled[0], c[1].culled[1], c[1].culled[2],
+                   c[1].culled[3], earlyTriangles + c[1].triangles};
 }
 
 void ComputeRaster::resize(VkExtent2D extent) {
@@ -64,15 +66,20 @@ void ComputeRaster::resize(VkExtent2D extent) {
 }
 
 void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits,
-                           vk::GpuTimer& timer, uint32_t frame, const CullCamera* cull) {
+                           vk::GpuTimer& timer, uint32_t frame, const CullCamera& camera, bool cull) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
   const VkBuffer uv = scene_.texcoords() ? scene_.texcoords() : scene_.positions();
-  const bool culling = cull && scene_.clusterCount() > 0;
+  // Level 0 only (the first baseClusterCount() records) unless a cut is chosen.
+  const bool lod = scene_.clusterLods() && camera.lodThreshold > 0.0f && !camera.orthographic;
+  const uint32_t clusterCount = lod ? scene_.clusterCount() : scene_.baseClusterCount();
+  const bool twoPhase = cull && clusterCount > 0, culling = (cull || lod) && clusterCount > 0;
   if (culling && !culler_) culler_.emplace(ctx_, scene_.clusterCount());
-  if (culling && !pyramid_) pyramid_.emplace(ctx_, extent_);
+  if (twoPhase && !pyramid_) pyramid_.emplace(ctx_, extent_);
   culled_.at(frame) = culling;
+  twoPhase_.at(frame) = twoPhase;
+  const VkBuffer lods = lod ? scene_.clusterLods() : VK_NULL_HANDLE;
   auto bind = [&](const vk::Pipeline& p, bool fromList = false) {
     p.bind(cb);
     vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
@@ -87,7 +94,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
       else w.buffer(b.binding, buffers[b.binding]);
     }
     w.push(cb, p);
-    p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, scene_.clusterCount(), fromList, 0, 0, 0});
+    p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, clusterCount, fromList, 0, 0, 0});
   };
   // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.
   constexpr vk::BufferUse kReaders = vk::kComputeReadWrite | vk::kFragmentReadWrite | vk::kVertexReadWrite | vk::kIndirectRead;
@@ -108,8 +115,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     } else {
       // Workgroup counts per dimension are limited (65535 on many devices): clusters over x, then y.
       const uint32_t maxX = std::min(ctx_.properties().limits.maxComputeWorkGroupCount[0], 65535u);
-      const uint32_t x = std::min(scene_.clusterCount(), maxX);
-      vkCmdDispatch(cb, x, (scene_.clusterCount() + x - 1) / x, 1);
+      const uint32_t x = std::min(clusterCount, maxX);
+      vkCmdDispatch(cb, x, (clusterCount + x - 1) / x, 1);
     }
     timer.mark(cb, name);
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite);
@@ -117,8 +124,14 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     vkCmdDispatch(cb, RASTER_LARGE_GROUPS, 1, 1);
     timer.mark(cb, largeName);
   };
-  if (culling) {
-    culler_->record(cb, scene_.clusters(), scene_.clusterCount(), *cull, nullptr, {}, CullPhase::Early);
+  if (culling && !twoPhase) {  // the level-of-detail cut alone
+    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {false, false, false, true}, CullPhase::Single, lods);
+    vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
+    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+    timer.mark(cb, "cull");
+  }
+  if (twoPhase) {
+    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {}, CullPhase::Early, lods);
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[0]);
     timer.mark(cb, "cull early");
     rasterise("raster early", "raster large early");
@@ -129,12 +142,12 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     pyramid_->buildFromBuffer(cb, vis_.handle());
     timer.mark(cb, "pyramid");
     // Its first barrier orders the copies above before its reset, its second makes them visible to compute.
-    culler_->record(cb, scene_.clusters(), scene_.clusterCount(), *cull, &*pyramid_, {}, CullPhase::Late);
+    culler_->record(cb, scene_.clusters(), clusterCount, camera, &*pyramid_, {}, CullPhase::Late, lods);
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
     vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     timer.mark(cb, "cull");
   }
-  if (scene_.clusterCount() > 0) rasterise("raster", "raster large");
+  if (clusterCount > 0) rasterise("raster", "raster large");
   vk::bufferBarrier(cb, vk::kComputeWrite, kReaders);
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};

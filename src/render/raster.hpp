@@ -28,16 +28,20 @@ class ComputeRaster {
   // With `cull` (the frame's camera), two-phase cluster culling (docs/culling.md): "cull early" lists the
   // clusters visible last frame, "raster early" + "raster large early" draw them, "pyramid" reduces their
   // depth, "cull" tests the rest against it, and the passes above draw those; the hardware hand-off once.
+  // Level of detail (docs/virtual-geometry.md): with a scene hierarchy and camera.lodThreshold > 0, the
+  // culling pass picks each instance's clusters of the cut (without `cull`: one pass, "cull", testing
+  // nothing else); otherwise only the full-detail clusters are drawn.
   void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer,
-              uint32_t frame, const CullCamera* cull);
+              uint32_t frame, const CullCamera& camera, bool cull);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
   // The hand-off's texture array (set 1 of its layout), for the one writer of every texture set.
   const vk::PipelineLayout& textureLayout() const { return hardware_.layout; }
   VkDescriptorSet textureSet() const { return hardware_.layout.setCount() > 1 ? textures_.get(1) : VK_NULL_HANDLE; }
   // The culling counts of the last completed use of `frame` (none if it did not cull).
   struct CullStats {
-    uint32_t clusters = 0, early = 0, late = 0;  // listed by each phase
-    uint32_t frustum = 0, cone = 0, occlusion = 0;  // culled, by the late phase (every cluster tested)
+    uint32_t clusters = 0, early = 0, late = 0;  // listed by each phase (one pass: late)
+    uint32_t frustum = 0, cone = 0, occlusion = 0, lod = 0;  // culled, by the late phase (every cluster tested)
+    uint32_t triangles = 0;  // of the listed clusters, both phases
   };
   std::optional<CullStats> cullStats(uint32_t frame) const;
 
@@ -52,6 +56,7 @@ class ComputeRaster {
   std::optional<DepthPyramid> pyramid_;
   vk::Buffer cullReadback_;              // per frame in flight: the early and the late CullCounts
   std::vector<bool> culled_;             // per frame in flight: whether its last use culled
+  std::vector<bool> twoPhase_;           // per frame in flight: whether that was in two phases
 };
 
 }  // namespace rtr::render

@@ -62,7 +62,7 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
   uint32_t maxTriangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
     for (const DrawItem& d : scene.draws(DrawKind(k))) {
-      maxTriangles = std::max(maxTriangles, d.indexCount / 3);
+      maxTriangles = std::max(maxTriangles, d.primitives);
       triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
     }
   const uint32_t instances = scene.instanceCount();
@@ -430,8 +430,9 @@ void Renderer::frame(FrameContext& fc) {
   timer.reset(cb);
   timer.begin(cb);
   if (compute) {
-    const CullCamera cam{u.viewProj, pose.position, lens.orthographic};
-    raster_->record(cb, uniforms_, primitiveBits_, timer, frame, s.cull ? &cam : nullptr);
+    const float pixelsPerUnit = float(target.extent.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
+    const CullCamera cam{u.viewProj, pose.position, lens.orthographic, s.lodError, pixelsPerUnit, lens.zNear};
+    raster_->record(cb, uniforms_, primitiveBits_, timer, frame, cam, s.cull);
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
   } else {
     rasterPass(cb, frame, set, pose.position, s.background, backdrop);

@@ -47,6 +47,9 @@ struct RenderSettings {
   // on the H200 its fixed cost (depth pyramid + two cull passes) exceeded the raster time it saved in
   // every measured scene (docs/raster.md).
   bool cull = false;
+  // Compute raster, scenes with a cluster hierarchy: the level-of-detail cut's projected error in pixels
+  // (docs/virtual-geometry.md); 0: full detail, exactly the image without a hierarchy.
+  float lodError = 0.0f;  // rtr-view: --lod-error, default 1
   float lodBias = 0.0f;
   SamplerSettings sampler;        // how scene textures are filtered (mip experiments)
   MosaicMode mosaic = MosaicMode::Compute;

@@ -6,6 +6,10 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "core/error.hpp"
+#include "core/parallel.hpp"
+#include "scene/clusters.hpp"
+
 #include "cluster.h"
 #include "cluster_lod.h"
 
@@ -14,12 +18,6 @@ namespace rtr {
 namespace {
 
 using Indices = std::vector<uint32_t>;
-
-glm::vec4 sphereOf(const uint32_t* idx, size_t count, const Mesh& mesh) {
-  const meshopt_Bounds b =
-      meshopt_computeClusterBounds(idx, count, &mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3));
-  return {b.center[0], b.center[1], b.center[2], b.radius};
-}
 
 // The smallest sphere around both (exact for two spheres).
 glm::vec4 merge(glm::vec4 a, glm::vec4 b) {
@@ -153,21 +151,51 @@ size_t ClusterLod::triangles(uint32_t level) const {
   return n;
 }
 
-ClusterLod buildClusterLod(const Mesh& mesh) {
+std::span<const uint32_t> lodTriangles(const Mesh& mesh, const LodCluster& c) {
+  const size_t base = mesh.indices.size() / 3, first = size_t(c.firstTriangle) * 3, n = size_t(c.triangleCount) * 3;
+  if (c.firstTriangle < base) return {mesh.indices.data() + first, n};
+  return {mesh.lod.indices.data() + (first - base * 3), n};
+}
+
+ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads) {
   ClusterLod lod;
   if (mesh.indices.empty() || mesh.positions.empty()) return lod;
+  if (mesh.clusters.empty()) throw Error("mesh '" + mesh.name + "': a cluster hierarchy needs the mesh's clusters");
   const float scale = meshopt_simplifyScale(&mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3));
   const float epsilon = std::max(scale, 1e-30f) * 1e-7f;  // parents' errors rise at least by this
+  const uint32_t base = mesh.triangleCount();
 
+  // Level 0: the mesh's clusters as they are (the same triangles, ids and bounds the renderer draws).
+  std::vector<Indices> current;
+  std::vector<uint32_t> ids;
+  for (const Cluster& mc : mesh.clusters) {
+    LodCluster c;
+    c.firstTriangle = mc.firstTriangle;
+    c.triangleCount = mc.triangleCount;
+    c.center = mc.center;
+    c.radius = mc.radius;
+    c.coneAxis = mc.coneAxis;
+    c.coneCutoff = mc.coneCutoff;
+    c.sphere = glm::vec4(mc.center, mc.radius);
+    c.parentSphere = c.sphere;
+    c.parentError = shader::LOD_ERROR_INFINITE;
+    ids.push_back(uint32_t(lod.clusters.size()));
+    lod.clusters.push_back(c);
+    const auto* t = mesh.indices.data() + size_t(mc.firstTriangle) * 3;
+    current.emplace_back(t, t + size_t(mc.triangleCount) * 3);
+  }
   auto add = [&](const Indices& tris, uint32_t level, glm::vec4 sphere, float error) {
     LodCluster c;
-    c.firstIndex = uint32_t(lod.indices.size());
+    c.firstTriangle = base + uint32_t(lod.indices.size() / 3);
     c.triangleCount = uint32_t(tris.size() / 3);
     c.level = level;
-    const glm::vec4 own = sphereOf(tris.data(), tris.size(), mesh);
-    c.center = glm::vec3(own);
-    c.radius = own.w;
-    c.sphere = level == 0 ? own : sphere;
+    const meshopt_Bounds b = meshopt_computeClusterBounds(tris.data(), tris.size(), &mesh.positions[0].x,
+                                                          mesh.positions.size(), sizeof(glm::vec3));
+    c.center = {b.center[0], b.center[1], b.center[2]};
+    c.radius = b.radius;
+    c.coneAxis = {b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};
+    c.coneCutoff = backfaceCone ? b.cone_cutoff : 1.0f;
+    c.sphere = sphere;
     c.error = error;
     c.parentSphere = c.sphere;
     c.parentError = shader::LOD_ERROR_INFINITE;
@@ -176,32 +204,44 @@ ClusterLod buildClusterLod(const Mesh& mesh) {
     return uint32_t(lod.clusters.size() - 1);
   };
 
-  std::vector<Indices> current = split(mesh.indices, mesh);
-  std::vector<uint32_t> ids;
-  for (const Indices& c : current) ids.push_back(add(c, 0, {}, 0.0f));
+  lod.levels = 1;
   for (uint32_t level = 1; current.size() > 1; ++level) {
-    std::vector<Indices> next;
-    std::vector<uint32_t> nextIds;
-    for (const std::vector<uint32_t>& g : groupClusters(current)) {
-      if (g.size() < 2) continue;  // alone: nothing around it to share a border with; a root
+    const std::vector<std::vector<uint32_t>> groups = groupClusters(current);
+    // Each group is simplified and split on its own (all cores); the results are taken in group order.
+    struct Result {
+      glm::vec4 sphere{0.0f};
+      float error = 0.0f;
+      std::vector<Indices> clusters;  // empty: the group stays as it is, its clusters roots
+    };
+    std::vector<Result> results(groups.size());
+    parallelFor(groups.size(), threads, [&](size_t gi) {
+      const std::vector<uint32_t>& g = groups[gi];
+      if (g.size() < 2) return;  // alone: nothing around it to share a border with; a root
       Indices tris;
-      glm::vec4 sphere = lod.clusters[ids[g[0]]].sphere;
+      Result& r = results[gi];
+      r.sphere = lod.clusters[ids[g[0]]].sphere;
       float childError = 0.0f;
       for (uint32_t k : g) {
         tris.insert(tris.end(), current[k].begin(), current[k].end());
-        sphere = merge(sphere, lod.clusters[ids[k]].sphere);
+        r.sphere = merge(r.sphere, lod.clusters[ids[k]].sphere);
         childError = std::max(childError, lod.clusters[ids[k]].error);
       }
-      float error = 0.0f;
-      const Indices simpler = simplifyGroup(tris, mesh, error);
-      if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) continue;  // stuck: these stay roots
-      error = std::max(error, childError + epsilon);  // monotone up the hierarchy, strictly
-      for (uint32_t k : g) {
-        lod.clusters[ids[k]].parentError = error;
-        lod.clusters[ids[k]].parentSphere = sphere;
+      const Indices simpler = simplifyGroup(tris, mesh, r.error);
+      if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) return;  // stuck: these stay roots
+      r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
+      r.clusters = split(simpler, mesh);
+    });
+    std::vector<Indices> next;
+    std::vector<uint32_t> nextIds;
+    for (size_t gi = 0; gi < groups.size(); ++gi) {
+      Result& r = results[gi];
+      if (r.clusters.empty()) continue;
+      for (uint32_t k : groups[gi]) {
+        lod.clusters[ids[k]].parentError = r.error;
+        lod.clusters[ids[k]].parentSphere = r.sphere;
       }
-      for (Indices& c : split(simpler, mesh)) {
-        nextIds.push_back(add(c, level, sphere, error));
+      for (Indices& c : r.clusters) {
+        nextIds.push_back(add(c, level, r.sphere, r.error));
         next.push_back(std::move(c));
       }
     }
@@ -210,8 +250,20 @@ ClusterLod buildClusterLod(const Mesh& mesh) {
     current = std::move(next);
     ids = std::move(nextIds);
   }
-  lod.levels = std::max(lod.levels, 1u);
   return lod;
+}
+
+// Meshes one after another, each on all cores (its groups).
+size_t buildMissingClusterLods(Scene& scene, unsigned threads) {
+  size_t n = 0;
+  for (Mesh& m : scene.meshes) {
+    if (m.clusters.empty() || m.lod.levels > 0) continue;
+    const bool cones = m.material >= scene.materials.size() || conesCull(scene.materials[m.material]);
+    m.lod = buildClusterLod(m, cones, threads);
+    if (m.lod.levels < 2) m.lod = {};  // nothing simpler than the mesh: nothing to store
+    else ++n;
+  }
+  return n;
 }
 
 }  // namespace rtr

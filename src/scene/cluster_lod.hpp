@@ -5,35 +5,21 @@
 // simplification that made it and of the one that replaced it, with spheres that bound where the error
 // is, so a view chooses its cut with shaders/shared/cluster_lod.h's rule and no CPU work. No GPU here.
 #include <cstdint>
-#include <vector>
-
-#include <glm/vec3.hpp>
-#include <glm/vec4.hpp>
+#include <span>
 
 #include "scene/scene.hpp"
 
 namespace rtr {
 
-struct LodCluster {
-  uint32_t firstIndex = 0, triangleCount = 0;  // in ClusterLod::indices
-  uint32_t level = 0;                          // 0: the mesh's own triangles
-  glm::vec3 center{0.0f};                      // bounds of its triangles (culling)
-  float radius = 0.0f;
-  glm::vec4 sphere{0.0f};     // where `error` applies (the group that made it; level 0: its own bounds)
-  float error = 0.0f;         // object-space error of the simplification that made it (level 0: 0)
-  glm::vec4 parentSphere{0.0f};
-  float parentError = 0.0f;   // of the simplification that replaced it; LOD_ERROR_INFINITE for a root
-};
+// The hierarchy of `mesh` (positions, indices and its clusters, which become level 0: build them first,
+// scene/clusters.hpp). Deterministic, whatever the thread count (0: one per core). Groups whose
+// simplification cannot remove a sixth of their triangles (locked borders everywhere) stop as roots.
+// `backfaceCone` as buildClusters' (false: the clusters above level 0 get cones that never cull).
+ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone = true, unsigned threads = 0);
+// Builds the hierarchy of every mesh that has clusters and none (rtr-bake); returns how many.
+size_t buildMissingClusterLods(Scene& scene, unsigned threads = 0);
 
-struct ClusterLod {
-  std::vector<uint32_t> indices;  // triangles of every level, cluster by cluster; the mesh's vertices
-  std::vector<LodCluster> clusters;
-  uint32_t levels = 0;
-  size_t triangles(uint32_t level) const;  // of that level's clusters
-};
-
-// The hierarchy of `mesh` (positions and indices). Deterministic. Groups whose simplification cannot
-// remove a sixth of their triangles (locked borders everywhere) stop there as roots.
-ClusterLod buildClusterLod(const Mesh& mesh);
+// The vertex indices of cluster `c`'s triangles: the mesh's own (level 0) or the hierarchy's.
+std::span<const uint32_t> lodTriangles(const Mesh& mesh, const LodCluster& c);
 
 }  // namespace rtr

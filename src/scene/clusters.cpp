@@ -81,7 +81,7 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
   parallelFor(jobs.size(), 0, [&](size_t j) {
     pieces[j] = clusterPiece(*meshes[jobs[j].mesh], jobs[j].first, jobs[j].end, backfaceCone[jobs[j].mesh]);
   });
-  for (Mesh* m : meshes) m->clusters.clear();
+  for (Mesh* m : meshes) m->clusters.clear(), m->lod = {};
   for (size_t j = 0; j < jobs.size(); ++j) {  // pieces in order: every triangle once, in its mesh's place
     Mesh& m = *meshes[jobs[j].mesh];
     std::copy(pieces[j].indices.begin(), pieces[j].indices.end(), m.indices.begin() + jobs[j].first * 3);
@@ -93,6 +93,7 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
 
 void buildClusters(Mesh& mesh, bool backfaceCone) {
   mesh.clusters.clear();
+  mesh.lod = {};  // built over the old triangle order
   if (mesh.indices.empty()) return;
   Mesh* one = &mesh;
   clusterMeshes({&one, 1}, {backfaceCone});

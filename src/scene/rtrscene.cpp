@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -11,6 +12,7 @@
 #include "cluster.h"
 #include "core/bounds.hpp"
 #include "scene/binio.hpp"
+#include "scene/rtrscene_lod.hpp"
 #include "core/parallel.hpp"
 #include "scene/rtrscene_texs.hpp"
 
@@ -349,9 +351,13 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
 }
 
 // Version 6: chunks to the end of the payload. An unknown or repeated tag is refused, named with its offset.
-void readChunks(ByteReader& r, std::span<const uint8_t> bytes, Scene& scene, const std::shared_ptr<const void>& owner,
-                const std::string& file) {
-  bool texs = false;
+// Version 6's chunks after the meshes: TEXS is read here; CLOD refers to the meshes' arrays, so only its
+// place is returned, for reading once they are.
+struct ChunkSpan { size_t at = 0, body = 0; uint64_t size = 0; };
+std::optional<ChunkSpan> readChunks(ByteReader& r, std::span<const uint8_t> bytes, Scene& scene,
+                                    const std::shared_ptr<const void>& owner, const std::string& file) {
+  std::optional<size_t> texs;
+  std::optional<ChunkSpan> clod;
   while (r.remaining() != 0) {
     const size_t at = r.pos();
     char tag[4];
@@ -363,12 +369,19 @@ void readChunks(ByteReader& r, std::span<const uint8_t> bytes, Scene& scene, con
     if (size > r.remaining())
       r.failAt(at + 8, "chunk '" + name + "' of " + std::to_string(size) + " bytes: the file ends after " +
                            std::to_string(r.remaining()));
-    if (name != "TEXS") r.failAt(at, "unknown chunk '" + name + "'");
-    if (texs) r.failAt(at, "chunk '" + name + "' repeated");
-    texs = true;
-    readTexs(r, r.pos() + size, bytes, scene, owner, file);
+    if (name != "TEXS" && name != "CLOD") r.failAt(at, "unknown chunk '" + name + "'");
+    const std::optional<size_t> first = name == "TEXS" ? texs : clod ? std::optional<size_t>(clod->at) : std::nullopt;
+    if (first) r.failAt(at, "chunk '" + name + "' repeated (first at byte " + std::to_string(*first) + ")");
+    if (name == "TEXS") {
+      texs = at;
+      readTexs(r, r.pos() + size, bytes, scene, owner, file);
+    } else {
+      clod = ChunkSpan{at, r.pos(), size};
+      r.skip(size, "a chunk");
+    }
     r.align(kAlign, "a chunk's padding");
   }
+  return clod;
 }
 
 }  // namespace
@@ -512,17 +525,19 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     }
     w.pad(kAlign);
   }
-  // Version 6: chunks, each a 16-byte header {tag, 0, body size}, the body, pad16.
-  if (hasBakedTextures(scene)) {
-    w.bytes("TEXS", 4);
+  // Version 6: chunks, each a 16-byte header {tag, 0, u64 body size}, the body, pad16.
+  const auto chunk = [&w](const char* tag, const auto& writeBody) {
+    const size_t at = w.size();
+    w.bytes(tag, 4);
     w.u32(0);
-    const size_t sizeAt = w.size();
     w.pod(uint64_t(0));
-    writeTexs(w, scene);
-    const uint64_t body = w.size() - sizeAt - 8;
-    std::memcpy(w.data().data() + sizeAt, &body, 8);
+    writeBody();
+    const uint64_t body = w.size() - at - 16;
+    std::memcpy(w.data().data() + at + 8, &body, 8);
     w.pad(kAlign);
-  }
+  };
+  if (hasBakedTextures(scene)) chunk("TEXS", [&] { writeTexs(w, scene); });
+  if (version >= 6 && hasClusterLods(scene)) chunk("CLOD", [&] { writeClusterLods(w, scene); });
   std::string& out = w.data();
   const uint64_t payload = out.size() - kHeaderSize;
   const std::span<const uint8_t> payloadBytes{reinterpret_cast<const uint8_t*>(out.data()) + kHeaderSize, payload};
@@ -734,8 +749,13 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     m.clusters.resize(l.clusters);
   }
   if (version < 6 && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
-  readChunks(r, bytes, scene, owner, file);
+  const std::optional<ChunkSpan> clod = readChunks(r, bytes, scene, owner, file);
   readArrays(bytes, scene, layout, threads, r);
+  if (clod) {
+    ByteReader body(bytes.first(clod->body + clod->size), file);
+    body.skip(clod->body, "a chunk");
+    readClusterLods(body, clod->size, scene);
+  }
   return scene;
 }
 

@@ -12,7 +12,8 @@ namespace rtr {
 
 // 2 added lights, 3 clusters, 4 a checksum summed on all cores (pieceChecksum64), 5 what glTF brings
 // (instances, samplers, uv transforms, more attributes and light kinds), 6 chunks after the version-5
-// layout (TEXS: textures baked as the GPU samples them); versions 1-5 still load.
+// layout (TEXS: textures baked as the GPU samples them; CLOD: the cluster hierarchies); versions 1-5 still
+// load (older writers drop the chunks).
 constexpr uint32_t kRtrSceneVersion = 6;
 
 // `version` below the current one writes an older layout (lights need 2, clusters 3, the checksum of

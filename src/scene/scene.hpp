@@ -106,6 +106,29 @@ struct Cluster {
   float coneCutoff = 1.0f;
 };
 
+// A cluster of a mesh's level-of-detail hierarchy (scene/cluster_lod.hpp, docs/virtual-geometry.md).
+// Its triangles are numbered past the mesh's own: level 0 is the mesh's clusters (Mesh::clusters, the
+// same triangles), and triangle t of ClusterLod::indices is triangle triangleCount() + t of the mesh, so
+// a visibility id names any level's triangle as it names the mesh's.
+struct LodCluster {
+  uint32_t firstTriangle = 0, triangleCount = 0;
+  uint32_t level = 0;                 // 0: the mesh's own triangles
+  glm::vec3 center{0.0f};             // bounds of its triangles (culling)
+  float radius = 0.0f;
+  glm::vec3 coneAxis{0.0f};           // normal cone as Cluster's; cutoff >= 1: none
+  float coneCutoff = 1.0f;
+  glm::vec4 sphere{0.0f};             // where `error` applies (the group that made it; level 0: its bounds)
+  float error = 0.0f;                 // object-space error of the simplification that made it (level 0: 0)
+  glm::vec4 parentSphere{0.0f};
+  float parentError = 0.0f;           // of the simplification that replaced it; LOD_ERROR_INFINITE: a root
+};
+struct ClusterLod {
+  std::vector<uint32_t> indices;      // the triangles of levels 1 and up, cluster by cluster; mesh vertices
+  std::vector<LodCluster> clusters;   // level 0 first (Mesh::clusters' order), then level by level
+  uint32_t levels = 0;                // 0: no hierarchy
+  size_t triangles(uint32_t level) const;  // of that level's clusters
+};
+
 struct Mesh {
   std::string name;  // OBJ object/group name
   uint32_t material = 0;
@@ -118,6 +141,7 @@ struct Mesh {
   std::vector<uint32_t> indices;     // triangle list, local to the mesh
   Bounds bounds;                     // object space (before any instance transform)
   std::vector<Cluster> clusters;     // tile the triangles in order; empty until built (scene/clusters.hpp)
+  ClusterLod lod;                    // the level-of-detail hierarchy; empty: none (scene/cluster_lod.hpp)
 
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
 };

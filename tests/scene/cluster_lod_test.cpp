@@ -8,6 +8,7 @@
 
 #include "cluster_lod.h"
 #include "scene/cluster_lod.hpp"
+#include "scene/clusters.hpp"
 
 namespace rtr {
 namespace {
@@ -35,15 +36,20 @@ Mesh bumpySphere(uint32_t rings, uint32_t segments) {
       m.indices.insert(m.indices.end(), {at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)});
     }
   m.normals = m.positions;
+  buildClusters(m, true);  // level 0 of the hierarchy
   return m;
 }
 
 // The triangles of the cut at `threshold` pixels from `eye` (1000 px / unit: a 60° view ~866 px high).
-std::vector<uint32_t> cut(const ClusterLod& lod, glm::vec3 eye, float threshold) {
+std::vector<uint32_t> cut(const Mesh& m, const ClusterLod& lod, glm::vec3 eye, float threshold) {
+  Mesh withLod = m;
+  withLod.lod = lod;
   std::vector<uint32_t> tris;
   for (const LodCluster& c : lod.clusters)
-    if (shader::lodSelected(c.sphere, c.error, c.parentSphere, c.parentError, eye, 1000.0f, 0.01f, threshold))
-      tris.insert(tris.end(), lod.indices.begin() + c.firstIndex, lod.indices.begin() + c.firstIndex + c.triangleCount * 3);
+    if (shader::lodSelected(c.sphere, c.error, c.parentSphere, c.parentError, eye, 1000.0f, 0.01f, threshold)) {
+      const std::span<const uint32_t> t = lodTriangles(withLod, c);
+      tris.insert(tris.end(), t.begin(), t.end());
+    }
   return tris;
 }
 
@@ -71,7 +77,7 @@ TEST(ClusterLod, LevelsHalveAndStayWithinTheMemoryBound) {
     EXPECT_LT(lod.triangles(l), lod.triangles(l - 1) * 0.75) << "level " << l;
     if (l + 1 < lod.levels) EXPECT_GT(lod.triangles(l), lod.triangles(l - 1) * 0.3) << "level " << l;
   }
-  EXPECT_LE(lod.indices.size(), m.indices.size() * 5 / 2);  // the hierarchy <= 2.5x the base triangles
+  EXPECT_LE(m.indices.size() + lod.indices.size(), m.indices.size() * 5 / 2);  // all levels <= 2.5x the mesh
 }
 
 TEST(ClusterLod, ErrorsAndSpheresGrowUpTheHierarchy) {
@@ -98,7 +104,7 @@ TEST(ClusterLod, ErrorsAndSpheresGrowUpTheHierarchy) {
 TEST(ClusterLod, ThresholdZeroIsTheMeshItself) {
   const Mesh m = bumpySphere(40, 80);
   const ClusterLod lod = buildClusterLod(m);
-  std::vector<uint32_t> tris = cut(lod, {0, 0, 5}, 0.0f);
+  std::vector<uint32_t> tris = cut(m, lod, {0, 0, 5}, 0.0f);
   auto sorted = [](std::vector<uint32_t> t) {
     std::vector<std::array<uint32_t, 3>> v;
     for (size_t i = 0; i < t.size(); i += 3) {
@@ -119,7 +125,7 @@ TEST(ClusterLod, EveryCutOfAClosedMeshIsClosed) {
   size_t fewest = m.indices.size();
   for (glm::vec3 eye : {glm::vec3(0, 0, 3), glm::vec3(0, 0, 30), glm::vec3(2, 1, 0), glm::vec3(0, 200, 0)})
     for (float threshold : {0.25f, 1.0f, 4.0f, 32.0f}) {
-      const std::vector<uint32_t> tris = cut(lod, eye, threshold);
+      const std::vector<uint32_t> tris = cut(m, lod, eye, threshold);
       EXPECT_EQ(openEdges(tris), 0u) << "eye " << eye.x << "," << eye.y << "," << eye.z << " threshold " << threshold;
       fewest = std::min(fewest, tris.size());
     }

@@ -134,7 +134,7 @@ size_t find(const std::string& bytes, std::initializer_list<float> values) {
 TEST(RtrSceneV5, KeepsEverythingTheSceneModelHolds) {
   const Scene want = rich();
   const std::string bytes = encodeRtrScene(want);
-  EXPECT_EQ(bytes[8], 6);  // the current version: the version-5 layout, no chunks for this scene
+  EXPECT_EQ(bytes[8], kRtrSceneVersion);
   EXPECT_EQ(bytes.size() % 16, 0u);
   for (unsigned threads : {1u, 3u}) {
     const Scene got = decodeRtrScene(span(bytes), "v5.rtrscene", threads);

@@ -1,6 +1,8 @@
 // scenegen: writes the default scene, a temple courtyard standing in for Sun Temple (which cannot be
 // shipped): zstd OBJ + MTL with the Sun Temple keys + generated PNGs of every PNG type and odd sizes.
 // --scale N refines the tessellation for benchmarks (N = 100 gives about 1.6M vertices).
+// --instances N also bakes temple-grid.rtrscene: N instances of the temple in a grid (rtr-bake's work,
+// cluster hierarchy included; each mesh stored once, placed N times).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -11,8 +13,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "bake.hpp"
+#include "core/atomic_file.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
+#include "scene/rtrscene.hpp"
 #include "objwriter.hpp"
 #include "png.hpp"
 
@@ -151,6 +158,26 @@ void writeTextureSet(const fs::path& dir, int count, ObjWriter& o, std::ofstream
   }
 }
 
+// The temple baked (textures into temple-grid-tex/), then placed `count` times in a square grid, one
+// instance per (cell, mesh), each cell a temple's width and a margin from the next.
+void bakeGrid(const fs::path& dir, const fs::path& obj, int count) {
+  const fs::path out = dir / "temple-grid.rtrscene";
+  rtr::BakeOptions bo;
+  bo.input = obj;
+  bo.output = out;
+  bo.force = true;
+  bo.view = rtr::CameraPose{{0, 2.2f, -2.5f}, 0, -3};
+  rtr::bake(bo);
+  rtr::Scene s = rtr::loadRtrScene(out);
+  const rtr::Bounds b = s.bounds();
+  const glm::vec3 step = b.max - b.min + glm::vec3(4.0f);
+  const int cols = int(std::ceil(std::sqrt(double(count))));
+  for (int i = 0; i < count; ++i)
+    for (uint32_t m = 0; m < s.meshes.size(); ++m)
+      s.instances.push_back({m, glm::translate(glm::mat4(1.0f), glm::vec3(step.x * (i % cols), 0, -step.z * (i / cols)))});
+  rtr::writeFileAtomic(out, rtr::encodeRtrScene(s));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -164,6 +191,9 @@ int main(int argc, char** argv) {
       ->check(rtr::cli::integer(0, 10000));
   app.add_option("--scale", scale, "tessellation factor (100: about 1.6M vertices)")->check(rtr::cli::number(0.05, 10000.0));
   app.add_flag("--plain", plain, "write temple.obj instead of temple.obj.zst");
+  int instances = 0;
+  app.add_option("--instances", instances, "also bake temple-grid.rtrscene: N instances of the temple in a grid")
+      ->check(rtr::cli::integer(0, 1000000));
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     const fs::path dir = out;
@@ -221,6 +251,10 @@ int main(int argc, char** argv) {
     }
     o.finish();
     std::printf("wrote %s: %zu OBJ vertices (v records)\n", dir.c_str(), o.vertices());
+    if (instances > 0) {
+      bakeGrid(dir, dir / (plain ? "temple.obj" : "temple.obj.zst"), instances);
+      std::printf("wrote %s: %d instances of the temple\n", (dir / "temple-grid.rtrscene").c_str(), instances);
+    }
   } catch (const std::exception& e) {
     return rtr::cli::fail("scenegen", e);
   }

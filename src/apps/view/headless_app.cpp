@@ -191,8 +191,9 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     if (const auto c = renderer.renderer().cullStats(0)) {
       const double n = std::max(1u, c->clusters);
       std::printf("cull: %u clusters; listed early %u, late %u; culled by frustum %u (%.1f %%), cone %u (%.1f %%), "
-                  "occlusion %u (%.1f %%)\n", c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone,
-                  100 * c->cone / n, c->occlusion, 100 * c->occlusion / n);
+                  "occlusion %u (%.1f %%), not in the level-of-detail cut %u; %u triangles listed\n", c->clusters, c->early,
+                  c->late, c->frustum, 100 * c->frustum / n, c->cone, 100 * c->cone / n, c->occlusion,
+                  100 * c->occlusion / n, c->lod, c->triangles);
     }
   }
   if (!o.screenshot.empty()) {

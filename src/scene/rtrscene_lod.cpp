@@ -1,0 +1,147 @@
+#include "scene/rtrscene_lod.hpp"
+
+#include <cmath>
+
+#include "cluster.h"
+#include "cluster_lod.h"
+
+namespace rtr {
+namespace {
+
+constexpr size_t kClusterSize = 96, kMeshSize = 16, kMaxLevels = 64;
+
+void vec4(ByteWriter& w, glm::vec4 v) {
+  for (int k = 0; k < 4; ++k) w.f32(v[k]);
+}
+
+}  // namespace
+
+bool hasClusterLods(const Scene& scene) {
+  for (const Mesh& m : scene.meshes)
+    if (m.lod.levels > 0) return true;
+  return false;
+}
+
+void writeClusterLods(ByteWriter& w, const Scene& scene) {
+  uint32_t meshes = 0;
+  for (const Mesh& m : scene.meshes) meshes += m.lod.levels > 0;
+  w.u32(meshes);
+  w.data().append(12, '\0');
+  for (uint32_t i = 0; i < scene.meshes.size(); ++i) {
+    const ClusterLod& lod = scene.meshes[i].lod;
+    if (lod.levels == 0) continue;
+    for (uint32_t v : {i, lod.levels, uint32_t(lod.clusters.size()), uint32_t(lod.indices.size())}) w.u32(v);
+    for (const LodCluster& c : lod.clusters) {  // 96 bytes each
+      for (uint32_t v : {c.firstTriangle, c.triangleCount, c.level}) w.u32(v);
+      w.f32(c.error);
+      vec4(w, glm::vec4(c.center, c.radius));
+      vec4(w, glm::vec4(c.coneAxis, c.coneCutoff));
+      vec4(w, c.sphere);
+      vec4(w, c.parentSphere);
+      w.f32(c.parentError);
+      w.data().append(12, '\0');
+    }
+    w.array(lod.indices);
+    w.pad(16);
+  }
+}
+
+void readClusterLods(ByteReader& r, uint64_t size, Scene& scene) {
+  const size_t end = r.pos() + size;
+  auto left = [&] { return end - r.pos(); };
+  auto finite = [&](const char* what) {
+    const size_t at = r.pos();
+    const float f = r.f32(what);
+    if (!std::isfinite(f)) r.failAt(at, std::string("CLOD chunk: ") + what + " is not finite");
+    return f;
+  };
+  auto vec4 = [&](const char* what) {
+    glm::vec4 v;
+    for (int k = 0; k < 4; ++k) v[k] = finite(what);
+    return v;
+  };
+  if (size < 16) r.fail("CLOD chunk: " + std::to_string(size) + " bytes, shorter than its 16-byte header");
+  const size_t countAt = r.pos();
+  const uint32_t meshes = r.u32("the CLOD chunk");
+  for (int k = 0; k < 3; ++k)
+    if (r.u32("the CLOD chunk") != 0) r.failAt(countAt + 4, "CLOD chunk: reserved field is not 0");
+  if (uint64_t(meshes) * kMeshSize > left()) r.failAt(countAt, "CLOD chunk: mesh count " + std::to_string(meshes) + " cannot fit in it");
+  int64_t last = -1;
+  for (uint32_t n = 0; n < meshes; ++n) {
+    const size_t at = r.pos();
+    if (left() < kMeshSize) r.fail("CLOD chunk: ends inside a mesh record");
+    const uint32_t mi = r.u32("a CLOD mesh"), levels = r.u32("a CLOD mesh"), count = r.u32("a CLOD mesh"),
+                   indexCount = r.u32("a CLOD mesh");
+    if (int64_t(mi) <= last || mi >= scene.meshes.size())
+      r.failAt(at, "CLOD chunk: mesh " + std::to_string(mi) + " out of range or not after mesh " + std::to_string(last) +
+                       " (" + std::to_string(scene.meshes.size()) + " meshes)");
+    last = mi;
+    Mesh& m = scene.meshes[mi];
+    const std::string which = "CLOD chunk: mesh " + std::to_string(mi) + ": ";
+    const size_t base = m.clusters.size();
+    if (levels < 1 || levels > kMaxLevels) r.failAt(at + 4, which + "level count " + std::to_string(levels) + " not in 1..64");
+    if (base == 0 || count < base) r.failAt(at + 8, which + std::to_string(count) + " clusters, fewer than its " + std::to_string(base) + " own");
+    if (indexCount % 3 != 0) r.failAt(at + 12, which + "index count " + std::to_string(indexCount) + " is not a multiple of 3");
+    if ((uint64_t(count) * kClusterSize + uint64_t(indexCount) * 4) > left())
+      r.failAt(at + 8, which + std::to_string(count) + " clusters and " + std::to_string(indexCount) + " indices cannot fit in the chunk");
+    ClusterLod& lod = m.lod;
+    lod.levels = levels;
+    lod.clusters.resize(count);
+    const uint32_t triangles = m.triangleCount();
+    uint64_t next = triangles;  // where the next cluster above level 0 starts
+    for (uint32_t k = 0; k < count; ++k) {
+      const size_t cAt = r.pos();
+      const std::string cl = which + "cluster " + std::to_string(k) + ": ";
+      LodCluster& c = lod.clusters[k];
+      c.firstTriangle = r.u32("a CLOD cluster");
+      c.triangleCount = r.u32("a CLOD cluster");
+      c.level = r.u32("a CLOD cluster");
+      c.error = finite("a cluster's error");
+      const glm::vec4 bounds = vec4("a cluster's sphere"), cone = vec4("a cluster's cone");
+      c.center = glm::vec3(bounds);
+      c.radius = bounds.w;
+      c.coneAxis = glm::vec3(cone);
+      c.coneCutoff = cone.w;
+      c.sphere = vec4("a cluster's error sphere");
+      c.parentSphere = vec4("a cluster's parent sphere");
+      c.parentError = finite("a cluster's parent error");
+      for (int z = 0; z < 3; ++z)
+        if (r.u32("a CLOD cluster") != 0) r.failAt(cAt + 84, cl + "reserved field is not 0");
+      if (k < base) {  // level 0: the mesh's own clusters
+        const Cluster& own = m.clusters[k];
+        if (c.level != 0 || c.firstTriangle != own.firstTriangle || c.triangleCount != own.triangleCount || c.error != 0.0f)
+          r.failAt(cAt, cl + "level 0 must be the mesh's cluster " + std::to_string(k) + " with error 0");
+      } else {
+        const uint32_t prev = lod.clusters[k - 1].level;
+        if (c.level < std::max(prev, 1u) || c.level >= levels)
+          r.failAt(cAt + 8, cl + "level " + std::to_string(c.level) + " not in " + std::to_string(std::max(prev, 1u)) + ".." +
+                                std::to_string(levels - 1));
+        if (c.firstTriangle != next)
+          r.failAt(cAt, cl + "first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
+                            " (clusters tile the hierarchy's triangles in order)");
+        if (c.triangleCount < 1 || c.triangleCount > CLUSTER_MAX_TRIANGLES || next + c.triangleCount > triangles + indexCount / 3)
+          r.failAt(cAt + 4, cl + "triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
+                                std::to_string(CLUSTER_MAX_TRIANGLES) + " or past the hierarchy's triangles");
+        next += c.triangleCount;
+      }
+      if (!(c.radius >= 0.0f && c.sphere.w >= 0.0f && c.parentSphere.w >= 0.0f && c.error >= 0.0f))
+        r.failAt(cAt + 12, cl + "negative radius or error");
+      if (!(c.parentError > c.error) || c.parentError > shader::LOD_ERROR_INFINITE)
+        r.failAt(cAt + 80, cl + "parent error not above its own error");
+      if (c.coneCutoff < 1.0f && (c.coneCutoff < 0.0f || std::abs(glm::length(c.coneAxis) - 1.0f) > 1e-3f))
+        r.failAt(cAt + 32, cl + "cone axis not a unit vector or cutoff below 0");
+    }
+    if (next != uint64_t(triangles) + indexCount / 3)
+      r.failAt(at + 12, which + std::to_string(indexCount / 3) + " triangles, but its clusters hold " + std::to_string(next - triangles));
+    const size_t iAt = r.pos();
+    r.array(lod.indices, indexCount, "CLOD indices");
+    for (size_t k = 0; k < lod.indices.size(); ++k)
+      if (lod.indices[k] >= m.positions.size())
+        r.failAt(iAt + 4 * k, which + "index " + std::to_string(lod.indices[k]) + " out of range (" +
+                                  std::to_string(m.positions.size()) + " vertices)");
+    r.align(16, "CLOD indices");
+  }
+  if (r.pos() != end) r.fail("CLOD chunk: " + std::to_string(end - r.pos()) + " bytes after its last mesh");
+}
+
+}  // namespace rtr
