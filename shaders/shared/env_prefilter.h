@@ -45,27 +45,14 @@ RTR_FN vec2 envHammersley(uint i, uint n) {
   return vec2(float(i) / float(n), float(b) * 2.3283064365386963e-10f);
 }
 
-// A GGX half vector (alpha = roughness²) drawn in proportion to D(h) (h.n), in the frame whose z is n; its
-// density per solid angle of h is D · n.h, with brdf.h's brdfGgxD.
-RTR_FN vec3 envGgxHalf(vec2 u, float alpha) {
-  float phi = 2.0f * BRDF_PI * u.x;
-  float cos2 = (1.0f - u.y) / (1.0f + (alpha * alpha - 1.0f) * u.y);
-  float c = sqrt(cos2), s = sqrt(max(1.0f - cos2, 0.0f));
-  return vec3(s * cos(phi), s * sin(phi), c);
-}
+// A GGX half vector about +z from a Hammersley pair (alpha = roughness²), density D · n.h per solid
+// angle of h: brdf.h's sampling, with the pair's radical inverse picking the angle from n.
+RTR_FN vec3 envGgxHalf(vec2 u, float alpha) { return brdfSampleHalfLocal(BRDF_GGX, vec2(u.y, u.x), alpha); }
 
 // Any unit vector t perpendicular to n, and b = n x t: the frame envGgxHalf's vectors are given in.
 RTR_FN vec3 envTangent(vec3 n) {
   vec3 up = abs(n.z) < 0.999f ? vec3(0.0f, 0.0f, 1.0f) : vec3(1.0f, 0.0f, 0.0f);
   return normalize(cross(up, n));
-}
-
-// A Beckmann half vector (alpha = roughness²) drawn in proportion to D(h) (h.n): tan²θ = -alpha² ln(1 - u).
-RTR_FN vec3 envBeckmannHalf(vec2 u, float alpha) {
-  float phi = 2.0f * BRDF_PI * u.x;
-  float t2 = -alpha * alpha * log(max(1.0f - u.y, 1e-30f));
-  float c = 1.0f / sqrt(1.0f + t2), s = sqrt(max(1.0f - c * c, 0.0f));
-  return vec3(s * cos(phi), s * sin(phi), c);
 }
 
 // One texel of the split-sum table for BRDF `brdf` (brdf.h's BRDF_BECKMANN or BRDF_GGX): for view angle
@@ -83,7 +70,7 @@ RTR_FN vec3 envBrdfLut(int brdf, float nv, float roughness, uint samples) {
   float a = 0.0f, b = 0.0f, cw = 0.0f;
   for (uint i = 0u; i < samples; ++i) {
     vec2 u = envHammersley(i, samples);
-    vec3 h = brdf == BRDF_GGX ? envGgxHalf(u, alpha) : envBeckmannHalf(u, alpha);
+    vec3 h = brdfSampleHalfLocal(brdf, vec2(u.y, u.x), alpha);
     float vh = dot(v, h);
     vec3 l = 2.0f * vh * h - v;
     float nl = l.z, nh = h.z;

@@ -163,12 +163,14 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
 }
 
 void Renderer::writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout) const {
-  if (!env_ || !hasBinding(layout, 0, 20)) return;
+  if (!env_) return;
+  // Each binding where the variant kept it (specialization drops what its code does not read: the
+  // forward shader has no backdrop, so no source cube).
   constexpr VkImageLayout kRead = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  w.image(20, env_->specular().view(), kRead, env_->sampler())
-      .image(21, env_->brdfLut().view(), kRead, env_->sampler())
-      .buffer(22, env_->sh())
-      .image(23, env_->source().view(), kRead, env_->sampler());
+  if (hasBinding(layout, 0, 20)) w.image(20, env_->specular().view(), kRead, env_->sampler());
+  if (hasBinding(layout, 0, 21)) w.image(21, env_->brdfLut().view(), kRead, env_->sampler());
+  if (hasBinding(layout, 0, 22)) w.buffer(22, env_->sh());
+  if (hasBinding(layout, 0, 23)) w.image(23, env_->source().view(), kRead, env_->sampler());
 }
 
 void Renderer::setEnvironment(std::shared_ptr<const EnvironmentMaps> env) {

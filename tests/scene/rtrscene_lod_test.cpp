@@ -121,7 +121,7 @@ TEST(RtrSceneLod, DamageIsRefusedWithItsOffset) {
       {above + 80, 0, "byte " + std::to_string(above + 80) + ": " + c + k + ": parent error not above"},
       {cluster0 + 96 * s.meshes[0].lod.clusters.size(), 0x00FFFFFF, "CLOD chunk: mesh 0: index 16777215 out of range"},
       {body - 16, 0x54584554 /* "TEXT" */, "byte " + std::to_string(body - 16) + ": unknown chunk 'TEXT'"},
-      {body - 8, 1u << 30, "byte " + std::to_string(body - 8) + ": chunk 'CLOD': 1073741824 bytes"},
+      {body - 8, 1u << 30, "byte " + std::to_string(body - 8) + ": chunk 'CLOD' of 1073741824 bytes: the file ends after"},
   };
   for (const Case& e : cases) {
     std::string bad = good;
