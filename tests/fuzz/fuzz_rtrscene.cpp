@@ -23,9 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::vector<uint8_t> chain(t.baked->bytes());
     try {
       for (size_t k = 0; k < t.baked->pieces.size(); ++k) unpackBakedPiece(*t.baked, k, chain.data());
-    } catch (const Error& e) {
-      fuzz::requireNamesFile(e, "fuzz.rtrscene");
-    }
+    } catch (const Error& e) { fuzz::requireNamesFile(e, "fuzz.rtrscene"); }
   }
   std::string once, twice;
   try {
