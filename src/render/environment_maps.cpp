@@ -176,3 +176,21 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
 }
 
 }  // namespace rtr::render
+
+namespace rtr::render {
+
+void writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout, const EnvironmentMaps* env) {
+  if (!env) return;
+  const auto has = [&layout](uint32_t binding) {
+    for (const vk::ReflectedBinding& b : layout.interface().bindings)
+      if (b.set == 0 && b.binding == binding) return true;
+    return false;
+  };
+  constexpr VkImageLayout kRead = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  if (has(20)) w.image(20, env->specular().view(), kRead, env->sampler());
+  if (has(21)) w.image(21, env->brdfLut().view(), kRead, env->sampler());
+  if (has(22)) w.buffer(22, env->sh());
+  if (has(23)) w.image(23, env->source().view(), kRead, env->sampler());
+}
+
+}  // namespace rtr::render

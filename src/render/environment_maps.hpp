@@ -11,7 +11,11 @@
 #include "scene/environment.hpp"
 #include "vk/resources.hpp"
 
-namespace rtr::vk { class Context; }
+namespace rtr::vk {
+class Context;
+class DescriptorWriter;
+class PipelineLayout;
+}  // namespace rtr::vk
 
 namespace rtr::render {
 
@@ -46,5 +50,9 @@ class EnvironmentMaps {
   vk::Sampler sampler_;
   std::vector<std::pair<std::string, double>> times_;
 };
+
+// Writes `env`'s maps to set 0, bindings 20-23 (shaders/env_light.glsl), each where `layout` has it
+// (specialization drops what a variant does not read); nothing without an environment.
+void writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout, const EnvironmentMaps* env);
 
 }  // namespace rtr::render

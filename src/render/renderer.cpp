@@ -116,7 +116,7 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
     const VkBuffer streams[] = {scene_.drawInfo(), scene_.texcoords1(), scene_.tangents(), scene_.colors()};
     for (uint32_t b = 3; b <= 6; ++b)
       if (hasBinding(layout, 0, b)) w.buffer(b, streams[b - 3] ? streams[b - 3] : scene_.positions());
-    writeEnvironment(w, layout);
+    writeEnvironment(w, layout, env_.get());
     w.commit();
     if (layout.setCount() > 1) writeTextures(layout, p.sets.get(1, frame));
   }
@@ -162,16 +162,6 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
   return v;
 }
 
-void Renderer::writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout) const {
-  if (!env_) return;
-  // Each binding where the variant kept it (specialization drops what its code does not read: the
-  // forward shader has no backdrop, so no source cube).
-  constexpr VkImageLayout kRead = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  if (hasBinding(layout, 0, 20)) w.image(20, env_->specular().view(), kRead, env_->sampler());
-  if (hasBinding(layout, 0, 21)) w.image(21, env_->brdfLut().view(), kRead, env_->sampler());
-  if (hasBinding(layout, 0, 22)) w.buffer(22, env_->sh());
-  if (hasBinding(layout, 0, 23)) w.image(23, env_->source().view(), kRead, env_->sampler());
-}
 
 void Renderer::setEnvironment(std::shared_ptr<const EnvironmentMaps> env) {
   VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
@@ -179,6 +169,11 @@ void Renderer::setEnvironment(std::shared_ptr<const EnvironmentMaps> env) {
   pipelines_[kShaded].reset();
   shade_ = {};
   backdrop_.reset();
+  if (transparency_) {  // blended surfaces are lit by the environment too
+    transparency_.reset();
+    transparency_.emplace(ctx_, scene_, env_.get());
+    for (const auto& [layout, set] : transparency_->textureSets()) writeTextures(*layout, set);
+  }
 }
 
 void Renderer::backdropPass(VkCommandBuffer cb) {
@@ -188,7 +183,7 @@ void Renderer::backdropPass(VkCommandBuffer cb) {
   backdrop_->bind(cb);
   vk::DescriptorWriter w(ctx_, backdrop_->layout, 0, VK_NULL_HANDLE);
   w.buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms)).image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
-  writeEnvironment(w, backdrop_->layout);
+  writeEnvironment(w, backdrop_->layout, env_.get());
   w.push(cb, *backdrop_);
   backdrop_->dispatch(cb, extent_.width, extent_.height);
 }
@@ -211,7 +206,7 @@ void Renderer::rebuildPipelines() {
   std::optional<vk::Pipeline> backdrop;
   if (backdrop_) backdrop.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
   std::optional<TransparencyPass> transparency;
-  if (transparency_) transparency.emplace(ctx_, scene_);
+  if (transparency_) transparency.emplace(ctx_, scene_, env_.get());
   vkDeviceWaitIdle(ctx_.device());
   pipelines_ = std::move(fresh);
   shade_ = std::move(shade);
@@ -334,7 +329,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(10, scene_.instances())
       .buffer(13, scene_.colors() ? scene_.colors() : scene_.positions())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
-  writeEnvironment(w, c.layout);
+  writeEnvironment(w, c.layout, env_.get());
   if (raster == RasterPath::Compute) w.buffer(14, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   if (hasBinding(c.layout, 0, 9)) {  // the textured variant's

@@ -141,7 +141,6 @@ class Renderer {
                               std::vector<vk::SpecializationConstant> variant) const;
   KindPipelines makePipelines(PipelineSet set) const;
   VisShade makeShade(bool fromBuffer) const;
-  void writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout) const;  // bindings 20-23
   void backdropPass(VkCommandBuffer cb);
   void ensurePipelines(PipelineSet set);
   void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye, const glm::vec3& background,

@@ -20,7 +20,8 @@ std::vector<const BlendDraw*> farthestFirst(std::span<const BlendDraw> draws, co
   return order;
 }
 
-TransparencyPass::TransparencyPass(const vk::Context& ctx, const GpuScene& scene) : ctx_(ctx), scene_(scene) {
+TransparencyPass::TransparencyPass(const vk::Context& ctx, const GpuScene& scene, const EnvironmentMaps* env)
+    : ctx_(ctx), scene_(scene), env_(env) {
   std::vector<std::function<void()>> jobs;
   for (size_t v = 0; v < variants_.size(); ++v) {
     const bool textured = v >= 2, doubleSided = v % 2;
@@ -29,7 +30,7 @@ TransparencyPass::TransparencyPass(const vk::Context& ctx, const GpuScene& scene
     jobs.push_back([this, textured, doubleSided, &slot = variants_[v]] {
       vk::GraphicsDesc d;
       d.modules = {vk::loadShader("scene.vert"), vk::loadShader("pbr.frag")};  // the forward shading, BLEND variant
-      d.specialization = {{VARIANT_TEXCOORDS, textured}, {VARIANT_BLEND, 1}};
+      d.specialization = {{VARIANT_TEXCOORDS, textured}, {VARIANT_BLEND, 1}, {VARIANT_ENV, env_ != nullptr}};
       d.cullMode = doubleSided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT;
       d.dynamicFrontFace = true;  // mirrored instances' front faces are clockwise
       d.depthWrite = false;
@@ -95,6 +96,7 @@ void TransparencyPass::record(VkCommandBuffer cb, const vk::UploadArena::Slice& 
       const VkBuffer streams[] = {scene_.drawInfo(), scene_.texcoords1(), scene_.tangents(), scene_.colors(),
                                   opaqueIds ? opaqueIds : scene_.positions()};
       for (uint32_t b = 3; b <= 7; ++b) w.buffer(b, streams[b - 3] ? streams[b - 3] : scene_.positions());
+      writeEnvironment(w, pl.layout, env_);
       w.push(cb, pl);
       if (pl.layout.setCount() > 1) pl.bindSet(cb, 1, v.textures.get(1));
       vkCmdBindVertexBuffers(cb, 0, bd->textured ? 3 : 2, forward, offsets);

@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "render/environment_maps.hpp"
 #include "render/gpu_scene.hpp"
 #include "vk/frame_ring.hpp"
 #include "vk/pipeline.hpp"
@@ -20,7 +21,8 @@ std::vector<const BlendDraw*> farthestFirst(std::span<const BlendDraw> draws, co
 
 class TransparencyPass {
  public:
-  TransparencyPass(const vk::Context& ctx, const GpuScene& scene);
+  // `env`: the environment the shaded view adds (kept by the renderer while the pass lives), or null.
+  TransparencyPass(const vk::Context& ctx, const GpuScene& scene, const EnvironmentMaps* env = nullptr);
 
   // Records the pass over `color` (left a colour attachment). `opaqueIds`: the compute rasteriser's
   // buffer (row length extent.width) when it drew the opaque surfaces, else null: `depth` holds their depth.
@@ -36,6 +38,7 @@ class TransparencyPass {
   };
   const vk::Context& ctx_;
   const GpuScene& scene_;
+  const EnvironmentMaps* env_;
   std::array<Variant, 4> variants_;
 };
 

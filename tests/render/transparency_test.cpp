@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "core/image.hpp"
+#include "render/environment_maps.hpp"
 #include "render/headless.hpp"
 #include "render/transparency.hpp"
 #include "vk_fixture.hpp"
@@ -82,6 +83,42 @@ TEST_F(VulkanTest, BlendedQuadsCompositeFarthestFirstInEveryPath) {
       for (int c = 0; c < 3; ++c)
         EXPECT_NEAR(px[c], std::lround(linearToSrgb(p.want[c]) * 255.0f), 1) << p.what << ", channel " << c;
     }
+  }
+}
+
+// With an environment, blended surfaces get its light as the opaque ones do (the pass's HAS_ENV variant):
+// a white half-transparent quad, lit by nothing but uniform radiance 1, over an unlit grey 0.2. Without the
+// environment's term the quad adds nothing (c = 0.5 · 0 + 0.5 · 0.2); with it, it reflects its albedo
+// (about 1 at normal view in the white furnace), so c ≈ 0.5 · 1 + 0.5 · 0.2 = 0.6.
+TEST_F(VulkanTest, BlendedSurfacesAreLitByTheEnvironment) {
+  Scene scene;
+  Material white;
+  white.flags = kMaterialGltf | kMaterialBlend;
+  white.baseColor = glm::vec3(1.0f);
+  white.opacity = 0.5f;
+  white.roughness = 0.5f;
+  scene.materials = {unlit(glm::vec3(0.2f), 1, false), white};
+  scene.meshes = {quad(-5, 5, -5, 5, -1.0f, 0), quad(-1.0f, 1.0f, -1.0f, 1.0f, 0.0f, 1)};
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  render::HeadlessRenderer r(*ctx, gpu, {kSize, kSize});
+  ImageF uniform{64, 32, std::vector<glm::vec4>(64 * 32, glm::vec4(1.0f))};
+  r.renderer().setEnvironment(std::make_shared<const render::EnvironmentMaps>(*ctx, Environment(std::move(uniform), 1.0f, 0.0f)));
+  render::RenderSettings s;
+  s.mosaic = render::MosaicMode::Off;
+  s.lights = {};  // no light, no ambient: only the environment
+  Lens lens;
+  lens.fovYDeg = 90.0f;
+  for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
+                              {render::ShadingPath::Visibility, render::RasterPath::Compute}}) {
+    SCOPED_TRACE(testing::Message() << enumName(path) << ", " << enumName(raster));
+    s.shading = path;
+    s.raster = raster;
+    const ImageRGBA8 img = r.render(CameraPose{{0, 0, 2.0f}, 0.0f, 0.0f}, lens, s).image;
+    const float centre = srgbToLinear(img.at(kSize / 2, kSize / 2)[1] / 255.0f);
+    const float outside = srgbToLinear(img.at(2, 2)[1] / 255.0f);
+    EXPECT_NEAR(outside, 0.2f, 0.01f) << "the unlit grey behind";
+    EXPECT_GT(centre, 0.45f) << "the quad reflects the environment (0.1 would be no light at all)";
+    EXPECT_LT(centre, 0.65f);
   }
 }
 
