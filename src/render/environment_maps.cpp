@@ -181,11 +181,7 @@ namespace rtr::render {
 
 void writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout, const EnvironmentMaps* env) {
   if (!env) return;
-  const auto has = [&layout](uint32_t binding) {
-    for (const vk::ReflectedBinding& b : layout.interface().bindings)
-      if (b.set == 0 && b.binding == binding) return true;
-    return false;
-  };
+  const auto has = [&layout](uint32_t binding) { return layout.hasBinding(0, binding); };
   constexpr VkImageLayout kRead = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   if (has(20)) w.image(20, env->specular().view(), kRead, env->sampler());
   if (has(21)) w.image(21, env->brdfLut().view(), kRead, env->sampler());

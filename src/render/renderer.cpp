@@ -30,12 +30,6 @@ constexpr KindInfo kKinds[kDrawKindCount] = {
 constexpr const char* kSceneVert = "scene.vert";
 constexpr const char* kFrag[] = {"pbr.frag", "debug.frag"};  // by PipelineSet: kShaded, kDebug
 
-bool hasBinding(const vk::PipelineLayout& layout, uint32_t set, uint32_t binding) {
-  for (const vk::ReflectedBinding& b : layout.interface().bindings)
-    if (b.set == set && b.binding == binding) return true;
-  return false;
-}
-
 }  // namespace
 
 std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const glm::vec3& eye) {
@@ -110,12 +104,12 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
     if (layout.setCount() == 0) break;
     // Binding 0 (the uniforms) is written per frame: they live in the frame's upload arena.
     vk::DescriptorWriter w(ctx_, layout, 0, p.sets.get(0, frame));
-    if (hasBinding(layout, 0, 1)) w.buffer(1, scene_.materials());
-    if (hasBinding(layout, 0, 2)) w.buffer(2, scene_.instances());
+    if (layout.hasBinding(0, 1)) w.buffer(1, scene_.materials());
+    if (layout.hasBinding(0, 2)) w.buffer(2, scene_.instances());
     // glTF's streams (a scene without one: any buffer fills the binding; the draw's flags say none).
     const VkBuffer streams[] = {scene_.drawInfo(), scene_.texcoords1(), scene_.tangents(), scene_.colors()};
     for (uint32_t b = 3; b <= 6; ++b)
-      if (hasBinding(layout, 0, b)) w.buffer(b, streams[b - 3] ? streams[b - 3] : scene_.positions());
+      if (layout.hasBinding(0, b)) w.buffer(b, streams[b - 3] ? streams[b - 3] : scene_.positions());
     writeEnvironment(w, layout, env_.get());
     w.commit();
     if (layout.setCount() > 1) writeTextures(layout, p.sets.get(1, frame));
@@ -279,7 +273,7 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
   // This frame index's sets are not in use (its previous frame's fence signalled): point them at this
   // frame's uniforms, once each, before any is bound (kinds may share a pipeline).
   for (ScenePipelines& p : pipelines)
-    if (p.pipeline && hasBinding(p.pipeline->layout, 0, 0))
+    if (p.pipeline && p.pipeline->layout.hasBinding(0, 0))
       vk::DescriptorWriter(ctx_, p.pipeline->layout, 0, p.sets.get(0, frame))
           .buffer(0, uniforms_.buffer, uniforms_.offset, sizeof(shader::FrameUniforms))
           .commit();
@@ -332,7 +326,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
   writeEnvironment(w, c.layout, env_.get());
   if (raster == RasterPath::Compute) w.buffer(14, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  if (hasBinding(c.layout, 0, 9)) {  // the textured variant's
+  if (c.layout.hasBinding(0, 9)) {  // the textured variant's
     w.buffer(9, scene_.texcoords());
     w.buffer(11, scene_.texcoords1() ? scene_.texcoords1() : scene_.positions());
     w.buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions());

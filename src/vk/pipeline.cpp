@@ -118,6 +118,11 @@ const ReflectedBinding& PipelineLayout::binding(uint32_t set, uint32_t binding) 
   throw Error("no set " + std::to_string(set) + " binding " + std::to_string(binding) + " in the pipeline's shaders");
 }
 
+bool PipelineLayout::hasBinding(uint32_t set, uint32_t binding) const {
+  return std::any_of(interface_.bindings.begin(), interface_.bindings.end(),
+                     [&](const ReflectedBinding& b) { return b.set == set && b.binding == binding; });
+}
+
 uint32_t PipelineLayout::arrayCount(const ReflectedBinding& b) const {
   if (b.count != 0) return b.count;
   auto it = options_.runtimeArrayCounts.find({b.set, b.binding});

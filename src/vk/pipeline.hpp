@@ -49,6 +49,8 @@ class PipelineLayout {
   uint32_t setCount() const { return uint32_t(sets_.size()); }
   const PipelineInterface& interface() const { return interface_; }
   const ReflectedBinding& binding(uint32_t set, uint32_t binding) const;
+  // Whether the shaders use it (a specialized variant keeps only what its code reads).
+  bool hasBinding(uint32_t set, uint32_t binding) const;
   uint32_t arrayCount(const ReflectedBinding& b) const;  // the count the layout was made with
   bool isPushDescriptorSet(uint32_t set) const {
     return std::find(options_.pushDescriptorSets.begin(), options_.pushDescriptorSets.end(), set) !=
