@@ -58,9 +58,7 @@ void verifyTextures(const TexturePlan& plan, unsigned threads, const std::string
     if (plan.bytes[i]) {
       try {
         decodeImage(*plan.bytes[i], plan.scene.textures[i].path.string(), plan.scene.textures[i].channels);
-      } catch (const Error& e) {
-        errors[i] = std::string(e.what()) + " (an image embedded in the glTF is not readable)";
-      }
+      } catch (const Error& e) { errors[i] = std::string(e.what()) + " (an image embedded in the glTF is not readable)"; }
     }
     if (src.empty()) return;
     std::error_code ec;
@@ -107,8 +105,9 @@ BakeReport bake(const BakeOptions& opt) {
   if (course && opt.textures != TextureStore::Files)
     throw UsageError(opt.output.string() + ": the .comp5892mesh format stores texture files only (--textures files)");
   if (gltf && course)
-    throw UsageError(opt.output.string() + ": a glTF bakes to .rtrscene only (the .comp5892mesh format has no instances, "
-                                           "samplers, uv transforms or glTF materials)");
+    throw UsageError(opt.output.string() +
+                     ": a glTF bakes to .rtrscene only (the .comp5892mesh format has no instances, "
+                     "samplers, uv transforms or glTF materials)");
   std::error_code ec;
   const Replace replace = opt.force ? Replace::Yes : Replace::No;
   if (std::filesystem::exists(opt.output, ec) && !opt.force)
@@ -167,9 +166,12 @@ BakeReport bake(const BakeOptions& opt) {
   if (baked) {  // into the file: no texture file is written
     if (opt.progress) opt.progress("baking textures", 0.0);
     stage("baking the textures of " + input, [&] {
-      bakeTexels(plan, threads, gltf ? "glTF" : "MTL", [&](double f) {
-        if (opt.progress) opt.progress("baking textures", f);
-      }, opt.textures == TextureStore::Bc, &rep.bcError);
+      bakeTexels(
+          plan, threads, gltf ? "glTF" : "MTL",
+          [&](double f) {
+            if (opt.progress) opt.progress("baking textures", f);
+          },
+          opt.textures == TextureStore::Bc, &rep.bcError);
     });
     for (const Texture& t : plan.scene.textures) {
       rep.texelBytes += t.baked->bytes();
@@ -224,9 +226,7 @@ BakeReport bake(const BakeOptions& opt) {
     if (opt.progress) opt.progress("clustering", 0.0);
     try {
       stage("clustering " + input, [&] { buildMissingClusters(plan.scene); });
-    } catch (const Error& e) {
-      throw fileError(input, "", e.what());
-    }
+    } catch (const Error& e) { throw fileError(input, "", e.what()); }
     rep.clusterSeconds = since(t0);
     // The level-of-detail hierarchy over those clusters (docs/virtual-geometry.md), on all cores.
     if (opt.lod) {
@@ -234,9 +234,7 @@ BakeReport bake(const BakeOptions& opt) {
       if (opt.progress) opt.progress("cluster hierarchy", 0.0);
       try {
         stage("cluster hierarchy of " + input, [&] { buildMissingClusterLods(plan.scene, threads); });
-      } catch (const Error& e) {
-        throw fileError(input, "", e.what());
-      }
+      } catch (const Error& e) { throw fileError(input, "", e.what()); }
       rep.lodSeconds = since(t0);
     }
   }
@@ -246,8 +244,8 @@ BakeReport bake(const BakeOptions& opt) {
   // textures already placed are removed again).
   t0 = Clock::now();
   if (opt.progress) opt.progress("writing", 0.0);
-  const std::string bytes =
-      stage("encoding " + opt.output.string(), [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
+  const std::string bytes = stage("encoding " + opt.output.string(),
+                                  [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
   AtomicFile sceneFile(opt.output);
   sceneFile.write(bytes.data(), bytes.size());
   sceneFile.sync();

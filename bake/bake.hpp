@@ -38,29 +38,30 @@ struct LevelError {
 
 struct BakeOptions {
   std::filesystem::path input, output;
-  bool force = false;                     // overwrite an existing output and texture files
-  std::optional<CameraPose> view;         // stored as the default view (.rtrscene only)
-  std::optional<std::filesystem::path> mtl;  // the OBJ's MTL instead of its mtllib lines (LoadOptions::mtl)
-  std::vector<Light> lights;              // stored with the scene (.rtrscene only); empty: none stored
+  bool force = false;                         // overwrite an existing output and texture files
+  std::optional<CameraPose> view;             // stored as the default view (.rtrscene only)
+  std::optional<std::filesystem::path> mtl;   // the OBJ's MTL instead of its mtllib lines (LoadOptions::mtl)
+  std::vector<Light> lights;                  // stored with the scene (.rtrscene only); empty: none stored
   float creaseDeg = LoadOptions{}.creaseDeg;  // --crease: normals made for faces without them split at this angle
-  glm::mat3 up{1.0f};                     // --up: the rotation that turns the model's up axis to +Y
+  glm::mat3 up{1.0f};                         // --up: the rotation that turns the model's up axis to +Y
   std::function<void(const std::string&)> warn;
   std::function<void(const std::string&)> note;  // glTF: what the reader chose on its own (LoadOptions::note)
   std::function<void(const char* phase, double fraction)> progress;
   unsigned threads = 0;
   TextureStore textures = TextureStore::Files;  // .rtrscene only
-  bool lod = true;                        // --no-lod: no cluster hierarchy (.rtrscene's CLOD chunk)
+  bool lod = true;                              // --no-lod: no cluster hierarchy (.rtrscene's CLOD chunk)
 };
 
 struct BakeReport {
   ObjStats obj;
-  bool gltf = false;                      // read as glTF (obj stays empty)
+  bool gltf = false;  // read as glTF (obj stays empty)
   size_t meshes = 0, materials = 0, textures = 0, fallbackTextures = 0, embeddedTextures = 0;
   size_t triangles = 0, instances = 0;
   uint64_t outputBytes = 0;
   uint64_t texelBytes = 0, storedTexelBytes = 0;  // baked textures: their chains, and as stored (zstd)
   std::vector<LevelError> bcError;                // --textures bc: per level
-  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, lodSeconds = 0, writeSeconds = 0, totalSeconds = 0;
+  double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, lodSeconds = 0, writeSeconds = 0,
+         totalSeconds = 0;
 };
 
 // Throws rtr::Error naming the file and place; on failure nothing it created is left behind.
@@ -72,8 +73,8 @@ BakeReport bake(const BakeOptions& options);
 // (materials in order, slots in course order), missing baseColor/roughness/metalness/emissive slots
 // pointing at fallback textures (docs/formats.md).
 struct TexturePlan {
-  Scene scene;                                       // the scene to encode (shares nothing with the input)
-  std::vector<std::filesystem::path> sources;        // per texture of `scene`: the file to copy; empty otherwise
+  Scene scene;                                                     // the scene to encode (shares nothing with the input)
+  std::vector<std::filesystem::path> sources;                      // per texture of `scene`: the file to copy; empty otherwise
   std::vector<std::shared_ptr<const std::vector<uint8_t>>> bytes;  // per texture: the image to write, or null
 };
 TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks);
@@ -83,9 +84,8 @@ TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool cou
 // linear light, each level from the one before) and sets Texture::baked; sources and bytes are cleared.
 // Textures on all cores. `progress` gets the fraction done.
 // `blocks`: block-compressed, with the error per level added to `bcError`.
-void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn,
-                const std::function<void(double)>& progress = {}, bool blocks = false,
-                std::vector<LevelError>* bcError = nullptr);
+void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn, const std::function<void(double)>& progress = {},
+                bool blocks = false, std::vector<LevelError>* bcError = nullptr);
 // One texture's chain as bakeTexels makes it, from decoded texels (channels 1 or 4).
 std::vector<uint8_t> referenceChain(const TexelData& level0, bool srgb);
 

@@ -13,9 +13,10 @@
 #include "scene/first_look.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh, or a glTF 2.0 "
-               "scene (.gltf, .glb) into .rtrscene",
-               "rtr-bake"};
+  CLI::App app{
+      "Bakes an OBJ (.obj, .obj.zst, .obj-zstd) and its MTL into .rtrscene or .comp5892mesh, or a glTF 2.0 "
+      "scene (.gltf, .glb) into .rtrscene",
+      "rtr-bake"};
   rtr::BakeOptions opt;
   std::string input, output, view, light, lightColor, mtl;
   app.add_option("INPUT", input, "OBJ or glTF file")->required();
@@ -29,20 +30,26 @@ int main(int argc, char** argv) {
       app.add_option("--light", light, "store a point light at x,y,z with the scene (.rtrscene); it replaces the scene's own")
           ->check(checked([](const std::string& t) { rtr::cli::parseVec3("--light", t); }, "X,Y,Z"));
   app.add_option("--light-color", lightColor, "colour x intensity of --light, r,g,b")
-      ->needs(lightOpt)->check(checked([](const std::string& t) { rtr::cli::parseColor("--light-color", t); }, "R,G,B"));
+      ->needs(lightOpt)
+      ->check(checked([](const std::string& t) { rtr::cli::parseColor("--light-color", t); }, "R,G,B"));
   bool noLod = false;
   app.add_flag("--no-lod", noLod, "store no cluster hierarchy (level of detail; docs/virtual-geometry.md)");
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
   std::string up = "+Y";
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
       ->capture_default_str();
-  app.add_option("--crease", opt.creaseDeg, "faces without normals: normals split where faces meet at more than DEG "
-                 "degrees (0 flat, 180 smooth)")->capture_default_str()->check(rtr::cli::number(0, 180));
+  app.add_option("--crease", opt.creaseDeg,
+                 "faces without normals: normals split where faces meet at more than DEG "
+                 "degrees (0 flat, 180 smooth)")
+      ->capture_default_str()
+      ->check(rtr::cli::number(0, 180));
   std::string textures = "files";
-  app.add_option("--textures", textures, "how an .rtrscene carries its textures: files (image files in NAME-tex/, "
+  app.add_option("--textures", textures,
+                 "how an .rtrscene carries its textures: files (image files in NAME-tex/, "
                  "decoded at load) | lossless (the mip chains as the GPU samples them, zstd, in the file) | bc (the same, "
                  "block-compressed: BC1/BC3/BC4; prints the error against lossless per level)")
-      ->check(rtr::cli::oneOf<rtr::TextureStore>())->capture_default_str();
+      ->check(rtr::cli::oneOf<rtr::TextureStore>())
+      ->capture_default_str();
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
   opt.textures = rtr::cli::enumOption<rtr::TextureStore>("--textures", textures);
   opt.lod = !noLod;
@@ -83,8 +90,8 @@ int main(int argc, char** argv) {
       std::printf("  meshes %zu, instances %zu, materials %zu, textures %zu (%zu images written from the glTF)\n", r.meshes,
                   r.instances, r.materials, r.textures, r.embeddedTextures);
       std::printf("  triangles %zu, output %.2f MB\n", r.triangles, double(r.outputBytes) / 1e6);
-      std::printf("  time: read %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n", r.parseSeconds,
-                  r.textureSeconds, r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.totalSeconds);
+      std::printf("  time: read %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n",
+                  r.parseSeconds, r.textureSeconds, r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.totalSeconds);
       return 0;
     }
     std::printf("  meshes %zu, materials %zu, textures %zu (+%zu fallback)\n", r.meshes, r.materials, r.textures,
@@ -92,9 +99,10 @@ int main(int argc, char** argv) {
     std::printf("  faces %zu, triangles %zu, degenerate skipped %zu\n", o.faces, o.triangles, o.degenerateSkipped);
     std::printf("  vertices %zu before welding, %zu after\n", o.verticesBeforeWeld, o.verticesAfterWeld);
     std::printf("  warnings %zu, output %.2f MB\n", o.warnings, double(r.outputBytes) / 1e6);
-    std::printf("  time: parse %.3f s (%.0f MB/s of OBJ text), weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n",
-                r.parseSeconds, r.parseSeconds > 0 ? mb / r.parseSeconds : 0.0, r.weldSeconds, r.textureSeconds,
-                r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.totalSeconds);
+    std::printf(
+        "  time: parse %.3f s (%.0f MB/s of OBJ text), weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n",
+        r.parseSeconds, r.parseSeconds > 0 ? mb / r.parseSeconds : 0.0, r.weldSeconds, r.textureSeconds, r.clusterSeconds,
+        r.lodSeconds, r.writeSeconds, r.totalSeconds);
     return 0;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");

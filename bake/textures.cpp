@@ -31,8 +31,8 @@ std::string contentName(const std::vector<uint8_t>& bytes) {
 std::string key(const std::string& rel, const Texture& t) {
   const SamplerDesc& s = t.sampler;
   char k[64];
-  std::snprintf(k, sizeof k, "|%d%d%d|%d%d%d%d%d", t.srgb, t.channels, t.sourceChannel, int(s.wrapU), int(s.wrapV),
-                s.nearestMag, s.nearestMin, s.nearestMip);
+  std::snprintf(k, sizeof k, "|%d%d%d|%d%d%d%d%d", t.srgb, t.channels, t.sourceChannel, int(s.wrapU), int(s.wrapV), s.nearestMag,
+                s.nearestMin, s.nearestMip);
   return rel + k;
 }
 
@@ -46,8 +46,8 @@ TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool cou
   plan.scene.defaultView = in.defaultView;
   plan.scene.defaultFovYDeg = in.defaultFovYDeg;
   plan.scene.lights = in.lights;
-  std::unordered_map<std::string, uint32_t> ids;           // destination path and sampling -> new id
-  std::unordered_map<std::string, std::string> sourceOf;   // destination path -> source, to catch clashes
+  std::unordered_map<std::string, uint32_t> ids;          // destination path and sampling -> new id
+  std::unordered_map<std::string, std::string> sourceOf;  // destination path -> source, to catch clashes
   const std::string folder = sceneName + "-tex/";
 
   auto idFor = [&](const std::string& rel, const std::filesystem::path& src, const Texture& t) {
@@ -87,7 +87,7 @@ TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool cou
       if (id != kNoTexture) {
         out.textures[s] = courseFallbacks ? planned(id, m.name) : id < remap.size() ? remap[id] : planned(id, m.name);
       } else if (courseFallbacks && slot != TextureSlot::AlphaMask && slot != TextureSlot::NormalMap) {
-        std::string_view name = slot == TextureSlot::BaseColor ? kFallbackBaseColor
+        std::string_view name = slot == TextureSlot::BaseColor  ? kFallbackBaseColor
                                 : slot == TextureSlot::Emissive ? kFallbackEmissive
                                                                 : kFallbackOne;
         const SlotFormat f = slotFormat(slot);

@@ -76,9 +76,7 @@ const mode_t gFileMode = [] {
   return mode_t(0666 & ~m);
 }();
 
-std::string tempPrefix(const std::filesystem::path& target) {
-  return "." + target.filename().string() + ".rtrtmp-";
-}
+std::string tempPrefix(const std::filesystem::path& target) { return "." + target.filename().string() + ".rtrtmp-"; }
 
 void fsyncFolder(const std::filesystem::path& dir) {
   const int d = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -102,7 +100,7 @@ size_t removeStaleTemporaries(const std::filesystem::path& target) {
     if (!name.starts_with(prefix)) continue;
     char* end = nullptr;
     const long pid = std::strtol(e->d_name + prefix.size(), &end, 10);
-    if (pid <= 0 || *end != '-') continue;  // not one of ours
+    if (pid <= 0 || *end != '-') continue;                       // not one of ours
     if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // its writer may still be running
     if (::unlink((dir / e->d_name).c_str()) == 0) ++removed;
   }

@@ -12,14 +12,14 @@ namespace rtr {
 enum class Replace { Yes, No };  // No: an existing target is kept and OutputExists is thrown
 
 class AtomicFile {
-public:
+ public:
   explicit AtomicFile(std::filesystem::path target);  // creates the temporary; throws rtr::Error naming target
-  ~AtomicFile();                                       // removes the temporary unless committed
+  ~AtomicFile();                                      // removes the temporary unless committed
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   int fd() const { return fd_; }
-  void write(const void* data, size_t size);  // all of it, or throws
+  void write(const void* data, size_t size);            // all of it, or throws
   void writeFrom(const std::filesystem::path& source);  // a regular file's bytes (core/input_file), or throws
   // fsync and close: the bytes are safely on disk under the temporary's name (a full disk has shown by
   // now), to be put in place by commit() later — how several files become one unit (rtr-bake's scene and
@@ -31,7 +31,7 @@ public:
   const std::filesystem::path& target() const { return target_; }
   const std::filesystem::path& temporary() const { return tmp_; }
 
-private:
+ private:
   std::filesystem::path target_, tmp_;
   int fd_ = -1;
   int slot_ = -1;  // in the signal handler's registry

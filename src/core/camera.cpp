@@ -21,21 +21,19 @@ CameraPose parsePose(std::string_view text) {
     char* stop = nullptr;
     float f = std::strtof(field.c_str(), &stop);
     if (field.empty() || *stop != '\0' || !std::isfinite(f))
-      throw Error("camera pose '" + std::string(text) + "': field " + std::to_string(v.size() + 1) +
-                  " ('" + field + "') is not a finite number; expected x,y,z,yaw,pitch");
+      throw Error("camera pose '" + std::string(text) + "': field " + std::to_string(v.size() + 1) + " ('" + field +
+                  "') is not a finite number; expected x,y,z,yaw,pitch");
     v.push_back(f);
     start = end + 1;
   }
   if (v.size() != 5)
-    throw Error("camera pose '" + std::string(text) + "': expected 5 numbers x,y,z,yaw,pitch, got " +
-                std::to_string(v.size()));
+    throw Error("camera pose '" + std::string(text) + "': expected 5 numbers x,y,z,yaw,pitch, got " + std::to_string(v.size()));
   return {{v[0], v[1], v[2]}, v[3], v[4]};
 }
 
 std::string formatPose(const CameraPose& p) {
   char buf[160];
-  std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g,%.9g,%.9g", p.position.x, p.position.y, p.position.z, p.yawDeg,
-                p.pitchDeg);
+  std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g,%.9g,%.9g", p.position.x, p.position.y, p.position.z, p.yawDeg, p.pitchDeg);
   return buf;
 }
 
@@ -49,9 +47,15 @@ CameraBasis basis(const CameraPose& p) {
 glm::mat4 viewMatrix(const CameraPose& p) {
   const CameraBasis b = basis(p);
   glm::mat4 m(1.0f);  // rows are the camera axes; camera looks down its -z
-  m[0][0] = b.right.x; m[1][0] = b.right.y; m[2][0] = b.right.z;
-  m[0][1] = b.up.x;    m[1][1] = b.up.y;    m[2][1] = b.up.z;
-  m[0][2] = -b.forward.x; m[1][2] = -b.forward.y; m[2][2] = -b.forward.z;
+  m[0][0] = b.right.x;
+  m[1][0] = b.right.y;
+  m[2][0] = b.right.z;
+  m[0][1] = b.up.x;
+  m[1][1] = b.up.y;
+  m[2][1] = b.up.z;
+  m[0][2] = -b.forward.x;
+  m[1][2] = -b.forward.y;
+  m[2][2] = -b.forward.z;
   m[3][0] = -glm::dot(b.right, p.position);
   m[3][1] = -glm::dot(b.up, p.position);
   m[3][2] = glm::dot(b.forward, p.position);
@@ -59,10 +63,9 @@ glm::mat4 viewMatrix(const CameraPose& p) {
 }
 
 glm::mat4 projectionMatrix(const Lens& lens, float aspect) {
-  glm::mat4 m = lens.orthographic
-                    ? glm::orthoRH_ZO(-aspect * lens.orthoHalfHeight, aspect * lens.orthoHalfHeight,
-                                      -lens.orthoHalfHeight, lens.orthoHalfHeight, lens.zNear, lens.zFar)
-                    : glm::perspectiveRH_ZO(glm::radians(lens.fovYDeg), aspect, lens.zNear, lens.zFar);
+  glm::mat4 m = lens.orthographic ? glm::orthoRH_ZO(-aspect * lens.orthoHalfHeight, aspect * lens.orthoHalfHeight,
+                                                    -lens.orthoHalfHeight, lens.orthoHalfHeight, lens.zNear, lens.zFar)
+                                  : glm::perspectiveRH_ZO(glm::radians(lens.fovYDeg), aspect, lens.zNear, lens.zFar);
   m[1][1] = -m[1][1];  // Vulkan's framebuffer y points down
   return m;
 }
@@ -74,8 +77,7 @@ glm::vec2 pixelToNdc(float px, float py, uint32_t width, uint32_t height) {
 CameraRay cameraRay(const CameraPose& pose, const Lens& lens, float aspect, glm::vec2 ndc) {
   const CameraBasis b = basis(pose);
   if (lens.orthographic) {
-    const glm::vec3 o = pose.position + b.right * (ndc.x * aspect * lens.orthoHalfHeight) +
-                        b.up * (ndc.y * lens.orthoHalfHeight);
+    const glm::vec3 o = pose.position + b.right * (ndc.x * aspect * lens.orthoHalfHeight) + b.up * (ndc.y * lens.orthoHalfHeight);
     return {o, b.forward};
   }
   const float t = std::tan(glm::radians(lens.fovYDeg) * 0.5f);

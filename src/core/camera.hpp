@@ -30,7 +30,9 @@ struct Lens {
 CameraPose parsePose(std::string_view text);
 std::string formatPose(const CameraPose& pose);  // round-trips through parsePose
 
-struct CameraBasis { glm::vec3 forward, right, up; };
+struct CameraBasis {
+  glm::vec3 forward, right, up;
+};
 CameraBasis basis(const CameraPose& pose);
 glm::mat4 viewMatrix(const CameraPose& pose);
 // Vulkan clip space: depth in [0,1], y pointing down in framebuffer space.
@@ -38,7 +40,9 @@ glm::mat4 projectionMatrix(const Lens& lens, float aspect);
 
 // The ray through the point `ndc` of the image, ndc in [-1,1]² with +y up. Identical rule to the raster
 // projection above, so a pixel centre's ray passes through the point the rasteriser samples there.
-struct CameraRay { glm::vec3 origin, direction; };
+struct CameraRay {
+  glm::vec3 origin, direction;
+};
 CameraRay cameraRay(const CameraPose& pose, const Lens& lens, float aspect, glm::vec2 ndc);
 glm::vec2 pixelToNdc(float px, float py, uint32_t width, uint32_t height);  // px,py: pixel centre coords
 

@@ -19,10 +19,10 @@ namespace {
 
 // The usage errors a tool can make: an existing output only where it has --force.
 std::string footer(const CLI::App& app) {
-  return std::string("Exit status: 0 success; 1 failure while working (unreadable input, I/O error); 2 usage error "
-                     "(bad option value") +
-         (app.get_option_no_throw("--force") ? ", unknown output format, an output that exists without --force)."
-                                             : ").");
+  return std::string(
+             "Exit status: 0 success; 1 failure while working (unreadable input, I/O error); 2 usage error "
+             "(bad option value") +
+         (app.get_option_no_throw("--force") ? ", unknown output format, an output that exists without --force)." : ").");
 }
 
 std::string fmt(double v) {
@@ -42,9 +42,7 @@ bool toDouble(const std::string& text, double& out) {
 
 }  // namespace
 
-std::string version(const std::string& tool) {
-  return tool + " " + kVersion + " (git " + kGitCommit + ", " + kBuildType + ")";
-}
+std::string version(const std::string& tool) { return tool + " " + kVersion + " (git " + kGitCommit + ", " + kBuildType + ")"; }
 
 int parse(CLI::App& app, int argc, char** argv) {
   const std::string tool = app.get_name();
@@ -53,13 +51,9 @@ int parse(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
     return -1;
-  } catch (const CLI::CallForHelp& e) {
+  } catch (const CLI::CallForHelp& e) { return app.exit(e); } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForVersion& e) { return app.exit(e); } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "%s: error: %s\nRun with --help for the options.\n", tool.c_str(), e.what());
     return kExitUsage;
   }
@@ -76,9 +70,7 @@ int run(CLI::App& app, int argc, char** argv, const std::function<int()>& body) 
   if (const int rc = parse(app, argc, argv); rc >= 0) return rc;
   try {
     return body();
-  } catch (const std::exception& e) {
-    return fail(app.get_name(), e);
-  }
+  } catch (const std::exception& e) { return fail(app.get_name(), e); }
 }
 
 CLI::Validator number(double lo, double hi, bool open) {
@@ -99,11 +91,9 @@ CLI::Validator integer(long long lo, long long hi) {
       [=](std::string& text) -> std::string {
         long long v = 0;
         const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-        if (ec == std::errc::result_out_of_range || (ec == std::errc{} && end == text.data() + text.size() &&
-                                                     (v < lo || v > hi)))
+        if (ec == std::errc::result_out_of_range || (ec == std::errc{} && end == text.data() + text.size() && (v < lo || v > hi)))
           return "'" + text + "' is outside " + range;
-        if (ec != std::errc{} || end != text.data() + text.size() || text.empty())
-          return "'" + text + "' is not a whole number";
+        if (ec != std::errc{} || end != text.data() + text.size() || text.empty()) return "'" + text + "' is not a whole number";
         return {};
       },
       "INTEGER in " + range);
@@ -138,8 +128,7 @@ glm::vec3 parseVec3(const std::string& option, const std::string& text, bool sca
     const size_t end = i < 2 ? text.find(',', start) : text.size();
     double d = 0;
     if (end == std::string::npos || !toDouble(text.substr(start, end - start), d) || std::fabs(d) > 3.0e38)
-      throw UsageError(option + " '" + text + "': expected three finite numbers x,y,z" +
-                       (scalarAllowed ? " or one" : ""));
+      throw UsageError(option + " '" + text + "': expected three finite numbers x,y,z" + (scalarAllowed ? " or one" : ""));
     v[i] = float(d);
     start = end + 1;
   }
@@ -169,17 +158,13 @@ CLI::Validator checked(std::function<void(const std::string&)> parse, const std:
 CameraPose parsePose(const std::string& option, const std::string& text) {
   try {
     return rtr::parsePose(text);
-  } catch (const Error& e) {
-    throw UsageError(option + ": " + e.what());
-  }
+  } catch (const Error& e) { throw UsageError(option + ": " + e.what()); }
 }
 
 void checkImageOutput(const std::string& option, const std::filesystem::path& file, bool force) {
   try {
     imageFormatFor(file);
-  } catch (const UsageError& e) {
-    throw UsageError(option + " " + e.what());
-  }
+  } catch (const UsageError& e) { throw UsageError(option + " " + e.what()); }
   std::error_code ec;
   const std::filesystem::path dir = file.parent_path().empty() ? "." : file.parent_path();
   const std::string bad = option + " " + file.string() + ": ";

@@ -52,7 +52,9 @@ E enumOption(const std::string& option, const std::string& text) {
 }
 
 // Option values that CLI11 cannot check alone. Each throws rtr::UsageError naming the option.
-struct Size { uint32_t width, height; };
+struct Size {
+  uint32_t width, height;
+};
 Size parseSize(const std::string& option, const std::string& text, uint32_t max = 16384);
 // "x,y,z", or one value for all three where `scalarAllowed` (a grey colour).
 glm::vec3 parseVec3(const std::string& option, const std::string& text, bool scalarAllowed = false);

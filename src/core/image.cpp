@@ -61,8 +61,8 @@ bool decodeJpeg(std::span<const uint8_t> bytes, int channels, TexelData& out, st
   jpeg_mem_src(&cinfo, bytes.data(), static_cast<unsigned long>(bytes.size()));
   jpeg_read_header(&cinfo, TRUE);
   if (cinfo.image_width > kMaxImageSide || cinfo.image_height > kMaxImageSide) {
-    std::snprintf(err.message, sizeof err.message, "%ux%u is larger than %u a side", cinfo.image_width,
-                  cinfo.image_height, kMaxImageSide);
+    std::snprintf(err.message, sizeof err.message, "%ux%u is larger than %u a side", cinfo.image_width, cinfo.image_height,
+                  kMaxImageSide);
     std::longjmp(err.jump, 1);
   }
   const bool grey = channels <= 2;  // 1: grey, 2: grey + alpha, 3: RGB, 4: RGBA (alpha opaque)
@@ -198,8 +198,9 @@ TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, i
   const int size = int(std::min<size_t>(bytes.size(), INT32_MAX));
   int w = 0, h = 0, n = 0;
   if (stbi_info_from_memory(bytes.data(), size, &w, &h, &n) && (uint32_t(w) > kMaxImageSide || uint32_t(h) > kMaxImageSide))
-    throw fileError(name, "", "cannot decode image: " + std::to_string(w) + "x" + std::to_string(h) +
-                                  " is larger than " + std::to_string(kMaxImageSide) + " a side");
+    throw fileError(name, "",
+                    "cannot decode image: " + std::to_string(w) + "x" + std::to_string(h) + " is larger than " +
+                        std::to_string(kMaxImageSide) + " a side");
   stbi_uc* data = stbi_load_from_memory(bytes.data(), size, &w, &h, &n, channels);
   if (!data) {  // stb can fail without a reason
     const char* why = stbi_failure_reason();
@@ -214,9 +215,7 @@ TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, i
   }
   stbi_image_free(data);
   return out;
-} catch (const std::bad_alloc&) {
-  throw fileError(name, "", "out of memory while decoding the image");
-}
+} catch (const std::bad_alloc&) { throw fileError(name, "", "out of memory while decoding the image"); }
 
 TexelData loadImage(const std::filesystem::path& file, int channels) {
   const MappedFile mapped(file, "image");  // a regular file; pages read only as the decoder gets to them

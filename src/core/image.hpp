@@ -37,7 +37,7 @@ struct TexelData {
 TexelData loadImage(const std::filesystem::path& file, int channels);
 TexelData decodeImage(std::span<const uint8_t> bytes, const std::string& name, int channels);
 void savePng(const std::filesystem::path& file, const ImageRGBA8& image);  // PNG whatever the name says
-void writePng(AtomicFile& file, const ImageRGBA8& image);  // into an open file; the caller commits it
+void writePng(AtomicFile& file, const ImageRGBA8& image);                  // into an open file; the caller commits it
 // A linear-light image, .hdr (Radiance) or .exr (OpenEXR), as floats. Throws rtr::Error naming the file.
 ImageF loadLinearImage(const std::filesystem::path& file);
 

@@ -79,7 +79,7 @@ ImageF decodeHdr(std::span<const uint8_t> b, const std::string& file) {
 ImageF loadLinearImage(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  const MappedFile mapped(file, "environment map");  // a regular file, or refused without blocking
+  const MappedFile mapped(file, "environment map");       // a regular file, or refused without blocking
   const std::span<const uint8_t> bytes = mapped.bytes();  // decoded in place, not copied
   if (bytes.size() > kMaxLinearBytes) throw fileError(file.string(), "", "larger than 2 GiB");
   ImageF out;
@@ -93,7 +93,8 @@ ImageF loadLinearImage(const std::filesystem::path& file) {
       throw fileError(file.string(), "", "cannot decode OpenEXR: " + why);
     }
     out = {uint32_t(w), uint32_t(h), std::vector<glm::vec4>(size_t(w) * h)};
-    for (size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = {rgba[i * 4], rgba[i * 4 + 1], rgba[i * 4 + 2], rgba[i * 4 + 3]};
+    for (size_t i = 0; i < out.pixels.size(); ++i)
+      out.pixels[i] = {rgba[i * 4], rgba[i * 4 + 1], rgba[i * 4 + 2], rgba[i * 4 + 3]};
     std::free(rgba);
   } else if (ext == ".hdr") {
     out = decodeHdr(bytes, file.string());

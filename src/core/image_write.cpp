@@ -28,18 +28,21 @@ namespace {
 
 // After a second of writing, a line on stderr that says how far it is (a 16384² PNG takes seconds).
 class ProgressLine {
-public:
+ public:
   ProgressLine(bool on, const std::filesystem::path& file) {
     if (on) watcher_ = std::thread([this, name = file.string()] { watch(name); });
   }
   ~ProgressLine() {
-    { std::lock_guard l(m_); done_ = true; }
+    {
+      std::lock_guard l(m_);
+      done_ = true;
+    }
     cv_.notify_all();
     if (watcher_.joinable()) watcher_.join();
   }
   std::atomic<double> fraction{0.0};
 
-private:
+ private:
   void watch(const std::string& name) {
     using namespace std::chrono;
     const auto start = steady_clock::now();
@@ -47,7 +50,8 @@ private:
     if (cv_.wait_for(l, seconds(1), [&] { return done_; })) return;
     const bool tty = ::isatty(STDERR_FILENO);  // a log gets one line, not a percentage every 250 ms
     if (!tty) std::fprintf(stderr, "writing %s ...\n", name.c_str());
-    do if (tty) std::fprintf(stderr, "\rwriting %s: %3.0f%%", name.c_str(), fraction.load() * 100.0);
+    do
+      if (tty) std::fprintf(stderr, "\rwriting %s: %3.0f%%", name.c_str(), fraction.load() * 100.0);
     while (!cv_.wait_for(l, milliseconds(250), [&] { return done_; }));
     std::fprintf(stderr, "%swriting %s: done in %.1f s\n", tty ? "\r" : "", name.c_str(),
                  duration<double>(steady_clock::now() - start).count());
@@ -91,7 +95,8 @@ void writePng(AtomicFile& f, const ImageRGBA8& img, ProgressLine& progress) {
     std::vector<Bytef> buf((row + 1) * 16);
     const size_t y0 = h * s / strips, y1 = h * (s + 1) / strips;
     z_stream z{};
-    if (deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) throw fileError(f.target().string(), "", "PNG compression failed");
+    if (deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+      throw fileError(f.target().string(), "", "PNG compression failed");
     out[s].resize(deflateBound(&z, (row + 1) * (y1 - y0)) + 64);
     z.next_out = reinterpret_cast<Bytef*>(out[s].data());
     z.avail_out = uInt(out[s].size());
@@ -102,7 +107,8 @@ void writePng(AtomicFile& f, const ImageRGBA8& img, ProgressLine& progress) {
       for (size_t yy = y; yy < ye; ++yy, o += row + 1) {
         const uint8_t* c = img.pixels.data() + row * yy;
         o[0] = yy ? 2 : 0;  // up; the first row has nothing above
-        if (yy) for (size_t i = 0; i < row; ++i) o[1 + i] = Bytef(c[i] - c[i - row]);
+        if (yy)
+          for (size_t i = 0; i < row; ++i) o[1 + i] = Bytef(c[i] - c[i - row]);
         else std::memcpy(o + 1, c, row);
       }
       z.next_in = buf.data();
@@ -249,8 +255,8 @@ void saveImage(const std::filesystem::path& file, const ImageRGBA8& image, const
       writePng(f, image, progress);
     } else {
       StbSink sink{&f};
-      checkStb(stbi_write_jpg_to_func(stbWrite, &sink, int(image.width), int(image.height), 4, image.pixels.data(), 95),
-               sink, f, "JPEG");
+      checkStb(stbi_write_jpg_to_func(stbWrite, &sink, int(image.width), int(image.height), 4, image.pixels.data(), 95), sink, f,
+               "JPEG");
     }
   }
   f.commit(opt.replace);

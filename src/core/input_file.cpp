@@ -15,8 +15,12 @@ namespace rtr {
 namespace {
 
 const char* kindOf(mode_t m) {
-  return S_ISDIR(m) ? "a folder" : S_ISFIFO(m) ? "a FIFO (named pipe)" : S_ISCHR(m) ? "a character device"
-       : S_ISBLK(m) ? "a block device" : S_ISSOCK(m) ? "a socket" : "not a regular file";
+  return S_ISDIR(m)    ? "a folder"
+         : S_ISFIFO(m) ? "a FIFO (named pipe)"
+         : S_ISCHR(m)  ? "a character device"
+         : S_ISBLK(m)  ? "a block device"
+         : S_ISSOCK(m) ? "a socket"
+                       : "not a regular file";
 }
 
 std::string mb(uint64_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MB"; }
@@ -27,8 +31,7 @@ InputFile::InputFile(const std::filesystem::path& file, const char* what) : name
   // stat first, so that a device is never opened at all; O_NONBLOCK so that a FIFO swapped in meanwhile
   // cannot block the open either; fstat decides.
   struct stat st {};
-  if (::stat(file.c_str(), &st) != 0)
-    throw fileError(name_, "", "cannot open " + what_ + ": " + std::strerror(errno));
+  if (::stat(file.c_str(), &st) != 0) throw fileError(name_, "", "cannot open " + what_ + ": " + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) throw fileError(name_, "", std::string(kindOf(st.st_mode)) + ", not a regular file");
   fd_ = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd_ < 0) throw fileError(name_, "", "cannot open " + what_ + ": " + std::strerror(errno));
@@ -65,9 +68,7 @@ std::string InputFile::readAll(uint64_t maxBytes) {
   std::string out;
   try {
     out.resize(size_t(size_));
-  } catch (const std::bad_alloc&) {
-    throw fileError(name_, "", "out of memory while reading it: needs " + mb(size_));
-  }
+  } catch (const std::bad_alloc&) { throw fileError(name_, "", "out of memory while reading it: needs " + mb(size_)); }
   out.resize(read(out.data(), out.size()));
   return out;
 }
@@ -84,8 +85,9 @@ MappedFile::MappedFile(const std::filesystem::path& file, const char* what) {
   if (data_ == MAP_FAILED) {
     data_ = nullptr;
     const int err = errno;
-    throw fileError(in.name(), "", err == ENOMEM ? "out of memory (address space) while mapping its " + mb(size_)
-                                                 : std::string("cannot map: ") + std::strerror(err));
+    throw fileError(in.name(), "",
+                    err == ENOMEM ? "out of memory (address space) while mapping its " + mb(size_)
+                                  : std::string("cannot map: ") + std::strerror(err));
   }
   ::madvise(data_, size_, MADV_SEQUENTIAL);
 }  // the mapping keeps the file

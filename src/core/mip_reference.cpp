@@ -53,9 +53,7 @@ MipLevel boxFilter(const MipLevel& src, uint32_t channels, uint32_t dw, uint32_t
 }
 
 // Channel 3 exists only in RGBA images, where it is alpha: always linear.
-bool isSrgbChannel(uint32_t channel, TexelEncoding encoding) {
-  return encoding == TexelEncoding::Srgb && channel < 3;
-}
+bool isSrgbChannel(uint32_t channel, TexelEncoding encoding) { return encoding == TexelEncoding::Srgb && channel < 3; }
 
 }  // namespace
 
@@ -78,8 +76,7 @@ double decodeTexel(uint8_t value, uint32_t channel, TexelEncoding encoding) {
 
 uint8_t encodeTexel(double linear, uint32_t channel, TexelEncoding encoding) {
   double c = std::clamp(linear, 0.0, 1.0);
-  if (isSrgbChannel(channel, encoding))
-    c = c <= 0.0031308 ? c * 12.92 : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  if (isSrgbChannel(channel, encoding)) c = c <= 0.0031308 ? c * 12.92 : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
   return uint8_t(std::floor(std::clamp(c, 0.0, 1.0) * 255.0 + 0.5));
 }
 
@@ -88,13 +85,12 @@ MipChain buildMipReference(const TexelData& image, TexelEncoding encoding, MipSo
   if (ch < 1 || ch > 4) throw Error("mip reference: channel count " + std::to_string(ch) + " is not 1..4");
   if (image.width == 0 || image.height == 0) throw Error("mip reference: empty image");
   if (image.texels.size() != size_t(image.width) * image.height * ch)
-    throw Error("mip reference: " + std::to_string(image.texels.size()) + " bytes for a " +
-                std::to_string(image.width) + "x" + std::to_string(image.height) + "x" + std::to_string(ch) + " image");
+    throw Error("mip reference: " + std::to_string(image.texels.size()) + " bytes for a " + std::to_string(image.width) + "x" +
+                std::to_string(image.height) + "x" + std::to_string(ch) + " image");
 
   MipChain chain{ch, encoding, {}};
   MipLevel base{image.width, image.height, std::vector<double>(image.texels.size())};
-  for (size_t i = 0; i < image.texels.size(); ++i)
-    base.texels[i] = decodeTexel(image.texels[i], uint32_t(i % ch), encoding);
+  for (size_t i = 0; i < image.texels.size(); ++i) base.texels[i] = decodeTexel(image.texels[i], uint32_t(i % ch), encoding);
   chain.levels.push_back(std::move(base));
 
   const uint32_t count = mipLevelCount(image.width, image.height);

@@ -87,9 +87,8 @@ void appendClusters(const Mesh& m, const glm::mat4& transform, uint32_t instance
   const float noCone = 2.0f;
   const size_t first = out.size();
   for (const Cluster& c : m.clusters)
-    out.push_back({glm::vec4(c.center, c.radius),
-                   glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff), instance,
-                   c.firstTriangle, c.triangleCount, flags});
+    out.push_back({glm::vec4(c.center, c.radius), glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff),
+                   instance, c.firstTriangle, c.triangleCount, flags});
   if (m.clusters.empty()) {
     const uint32_t triangles = uint32_t(m.indices.size() / 3);
     for (uint32_t f = 0; f < triangles; f += CLUSTER_MAX_TRIANGLES) {
@@ -105,8 +104,8 @@ void appendClusters(const Mesh& m, const glm::mat4& transform, uint32_t instance
   place(transform, first, out);
 }
 
-void appendClusterLods(const Mesh& m, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above,
-                       size_t first, std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods) {
+void appendClusterLods(const Mesh& m, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above, size_t first,
+                       std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods) {
   const float noCone = 2.0f;
   const size_t firstOut = out.size(), firstLod = lods.size();
   if (!above && m.lod.levels == 0) {  // always in the cut: its own error 0, no parent
@@ -118,9 +117,8 @@ void appendClusterLods(const Mesh& m, const glm::mat4& transform, uint32_t insta
     if ((c.level > 0) != above) continue;
     lods.push_back({c.sphere, c.parentSphere, glm::vec4(c.error, c.parentError, 0.0f, 0.0f)});
     if (above)
-      out.push_back({glm::vec4(c.center, c.radius),
-                     glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff), instance,
-                     c.firstTriangle, c.triangleCount, flags});
+      out.push_back({glm::vec4(c.center, c.radius), glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff),
+                     instance, c.firstTriangle, c.triangleCount, flags});
   }
   if (above) place(transform, firstOut, out);
   if (transform == glm::mat4(1.0f)) return;
@@ -187,8 +185,8 @@ void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk:
   constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   constexpr auto kReadWrite = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT;
   if (!initialised_) {
-    vk::barrier(cb, {{image_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
-                      kCompute, VK_ACCESS_2_NONE, kReadWrite}});
+    vk::barrier(cb, {{image_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, kCompute,
+                      VK_ACCESS_2_NONE, kReadWrite}});
     initialised_ = true;
   } else {  // the last frame's culling read it
     vk::bufferBarrier(cb, vk::kComputeRead | vk::kCopyRead, vk::kComputeReadWrite);
@@ -219,9 +217,9 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                            VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                        vk::MemoryUse::Device, "cull counts");
-  history_ = vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
-                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device,
-                        "cluster history");
+  history_ =
+      vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, "cluster history");
   vk::ImageDesc d;
   d.format = kPyramidFormat;
   d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
@@ -238,7 +236,8 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
 
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
                            const DepthPyramid* pyramid, CullTests tests, CullPhase phase, VkBuffer lods) {
-  if (count > maxClusters_) throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
+  if (count > maxClusters_)
+    throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
   vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);

@@ -18,7 +18,9 @@
 #include "vk/pipeline.hpp"
 #include "vk/resources.hpp"
 
-namespace rtr::vk { class Context; }
+namespace rtr::vk {
+class Context;
+}
 
 namespace rtr::render {
 
@@ -45,8 +47,8 @@ void appendClusters(const Mesh& mesh, const glm::mat4& transform, uint32_t insta
 // `first` on (a mesh without a hierarchy: always in the cut), or, with `above`, the records of its
 // hierarchy's clusters above level 0 appended to `out` and their level-of-detail records to `lods`; all
 // placed by `transform` as appendClusters places them, errors scaled by its largest stretch.
-void appendClusterLods(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above,
-                       size_t first, std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods);
+void appendClusterLods(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above, size_t first,
+                       std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods);
 // Every GpuCluster of a scene, numbered as GpuScene numbers its instances.
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
 
@@ -73,7 +75,7 @@ class DepthPyramid {
   VkExtent2D depthExtent_;
   vk::Image image_;
   std::vector<vk::ImageView> levelViews_;  // per level: storage (write) and sampled (read by the next level)
-  vk::Pipeline pipeline_, fromBuffer_;  // fromBuffer_: level 0 from a visibility buffer, made on first use
+  vk::Pipeline pipeline_, fromBuffer_;     // fromBuffer_: level 0 from a visibility buffer, made on first use
   void buildLevels(VkCommandBuffer cb, const std::function<const vk::Pipeline&(VkImageView)>& bindLevel0);
   bool initialised_ = false;
 };
@@ -90,7 +92,7 @@ struct CullCamera {
 
 struct CullTests {
   bool frustum = true, cone = true, occlusion = true;  // occlusion only when a pyramid is given
-  bool lod = true;  // only with a GpuClusterLod buffer and a camera's threshold above 0
+  bool lod = true;                                     // only with a GpuClusterLod buffer and a camera's threshold above 0
 };
 
 // Single: every cluster tested once (occlusion conservative only for the view the pyramid was built from).
@@ -107,9 +109,8 @@ class ClusterCuller {
   // too: a cluster whose every point lies behind that depth image there cannot be seen above it. Ends with
   // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
   // `lods`: the clusters' GpuClusterLod records (cluster.h), for the level-of-detail cut, tested first.
-  void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
-              const DepthPyramid* pyramid, CullTests tests = {}, CullPhase phase = CullPhase::Single,
-              VkBuffer lods = VK_NULL_HANDLE);
+  void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera, const DepthPyramid* pyramid,
+              CullTests tests = {}, CullPhase phase = CullPhase::Single, VkBuffer lods = VK_NULL_HANDLE);
   VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
   VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
   uint32_t maxClusters() const { return maxClusters_; }

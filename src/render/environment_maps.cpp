@@ -57,11 +57,23 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
 
   // Copy source: the maps can be read back (tests, the report's error figures).
   constexpr VkImageUsageFlags kRw = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  vk::Image equirect(ctx, {{map.width, map.height}, kSourceFormat, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                           0, 0, "environment map"});
-  source_ = vk::Image(ctx, {{s.sourceSize, s.sourceSize}, kSourceFormat, sourceLevels, kRw, 0, 0, "environment source cube", true});
-  specular_ = vk::Image(ctx, {{s.specularSize, s.specularSize}, VK_FORMAT_R16G16B16A16_SFLOAT, s.specularLevels, kRw, 0, 0,
-                              "environment specular cube", true});
+  vk::Image equirect(ctx, {{map.width, map.height},
+                           kSourceFormat,
+                           1,
+                           VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                           0,
+                           0,
+                           "environment map"});
+  source_ =
+      vk::Image(ctx, {{s.sourceSize, s.sourceSize}, kSourceFormat, sourceLevels, kRw, 0, 0, "environment source cube", true});
+  specular_ = vk::Image(ctx, {{s.specularSize, s.specularSize},
+                              VK_FORMAT_R16G16B16A16_SFLOAT,
+                              s.specularLevels,
+                              kRw,
+                              0,
+                              0,
+                              "environment specular cube",
+                              true});
   lut_ = vk::Image(ctx, {{s.lutSize, 2 * s.lutSize}, VK_FORMAT_R16G16B16A16_SFLOAT, 1, kRw, 0, 0, "split-sum table"});
   sh_ = vk::Buffer(ctx, 9 * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                    vk::MemoryUse::Device, "environment sh");
@@ -114,7 +126,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     timer.mark(cb, "env cube");
 
     down.bind(cb);
-    for (uint32_t l = 1; l < sourceLevels; ++l) {  // each level reads the one just written
+    for (uint32_t l = 1; l < sourceLevels; ++l) {                       // each level reads the one just written
       vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite);  // a global barrier: images in GENERAL too
       pc.size = s.sourceSize >> l;
       vk::DescriptorWriter(ctx, down.layout, 0, VK_NULL_HANDLE)
@@ -126,7 +138,8 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     }
     timer.mark(cb, "env mips");
 
-    vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kCompute}, {specular_.tracked(), vk::Use::Storage, kCompute, true},
+    vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kCompute},
+                     {specular_.tracked(), vk::Use::Storage, kCompute, true},
                      {lut_.tracked(), vk::Use::Storage, kCompute, true}});
     spec.bind(cb);
     pc.srcLevels = sourceLevels;
@@ -168,7 +181,8 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
 
     // Ready for shading in compute or fragment shaders.
     constexpr VkPipelineStageFlags2 kShading = kCompute | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-    vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kShading}, {specular_.tracked(), vk::Use::Sampled, kShading},
+    vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kShading},
+                     {specular_.tracked(), vk::Use::Sampled, kShading},
                      {lut_.tracked(), vk::Use::Sampled, kShading}});
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead | vk::kFragmentRead);  // the sh buffer
   });

@@ -20,10 +20,10 @@ class PipelineLayout;
 namespace rtr::render {
 
 struct EnvironmentMapSettings {
-  uint32_t sourceSize = 0;     // source cube face; 0: a quarter of the map's width, 32..512, a power of two
-  uint32_t specularSize = 128; // level 0 of the specular cube (roughness 0)
-  uint32_t specularLevels = 5; // roughness (level / (levels - 1)); the last level is at least 8²
-  uint32_t samples = 512;      // half vectors per texel of specular level 1, doubling each level down (level 0: one)
+  uint32_t sourceSize = 0;      // source cube face; 0: a quarter of the map's width, 32..512, a power of two
+  uint32_t specularSize = 128;  // level 0 of the specular cube (roughness 0)
+  uint32_t specularLevels = 5;  // roughness (level / (levels - 1)); the last level is at least 8²
+  uint32_t samples = 512;       // half vectors per texel of specular level 1, doubling each level down (level 0: one)
   uint32_t lutSize = 64;
   uint32_t lutSamples = 256;
 };
@@ -37,8 +37,8 @@ class EnvironmentMaps {
   const vk::Image& specular() const { return specular_; }  // RGBA16F cube, roughness per mip
   // RGBA16F (A, B, C, 0), lutSize wide and 2 lutSize high: Beckmann's rows, then GGX's (envLutUv).
   const vk::Image& brdfLut() const { return lut_; }
-  VkBuffer sh() const { return sh_.handle(); }             // 9 vec4: rgb coefficients
-  VkSampler sampler() const { return sampler_; }           // linear, mips, clamped
+  VkBuffer sh() const { return sh_.handle(); }    // 9 vec4: rgb coefficients
+  VkSampler sampler() const { return sampler_; }  // linear, mips, clamped
   const EnvironmentMapSettings& settings() const { return settings_; }
   // GPU milliseconds of each pass of the build, in order: cube, source mips, specular, sh, lut.
   const std::vector<std::pair<std::string, double>>& times() const { return times_; }

@@ -91,7 +91,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
     texturedMaterials_ = materials;
-    for (shader::GpuMaterial& g : materials) g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
+    for (shader::GpuMaterial& g : materials)
+      g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
   }
   uploadGeometry(plan, materials, upload);
   stats_.geometryMs = msSince(t);
@@ -157,8 +158,7 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
       if (autoSmall(mipMode_, s.extent)) chain = hostMipChain(texels, formats_[i]);
       const std::vector<uint8_t>& bytes = chain.offsets.empty() ? texels.texels : chain.bytes;
       s.levels = std::move(chain.offsets);
-      s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                            vk::MemoryUse::Upload);
+      s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
       std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
       s.buffer.flush();
       done();
@@ -182,7 +182,11 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   p.anyUv1 = any([](const Mesh& m) { return !m.texcoords1.empty(); });
   p.anyTangents = any([](const Mesh& m) { return !m.tangents.empty(); });
   p.anyColors = any([](const Mesh& m) { return !m.colors.empty(); });
-  struct MeshDraw { DrawItem item; DrawKind kind; uint32_t flags; };
+  struct MeshDraw {
+    DrawItem item;
+    DrawKind kind;
+    uint32_t flags;
+  };
   std::vector<std::optional<MeshDraw>> meshDraw(scene.meshes.size());
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
@@ -207,9 +211,8 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     const DrawKind kind = !textured ? DrawKind::Untextured : flags ? DrawKind::AlphaMasked : DrawKind::Opaque;
     d.id = uint32_t(p.draws.size());
     p.draws.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
-                       (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u) |
-                           (m.colors.empty() ? 0u : DRAW_COLORS) | (m.tangents.empty() ? 0u : DRAW_TANGENTS) |
-                           (m.texcoords1.empty() ? 0u : DRAW_UV1)});
+                       (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u) | (m.colors.empty() ? 0u : DRAW_COLORS) |
+                           (m.tangents.empty() ? 0u : DRAW_TANGENTS) | (m.texcoords1.empty() ? 0u : DRAW_UV1)});
     meshDraw[mi] = MeshDraw{d, kind, flags};
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
@@ -274,7 +277,10 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
                                           : glm::vec4(c * u.scale.x, sn * u.scale.y, u.offset.x, float(u.texCoord));
       g.uvTransform[2 * s + 1] = u.identity() ? glm::vec4(0, 1, 0, 0) : glm::vec4(-sn * u.scale.x, c * u.scale.y, u.offset.y, 0);
     }
-    auto tex = [&](TextureSlot s) { uint32_t t = m.texture(s); return t == kNoTexture ? NO_TEXTURE : gpuIndex[t]; };
+    auto tex = [&](TextureSlot s) {
+      uint32_t t = m.texture(s);
+      return t == kNoTexture ? NO_TEXTURE : gpuIndex[t];
+    };
     g.textures = glm::uvec4(tex(TextureSlot::BaseColor), tex(TextureSlot::Roughness), tex(TextureSlot::Metalness),
                             tex(TextureSlot::AlphaMask));
     const uint32_t mask = m.texture(TextureSlot::AlphaMask);
@@ -320,10 +326,10 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&clusterLods_, bytes(plan.lods), plan.lods.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
-  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex, kVertex, kVertex, kIndex, kIndex, kStorage, kStorage,
+  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage, kStorage,
                                                        kStorage, kStorage, kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions", "normals", "texcoords", "indices16", "indices32", "materials",
-                                 "draws", "instances", "clusters", "texcoords1", "tangents", "colours", "cluster lods"};
+  const char* names[kTargets] = {"positions", "normals",  "texcoords",  "indices16", "indices32", "materials",   "draws",
+                                 "instances", "clusters", "texcoords1", "tangents",  "colours",   "cluster lods"};
   clusterCount_ = uint32_t(plan.clusters.size());
   baseClusterCount_ = uint32_t(plan.baseClusters);
   size_t stagingSize = 0;
@@ -483,8 +489,8 @@ void GpuScene::recordUpload(VkCommandBuffer cb) const {
   for (size_t i = 0; i < textures_.size(); ++i) {
     const uint32_t levels = hostMips_[i] ? textures_[i].mipLevels() : 1;
     toDst.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                     VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, levels});
+                     VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0,
+                     levels});
     if (hostMips_[i])
       ready.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                        VK_PIPELINE_STAGE_2_COPY_BIT,
@@ -548,7 +554,7 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings,
   si.magFilter = nearest || desc.nearestMag ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
   si.minFilter = nearest || desc.nearestMin ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
   si.mipmapMode = settings.filter == TextureFilter::Trilinear && !desc.nearestMip ? VK_SAMPLER_MIPMAP_MODE_LINEAR
-                                                                                 : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+                                                                                  : VK_SAMPLER_MIPMAP_MODE_NEAREST;
   auto wrap = [](Wrap w) {
     return w == Wrap::ClampToEdge      ? VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
            : w == Wrap::MirroredRepeat ? VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT

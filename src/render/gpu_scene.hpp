@@ -21,7 +21,9 @@
 #include "vk/commands.hpp"
 #include "vk/resources.hpp"
 
-namespace rtr::vk { class Context; }
+namespace rtr::vk {
+class Context;
+}
 
 namespace rtr::render {
 
@@ -33,15 +35,15 @@ constexpr size_t kDrawKindCount = size_t(DrawKind::Count);
 // One instanced draw: a mesh under a range of instances (all mirrored or none: the front face is per draw).
 struct DrawItem {
   uint32_t material = 0;
-  uint32_t indexCount = 0;   // the mesh's own triangles (what a hardware draw draws)
-  uint32_t primitives = 0;   // triangles its ids may name: the mesh's, then its hierarchy's (Mesh::lod)
-  uint32_t firstIndex = 0;   // in the index buffer of its type
+  uint32_t indexCount = 0;  // the mesh's own triangles (what a hardware draw draws)
+  uint32_t primitives = 0;  // triangles its ids may name: the mesh's, then its hierarchy's (Mesh::lod)
+  uint32_t firstIndex = 0;  // in the index buffer of its type
   int32_t vertexOffset = 0;
   VkIndexType indexType = VK_INDEX_TYPE_UINT32;
-  uint32_t id = 0;           // index of its mesh's GpuDraw in drawInfo()
+  uint32_t id = 0;                                // index of its mesh's GpuDraw in drawInfo()
   uint32_t firstInstance = 0, instanceCount = 1;  // range of the instance buffer (gl_InstanceIndex)
-  bool mirrored = false;     // its instances flip the winding: front faces are clockwise
-  glm::vec3 center{0.0f};    // of its instances' scene-space box (frames draw the nearest first)
+  bool mirrored = false;                          // its instances flip the winding: front faces are clockwise
+  glm::vec3 center{0.0f};                         // of its instances' scene-space box (frames draw the nearest first)
 };
 // A draw of a glTF BLEND material: one instance each (the transparency pass sorts them per frame), in
 // neither draws() nor the clusters (they write no visibility id or depth).
@@ -55,10 +57,10 @@ struct GeometryPlan;
 // (pipeline creation for the mips aside, which the context's pipeline cache counts).
 struct GpuSceneStats {
   uint32_t meshes = 0, triangles = 0, vertices = 0, textures = 0, meshes16 = 0;  // stored once each
-  uint32_t instances = 0;       // placements drawn (GpuInstance records)
-  double decodeMs = 0;          // texture files decoded on all cores, into staging memory
-  double geometryMs = 0;        // vertex and index streams laid out, written and (where needed) copied
-  double textureUploadMs = 0;   // staging memory to level 0 of each texture
+  uint32_t instances = 0;                                                        // placements drawn (GpuInstance records)
+  double decodeMs = 0;              // texture files decoded on all cores, into staging memory
+  double geometryMs = 0;            // vertex and index streams laid out, written and (where needed) copied
+  double textureUploadMs = 0;       // staging memory to level 0 of each texture
   double mipsMs = 0, mipGpuMs = 0;  // mip chains: wall time, and the GPU's share of it
   size_t geometryBytes = 0;
 };
@@ -70,7 +72,8 @@ using LoadProgress = std::function<void(const char* what, size_t done, size_t to
 // level, filtered linearly within it; or nearest texel of the nearest level. Anisotropy 1 is off.
 enum class TextureFilter { Trilinear, NearestMip, Nearest };
 constexpr std::array<EnumName<TextureFilter>, 3> enumNames(TextureFilter) {
-  return {{{TextureFilter::Trilinear, "trilinear"}, {TextureFilter::NearestMip, "nearest-mip"}, {TextureFilter::Nearest, "nearest"}}};
+  return {
+      {{TextureFilter::Trilinear, "trilinear"}, {TextureFilter::NearestMip, "nearest-mip"}, {TextureFilter::Nearest, "nearest"}}};
 }
 struct SamplerSettings {
   TextureFilter filter = TextureFilter::Trilinear;
@@ -122,7 +125,7 @@ class GpuScene {
   VkBuffer indices16() const { return indices16_.handle(); }
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }
-  VkBuffer drawInfo() const { return drawInfo_.handle(); }  // GpuDraw per draw, for shading in compute
+  VkBuffer drawInfo() const { return drawInfo_.handle(); }    // GpuDraw per draw, for shading in compute
   VkBuffer instances() const { return instances_.handle(); }  // GpuInstance (frame.h), gpuInstances() order
   uint32_t instanceCount() const { return stats_.instances; }
   // GpuCluster (cluster.h): every instance's full-detail clusters (the first baseClusterCount(), instance by
@@ -141,7 +144,7 @@ class GpuScene {
 
  private:
   std::vector<uint32_t> startTextures(const Scene& scene, TextureLoad load);  // decode (or start to)
-  GeometryPlan planGeometry(const Scene& scene);  // draws_, stats_ and the records
+  GeometryPlan planGeometry(const Scene& scene);                              // draws_, stats_ and the records
   std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
   void uploadGeometry(const GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials, GeometryUpload upload);
   void finishTextures();  // staging buffers to images, mips (a waited load)
@@ -157,14 +160,14 @@ class GpuScene {
     VkExtent2D extent;
     std::vector<VkDeviceSize> levels;  // a chain made on the CPU: each level's offset; else empty
   };
-  std::vector<bool> hostMips_;  // per texture: its chain was made on the CPU (uploaded whole)
-  std::vector<const vk::Image*> gpuMipBatch() const;  // the textures whose chains the GPU makes
-  std::vector<Staged> staged_;     // decoded texels, until uploaded
-  std::vector<VkFormat> formats_;  // of each texture
+  std::vector<bool> hostMips_;                          // per texture: its chain was made on the CPU (uploaded whole)
+  std::vector<const vk::Image*> gpuMipBatch() const;    // the textures whose chains the GPU makes
+  std::vector<Staged> staged_;                          // decoded texels, until uploaded
+  std::vector<VkFormat> formats_;                       // of each texture
   std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in
   std::atomic<size_t> decoded_{0};
-  std::future<void> decoding_;     // a deferred load's decode, until taken in
-  bool ready_ = false;             // the textures are on the GPU and the materials point at them
+  std::future<void> decoding_;  // a deferred load's decode, until taken in
+  bool ready_ = false;          // the textures are on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
@@ -172,7 +175,7 @@ class GpuScene {
   uint32_t clusterCount_ = 0, baseClusterCount_ = 0;
   std::vector<vk::Image> textures_;
   std::vector<SamplerDesc> samplers_;  // of each texture (Texture::sampler)
-  struct PendingUpload {  // alive until its submission completed
+  struct PendingUpload {               // alive until its submission completed
     explicit PendingUpload(const vk::Context& ctx) : mips(ctx), timer(ctx, 1) {}
     MipGenerator mips;
     MipViews views;

@@ -9,8 +9,8 @@ namespace rtr::render {
 HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent)
     : ctx_(ctx), extent_(extent), renderer_(ctx, scene, 1), ring_(ctx, 1) {
   target_ = vk::Image(ctx, {extent, VK_FORMAT_R8G8B8A8_UNORM, 1,
-                            VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                            0, 0, "headless target"});
+                            VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0,
+                            0, "headless target"});
   const VkDeviceSize pixels = VkDeviceSize(extent.width) * extent.height;
   readback_ = vk::Buffer(ctx, pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "target readback");
 }
@@ -24,8 +24,8 @@ void HeadlessRenderer::frame(const CameraPose& pose, const Lens& lens, const Ren
   ring_.waitIdle();
 }
 
-HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
-                                       int frames, bool readSceneColor) {
+HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings, int frames,
+                                       bool readSceneColor) {
   const VkDeviceSize pixels = VkDeviceSize(extent_.width) * extent_.height;
   if (readSceneColor && !colorReadback_.handle())
     colorReadback_ = vk::Buffer(ctx_, pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "colour readback");

@@ -10,8 +10,8 @@
 namespace rtr::render {
 
 struct HeadlessFrame {
-  ImageRGBA8 image;   // the post-processed target, as a viewer would show it (sRGB-encoded)
-  ImageF sceneColor;  // the linear-light intermediate image (filled when asked for)
+  ImageRGBA8 image;                                      // the post-processed target, as a viewer would show it (sRGB-encoded)
+  ImageF sceneColor;                                     // the linear-light intermediate image (filled when asked for)
   std::vector<std::pair<std::string, double>> gpuTimes;  // ms per pass, of the last frame
 };
 
@@ -31,9 +31,7 @@ class HeadlessRenderer {
                                                                  const RenderSettings& settings, int frames);
 
  private:
-  RenderTarget target() const {
-    return {target_.tracked(), target_.view(), target_.format(), extent_};
-  }
+  RenderTarget target() const { return {target_.tracked(), target_.view(), target_.format(), extent_}; }
   // One frame through Renderer::frame, as the window app's; `after` records more into it. Waits for it.
   void frame(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
              const std::function<void(VkCommandBuffer)>& after = {});

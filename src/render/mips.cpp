@@ -45,9 +45,7 @@ bool axisFits(uint32_t size0, uint32_t levels) {
 
 }  // namespace
 
-bool autoSmall(MipMode mode, VkExtent2D e) {
-  return mode == MipMode::Auto && uint64_t(e.width) * e.height <= kAutoSmallTexels;
-}
+bool autoSmall(MipMode mode, VkExtent2D e) { return mode == MipMode::Auto && uint64_t(e.width) * e.height <= kAutoSmallTexels; }
 
 MipMode autoMipMode(MipMode mode, VkExtent2D e) {
   if (mode != MipMode::Auto) return mode;
@@ -124,7 +122,10 @@ HostMipChain hostMipChain(const TexelData& level0, VkFormat format) {
 
 uint32_t mipLevelCount(VkExtent2D e) {
   uint32_t m = std::max(e.width, e.height), n = 0;
-  while (m) { ++n; m >>= 1; }
+  while (m) {
+    ++n;
+    m >>= 1;
+  }
   return n;
 }
 
@@ -133,8 +134,8 @@ vk::ImageDesc textureDesc(VkExtent2D extent, VkFormat format, const char* name) 
   d.extent = extent;
   d.format = format;
   d.mipLevels = mipLevelCount(extent);
-  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-            VK_IMAGE_USAGE_STORAGE_BIT;
+  d.usage =
+      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
   if (isSrgb(format)) {
     d.flags = VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT | VK_IMAGE_CREATE_EXTENDED_USAGE_BIT;
     d.viewUsage = d.usage & ~VK_IMAGE_USAGE_STORAGE_BIT;
@@ -152,8 +153,8 @@ std::vector<MipDispatch> planMipDispatches(VkExtent2D extent) {
     d.srcLevel = s;
     const VkExtent2D src{levelSize(extent.width, s), levelSize(extent.height, s)};
     uint32_t even = 0;
-    while (even < MIP_MAX_LEVELS_PER_DISPATCH && s + even + 1 < total &&
-           halves(levelSize(extent.width, s + even)) && halves(levelSize(extent.height, s + even)))
+    while (even < MIP_MAX_LEVELS_PER_DISPATCH && s + even + 1 < total && halves(levelSize(extent.width, s + even)) &&
+           halves(levelSize(extent.height, s + even)))
       ++even;
     d.even = even > 0;
     if (d.even) {
@@ -174,8 +175,7 @@ MipGenerator::MipGenerator(const vk::Context& ctx) : ctx_(ctx) {}
 
 const vk::Pipeline& MipGenerator::pipeline(bool even) const {
   std::optional<vk::Pipeline>& p = even ? even_ : general_;
-  if (!p) p = vk::makeComputePipeline(ctx_, vk::loadShader(even ? "mips_even.comp" : "mips.comp"),
-                                      {.pushDescriptorSets = {0}});
+  if (!p) p = vk::makeComputePipeline(ctx_, vk::loadShader(even ? "mips_even.comp" : "mips.comp"), {.pushDescriptorSets = {0}});
   return *p;
 }
 
@@ -185,11 +185,10 @@ void MipGenerator::recordBlit(VkCommandBuffer cb, const vk::Image& image) const 
   for (uint32_t i = 1; i < n; ++i) {
     // Level i-1 was just written (upload or previous blit): make it a blit source; level i a destination.
     vk::barrier(cb, {{img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_PIPELINE_STAGE_2_BLIT_BIT,
-                      VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, i - 1, 1},
-                     {img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_BLIT_BIT,
-                      VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, i, 1}});
+                      VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_PIPELINE_STAGE_2_BLIT_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                      VK_ACCESS_2_TRANSFER_READ_BIT, i - 1, 1},
+                     {img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                      VK_PIPELINE_STAGE_2_BLIT_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, i, 1}});
     VkImageBlit b{};
     b.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, i - 1, 0, 1};
     b.srcOffsets[1] = {int32_t(levelSize(image.extent().width, i - 1)), int32_t(levelSize(image.extent().height, i - 1)), 1};
@@ -284,8 +283,7 @@ void MipGenerator::recordCompute(VkCommandBuffer cb, std::span<const vk::Image* 
 
   for (size_t k = 0; k < steps; ++k) {
     // Step k - 1's float copies are step k's sources. One barrier for the whole batch.
-    if (k > 0)
-      vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead);
+    if (k > 0) vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead);
     const vk::Pipeline* bound = nullptr;
     for (size_t j = 0; j < jobs.size(); ++j) {
       const Job& job = jobs[j];
@@ -304,7 +302,8 @@ void MipGenerator::recordCompute(VkCommandBuffer cb, std::span<const vk::Image* 
       // Unused slots repeat the last level written, so every descriptor is valid and no extra level is touched.
       std::vector<VkDescriptorImageInfo> outs;
       for (uint32_t l = 1; l <= MIP_MAX_LEVELS_PER_DISPATCH; ++l)
-        outs.push_back({VK_NULL_HANDLE, views.storage[job.base + d.srcLevel + std::min(l, d.levels) - 1], VK_IMAGE_LAYOUT_GENERAL});
+        outs.push_back(
+            {VK_NULL_HANDLE, views.storage[job.base + d.srcLevel + std::min(l, d.levels) - 1], VK_IMAGE_LAYOUT_GENERAL});
       w.images(2, outs);
       w.buffer(3, views.scratch.handle(), job.region[k], job.regionSize[k]);
       w.push(cb, p);

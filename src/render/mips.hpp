@@ -36,7 +36,7 @@ constexpr std::array<EnumName<MipMode>, 3> enumNames(MipMode) {
 // compute is faster than blit below it, blit faster above; and a process's first blits and compute
 // pipelines cost compilation there, which the CPU chains avoid.
 constexpr uint64_t kAutoSmallTexels = 128 * 128;
-bool autoSmall(MipMode mode, VkExtent2D extent);  // Auto, and an image of at most kAutoSmallTexels
+bool autoSmall(MipMode mode, VkExtent2D extent);       // Auto, and an image of at most kAutoSmallTexels
 MipMode autoMipMode(MipMode mode, VkExtent2D extent);  // on the GPU: `mode` itself unless Auto
 
 // The whole chain of an 8-bit texture (1 or 4 channels, sRGB as in `format`) on the CPU: the float64 box

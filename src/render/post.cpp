@@ -32,9 +32,11 @@ void MosaicPass::record(VkCommandBuffer cb, vk::TrackedImage input, VkImageView 
   const VkExtent2D block = mode == MosaicMode::Off ? VkExtent2D{1, 1} : block_;
   const shader::MosaicPush push{{int(block.width), int(block.height)}, {int(extent.width), int(extent.height)}};
   const bool raster = mode == MosaicMode::Graphics;
-  const VkPipelineStageFlags2 stage = raster ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-  vk::require(cb, {{input, vk::Use::Sampled, raster ? VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
-                   {output, raster ? vk::Use::ColorAttachment : vk::Use::Storage, stage, true}});
+  const VkPipelineStageFlags2 stage =
+      raster ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  vk::require(
+      cb, {{input, vk::Use::Sampled, raster ? VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT},
+           {output, raster ? vk::Use::ColorAttachment : vk::Use::Storage, stage, true}});
   if (raster) {
     const vk::Pipeline& p = graphics(outputFormat);
     vk::beginColorRendering(cb, outputView, extent, VK_ATTACHMENT_LOAD_OP_DONT_CARE);  // the triangle covers all

@@ -39,9 +39,10 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   hwList_ = vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryUse::Device,
                        "raster hand-off");
-  largeList_ = vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
-                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                          vk::MemoryUse::Device, "raster tiles");
+  largeList_ =
+      vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                 vk::MemoryUse::Device, "raster tiles");
   cullReadback_ = vk::Buffer(ctx, 2 * sizeof(shader::CullCounts) * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryUse::Readback, "cull counts read-back");
 }
@@ -52,8 +53,8 @@ std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame)
   shader::CullCounts c[2];
   std::memcpy(c, static_cast<const char*>(cullReadback_.mapped()) + sizeof c * frame, sizeof c);
   const uint32_t early = twoPhase_.at(frame) ? c[0].listed : 0, earlyTriangles = twoPhase_.at(frame) ? c[0].triangles : 0;
-  return CullStats{scene_.clusterCount(), early, c[1].listed, c[1].culled[0], c[1].culled[1], c[1].culled[2],
-                   c[1].culled[3], earlyTriangles + c[1].triangles};
+  return CullStats{scene_.clusterCount(), early,          c[1].listed,    c[1].culled[0],
+                   c[1].culled[1],        c[1].culled[2], c[1].culled[3], earlyTriangles + c[1].triangles};
 }
 
 void ComputeRaster::resize(VkExtent2D extent) {
@@ -87,9 +88,20 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
       if (b.set != 0) continue;
       const VkBuffer list = culler_ ? culler_->visible() : scene_.clusters();  // not read without culling
       const VkBuffer counts = culler_ ? culler_->counts() : scene_.clusters();
-      const VkBuffer buffers[] = {uniforms.buffer, scene_.clusters(), scene_.drawInfo(), scene_.positions(),
-                                  i32, i16, vis_.handle(), hwList_.handle(), scene_.materials(), uv,
-                                  largeList_.handle(), list, counts, scene_.instances()};
+      const VkBuffer buffers[] = {uniforms.buffer,
+                                  scene_.clusters(),
+                                  scene_.drawInfo(),
+                                  scene_.positions(),
+                                  i32,
+                                  i16,
+                                  vis_.handle(),
+                                  hwList_.handle(),
+                                  scene_.materials(),
+                                  uv,
+                                  largeList_.handle(),
+                                  list,
+                                  counts,
+                                  scene_.instances()};
       if (b.binding == 0) w.buffer(0, uniforms.buffer, uniforms.offset, sizeof(shader::FrameUniforms));
       else w.buffer(b.binding, buffers[b.binding]);
     }

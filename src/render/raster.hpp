@@ -39,9 +39,9 @@ class ComputeRaster {
   VkDescriptorSet textureSet() const { return hardware_.layout.setCount() > 1 ? textures_.get(1) : VK_NULL_HANDLE; }
   // The culling counts of the last completed use of `frame` (none if it did not cull).
   struct CullStats {
-    uint32_t clusters = 0, early = 0, late = 0;  // listed by each phase (one pass: late)
+    uint32_t clusters = 0, early = 0, late = 0;              // listed by each phase (one pass: late)
     uint32_t frustum = 0, cone = 0, occlusion = 0, lod = 0;  // culled, by the late phase (every cluster tested)
-    uint32_t triangles = 0;  // of the listed clusters, both phases
+    uint32_t triangles = 0;                                  // of the listed clusters, both phases
   };
   std::optional<CullStats> cullStats(uint32_t frame) const;
 
@@ -54,9 +54,9 @@ class ComputeRaster {
   VkExtent2D extent_{0, 0};
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
   std::optional<DepthPyramid> pyramid_;
-  vk::Buffer cullReadback_;              // per frame in flight: the early and the late CullCounts
-  std::vector<bool> culled_;             // per frame in flight: whether its last use culled
-  std::vector<bool> twoPhase_;           // per frame in flight: whether that was in two phases
+  vk::Buffer cullReadback_;     // per frame in flight: the early and the late CullCounts
+  std::vector<bool> culled_;    // per frame in flight: whether its last use culled
+  std::vector<bool> twoPhase_;  // per frame in flight: whether that was in two phases
 };
 
 }  // namespace rtr::render

@@ -41,11 +41,7 @@ std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const
 }
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx),
-      scene_(scene),
-      framesInFlight_(framesInFlight),
-      texturesBound_(scene.texturesReady()),
-      post_(ctx) {
+    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), texturesBound_(scene.texturesReady()), post_(ctx) {
   makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 13);  // at most: ComputeRaster::record's nine passes, shade, transparent, post
@@ -73,7 +69,7 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
 
 ShadingPath Renderer::pathFor(const RenderSettings& s) const {
   return s.shading == ShadingPath::Visibility && s.mode == VIEW_SHADED && canUseVisibility_ ? ShadingPath::Visibility
-                                                                                           : ShadingPath::Forward;
+                                                                                            : ShadingPath::Forward;
 }
 
 RasterPath Renderer::rasterFor(const RenderSettings& s) const {
@@ -85,8 +81,8 @@ RasterPath Renderer::rasterFor(const RenderSettings& s) const {
   return canHardware_ ? RasterPath::Hardware : RasterPath::Compute;
 }
 
-Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* frag, VkFormat colorFormat,
-                                                VkCullModeFlags cull, std::vector<vk::SpecializationConstant> variant) const {
+Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull,
+                                                std::vector<vk::SpecializationConstant> variant) const {
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader(vert), vk::loadShader(frag)};
   d.specialization = std::move(variant);
@@ -147,15 +143,15 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
   vk::LayoutOptions options{.pushDescriptorSets = {0}};
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
   VisShade v;
-  v.pipeline.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
-                                             {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}, {VARIANT_ENV, env_ != nullptr}}));
+  v.pipeline.emplace(
+      vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
+                              {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}, {VARIANT_ENV, env_ != nullptr}}));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
   }
   return v;
 }
-
 
 void Renderer::setEnvironment(std::shared_ptr<const EnvironmentMaps> env) {
   VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
@@ -198,7 +194,8 @@ void Renderer::rebuildPipelines() {
     if (shade_[size_t(r)].pipeline) shade[size_t(r)] = makeShade(r == RasterPath::Compute);
   if (raster_) raster.emplace(ctx_, scene_, framesInFlight_);
   std::optional<vk::Pipeline> backdrop;
-  if (backdrop_) backdrop.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
+  if (backdrop_)
+    backdrop.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
   std::optional<TransparencyPass> transparency;
   if (transparency_) transparency.emplace(ctx_, scene_, env_.get());
   vkDeviceWaitIdle(ctx_.device());
@@ -263,8 +260,8 @@ void Renderer::createTargets(VkExtent2D extent, bool visibility) {
   }
   if (visibility && !vis_.handle())
     vis_ = vk::Image(ctx_, {extent, kVisFormat, 1,
-                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0,
-                            "visibility"});
+                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0,
+                            0, "visibility"});
 }
 
 void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye) {
@@ -384,14 +381,15 @@ void Renderer::frame(FrameContext& fc) {
   for (uint32_t i = 0; i < u.lightCount.x; ++i) {
     const Light& l = s.lights.lights[i];
     const glm::vec3 p = l.kind == Light::Kind::Headlight ? pose.position : l.position;
-    u.lights[i] = shader::makeGpuLight(unsigned(l.kind), p, l.color, l.falloff, l.direction, l.innerConeCos,
-                                       l.outerConeCos, l.range);
+    u.lights[i] =
+        shader::makeGpuLight(unsigned(l.kind), p, l.color, l.falloff, l.direction, l.innerConeCos, l.outerConeCos, l.range);
   }
   u.params = glm::vec4(float(s.mode), s.lodBias, lens.zNear, lens.zFar);
   if (env_) {
     const EnvironmentMapSettings& es = env_->settings();
-    u.environment = glm::vec4(float(es.specularLevels - 1), s.backdropBlur < 0.0f ? ENV_BACKDROP_COLOR : std::min(s.backdropBlur, 1.0f),
-                              float(es.lutSize), 0.0f);
+    u.environment =
+        glm::vec4(float(es.specularLevels - 1), s.backdropBlur < 0.0f ? ENV_BACKDROP_COLOR : std::min(s.backdropBlur, 1.0f),
+                  float(es.lutSize), 0.0f);
   }
   u.background = glm::vec4(s.background, 0.0f);
   u.options.x = s.brdf ? uint32_t(*s.brdf) + 1u : 0u;
@@ -414,7 +412,8 @@ void Renderer::frame(FrameContext& fc) {
 
   if (env_) {  // left sampled by their build; a read-back (tests) may have moved them since
     constexpr VkPipelineStageFlags2 kShading = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-    vk::require(cb, {{env_->source().tracked(), vk::Use::Sampled, kShading}, {env_->specular().tracked(), vk::Use::Sampled, kShading},
+    vk::require(cb, {{env_->source().tracked(), vk::Use::Sampled, kShading},
+                     {env_->specular().tracked(), vk::Use::Sampled, kShading},
                      {env_->brdfLut().tracked(), vk::Use::Sampled, kShading}});
   }
   vk::GpuTimer& timer = timers_[frame];
@@ -449,8 +448,8 @@ void Renderer::frame(FrameContext& fc) {
 }
 
 // The scene pass by the hardware: forward colour or visibility ids, with depth.
-void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye,
-                          const glm::vec3& background, bool backdrop) {
+void Renderer::rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye, const glm::vec3& background,
+                          bool backdrop) {
   const bool visibility = set == kVisibility;
   // Old contents are discarded; the tracker waits for the previous frame's readers (post or shading pass).
   const vk::Image& target0 = visibility ? vis_ : color_;

@@ -40,7 +40,7 @@ constexpr std::array<EnumName<RasterPath>, 3> enumNames(RasterPath) {
 }
 
 struct RenderSettings {
-  int mode = VIEW_SHADED;         // VIEW_* from frame.h
+  int mode = VIEW_SHADED;                         // VIEW_* from frame.h
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   RasterPath raster = RasterPath::Auto;
   // Compute raster only: two-phase cluster culling (docs/culling.md); never changes the image. Off by default:
@@ -51,7 +51,7 @@ struct RenderSettings {
   // (docs/virtual-geometry.md); 0: full detail, exactly the image without a hierarchy.
   float lodError = 0.0f;  // rtr-view: --lod-error, default 1
   float lodBias = 0.0f;
-  SamplerSettings sampler;        // how scene textures are filtered (mip experiments)
+  SamplerSettings sampler;  // how scene textures are filtered (mip experiments)
   MosaicMode mosaic = MosaicMode::Compute;
   // The shaded view's lights (at most MAX_LIGHTS; a headlight follows the camera) and ambient colour;
   // the apps resolve them once from the scene and the command line (scene/lights.hpp).
@@ -159,13 +159,13 @@ class Renderer {
   SamplerSettings samplerSettings_;
   std::vector<vk::Sampler> samplers_;  // made from samplerSettings_, one per distinct SamplerDesc
   std::vector<VkDescriptorImageInfo> textureInfos_;
-  bool texturesBound_;   // the scene's textures were ready when the texture sets were written
+  bool texturesBound_;               // the scene's textures were ready when the texture sets were written
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
-  std::array<VisShade, 3> shade_;  // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
+  std::array<VisShade, 3> shade_;        // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
   std::optional<ComputeRaster> raster_;  // built on first use
   std::shared_ptr<const EnvironmentMaps> env_;
-  std::optional<vk::Pipeline> backdrop_;  // the forward path's environment backdrop, on first use
+  std::optional<vk::Pipeline> backdrop_;          // the forward path's environment backdrop, on first use
   std::optional<TransparencyPass> transparency_;  // a scene with blended draws only
   RasterPath lastRaster_ = RasterPath::Auto;
   bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;

@@ -36,8 +36,8 @@ std::string StartupTimeline::format(double totalMs) const {
     out += line;
     sum += ms;
   }
-  std::snprintf(line, sizeof line, "  %-58s %9.1f\n  %-58s %9.1f\n", "sum of the phases", sum,
-                "total from process start", totalMs);
+  std::snprintf(line, sizeof line, "  %-58s %9.1f\n  %-58s %9.1f\n", "sum of the phases", sum, "total from process start",
+                totalMs);
   return out + line;
 }
 
@@ -45,10 +45,8 @@ DeviceDefaults deviceDefaults(VkPhysicalDeviceType type) {
   // A CPU rasteriser (lavapipe) pays the same for fragment and compute work, so the visibility path's
   // extra pass only costs; its blit chain beats the compute mips on large textures, and small ones' chains
   // are cheapest made on the CPU (no pipeline or blit shader to compile): Auto.
-  if (type == VK_PHYSICAL_DEVICE_TYPE_CPU)
-    return {ShadingPath::Forward, MipMode::Auto, "a CPU device, measured fastest there"};
-  return {ShadingPath::Visibility, MipMode::Compute,
-          "a GPU, measured fastest with a discrete one"};
+  if (type == VK_PHYSICAL_DEVICE_TYPE_CPU) return {ShadingPath::Forward, MipMode::Auto, "a CPU device, measured fastest there"};
+  return {ShadingPath::Visibility, MipMode::Compute, "a GPU, measured fastest with a discrete one"};
 }
 
 }  // namespace rtr::render

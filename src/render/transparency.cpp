@@ -59,7 +59,8 @@ void TransparencyPass::record(VkCommandBuffer cb, const vk::UploadArena::Slice& 
   // (never nearer than anything) where the compute rasteriser's word holds the opaque depth.
   vk::require(cb, {{color.tracked(), vk::Use::ColorAttachment, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT},
                    {depth.tracked(), vk::Use::DepthAttachment,
-                    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, opaqueIds != VK_NULL_HANDLE}});
+                    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                    opaqueIds != VK_NULL_HANDLE}});
   VkRenderingAttachmentInfo colorAtt{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   colorAtt.imageView = color.view();
   colorAtt.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;

@@ -129,7 +129,8 @@ std::shared_ptr<const BakedTexels> packBakedTexels(BakedFormat format, uint32_t 
   t->width = width;
   t->height = height;
   const uint64_t bytes = t->bytes();
-  if (chain.size() != bytes) throw Error("baked texels: " + std::to_string(chain.size()) + " bytes for a chain of " + std::to_string(bytes));
+  if (chain.size() != bytes)
+    throw Error("baked texels: " + std::to_string(chain.size()) + " bytes for a chain of " + std::to_string(bytes));
   const size_t count = size_t((bytes + kBakedPiece - 1) / kBakedPiece);
   std::vector<std::vector<uint8_t>> packed(count);
   parallelFor(count, threads, [&](size_t k) {

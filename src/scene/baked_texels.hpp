@@ -29,7 +29,7 @@ std::vector<uint8_t> encodeBakedLevel(BakedFormat f, uint32_t width, uint32_t he
 constexpr size_t kBakedPiece = size_t(1) << 18;  // bytes of texels per piece (the last one of a texture shorter)
 
 struct BakedPiece {
-  uint64_t at = 0;     // offset of its stored bytes in `BakedTexels::data`
+  uint64_t at = 0;      // offset of its stored bytes in `BakedTexels::data`
   uint32_t stored = 0;  // bytes stored; == its texel bytes: stored as they are, else one zstd frame
 };
 
@@ -37,9 +37,9 @@ struct BakedTexels {
   BakedFormat format = BakedFormat::Rgba8;
   uint32_t width = 0, height = 0;  // of level 0; the chain goes down to 1 x 1 (mipLevelCount)
   std::vector<BakedPiece> pieces;
-  std::span<const uint8_t> data;   // the stored pieces (in the mapped file, or `owner`'s bytes)
+  std::span<const uint8_t> data;      // the stored pieces (in the mapped file, or `owner`'s bytes)
   std::shared_ptr<const void> owner;  // keeps `data` alive
-  std::string file;                // for messages: the file, and the offset of `data` in it
+  std::string file;                   // for messages: the file, and the offset of `data` in it
   uint64_t fileOffset = 0;
 
   uint32_t levels() const;

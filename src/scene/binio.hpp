@@ -19,25 +19,29 @@ namespace rtr {
 static_assert(std::endian::native == std::endian::little, "the baked formats are little-endian");
 
 class ByteWriter {
-public:
+ public:
   void bytes(const void* p, size_t n) { out_.append(static_cast<const char*>(p), n); }
   template <class T>
-  void pod(const T& v) { bytes(&v, sizeof v); }
+  void pod(const T& v) {
+    bytes(&v, sizeof v);
+  }
   void u8(uint8_t v) { pod(v); }
   void u32(uint32_t v) { pod(v); }
   void f32(float v) { pod(v); }
   template <class T>
-  void array(const std::vector<T>& v) { bytes(v.data(), v.size() * sizeof(T)); }
+  void array(const std::vector<T>& v) {
+    bytes(v.data(), v.size() * sizeof(T));
+  }
   void pad(size_t align) { out_.append((align - out_.size() % align) % align, '\0'); }
   size_t size() const { return out_.size(); }
   std::string& data() { return out_; }
 
-private:
+ private:
   std::string out_;
 };
 
 class ByteReader {
-public:
+ public:
   ByteReader(std::span<const uint8_t> data, std::string file) : d_(data), file_(std::move(file)) {}
 
   [[noreturn]] void fail(const std::string& what) const { failAt(pos_, what); }
@@ -48,8 +52,8 @@ public:
   size_t remaining() const { return d_.size() - pos_; }
   void need(size_t n, const char* what) const {
     if (n > remaining())
-      fail(std::string("file ends inside ") + what + " (needs " + std::to_string(n) + " bytes, " +
-           std::to_string(remaining()) + " left)");
+      fail(std::string("file ends inside ") + what + " (needs " + std::to_string(n) + " bytes, " + std::to_string(remaining()) +
+           " left)");
   }
   void raw(void* dst, size_t n, const char* what) {
     need(n, what);
@@ -70,15 +74,15 @@ public:
     const size_t at = pos_;
     uint32_t n = u32(what);
     if (minBytes && uint64_t(n) * minBytes > remaining())
-      failAt(at, std::string(what) + " " + std::to_string(n) + " cannot fit in the " + std::to_string(remaining()) +
-                     " bytes left");
+      failAt(at,
+             std::string(what) + " " + std::to_string(n) + " cannot fit in the " + std::to_string(remaining()) + " bytes left");
     return n;
   }
   // Passes over n elements of `size` bytes (to be read in place later); returns where they start.
   size_t skipArray(size_t n, size_t size, const char* what) {
     if (n > remaining() / size)
-      fail(std::string("file ends inside ") + what + " (" + std::to_string(n) + " elements of " +
-           std::to_string(size) + " bytes, " + std::to_string(remaining()) + " bytes left)");
+      fail(std::string("file ends inside ") + what + " (" + std::to_string(n) + " elements of " + std::to_string(size) +
+           " bytes, " + std::to_string(remaining()) + " bytes left)");
     const size_t at = pos_;
     pos_ += n * size;
     return at;
@@ -89,7 +93,10 @@ public:
     v.resize(n);
     if (n) std::memcpy(v.data(), d_.data() + at, n * sizeof(T));
   }
-  void skip(size_t n, const char* what) { need(n, what); pos_ += n; }
+  void skip(size_t n, const char* what) {
+    need(n, what);
+    pos_ += n;
+  }
   void align(size_t a, const char* what) { skip((a - pos_ % a) % a, what); }
   std::string_view view(size_t n, const char* what) {
     need(n, what);
@@ -98,7 +105,7 @@ public:
     return s;
   }
 
-private:
+ private:
   std::span<const uint8_t> d_;
   std::string file_;
   size_t pos_ = 0;

@@ -52,8 +52,8 @@ std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
   std::vector<meshopt_Meshlet> ml(meshopt_buildMeshletsBound(tris.size(), kMaxV, kMaxT));
   std::vector<unsigned> verts(ml.size() * kMaxV);
   std::vector<unsigned char> local(ml.size() * kMaxT * 3);
-  ml.resize(meshopt_buildMeshlets(ml.data(), verts.data(), local.data(), l.indices.data(), l.indices.size(),
-                                  &l.positions[0].x, l.positions.size(), sizeof(glm::vec3), kMaxV, kMaxT, 0.0f));
+  ml.resize(meshopt_buildMeshlets(ml.data(), verts.data(), local.data(), l.indices.data(), l.indices.size(), &l.positions[0].x,
+                                  l.positions.size(), sizeof(glm::vec3), kMaxV, kMaxT, 0.0f));
   std::vector<Indices> out;
   for (const meshopt_Meshlet& m : ml) {
     Indices c(size_t(m.triangle_count) * 3);
@@ -189,8 +189,8 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     c.firstTriangle = base + uint32_t(lod.indices.size() / 3);
     c.triangleCount = uint32_t(tris.size() / 3);
     c.level = level;
-    const meshopt_Bounds b = meshopt_computeClusterBounds(tris.data(), tris.size(), &mesh.positions[0].x,
-                                                          mesh.positions.size(), sizeof(glm::vec3));
+    const meshopt_Bounds b =
+        meshopt_computeClusterBounds(tris.data(), tris.size(), &mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3));
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
     c.coneAxis = {b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};
@@ -228,7 +228,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       }
       const Indices simpler = simplifyGroup(tris, mesh, r.error);
       if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) return;  // stuck: these stay roots
-      r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
+      r.error = std::max(r.error, childError + epsilon);                    // monotone up the hierarchy, strictly
       r.clusters = split(simpler, mesh);
     });
     std::vector<Indices> next;

@@ -30,8 +30,8 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
   std::vector<unsigned> vertices(meshlets.size() * kMaxV);
   std::vector<unsigned char> triangles(meshlets.size() * kMaxT * 3);
   // cone_weight 0.25 trades a little spatial compactness for tighter normal cones (meshoptimizer's advice).
-  meshlets.resize(meshopt_buildMeshlets(meshlets.data(), vertices.data(), triangles.data(), in, count, pos, nv,
-                                        sizeof(glm::vec3), kMaxV, kMaxT, backfaceCone ? 0.25f : 0.0f));
+  meshlets.resize(meshopt_buildMeshlets(meshlets.data(), vertices.data(), triangles.data(), in, count, pos, nv, sizeof(glm::vec3),
+                                        kMaxV, kMaxT, backfaceCone ? 0.25f : 0.0f));
   Piece out;
   out.indices.reserve(count);
   out.clusters.reserve(meshlets.size());
@@ -69,10 +69,11 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
         throw Error("mesh '" + m->name + "': position " + std::to_string(k) +
                     " is not finite or beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
     for (const uint32_t i : m->indices)  // meshoptimizer asserts this too
-      if (i >= m->positions.size())
-        throw Error("mesh '" + m->name + "': index " + std::to_string(i) + " out of range");
+      if (i >= m->positions.size()) throw Error("mesh '" + m->name + "': index " + std::to_string(i) + " out of range");
   }
-  struct Job { size_t mesh, first, end; };
+  struct Job {
+    size_t mesh, first, end;
+  };
   std::vector<Job> jobs;
   for (size_t i = 0; i < meshes.size(); ++i)
     for (size_t t = 0, n = meshes[i]->indices.size() / 3; t < n; t += kPieceTriangles)
@@ -99,9 +100,7 @@ void buildClusters(Mesh& mesh, bool backfaceCone) {
   clusterMeshes({&one, 1}, {backfaceCone});
 }
 
-bool conesCull(const Material& material) {
-  return !(material.flags & (kMaterialAlphaMasked | kMaterialDoubleSided));
-}
+bool conesCull(const Material& material) { return !(material.flags & (kMaterialAlphaMasked | kMaterialDoubleSided)); }
 
 size_t buildMissingClusters(Scene& scene) {
   std::vector<Mesh*> todo;

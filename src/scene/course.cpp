@@ -133,7 +133,8 @@ Scene decodeCourseMesh(std::span<const uint8_t> bytes, const std::string& file) 
         r.failAt(posAt + size_t(k) * 12, "mesh " + std::to_string(i) + ": position " + std::to_string(k) +
                                              " is beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
       if (!std::isfinite(nn.x + nn.y + nn.z) || !std::isfinite(t.x + t.y))
-        r.failAt(posAt + size_t(v) * 12 + size_t(k) * 12, "mesh " + std::to_string(i) + ": vertex " + std::to_string(k) + " has a non-finite normal or texcoord");
+        r.failAt(posAt + size_t(v) * 12 + size_t(k) * 12,
+                 "mesh " + std::to_string(i) + ": vertex " + std::to_string(k) + " has a non-finite normal or texcoord");
       m.bounds.extend(p);
     }
     // The format always stores texcoords; all zeros means the source had none.

@@ -19,7 +19,8 @@ float rowSin(uint32_t y, uint32_t h) { return std::max(std::sin((float(y) + 0.5f
 
 }  // namespace
 
-Environment::Environment(ImageF radiance, float intensity, float rotationRad) : map_(std::move(radiance)), rotation_(rotationRad) {
+Environment::Environment(ImageF radiance, float intensity, float rotationRad)
+    : map_(std::move(radiance)), rotation_(rotationRad) {
   if (map_.width == 0 || map_.height == 0 || map_.pixels.size() != size_t(map_.width) * map_.height)
     throw Error("environment map is empty");
   if (!std::isfinite(intensity) || intensity < 0.0f) throw Error("environment intensity must be finite and >= 0");
@@ -40,13 +41,10 @@ Environment Environment::load(const EnvironmentSettings& s) {
   const std::filesystem::path file = s.source;
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext != ".hdr" && ext != ".exr")
-    throw UsageError("--env: '" + s.source + "' is not 'sky', 'none' or an .hdr/.exr file");
+  if (ext != ".hdr" && ext != ".exr") throw UsageError("--env: '" + s.source + "' is not 'sky', 'none' or an .hdr/.exr file");
   try {
     return Environment(loadLinearImage(file), s.intensity, rotation);
-  } catch (const UsageError&) {
-    throw;
-  } catch (const Error& e) {
+  } catch (const UsageError&) { throw; } catch (const Error& e) {
     const std::string what = e.what();
     if (what.find(file.string()) != std::string::npos) throw;
     throw Error(file.string() + ": " + what);
@@ -136,7 +134,8 @@ EnvSample Environment::sample(glm::vec2 u) const {
   }
   const uint32_t w = map_.width, h = map_.height;
   const uint32_t tx = uint32_t(texel % w), ty = uint32_t(texel / w);
-  const glm::vec2 uv{(float(tx) + std::min(u.y, 0x1.fffffep-1f)) / float(w), (float(ty) + std::min(frac, 0x1.fffffep-1f)) / float(h)};
+  const glm::vec2 uv{(float(tx) + std::min(u.y, 0x1.fffffep-1f)) / float(w),
+                     (float(ty) + std::min(frac, 0x1.fffffep-1f)) / float(h)};
   EnvSample s;
   s.direction = shader::envUvToDir(uv, rotation_);
   s.radiance = glm::vec3(map_.at(tx, ty));

@@ -65,21 +65,21 @@ bool outsideView(const Bounds& b, const CameraPose& pose, const Lens& lens, floa
   const float tanY = std::tan(glm::radians(lens.fovYDeg) * 0.5f), tanX = tanY * aspect;
   int out[5] = {};
   for (int i = 0; i < 8; ++i) {
-    const glm::vec3 p = glm::vec3(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z) -
-                        pose.position;
+    const glm::vec3 p =
+        glm::vec3(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z) - pose.position;
     const float z = glm::dot(p, cb.forward), x = glm::dot(p, cb.right), y = glm::dot(p, cb.up);
     const float hx = lens.orthographic ? lens.orthoHalfHeight * aspect : z * tanX;
     const float hy = lens.orthographic ? lens.orthoHalfHeight : z * tanY;
     out[0] += !lens.orthographic && z <= 0.0f;
-    out[1] += x > hx, out[2] += x < -hx, out[3] += y > hy, out[4] += y < -hy;
+    out[1] += x > hx, out[2] += x<-hx, out[3] += y> hy, out[4] += y < -hy;
   }
   return std::any_of(std::begin(out), std::end(out), [](int n) { return n == 8; });
 }
 
 }  // namespace
 
-std::string emptyImageWarning(const Scene& scene, const CameraPose& pose, const Lens& lens, float aspect,
-                              bool anyLitPixel, size_t lightCount) {
+std::string emptyImageWarning(const Scene& scene, const CameraPose& pose, const Lens& lens, float aspect, bool anyLitPixel,
+                              size_t lightCount) {
   const Bounds b = scene.bounds();
   if (b.empty() || outsideView(b, pose, lens, aspect))
     return "the scene lies wholly outside the view: the image is empty (drop --camera, or press F in the window)";

@@ -30,7 +30,7 @@ bool drawBothSides(Scene& scene);
 
 // The warning for an image that shows nothing ("" when it shows something): the scene's bounds wholly
 // outside the view, or no lit pixel (`lightCount`: the lights used, 0 with --no-default-light).
-std::string emptyImageWarning(const Scene& scene, const CameraPose& pose, const Lens& lens, float aspect,
-                              bool anyLitPixel, size_t lightCount);
+std::string emptyImageWarning(const Scene& scene, const CameraPose& pose, const Lens& lens, float aspect, bool anyLitPixel,
+                              size_t lightCount);
 
 }  // namespace rtr

@@ -18,15 +18,18 @@ std::vector<double> frontAreas(const Scene& scene, std::span<const glm::vec3> to
   // pieces of a fixed size whose sums are added in piece order, so the result does not depend on the
   // thread count.
   constexpr size_t kPiece = size_t(1) << 16;  // triangles
-  struct Piece { const Mesh* mesh; size_t first, end; };
+  struct Piece {
+    const Mesh* mesh;
+    size_t first, end;
+  };
   std::vector<Piece> pieces;
   for (const Mesh& m : scene.meshes)
     for (size_t t = 0, n = m.indices.size() / 3; t < n; t += kPiece) pieces.push_back({&m, t, std::min(n, t + kPiece)});
   std::vector<double> sums(pieces.size() * toViewer.size(), 0.0);
   parallelFor(pieces.size(), 0, [&](size_t p) {
     const Mesh& m = *pieces[p].mesh;
-    const bool twoSided = !windingOnly && m.material < scene.materials.size() &&
-                          (scene.materials[m.material].flags & kMaterialDoubleSided);
+    const bool twoSided =
+        !windingOnly && m.material < scene.materials.size() && (scene.materials[m.material].flags & kMaterialDoubleSided);
     double* area = &sums[p * toViewer.size()];
     for (size_t t = pieces[p].first; t < pieces[p].end; ++t) {
       const glm::vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
@@ -80,8 +83,8 @@ glm::vec3 stagedSide(const Scene& scene) {
   for (int s = 0; s < 4; ++s) {
     const int axis = s < 2 ? 2 : 0;
     const float faceArea = axis == 2 ? e.x * e.y : e.z * e.y;
-    const float score = (covered[s] < 0.5 * faceArea ? 4.0f : 0.0f) + (glm::dot(towards, sides[s]) > 0.1f ? 2.0f : 0.0f) +
-                        (s == 0 ? 1.0f : 0.0f);
+    const float score =
+        (covered[s] < 0.5 * faceArea ? 4.0f : 0.0f) + (glm::dot(towards, sides[s]) > 0.1f ? 2.0f : 0.0f) + (s == 0 ? 1.0f : 0.0f);
     if (score > bestScore) bestScore = score, best = s;
   }
   return sides[best];

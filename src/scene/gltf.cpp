@@ -27,7 +27,7 @@ namespace {
 using gltf::Json;
 
 constexpr std::string_view kSupported[] = {
-    "KHR_materials_emissive_strength", "KHR_texture_transform",       "KHR_lights_punctual", "KHR_mesh_quantization",
+    "KHR_materials_emissive_strength", "KHR_texture_transform",      "KHR_lights_punctual", "KHR_mesh_quantization",
     "EXT_meshopt_compression",         "KHR_draco_mesh_compression", "KHR_materials_unlit"};
 
 struct Glb {
@@ -47,7 +47,8 @@ Glb splitGlb(std::span<const uint8_t> d, const std::string& name) {
   if (const uint32_t v = le32(d, 4); v != 2) fail(4, "GLB version " + std::to_string(v) + " (rtr reads version 2)");
   const uint32_t length = le32(d, 8);
   if (length > d.size())
-    fail(8, "the GLB header's length " + std::to_string(length) + " is more than the file's " + std::to_string(d.size()) + " bytes");
+    fail(8,
+         "the GLB header's length " + std::to_string(length) + " is more than the file's " + std::to_string(d.size()) + " bytes");
   d = d.first(length);
   Glb g;
   for (size_t pos = 12, chunk = 0; pos < d.size(); ++chunk) {
@@ -94,7 +95,7 @@ bool finite(const glm::mat4& m) {
 }
 
 class Loader {
-public:
+ public:
   Loader(const std::string& name, std::filesystem::path baseDir, const LoadOptions& options)
       : name_(name), baseDir_(std::move(baseDir)), opt_(options) {}
 
@@ -121,7 +122,8 @@ public:
 
     scene_.baseDir = baseDir_;
     gltf::Accessors acc(root, baseDir_, bin, glb);
-    gltf::Materials mats(root, acc, scene_, [&](const std::string& s) { note(s); }, [&](const std::string& s) { warn(s); });
+    gltf::Materials mats(
+        root, acc, scene_, [&](const std::string& s) { note(s); }, [&](const std::string& s) { warn(s); });
     acc_ = &acc;
     mats_ = &mats;
     traverse(root);
@@ -133,12 +135,14 @@ public:
     if (warnings_ > kShownWarnings)
       message(opt_.warn, "warning", std::to_string(warnings_) + " warnings, first " + std::to_string(kShownWarnings) + " shown");
     if (scene_.instances.empty())
-      throw fileError(name_, "", "the scene has no triangles to draw" +
-                                     (skipped_ ? " (" + std::to_string(skipped_) + " primitive(s) of points or lines left out)" : std::string()));
+      throw fileError(
+          name_, "",
+          "the scene has no triangles to draw" +
+              (skipped_ ? " (" + std::to_string(skipped_) + " primitive(s) of points or lines left out)" : std::string()));
     return std::move(scene_);
   }
 
-private:
+ private:
   void message(const std::function<void(const std::string&)>& f, const char* kind, const std::string& s) {
     const std::string line = name_ + ": " + s;
     if (!said_.insert(line).second) return;
@@ -153,7 +157,9 @@ private:
   }
 
   void checkExtensions(const Json& root) {
-    auto supported = [](std::string_view e) { return std::find(std::begin(kSupported), std::end(kSupported), e) != std::end(kSupported); };
+    auto supported = [](std::string_view e) {
+      return std::find(std::begin(kSupported), std::end(kSupported), e) != std::end(kSupported);
+    };
     std::set<std::string_view> required;
     if (auto req = root.get("extensionsRequired"))
       for (size_t i = 0, n = req->size(); i < n; ++i) {
@@ -247,7 +253,8 @@ private:
     const uint32_t a = attrs.index(key, acc_->accessorCount(), "accessors");
     const uint32_t n = acc_->info(a).count;
     if (n != count)
-      attrs.at(key).fail("accessor " + std::to_string(a) + " has " + std::to_string(n) + " elements, POSITION has " + std::to_string(count));
+      attrs.at(key).fail("accessor " + std::to_string(a) + " has " + std::to_string(n) + " elements, POSITION has " +
+                         std::to_string(count));
     out.resize(count);
     acc_->readFloats(a, &out[0][0], int(sizeof(V) / sizeof(float)), comps);
     return true;
@@ -263,7 +270,8 @@ private:
     }
     Mesh m;
     m.name = name;
-    m.material = mats_->material(p.get("material") ? std::optional(p.index("material", mats_->count(), "materials")) : std::nullopt);
+    m.material =
+        mats_->material(p.get("material") ? std::optional(p.index("material", mats_->count(), "materials")) : std::nullopt);
     const Json attrs = p.at("attributes");
     if (!attrs.isObject()) attrs.fail("expected an object");
     std::optional<Json> indicesJ = p.get("indices");
@@ -333,8 +341,8 @@ private:
   }
 
   // Stream `stream` of a mesh: read, and (deferred) checked on its own.
-  void readStream(Mesh& m, const Json& p, const Json& attrs, const std::optional<Json>& indicesJ, uint32_t count,
-                  int stream, bool deferred) {
+  void readStream(Mesh& m, const Json& p, const Json& attrs, const std::optional<Json>& indicesJ, uint32_t count, int stream,
+                  bool deferred) {
     switch (stream) {
       case 0:
         attribute(attrs, "POSITION", m.positions, count, {3});
@@ -377,7 +385,8 @@ private:
     uint32_t maxIndex = 0;
     for (uint32_t i : m.indices) maxIndex = std::max(maxIndex, i);
     if (maxIndex >= vertices && !m.indices.empty()) {
-      const size_t i = size_t(std::find_if(m.indices.begin(), m.indices.end(), [&](uint32_t v) { return v >= vertices; }) - m.indices.begin());
+      const size_t i =
+          size_t(std::find_if(m.indices.begin(), m.indices.end(), [&](uint32_t v) { return v >= vertices; }) - m.indices.begin());
       where.fail("index " + std::to_string(m.indices[i]) + " (element " + std::to_string(i) + ") is not below the vertex count " +
                  std::to_string(vertices));
     }
@@ -450,19 +459,21 @@ private:
   void readDraco(const Json& d, Mesh& m) {
     const auto view = acc_->view(d.index("bufferView", acc_->viewCount(), "bufferViews"));
     std::vector<std::pair<std::string, int>> ids;
-    d.at("attributes").members([&](std::string_view k, const Json& v) { ids.push_back({std::string(k), int(std::min<uint64_t>(v.uinteger(), 1u << 30))}); });
+    d.at("attributes").members([&](std::string_view k, const Json& v) {
+      ids.push_back({std::string(k), int(std::min<uint64_t>(v.uinteger(), 1u << 30))});
+    });
     gltf::DracoMesh dm;
     try {
       dm = gltf::decodeDraco(view, ids);
-    } catch (const Error& e) {
-      d.fail(e.what());
-    }
+    } catch (const Error& e) { d.fail(e.what()); }
     const uint32_t n = dm.vertexCount;
     for (const gltf::DracoAttribute& a : dm.attributes) {
       auto take = [&](auto& out, int want) {
         using V = typename std::decay_t<decltype(out)>::value_type;
         if (a.components < 1 || a.components > want || a.values.size() != size_t(n) * a.components)
-          d.at("attributes").at(a.name).fail("the draco data has " + std::to_string(a.components) + " components, expected " + std::to_string(want));
+          d.at("attributes")
+              .at(a.name)
+              .fail("the draco data has " + std::to_string(a.components) + " components, expected " + std::to_string(want));
         out.assign(n, V(0.0f));
         for (uint32_t i = 0; i < n; ++i)
           for (int c = 0; c < a.components; ++c) out[i][c] = a.values[size_t(i) * a.components + c];

@@ -15,9 +15,12 @@ std::string bytes(uint64_t n) { return std::to_string(n) + (n == 1 ? " byte" : "
 
 int componentSize(uint32_t type) {
   switch (type) {
-    case 5120: case 5121: return 1;
-    case 5122: case 5123: return 2;
-    case 5125: case 5126: return 4;
+    case 5120:
+    case 5121: return 1;
+    case 5122:
+    case 5123: return 2;
+    case 5125:
+    case 5126: return 4;
     default: return 0;
   }
 }
@@ -73,8 +76,16 @@ void convert(uint32_t type, bool normalized, const uint8_t* p, size_t stride, ui
 uint32_t toIndex(const uint8_t* p, uint32_t type) {
   switch (type) {
     case 5121: return *p;
-    case 5123: { uint16_t v; std::memcpy(&v, p, 2); return v; }
-    default: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+    case 5123: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    default: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
   }
 }
 
@@ -127,7 +138,9 @@ std::vector<uint8_t> decodeDataUri(const Json& where, std::string_view uri) {
 std::string uriToPath(std::string_view uri) {
   std::string out;
   for (size_t i = 0; i < uri.size(); ++i) {
-    auto hex = [](char c) { return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1; };
+    auto hex = [](char c) {
+      return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+    };
     if (uri[i] == '%' && i + 2 < uri.size() + 0 && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
       out += char(hex(uri[i + 1]) * 16 + hex(uri[i + 2]));
       i += 2;
@@ -168,9 +181,7 @@ std::span<const uint8_t> Accessors::buffer(uint32_t i) {
       const std::filesystem::path file = baseDir_ / uriToPath(u);
       try {
         mapped_.push_back(std::make_unique<MappedFile>(file));
-      } catch (const Error& e) {
-        uri->fail(e.what());
-      }
+      } catch (const Error& e) { uri->fail(e.what()); }
       data = mapped_.back()->bytes();
     }
   } else if (isGlb_ && i == 0) {
@@ -180,8 +191,7 @@ std::span<const uint8_t> Accessors::buffer(uint32_t i) {
     b.fail(b.get("extensions") ? "has no data (a compression extension's fallback buffer that is read)"
                                : "has no uri and is not the GLB's BIN chunk");
   }
-  if (length > data.size())
-    lenJ.fail(bytes(length) + ", but the buffer's data has only " + bytes(data.size()));
+  if (length > data.size()) lenJ.fail(bytes(length) + ", but the buffer's data has only " + bytes(data.size()));
   buffers_[i] = data.first(size_t(length));
   return *buffers_[i];
 }
@@ -196,7 +206,8 @@ std::span<const uint8_t> Accessors::view(uint32_t i) {
     const std::span<const uint8_t> buf = buffer(m.index("buffer", buffersJ_.size(), "buffers"));
     const uint64_t off = m.uinteger("byteOffset", 0), len = m.at("byteLength").uinteger();
     if (off > buf.size() || len > buf.size() - off)
-      m.fail("byteOffset " + std::to_string(off) + " + byteLength " + std::to_string(len) + " run past the end of its buffer (" + bytes(buf.size()) + ")");
+      m.fail("byteOffset " + std::to_string(off) + " + byteLength " + std::to_string(len) + " run past the end of its buffer (" +
+             bytes(buf.size()) + ")");
     const uint64_t count = m.at("count").uinteger(), stride = m.at("byteStride").uinteger();
     if (stride == 0 || stride > 256) m.at("byteStride").fail("must be 1..256, is " + std::to_string(stride));
     if (count > kMaxUnbackedElements || count * stride > (len + 1024) * 256)
@@ -207,9 +218,7 @@ std::span<const uint8_t> Accessors::view(uint32_t i) {
     try {
       decodeMeshopt(buf.subspan(size_t(off), size_t(len)), size_t(count), size_t(stride), m.string("mode", ""),
                     m.string("filter", "NONE"), out);
-    } catch (const Error& e) {
-      m.fail(e.what());
-    }
+    } catch (const Error& e) { m.fail(e.what()); }
     out.resize(size_t(length));
     decodedViews_[i] = std::move(out);
     return *decodedViews_[i];
@@ -217,8 +226,8 @@ std::span<const uint8_t> Accessors::view(uint32_t i) {
   const std::span<const uint8_t> buf = buffer(v.index("buffer", buffersJ_.size(), "buffers"));
   const uint64_t off = v.uinteger("byteOffset", 0);
   if (off > buf.size() || length > buf.size() - off)
-    v.fail("byteOffset " + std::to_string(off) + " + byteLength " + std::to_string(length) +
-           " run past the end of buffer " + std::to_string(v.uinteger("buffer", 0)) + " (" + bytes(buf.size()) + ")");
+    v.fail("byteOffset " + std::to_string(off) + " + byteLength " + std::to_string(length) + " run past the end of buffer " +
+           std::to_string(v.uinteger("buffer", 0)) + " (" + bytes(buf.size()) + ")");
   return buf.subspan(size_t(off), size_t(length));
 }
 
@@ -242,16 +251,14 @@ Accessors::Info Accessors::info(uint32_t accessor) const {
   return r;
 }
 
-Accessors::Range Accessors::range(const Json& a, uint32_t viewIndex, uint64_t byteOffset, uint64_t count,
-                                  size_t elemSize, bool viewStrideAllowed) {
+Accessors::Range Accessors::range(const Json& a, uint32_t viewIndex, uint64_t byteOffset, uint64_t count, size_t elemSize,
+                                  bool viewStrideAllowed) {
   const std::span<const uint8_t> v = view(viewIndex);
   size_t stride = elemSize;
   if (auto s = views_[viewIndex].get("byteStride"); s && viewStrideAllowed) {
     const uint64_t st = s->uinteger();
-    if (st < 4 || st > 252 || st % 4)
-      s->fail(std::to_string(st) + " is not a byte stride (a multiple of 4 in 4..252)");
-    if (st < elemSize)
-      s->fail(std::to_string(st) + " is less than the " + bytes(elemSize) + " of one element of " + a.path());
+    if (st < 4 || st > 252 || st % 4) s->fail(std::to_string(st) + " is not a byte stride (a multiple of 4 in 4..252)");
+    if (st < elemSize) s->fail(std::to_string(st) + " is less than the " + bytes(elemSize) + " of one element of " + a.path());
     stride = size_t(st);
   }
   // offset + (count - 1) * stride + elemSize <= view size, without overflow (count < 2^32, stride < 2^8).
@@ -286,8 +293,8 @@ void Accessors::forEach(uint32_t accessor, const Info& in, Write&& write) {
     idx.at("componentType").fail("sparse indices must be 5121, 5123 or 5125");
   const Range ir = range(idx, idx.index("bufferView", views_.size(), "bufferViews"), idx.uinteger("byteOffset", 0), n,
                          size_t(componentSize(idxType)), false);
-  const Range vr = range(val, val.index("bufferView", views_.size(), "bufferViews"), val.uinteger("byteOffset", 0), n,
-                         elemSize, false);
+  const Range vr =
+      range(val, val.index("bufferView", views_.size(), "bufferViews"), val.uinteger("byteOffset", 0), n, elemSize, false);
   for (uint64_t k = 0; k < n; ++k) {
     const uint32_t i = toIndex(ir.data.data() + k * ir.stride, idxType);
     if (i >= in.count)
@@ -312,11 +319,15 @@ void Accessors::readFloats(uint32_t accessor, float* dst, int dstComponents, std
   if (std::find(allowed.begin(), allowed.end(), in.components) == allowed.end()) {
     std::string list;
     for (int c : allowed) list += std::string(list.empty() ? "" : " or ") + (c == 1 ? "SCALAR" : "VEC" + std::to_string(c));
-    accessors_[accessor].at("type").fail("'" + std::string(accessors_[accessor].string("type", "")) + "' where " + list + " is expected");
+    accessors_[accessor].at("type").fail("'" + std::string(accessors_[accessor].string("type", "")) + "' where " + list +
+                                         " is expected");
   }
   const int comps = std::min(in.components, dstComponents);
   struct {
-    float* dst; int dc, comps; uint32_t count, type; bool norm;
+    float* dst;
+    int dc, comps;
+    uint32_t count, type;
+    bool norm;
     void one(uint32_t i, const uint8_t* p) const { convert(type, norm, p, 0, 1, comps, dst + size_t(i) * dc, dc); }
     void all(const uint8_t* p, size_t stride) const {
       if (type == 5126 && comps == dc && stride == size_t(4 * dc)) {  // the layout matches: one copy, no conversion
@@ -341,7 +352,8 @@ void Accessors::readIndices(uint32_t accessor, std::vector<uint32_t>& out) {
     a.at("componentType").fail("indices must be unsigned (5121, 5123 or 5125)");
   out.resize(in.count);
   struct {
-    uint32_t* dst; uint32_t count, type;
+    uint32_t* dst;
+    uint32_t count, type;
     void one(uint32_t i, const uint8_t* p) const { dst[i] = toIndex(p, type); }
     void all(const uint8_t* p, size_t stride) const {
       if (type == 5125 && stride == 4) {

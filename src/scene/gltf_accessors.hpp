@@ -26,7 +26,7 @@ std::vector<uint8_t> decodeDataUri(const Json& where, std::string_view uri);
 std::string uriToPath(std::string_view uri);
 
 class Accessors {
-public:
+ public:
   // `glbBin`: the GLB's BIN chunk (empty for .gltf), used for a buffer without uri.
   Accessors(const Json& root, std::filesystem::path baseDir, std::span<const uint8_t> glbBin, bool isGlb);
   ~Accessors();
@@ -39,8 +39,8 @@ public:
   // Accessor facts, checked: component type and count against its view.
   struct Info {
     uint32_t count = 0;
-    int components = 0;         // 1..4 (SCALAR..VEC4); matrices are not read
-    uint32_t componentType = 0; // 5120..5126
+    int components = 0;          // 1..4 (SCALAR..VEC4); matrices are not read
+    uint32_t componentType = 0;  // 5120..5126
     bool normalized = false;
   };
   Info info(uint32_t accessor) const;
@@ -56,10 +56,13 @@ public:
   // Reads a SCALAR integer accessor (indices) as uint32.
   void readIndices(uint32_t accessor, std::vector<uint32_t>& out);
 
-private:
+ private:
   std::span<const uint8_t> buffer(uint32_t i);
   // The checked byte range of an accessor's elements: element i at data[i * stride].
-  struct Range { std::span<const uint8_t> data; size_t stride = 0; };
+  struct Range {
+    std::span<const uint8_t> data;
+    size_t stride = 0;
+  };
   Range range(const Json& a, uint32_t viewIndex, uint64_t byteOffset, uint64_t count, size_t elemSize, bool viewStrideAllowed);
   template <class Write>
   void forEach(uint32_t accessor, const Info& info, Write&& write);
@@ -71,7 +74,7 @@ private:
   std::vector<Json> buffersJ_, views_, accessors_;
   std::vector<std::optional<std::span<const uint8_t>>> buffers_;
   std::vector<std::unique_ptr<MappedFile>> mapped_;
-  std::vector<std::vector<uint8_t>> owned_;  // decoded data URIs
+  std::vector<std::vector<uint8_t>> owned_;                        // decoded data URIs
   std::vector<std::optional<std::vector<uint8_t>>> decodedViews_;  // meshopt
 };
 

@@ -16,12 +16,12 @@ std::string str(std::string_view s) { return std::string(s); }
 
 }  // namespace
 
-void decodeMeshopt(std::span<const uint8_t> src, size_t count, size_t byteStride, std::string_view mode,
-                   std::string_view filter, std::span<uint8_t> out) {
+void decodeMeshopt(std::span<const uint8_t> src, size_t count, size_t byteStride, std::string_view mode, std::string_view filter,
+                   std::span<uint8_t> out) {
   // The library asserts what it expects instead of reporting it: each of its preconditions is checked here.
   if (byteStride == 0 || count > out.size() / byteStride || count * byteStride != out.size())
-    throw Error("meshopt: count " + std::to_string(count) + " × byteStride " + std::to_string(byteStride) +
-                " is not the " + std::to_string(out.size()) + " bytes of the bufferView");
+    throw Error("meshopt: count " + std::to_string(count) + " × byteStride " + std::to_string(byteStride) + " is not the " +
+                std::to_string(out.size()) + " bytes of the bufferView");
   const bool attributes = mode == "ATTRIBUTES";
   if (!attributes && mode != "TRIANGLES" && mode != "INDICES") throw Error("meshopt: unknown mode '" + str(mode) + "'");
   if (filter != "NONE" && !attributes)
@@ -48,8 +48,8 @@ void decodeMeshopt(std::span<const uint8_t> src, size_t count, size_t byteStride
                              : meshopt_decodeIndexSequence(out.data(), count, byteStride, src.data(), src.size());
   }
   if (rc != 0)
-    throw Error("meshopt: the " + std::to_string(src.size()) + " compressed bytes do not decode as " + str(mode) +
-                " (error " + std::to_string(rc) + ")");
+    throw Error("meshopt: the " + std::to_string(src.size()) + " compressed bytes do not decode as " + str(mode) + " (error " +
+                std::to_string(rc) + ")");
 }
 
 DracoMesh decodeDraco(std::span<const uint8_t> src, const std::vector<std::pair<std::string, int>>& attributes) {
@@ -63,9 +63,7 @@ DracoMesh decodeDraco(std::span<const uint8_t> src, const std::vector<std::pair<
     mesh = std::move(decoded).value();
   } catch (const std::bad_alloc&) {
     throw Error("draco: the data asks for more memory than there is");
-  } catch (const std::length_error&) {
-    throw Error("draco: the data asks for more memory than there is");
-  }
+  } catch (const std::length_error&) { throw Error("draco: the data asks for more memory than there is"); }
   if (!mesh) throw Error("draco: not a triangle mesh");
   DracoMesh out;
   out.vertexCount = mesh->num_points();
@@ -83,8 +81,13 @@ DracoMesh decodeDraco(std::span<const uint8_t> src, const std::vector<std::pair<
     if (!a) throw Error("draco: attribute " + name + " names id " + std::to_string(id) + ", which the data does not have");
     // glTF's component types only (a bool attribute would be read as bools whatever its bytes are).
     switch (a->data_type()) {
-      case draco::DT_INT8: case draco::DT_UINT8: case draco::DT_INT16: case draco::DT_UINT16:
-      case draco::DT_INT32: case draco::DT_UINT32: case draco::DT_FLOAT32: break;
+      case draco::DT_INT8:
+      case draco::DT_UINT8:
+      case draco::DT_INT16:
+      case draco::DT_UINT16:
+      case draco::DT_INT32:
+      case draco::DT_UINT32:
+      case draco::DT_FLOAT32: break;
       default: throw Error("draco: attribute " + name + " has a data type glTF does not use");
     }
     const int n = a->num_components();

@@ -14,8 +14,8 @@ namespace rtr::gltf {
 
 // EXT_meshopt_compression: decodes one compressed bufferView (its extension object's fields) into `out`,
 // which holds count * byteStride bytes. Throws rtr::Error with what is wrong (the caller adds file and path).
-void decodeMeshopt(std::span<const uint8_t> src, size_t count, size_t byteStride, std::string_view mode,
-                   std::string_view filter, std::span<uint8_t> out);
+void decodeMeshopt(std::span<const uint8_t> src, size_t count, size_t byteStride, std::string_view mode, std::string_view filter,
+                   std::span<uint8_t> out);
 
 // KHR_draco_mesh_compression: decodes a primitive's draco bufferView. `attributes` maps glTF attribute
 // names (POSITION, NORMAL, TEXCOORD_0, ...) to draco attribute ids. Values come out as floats, `components`

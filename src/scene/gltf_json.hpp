@@ -14,7 +14,7 @@
 namespace rtr::gltf {
 
 class Json {
-public:
+ public:
   Json(simdjson::dom::element e, std::string path, const std::string* file) : e_(e), path_(std::move(path)), file_(file) {}
 
   const std::string& path() const { return path_; }
@@ -89,10 +89,22 @@ public:
   }
 
   // Optional members with defaults.
-  double number(std::string_view key, double def) const { auto v = get(key); return v ? v->number() : def; }
-  uint64_t uinteger(std::string_view key, uint64_t def) const { auto v = get(key); return v ? v->uinteger() : def; }
-  std::string_view string(std::string_view key, std::string_view def) const { auto v = get(key); return v ? v->string() : def; }
-  bool boolean(std::string_view key, bool def) const { auto v = get(key); return v ? v->boolean() : def; }
+  double number(std::string_view key, double def) const {
+    auto v = get(key);
+    return v ? v->number() : def;
+  }
+  uint64_t uinteger(std::string_view key, uint64_t def) const {
+    auto v = get(key);
+    return v ? v->uinteger() : def;
+  }
+  std::string_view string(std::string_view key, std::string_view def) const {
+    auto v = get(key);
+    return v ? v->string() : def;
+  }
+  bool boolean(std::string_view key, bool def) const {
+    auto v = get(key);
+    return v ? v->boolean() : def;
+  }
   // An index into an array of `n` elements named `what` (e.g. "accessors").
   uint32_t index(std::string_view key, size_t n, std::string_view what) const {
     Json v = at(key);
@@ -109,7 +121,7 @@ public:
     for (size_t i = 0; i < N; ++i) out[i] = float((*v)[i].number());
   }
 
-private:
+ private:
   simdjson::dom::element e_;
   std::string path_;
   const std::string* file_;

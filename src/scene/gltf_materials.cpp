@@ -70,7 +70,8 @@ void Materials::image(uint32_t i, Texture& t) {
   if (!images_[i]) {
     const Json& im = imagesJ_[i];
     Texture img;
-    const std::string label = "image " + std::to_string(i) + (im.get("name") ? " (" + std::string(im.string("name", "")) + ")" : "");
+    const std::string label =
+        "image " + std::to_string(i) + (im.get("name") ? " (" + std::string(im.string("name", "")) + ")" : "");
     if (auto uri = im.get("uri")) {
       const std::string_view u = uri->string();
       if (u.substr(0, 5) == "data:") {
@@ -95,7 +96,8 @@ void Materials::image(uint32_t i, Texture& t) {
   t.bytes = images_[i]->bytes;
 }
 
-uint32_t Materials::texture(const Json& info, TextureSlot slot, Material& mat, bool srgb, uint8_t channels, uint8_t sourceChannel) {
+uint32_t Materials::texture(const Json& info, TextureSlot slot, Material& mat, bool srgb, uint8_t channels,
+                            uint8_t sourceChannel) {
   const uint32_t ti = info.index("index", texturesJ_.size(), "textures");
   const Json& tj = texturesJ_[ti];
   if (!tj.get("source")) {
@@ -116,9 +118,7 @@ uint32_t Materials::texture(const Json& info, TextureSlot slot, Material& mat, b
     uv.rotation = float(tt.number("rotation", 0.0));
     if (tt.get("texCoord")) uv.texCoord = uint32_t(tt.uinteger("texCoord", 0));
   }
-  if (uv.texCoord > 1) {
-    info.fail("texCoord " + std::to_string(uv.texCoord) + ": rtr reads TEXCOORD_0 and TEXCOORD_1 only");
-  }
+  if (uv.texCoord > 1) { info.fail("texCoord " + std::to_string(uv.texCoord) + ": rtr reads TEXCOORD_0 and TEXCOORD_1 only"); }
   const auto key = std::make_tuple(img, samplerIndex, srgb, channels, sourceChannel);
   if (auto it = textures_.find(key); it != textures_.end()) return mat.textures[uint32_t(slot)] = it->second;
   Texture t;

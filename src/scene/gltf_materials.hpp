@@ -13,7 +13,7 @@
 namespace rtr::gltf {
 
 class Materials {
-public:
+ public:
   // `note`/`warn` get messages without the file name (the caller adds it).
   Materials(const Json& root, Accessors& accessors, Scene& scene, std::function<void(const std::string&)> note,
             std::function<void(const std::string&)> warn);
@@ -21,7 +21,7 @@ public:
   uint32_t material(std::optional<uint32_t> index);
   size_t count() const { return materialsJ_.size(); }
 
-private:
+ private:
   uint32_t make(const Json& m);
   uint32_t texture(const Json& info, TextureSlot slot, Material& mat, bool srgb, uint8_t channels, uint8_t sourceChannel);
   SamplerDesc sampler(const Json& s) const;

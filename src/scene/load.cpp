@@ -28,7 +28,8 @@ Scene loadAny(const std::filesystem::path& file, const LoadOptions& options) {
   std::string lower = n;
   for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (lower.ends_with(".gltf") || lower.ends_with(".glb")) return loadGltf(file, options);  // as rtr-bake: any case
-  throw fileError(file.string(), "", "unknown scene format (expected .obj, .obj.zst, .obj-zstd, .gltf, .glb, .comp5892mesh, .rtrscene)");
+  throw fileError(file.string(), "",
+                  "unknown scene format (expected .obj, .obj.zst, .obj-zstd, .gltf, .glb, .comp5892mesh, .rtrscene)");
 }
 
 }  // namespace
@@ -38,9 +39,7 @@ Scene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
   try {
     // every format but .rtrscene version 3 or later (rtr-bake builds them there)
     stage("clustering", [&] { buildMissingClusters(scene); });
-  } catch (const Error& e) {
-    throw fileError(file.string(), "", e.what());
-  }
+  } catch (const Error& e) { throw fileError(file.string(), "", e.what()); }
   return scene;
 }
 

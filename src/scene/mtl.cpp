@@ -87,7 +87,10 @@ struct MtlParser {
         for (;;) {  // numeric arguments, as many as there are
           std::string_view save = rest;
           float v;
-          if (text::nextFloat(rest, v) != text::NumResult::Ok) { rest = save; break; }
+          if (text::nextFloat(rest, v) != text::NumResult::Ok) {
+            rest = save;
+            break;
+          }
         }
       }
       rest = text::trim(rest);
@@ -105,7 +108,8 @@ struct MtlParser {
     if (key.empty() || key[0] == '#') return;
     if (key == "newmtl") {
       std::string_view name = text::trim(rest);  // bytes in any encoding
-      if (name.empty() && warn) warn(file + ":" + std::to_string(line) + ": 'newmtl' without a name (usable as 'usemtl' with no name)");
+      if (name.empty() && warn)
+        warn(file + ":" + std::to_string(line) + ": 'newmtl' without a name (usable as 'usemtl' with no name)");
       if (name.size() >= 32768) throw error("material name too long");
       givenPr.push_back(0);
       givenNs.push_back(0);
@@ -117,14 +121,27 @@ struct MtlParser {
     }
     auto slot = [&](TextureSlot s) -> std::string& { return current(key).maps[uint32_t(s)]; };
     Material* m = nullptr;
-    auto mat = [&]() -> Material& { if (!m) m = &current(key).material; return *m; };
-    if (key == "Kd") { glm::vec3 c = colour(key, rest); mat().kd = c; mat().baseColor = c; }
-    else if (key == "Ka") mat().ka = colour(key, rest);
+    auto mat = [&]() -> Material& {
+      if (!m) m = &current(key).material;
+      return *m;
+    };
+    if (key == "Kd") {
+      glm::vec3 c = colour(key, rest);
+      mat().kd = c;
+      mat().baseColor = c;
+    } else if (key == "Ka") mat().ka = colour(key, rest);
     else if (key == "Ks") mat().ks = colour(key, rest);
-    else if (key == "Ke") { glm::vec3 c = colour(key, rest); mat().ke = c; mat().emissive = c; }
-    else if (key == "Ns") { mat().ns = scalar(key, rest); givenNs.back() = 1; }
-    else if (key == "Pr") { mat().roughness = scalar(key, rest); givenPr.back() = 1; }
-    else if (key == "Pm") mat().metalness = scalar(key, rest);
+    else if (key == "Ke") {
+      glm::vec3 c = colour(key, rest);
+      mat().ke = c;
+      mat().emissive = c;
+    } else if (key == "Ns") {
+      mat().ns = scalar(key, rest);
+      givenNs.back() = 1;
+    } else if (key == "Pr") {
+      mat().roughness = scalar(key, rest);
+      givenPr.back() = 1;
+    } else if (key == "Pm") mat().metalness = scalar(key, rest);
     else if (key == "N_mirr") mat().mirror = scalar(key, rest);
     else if (key == "N_ior") mat().ior = scalar(key, rest);
     else if (key == "N_transp" || key == "Tr") mat().transparency = scalar(key, rest);
@@ -132,11 +149,13 @@ struct MtlParser {
     else if (key == "map_Kd") slot(TextureSlot::BaseColor) = mapFile(key, rest);
     else if (key == "map_Pr") slot(TextureSlot::Roughness) = mapFile(key, rest);
     else if (key == "map_Pm") slot(TextureSlot::Metalness) = mapFile(key, rest);
-    else if (key == "map_d") { slot(TextureSlot::AlphaMask) = mapFile(key, rest); mat().flags |= kMaterialAlphaMasked; }
-    else if (key == "norm") slot(TextureSlot::NormalMap) = mapFile(key, rest);
+    else if (key == "map_d") {
+      slot(TextureSlot::AlphaMask) = mapFile(key, rest);
+      mat().flags |= kMaterialAlphaMasked;
+    } else if (key == "norm") slot(TextureSlot::NormalMap) = mapFile(key, rest);
     else if (key == "map_Ke") slot(TextureSlot::Emissive) = mapFile(key, rest);
-    else if (key == "Ni" || key == "Tf" || key == "illum" || key == "map_Ka" ||
-             key == "map_Ks" || key == "map_Ns" || key == "map_bump" || key == "bump" || key == "map_Bump") {
+    else if (key == "Ni" || key == "Tf" || key == "illum" || key == "map_Ka" || key == "map_Ks" || key == "map_Ns" ||
+             key == "map_bump" || key == "bump" || key == "map_Bump") {
       current(key);  // known to the wider MTL world; not used by our scenes
     } else {
       std::string k(key);
@@ -166,8 +185,7 @@ std::vector<MtlMaterial> parseMtl(std::string_view src, const std::string& file,
     Material& m = p.out[i].material;
     if (!p.givenPr[i] && p.givenNs[i]) m.roughness = roughnessFromNs(m.ns);
     // Exporters often write Kd 0 0 0 beside a map_Kd; viewers then show the texture, not black.
-    if (m.baseColor == glm::vec3(0.0f) && !p.out[i].maps[uint32_t(TextureSlot::BaseColor)].empty())
-      m.baseColor = glm::vec3(1.0f);
+    if (m.baseColor == glm::vec3(0.0f) && !p.out[i].maps[uint32_t(TextureSlot::BaseColor)].empty()) m.baseColor = glm::vec3(1.0f);
   }
   return std::move(p.out);
 }

@@ -27,7 +27,10 @@ std::vector<MtlMaterial> parseMtl(std::string_view text, const std::string& file
 float roughnessFromNs(float ns);
 
 // The slot conventions of the course format (docs/formats.md): colour space and channel count.
-struct SlotFormat { bool srgb; uint8_t channels; };
+struct SlotFormat {
+  bool srgb;
+  uint8_t channels;
+};
 SlotFormat slotFormat(TextureSlot slot);
 
 }  // namespace rtr

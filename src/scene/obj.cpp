@@ -40,7 +40,7 @@ struct MeshBuild {
 };
 
 class ObjParser {
-public:
+ public:
   ObjParser(const std::string& name, const MtlReader& readMtl, const ObjOptions& options, ObjStats& stats,
             const std::string& besideMtl)
       : name_(name), readMtl_(readMtl), opt_(options), stats_(stats), besideMtl_(besideMtl) {}
@@ -87,7 +87,7 @@ public:
 
   Scene finish();
 
-private:
+ private:
   Error error(const std::string& what) const { return fileError(name_, std::to_string(line_), what); }
   void warn(const std::string& what) { warnRaw(name_ + ":" + std::to_string(line_) + ": " + what); }
   // Every warning is counted; the first few are passed on, finish() reports the total.
@@ -103,8 +103,7 @@ private:
 
   // Text OBJ is ASCII or any 8-bit encoding; UTF-16 and binary data would otherwise parse as nothing.
   void sniff(std::string_view data, uint64_t offset) {
-    if (offset == 0 && data.size() >= 2 &&
-        ((data[0] == '\xFE' && data[1] == '\xFF') || (data[0] == '\xFF' && data[1] == '\xFE')))
+    if (offset == 0 && data.size() >= 2 && ((data[0] == '\xFE' && data[1] == '\xFF') || (data[0] == '\xFF' && data[1] == '\xFE')))
       throw fileError(name_, "", "UTF-16 text (byte order mark); an OBJ file must be ASCII or UTF-8");
     for (size_t i = 0; i < data.size() && offset + i < kSniffBytes; ++i) {
       const unsigned char c = static_cast<unsigned char>(data[i]);
@@ -176,8 +175,10 @@ private:
     const bool sep1 = c1 == '\0' || text::isSpace(c1);
     if (c0 == 'v' && sep1) return vertex(l.substr(i + 1));
     if (c0 == 'f' && sep1) return face(l.substr(i + 1));
-    if (c0 == 'v' && c1 == 'n' && (i + 2 == l.size() || text::isSpace(l[i + 2]))) return vec<3>(l.substr(i + 2), normals_, "vn", 3);
-    if (c0 == 'v' && c1 == 't' && (i + 2 == l.size() || text::isSpace(l[i + 2]))) return vec<2>(l.substr(i + 2), texcoords_, "vt", 1);
+    if (c0 == 'v' && c1 == 'n' && (i + 2 == l.size() || text::isSpace(l[i + 2])))
+      return vec<3>(l.substr(i + 2), normals_, "vn", 3);
+    if (c0 == 'v' && c1 == 't' && (i + 2 == l.size() || text::isSpace(l[i + 2])))
+      return vec<2>(l.substr(i + 2), texcoords_, "vt", 1);
     if (c0 == '#') return;
     std::string_view rest = l.substr(i);
     const std::string_view key = text::nextToken(rest);
@@ -205,7 +206,9 @@ private:
       const std::string file = checkedName("mtllib file name", rest);
       if (file.empty()) throw error("'mtllib' names no file");
       if (opt_.mtl) {
-        if (!mtllibIgnored_) note(name_ + ":" + std::to_string(line_) + ": 'mtllib " + file + "' ignored; using '" + opt_.mtl->string() + "' as given");
+        if (!mtllibIgnored_)
+          note(name_ + ":" + std::to_string(line_) + ": 'mtllib " + file + "' ignored; using '" + opt_.mtl->string() +
+               "' as given");
         mtllibIgnored_ = true;
       } else if (!loadMtl(file, mtlLabel(file))) {
         warn("material library '" + mtlLabel(file) + "' named by 'mtllib' does not exist; its materials get default values");
@@ -234,9 +237,7 @@ private:
   }
 
   // An MTL's path for messages: beside the OBJ (given MTLs are named as given).
-  std::string mtlLabel(const std::string& file) const {
-    return (std::filesystem::path(name_).parent_path() / file).string();
-  }
+  std::string mtlLabel(const std::string& file) const { return (std::filesystem::path(name_).parent_path() / file).string(); }
 
   // Reads the MTL `file` (as the reader knows it) once; false when it does not exist.
   bool loadMtl(const std::string& file, const std::string& label) {
@@ -261,7 +262,10 @@ private:
   // Parses one signed index; returns false at the end of the token.
   static bool parseIndex(const char*& p, const char* e, int64_t& v) {
     bool neg = false;
-    if (p < e && *p == '-') { neg = true; ++p; }
+    if (p < e && *p == '-') {
+      neg = true;
+      ++p;
+    }
     const char* s = p;
     int64_t x = 0;
     while (p < e && unsigned(*p - '0') < 10u) {
@@ -279,8 +283,8 @@ private:
     const int64_t r = idx > 0 ? idx - 1 : int64_t(count) + idx;
     if (idx != 0 && r >= 0 && r < int64_t(count)) return uint32_t(r);
     if (!dropped && ++danglingFaces_ == 1)
-      warn(std::string("face ") + what + " index " + std::to_string(idx) + " points nowhere (" + std::to_string(count) +
-           " " + what + "s defined so far): the face's " + what + "s are dropped" +
+      warn(std::string("face ") + what + " index " + std::to_string(idx) + " points nowhere (" + std::to_string(count) + " " +
+           what + "s defined so far): the face's " + what + "s are dropped" +
            (std::string(what) == "normal" ? " and computed" : "") + " (so for every such face; no more warnings)");
     dropped = true;
     return kAbsent;
@@ -290,8 +294,8 @@ private:
     if (idx == 0) throw error(std::string("face ") + what + " index 0 is invalid (OBJ indices start at 1)");
     int64_t r = idx > 0 ? idx - 1 : int64_t(count) + idx;
     if (r < 0 || r >= int64_t(count))
-      throw error(std::string("face ") + what + " index " + std::to_string(idx) + " out of range (" +
-                  std::to_string(count) + " " + what + "s defined so far)");
+      throw error(std::string("face ") + what + " index " + std::to_string(idx) + " out of range (" + std::to_string(count) +
+                  " " + what + "s defined so far)");
     return uint32_t(r);
   }
 
@@ -430,16 +434,17 @@ Scene ObjParser::finish() {
   else if (stats_.warnings > kShownWarnings)
     std::cerr << "warning: " << name_ << ": " << stats_.warnings << " warnings, first " << kShownWarnings << " shown\n";
   if (scene.meshes.empty())
-    throw fileError(name_, "", stats_.faces ? "all " + std::to_string(stats_.faces) + " faces are degenerate; nothing to draw"
-                               : pointsAndLines_ ? "no faces, only " + skipped + "; nothing to draw"
-                                                 : "no faces; nothing to draw (is it an OBJ file?)");
+    throw fileError(name_, "",
+                    stats_.faces      ? "all " + std::to_string(stats_.faces) + " faces are degenerate; nothing to draw"
+                    : pointsAndLines_ ? "no faces, only " + skipped + "; nothing to draw"
+                                      : "no faces; nothing to draw (is it an OBJ file?)");
   return scene;
 }
 
 }  // namespace
 
-Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& readMtl, const ObjOptions& options,
-               ObjStats* stats, const std::string& besideMtl) {
+Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& readMtl, const ObjOptions& options, ObjStats* stats,
+               const std::string& besideMtl) {
   ObjStats local;
   ObjStats& st = stats ? *stats : local;
   st.fileBytes = source.fileSize();

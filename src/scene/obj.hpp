@@ -23,15 +23,15 @@ struct ObjOptions : LoadOptions {
 };
 
 struct ObjStats {
-  uint64_t fileBytes = 0;         // bytes of the input file (compressed when zstd)
-  uint64_t textBytes = 0;         // bytes of OBJ text parsed
+  uint64_t fileBytes = 0;                            // bytes of the input file (compressed when zstd)
+  uint64_t textBytes = 0;                            // bytes of OBJ text parsed
   size_t positions = 0, normals = 0, texcoords = 0;  // v / vn / vt records
   size_t faces = 0;
   size_t triangles = 0;           // kept triangles
   size_t degenerateSkipped = 0;   // triangles with repeated corners or zero area
   size_t verticesBeforeWeld = 0;  // triangle corners (the soup)
   size_t verticesAfterWeld = 0;
-  size_t warnings = 0;            // all of them, also those not passed on to the sink
+  size_t warnings = 0;  // all of them, also those not passed on to the sink
   double parseSeconds = 0, weldSeconds = 0;
 };
 
@@ -45,7 +45,7 @@ Scene loadObj(const std::filesystem::path& file, const ObjOptions& options = {},
 // exist (throwing rtr::Error when it cannot be read). `besideMtl` (may be empty) is read at the first
 // `usemtl` when no `mtllib` came before. Used by loadObj, tests and fuzzing.
 using MtlReader = std::function<std::optional<std::string>(const std::string& mtlName)>;
-Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& readMtl,
-               const ObjOptions& options = {}, ObjStats* stats = nullptr, const std::string& besideMtl = {});
+Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& readMtl, const ObjOptions& options = {},
+               ObjStats* stats = nullptr, const std::string& besideMtl = {});
 
 }  // namespace rtr

@@ -24,9 +24,9 @@ constexpr size_t kHeaderSize = 80;
 constexpr size_t kAlign = 16;
 constexpr uint32_t kMaxString = 32768;
 
-constexpr uint32_t kHasView = 1u << 0;  // header flags
-constexpr uint32_t kLightFalloff = 1u << 0;  // light flags
-constexpr uint32_t kHasNormals = 1u << 0, kHasTexcoords = 1u << 1, kIndex16 = 1u << 2;  // mesh flags
+constexpr uint32_t kHasView = 1u << 0;                                                      // header flags
+constexpr uint32_t kLightFalloff = 1u << 0;                                                 // light flags
+constexpr uint32_t kHasNormals = 1u << 0, kHasTexcoords = 1u << 1, kIndex16 = 1u << 2;      // mesh flags
 constexpr uint32_t kHasTexcoords1 = 1u << 3, kHasTangents = 1u << 4, kHasColors = 1u << 5;  // version 5
 constexpr uint32_t kKnownMaterialFlags4 = kMaterialAlphaMasked | kMaterialDoubleSided | kMaterialLight;
 constexpr uint32_t kKnownMaterialFlags = kKnownMaterialFlags4 | kMaterialBlend | kMaterialUnlit | kMaterialGltf;
@@ -42,7 +42,11 @@ void writeString(ByteWriter& w, const std::string& s) {
   w.pad(4);
 }
 
-void writeVec(ByteWriter& w, const glm::vec3& v) { w.f32(v.x); w.f32(v.y); w.f32(v.z); }
+void writeVec(ByteWriter& w, const glm::vec3& v) {
+  w.f32(v.x);
+  w.f32(v.y);
+  w.f32(v.z);
+}
 
 std::string readString(ByteReader& r, const char* what) {
   const size_t at = r.pos();
@@ -110,9 +114,7 @@ constexpr const char* kStreamName[kVertexStreams] = {"positions", "normals", "te
 struct MeshLayout {
   uint32_t flags = 0, vertices = 0, indices = 0, clusters = 0;
   size_t at[kVertexStreams] = {}, indexAt = 0, clusterHeaderAt = 0, clusterAt = 0;
-  size_t count(Stream s) const {
-    return s == kIndices ? indices : s == kPositions || (flags & kStreamFlag[s]) ? vertices : 0;
-  }
+  size_t count(Stream s) const { return s == kIndices ? indices : s == kPositions || (flags & kStreamFlag[s]) ? vertices : 0; }
   size_t elementSize(Stream s) const { return s == kIndices ? (flags & kIndex16 ? 2 : 4) : kVertexSize[s]; }
 };
 
@@ -154,7 +156,9 @@ const T* as(const uint8_t* base, size_t at) {
 
 // assign copies without first zeroing the vectors (a resize would write every byte twice).
 template <class T>
-void copyTo(std::vector<T>& v, const uint8_t* base, size_t at, size_t n) { v.assign(as<T>(base, at), as<T>(base, at) + n); }
+void copyTo(std::vector<T>& v, const uint8_t* base, size_t at, size_t n) {
+  v.assign(as<T>(base, at), as<T>(base, at) + n);
+}
 
 void copyStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base) {
   const size_t v = l.vertices, n = l.indices;
@@ -166,10 +170,8 @@ void copyStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base) {
     case kTangents: copyTo(m.tangents, base, l.at[s], v); break;
     case kColors: copyTo(m.colors, base, l.at[s], v); break;
     case kIndices:
-      if (l.flags & kIndex16)
-        m.indices.assign(as<uint16_t>(base, l.indexAt), as<uint16_t>(base, l.indexAt) + n);
-      else
-        m.indices.assign(as<uint32_t>(base, l.indexAt), as<uint32_t>(base, l.indexAt) + n);
+      if (l.flags & kIndex16) m.indices.assign(as<uint16_t>(base, l.indexAt), as<uint16_t>(base, l.indexAt) + n);
+      else m.indices.assign(as<uint32_t>(base, l.indexAt), as<uint32_t>(base, l.indexAt) + n);
       break;
     case kClusters: break;
   }
@@ -191,11 +193,13 @@ void scan(const uint8_t* p, size_t first, size_t end, Ok ok, Exact exact) {
 
 template <class Index>
 void checkIndices(const MeshLayout& l, const uint8_t* base, uint32_t i, size_t first, size_t end) {
-  scan<Index>(base + l.indexAt, first, end, [&](Index v) { return v < l.vertices; }, [&](size_t k, Index v) {
-    if (v >= l.vertices)
-      throw Fault{l.indexAt + k * sizeof(Index),
-                  meshName(i) + ": index " + std::to_string(v) + " out of range (" + std::to_string(l.vertices) + " vertices)"};
-  });
+  scan<Index>(
+      base + l.indexAt, first, end, [&](Index v) { return v < l.vertices; },
+      [&](size_t k, Index v) {
+        if (v >= l.vertices)
+          throw Fault{l.indexAt + k * sizeof(Index), meshName(i) + ": index " + std::to_string(v) + " out of range (" +
+                                                         std::to_string(l.vertices) + " vertices)"};
+      });
 }
 
 // Finite when every component times 0 is 0 (an infinity or a NaN gives NaN): no branch, no overflow.
@@ -224,7 +228,8 @@ void checkArray(const Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_
     case kPositions:
       return scan<glm::vec3>(base + at, first, end, inside, [&](size_t k, glm::vec3 p) {
         if (!allFinite<3>(p)) throw Fault{at + k * 12, meshName(i) + ": position " + std::to_string(k) + " is not finite"};
-        if (!inside(p)) throw Fault{at + k * 12, meshName(i) + ": position " + std::to_string(k) + " lies outside the mesh bounds"};
+        if (!inside(p))
+          throw Fault{at + k * 12, meshName(i) + ": position " + std::to_string(k) + " lies outside the mesh bounds"};
       });
     case kNormals: return checkFiniteArray<3>(base, at, first, end, meshName(i) + ": a normal");
     case kTexcoords: return checkFiniteArray<2>(base, at, first, end, meshName(i) + ": a texcoord");
@@ -271,13 +276,15 @@ void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i
     if (c.coneCutoff < 1.0f && (c.coneCutoff < 0.0f || std::abs(glm::length(c.coneAxis) - 1.0f) > 1e-3f))
       fault(cAt + 16, k, "cone axis not a unit vector or cutoff below 0");
     if (c.firstTriangle != next)
-      fault(cAt + 32, k, "first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
-                             " (clusters tile the triangles in order)");
+      fault(cAt + 32, k,
+            "first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
+                " (clusters tile the triangles in order)");
     // Past the end only when the cluster before is damaged: its piece reports that, at a lower offset.
     const uint32_t left = next <= triangles ? triangles - uint32_t(next) : 0;
     if (c.triangleCount < 1 || c.triangleCount > CLUSTER_MAX_TRIANGLES || c.triangleCount > left)
-      fault(cAt + 36, k, "triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
-                             std::to_string(std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, left)));
+      fault(cAt + 36, k,
+            "triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
+                std::to_string(std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, left)));
     next += c.triangleCount;
     // Its distinct vertices gathered first (a small open-addressed set: at most 65 of 128 slots filled),
     // then their positions read together: they are scattered over the array, the loads overlap.
@@ -300,14 +307,14 @@ void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i
         fault(cAt, k, "vertex " + std::to_string(vertices[j]) + " lies outside its bounding sphere");
   }
   if (end == l.clusters && next != triangles)
-    throw Fault{l.clusterHeaderAt, meshName(i) + ": clusters cover " + std::to_string(next) + " of " +
-                                       std::to_string(triangles) + " triangles"};
+    throw Fault{l.clusterHeaderAt,
+                meshName(i) + ": clusters cover " + std::to_string(next) + " of " + std::to_string(triangles) + " triangles"};
 }
 
 // The second pass: every array copied out of the file and every value, index and cluster checked, in
 // pieces on `threads` threads, biggest first.
-void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<MeshLayout>& layout,
-                unsigned threads, const ByteReader& r) {
+void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<MeshLayout>& layout, unsigned threads,
+                const ByteReader& r) {
   constexpr size_t kPiece = size_t(1) << 18, kClusterPiece = 2048;
   std::vector<Job> jobs;
   for (uint32_t i = 0; i < layout.size(); ++i) {
@@ -334,14 +341,11 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
     Mesh& m = scene.meshes[job.mesh];
     const MeshLayout& l = layout[job.mesh];
     try {
-      if (job.copy)
-        copyStream(m, l, job.stream, bytes.data());
+      if (job.copy) copyStream(m, l, job.stream, bytes.data());
       else if (job.stream == kClusters && (l.flags & kIndex16))
         checkClusters<uint16_t>(m, l, bytes.data(), job.mesh, job.first, job.first + job.count);
-      else if (job.stream == kClusters)
-        checkClusters<uint32_t>(m, l, bytes.data(), job.mesh, job.first, job.first + job.count);
-      else
-        checkArray(m, l, bytes.data(), job.mesh, job.stream, job.first, job.first + job.count);
+      else if (job.stream == kClusters) checkClusters<uint32_t>(m, l, bytes.data(), job.mesh, job.first, job.first + job.count);
+      else checkArray(m, l, bytes.data(), job.mesh, job.stream, job.first, job.first + job.count);
     } catch (Fault& f) {
       std::lock_guard lock(firstMutex);
       if (f.at < first.at) first = std::move(f);
@@ -353,7 +357,10 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
 // Version 6: chunks to the end of the payload. An unknown or repeated tag is refused, named with its offset.
 // Version 6's chunks after the meshes: TEXS is read here; CLOD refers to the meshes' arrays, so only its
 // place is returned, for reading once they are.
-struct ChunkSpan { size_t at = 0, body = 0; uint64_t size = 0; };
+struct ChunkSpan {
+  size_t at = 0, body = 0;
+  uint64_t size = 0;
+};
 std::optional<ChunkSpan> readChunks(ByteReader& r, std::span<const uint8_t> bytes, Scene& scene,
                                     const std::shared_ptr<const void>& owner, const std::string& file) {
   std::optional<size_t> texs;
@@ -396,7 +403,8 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   for (const Light& l : scene.lights)
     if (const char* f = lightFault(l)) throw Error(std::string("cannot encode a light: ") + f);
   for (const Instance& i : scene.instances)
-    if (i.mesh >= scene.meshes.size()) throw Error("cannot encode an instance of mesh " + std::to_string(i.mesh) + ": no such mesh");
+    if (i.mesh >= scene.meshes.size())
+      throw Error("cannot encode an instance of mesh " + std::to_string(i.mesh) + ": no such mesh");
   ByteWriter w;
   w.bytes(kMagic, 8);
   w.u32(version);
@@ -441,7 +449,8 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
       w.u8(t.sourceChannel);
       w.u8(uint8_t(t.sampler.wrapU));
       w.u8(uint8_t(t.sampler.wrapV));
-      w.u8((t.sampler.nearestMag ? kNearestMag : 0) | (t.sampler.nearestMin ? kNearestMin : 0) | (t.sampler.nearestMip ? kNearestMip : 0));
+      w.u8((t.sampler.nearestMag ? kNearestMag : 0) | (t.sampler.nearestMin ? kNearestMin : 0) |
+           (t.sampler.nearestMip ? kNearestMip : 0));
     }
     w.pod(uint16_t(0));
     writeString(w, t.path.generic_string());
@@ -480,8 +489,8 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     if (!sized(m.normals) || !sized(m.texcoords) || !sized(m.texcoords1) || !sized(m.tangents) || !sized(m.colors))
       throw Error("mesh '" + m.name + "': attribute counts differ");
     const bool small = v <= 0x10000;
-    const uint32_t present[kVertexStreams] = {1, !m.normals.empty(), !m.texcoords.empty(), !m.texcoords1.empty(),
-                                              !m.tangents.empty(), !m.colors.empty()};
+    const uint32_t present[kVertexStreams] = {
+        1, !m.normals.empty(), !m.texcoords.empty(), !m.texcoords1.empty(), !m.tangents.empty(), !m.colors.empty()};
     uint32_t flags = small ? kIndex16 : 0;
     for (size_t s = 1; s < kVertexStreams; ++s) flags |= present[s] ? kStreamFlag[s] : 0;
     w.u32(m.material);
@@ -506,10 +515,8 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
       w.array(m.colors);
       w.pad(kAlign);
     }
-    if (small)
-      w.array(std::vector<uint16_t>(m.indices.begin(), m.indices.end()));
-    else
-      w.array(m.indices);
+    if (small) w.array(std::vector<uint16_t>(m.indices.begin(), m.indices.end()));
+    else w.array(m.indices);
     w.pad(kAlign);
     // Version 3: the clusters (zero: none stored, built at load).
     if (version < 3) continue;
@@ -561,7 +568,8 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
   if (std::memcmp(magic, kMagic, 8) != 0) r.failAt(0, "not an .rtrscene file (magic mismatch)");
   const uint32_t version = r.u32("the header");
   if (version < 1 || version > kRtrSceneVersion)
-    r.failAt(8, "unsupported version " + std::to_string(version) + " (this build reads " + std::to_string(kRtrSceneVersion) + ")");
+    r.failAt(8,
+             "unsupported version " + std::to_string(version) + " (this build reads " + std::to_string(kRtrSceneVersion) + ")");
   const uint32_t flags = r.u32("the header");
   if (flags & ~uint32_t(kHasView)) r.failAt(12, "unknown header flags");
   const uint32_t texCount = r.u32("the header"), matCount = r.u32("the header"), meshCount = r.u32("the header");
@@ -602,16 +610,19 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
     r.failAt(28, "light count " + std::to_string(lightCount) + " cannot fit in the file");
   if (uint64_t(instanceCount) * kInstanceSize > r.remaining())
     r.failAt(68, "instance count " + std::to_string(instanceCount) + " cannot fit in the file");
-  if (uint64_t(texCount) * (v5 ? 12 : 8) > r.remaining()) r.failAt(16, "texture count " + std::to_string(texCount) + " cannot fit in the file");
+  if (uint64_t(texCount) * (v5 ? 12 : 8) > r.remaining())
+    r.failAt(16, "texture count " + std::to_string(texCount) + " cannot fit in the file");
   if (uint64_t(matCount) * (v5 ? kMaterialMin5 : kMaterialMin4) > r.remaining())
     r.failAt(20, "material count " + std::to_string(matCount) + " cannot fit in the file");
-  if (uint64_t(meshCount) * 64 > r.remaining()) r.failAt(24, "mesh count " + std::to_string(meshCount) + " cannot fit in the file");
+  if (uint64_t(meshCount) * 64 > r.remaining())
+    r.failAt(24, "mesh count " + std::to_string(meshCount) + " cannot fit in the file");
 
   scene.lights.resize(lightCount);
   for (Light& l : scene.lights) {
     const size_t at = r.pos();
     const uint32_t kind = r.u32("a light record"), lflags = r.u32("a light record");
-    if (kind > uint32_t(v5 ? Light::Kind::Directional : Light::Kind::Headlight)) r.failAt(at, "unknown light kind " + std::to_string(kind));
+    if (kind > uint32_t(v5 ? Light::Kind::Directional : Light::Kind::Headlight))
+      r.failAt(at, "unknown light kind " + std::to_string(kind));
     if (lflags & ~kLightFalloff) r.failAt(at + 4, "unknown light flags");
     l.kind = Light::Kind(kind);
     l.falloff = (lflags & kLightFalloff) != 0;
@@ -649,11 +660,13 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
       t.sourceChannel = r.u8("a texture record");
       const uint8_t wrapU = r.u8("a texture record"), wrapV = r.u8("a texture record"), filter = r.u8("a texture record");
       if (t.sourceChannel > (ch == 1 ? 4 : 0))
-        r.failAt(at + 2, "texture source channel " + std::to_string(t.sourceChannel) + " for " + std::to_string(ch) + " channels");
+        r.failAt(at + 2,
+                 "texture source channel " + std::to_string(t.sourceChannel) + " for " + std::to_string(ch) + " channels");
       for (uint8_t wrap : {wrapU, wrapV})
         if (wrap > uint8_t(Wrap::MirroredRepeat)) r.failAt(at + 3, "unknown texture wrap mode " + std::to_string(wrap));
       if (filter & ~(kNearestMag | kNearestMin | kNearestMip)) r.failAt(at + 5, "unknown texture filter flags");
-      t.sampler = {Wrap(wrapU), Wrap(wrapV), (filter & kNearestMag) != 0, (filter & kNearestMin) != 0, (filter & kNearestMip) != 0};
+      t.sampler = {Wrap(wrapU), Wrap(wrapV), (filter & kNearestMag) != 0, (filter & kNearestMin) != 0,
+                   (filter & kNearestMip) != 0};
     }
     const size_t reservedAt = r.pos();
     if (r.pod<uint16_t>("a texture record") != 0 && v5) r.failAt(reservedAt, "reserved texture field is not 0");

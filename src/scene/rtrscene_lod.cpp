@@ -65,7 +65,8 @@ void readClusterLods(ByteReader& r, uint64_t size, Scene& scene) {
   const uint32_t meshes = r.u32("the CLOD chunk");
   for (int k = 0; k < 3; ++k)
     if (r.u32("the CLOD chunk") != 0) r.failAt(countAt + 4, "CLOD chunk: reserved field is not 0");
-  if (uint64_t(meshes) * kMeshSize > left()) r.failAt(countAt, "CLOD chunk: mesh count " + std::to_string(meshes) + " cannot fit in it");
+  if (uint64_t(meshes) * kMeshSize > left())
+    r.failAt(countAt, "CLOD chunk: mesh count " + std::to_string(meshes) + " cannot fit in it");
   int64_t last = -1;
   for (uint32_t n = 0; n < meshes; ++n) {
     const size_t at = r.pos();
@@ -73,17 +74,19 @@ void readClusterLods(ByteReader& r, uint64_t size, Scene& scene) {
     const uint32_t mi = r.u32("a CLOD mesh"), levels = r.u32("a CLOD mesh"), count = r.u32("a CLOD mesh"),
                    indexCount = r.u32("a CLOD mesh");
     if (int64_t(mi) <= last || mi >= scene.meshes.size())
-      r.failAt(at, "CLOD chunk: mesh " + std::to_string(mi) + " out of range or not after mesh " + std::to_string(last) +
-                       " (" + std::to_string(scene.meshes.size()) + " meshes)");
+      r.failAt(at, "CLOD chunk: mesh " + std::to_string(mi) + " out of range or not after mesh " + std::to_string(last) + " (" +
+                       std::to_string(scene.meshes.size()) + " meshes)");
     last = mi;
     Mesh& m = scene.meshes[mi];
     const std::string which = "CLOD chunk: mesh " + std::to_string(mi) + ": ";
     const size_t base = m.clusters.size();
     if (levels < 1 || levels > kMaxLevels) r.failAt(at + 4, which + "level count " + std::to_string(levels) + " not in 1..64");
-    if (base == 0 || count < base) r.failAt(at + 8, which + std::to_string(count) + " clusters, fewer than its " + std::to_string(base) + " own");
+    if (base == 0 || count < base)
+      r.failAt(at + 8, which + std::to_string(count) + " clusters, fewer than its " + std::to_string(base) + " own");
     if (indexCount % 3 != 0) r.failAt(at + 12, which + "index count " + std::to_string(indexCount) + " is not a multiple of 3");
     if ((uint64_t(count) * kClusterSize + uint64_t(indexCount) * 4) > left())
-      r.failAt(at + 8, which + std::to_string(count) + " clusters and " + std::to_string(indexCount) + " indices cannot fit in the chunk");
+      r.failAt(at + 8, which + std::to_string(count) + " clusters and " + std::to_string(indexCount) +
+                           " indices cannot fit in the chunk");
     ClusterLod& lod = m.lod;
     lod.levels = levels;
     lod.clusters.resize(count);
@@ -132,7 +135,8 @@ void readClusterLods(ByteReader& r, uint64_t size, Scene& scene) {
         r.failAt(cAt + 32, cl + "cone axis not a unit vector or cutoff below 0");
     }
     if (next != uint64_t(triangles) + indexCount / 3)
-      r.failAt(at + 12, which + std::to_string(indexCount / 3) + " triangles, but its clusters hold " + std::to_string(next - triangles));
+      r.failAt(at + 12,
+               which + std::to_string(indexCount / 3) + " triangles, but its clusters hold " + std::to_string(next - triangles));
     const size_t iAt = r.pos();
     r.array(lod.indices, indexCount, "CLOD indices");
     for (size_t k = 0; k < lod.indices.size(); ++k)

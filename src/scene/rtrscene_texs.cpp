@@ -53,8 +53,8 @@ void writeTexs(ByteWriter& w, const Scene& scene) {
     for (const BakedPiece& p : t.baked->pieces) w.bytes(t.baked->data.data() + p.at, p.stored);
 }
 
-void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& scene,
-              const std::shared_ptr<const void>& owner, const std::string& file) {
+void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& scene, const std::shared_ptr<const void>& owner,
+              const std::string& file) {
   const size_t body = r.pos();
   const size_t size = end - body;
   auto need = [&](uint64_t n, const char* what) {
@@ -66,8 +66,7 @@ void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& 
   const uint32_t count = r.u32("the TEXS header");
   if (count != scene.textures.size())
     r.failAt(body, "TEXS holds " + std::to_string(count) + " textures; the file has " + std::to_string(scene.textures.size()));
-  if (r.u32("the TEXS header") != kBakedPiece)
-    r.failAt(body + 4, "TEXS piece size is not " + std::to_string(kBakedPiece));
+  if (r.u32("the TEXS header") != kBakedPiece) r.failAt(body + 4, "TEXS piece size is not " + std::to_string(kBakedPiece));
   if (r.pod<uint64_t>("the TEXS header") != 0) r.failAt(body + 8, "reserved TEXS field is not 0");
   need(uint64_t(count) * kTexsRecord, "its texture records");
   std::vector<std::shared_ptr<BakedTexels>> baked(count);
@@ -91,9 +90,12 @@ void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& 
                        std::to_string(t.channels) + " channels");
     if (b->width < 1 || b->width > kMaxSide || b->height < 1 || b->height > kMaxSide)
       r.failAt(at + 4, which + ": size " + std::to_string(b->width) + "x" + std::to_string(b->height) + " not in 1..32768");
-    if (levels != b->levels()) r.failAt(at + 12, which + ": " + std::to_string(levels) + " levels, not the full chain's " + std::to_string(b->levels()));
-    if (chain != b->bytes()) r.failAt(at + 16, which + ": " + std::to_string(chain) + " texel bytes, not the chain's " + std::to_string(b->bytes()));
-    if (n != (chain + kBakedPiece - 1) / kBakedPiece) r.failAt(at + 24, which + ": " + std::to_string(n) + " pieces for " + std::to_string(chain) + " bytes");
+    if (levels != b->levels())
+      r.failAt(at + 12, which + ": " + std::to_string(levels) + " levels, not the full chain's " + std::to_string(b->levels()));
+    if (chain != b->bytes())
+      r.failAt(at + 16, which + ": " + std::to_string(chain) + " texel bytes, not the chain's " + std::to_string(b->bytes()));
+    if (n != (chain + kBakedPiece - 1) / kBakedPiece)
+      r.failAt(at + 24, which + ": " + std::to_string(n) + " pieces for " + std::to_string(chain) + " bytes");
     pieces += n;
     baked[i] = std::move(b);
   }
@@ -113,9 +115,11 @@ void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& 
       const std::string which = "baked texture " + std::to_string(i) + " piece " + std::to_string(k);
       if (offset != next) r.failAt(at, which + ": stored at " + std::to_string(offset) + ", not at " + std::to_string(next));
       if (stored < 1 || stored > b.pieceBytes(k))
-        r.failAt(at + 8, which + ": " + std::to_string(stored) + " stored bytes for " + std::to_string(b.pieceBytes(k)) + " texel bytes");
+        r.failAt(at + 8,
+                 which + ": " + std::to_string(stored) + " stored bytes for " + std::to_string(b.pieceBytes(k)) + " texel bytes");
       if (offset + stored > size)
-        r.failAt(at + 8, which + ": ends at byte " + std::to_string(body + offset + stored) + ", past the TEXS chunk's end " + std::to_string(end));
+        r.failAt(at + 8, which + ": ends at byte " + std::to_string(body + offset + stored) + ", past the TEXS chunk's end " +
+                             std::to_string(end));
       b.pieces[k] = {offset, stored};
       next = offset + stored;
     }

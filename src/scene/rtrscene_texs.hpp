@@ -15,7 +15,7 @@ bool hasBakedTextures(const Scene& scene);
 void writeTexs(ByteWriter& w, const Scene& scene);
 // Reads the body that ends at `end` into scene.textures[i].baked; `owner` keeps `bytes` alive (null: the
 // stored pieces are copied). Faults throw rtr::Error naming the file and byte offset.
-void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& scene,
-              const std::shared_ptr<const void>& owner, const std::string& file);
+void readTexs(ByteReader& r, size_t end, std::span<const uint8_t> bytes, Scene& scene, const std::shared_ptr<const void>& owner,
+              const std::string& file);
 
 }  // namespace rtr

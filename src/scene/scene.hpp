@@ -41,7 +41,7 @@ struct SamplerDesc {
 struct Texture {
   std::filesystem::path path;  // absolute, or relative to Scene::baseDir; with `bytes`: a name for messages
   bool srgb = false;
-  uint8_t channels = 4;        // channel count the slot needs; loaders force it
+  uint8_t channels = 4;  // channel count the slot needs; loaders force it
   // channels == 1: 0 takes the image as grey (its luminance: OBJ/MTL and course textures); 1-4 take its
   // R, G, B or A (glTF packs occlusion in R, roughness in G, metalness in B; a mask is the alpha).
   uint8_t sourceChannel = 0;
@@ -78,10 +78,10 @@ struct Material {
   glm::vec3 baseColor{1.0f};
   float roughness = 1.0f;
   float metalness = 0.0f;
-  glm::vec3 emissive{0.0f};   // glTF: emissiveFactor × KHR_materials_emissive_strength
-  float opacity = 1.0f;       // glTF baseColorFactor's alpha
-  float alphaCutoff = 0.5f;   // alpha-masked: texels below it are cut out
-  float normalScale = 1.0f;   // glTF normalTexture.scale
+  glm::vec3 emissive{0.0f};  // glTF: emissiveFactor × KHR_materials_emissive_strength
+  float opacity = 1.0f;      // glTF baseColorFactor's alpha
+  float alphaCutoff = 0.5f;  // alpha-masked: texels below it are cut out
+  float normalScale = 1.0f;  // glTF normalTexture.scale
   float occlusionStrength = 1.0f;
   std::array<uint32_t, kTextureSlotCount> textures{kNoTexture, kNoTexture, kNoTexture, kNoTexture,
                                                    kNoTexture, kNoTexture, kNoTexture};
@@ -102,7 +102,7 @@ struct Cluster {
   uint32_t firstTriangle = 0, triangleCount = 0;  // triangles [first, first + count) of the mesh
   glm::vec3 center{0.0f};                         // bounding sphere, scene space
   float radius = 0.0f;
-  glm::vec3 coneAxis{0.0f};                       // normal cone (shaders/shared/cluster.h); cutoff >= 1: none
+  glm::vec3 coneAxis{0.0f};  // normal cone (shaders/shared/cluster.h); cutoff >= 1: none
   float coneCutoff = 1.0f;
 };
 
@@ -112,20 +112,20 @@ struct Cluster {
 // a visibility id names any level's triangle as it names the mesh's.
 struct LodCluster {
   uint32_t firstTriangle = 0, triangleCount = 0;
-  uint32_t level = 0;                 // 0: the mesh's own triangles
-  glm::vec3 center{0.0f};             // bounds of its triangles (culling)
+  uint32_t level = 0;      // 0: the mesh's own triangles
+  glm::vec3 center{0.0f};  // bounds of its triangles (culling)
   float radius = 0.0f;
-  glm::vec3 coneAxis{0.0f};           // normal cone as Cluster's; cutoff >= 1: none
+  glm::vec3 coneAxis{0.0f};  // normal cone as Cluster's; cutoff >= 1: none
   float coneCutoff = 1.0f;
-  glm::vec4 sphere{0.0f};             // where `error` applies (the group that made it; level 0: its bounds)
-  float error = 0.0f;                 // object-space error of the simplification that made it (level 0: 0)
+  glm::vec4 sphere{0.0f};  // where `error` applies (the group that made it; level 0: its bounds)
+  float error = 0.0f;      // object-space error of the simplification that made it (level 0: 0)
   glm::vec4 parentSphere{0.0f};
-  float parentError = 0.0f;           // of the simplification that replaced it; LOD_ERROR_INFINITE: a root
+  float parentError = 0.0f;  // of the simplification that replaced it; LOD_ERROR_INFINITE: a root
 };
 struct ClusterLod {
-  std::vector<uint32_t> indices;      // the triangles of levels 1 and up, cluster by cluster; mesh vertices
-  std::vector<LodCluster> clusters;   // level 0 first (Mesh::clusters' order), then level by level
-  uint32_t levels = 0;                // 0: no hierarchy
+  std::vector<uint32_t> indices;           // the triangles of levels 1 and up, cluster by cluster; mesh vertices
+  std::vector<LodCluster> clusters;        // level 0 first (Mesh::clusters' order), then level by level
+  uint32_t levels = 0;                     // 0: no hierarchy
   size_t triangles(uint32_t level) const;  // of that level's clusters
 };
 
@@ -133,15 +133,15 @@ struct Mesh {
   std::string name;  // OBJ object/group name
   uint32_t material = 0;
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;    // same count as positions
-  std::vector<glm::vec2> texcoords;  // empty when the source has none
-  std::vector<glm::vec2> texcoords1; // a second uv set (glTF TEXCOORD_1); empty when none
-  std::vector<glm::vec4> tangents;   // xyz unit tangent, w ±1 bitangent sign (glTF); empty when none
-  std::vector<glm::vec4> colors;     // linear RGBA vertex colours (glTF COLOR_0, OBJ `v x y z r g b`); empty when none
-  std::vector<uint32_t> indices;     // triangle list, local to the mesh
-  Bounds bounds;                     // object space (before any instance transform)
-  std::vector<Cluster> clusters;     // tile the triangles in order; empty until built (scene/clusters.hpp)
-  ClusterLod lod;                    // the level-of-detail hierarchy; empty: none (scene/cluster_lod.hpp)
+  std::vector<glm::vec3> normals;     // same count as positions
+  std::vector<glm::vec2> texcoords;   // empty when the source has none
+  std::vector<glm::vec2> texcoords1;  // a second uv set (glTF TEXCOORD_1); empty when none
+  std::vector<glm::vec4> tangents;    // xyz unit tangent, w ±1 bitangent sign (glTF); empty when none
+  std::vector<glm::vec4> colors;      // linear RGBA vertex colours (glTF COLOR_0, OBJ `v x y z r g b`); empty when none
+  std::vector<uint32_t> indices;      // triangle list, local to the mesh
+  Bounds bounds;                      // object space (before any instance transform)
+  std::vector<Cluster> clusters;      // tile the triangles in order; empty until built (scene/clusters.hpp)
+  ClusterLod lod;                     // the level-of-detail hierarchy; empty: none (scene/cluster_lod.hpp)
 
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
 };
@@ -152,14 +152,14 @@ struct Light {
   // Spot and Directional: glTF's KHR_lights_punctual.
   enum class Kind : uint32_t { Point, Area, Headlight, Spot, Directional };
   Kind kind = Kind::Point;
-  glm::vec3 position{0.0f};  // point light position, or the area light's centre
-  glm::vec3 color{1.0f};     // colour x intensity
-  bool falloff = false;      // inverse-square falloff with distance
+  glm::vec3 position{0.0f};                          // point light position, or the area light's centre
+  glm::vec3 color{1.0f};                             // colour x intensity
+  bool falloff = false;                              // inverse-square falloff with distance
   glm::vec3 corner{0.0f}, edge1{0.0f}, edge2{0.0f};  // area light: corner + s·edge1 + t·edge2
-  glm::vec3 normal{0.0f};    // area light: normal of its first face
-  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // spot and directional: the unit direction the light travels
-  float innerConeCos = 1.0f, outerConeCos = 0.0f;  // spot: full inside the inner cone, none outside the outer
-  float range = 0.0f;        // > 0: no light beyond this distance (glTF range); 0: unbounded
+  glm::vec3 normal{0.0f};                            // area light: normal of its first face
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};            // spot and directional: the unit direction the light travels
+  float innerConeCos = 1.0f, outerConeCos = 0.0f;    // spot: full inside the inner cone, none outside the outer
+  float range = 0.0f;                                // > 0: no light beyond this distance (glTF range); 0: unbounded
   // Where to aim shadow ray `i` of `n` (n = 1: the centre; otherwise a stratified grid on the quad).
   glm::vec3 samplePoint(int i, int n) const;
 };

@@ -15,8 +15,8 @@ namespace rtr {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kEarth = 6360e3, kTop = 6420e3;  // radii, metres
-constexpr double kHeightR = 8000.0, kHeightM = 1200.0;  // scale heights of air and haze
+constexpr double kEarth = 6360e3, kTop = 6420e3;           // radii, metres
+constexpr double kHeightR = 8000.0, kHeightM = 1200.0;     // scale heights of air and haze
 const glm::dvec3 kRayleigh{5.802e-6, 13.558e-6, 33.1e-6};  // scattering = extinction, per metre at sea level
 constexpr double kMieScatter = 3.996e-6, kMieExtinct = 4.40e-6, kMieG = 0.8;
 
@@ -33,7 +33,9 @@ bool hitsGround(const glm::dvec3& o, const glm::dvec3& d) {
   return b < 0.0 && b * b - c >= 0.0;
 }
 
-struct Optical { double rayleigh = 0.0, mie = 0.0; };  // optical depths per unit coefficient
+struct Optical {
+  double rayleigh = 0.0, mie = 0.0;
+};  // optical depths per unit coefficient
 
 Optical depthAlong(const glm::dvec3& o, const glm::dvec3& d, double length, int steps) {
   Optical od;

@@ -13,24 +13,24 @@ namespace {
 
 // Raw bytes from a file or memory, the layer under the optional zstd decoder.
 class RawSource {
-public:
+ public:
   virtual ~RawSource() = default;
   virtual size_t read(char* dst, size_t n) = 0;
   virtual uint64_t size() const = 0;
 };
 
 class RawFile final : public RawSource {
-public:
+ public:
   explicit RawFile(const std::filesystem::path& file) : in_(file, "scene file") {}
   size_t read(char* dst, size_t n) override { return in_.read(dst, n); }
   uint64_t size() const override { return in_.size(); }
 
-private:
+ private:
   InputFile in_;  // a regular file only, read no further than its size at open
 };
 
 class RawMemory final : public RawSource {
-public:
+ public:
   explicit RawMemory(std::string data) : data_(std::move(data)) {}
   size_t read(char* dst, size_t n) override {
     size_t k = std::min(n, data_.size() - pos_);
@@ -40,13 +40,13 @@ public:
   }
   uint64_t size() const override { return data_.size(); }
 
-private:
+ private:
   std::string data_;
   size_t pos_ = 0;
 };
 
 class PlainSource final : public ByteSource {
-public:
+ public:
   explicit PlainSource(std::unique_ptr<RawSource> raw) : raw_(std::move(raw)) {}
   size_t read(char* dst, size_t n) override {
     size_t k = raw_->read(dst, n);
@@ -56,7 +56,7 @@ public:
   uint64_t consumed() const override { return consumed_; }
   uint64_t fileSize() const override { return raw_->size(); }
 
-private:
+ private:
   std::unique_ptr<RawSource> raw_;
   uint64_t consumed_ = 0;
 };
@@ -66,7 +66,7 @@ struct DStreamFree {
 };
 
 class ZstdSource final : public ByteSource {
-public:
+ public:
   ZstdSource(std::unique_ptr<RawSource> raw, std::string name)
       : raw_(std::move(raw)), name_(std::move(name)), in_(ZSTD_DStreamInSize()), z_(ZSTD_createDStream()) {
     if (!z_) throw fileError(name_, "", "out of memory creating the zstd decoder");
@@ -104,7 +104,7 @@ public:
   uint64_t consumed() const override { return consumed_; }
   uint64_t fileSize() const override { return raw_->size(); }
 
-private:
+ private:
   std::unique_ptr<RawSource> raw_;
   std::string name_;
   std::vector<char> in_;

@@ -10,7 +10,7 @@
 namespace rtr {
 
 class ByteSource {
-public:
+ public:
   virtual ~ByteSource() = default;
   // Fills up to n bytes; returns 0 only at the end. Throws rtr::Error naming the file on I/O or codec faults.
   virtual size_t read(char* dst, size_t n) = 0;

@@ -31,7 +31,10 @@ enum class NumResult { Ok, Missing, Bad, NotFinite };
 inline NumResult nextFloat(std::string_view& s, float& out) {
   size_t i = 0;
   while (i < s.size() && isSpace(s[i])) ++i;
-  if (i == s.size()) { s.remove_prefix(i); return NumResult::Missing; }
+  if (i == s.size()) {
+    s.remove_prefix(i);
+    return NumResult::Missing;
+  }
   const char* b = s.data() + i;
   const char* e = s.data() + s.size();
   if (*b == '+') ++b;  // from_chars does not take a leading '+'

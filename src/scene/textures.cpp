@@ -64,8 +64,7 @@ TexelData fallbackTexels(int channels) {
   return t;
 }
 
-void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
-                    const std::function<void(size_t, TexelData&&)>& use,
+void decodeTextures(const Scene& scene, std::span<const uint32_t> which, const std::function<void(size_t, TexelData&&)>& use,
                     const std::function<void(const std::string&)>& warn) {
   std::mutex warnMutex;
   // A missing or broken texture must not stop a model from showing: warn, and show the checker instead.
@@ -78,9 +77,7 @@ void decodeTextures(const Scene& scene, std::span<const uint32_t> which,
     } else {
       try {
         return decodeTexture(scene, t);
-      } catch (const Error& e) {
-        why = e.what();
-      }
+      } catch (const Error& e) { why = e.what(); }
     }
     const std::lock_guard lock(warnMutex);
     const std::string msg = why + "; showing a magenta/black checker instead";

@@ -5,7 +5,9 @@
 namespace rtr {
 namespace {
 
-struct P2 { double x, y; };
+struct P2 {
+  double x, y;
+};
 
 double cross(P2 a, P2 b, P2 c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
 

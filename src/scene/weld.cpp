@@ -41,15 +41,14 @@ struct Vertex {
 
 inline bool near(const Vertex& a, const Vertex& b) {
   auto c = [](float x, float y) { return std::fabs(x - y) <= kWeldTolerance; };
-  return c(a.p.x, b.p.x) && c(a.p.y, b.p.y) && c(a.p.z, b.p.z) && c(a.n.x, b.n.x) && c(a.n.y, b.n.y) &&
-         c(a.n.z, b.n.z) && c(a.t.x, b.t.x) && c(a.t.y, b.t.y) && a.c == b.c;
+  return c(a.p.x, b.p.x) && c(a.p.y, b.p.y) && c(a.p.z, b.p.z) && c(a.n.x, b.n.x) && c(a.n.y, b.n.y) && c(a.n.z, b.n.z) &&
+         c(a.t.x, b.t.x) && c(a.t.y, b.t.y) && a.c == b.c;
 }
 
 }  // namespace
 
-WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions,
-                    std::span<const glm::vec3> normals, std::span<const glm::vec2> texcoords, Mesh& out,
-                    float creaseDeg, std::span<const glm::vec4> colors) {
+WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                    std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors) {
   WeldCounts counts;
   const size_t triCount = corners.size() / 3;
 
@@ -120,8 +119,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
         const uint32_t lp = normalOfPos[c.p];
         glm::vec3 sum(0.0f);
         for (uint32_t i = start[lp]; i < start[lp + 1]; ++i)
-          if (around[i] == t || (creaseDeg > 0.0f && glm::dot(own, unit(cross[around[i]])) >= cosCrease))
-            sum += cross[around[i]];
+          if (around[i] == t || (creaseDeg > 0.0f && glm::dot(own, unit(cross[around[i]])) >= cosCrease)) sum += cross[around[i]];
         const glm::vec3 n = unit(sum);
         uint32_t g = firstGen[lp];
         while (g != kAbsent && gen[g] != n) g = nextGen[g];
@@ -194,7 +192,10 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       for (int64_t y = lo[1]; y <= hi[1] && found == kAbsent; ++y)
         for (int64_t z = lo[2]; z <= hi[2] && found == kAbsent; ++z)
           for (uint32_t r = slots[cellHash(x, y, z) & mask]; r != kAbsent; r = next[r])
-            if (near(reps[r], v)) { found = r; break; }
+            if (near(reps[r], v)) {
+              found = r;
+              break;
+            }
     if (found == kAbsent) {
       found = uint32_t(reps.size());
       uint32_t& head = slots[cellHash(cell[0], cell[1], cell[2]) & mask];
@@ -225,7 +226,11 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   out.indices.reserve(cornerVertex.size());
   for (size_t i = 0; i < cornerVertex.size(); i += 3) {
     uint32_t a = remap[cornerVertex[i]], b = remap[cornerVertex[i + 1]], c = remap[cornerVertex[i + 2]];
-    if (a == b || b == c || a == c) { ++counts.degenerate; --counts.triangles; continue; }
+    if (a == b || b == c || a == c) {
+      ++counts.degenerate;
+      --counts.triangles;
+      continue;
+    }
     out.indices.insert(out.indices.end(), {a, b, c});
   }
   counts.vertices = reps.size();

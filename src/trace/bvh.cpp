@@ -31,8 +31,14 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // The operand order of min/max is glm's (min(a, b) = b < a ? b : a), so signed zeros land as before.
 struct Box {
   __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);
-  void grow(__m128 p) { lo = _mm_min_ps(p, lo); hi = _mm_max_ps(p, hi); }
-  void grow(const Box& b) { lo = _mm_min_ps(b.lo, lo); hi = _mm_max_ps(b.hi, hi); }
+  void grow(__m128 p) {
+    lo = _mm_min_ps(p, lo);
+    hi = _mm_max_ps(p, hi);
+  }
+  void grow(const Box& b) {
+    lo = _mm_min_ps(b.lo, lo);
+    hi = _mm_max_ps(b.hi, hi);
+  }
   float halfArea() const {
     alignas(16) float e[4];
     _mm_store_ps(e, _mm_max_ps(_mm_setzero_ps(), _mm_sub_ps(hi, lo)));
@@ -89,10 +95,14 @@ double sahCost(const Node* nodes, uint32_t root) {
     for (int k = 0; k < int(kWidth); ++k) {
       if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty slot
       if (&n == &nodes[root])
-        rootBox.grow(Box{_mm_set_ps(0, n.box[0][2][k], n.box[0][1][k], n.box[0][0][k]), _mm_set_ps(0, n.box[1][2][k], n.box[1][1][k], n.box[1][0][k])});
+        rootBox.grow(Box{_mm_set_ps(0, n.box[0][2][k], n.box[0][1][k], n.box[0][0][k]),
+                         _mm_set_ps(0, n.box[1][2][k], n.box[1][1][k], n.box[1][0][k])});
       const uint32_t c = n.child[k];
       if (c & Bvh::kLeafBit) total += area(n, k) * double(((c >> 28) & 7u) + 1);
-      else { total += area(n, k) * kNodeCost; stack.push_back(c); }
+      else {
+        total += area(n, k) * kNodeCost;
+        stack.push_back(c);
+      }
     }
   }
   rootArea = rootBox.halfArea();
@@ -113,9 +123,9 @@ struct BvhBuilder {
   std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
   ThreadPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
-  static constexpr uint32_t kSubtreeTask = 4096;  // triangles from which a subtree is a task of its own
+  static constexpr uint32_t kSubtreeTask = 4096;         // triangles from which a subtree is a task of its own
   static constexpr uint32_t kParallelChunk = 16 * 1024;  // refs a chunk at least, when binned by many threads
-  static constexpr uint32_t kSmallRange = 24;  // ranges up to this size: findSplitSmall
+  static constexpr uint32_t kSmallRange = 24;            // ranges up to this size: findSplitSmall
 
   struct Split {
     int axis = -1, bin = 0;
@@ -132,7 +142,10 @@ struct BvhBuilder {
     // range was cut up between threads.
     void merge(const Bins& o) {
       for (int a = 0; a < 3; ++a)
-        for (int k = 0; k < kBins; ++k) { b[a][k].grow(o.b[a][k]); n[a][k] += o.n[a][k]; }
+        for (int k = 0; k < kBins; ++k) {
+          b[a][k].grow(o.b[a][k]);
+          n[a][k] += o.n[a][k];
+        }
     }
   };
 
@@ -191,14 +204,23 @@ struct BvhBuilder {
       __m128 h0 = all.b[0][k].hi, h1 = all.b[1][k].hi, h2 = all.b[2][k].hi, h3 = _mm_setzero_ps();
       _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
       _MM_TRANSPOSE4_PS(h0, h1, h2, h3);
-      lo[0][k] = l0; lo[1][k] = l1; lo[2][k] = l2;
-      hi[0][k] = h0; hi[1][k] = h1; hi[2][k] = h2;
+      lo[0][k] = l0;
+      lo[1][k] = l1;
+      lo[2][k] = l2;
+      hi[0][k] = h0;
+      hi[1][k] = h1;
+      hi[2][k] = h2;
       count[k] = _mm_set_epi32(0, int(all.n[2][k]), int(all.n[1][k]), int(all.n[0][k]));
     }
     struct Acc {
       __m128 lo[3], hi[3];
       __m128i n = _mm_setzero_si128();
-      Acc() { for (int i = 0; i < 3; ++i) { lo[i] = _mm_set1_ps(kInf); hi[i] = _mm_set1_ps(-kInf); } }
+      Acc() {
+        for (int i = 0; i < 3; ++i) {
+          lo[i] = _mm_set1_ps(kInf);
+          hi[i] = _mm_set1_ps(-kInf);
+        }
+      }
       // Grows by bin k; returns halfArea() · packsFor(n) per axis.
       __m128 add(const __m128 (&l)[3][kBins], const __m128 (&h)[3][kBins], const __m128i* c, int k) {
         __m128 e[3];
@@ -236,7 +258,11 @@ struct BvhBuilder {
     _mm_store_si128(reinterpret_cast<__m128i*>(bb), bestBin);
     Split best;
     for (int a = 0; a < 3; ++a)  // the first axis of equal cost wins, as in a sweep of one axis after another
-      if (bc[a] < best.cost) { best.cost = bc[a]; best.axis = a; best.bin = bb[a]; }
+      if (bc[a] < best.cost) {
+        best.cost = bc[a];
+        best.axis = a;
+        best.bin = bb[a];
+      }
     if (best.axis < 0) return best;
     // Child ranges' bounds straight from the bins (their centroid bounds: partition()).
     Range L, R;
@@ -245,7 +271,10 @@ struct BvhBuilder {
       (k <= best.bin ? L : R).bounds.grow(all.b[best.axis][k]);
       if (k <= best.bin) nl += all.n[best.axis][k];
     }
-    L.begin = r.begin; L.end = r.begin + nl; R.begin = L.end; R.end = r.end;
+    L.begin = r.begin;
+    L.end = r.begin + nl;
+    R.begin = L.end;
+    R.end = r.end;
     L.depth = R.depth = r.depth + 1;
     best.left = L;
     best.right = R;
@@ -267,7 +296,10 @@ struct BvhBuilder {
     Box box[3][kBins];  // uninitialised but for the bins in use
     uint32_t count[3][kBins];
     for (int a = 0; a < 3; ++a)
-      for (uint32_t u = used[a]; u; u &= u - 1) { box[a][__builtin_ctz(u)] = Box{}; count[a][__builtin_ctz(u)] = 0; }
+      for (uint32_t u = used[a]; u; u &= u - 1) {
+        box[a][__builtin_ctz(u)] = Box{};
+        count[a][__builtin_ctz(u)] = 0;
+      }
     for (uint32_t i = 0; i < n; ++i)
       for (int a = 0; a < 3; ++a) {
         box[a][bin[i][a]].grow(refs[r.begin + i].box());
@@ -292,7 +324,11 @@ struct BvhBuilder {
         acc.grow(box[a][list[i]]);
         nl += count[a][list[i]];
         const float cost = acc.halfArea() * float(packsFor(nl)) + rightCost[i + 1];
-        if (cost < best.cost) { best.cost = cost; best.axis = a; best.bin = list[i]; }
+        if (cost < best.cost) {
+          best.cost = cost;
+          best.axis = a;
+          best.bin = list[i];
+        }
       }
     }
     if (best.axis < 0) return best;
@@ -302,7 +338,9 @@ struct BvhBuilder {
       (k <= best.bin ? best.left : best.right).bounds.grow(box[best.axis][k]);
       if (k <= best.bin) nl += count[best.axis][k];
     }
-    best.left.begin = r.begin; best.left.end = best.right.begin = r.begin + nl; best.right.end = r.end;
+    best.left.begin = r.begin;
+    best.left.end = best.right.begin = r.begin + nl;
+    best.right.end = r.end;
     best.left.depth = best.right.depth = r.depth + 1;
     return best;
   }
@@ -311,7 +349,8 @@ struct BvhBuilder {
   template <class Fn>
   void chunked(uint32_t chunks, const Fn& fn) const {
     if (pool) parallelFor(*pool, chunks, fn);
-    else for (uint32_t c = 0; c < chunks; ++c) fn(c);
+    else
+      for (uint32_t c = 0; c < chunks; ++c) fn(c);
   }
 
   // Moves the refs of bins ≤ s.bin in front. The k-th misplaced ref from the front trades places with the
@@ -339,12 +378,18 @@ struct BvhBuilder {
       for (;;) {
         for (; i < j; ++i) {
           const __m128 c = refs[i].centroid2();
-          if (!isLeft(c)) { cr.grow(c); break; }
+          if (!isLeft(c)) {
+            cr.grow(c);
+            break;
+          }
           cl.grow(c);
         }
         for (; i < j; --j) {
           const __m128 c = refs[j - 1].centroid2();
-          if (isLeft(c)) { cl.grow(c); break; }
+          if (isLeft(c)) {
+            cl.grow(c);
+            break;
+          }
           cr.grow(c);
         }
         if (i >= j) break;
@@ -366,7 +411,10 @@ struct BvhBuilder {
       for (uint32_t i = r.end - cut(0, r.end - mid, c); i > r.end - cut(0, r.end - mid, c + 1); --i)
         if (left(refs[i - 1], cb[c].data())) back[c].push_back(i - 1);
     });
-    for (uint32_t c = 0; c < chunks; ++c) { s.left.cbounds.grow(cb[c][0]); s.right.cbounds.grow(cb[c][1]); }
+    for (uint32_t c = 0; c < chunks; ++c) {
+      s.left.cbounds.grow(cb[c][0]);
+      s.right.cbounds.grow(cb[c][1]);
+    }
     std::vector<uint32_t> f, b;
     for (uint32_t c = 0; c < chunks; ++c) {
       f.insert(f.end(), front[c].begin(), front[c].end());
@@ -374,14 +422,20 @@ struct BvhBuilder {
     }
     if (f.size() != b.size()) throw Error("BVH build: partition counts disagree with the bins");  // never: same arithmetic
     chunked(chunks, [&](uint32_t c) {
-      for (size_t k = size_t(f.size()) * c / chunks; k < size_t(f.size()) * (c + 1) / chunks; ++k) std::swap(refs[f[k]], refs[b[k]]);
+      for (size_t k = size_t(f.size()) * c / chunks; k < size_t(f.size()) * (c + 1) / chunks; ++k)
+        std::swap(refs[f[k]], refs[b[k]]);
     });
   }
 
   static Range boundsOf(const PrimRef* refs, uint32_t b, uint32_t e, uint32_t depth) {
     Range r;
-    r.begin = b; r.end = e; r.depth = depth;
-    for (uint32_t i = b; i < e; ++i) { r.bounds.grow(refs[i].box()); r.cbounds.grow(refs[i].centroid2()); }
+    r.begin = b;
+    r.end = e;
+    r.depth = depth;
+    for (uint32_t i = b; i < e; ++i) {
+      r.bounds.grow(refs[i].box());
+      r.cbounds.grow(refs[i].centroid2());
+    }
     return r;
   }
 
@@ -409,8 +463,9 @@ struct BvhBuilder {
     _mm_store_ps(e, _mm_sub_ps(r.cbounds.hi, r.cbounds.lo));
     const int axis = e[0] >= e[1] && e[0] >= e[2] ? 0 : (e[1] >= e[2] ? 1 : 2);
     const uint32_t mid = r.begin + n / 2;
-    std::nth_element(&refs[r.begin], &refs[mid], &refs[r.end],
-                     [axis](const PrimRef& p, const PrimRef& q) { return lane(p.centroid2(), axis) < lane(q.centroid2(), axis); });
+    std::nth_element(&refs[r.begin], &refs[mid], &refs[r.end], [axis](const PrimRef& p, const PrimRef& q) {
+      return lane(p.centroid2(), axis) < lane(q.centroid2(), axis);
+    });
     a = boundsOf(refs.get(), r.begin, mid, r.depth + 1);
     b = boundsOf(refs.get(), mid, r.end, r.depth + 1);
     return true;
@@ -452,8 +507,7 @@ struct BvhBuilder {
       n.child[k] = nextNode;
       if (pool && subtree[c][1] * kWidth >= kSubtreeTask)
         pool->run(g, [this, c, &bvh, nextNode, nextPack, &g] { relayout(c, bvh, nextNode, nextPack, g); });
-      else
-        relayout(c, bvh, nextNode, nextPack, g);
+      else relayout(c, bvh, nextNode, nextPack, g);
       nextNode += subtree[c][0];
       nextPack += subtree[c][1];
     }
@@ -463,7 +517,10 @@ struct BvhBuilder {
   uint32_t build(const Range& r, uint32_t level = 0) {
     uint32_t d = maxDepth.load();
     while (r.depth > d && !maxDepth.compare_exchange_weak(d, r.depth)) {}
-    struct Child { Range r; bool leaf = false; };
+    struct Child {
+      Range r;
+      bool leaf = false;
+    };
     Child c[kWidth];
     int count = 1;
     c[0].r = r;
@@ -476,9 +533,15 @@ struct BvhBuilder {
       int pick = -1;
       float area = -1.0f;
       for (int i = 0; i < count; ++i)
-        if (!c[i].leaf && c[i].r.bounds.halfArea() > area) { area = c[i].r.bounds.halfArea(); pick = i; }
+        if (!c[i].leaf && c[i].r.bounds.halfArea() > area) {
+          area = c[i].r.bounds.halfArea();
+          pick = i;
+        }
       if (pick < 0) break;
-      if (!split(c[pick].r, a, b, level)) { c[pick].leaf = true; continue; }
+      if (!split(c[pick].r, a, b, level)) {
+        c[pick].leaf = true;
+        continue;
+      }
       c[pick].r = a;
       c[count++].r = b;
     }
@@ -498,7 +561,8 @@ struct BvhBuilder {
     while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < kSubtreeTask)) --last;
     for (int k = 0; k < count; ++k) {
       if (c[k].leaf) node.child[k] = makeLeaf(c[k].r);
-      else if (pool && k != last && c[k].r.size() >= kSubtreeTask) pool->run(g, [this, &node, k, rr = c[k].r, level] { node.child[k] = build(rr, level + 1); });
+      else if (pool && k != last && c[k].r.size() >= kSubtreeTask)
+        pool->run(g, [this, &node, k, rr = c[k].r, level] { node.child[k] = build(rr, level + 1); });
       else node.child[k] = build(c[k].r, level + 1);
     }
     if (pool) pool->wait(g);
@@ -507,7 +571,10 @@ struct BvhBuilder {
     for (int k = 0; k < count; ++k) {
       const uint32_t ch = node.child[k];
       if (ch & Bvh::kLeafBit) size[1] += ((ch >> 28) & 7u) + 1;
-      else { size[0] += subtree[ch][0]; size[1] += subtree[ch][1]; }
+      else {
+        size[0] += subtree[ch][0];
+        size[1] += subtree[ch][1];
+      }
     }
     subtree[index] = size;
     return index;
@@ -542,7 +609,9 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
       const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
       if (!finite(t.v0) || !finite(t.v1) || !finite(t.v2)) continue;
       Box box;
-      box.grow(load3(t.v0)); box.grow(load3(t.v1)); box.grow(load3(t.v2));
+      box.grow(load3(t.v0));
+      box.grow(load3(t.v1));
+      box.grow(load3(t.v2));
       const PrimRef& p = b.refs[out++] = {_mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(box.lo), int(i), 3)), box.hi};
       part[c].bounds.grow(p.box());
       part[c].cbounds.grow(p.centroid2());
@@ -602,18 +671,20 @@ HugeArray<T>::HugeArray(size_t n) : n_(n) {
 }
 
 template <class T>
-void HugeArray<T>::Free::operator()(T* p) const { std::free(p); }
+void HugeArray<T>::Free::operator()(T* p) const {
+  std::free(p);
+}
 
 template class HugeArray<Node>;
 template class HugeArray<TriPack>;
 
-#define RTR_DECLARE_TRAVERSAL(ns)                                 \
-  namespace ns {                                                  \
-  bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);  \
-  bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&); \
-  unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
-  unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*); \
-  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
+#define RTR_DECLARE_TRAVERSAL(ns)                                                         \
+  namespace ns {                                                                          \
+  bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);                      \
+  bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&);                     \
+  unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*);              \
+  unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*);             \
+  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);  \
   unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int); \
   }
 RTR_DECLARE_TRAVERSAL(sse)
@@ -632,7 +703,8 @@ struct Traversal {
   unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
   unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int);
 };
-#define RTR_TRAVERSAL(ns) {ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket}
+#define RTR_TRAVERSAL(ns) \
+  { ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket }
 constexpr Traversal kTraversals[] = {RTR_TRAVERSAL(sse), RTR_TRAVERSAL(avx2), RTR_TRAVERSAL(avx512)};
 constexpr Traversal kCounted = RTR_TRAVERSAL(counted);
 std::atomic<bool> counting{false};
@@ -673,9 +745,7 @@ void Bvh::setPacketLeafRays(int n) { packetLeafRays = n; }
 BvhCounters& Bvh::counters() { return threadCounters; }
 
 namespace {
-const Traversal& traversal() {
-  return counting.load(std::memory_order_relaxed) ? kCounted : kTraversals[int(Bvh::isa())];
-}
+const Traversal& traversal() { return counting.load(std::memory_order_relaxed) ? kCounted : kTraversals[int(Bvh::isa())]; }
 }  // namespace
 
 const char* Bvh::isaName(BvhIsa isa) {
@@ -716,11 +786,15 @@ std::array<bool, 2> Bvh::occludedPair(const std::array<Ray, 2>& rays, IntersectM
 void Bvh::closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method) const {
   for (int i = 0; i < n; ++i) hits[i] = Hit{};
   if (root_ == kEmpty || n <= 0) return;
-  if (n == 1) { hits[0] = closest(rays[0], method); return; }
+  if (n == 1) {
+    hits[0] = closest(rays[0], method);
+    return;
+  }
   const Traversal& tr = traversal();
   const View v{nodes_.data(), packs_.data(), root_};
   // Rays with a near-tie between two candidates are traced again alone (bvh_packet.inl).
-  for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits, packetLeafRays.load(std::memory_order_relaxed)); retry; retry &= retry - 1) {
+  for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits, packetLeafRays.load(std::memory_order_relaxed));
+       retry; retry &= retry - 1) {
     const int i = __builtin_ctz(retry);
     if (&tr == &kCounted) ++threadCounters.retries;
     hits[i] = Hit{};
@@ -733,7 +807,7 @@ unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method) const {
   if (n == 1) return unsigned(occluded(rays[0], method));
   Hit scratch[8];
   return traversal().occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch,
-                                      packetLeafRays.load(std::memory_order_relaxed));
+                                    packetLeafRays.load(std::memory_order_relaxed));
 }
 
 }  // namespace rtr::trace

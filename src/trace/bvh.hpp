@@ -28,7 +28,7 @@ struct BvhStats {
   uint32_t nodes = 0, packs = 0, triangles = 0, maxDepth = 0;
   double buildSeconds = 0.0;
   double refSeconds = 0.0, treeSeconds = 0.0;  // of it: the references, the tree (the rest: copy-out)
-  double sahCost = 0.0;  // expected node and pack tests of a ray through the root box (bvh.cpp)
+  double sahCost = 0.0;                        // expected node and pack tests of a ray through the root box (bvh.cpp)
 };
 
 // What the traversals did, counted only while Bvh::setCounting(true) (a separate, counting copy of the
@@ -58,7 +58,9 @@ class HugeArray {
   T& operator[](size_t i) const { return p_[i]; }
 
  private:
-  struct Free { void operator()(T* p) const; };
+  struct Free {
+    void operator()(T* p) const;
+  };
   std::unique_ptr<T[], Free> p_;
   size_t n_ = 0;
 };

@@ -44,7 +44,8 @@ inline float minLane(F x) {
 }
 inline F laneMask(unsigned m) {
   const __m128i v = _mm_set1_epi32(int(m)), lo = _mm_setr_epi32(1, 2, 4, 8), hi = _mm_setr_epi32(16, 32, 64, 128);
-  return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, lo), lo)), _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, hi), hi))};
+  return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, lo), lo)),
+          _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(v, hi), hi))};
 }
 #endif
 
@@ -52,7 +53,9 @@ inline F laneMask(unsigned m) {
 // eight scalar stores read back as one vector stall on store forwarding, and a gather was slower still
 // (AMD VM); most temple packets end after a node or two, so their set-up is a good part of their time
 // (docs/bench/trace.md, round 9).
-struct PacketRays { F o[3], d[3], tMax; };
+struct PacketRays {
+  F o[3], d[3], tMax;
+};
 RTR_INLINE F lanesOf(const float* const* p, int k) {  // p[i][k] in lane i
 #if RTR_BVH_AVX2
   return {_mm256_setr_ps(p[0][k], p[1][k], p[2][k], p[3][k], p[4][k], p[5][k], p[6][k], p[7][k])};
@@ -145,7 +148,10 @@ struct PacketWalker {
       oAxis[a] = pr.o[a];
       const F rcp = set1(1.0f) / pr.d[a];
 #if RTR_BVH_AVX2
-      if (!(Parallel >> a & 1)) { rcpLo[a] = allMin(rcp); rcpHi[a] = allMax(rcp); }
+      if (!(Parallel >> a & 1)) {
+        rcpLo[a] = allMin(rcp);
+        rcpHi[a] = allMax(rcp);
+      }
 #endif
       neg[a] = lt(rcp, zero);
 #if RTR_BVH_AVX2
@@ -178,8 +184,10 @@ struct PacketWalker {
       if (signs != 0 && signs != 0xFFu) ok = set1(0.0f);
       // A product with a positive constant rounds monotonically: the bounds of rNear and rFar are the
       // bounds of the reciprocals times the same constants, two reductions fewer an axis.
-      rnLo[a] = rcpLo[a] * set1(1.0f - 0x1p-21f); rnHi[a] = rcpHi[a] * set1(1.0f - 0x1p-21f);
-      rfLo[a] = rcpLo[a] * set1(1.0f + 0x1p-21f); rfHi[a] = rcpHi[a] * set1(1.0f + 0x1p-21f);
+      rnLo[a] = rcpLo[a] * set1(1.0f - 0x1p-21f);
+      rnHi[a] = rcpHi[a] * set1(1.0f - 0x1p-21f);
+      rfLo[a] = rcpLo[a] * set1(1.0f + 0x1p-21f);
+      rfHi[a] = rcpHi[a] * set1(1.0f + 0x1p-21f);
       qnHi[a] = allMax(qNear[a]);
       qfLo[a] = allMin(qFar[a]);
       const int nearSide = signs ? 1 : 0;
@@ -202,13 +210,24 @@ struct PacketWalker {
       const float* d = &ray.direction.x;
       int x, y, z;
       W::shearAxes(d, 1, x, y, z);
-      if (i == 0) { kx = x; ky = y; kz = z; }
+      if (i == 0) {
+        kx = x;
+        ky = y;
+        kz = z;
+      }
       sameShear = sameShear && x == kx && y == ky && z == kz;
       const float szs = 1.0f / d[z];
-      so[0][i] = o[x]; so[1][i] = o[y]; so[2][i] = o[z];
-      ss[0][i] = d[x] * szs; ss[1][i] = d[y] * szs; ss[2][i] = szs;
+      so[0][i] = o[x];
+      so[1][i] = o[y];
+      so[2][i] = o[z];
+      ss[0][i] = d[x] * szs;
+      ss[1][i] = d[y] * szs;
+      ss[2][i] = szs;
     }
-    for (int a = 0; a < 3; ++a) { shO[a] = load(so[a]); shS[a] = load(ss[a]); }
+    for (int a = 0; a < 3; ++a) {
+      shO[a] = load(so[a]);
+      shS[a] = load(ss[a]);
+    }
     return sameShear;
   }
 
@@ -235,7 +254,8 @@ struct PacketWalker {
 
   // The rays of `active` (activeV: as a lane mask) whose box test passes child c of node n, with their
   // entry distances and the nearest of those (a vector minimum: a loop over the rays mispredicts).
-  RTR_INLINE unsigned testChild(const Node& n, int c, [[maybe_unused]] unsigned active, F activeV, F tHitV, F& tNearOut, float& nearest) const {
+  RTR_INLINE unsigned testChild(const Node& n, int c, [[maybe_unused]] unsigned active, F activeV, F tHitV, F& tNearOut,
+                                float& nearest) const {
     RTR_COUNT(c.childTests += 1; c.childTestRays += unsigned(__builtin_popcount(active)));
     const F zero = set1(0.0f);
     F tn[3], tf[3];
@@ -299,7 +319,10 @@ struct PacketWalker {
       tn[c] = tNear;
       mk[c] = m;
       int j = k++;
-      while (j > 0 && keys[j - 1] > key) { keys[j] = keys[j - 1]; --j; }
+      while (j > 0 && keys[j - 1] > key) {
+        keys[j] = keys[j - 1];
+        --j;
+      }
       keys[j] = key;
     }
     if (k == 0) return false;
@@ -357,7 +380,10 @@ struct PacketWalker {
       if (m) {
         const F inv = set1(1.0f) / det;
         alignas(32) float tv[8], iv[8], vv[8], wv[8];
-        store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W3);
+        store(tv, T * inv);
+        store(iv, inv);
+        store(vv, V);
+        store(wv, W3);
         for (; m; m &= m - 1) {
           const int lane = ctz(m);
           const float t = tv[lane];
@@ -377,7 +403,10 @@ struct PacketWalker {
   // Triangle `lane` of pk against the `active` rays at once, each lane with exactly Walker::testLeaf's
   // operations for its ray: m, the rays that meet it in (0, tLimit); edge, those exactly on an edge in
   // float (for the scalar test); det, T, V, W3 for t and the barycentrics. False: neither.
-  struct Lanes { unsigned m, edge; F det, T, V, W3; };
+  struct Lanes {
+    unsigned m, edge;
+    F det, T, V, W3;
+  };
   RTR_INLINE bool triangleRays(const TriPack& pk, int lane, unsigned active, F tLimit, Lanes& o) const {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
     const F Az = set1(pk.v[0][kz][lane]) - shO[2], Bz = set1(pk.v[1][kz][lane]) - shO[2], Cz = set1(pk.v[2][kz][lane]) - shO[2];
@@ -421,7 +450,7 @@ struct PacketWalker {
       const TriPack& pk = bvh.packs[p];
       unsigned tris = realLanes(pk);
       if constexpr (AnyHit) tris &= ~topBits(pk.prim);  // shadow casters only
-      const F tLimit = load(AnyHit ? tMax : cull);  // cull ≤ tMax (offer)
+      const F tLimit = load(AnyHit ? tMax : cull);      // cull ≤ tMax (offer)
       for (; tris; tris &= tris - 1) {
         const int lane = ctz(tris);
         RTR_COUNT(c.triangleTests += 1; c.packetTriangles += unsigned(__builtin_popcount(active)));
@@ -438,7 +467,10 @@ struct PacketWalker {
         if (l.m) {
           const F inv = set1(1.0f) / l.det;
           alignas(32) float tv[8], iv[8], vv[8], wv[8];
-          store(tv, l.T * inv); store(iv, inv); store(vv, l.V); store(wv, l.W3);
+          store(tv, l.T * inv);
+          store(iv, inv);
+          store(vv, l.V);
+          store(wv, l.W3);
           for (unsigned m = l.m; m; m &= m - 1) {
             const int i = ctz(m);
             const float t = tv[i];
@@ -570,7 +602,10 @@ struct PacketWalker {
         }
         const PacketEntry& e = stack[--sp];
         active = e.mask & bits(ngt(e.tNear, load(cull))) & ~done;
-        if (active) { ref = e.ref; break; }
+        if (active) {
+          ref = e.ref;
+          break;
+        }
       }
     }
   }

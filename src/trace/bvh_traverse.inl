@@ -13,7 +13,9 @@ namespace {
 
 // Eight floats: one AVX register, or two SSE ones with the same per-lane results.
 #if RTR_BVH_AVX2
-struct F { __m256 v; };
+struct F {
+  __m256 v;
+};
 inline F load(const float* p) { return {_mm256_load_ps(p)}; }
 inline F set1(float x) { return {_mm256_set1_ps(x)}; }
 inline F operator+(F a, F b) { return {_mm256_add_ps(a.v, b.v)}; }
@@ -39,7 +41,9 @@ inline F imax(F a, F b) { return {_mm256_castsi256_ps(_mm256_max_epi32(_mm256_ca
 inline F imin(F a, F b) { return {_mm256_castsi256_ps(_mm256_min_epi32(_mm256_castps_si256(a.v), _mm256_castps_si256(b.v)))}; }
 inline unsigned bits(F a) { return unsigned(_mm256_movemask_ps(a.v)); }
 template <int Lane>
-inline F lane(__m128 v) { return {_mm256_broadcastss_ps(_mm_shuffle_ps(v, v, _MM_SHUFFLE(Lane, Lane, Lane, Lane)))}; }
+inline F lane(__m128 v) {
+  return {_mm256_broadcastss_ps(_mm_shuffle_ps(v, v, _MM_SHUFFLE(Lane, Lane, Lane, Lane)))};
+}
 inline void store(float* p, F a) { _mm256_store_ps(p, a.v); }
 inline F fmsub(F a, F b, F c) { return {_mm256_fmsub_ps(a.v, b.v, c.v)}; }  // a·b − c, rounded once
 // The top bits of eight 32-bit integers.
@@ -47,7 +51,9 @@ inline unsigned topBits(const uint32_t* p) {
   return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(p)))));
 }
 #else
-struct F { __m128 a, b; };
+struct F {
+  __m128 a, b;
+};
 inline F load(const float* p) { return {_mm_load_ps(p), _mm_load_ps(p + 4)}; }
 inline F set1(float x) { return {_mm_set1_ps(x), _mm_set1_ps(x)}; }
 inline F operator+(F x, F y) { return {_mm_add_ps(x.a, y.a), _mm_add_ps(x.b, y.b)}; }
@@ -67,7 +73,10 @@ inline F eq(F x, F y) { return {_mm_cmpeq_ps(x.a, y.a), _mm_cmpeq_ps(x.b, y.b)};
 inline F neq(F x, F y) { return {_mm_cmpneq_ps(x.a, y.a), _mm_cmpneq_ps(x.b, y.b)}; }
 inline F ngt(F x, F y) { return {_mm_cmpngt_ps(x.a, y.a), _mm_cmpngt_ps(x.b, y.b)}; }
 inline unsigned bits(F x) { return unsigned(_mm_movemask_ps(x.a)) | unsigned(_mm_movemask_ps(x.b)) << 4; }
-inline void store(float* p, F x) { _mm_store_ps(p, x.a); _mm_store_ps(p + 4, x.b); }
+inline void store(float* p, F x) {
+  _mm_store_ps(p, x.a);
+  _mm_store_ps(p + 4, x.b);
+}
 inline unsigned topBits(const uint32_t* p) {
   const __m128i* q = reinterpret_cast<const __m128i*>(p);
   return unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(q)))) |
@@ -104,7 +113,9 @@ inline int ctz(unsigned m) { return __builtin_ctz(m); }
 
 // The axes that get slab distances: those the ray is not parallel to (a plain struct, not std::array:
 // see the top of this file).
-struct SlabAxes { int axis[3]; };
+struct SlabAxes {
+  int axis[3];
+};
 constexpr SlabAxes slabAxesOf(unsigned parallel) {
   SlabAxes s{};
   for (int a = 0, i = 0; a < 3; ++a)
@@ -117,9 +128,15 @@ constexpr SlabAxes slabAxesOf(unsigned parallel) {
 // Counting (bvh_counted.cpp only): RTR_COUNT(c.nodes += 1) adds to the thread's BvhCounters; elsewhere
 // it compiles to nothing.
 #if RTR_BVH_COUNT
-#define RTR_COUNT(...) do { BvhCounters& c = Bvh::counters(); __VA_ARGS__; } while (0)
+#define RTR_COUNT(...)                \
+  do {                                \
+    BvhCounters& c = Bvh::counters(); \
+    __VA_ARGS__;                      \
+  } while (0)
 #else
-#define RTR_COUNT(...) do {} while (0)
+#define RTR_COUNT(...) \
+  do {                 \
+  } while (0)
 #endif
 
 // The real triangles of a pack (a short pack repeats its last one).
@@ -182,12 +199,22 @@ struct Walker {
     const __m128 r4 = _mm_setr_ps(rcp[0], rcp[1], rcp[2], 1.0f), o4 = _mm_setr_ps(o[0], o[1], o[2], 0.0f);
     const __m128 rn4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f - 0x1p-21f)), rf4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f + 0x1p-21f));
     const __m128 qn0 = _mm_mul_ps(o4, rn4), qf0 = _mm_mul_ps(o4, rf4), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
-    const __m128 qn4 = _mm_add_ps(qn0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qn0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
-    const __m128 qf4 = _mm_sub_ps(qf0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qf0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
-    rNear[0] = lane<0>(rn4); rNear[1] = lane<1>(rn4); rNear[2] = lane<2>(rn4);
-    qNear[0] = lane<0>(qn4); qNear[1] = lane<1>(qn4); qNear[2] = lane<2>(qn4);
-    rFar[0] = lane<0>(rf4); rFar[1] = lane<1>(rf4); rFar[2] = lane<2>(rf4);
-    qFar[0] = lane<0>(qf4); qFar[1] = lane<1>(qf4); qFar[2] = lane<2>(qf4);
+    const __m128 qn4 =
+        _mm_add_ps(qn0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qn0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
+    const __m128 qf4 =
+        _mm_sub_ps(qf0, _mm_add_ps(_mm_mul_ps(_mm_and_ps(qf0, absMask), _mm_set1_ps(0x1p-22f)), _mm_set1_ps(0x1p-100f)));
+    rNear[0] = lane<0>(rn4);
+    rNear[1] = lane<1>(rn4);
+    rNear[2] = lane<2>(rn4);
+    qNear[0] = lane<0>(qn4);
+    qNear[1] = lane<1>(qn4);
+    qNear[2] = lane<2>(qn4);
+    rFar[0] = lane<0>(rf4);
+    rFar[1] = lane<1>(rf4);
+    rFar[2] = lane<2>(rf4);
+    qFar[0] = lane<0>(qf4);
+    qFar[1] = lane<1>(qf4);
+    qFar[2] = lane<2>(qf4);
     const unsigned negative = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r4, _mm_setzero_ps())));
     for (int a = 0; a < 3; ++a) {
       const int nearSide = negative >> a & 1;
@@ -212,8 +239,12 @@ struct Walker {
     // must shear identically), inline here and sharing the reciprocal with the slab test.
     shearAxes(d, 1, kx, ky, kz);
     const float szs = rcp[kz];
-    ox = set1(o[kx]); oy = set1(o[ky]); oz = set1(o[kz]);
-    sx = set1(d[kx] * szs); sy = set1(d[ky] * szs); sz = set1(szs);
+    ox = set1(o[kx]);
+    oy = set1(o[ky]);
+    oz = set1(o[kz]);
+    sx = set1(d[kx] * szs);
+    sy = set1(d[ky] * szs);
+    sz = set1(szs);
   }
 
   // The watertight test's axis order for direction d[0], d[stride], d[2 * stride] (packets keep theirs
@@ -223,7 +254,11 @@ struct Walker {
     kz = ad[0] > ad[1] ? (ad[0] > ad[2] ? 0 : 2) : (ad[1] > ad[2] ? 1 : 2);
     kx = kz == 2 ? 0 : kz + 1;
     ky = kx == 2 ? 0 : kx + 1;
-    if (d[kz * stride] < 0.0f) { const int t = kx; kx = ky; ky = t; }
+    if (d[kz * stride] < 0.0f) {
+      const int t = kx;
+      kx = ky;
+      ky = t;
+    }
   }
 
   // Tests the inner node at.ref's children: false when it meets none; else at.ref is the child to visit
@@ -268,7 +303,10 @@ struct Walker {
     if (mask == 0) return false;
     const int c0 = ctz(mask);
     mask &= mask - 1;
-    if (mask == 0) { at.ref = n.child[c0]; return true; }
+    if (mask == 0) {
+      at.ref = n.child[c0];
+      return true;
+    }
     // Two or more children: the one visited next is the smallest key, the others go on the stack.
     // Closest hit goes nearest first, so that a hit culls the rest. Any hit goes farthest first: a
     // shadow ray leaves a surface, and the boxes around its origin hold that surface and its
@@ -293,7 +331,10 @@ struct Walker {
     for (mask |= 1u << c0 | 1u << c1; mask; mask &= mask - 1) {
       const uint64_t kc = key(ctz(mask));
       int j = k++;
-      while (j > 0 && run[j - 1] < kc) { run[j] = run[j - 1]; --j; }
+      while (j > 0 && run[j - 1] < kc) {
+        run[j] = run[j - 1];
+        --j;
+      }
       run[j] = kc;
     }
     at.sp += k - 1;
@@ -320,7 +361,9 @@ struct Walker {
           const float t = intersect(method, r, laneTriangle(pk, lane), b1, b2);
           if (t > 0.0f) {
             if constexpr (AnyHit) return true;
-            at.tHit = t; hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit}; at.found = true;
+            at.tHit = t;
+            hit = {t, b1, b2, prim & ~Bvh::kNoShadowBit};
+            at.found = true;
           }
         }
         continue;
@@ -350,7 +393,10 @@ struct Walker {
       } else if (m) {
         const F inv = set1(1.0f) / det;
         alignas(32) float tv[8], iv[8], vv[8], wv[8];
-        store(tv, T * inv); store(iv, inv); store(vv, V); store(wv, W);
+        store(tv, T * inv);
+        store(iv, inv);
+        store(vv, V);
+        store(wv, W);
         for (; m; m &= m - 1) {
           const int lane = ctz(m);
           const float t = tv[lane];
@@ -369,7 +415,9 @@ struct Walker {
         const float t = intersectWatertight(r, laneTriangle(pk, lane), b1, b2);
         if (t > 0.0f) {
           if constexpr (AnyHit) return true;
-          at.tHit = t; hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit}; at.found = true;
+          at.tHit = t;
+          hit = {t, b1, b2, pk.prim[lane] & ~Bvh::kNoShadowBit};
+          at.found = true;
         }
       }
     }
@@ -479,8 +527,8 @@ unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
     case 6: return walkPair<AnyHit, 6>(bvh, rays, method, hits);
     case 7: return 0;
     default:
-      return unsigned(dispatch<AnyHit>(bvh, rays[0], method, hits[0])) |
-             unsigned(dispatch<AnyHit>(bvh, rays[1], method, hits[1])) << 1;
+      return unsigned(dispatch<AnyHit>(bvh, rays[0], method, hits[0])) | unsigned(dispatch<AnyHit>(bvh, rays[1], method, hits[1]))
+                                                                             << 1;
   }
 }
 

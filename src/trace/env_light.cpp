@@ -14,8 +14,8 @@
 
 namespace rtr::trace {
 
-glm::vec3 Tracer::environmentLight(const SurfacePoint& sp, const glm::vec3& n, const glm::vec3& v,
-                                   const SurfaceInputs& in, int brdf, const Frame& f, Counters& c) const {
+glm::vec3 Tracer::environmentLight(const SurfacePoint& sp, const glm::vec3& n, const glm::vec3& v, const SurfaceInputs& in,
+                                   int brdf, const Frame& f, Counters& c) const {
   const TraceSettings& s = *f.s;
   const Environment& env = *f.env;
   // One strategy's sample l (scene space) with the radiance arriving along it: f L cos / p, weighted.

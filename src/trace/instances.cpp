@@ -36,8 +36,8 @@ bool boxHit(const glm::vec3& lo, const glm::vec3& hi, const Ray& r, const glm::v
 
 }  // namespace
 
-InstanceBvh::InstanceBvh(std::span<const Triangle> tris, std::span<const uint8_t> castsShadow,
-                         std::span<const Object> objects, std::span<const Placement> placements, unsigned threads) {
+InstanceBvh::InstanceBvh(std::span<const Triangle> tris, std::span<const uint8_t> castsShadow, std::span<const Object> objects,
+                         std::span<const Placement> placements, unsigned threads) {
   std::vector<glm::dvec3> objLo, objHi;
   for (const Object& o : objects) {
     if (size_t(o.first) + o.count > tris.size()) throw Error("instance BVH: an object's triangles are out of range");
@@ -98,9 +98,11 @@ InstanceBvh::InstanceBvh(std::span<const Triangle> tris, std::span<const uint8_t
 // Node 0 is filled for the whole range; children are made in pairs. Median split of the centroids along
 // their widest axis, leaves of at most two instances: the top level is small and rarely the cost.
 void InstanceBvh::build(std::vector<uint32_t>& ids, uint32_t begin, uint32_t end, const std::vector<glm::vec3>& lo,
-                            const std::vector<glm::vec3>& hi) {
+                        const std::vector<glm::vec3>& hi) {
   // An explicit stack: (node, begin, end).
-  struct Task { uint32_t node, begin, end; };
+  struct Task {
+    uint32_t node, begin, end;
+  };
   std::vector<Task> tasks{{0, begin, end}};
   while (!tasks.empty()) {
     const Task t = tasks.back();
@@ -141,7 +143,10 @@ template <bool kAny>
 bool InstanceBvh::walk(const Ray& ray, IntersectMethod method, Hit& best) const {
   if (nodes_.empty()) return false;
   const glm::vec3 inv(1.0f / ray.direction.x, 1.0f / ray.direction.y, 1.0f / ray.direction.z);
-  struct Entry { uint32_t node; float t; };
+  struct Entry {
+    uint32_t node;
+    float t;
+  };
   Entry stack[128];
   int sp = 0;
   float t0;

@@ -69,12 +69,12 @@ Mesh box(glm::vec3 lo, glm::vec3 hi, uint32_t material, bool inward) {
     for (uint32_t i : q.indices) m.indices.push_back(base + i);
   };
   const glm::vec3 X{d.x, 0, 0}, Y{0, d.y, 0}, Z{0, 0, d.z};
-  face(lo, Y, X);                // -z
-  face(lo + Z, X, Y);            // +z
-  face(lo, Z, Y);                // -x
-  face(lo + X, Y, Z);            // +x
-  face(lo, X, Z);                // -y
-  face(lo + Y, Z, X);            // +y
+  face(lo, Y, X);      // -z
+  face(lo + Z, X, Y);  // +z
+  face(lo, Z, Y);      // -x
+  face(lo + X, Y, Z);  // +x
+  face(lo, X, Z);      // -y
+  face(lo + Y, Z, X);  // +y
   for (const glm::vec3& p : m.positions) m.bounds.extend(p);
   return m;
 }

@@ -42,7 +42,9 @@ struct Hit {
 // Watertight is Woop, Benthin and Wald 2013; MollerTrumbore is there to be measured against.
 enum class IntersectMethod { HalfPlane, Watertight, MollerTrumbore };
 constexpr std::array<EnumName<IntersectMethod>, 3> enumNames(IntersectMethod) {
-  return {{{IntersectMethod::HalfPlane, "halfplane"}, {IntersectMethod::Watertight, "watertight"}, {IntersectMethod::MollerTrumbore, "moller"}}};
+  return {{{IntersectMethod::HalfPlane, "halfplane"},
+           {IntersectMethod::Watertight, "watertight"},
+           {IntersectMethod::MollerTrumbore, "moller"}}};
 }
 
 }  // namespace rtr::trace

@@ -16,7 +16,7 @@ namespace rtr::trace {
 
 // p: point on the surface; n: unit geometric normal on the side the new ray leaves from.
 inline glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n) {
-  constexpr float kNearOrigin = 1.0f / 32.0f;   // below this, ulps are too small: use a fixed step
+  constexpr float kNearOrigin = 1.0f / 32.0f;  // below this, ulps are too small: use a fixed step
   constexpr float kFixedStep = 1.0f / 65536.0f;
   constexpr float kUlps = 256.0f;
   glm::vec3 out;

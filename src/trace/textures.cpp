@@ -59,8 +59,7 @@ MipTexture::MipTexture(const TexelData& image, bool srgb, const SamplerDesc& sam
     : channels_(image.channels), srgb_(srgb), sampler_(sampler) {
   if (channels_ != 1 && channels_ != 4)
     throw Error("texture: " + std::to_string(channels_) + " channels; the tracer samples 1 or 4");
-  const MipChain chain = buildMipReference(image, srgb ? TexelEncoding::Srgb : TexelEncoding::Unorm,
-                                           MipSource::PreviousLevel);
+  const MipChain chain = buildMipReference(image, srgb ? TexelEncoding::Srgb : TexelEncoding::Unorm, MipSource::PreviousLevel);
   for (uint32_t k = 0; k < chain.levels.size(); ++k) {
     const MipLevel& l = chain.levels[k];
     levels_.push_back({l.width, l.height, k == 0 ? image.texels : quantizeMipLevel(chain, k)});
@@ -95,9 +94,7 @@ glm::vec4 MipTexture::sample(glm::vec2 uv, float lod) const {
 
 float MipTexture::lod(float uvWidth) const { return std::log2(uvWidth) + halfLog2Area_; }
 
-SurfaceInputs materialFactors(const Material& m) {
-  return {m.baseColor, m.roughness, m.metalness, m.emissive, 1.0f};
-}
+SurfaceInputs materialFactors(const Material& m) { return {m.baseColor, m.roughness, m.metalness, m.emissive, 1.0f}; }
 
 SceneTextures::SceneTextures(const Scene& scene) : index_(scene.textures.size(), kNoTexture) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -106,9 +103,7 @@ SceneTextures::SceneTextures(const Scene& scene) : index_(scene.textures.size(),
   decodeTextures(scene, used, [&](size_t i, TexelData&& t) {
     try {
       built[i].emplace(t, decodeSrgb(scene.textures[used[i]]), scene.textures[used[i]].sampler);
-    } catch (const Error& e) {
-      throw Error(scene.textures[used[i]].path.string() + ": " + e.what());
-    }
+    } catch (const Error& e) { throw Error(scene.textures[used[i]].path.string() + ": " + e.what()); }
   });
   for (size_t i = 0; i < used.size(); ++i) {
     index_[used[i]] = uint32_t(i);
@@ -133,8 +128,7 @@ glm::vec2 slotUv(const Material& m, TextureSlot slot, const SurfaceUv& uv, float
   return x.offset + glm::vec2(c * p.x + s * p.y, -s * p.x + c * p.y);
 }
 
-glm::vec4 SceneTextures::sample(const Material& m, TextureSlot slot, const SurfaceUv& uv, float uvWidth,
-                                glm::vec4 none) const {
+glm::vec4 SceneTextures::sample(const Material& m, TextureSlot slot, const SurfaceUv& uv, float uvWidth, glm::vec4 none) const {
   const MipTexture* t = texture(m, slot);
   if (!t) return none;
   float k;

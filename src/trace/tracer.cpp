@@ -63,10 +63,10 @@ struct LightRay {
 };
 LightRay lightRay(const Light& light, int i, int n, const glm::vec3& p, const glm::vec3& ng) {
   const glm::vec3 at = light.samplePoint(i, n);
-  const shader::LightSample ls = shader::lightSample(
-      shader::makeGpuLight(unsigned(light.kind), at, light.color, light.falloff, light.direction, light.innerConeCos,
-                           light.outerConeCos, light.range),
-      p);
+  const shader::LightSample ls =
+      shader::lightSample(shader::makeGpuLight(unsigned(light.kind), at, light.color, light.falloff, light.direction,
+                                               light.innerConeCos, light.outerConeCos, light.range),
+                          p);
   if (light.kind == Light::Kind::Directional) return {ls, spawnRay(p, ng, ls.l), true};
   const glm::vec3 toLight = at - p;
   return {ls, spawnRay(p, ng, toLight, 1.0f), glm::dot(toLight, toLight) > 0.0f};
@@ -81,17 +81,16 @@ Tracer::Tracer(const Scene& scene, unsigned buildThreads) : scene_(scene) {
   std::vector<InstanceBvh::Object> objects;
   for (size_t i = 0; i < scene.instances.size(); ++i)
     if (scene.instances[i].mesh >= scene.meshes.size())
-      throw Error("instance " + std::to_string(i) + " places mesh " + std::to_string(scene.instances[i].mesh) +
-                  " of " + std::to_string(scene.meshes.size()));
-    else
-      objectOf[scene.instances[i].mesh] = 0;
+      throw Error("instance " + std::to_string(i) + " places mesh " + std::to_string(scene.instances[i].mesh) + " of " +
+                  std::to_string(scene.meshes.size()));
+    else objectOf[scene.instances[i].mesh] = 0;
   for (uint32_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     const bool light = m.material < scene.materials.size() && isLightMaterial(scene.materials[m.material]);
     // glTF MASK materials cut out by the alpha of factor, texture and vertex colour, textured or not.
     const Material* mat = m.material < scene.materials.size() ? &scene.materials[m.material] : nullptr;
-    meshAlphaTested_.push_back(mat && ((mat->flags & kMaterialGltf) ? (mat->flags & kMaterialAlphaMasked) != 0
-                                                                    : alphaTested(m, *mat)));
+    meshAlphaTested_.push_back(mat &&
+                               ((mat->flags & kMaterialGltf) ? (mat->flags & kMaterialAlphaMasked) != 0 : alphaTested(m, *mat)));
     anyAlphaTested_ = anyAlphaTested_ || meshAlphaTested_.back();
     anyBaseTextured_ = anyBaseTextured_ || (m.material < scene.materials.size() && !m.texcoords.empty() &&
                                             scene.materials[m.material].texture(TextureSlot::BaseColor) != kNoTexture);
@@ -129,7 +128,10 @@ Hit Tracer::closestTriangle(const Ray& r, IntersectMethod m) const {
   for (uint32_t i = 0; i < tris_.size(); ++i) {
     float b1, b2;
     const float t = intersect(m, q, tris_[i], b1, b2);
-    if (t > 0.0f) { best = {t, b1, b2, i}; q.tMax = t; }
+    if (t > 0.0f) {
+      best = {t, b1, b2, i};
+      q.tMax = t;
+    }
   }
   return best;
 }
@@ -175,8 +177,7 @@ SurfacePoint Tracer::surface(const Ray& r, const Hit& h) const {
   }
   if (m.texcoords1.size() == m.positions.size())
     sp.uv1 = b0 * m.texcoords1[idx[0]] + h.b1 * m.texcoords1[idx[1]] + h.b2 * m.texcoords1[idx[2]];
-  if (m.colors.size() == m.positions.size())
-    sp.color = b0 * m.colors[idx[0]] + h.b1 * m.colors[idx[1]] + h.b2 * m.colors[idx[2]];
+  if (m.colors.size() == m.positions.size()) sp.color = b0 * m.colors[idx[0]] + h.b1 * m.colors[idx[1]] + h.b2 * m.colors[idx[2]];
   if (m.tangents.size() == m.positions.size()) {
     glm::vec4 t = b0 * m.tangents[idx[0]] + h.b1 * m.tangents[idx[1]] + h.b2 * m.tangents[idx[2]];
     glm::vec3 x(t);
@@ -214,8 +215,7 @@ bool Tracer::cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const
   return f.tex && meshAlphaTested_[sp.mesh] && f.tex->alpha(m, {sp.uv, sp.uv1}, uvWidth(sp, r, coneWidth)) < 0.5f;
 }
 
-Tracer::Visible Tracer::closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c,
-                                       const Hit* first) const {
+Tracer::Visible Tracer::closestVisible(const Ray& r, const Cone& cone, const Frame& f, Counters& c, const Hit* first) const {
   Visible v{r, first ? *first : closestTriangle(r, f.s->intersect), {}, cone.width};
   v.t = v.hit.t;
   for (int layer = 0; v.hit.hit(); ++layer) {
@@ -269,7 +269,8 @@ glm::vec3 Tracer::local(const Ray& r, const SurfacePoint& sp, float coneWidth, c
     if (mat.flags & kMaterialUnlit) return in.baseColor;  // KHR_materials_unlit: the base colour is the result
     if (textured) {
       normal = normalMapped(sp, f.tex->sample(mat, TextureSlot::NormalMap, uvs, width, glm::vec4(-1.0f)), mat.normalScale);
-      occlusion = 1.0f + mat.occlusionStrength * (f.tex->sample(mat, TextureSlot::Occlusion, uvs, width, glm::vec4(1.0f)).r - 1.0f);
+      occlusion =
+          1.0f + mat.occlusionStrength * (f.tex->sample(mat, TextureSlot::Occlusion, uvs, width, glm::vec4(1.0f)).r - 1.0f);
     }
   }
   // glTF materials have no Kd: Phong takes their base colour.
@@ -346,8 +347,8 @@ void Tracer::shadowPackets(const Visible* vis, int n, const Frame& f, std::vecto
   }
 }
 
-glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
-                        const Visible* first, const Shadows* pre, int blendDepth) const {
+glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c, const Visible* first,
+                        const Shadows* pre, int blendDepth) const {
   const TraceSettings& s = *f.s;
   const Visible vis = first ? *first : closestVisible(r, cone, f, c, nullptr);
   if (s.shading == Shading::Depth) {
@@ -364,8 +365,8 @@ glm::vec3 Tracer::shade(const Ray& r, const Cone& cone, int bounces, const Frame
     const float a = std::clamp(gltfAlpha(sp, vis.ray, vis.coneWidth, f), 0.0f, 1.0f);
     if (a < 1.0f) {
       ++c.alpha;
-      const glm::vec3 behind = shade(beyond(vis.ray, vis.hit, sp), {vis.coneWidth, cone.spread}, bounces, f, c, nullptr,
-                                     nullptr, blendDepth + 1);
+      const glm::vec3 behind =
+          shade(beyond(vis.ray, vis.hit, sp), {vis.coneWidth, cone.spread}, bounces, f, c, nullptr, nullptr, blendDepth + 1);
       col = a * col + (1.0f - a) * behind;
     }
   }
@@ -443,8 +444,7 @@ Ray Tracer::calculateRay(const TraceSettings& s, uint32_t px, uint32_t py) const
   return {glm::vec3(toScene * glm::vec4(cr.origin, 1.0f)), glm::vec3(toScene * glm::vec4(cr.direction, 0.0f))};
 }
 
-RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallback& onTile,
-                           std::atomic<bool>* cancel) const {
+RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallback& onTile, std::atomic<bool>* cancel) const {
   if (s.width == 0 || s.height == 0 || s.width > 32768 || s.height > 32768)
     throw Error("image size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " is out of range");
   if (s.bounces < 0 || s.bounces > 64) throw Error("bounces must be in 0..64, got " + std::to_string(s.bounces));
@@ -470,7 +470,8 @@ RenderStats Tracer::render(const TraceSettings& s, ImageF& out, const TileCallba
     Counters c;
     uint64_t primary = 0;
     std::vector<uint8_t> known, blocked;
-    const TileRect rect{uint32_t(tile % tilesX) * ts, uint32_t(tile / tilesX) * ts, std::min(s.width, uint32_t(tile % tilesX + 1) * ts),
+    const TileRect rect{uint32_t(tile % tilesX) * ts, uint32_t(tile / tilesX) * ts,
+                        std::min(s.width, uint32_t(tile % tilesX + 1) * ts),
                         std::min(s.height, uint32_t(tile / tilesX + 1) * ts)};
     // Primary rays go through the BVH eight at a time (a packet of neighbouring pixels of a row:
     // Bvh::closest8, the same hits as one at a time), then their shadow rays, a packet per light

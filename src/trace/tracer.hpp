@@ -47,16 +47,16 @@ struct TraceSettings {
   glm::mat4 model{1.0f};           // Task 1 model transform (a similarity); modelview = view × model
   Shading shading = Shading::Phong;
   bool shadows = true;
-  int bounces = N_BOUNCES;         // mirror recursion depth; 0 turns reflections off
+  int bounces = N_BOUNCES;  // mirror recursion depth; 0 turns reflections off
   IntersectMethod intersect = IntersectMethod::Watertight;
-  unsigned threads = 0;            // 0: every core
+  unsigned threads = 0;  // 0: every core
   uint32_t tileSize = 32;
-  int areaLightSamples = 1;        // shadow rays per area light: 1 aims at its centre (hard shadows)
+  int areaLightSamples = 1;  // shadow rays per area light: 1 aims at its centre (hard shadows)
   // The lights, in scene space, and pbr's ambient colour; none: resolveLights(scene) (scene/lights.hpp).
   // Phong's ambient is Ka x each light's colour, as the course's.
   std::optional<LightRig> lights;
-  float lodBias = 0.0f;            // pbr: added to every texture's level of detail, as the GPU's bias
-  std::optional<Brdf> brdf;        // pbr; none: per material, GGX for glTF materials, Beckmann for the rest
+  float lodBias = 0.0f;      // pbr: added to every texture's level of detail, as the GPU's bias
+  std::optional<Brdf> brdf;  // pbr; none: per material, GGX for glTF materials, Beckmann for the rest
   // Light from an environment (pbr): integrated at every shaded point by multiple importance sampling of
   // the environment and the BRDF, `spp` sample pairs a pixel, each with its shadow ray; rays that miss
   // the scene see it. None: no environment light, misses see `background`.
@@ -66,14 +66,16 @@ struct TraceSettings {
   glm::vec3 background{0.0f};
 };
 
-struct TileRect { uint32_t x0, y0, x1, y1; };  // half-open pixel rectangle
+struct TileRect {
+  uint32_t x0, y0, x1, y1;
+};  // half-open pixel rectangle
 // Called once per finished tile, never concurrently with itself (the tracer serialises the calls).
 using TileCallback = std::function<void(const TileRect&)>;
 
 struct RenderStats {
   double seconds = 0.0;
   uint64_t primaryRays = 0, shadowRays = 0, reflectionRays = 0;
-  uint64_t alphaRays = 0;  // rays continued beyond a cut-out texel (pbr with alpha-tested materials)
+  uint64_t alphaRays = 0;        // rays continued beyond a cut-out texel (pbr with alpha-tested materials)
   uint64_t environmentRays = 0;  // shadow rays of environment light samples (also counted in shadowRays)
   uint32_t tilesDone = 0, tilesTotal = 0;
   bool cancelled = false;
@@ -85,12 +87,12 @@ struct SurfacePoint {
   glm::vec3 geomNormal;  // unit, facing the incoming ray
   glm::vec3 normal;      // interpolated shading normal, unit, same side as geomNormal
   glm::vec2 uv{0.0f};
-  float uvScale = 0.0f;  // √(uv area / area) of the triangle: texture-coordinate units per scene unit
-  glm::vec2 uv1{0.0f};   // the second uv set (glTF TEXCOORD_1), where the mesh has one
-  glm::vec4 color{1.0f}; // vertex colour (glTF COLOR_0), white without
+  float uvScale = 0.0f;     // √(uv area / area) of the triangle: texture-coordinate units per scene unit
+  glm::vec2 uv1{0.0f};      // the second uv set (glTF TEXCOORD_1), where the mesh has one
+  glm::vec4 color{1.0f};    // vertex colour (glTF COLOR_0), white without
   glm::vec4 tangent{0.0f};  // xyz unit tangent in scene space, w the bitangent's sign; zero without
-  bool flipped = false;  // the normals were turned to face the ray (it hit the back of the interpolated side)
-  bool backFace = false; // the ray hit the triangle's back (clockwise as seen; glTF's culled side)
+  bool flipped = false;     // the normals were turned to face the ray (it hit the back of the interpolated side)
+  bool backFace = false;    // the ray hit the triangle's back (clockwise as seen; glTF's culled side)
   const Material* material = nullptr;
   uint32_t mesh = 0;
 };
@@ -143,18 +145,20 @@ class Tracer {
   };
   // A ray cone (Akenine-Möller et al., Ray Tracing Gems ch. 20) for texture LOD: width at the ray's
   // origin, growing by `spread` (radians) per unit of distance.
-  struct Cone { float width = 0.0f, spread = 0.0f; };
+  struct Cone {
+    float width = 0.0f, spread = 0.0f;
+  };
   // Per-render constants in scene space.
   struct Frame {
     const TraceSettings* s;
-    glm::mat4 toScene;      // inverse of the model transform
+    glm::mat4 toScene;          // inverse of the model transform
     std::vector<Light> lights;  // in scene space; a headlight placed at the camera
     glm::vec3 ambient{0.0f};    // pbr
-    glm::vec3 depthAxis;    // t · dot(d, depthAxis) = distance along the camera's forward axis
+    glm::vec3 depthAxis;        // t · dot(d, depthAxis) = distance along the camera's forward axis
     float depthFar;
-    const SceneTextures* tex = nullptr;  // pbr only
-    Cone camera;                         // a primary ray's cone
-    const Environment* env = nullptr;    // pbr with a non-empty environment
+    const SceneTextures* tex = nullptr;            // pbr only
+    Cone camera;                                   // a primary ray's cone
+    const Environment* env = nullptr;              // pbr with a non-empty environment
     glm::mat3 dirToWorld{1.0f}, dirToScene{1.0f};  // directions between scene space and the environment's
   };
   // A hit with its surface and the cone's width there; `ray` is the segment it was found on, t the hit's
@@ -177,14 +181,13 @@ class Tracer {
   // `first`: what r sees when the caller has traced it already (the render loop traces primary rays in
   // packets), else null; `pre`: shadow rays traced ahead for it, else null.
   // `blendDepth`: glTF BLEND surfaces composited in front of this ray already (at most kMaxAlphaLayers).
-  glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c,
-                  const Visible* first = nullptr, const Shadows* pre = nullptr, int blendDepth = 0) const;
+  glm::vec3 shade(const Ray& r, const Cone& cone, int bounces, const Frame& f, Counters& c, const Visible* first = nullptr,
+                  const Shadows* pre = nullptr, int blendDepth = 0) const;
   glm::vec3 local(const Ray& r, const SurfacePoint& sp, float coneWidth, const Frame& f, Counters& c,
                   const Shadows* pre = nullptr) const;
   // The shadow rays local() will ask for at these n ≤ 8 hits, traced as packets, one per light sample
   // (all go to the same point): known/blocked as in Shadows, left empty where local() must trace alone.
-  void shadowPackets(const Visible* vis, int n, const Frame& f, std::vector<uint8_t>& known,
-                     std::vector<uint8_t>& blocked) const;
+  void shadowPackets(const Visible* vis, int n, const Frame& f, std::vector<uint8_t>& known, std::vector<uint8_t>& blocked) const;
   // Whether a ray passes this hit: a cut-out texel; for glTF materials MASK below the cutoff and, with
   // `cull` (what the camera and mirrors see, not shadow rays), the back of a single-sided material.
   bool cutOut(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f, bool cull) const;
@@ -192,8 +195,8 @@ class Tracer {
   float gltfAlpha(const SurfacePoint& sp, const Ray& r, float coneWidth, const Frame& f) const;
   // The environment's light reflected towards v at sp (f.env set): the MIS estimate, s.spp pairs of one
   // environment sample and one BRDF sample, power heuristic, each with a shadow ray (env_light.cpp).
-  glm::vec3 environmentLight(const SurfacePoint& sp, const glm::vec3& n, const glm::vec3& v, const SurfaceInputs& in,
-                             int brdf, const Frame& f, Counters& c) const;
+  glm::vec3 environmentLight(const SurfacePoint& sp, const glm::vec3& n, const glm::vec3& v, const SurfaceInputs& in, int brdf,
+                             const Frame& f, Counters& c) const;
   // What a ray that leaves the scene in (scene-space) direction d sees; camera: a camera ray (or one
   // continuing it through a cut-out or a blended surface), not a mirror's.
   glm::vec3 missed(const glm::vec3& d, bool camera, const Frame& f) const;

@@ -52,9 +52,7 @@ void Submission::wait() const {
   VK_CHECK(vkWaitForFences(device_, 1, &f, VK_TRUE, UINT64_MAX));
 }
 
-void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record) {
-  Submission(ctx, record).wait();
-}
+void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record) { Submission(ctx, record).wait(); }
 
 void barrier(VkCommandBuffer cb, const std::vector<ImageBarrier>& images) {
   std::vector<VkImageMemoryBarrier2> bs;
@@ -105,12 +103,11 @@ void GpuTimer::reset(VkCommandBuffer cb) {
   names_.clear();
 }
 
-void GpuTimer::begin(VkCommandBuffer cb) {
-  vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, 0);
-}
+void GpuTimer::begin(VkCommandBuffer cb) { vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, 0); }
 
 void GpuTimer::mark(VkCommandBuffer cb, const std::string& pass) {
-  if (names_.size() + 1 >= capacity_) throw Error("GpuTimer: more passes than the " + std::to_string(capacity_ - 1) + " it was made for");
+  if (names_.size() + 1 >= capacity_)
+    throw Error("GpuTimer: more passes than the " + std::to_string(capacity_ - 1) + " it was made for");
   names_.push_back(pass);
   vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, uint32_t(names_.size()));
 }
@@ -119,8 +116,7 @@ std::vector<std::pair<std::string, double>> GpuTimer::results() const {
   std::vector<std::pair<std::string, double>> out;
   if (names_.empty()) return out;
   std::vector<uint64_t> ts(names_.size() + 1);
-  VkResult r = vkGetQueryPoolResults(device_, pool_, 0, uint32_t(ts.size()), ts.size() * 8, ts.data(), 8,
-                                     VK_QUERY_RESULT_64_BIT);
+  VkResult r = vkGetQueryPoolResults(device_, pool_, 0, uint32_t(ts.size()), ts.size() * 8, ts.data(), 8, VK_QUERY_RESULT_64_BIT);
   if (r != VK_SUCCESS) return out;
   for (size_t i = 0; i < names_.size(); ++i) out.push_back({names_[i], double(ts[i + 1] - ts[i]) * periodNs_ * 1e-6});
   return out;

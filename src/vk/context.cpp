@@ -31,7 +31,6 @@ void checkCpuDeviceAddressSpace(const VkPhysicalDeviceProperties& p) {
               std::to_string(uint64_t(r.rlim_cur) >> 20) + " MB");
 }
 
-
 std::atomic<uint32_t> g_validationMessages{0};
 
 VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -39,8 +38,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
                                                    const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
   if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
     ++g_validationMessages;
-    std::fprintf(stderr, "[vulkan %s] %s\n",
-                 severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning", data->pMessage);
+    std::fprintf(stderr, "[vulkan %s] %s\n", severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
+                 data->pMessage);
   }
   return VK_FALSE;
 }
@@ -199,7 +198,7 @@ Context::Context(const ContextOptions& options) {
     f13.maintenance4 = VK_TRUE;  // SPIR-V 1.6 from glslang declares workgroup sizes with LocalSizeId
     VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
     f12.hostQueryReset = VK_TRUE;
-    f12.runtimeDescriptorArray = VK_TRUE;           // one texture array sized by the scene
+    f12.runtimeDescriptorArray = VK_TRUE;  // one texture array sized by the scene
     f12.descriptorBindingPartiallyBound = VK_TRUE;
     f12.descriptorBindingVariableDescriptorCount = VK_TRUE;
     f12.shaderSampledImageArrayNonUniformIndexing = VK_TRUE;
@@ -210,7 +209,7 @@ Context::Context(const ContextOptions& options) {
     VkPhysicalDeviceFeatures supported{};
     vkGetPhysicalDeviceFeatures(physical_, &supported);
     f2.features.geometryShader = supported.geometryShader;
-    f2.features.samplerAnisotropy = supported.samplerAnisotropy;  // the viewer's --anisotropy; optional
+    f2.features.samplerAnisotropy = supported.samplerAnisotropy;        // the viewer's --anisotropy; optional
     f2.features.textureCompressionBC = supported.textureCompressionBC;  // textures baked as BC; optional
     // The compute rasteriser (render/raster.hpp): 64-bit atomicMin on a storage buffer, also from the
     // fragment stage for the triangles it hands to the hardware; optional, enabled where all are supported.
@@ -235,7 +234,8 @@ Context::Context(const ContextOptions& options) {
     dci.ppEnabledExtensionNames = deviceExtensions.data();
     checkCpuDeviceAddressSpace(properties_);
     VK_CHECK(vkCreateDevice(physical_, &dci, nullptr, &device_));
-    pushDescriptorFn_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
+    pushDescriptorFn_ =
+        reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
     vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
     VmaAllocatorCreateInfo ai{};
@@ -272,8 +272,8 @@ void Context::release() {
 
 void Context::setName(uint64_t handle, VkObjectType type, const char* name) const {
   if (!messenger_) return;
-  static auto fn = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
-      vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
+  static auto fn =
+      reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
   VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
   info.objectType = type;
   info.objectHandle = handle;
@@ -283,14 +283,30 @@ void Context::setName(uint64_t handle, VkObjectType type, const char* name) cons
 
 const char* resultName(VkResult r) {
   switch (r) {
-#define CASE(x) case x: return #x;
-    CASE(VK_SUCCESS) CASE(VK_NOT_READY) CASE(VK_TIMEOUT) CASE(VK_INCOMPLETE) CASE(VK_SUBOPTIMAL_KHR)
-    CASE(VK_ERROR_OUT_OF_HOST_MEMORY) CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY) CASE(VK_ERROR_INITIALIZATION_FAILED)
-    CASE(VK_ERROR_DEVICE_LOST) CASE(VK_ERROR_MEMORY_MAP_FAILED) CASE(VK_ERROR_LAYER_NOT_PRESENT)
-    CASE(VK_ERROR_EXTENSION_NOT_PRESENT) CASE(VK_ERROR_FEATURE_NOT_PRESENT) CASE(VK_ERROR_INCOMPATIBLE_DRIVER)
-    CASE(VK_ERROR_TOO_MANY_OBJECTS) CASE(VK_ERROR_FORMAT_NOT_SUPPORTED) CASE(VK_ERROR_SURFACE_LOST_KHR)
-    CASE(VK_ERROR_OUT_OF_DATE_KHR) CASE(VK_ERROR_NATIVE_WINDOW_IN_USE_KHR) CASE(VK_ERROR_OUT_OF_POOL_MEMORY)
-    CASE(VK_ERROR_FRAGMENTED_POOL) CASE(VK_ERROR_UNKNOWN)
+#define CASE(x) \
+  case x: return #x
+    CASE(VK_SUCCESS);
+    CASE(VK_NOT_READY);
+    CASE(VK_TIMEOUT);
+    CASE(VK_INCOMPLETE);
+    CASE(VK_SUBOPTIMAL_KHR);
+    CASE(VK_ERROR_OUT_OF_HOST_MEMORY);
+    CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    CASE(VK_ERROR_INITIALIZATION_FAILED);
+    CASE(VK_ERROR_DEVICE_LOST);
+    CASE(VK_ERROR_MEMORY_MAP_FAILED);
+    CASE(VK_ERROR_LAYER_NOT_PRESENT);
+    CASE(VK_ERROR_EXTENSION_NOT_PRESENT);
+    CASE(VK_ERROR_FEATURE_NOT_PRESENT);
+    CASE(VK_ERROR_INCOMPATIBLE_DRIVER);
+    CASE(VK_ERROR_TOO_MANY_OBJECTS);
+    CASE(VK_ERROR_FORMAT_NOT_SUPPORTED);
+    CASE(VK_ERROR_SURFACE_LOST_KHR);
+    CASE(VK_ERROR_OUT_OF_DATE_KHR);
+    CASE(VK_ERROR_NATIVE_WINDOW_IN_USE_KHR);
+    CASE(VK_ERROR_OUT_OF_POOL_MEMORY);
+    CASE(VK_ERROR_FRAGMENTED_POOL);
+    CASE(VK_ERROR_UNKNOWN);
 #undef CASE
     default: return "VkResult(?)";
   }

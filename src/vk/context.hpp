@@ -17,12 +17,12 @@ namespace rtr::vk {
 class PipelineCache;
 
 struct ContextOptions {
-  bool validation = false;            // Khronos validation layer + debug messenger (fails loudly if missing)
-  bool syncValidation = false;        // synchronization validation (tests turn it on)
-  std::string device;                 // "" = best; else an index ("1") or a substring of the device name
+  bool validation = false;                      // Khronos validation layer + debug messenger (fails loudly if missing)
+  bool syncValidation = false;                  // synchronization validation (tests turn it on)
+  std::string device;                           // "" = best; else an index ("1") or a substring of the device name
   std::vector<const char*> instanceExtensions;  // e.g. those GLFW needs for a surface
-  bool presentation = false;          // enable VK_KHR_swapchain on the device
-  std::filesystem::path pipelineCacheDir;  // where the pipeline cache file lives; empty: not on disk
+  bool presentation = false;                    // enable VK_KHR_swapchain on the device
+  std::filesystem::path pipelineCacheDir;       // where the pipeline cache file lives; empty: not on disk
 };
 
 // Options from the environment: RTR_VALIDATION=1 enables validation (+ sync validation),

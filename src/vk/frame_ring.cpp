@@ -9,8 +9,7 @@
 
 namespace rtr::vk {
 
-UploadArena::Slice UploadArena::alloc(VkDeviceSize bytes, VkDeviceSize align,
-                                      std::vector<std::function<void()>>& deletions) {
+UploadArena::Slice UploadArena::alloc(VkDeviceSize bytes, VkDeviceSize align, std::vector<std::function<void()>>& deletions) {
   VkDeviceSize offset = (used_ + align - 1) / align * align;
   if (!buffer_.handle() || offset + bytes > buffer_.size()) {
     if (buffer_.handle()) {  // earlier slices of this frame still live in it: freed with the frame
@@ -19,8 +18,9 @@ UploadArena::Slice UploadArena::alloc(VkDeviceSize bytes, VkDeviceSize align,
       deletions.push_back([old] { old->reset(); });
     }
     capacity_ = std::max(capacity_ * 2, bytes);
-    buffer_ = Buffer(*ctx_, capacity_, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
-                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+    buffer_ = Buffer(*ctx_, capacity_,
+                     VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                         VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                      MemoryUse::Upload, "frame upload arena");
     offset = 0;
   }

@@ -37,8 +37,8 @@ class UploadArena {
 };
 
 struct Frame {
-  uint32_t index = 0;    // which of the ring's frames: picks per-frame descriptor sets, uniforms, timers
-  uint64_t number = 0;   // frames begun before this one
+  uint32_t index = 0;   // which of the ring's frames: picks per-frame descriptor sets, uniforms, timers
+  uint64_t number = 0;  // frames begun before this one
   VkCommandBuffer cb = VK_NULL_HANDLE;
   // Bytes for this frame's CPU->GPU copies; valid until the frame's fence signals.
   UploadArena::Slice upload(VkDeviceSize bytes, VkDeviceSize align = 16) { return arena.alloc(bytes, align, deletions); }

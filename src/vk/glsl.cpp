@@ -15,9 +15,7 @@ namespace {
 
 constexpr uint64_t kMaxGlslBytes = uint64_t(16) << 20;
 
-std::string readText(const std::filesystem::path& file) {
-  return readInputFile(file, "GLSL file", kMaxGlslBytes);
-}
+std::string readText(const std::filesystem::path& file) { return readInputFile(file, "GLSL file", kMaxGlslBytes); }
 
 // Resolves #include "x" against the including file's folder, then the include folders.
 class Includer : public glslang::TShader::Includer {
@@ -51,11 +49,10 @@ class Includer : public glslang::TShader::Includer {
 // glslangValidator's file extensions.
 EShLanguage stageOf(const std::filesystem::path& file) {
   static const std::pair<const char*, EShLanguage> stages[] = {
-      {".vert", EShLangVertex}, {".tesc", EShLangTessControl}, {".tese", EShLangTessEvaluation},
-      {".geom", EShLangGeometry}, {".frag", EShLangFragment}, {".comp", EShLangCompute},
-      {".rgen", EShLangRayGen}, {".rint", EShLangIntersect}, {".rahit", EShLangAnyHit},
-      {".rchit", EShLangClosestHit}, {".rmiss", EShLangMiss}, {".rcall", EShLangCallable},
-      {".task", EShLangTask}, {".mesh", EShLangMesh}};
+      {".vert", EShLangVertex},   {".tesc", EShLangTessControl}, {".tese", EShLangTessEvaluation}, {".geom", EShLangGeometry},
+      {".frag", EShLangFragment}, {".comp", EShLangCompute},     {".rgen", EShLangRayGen},         {".rint", EShLangIntersect},
+      {".rahit", EShLangAnyHit},  {".rchit", EShLangClosestHit}, {".rmiss", EShLangMiss},          {".rcall", EShLangCallable},
+      {".task", EShLangTask},     {".mesh", EShLangMesh}};
   for (auto [ext, stage] : stages)
     if (file.extension() == ext) return stage;
   return EShLangCount;
@@ -69,7 +66,8 @@ SpirvModule compileGlsl(const std::filesystem::path& file, const std::vector<std
   static std::once_flag init;
   std::call_once(init, [] { glslang::InitializeProcess(); });  // process-wide; finalised at exit by the OS
   const EShLanguage stage = stageOf(file);
-  if (stage == EShLangCount) throw fileError(file.string(), "", "unknown shader stage: use .vert, .frag, .comp, .rgen, .rchit, ...");
+  if (stage == EShLangCount)
+    throw fileError(file.string(), "", "unknown shader stage: use .vert, .frag, .comp, .rgen, .rchit, ...");
   const std::string source = readText(file);
   const std::string name = file.string();
   const char* text = source.c_str();

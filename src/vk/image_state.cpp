@@ -130,9 +130,9 @@ void require(VkCommandBuffer cb, std::initializer_list<Requirement> reqs) {
   if (gLog)
     for (size_t i = 0; i < bs.size(); ++i) {
       const VkImageMemoryBarrier2& b = bs[i];
-      gLog->push_back(std::string(names[i]) + ": " + layoutName(b.oldLayout) + " -> " +
-                      layoutName(b.newLayout) + ", " + stageNames(b.srcStageMask) + "/" + accessNames(b.srcAccessMask) +
-                      " -> " + stageNames(b.dstStageMask) + "/" + accessNames(b.dstAccessMask));
+      gLog->push_back(std::string(names[i]) + ": " + layoutName(b.oldLayout) + " -> " + layoutName(b.newLayout) + ", " +
+                      stageNames(b.srcStageMask) + "/" + accessNames(b.srcAccessMask) + " -> " + stageNames(b.dstStageMask) +
+                      "/" + accessNames(b.dstAccessMask));
     }
   VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   di.imageMemoryBarrierCount = uint32_t(bs.size());

@@ -18,7 +18,7 @@ enum class Use {
   Storage,          // written in shaders (GENERAL)
   CopySrc,
   CopyDst,
-  Present,          // ordered by the submit's semaphore: layout only
+  Present,  // ordered by the submit's semaphore: layout only
 };
 
 struct ImageState {

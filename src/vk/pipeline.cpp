@@ -83,7 +83,8 @@ PipelineLayout::PipelineLayout(const Context& ctx, PipelineInterface interface, 
       if (b.set != set) continue;
       bindings.push_back({b.binding, b.type, arrayCount(b), b.stages, nullptr});
       // Only the highest binding of a set may have a variable count; runtime arrays are declared last.
-      flags.push_back(b.count == 0 ? VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT : 0);
+      flags.push_back(
+          b.count == 0 ? VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT : 0);
       variable |= b.count == 0;
     }
     VkDescriptorSetLayoutBindingFlagsCreateInfo fi{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO};
@@ -127,8 +128,8 @@ uint32_t PipelineLayout::arrayCount(const ReflectedBinding& b) const {
   if (b.count != 0) return b.count;
   auto it = options_.runtimeArrayCounts.find({b.set, b.binding});
   if (it == options_.runtimeArrayCounts.end() || it->second == 0)
-    throw Error("runtime array '" + b.name + "' (set " + std::to_string(b.set) + " binding " +
-                std::to_string(b.binding) + ") needs a count in LayoutOptions");
+    throw Error("runtime array '" + b.name + "' (set " + std::to_string(b.set) + " binding " + std::to_string(b.binding) +
+                ") needs a count in LayoutOptions");
   return it->second;
 }
 
@@ -151,10 +152,18 @@ ShaderModuleHandle createModule(VkDevice device, const SpirvModule& m) {
 
 uint32_t formatSize(VkFormat f) {
   switch (f) {
-    case VK_FORMAT_R32_SFLOAT: case VK_FORMAT_R32_UINT: case VK_FORMAT_R32_SINT: return 4;
-    case VK_FORMAT_R32G32_SFLOAT: case VK_FORMAT_R32G32_UINT: case VK_FORMAT_R32G32_SINT: return 8;
-    case VK_FORMAT_R32G32B32_SFLOAT: case VK_FORMAT_R32G32B32_UINT: case VK_FORMAT_R32G32B32_SINT: return 12;
-    case VK_FORMAT_R32G32B32A32_SFLOAT: case VK_FORMAT_R32G32B32A32_UINT: case VK_FORMAT_R32G32B32A32_SINT: return 16;
+    case VK_FORMAT_R32_SFLOAT:
+    case VK_FORMAT_R32_UINT:
+    case VK_FORMAT_R32_SINT: return 4;
+    case VK_FORMAT_R32G32_SFLOAT:
+    case VK_FORMAT_R32G32_UINT:
+    case VK_FORMAT_R32G32_SINT: return 8;
+    case VK_FORMAT_R32G32B32_SFLOAT:
+    case VK_FORMAT_R32G32B32_UINT:
+    case VK_FORMAT_R32G32B32_SINT: return 12;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+    case VK_FORMAT_R32G32B32A32_UINT:
+    case VK_FORMAT_R32G32B32A32_SINT: return 16;
     default: throw Error(std::string("vertex input of unsupported format ") + formatName(f));
   }
 }
@@ -296,8 +305,7 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
 }
 
 VkExtent3D groupCount(const PipelineInterface& p, uint32_t x, uint32_t y, uint32_t z) {
-  if (p.stages.size() != 1 || p.stages[0].stage != VK_SHADER_STAGE_COMPUTE_BIT)
-    throw Error("groupCount: not a compute pipeline");
+  if (p.stages.size() != 1 || p.stages[0].stage != VK_SHADER_STAGE_COMPUTE_BIT) throw Error("groupCount: not a compute pipeline");
   const StageInterface& st = p.stages[0];
   const uint32_t n[3] = {x, y, z};
   uint32_t g[3];

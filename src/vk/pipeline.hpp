@@ -25,7 +25,10 @@ SpirvModule loadShader(const std::string& name);  // "mosaic.comp" -> <shaderDir
 void setShaderOverride(const std::string& name, SpirvModule module);
 
 // A shader's variant: the value (32 bits; a bool is 0 or 1) of its `layout(constant_id = id)` constant.
-struct SpecializationConstant { uint32_t id; uint32_t value; };
+struct SpecializationConstant {
+  uint32_t id;
+  uint32_t value;
+};
 // The module with its specialization constants set and folded, and the code, inputs, outputs and
 // descriptors that only the branches not taken used removed, so that reflection derives the variant's own
 // layout and vertex streams. Both pipeline makers specialize through it; the driver gets the result (no
@@ -88,12 +91,11 @@ struct Pipeline {
 // workgroup size: the one rounding every dispatch uses, so no size is written twice.
 VkExtent3D groupCount(const PipelineInterface& p, uint32_t x, uint32_t y = 1, uint32_t z = 1);
 
-
 Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, const LayoutOptions& options = {},
                              const std::vector<SpecializationConstant>& specialization = {});
 
 struct GraphicsDesc {
-  std::vector<SpirvModule> modules;   // vertex + fragment
+  std::vector<SpirvModule> modules;  // vertex + fragment
   // Vertex inputs are reflected: each vertex-shader input location reads its own tightly packed stream,
   // bound at the binding number equal to its location.
   VkCullModeFlags cullMode = VK_CULL_MODE_BACK_BIT;

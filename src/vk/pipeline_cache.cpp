@@ -60,8 +60,8 @@ std::string whyNot(const std::vector<uint8_t>& bytes, const VkPhysicalDeviceProp
   if (h.size < 32) return "driver data shorter than its header";
   uint32_t words[4];
   std::memcpy(words, data, sizeof words);
-  if (words[0] < 32 || words[1] != VK_PIPELINE_CACHE_HEADER_VERSION_ONE || words[2] != p.vendorID ||
-      words[3] != p.deviceID || std::memcmp(data + 16, p.pipelineCacheUUID, VK_UUID_SIZE) != 0)
+  if (words[0] < 32 || words[1] != VK_PIPELINE_CACHE_HEADER_VERSION_ONE || words[2] != p.vendorID || words[3] != p.deviceID ||
+      std::memcmp(data + 16, p.pipelineCacheUUID, VK_UUID_SIZE) != 0)
     return "driver header does not match this device";
   return {};
 }
@@ -90,13 +90,9 @@ PipelineCache::PipelineCache(VkDevice device, const VkPhysicalDeviceProperties& 
         const std::string read = readInputFile(file_, "pipeline cache", uint64_t(1) << 30);
         bytes.assign(read.begin(), read.end());
         why = whyNot(bytes, props);
-      } catch (const Error& e) {
-        why = e.what();
-      }
-      if (!why.empty())
-        note("pipeline cache " + file_.string() + " ignored (" + why + "); it will be rewritten");
-      else
-        initial.assign(bytes.begin() + sizeof(FileHeader), bytes.end());
+      } catch (const Error& e) { why = e.what(); }
+      if (!why.empty()) note("pipeline cache " + file_.string() + " ignored (" + why + "); it will be rewritten");
+      else initial.assign(bytes.begin() + sizeof(FileHeader), bytes.end());
     }
   }
   VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
@@ -152,9 +148,7 @@ void PipelineCache::save() {
     std::filesystem::create_directories(file_.parent_path());
     writeFileAtomic(file_, bytes);
     loadedBytes_.assign(data, data + size);
-  } catch (const std::exception& e) {
-    note(std::string("pipeline cache not saved: ") + e.what());
-  }
+  } catch (const std::exception& e) { note(std::string("pipeline cache not saved: ") + e.what()); }
 }
 
 }  // namespace rtr::vk

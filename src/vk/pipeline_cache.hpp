@@ -36,7 +36,7 @@ class PipelineCache {
 
   VkPipelineCache handle() const { return cache_; }
   const std::filesystem::path& file() const { return file_; }  // empty when not on disk
-  bool loaded() const { return loaded_; }                       // a valid file was read
+  bool loaded() const { return loaded_; }                      // a valid file was read
 
   // Around each pipeline's creation, from any thread: begin(), then end() with its creation feedback
   // (nullptr when the creation failed).

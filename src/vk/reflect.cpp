@@ -18,12 +18,28 @@ namespace {
 constexpr uint64_t kMaxSpirvBytes = uint64_t(64) << 20;  // our largest module is a few hundred KB
 
 const char* resultName(SpvReflectResult r) {
-  static const char* const names[] = {
-      "success", "not ready", "parse failed", "allocation failed", "range exceeded", "null pointer",
-      "internal error", "count mismatch", "element not found", "invalid code size", "invalid magic number",
-      "unexpected end of file", "invalid id reference", "set number overflow", "invalid storage class",
-      "recursion", "invalid instruction", "unexpected block data", "invalid block member reference",
-      "invalid entry point", "invalid execution mode", "too deeply recursive"};
+  static const char* const names[] = {"success",
+                                      "not ready",
+                                      "parse failed",
+                                      "allocation failed",
+                                      "range exceeded",
+                                      "null pointer",
+                                      "internal error",
+                                      "count mismatch",
+                                      "element not found",
+                                      "invalid code size",
+                                      "invalid magic number",
+                                      "unexpected end of file",
+                                      "invalid id reference",
+                                      "set number overflow",
+                                      "invalid storage class",
+                                      "recursion",
+                                      "invalid instruction",
+                                      "unexpected block data",
+                                      "invalid block member reference",
+                                      "invalid entry point",
+                                      "invalid execution mode",
+                                      "too deeply recursive"};
   return size_t(r) < std::size(names) ? names[r] : "unknown error";
 }
 
@@ -35,9 +51,9 @@ void checkInstructionStream(const SpirvModule& s) {
   for (size_t i = 5; i < w.size();) {
     const uint32_t words = w[i] >> 16;
     if (words == 0 || words > w.size() - i)
-      throw fileError(s.name, "word " + std::to_string(i),
-                      "not SPIR-V: an instruction of " + std::to_string(words) + " words in a module of " +
-                          std::to_string(w.size()));
+      throw fileError(
+          s.name, "word " + std::to_string(i),
+          "not SPIR-V: an instruction of " + std::to_string(words) + " words in a module of " + std::to_string(w.size()));
     i += words;
   }
 }
@@ -48,8 +64,8 @@ struct ReflectModule {
     checkInstructionStream(s);
     SpvReflectResult r = spvReflectCreateShaderModule(s.code.size() * 4, s.code.data(), &m);
     if (r != SPV_REFLECT_RESULT_SUCCESS)
-      throw Error(s.name + ": SPIRV-Reflect cannot read this module (" + resultName(r) + ", error " +
-                  std::to_string(int(r)) + ")");
+      throw Error(s.name + ": SPIRV-Reflect cannot read this module (" + resultName(r) + ", error " + std::to_string(int(r)) +
+                  ")");
   }
   ~ReflectModule() { spvReflectDestroyShaderModule(&m); }
 };
@@ -79,8 +95,7 @@ uint32_t memberSize(const SpvReflectBlockVariable& v) {
 
 uint32_t blockEnd(const SpvReflectBlockVariable& b) {
   uint64_t end = 0;
-  for (uint32_t i = 0; i < b.member_count; ++i)
-    end = std::max(end, uint64_t(b.members[i].offset) + memberSize(b.members[i]));
+  for (uint32_t i = 0; i < b.member_count; ++i) end = std::max(end, uint64_t(b.members[i].offset) + memberSize(b.members[i]));
   return clamp32(end);
 }
 
@@ -112,8 +127,10 @@ bool sameLayout(const std::vector<BlockMember>& a, const std::vector<BlockMember
   // Members that fall inside the overlap [lo, hi) must agree in offset and size.
   auto inside = [&](const BlockMember& m) { return m.offset < hi && m.offset + m.size > lo; };
   std::vector<std::pair<uint32_t, uint32_t>> x, y;
-  for (auto& m : a) if (inside(m)) x.push_back({m.offset, m.size});
-  for (auto& m : b) if (inside(m)) y.push_back({m.offset, m.size});
+  for (auto& m : a)
+    if (inside(m)) x.push_back({m.offset, m.size});
+  for (auto& m : b)
+    if (inside(m)) y.push_back({m.offset, m.size});
   return x == y;
 }
 
@@ -122,23 +139,52 @@ std::string bindingPlace(const ReflectedBinding& b) {
 }
 
 // SpvImageFormat, which numbers its values 0..41, to Vulkan's format and GLSL's layout name.
-struct ImageFormat { VkFormat vk; const char* name; };
-constexpr ImageFormat kImageFormats[] = {
-    {VK_FORMAT_UNDEFINED, "unknown"}, {VK_FORMAT_R32G32B32A32_SFLOAT, "rgba32f"},
-    {VK_FORMAT_R16G16B16A16_SFLOAT, "rgba16f"}, {VK_FORMAT_R32_SFLOAT, "r32f"}, {VK_FORMAT_R8G8B8A8_UNORM, "rgba8"},
-    {VK_FORMAT_R8G8B8A8_SNORM, "rgba8_snorm"}, {VK_FORMAT_R32G32_SFLOAT, "rg32f"}, {VK_FORMAT_R16G16_SFLOAT, "rg16f"},
-    {VK_FORMAT_B10G11R11_UFLOAT_PACK32, "r11f_g11f_b10f"}, {VK_FORMAT_R16_SFLOAT, "r16f"},
-    {VK_FORMAT_R16G16B16A16_UNORM, "rgba16"}, {VK_FORMAT_A2B10G10R10_UNORM_PACK32, "rgb10_a2"},
-    {VK_FORMAT_R16G16_UNORM, "rg16"}, {VK_FORMAT_R8G8_UNORM, "rg8"}, {VK_FORMAT_R16_UNORM, "r16"},
-    {VK_FORMAT_R8_UNORM, "r8"}, {VK_FORMAT_R16G16B16A16_SNORM, "rgba16_snorm"}, {VK_FORMAT_R16G16_SNORM, "rg16_snorm"},
-    {VK_FORMAT_R8G8_SNORM, "rg8_snorm"}, {VK_FORMAT_R16_SNORM, "r16_snorm"}, {VK_FORMAT_R8_SNORM, "r8_snorm"},
-    {VK_FORMAT_R32G32B32A32_SINT, "rgba32i"}, {VK_FORMAT_R16G16B16A16_SINT, "rgba16i"},
-    {VK_FORMAT_R8G8B8A8_SINT, "rgba8i"}, {VK_FORMAT_R32_SINT, "r32i"}, {VK_FORMAT_R32G32_SINT, "rg32i"},
-    {VK_FORMAT_R16G16_SINT, "rg16i"}, {VK_FORMAT_R8G8_SINT, "rg8i"}, {VK_FORMAT_R16_SINT, "r16i"},
-    {VK_FORMAT_R8_SINT, "r8i"}, {VK_FORMAT_R32G32B32A32_UINT, "rgba32ui"}, {VK_FORMAT_R16G16B16A16_UINT, "rgba16ui"},
-    {VK_FORMAT_R8G8B8A8_UINT, "rgba8ui"}, {VK_FORMAT_R32_UINT, "r32ui"}, {VK_FORMAT_A2B10G10R10_UINT_PACK32, "rgb10_a2ui"},
-    {VK_FORMAT_R32G32_UINT, "rg32ui"}, {VK_FORMAT_R16G16_UINT, "rg16ui"}, {VK_FORMAT_R8G8_UINT, "rg8ui"},
-    {VK_FORMAT_R16_UINT, "r16ui"}, {VK_FORMAT_R8_UINT, "r8ui"}, {VK_FORMAT_R64_UINT, "r64ui"}, {VK_FORMAT_R64_SINT, "r64i"}};
+struct ImageFormat {
+  VkFormat vk;
+  const char* name;
+};
+constexpr ImageFormat kImageFormats[] = {{VK_FORMAT_UNDEFINED, "unknown"},
+                                         {VK_FORMAT_R32G32B32A32_SFLOAT, "rgba32f"},
+                                         {VK_FORMAT_R16G16B16A16_SFLOAT, "rgba16f"},
+                                         {VK_FORMAT_R32_SFLOAT, "r32f"},
+                                         {VK_FORMAT_R8G8B8A8_UNORM, "rgba8"},
+                                         {VK_FORMAT_R8G8B8A8_SNORM, "rgba8_snorm"},
+                                         {VK_FORMAT_R32G32_SFLOAT, "rg32f"},
+                                         {VK_FORMAT_R16G16_SFLOAT, "rg16f"},
+                                         {VK_FORMAT_B10G11R11_UFLOAT_PACK32, "r11f_g11f_b10f"},
+                                         {VK_FORMAT_R16_SFLOAT, "r16f"},
+                                         {VK_FORMAT_R16G16B16A16_UNORM, "rgba16"},
+                                         {VK_FORMAT_A2B10G10R10_UNORM_PACK32, "rgb10_a2"},
+                                         {VK_FORMAT_R16G16_UNORM, "rg16"},
+                                         {VK_FORMAT_R8G8_UNORM, "rg8"},
+                                         {VK_FORMAT_R16_UNORM, "r16"},
+                                         {VK_FORMAT_R8_UNORM, "r8"},
+                                         {VK_FORMAT_R16G16B16A16_SNORM, "rgba16_snorm"},
+                                         {VK_FORMAT_R16G16_SNORM, "rg16_snorm"},
+                                         {VK_FORMAT_R8G8_SNORM, "rg8_snorm"},
+                                         {VK_FORMAT_R16_SNORM, "r16_snorm"},
+                                         {VK_FORMAT_R8_SNORM, "r8_snorm"},
+                                         {VK_FORMAT_R32G32B32A32_SINT, "rgba32i"},
+                                         {VK_FORMAT_R16G16B16A16_SINT, "rgba16i"},
+                                         {VK_FORMAT_R8G8B8A8_SINT, "rgba8i"},
+                                         {VK_FORMAT_R32_SINT, "r32i"},
+                                         {VK_FORMAT_R32G32_SINT, "rg32i"},
+                                         {VK_FORMAT_R16G16_SINT, "rg16i"},
+                                         {VK_FORMAT_R8G8_SINT, "rg8i"},
+                                         {VK_FORMAT_R16_SINT, "r16i"},
+                                         {VK_FORMAT_R8_SINT, "r8i"},
+                                         {VK_FORMAT_R32G32B32A32_UINT, "rgba32ui"},
+                                         {VK_FORMAT_R16G16B16A16_UINT, "rgba16ui"},
+                                         {VK_FORMAT_R8G8B8A8_UINT, "rgba8ui"},
+                                         {VK_FORMAT_R32_UINT, "r32ui"},
+                                         {VK_FORMAT_A2B10G10R10_UINT_PACK32, "rgb10_a2ui"},
+                                         {VK_FORMAT_R32G32_UINT, "rg32ui"},
+                                         {VK_FORMAT_R16G16_UINT, "rg16ui"},
+                                         {VK_FORMAT_R8G8_UINT, "rg8ui"},
+                                         {VK_FORMAT_R16_UINT, "r16ui"},
+                                         {VK_FORMAT_R8_UINT, "r8ui"},
+                                         {VK_FORMAT_R64_UINT, "r64ui"},
+                                         {VK_FORMAT_R64_SINT, "r64i"}};
 
 SpecConstant specConstant(const SpvReflectSpecializationConstant& c) {
   SpecConstant out{c.constant_id, c.name ? c.name : "", "", ""};
@@ -154,9 +200,15 @@ SpecConstant specConstant(const SpvReflectSpecializationConstant& c) {
   } else if (t->type_flags & SPV_REFLECT_TYPE_FLAG_FLOAT) {
     out.type = "float" + std::to_string(width);
     std::ostringstream v;
-    if (width == 32) { float f; std::memcpy(&f, &bits, 4); v << f; }
-    else if (width == 64) { double d; std::memcpy(&d, &bits, 8); v << d; }
-    else v << "0x" << std::hex << bits;
+    if (width == 32) {
+      float f;
+      std::memcpy(&f, &bits, 4);
+      v << f;
+    } else if (width == 64) {
+      double d;
+      std::memcpy(&d, &bits, 8);
+      v << d;
+    } else v << "0x" << std::hex << bits;
     out.defaultValue = v.str();
   } else if (t->type_flags & SPV_REFLECT_TYPE_FLAG_INT) {
     const bool sign = t->traits.numeric.scalar.signedness;
@@ -204,7 +256,8 @@ ReflectedBinding binding(const SpvReflectDescriptorBinding& d, VkShaderStageFlag
                        (d.array.dims_count > 0 && d.array.dims[0] == SPV_REFLECT_ARRAY_DIM_RUNTIME);
   b.count = runtime ? 0 : d.count;
   b.stages = stage;
-  b.name = d.name && *d.name ? d.name : (d.type_description && d.type_description->type_name ? d.type_description->type_name : "");
+  b.name =
+      d.name && *d.name ? d.name : (d.type_description && d.type_description->type_name ? d.type_description->type_name : "");
   if (b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER || b.type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
     // SPIRV-Reflect gives 0 for storage buffers: the members say where the block ends.
     b.blockSize = d.block.size ? d.block.size : blockEnd(d.block);
@@ -253,7 +306,10 @@ void validateSpirv(const SpirvModule& module) {
 PipelineInterface reflectPipeline(const std::vector<SpirvModule>& modules) {
   PipelineInterface out;
   std::map<std::pair<uint32_t, uint32_t>, std::pair<ReflectedBinding, std::string>> bindings;  // + first module
-  struct Push { ReflectedPushConstants range; std::string module; };
+  struct Push {
+    ReflectedPushConstants range;
+    std::string module;
+  };
   std::vector<Push> pushes;
 
   for (const SpirvModule& s : modules) {
@@ -320,9 +376,8 @@ PipelineInterface reflectPipeline(const std::vector<SpirvModule>& modules) {
           uint32_t lo = std::max(p.range.offset, r.offset);
           uint32_t hi = std::min(p.range.offset + p.range.size, r.offset + r.size);
           if (lo < hi && !sameLayout(p.range.members, r.members, lo, hi))
-            throw Error("stage conflict in push constants: " + p.module + " and " + s.name +
-                        " lay out the overlapping bytes [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                        ") differently");
+            throw Error("stage conflict in push constants: " + p.module + " and " + s.name + " lay out the overlapping bytes [" +
+                        std::to_string(lo) + ", " + std::to_string(hi) + ") differently");
         }
         pushes.push_back({r, s.name});
       }

@@ -13,7 +13,7 @@
 namespace rtr::vk {
 
 struct SpirvModule {
-  std::string name;             // file name, for messages
+  std::string name;  // file name, for messages
   std::vector<uint32_t> code;
 };
 
@@ -29,7 +29,7 @@ void validateSpirv(const SpirvModule& module);
 
 struct BlockMember {
   std::string name;
-  uint32_t offset = 0, size = 0;  // bytes, as laid out in the SPIR-V (std140/std430/scalar as declared)
+  uint32_t offset = 0, size = 0;     // bytes, as laid out in the SPIR-V (std140/std430/scalar as declared)
   std::vector<BlockMember> members;  // a struct's members, or the members of the block a reference points to
   // A buffer reference (GL_EXT_buffer_reference), or an array of them: the block type it points to and
   // that block's size. A block's members are listed at its first reference within one binding only; a
@@ -44,7 +44,7 @@ struct ReflectedBinding {
   uint32_t count = 1;             // 0: a runtime-sized array, sized by whoever builds the layout
   VkShaderStageFlags stages = 0;  // merged across the pipeline's stages
   std::string name;
-  uint32_t blockSize = 0;         // buffers only: end of the last member (a runtime array counts 0)
+  uint32_t blockSize = 0;  // buffers only: end of the last member (a runtime array counts 0)
   std::vector<BlockMember> members;
   VkFormat imageFormat = VK_FORMAT_UNDEFINED;  // storage images and texel buffers that declare one
   uint32_t inputAttachmentIndex = 0;           // input attachments only
@@ -76,14 +76,14 @@ struct StageInterface {
   std::string module;
   VkShaderStageFlagBits stage{};
   std::string entryPoint;
-  std::array<uint32_t, 3> localSize{0, 0, 0};  // compute only; kSpecializedSize: set by a spec constant
+  std::array<uint32_t, 3> localSize{0, 0, 0};      // compute only; kSpecializedSize: set by a spec constant
   std::vector<InterfaceVariable> inputs, outputs;  // built-ins left out
   std::vector<SpecConstant> specConstants;         // the module's, sorted by id
 };
 
 struct PipelineInterface {
   std::vector<StageInterface> stages;
-  std::vector<ReflectedBinding> bindings;        // sorted by (set, binding)
+  std::vector<ReflectedBinding> bindings;             // sorted by (set, binding)
   std::vector<ReflectedPushConstants> pushConstants;  // at most one range (one block per stage, merged)
 
   uint32_t setCount() const { return bindings.empty() ? 0 : bindings.back().set + 1; }

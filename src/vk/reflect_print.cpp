@@ -10,8 +10,11 @@ std::string jsonString(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (static_cast<unsigned char>(c) < 0x20) { char buf[8]; std::snprintf(buf, sizeof buf, "\\u%04x", c); out += buf; }
-    else out += c;
+    else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else out += c;
   }
   return out + "\"";
 }
@@ -31,10 +34,12 @@ void textMembers(std::ostringstream& o, const std::vector<BlockMember>& ms, int 
 void jsonMembers(std::ostringstream& o, const std::vector<BlockMember>& ms) {
   o << "[";
   for (size_t i = 0; i < ms.size(); ++i) {
-    o << (i ? "," : "") << "{\"name\":" << jsonString(ms[i].name) << ",\"offset\":" << ms[i].offset
-      << ",\"size\":" << ms[i].size;
+    o << (i ? "," : "") << "{\"name\":" << jsonString(ms[i].name) << ",\"offset\":" << ms[i].offset << ",\"size\":" << ms[i].size;
     if (!ms[i].pointee.empty()) o << ",\"pointee\":" << jsonString(ms[i].pointee) << ",\"pointeeSize\":" << ms[i].pointeeSize;
-    if (!ms[i].members.empty()) { o << ",\"members\":"; jsonMembers(o, ms[i].members); }
+    if (!ms[i].members.empty()) {
+      o << ",\"members\":";
+      jsonMembers(o, ms[i].members);
+    }
     o << "}";
   }
   o << "]";
@@ -52,7 +57,9 @@ void jsonVars(std::ostringstream& o, const std::vector<InterfaceVariable>& vs) {
 
 std::string stageNames(VkShaderStageFlags s) {
   std::string out;
-  auto add = [&](VkShaderStageFlags bit, const char* name) { if (s & bit) out += (out.empty() ? "" : "|") + std::string(name); };
+  auto add = [&](VkShaderStageFlags bit, const char* name) {
+    if (s & bit) out += (out.empty() ? "" : "|") + std::string(name);
+  };
   add(VK_SHADER_STAGE_VERTEX_BIT, "vertex");
   add(VK_SHADER_STAGE_TESSELLATION_CONTROL_BIT, "tess-control");
   add(VK_SHADER_STAGE_TESSELLATION_EVALUATION_BIT, "tess-eval");
@@ -129,7 +136,8 @@ std::string toText(const PipelineInterface& p) {
     textMembers(o, b.members, 2);
   }
   for (const auto& pc : p.pushConstants) {
-    o << "push constants: offset " << pc.offset << " size " << pc.size << " " << pc.name << " (" << stageNames(pc.stages) << ")\n";
+    o << "push constants: offset " << pc.offset << " size " << pc.size << " " << pc.name << " (" << stageNames(pc.stages)
+      << ")\n";
     textMembers(o, pc.members, 2);
   }
   return o.str();
@@ -153,8 +161,8 @@ std::string toJson(const PipelineInterface& p) {
       o << ",\"specConstants\":[";
       for (size_t j = 0; j < s.specConstants.size(); ++j) {
         const auto& c = s.specConstants[j];
-        o << (j ? "," : "") << "{\"id\":" << c.id << ",\"name\":" << jsonString(c.name) << ",\"type\":"
-          << jsonString(c.type) << ",\"default\":" << jsonString(c.defaultValue) << "}";
+        o << (j ? "," : "") << "{\"id\":" << c.id << ",\"name\":" << jsonString(c.name) << ",\"type\":" << jsonString(c.type)
+          << ",\"default\":" << jsonString(c.defaultValue) << "}";
       }
       o << "]";
     }
@@ -163,13 +171,16 @@ std::string toJson(const PipelineInterface& p) {
   o << "],\"descriptorSets\":[";
   for (size_t i = 0; i < p.bindings.size(); ++i) {
     const auto& b = p.bindings[i];
-    o << (i ? "," : "") << "{\"set\":" << b.set << ",\"binding\":" << b.binding << ",\"type\":"
-      << jsonString(descriptorTypeName(b.type)) << ",\"count\":" << b.count << ",\"runtimeArray\":"
-      << (b.count == 0 ? "true" : "false") << ",\"name\":" << jsonString(b.name) << ",\"stages\":"
-      << jsonString(stageNames(b.stages));
+    o << (i ? "," : "") << "{\"set\":" << b.set << ",\"binding\":" << b.binding
+      << ",\"type\":" << jsonString(descriptorTypeName(b.type)) << ",\"count\":" << b.count
+      << ",\"runtimeArray\":" << (b.count == 0 ? "true" : "false") << ",\"name\":" << jsonString(b.name)
+      << ",\"stages\":" << jsonString(stageNames(b.stages));
     if (b.imageFormat != VK_FORMAT_UNDEFINED) o << ",\"imageFormat\":" << jsonString(imageFormatName(b.imageFormat));
     if (b.type == VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT) o << ",\"inputAttachmentIndex\":" << b.inputAttachmentIndex;
-    if (b.blockSize) { o << ",\"blockSize\":" << b.blockSize << ",\"members\":"; jsonMembers(o, b.members); }
+    if (b.blockSize) {
+      o << ",\"blockSize\":" << b.blockSize << ",\"members\":";
+      jsonMembers(o, b.members);
+    }
     o << "}";
   }
   o << "],\"pushConstants\":[";

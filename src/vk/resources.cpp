@@ -16,8 +16,7 @@ std::string mb(VkDeviceSize bytes) { return std::to_string((bytes + (1 << 20) - 
 // Allocation failures become OutOfMemory naming the object and its size; other failures stay VK_CHECK's.
 void checkAllocation(VkResult r, const char* call, const char* kind, const char* name, VkDeviceSize bytes) {
   if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY || r == VK_ERROR_MEMORY_MAP_FAILED)
-    throw OutOfMemory(std::string(kind) + " '" + (name ? name : "unnamed") + "' needs " + mb(bytes) + ": " +
-                      resultName(r));
+    throw OutOfMemory(std::string(kind) + " '" + (name ? name : "unnamed") + "' needs " + mb(bytes) + ": " + resultName(r));
   if (r < 0) throw Error(std::string(call) + " failed: " + resultName(r));
 }
 
@@ -36,16 +35,14 @@ Buffer::Buffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, 
   ai.usage = VMA_MEMORY_USAGE_AUTO;
   if (use == MemoryUse::Upload)
     ai.flags = VMA_ALLOCATION_CREATE_HOST_ACCESS_SEQUENTIAL_WRITE_BIT | VMA_ALLOCATION_CREATE_MAPPED_BIT;
-  if (use == MemoryUse::Readback)
-    ai.flags = VMA_ALLOCATION_CREATE_HOST_ACCESS_RANDOM_BIT | VMA_ALLOCATION_CREATE_MAPPED_BIT;
+  if (use == MemoryUse::Readback) ai.flags = VMA_ALLOCATION_CREATE_HOST_ACCESS_RANDOM_BIT | VMA_ALLOCATION_CREATE_MAPPED_BIT;
   if (use == MemoryUse::DeviceWrite) {
     ai.flags = VMA_ALLOCATION_CREATE_HOST_ACCESS_SEQUENTIAL_WRITE_BIT | VMA_ALLOCATION_CREATE_MAPPED_BIT |
                VMA_ALLOCATION_CREATE_HOST_ACCESS_ALLOW_TRANSFER_INSTEAD_BIT;
     ai.requiredFlags = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
   }
   VmaAllocationInfo info{};
-  checkAllocation(vmaCreateBuffer(allocator_, &bi, &ai, &buffer_, &allocation_, &info), "vmaCreateBuffer", "buffer",
-                  name, size);
+  checkAllocation(vmaCreateBuffer(allocator_, &bi, &ai, &buffer_, &allocation_, &info), "vmaCreateBuffer", "buffer", name, size);
   mapped_ = info.pMappedData;
   const bool mustMap = use == MemoryUse::Upload || use == MemoryUse::Readback;
   if (badMapping(mapped_) || (mustMap && !mapped_)) {
@@ -97,18 +94,16 @@ Image::Image(const Context& ctx, const ImageDesc& desc) : device_(ctx.device()),
   VmaAllocationCreateInfo ai{};
   ai.usage = VMA_MEMORY_USAGE_AUTO_PREFER_DEVICE;
   VmaAllocationInfo info{};
-  checkAllocation(vmaCreateImage(allocator_, &ii, &ai, &image_, &allocation_, &info), "vmaCreateImage", "image",
-                  desc.name, info.size ? info.size : VkDeviceSize(desc.extent.width) * desc.extent.height * 4);
+  checkAllocation(vmaCreateImage(allocator_, &ii, &ai, &image_, &allocation_, &info), "vmaCreateImage", "image", desc.name,
+                  info.size ? info.size : VkDeviceSize(desc.extent.width) * desc.extent.height * 4);
   if (desc.name) ctx.setName(uint64_t(image_), VK_OBJECT_TYPE_IMAGE, desc.name);
   // A copy-only image has no view (Vulkan allows none for such usage).
   constexpr VkImageUsageFlags kViewUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
-                                           VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-                                           VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+                                           VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
   if (desc.usage & kViewUsage) view_ = createView(desc.format, 0, desc.mipLevels, desc.viewUsage ? desc.viewUsage : desc.usage);
 }
 
-ImageView Image::createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage,
-                            bool faces) const {
+ImageView Image::createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage, bool faces) const {
   VkImageViewUsageCreateInfo ui{VK_STRUCTURE_TYPE_IMAGE_VIEW_USAGE_CREATE_INFO};
   ui.usage = usage;
   VkImageViewCreateInfo vi{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, &ui};

@@ -32,11 +32,18 @@ class Owned {
   Owned(VkDevice device, T handle) : device_(device), handle_(handle) {}
   Owned(Owned&& o) noexcept : device_(o.device_), handle_(std::exchange(o.handle_, VK_NULL_HANDLE)) {}
   Owned& operator=(Owned&& o) noexcept {
-    if (this != &o) { reset(); device_ = o.device_; handle_ = std::exchange(o.handle_, VK_NULL_HANDLE); }
+    if (this != &o) {
+      reset();
+      device_ = o.device_;
+      handle_ = std::exchange(o.handle_, VK_NULL_HANDLE);
+    }
     return *this;
   }
   ~Owned() { reset(); }
-  void reset() { if (handle_) Destroy(device_, handle_, nullptr); handle_ = VK_NULL_HANDLE; }
+  void reset() {
+    if (handle_) Destroy(device_, handle_, nullptr);
+    handle_ = VK_NULL_HANDLE;
+  }
   T get() const { return handle_; }
   operator T() const { return handle_; }
   explicit operator bool() const { return handle_ != VK_NULL_HANDLE; }
@@ -80,8 +87,8 @@ class Buffer {
   VkBuffer handle() const { return buffer_; }
   VkDeviceSize size() const { return size_; }
   void* mapped() const { return mapped_; }  // non-null for Upload and Readback (DeviceWrite: see there)
-  void flush() const;       // after host writes
-  void invalidate() const;  // before host reads
+  void flush() const;                       // after host writes
+  void invalidate() const;                  // before host reads
 
  private:
   VmaAllocator allocator_ = nullptr;
@@ -99,7 +106,7 @@ struct ImageDesc {
   VkImageCreateFlags flags = 0;     // e.g. MUTABLE_FORMAT for a UNORM storage view of an sRGB image
   VkImageUsageFlags viewUsage = 0;  // usage of the default view when narrower than `usage` (0: same)
   const char* name = nullptr;
-  bool cube = false;                // six layers, CUBE_COMPATIBLE; the default view is a cube
+  bool cube = false;  // six layers, CUBE_COMPATIBLE; the default view is a cube
 };
 
 class Image {
@@ -125,8 +132,7 @@ class Image {
 
   // A view of a mip range in another (compatible) format with a given usage, owned by the caller. A cube
   // image's views are cubes, or arrays of its six faces (storage writes) where `faces` says so.
-  ImageView createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage,
-                       bool faces = false) const;
+  ImageView createView(VkFormat format, uint32_t baseMip, uint32_t mipCount, VkImageUsageFlags usage, bool faces = false) const;
 
  private:
   VkDevice device_ = VK_NULL_HANDLE;

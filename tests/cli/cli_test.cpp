@@ -50,9 +50,9 @@ struct Result {
 };
 
 class Process {
-public:
-  Process(const std::vector<std::string>& args, const fs::path& logs, int id) : outFile_(logs / (std::to_string(id) + ".out")),
-                                                                               errFile_(logs / (std::to_string(id) + ".err")) {
+ public:
+  Process(const std::vector<std::string>& args, const fs::path& logs, int id)
+      : outFile_(logs / (std::to_string(id) + ".out")), errFile_(logs / (std::to_string(id) + ".err")) {
     pid_ = ::fork();
     if (pid_ == 0) {
       const int o = ::open(outFile_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -87,7 +87,7 @@ public:
     return r;
   }
 
-private:
+ private:
   fs::path outFile_, errFile_;
   pid_t pid_ = -1;
 };
@@ -230,7 +230,10 @@ TEST_F(Cli, EnvironmentOptions) {
   const std::string c = kCornell.string(), a = (dir / "a.png").string(), b = (dir / "b.png").string(),
                     e = (dir / "e.png").string();
   const std::vector<std::string> common = {c, "--headless", "--size", "48x32", "--validation"};
-  auto with = [&](std::vector<std::string> extra) { extra.insert(extra.begin(), common.begin(), common.end()); return extra; };
+  auto with = [&](std::vector<std::string> extra) {
+    extra.insert(extra.begin(), common.begin(), common.end());
+    return extra;
+  };
   Result r = run("rtr-view", with({"-o", a}));
   ASSERT_EQ(r.exitCode, 0) << r.err;
   r = run("rtr-view", with({"-o", b, "--env", "none"}));
@@ -303,7 +306,11 @@ TEST_F(Cli, ConcurrentBakesAndImageWritesLeaveOneCompleteFile) {
   ASSERT_EQ(run("rtr-bake", {kTemple.string(), ref.string()}).exitCode, 0);
   const fs::path png = dir / "t.png", refPng = dir / "ref.png";
   const std::vector<std::string> trace = {kCornell.string(), "--size", "96x64", "-q", "--threads", "1", "--force", "-o"};
-  auto traceTo = [&](const fs::path& f) { auto a = trace; a.push_back(f.string()); return a; };
+  auto traceTo = [&](const fs::path& f) {
+    auto a = trace;
+    a.push_back(f.string());
+    return a;
+  };
   ASSERT_EQ(run("rtr-trace", traceTo(refPng)).exitCode, 0);
   for (int n : {2, 8}) {
     std::vector<Process> ps;
@@ -387,8 +394,8 @@ TEST_F(Cli, NoLightsIsNeverBlackInSilence) {
   r = run("rtr-trace", {obj.string(), "-o", png, "--size", "32x24", "--force", "--no-default-light", "--ambient", "0"});
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("warning: the image has no lit pixel: the scene has no lights"));
-  r = run("rtr-view", {obj.string(), "--headless", "--screenshot", vpng, "--size", "32x24", "--no-default-light",
-                       "--ambient", "0"});
+  r = run("rtr-view",
+          {obj.string(), "--headless", "--screenshot", vpng, "--size", "32x24", "--no-default-light", "--ambient", "0"});
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("warning: the image has no lit pixel: the scene has no lights"));
   r = run("rtr-view", {obj.string(), "--headless", "--screenshot", vpng, "--size", "32x24", "--force"});

@@ -147,9 +147,7 @@ TEST_F(AtomicFileTest, MissingFolderIsAnErrorNamingTheTarget) {
   try {
     writeFileAtomic(dir / "nowhere/out.bin", "x");
     FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("nowhere/out.bin"), std::string::npos) << e.what();
-  }
+  } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find("nowhere/out.bin"), std::string::npos) << e.what(); }
 }
 
 }  // namespace

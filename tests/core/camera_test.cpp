@@ -26,9 +26,7 @@ TEST(Camera, BadPoseTextIsAClearError) {
   EXPECT_THROW(parsePose("1,2,3,nan,5"), Error);
   try {
     parsePose("1,2,x,4,5");
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("field 3"), std::string::npos) << e.what();
-  }
+  } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find("field 3"), std::string::npos) << e.what(); }
 }
 
 TEST(Camera, ZeroPoseLooksDownNegativeZ) {

@@ -82,9 +82,7 @@ TEST_F(ImageWrite, FormatFollowsTheExtension) {
   try {
     saveImage(dir / "a.bmp", img);
     FAIL() << "no error";
-  } catch (const UsageError& e) {
-    EXPECT_NE(std::string(e.what()).find(kImageExtensions), std::string::npos) << e.what();
-  }
+  } catch (const UsageError& e) { EXPECT_NE(std::string(e.what()).find(kImageExtensions), std::string::npos) << e.what(); }
   EXPECT_FALSE(std::filesystem::exists(dir / "a.bmp"));
 }
 
@@ -105,9 +103,7 @@ TEST_F(ImageWrite, PngConvertsChannelsAsBefore) {
         ASSERT_TRUE(d[0] == s[0] && d[1] == s[1] && d[2] == s[2]) << "pixel " << i;
       } else {
         ASSERT_EQ(d[0], (s[0] * 77 + s[1] * 150 + s[2] * 29) >> 8) << "pixel " << i;
-        if (channels == 2) {
-          ASSERT_EQ(d[1], s[3]) << "pixel " << i;
-        }
+        if (channels == 2) { ASSERT_EQ(d[1], s[3]) << "pixel " << i; }
       }
     }
   }
@@ -126,9 +122,7 @@ TEST_F(ImageWrite, DamagedPngIsRefusedNotDecodedWrong) {
   try {
     loadImage(dir / "flipped.png", 4);
     ADD_FAILURE() << "a damaged PNG was decoded";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("flipped.png"), std::string::npos) << e.what();
-  }
+  } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find("flipped.png"), std::string::npos) << e.what(); }
 }
 
 // Formats no scene names as a texture are not decoded at all (stb's PNM reader overflows on long numbers):
@@ -140,9 +134,7 @@ TEST_F(ImageWrite, UnsupportedFormatsAreRefusedByName) {
     try {
       loadImage(dir / f, 4);
       ADD_FAILURE() << f << " was decoded";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
-    }
+    } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what(); }
   }
 }
 
@@ -162,9 +154,7 @@ TEST_F(ImageWrite, JpegWhoseDataEndsEarlyIsRefused) {
     try {
       const TexelData t = loadImage(dir / f, 1);
       ADD_FAILURE() << f << " was decoded as " << t.width << "x" << t.height;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
-    }
+    } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what(); }
   }
 }
 
@@ -189,9 +179,7 @@ TEST_F(ImageWrite, JpegDecodesInEveryChannelCount) {
     } else {
       EXPECT_NEAR(p[0], 0.299 * 120 + 0.587 * 100 + 0.114 * 128, 6) << channels;  // luma
     }
-    if (channels % 2 == 0) {
-      EXPECT_EQ(p[channels - 1], 255) << "alpha is opaque";
-    }
+    if (channels % 2 == 0) { EXPECT_EQ(p[channels - 1], 255) << "alpha is opaque"; }
   }
   const std::string bytes = readAll(dir / "g.jpg");
   std::ofstream(dir / "cut.jpg", std::ios::binary) << bytes.substr(0, 200);
@@ -202,9 +190,7 @@ TEST_F(ImageWrite, JpegDecodesInEveryChannelCount) {
     try {
       const TexelData t = loadImage(dir / f, 4);
       EXPECT_EQ(t.texels.size(), size_t(t.width) * t.height * 4) << f;  // recovered: still consistent
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
-    }
+    } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what(); }
   }
 }
 

@@ -34,9 +34,7 @@ std::string errorOnFifo(const fs::path& fifo, const std::function<void()>& fn) {
     try {
       fn();
       return "no error";
-    } catch (const Error& e) {
-      return e.what();
-    }
+    } catch (const Error& e) { return e.what(); }
   });
   if (result.wait_for(std::chrono::seconds(5)) == std::future_status::timeout) {
     const int w = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
@@ -56,15 +54,11 @@ TEST_F(InputFileTest, RefusesFifoDeviceAndFolderAtOnceNamingThem) {
   try {
     loadImage("/dev/zero", 4);
     ADD_FAILURE() << "/dev/zero decoded";
-  } catch (const Error& e) {
-    EXPECT_THAT(e.what(), HasSubstr("/dev/zero: a character device, not a regular file"));
-  }
+  } catch (const Error& e) { EXPECT_THAT(e.what(), HasSubstr("/dev/zero: a character device, not a regular file")); }
   try {
     InputFile f(dir);
     ADD_FAILURE() << "a folder opened";
-  } catch (const Error& e) {
-    EXPECT_THAT(e.what(), HasSubstr(dir.string() + ": a folder, not a regular file"));
-  }
+  } catch (const Error& e) { EXPECT_THAT(e.what(), HasSubstr(dir.string() + ": a folder, not a regular file")); }
 }
 
 TEST_F(InputFileTest, SizeIsKnownAndBoundedBeforeReading) {
@@ -76,9 +70,7 @@ TEST_F(InputFileTest, SizeIsKnownAndBoundedBeforeReading) {
   try {
     readInputFile(f, "material library", 9);
     ADD_FAILURE() << "read past the limit";
-  } catch (const Error& e) {
-    EXPECT_THAT(e.what(), HasSubstr("a.txt: material library of 10 bytes; the limit is"));
-  }
+  } catch (const Error& e) { EXPECT_THAT(e.what(), HasSubstr("a.txt: material library of 10 bytes; the limit is")); }
   // A sparse file of 4 GiB is refused by its size, not read.
   const fs::path big = dir / "big.mtl";
   std::ofstream(big).close();

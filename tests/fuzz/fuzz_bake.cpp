@@ -17,7 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   rtr::Scene scene;
   try {
     auto src = rtr::memorySource(std::string(reinterpret_cast<const char*>(data), size), "fuzz.obj");
-    scene = rtr::parseObj(*src, "fuzz.obj", [](const std::string&) { return std::optional<std::string>(); }, opt);
+    scene = rtr::parseObj(
+        *src, "fuzz.obj", [](const std::string&) { return std::optional<std::string>(); }, opt);
     rtr::buildMissingClusters(scene);
   } catch (const rtr::Error& e) {
     rtr::fuzz::requireNamesFile(e, "fuzz");

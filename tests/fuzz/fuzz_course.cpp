@@ -7,8 +7,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     rtr::fuzz::checkScene(rtr::decodeCourseMesh({data, size}, "fuzz.comp5892mesh"));
-  } catch (const rtr::Error& e) {
-    rtr::fuzz::requireNamesFile(e, "fuzz.comp5892mesh");
-  }
+  } catch (const rtr::Error& e) { rtr::fuzz::requireNamesFile(e, "fuzz.comp5892mesh"); }
   return 0;
 }

@@ -23,8 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<uint8_t> out(count * stride);
   try {
     gltf::decodeMeshopt(src, count, stride, modes[pick % 3], filters[(pick / 3) % 4], out);
-  } catch (const Error&) {
-  }
+  } catch (const Error&) {}
   static const bool draco = std::getenv("RTR_FUZZ_DRACO") != nullptr;
   if (!draco) return 0;
   try {
@@ -33,7 +32,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (uint32_t i : m.indices) fuzz::require(i < m.vertexCount, "draco: index out of range");
     for (const gltf::DracoAttribute& a : m.attributes)
       fuzz::require(a.values.size() == size_t(m.vertexCount) * size_t(a.components), "draco: attribute size");
-  } catch (const Error&) {
-  }
+  } catch (const Error&) {}
   return 0;
 }

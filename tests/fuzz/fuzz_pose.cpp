@@ -14,9 +14,7 @@ void check(const std::string& text) {
   rtr::CameraPose p;
   try {
     p = rtr::parsePose(text);
-  } catch (const rtr::Error&) {
-    return;
-  }
+  } catch (const rtr::Error&) { return; }
   const float v[] = {p.position.x, p.position.y, p.position.z, p.yawDeg, p.pitchDeg};
   for (float f : v) require(std::isfinite(f), "a parsed pose is not finite");
   const rtr::CameraPose q = rtr::parsePose(rtr::formatPose(p));

@@ -31,8 +31,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         [&](const std::string& warning) {
           fuzz::require(warning.find(path) != std::string::npos, "the warning does not name the file");
         });
-  } catch (const Error& e) {
-    fuzz::requireNamesFile(e, path.c_str());
-  }
+  } catch (const Error& e) { fuzz::requireNamesFile(e, path.c_str()); }
   return 0;
 }

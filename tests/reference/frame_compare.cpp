@@ -38,22 +38,23 @@ int main(int argc, char** argv) {
     const auto poses = loadPoses(posesFile());
     if (cases.empty())
       for (const auto& [name, pose] : poses) cases.push_back(name);
-    const std::filesystem::path work = out.empty() ? std::filesystem::temp_directory_path() / "rtr-frame-compare"
-                                                   : std::filesystem::path(out);
+    const std::filesystem::path work =
+        out.empty() ? std::filesystem::temp_directory_path() / "rtr-frame-compare" : std::filesystem::path(out);
     std::filesystem::create_directories(work);
     const Limits lim = limits(View::Shaded);
-    std::printf("| case | size | GPU frame ms (median of %d) | CPU trace ms (%u threads) | CPU / GPU | CPU Mrays/s "
-                "| mean error | max error | failing %% (> %d steps) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
-                frames, threads, lim.threshold);
+    std::printf(
+        "| case | size | GPU frame ms (median of %d) | CPU trace ms (%u threads) | CPU / GPU | CPU Mrays/s "
+        "| mean error | max error | failing %% (> %d steps) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+        frames, threads, lim.threshold);
     for (const std::string& name : cases) {
       if (!poses.count(name)) throw Error(posesFile().string() + ": no case named '" + name + "'");
       const ReferenceScene rs = makeScene(name, work);
-      const CasePair p = renderPair(ctx, rs, poses.at(name), View::Shaded,
-                                    {.width = w, .height = h, .threads = threads, .benchFrames = frames});
+      const CasePair p =
+          renderPair(ctx, rs, poses.at(name), View::Shaded, {.width = w, .height = h, .threads = threads, .benchFrames = frames});
       const CompareResult r = compareEdgeTolerant(p.gpu, p.cpu, lim.threshold);
-      std::printf("| %s | %ux%u | %.3f | %.1f | %.0f× | %.2f | %.3f | %.0f | %.3f |\n", name.c_str(), w, h,
-                  p.gpuMs, p.cpuMs, p.cpuMs / p.gpuMs, double(p.cpuRays) / (p.cpuMs * 1e3), r.meanAbsError,
-                  r.maxAbsError, 100.0 * r.failingFraction);
+      std::printf("| %s | %ux%u | %.3f | %.1f | %.0f× | %.2f | %.3f | %.0f | %.3f |\n", name.c_str(), w, h, p.gpuMs, p.cpuMs,
+                  p.cpuMs / p.gpuMs, double(p.cpuRays) / (p.cpuMs * 1e3), r.meanAbsError, r.maxAbsError,
+                  100.0 * r.failingFraction);
       std::fflush(stdout);
       if (!out.empty()) {
         savePng(work / (name + "_gpu.png"), p.gpu);

@@ -46,16 +46,16 @@ std::filesystem::path outDir() {
   return d;
 }
 
-CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const PoseEntry& pe, View view,
-                    const PairOptions& o) {
+CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const PoseEntry& pe, View view, const PairOptions& o) {
   const std::optional<std::filesystem::path>& shaderDir = o.shaderDir;
   trace::TraceSettings ts;
   ts.width = o.width;
   ts.height = o.height;
   ts.pose = pe.pose;
   ts.lens.fovYDeg = pe.fovYDeg;
-  ts.shading = view == View::Shaded ? trace::Shading::Pbr : view == View::Normals ? trace::Shading::Normals
-                                                                                   : trace::Shading::Depth;
+  ts.shading = view == View::Shaded    ? trace::Shading::Pbr
+               : view == View::Normals ? trace::Shading::Normals
+                                       : trace::Shading::Depth;
   ts.shadows = false;  // the GPU renderer has no shadows
   ts.bounces = 0;      // nor reflections
   ts.threads = o.threads;
@@ -128,9 +128,9 @@ void writeOutputs(const std::string& id, const CasePair& pair, const CompareResu
   savePng(d / (id + "_err.png"), r.errorMap);
   char line[256];
   std::snprintf(line, sizeof line,
-                "%-24s threshold %d  failing %6.3f%% (limit %.2f%%)  mean %.3f  max %3.0f  max(passing) %2.0f\n",
-                id.c_str(), lim.threshold, 100.0 * r.failingFraction, 100.0 * lim.maxFailingFraction,
-                r.meanAbsError, r.maxAbsError, r.maxAbsErrorPassing);
+                "%-24s threshold %d  failing %6.3f%% (limit %.2f%%)  mean %.3f  max %3.0f  max(passing) %2.0f\n", id.c_str(),
+                lim.threshold, 100.0 * r.failingFraction, 100.0 * lim.maxFailingFraction, r.meanAbsError, r.maxAbsError,
+                r.maxAbsErrorPassing);
   std::ofstream(d / (id + ".txt")) << line;
   std::fputs(line, stdout);
 }

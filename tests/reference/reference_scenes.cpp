@@ -181,11 +181,9 @@ std::map<std::string, PoseEntry> loadPoses(const std::filesystem::path& file) {
     if (!(e.fovYDeg > 1.0f && e.fovYDeg < 179.0f)) throw fileError(file.string(), place, "fovY out of range");
     try {
       e.pose = parsePose(pose);
-    } catch (const Error& err) {
-      throw fileError(file.string(), place, err.what());
-    }
+    } catch (const Error& err) { throw fileError(file.string(), place, err.what()); }
     e.comment = line.substr(line.find_first_not_of("# \t", hash) == std::string::npos ? line.size()
-                                                                                       : line.find_first_not_of("# \t", hash));
+                                                                                      : line.find_first_not_of("# \t", hash));
     if (e.comment.empty()) throw fileError(file.string(), place, "empty comment");
     if (!out.emplace(name, e).second) throw fileError(file.string(), place, "case '" + name + "' repeated");
   }
@@ -271,8 +269,9 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
     if (name == "headlight") return ownLights(std::move(s));  // no lights of its own: the default headlight
     const bool falloff = name.ends_with("_falloff");
     const float k = falloff ? 20.0f : 1.0f;  // about the squared distance to the spheres
-    r.lights = pointLights({{{3.0f, 3.0f, -1.0f}, k * glm::vec3(1.2f, 1.0f, 0.8f)},
-                            {{-3.5f, 1.5f, -2.0f}, k * glm::vec3(0.3f, 0.4f, 0.6f)}}, falloff);
+    r.lights = pointLights(
+        {{{3.0f, 3.0f, -1.0f}, k * glm::vec3(1.2f, 1.0f, 0.8f)}, {{-3.5f, 1.5f, -2.0f}, k * glm::vec3(0.3f, 0.4f, 0.6f)}},
+        falloff);
     return r;
   }
   if (name == "rough0_patch") {
@@ -294,9 +293,9 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
     // read through Texture::sourceChannel), a GGX sphere beside it, on a floor.
     s.materials.push_back(gltfMaterial("floor", {0.5f, 0.5f, 0.5f}, 0.7f, 0.0f));
     Material q = gltfMaterial("metal_rough", glm::vec3(1.0f), 1.0f, 1.0f);
-    q.textures[uint32_t(TextureSlot::BaseColor)] = addPng(s, workDir, "mr_base", 8, 8, [](uint32_t x, uint32_t y) {
-      return glm::u8vec4(200 - 20 * x, 120 + 15 * y, 60 + 10 * (x + y), 255);
-    }, true);
+    q.textures[uint32_t(TextureSlot::BaseColor)] = addPng(
+        s, workDir, "mr_base", 8, 8,
+        [](uint32_t x, uint32_t y) { return glm::u8vec4(200 - 20 * x, 120 + 15 * y, 60 + 10 * (x + y), 255); }, true);
     auto packed = [](uint32_t x, uint32_t y) { return glm::u8vec4(255, 20 + 30 * x, y < 4 ? 255 : 0, 255); };
     q.textures[uint32_t(TextureSlot::Roughness)] = addPng(s, workDir, "mr_packed", 8, 8, packed, false, 1, 2);
     Texture metal = s.textures.back();  // the same image, its blue channel
@@ -316,9 +315,9 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
     s.materials.push_back(gltfMaterial("floor", {0.5f, 0.5f, 0.5f}, 0.7f, 0.0f));
     Material e = gltfMaterial("glow", {0.05f, 0.05f, 0.05f}, 0.6f, 0.0f);
     e.emissive = {2.5f, 1.2f, 0.3f};
-    e.textures[uint32_t(TextureSlot::Emissive)] = addPng(s, workDir, "glow", 8, 8, [](uint32_t x, uint32_t y) {
-      return glm::u8vec4((x + y) % 2 ? 255 : 90, 60 + 25 * x, 40 + 20 * y, 255);
-    }, true);
+    e.textures[uint32_t(TextureSlot::Emissive)] = addPng(
+        s, workDir, "glow", 8, 8,
+        [](uint32_t x, uint32_t y) { return glm::u8vec4((x + y) % 2 ? 255 : 90, 60 + 25 * x, 40 + 20 * y, 255); }, true);
     s.materials.push_back(e);
     s.meshes.push_back(grid("floor", 0, {-4, -1, 0}, {8, 0, 0}, {0, 0, -8}, 8, 8, false));
     s.meshes.push_back(grid("panel", 1, {-1.5f, -0.8f, -4.0f}, {3.0f, 0, 0}, {0, 1.8f, 0}, 8, 8, true));
@@ -393,17 +392,20 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
     Material m = gltfMaterial("panel", {0.8f, 0.7f, 0.5f}, 0.4f, 0.0f);
     Mesh panel = grid("panel", 1, {-1.5f, -0.8f, -4.0f}, {3.0f, 0, 0}, {0, 1.8f, 0}, 8, 8, true);
     if (name == "gltf_normal_map") {
-      m.textures[uint32_t(TextureSlot::NormalMap)] = addPng(s, workDir, "bumps", 16, 16, [](uint32_t x, uint32_t y) {
-        const float nx = 0.5f * std::sin(float(x) * 0.8f), ny = 0.5f * std::cos(float(y) * 0.8f);
-        const float nz = std::sqrt(std::max(0.0f, 1.0f - nx * nx - ny * ny));
-        return glm::u8vec4(uint8_t(127.5f + 127.5f * nx), uint8_t(127.5f + 127.5f * ny), uint8_t(127.5f + 127.5f * nz), 255);
-      }, false);
+      m.textures[uint32_t(TextureSlot::NormalMap)] = addPng(
+          s, workDir, "bumps", 16, 16,
+          [](uint32_t x, uint32_t y) {
+            const float nx = 0.5f * std::sin(float(x) * 0.8f), ny = 0.5f * std::cos(float(y) * 0.8f);
+            const float nz = std::sqrt(std::max(0.0f, 1.0f - nx * nx - ny * ny));
+            return glm::u8vec4(uint8_t(127.5f + 127.5f * nx), uint8_t(127.5f + 127.5f * ny), uint8_t(127.5f + 127.5f * nz), 255);
+          },
+          false);
       m.normalScale = 0.8f;
       panel.tangents.assign(panel.positions.size(), glm::vec4(1, 0, 0, 1));
     } else {
-      m.textures[uint32_t(TextureSlot::BaseColor)] = addPng(s, workDir, "stripes", 8, 8, [](uint32_t x, uint32_t y) {
-        return glm::u8vec4(40 + 25 * x, 200 - 20 * y, (x + y) % 3 ? 220 : 30, 255);
-      }, true);
+      m.textures[uint32_t(TextureSlot::BaseColor)] = addPng(
+          s, workDir, "stripes", 8, 8,
+          [](uint32_t x, uint32_t y) { return glm::u8vec4(40 + 25 * x, 200 - 20 * y, (x + y) % 3 ? 220 : 30, 255); }, true);
       UvTransform& t = m.uv[uint32_t(TextureSlot::BaseColor)];
       t.offset = {0.3f, -0.2f};
       t.rotation = 0.4f;

@@ -17,11 +17,27 @@
 namespace rtr::reftest {
 namespace {
 
-const char* const kCases[] = {"temple_nave",   "temple_aisle",  "cornell_box",   "cube_backplane",
-                              "grazing_floor", "metal_sphere",  "rough0_patch",  "backface_quad",
-                              "temple_nave_textured", "temple_aisle_textured", "cube_backplane_falloff",
-                              "two_lights", "two_lights_falloff", "headlight", "gltf_metal_rough", "gltf_emissive",
-                              "gltf_spot", "gltf_alpha_mask", "gltf_blend", "gltf_normal_map", "gltf_texture_transform"};
+const char* const kCases[] = {"temple_nave",
+                              "temple_aisle",
+                              "cornell_box",
+                              "cube_backplane",
+                              "grazing_floor",
+                              "metal_sphere",
+                              "rough0_patch",
+                              "backface_quad",
+                              "temple_nave_textured",
+                              "temple_aisle_textured",
+                              "cube_backplane_falloff",
+                              "two_lights",
+                              "two_lights_falloff",
+                              "headlight",
+                              "gltf_metal_rough",
+                              "gltf_emissive",
+                              "gltf_spot",
+                              "gltf_alpha_mask",
+                              "gltf_blend",
+                              "gltf_normal_map",
+                              "gltf_texture_transform"};
 
 // The shaded view runs once per visibility rasteriser (the debug views are forward: no ids).
 struct Param {
@@ -77,9 +93,7 @@ TEST_P(ReferenceTest, GpuMatchesCpu) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, ReferenceTest, ::testing::ValuesIn(allParams()),
-                         [](const ::testing::TestParamInfo<Param>& i) {
-                           return i.param.label();
-                         });
+                         [](const ::testing::TestParamInfo<Param>& i) { return i.param.label(); });
 
 // Every case in poses.txt is run, every run case has a pose, and each has its comment.
 TEST(ReferencePoses, FileAndCasesAgree) {

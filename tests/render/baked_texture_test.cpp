@@ -51,7 +51,8 @@ TEST_F(VulkanTest, BakedTexturesDrawWhatTheImagePathDraws) {
   const render::GpuScene b(*ctx, baked, render::MipMode::Compute);
   EXPECT_EQ(ctx->pipelineCache().stats().created, before) << "a mip pipeline was made for baked textures";
   EXPECT_EQ(b.stats().mipGpuMs, 0.0) << "a mip pass ran";
-  render::GpuScene deferred(*ctx, baked, render::MipMode::Compute, {}, render::GeometryUpload::Auto, render::TextureLoad::Deferred);
+  render::GpuScene deferred(*ctx, baked, render::MipMode::Compute, {}, render::GeometryUpload::Auto,
+                            render::TextureLoad::Deferred);
   deferred.updateTextures(true);
   const render::GpuScene compute(*ctx, files, render::MipMode::Compute), host(*ctx, files, render::MipMode::Auto);
   render::HeadlessRenderer rb(*ctx, b, {kW, kH}), rd(*ctx, deferred, {kW, kH}), rc(*ctx, compute, {kW, kH}),
@@ -67,8 +68,8 @@ TEST_F(VulkanTest, BakedTexturesDrawWhatTheImagePathDraws) {
         worst = std::max(worst, std::abs(int(x.pixels[i]) - int(y.pixels[i])));
         differ += x.pixels[i] != y.pixels[i];
       }
-      std::printf("baked vs %s mips, view %d: %zu of %zu bytes differ, by at most %d\n", other == &rc ? "compute" : "auto",
-                  mode, differ, x.pixels.size(), worst);
+      std::printf("baked vs %s mips, view %d: %zu of %zu bytes differ, by at most %d\n", other == &rc ? "compute" : "auto", mode,
+                  differ, x.pixels.size(), worst);
       if (mode == VIEW_MIP_LEVEL) EXPECT_EQ(differ, 0u) << "the same levels are sampled";
       EXPECT_LE(worst, 3) << "mode " << mode;
       EXPECT_LT(differ, x.pixels.size() / 10) << "mode " << mode;
@@ -98,7 +99,8 @@ TEST_F(VulkanTest, BlockCompressedTexturesDrawNearTheLosslessOnes) {
   EXPECT_GT(error[0].sumAbs, 0.0) << "BC is lossy";
   const CameraPose pose = *files.defaultView;
   const Lens lens = fitDepthRange(Lens{}, files.bounds(), pose);
-  const render::GpuScene lossless(*ctx, plan.scene, render::MipMode::Compute), blocks(*ctx, bcPlan.scene, render::MipMode::Compute);
+  const render::GpuScene lossless(*ctx, plan.scene, render::MipMode::Compute),
+      blocks(*ctx, bcPlan.scene, render::MipMode::Compute);
   EXPECT_EQ(blocks.stats().mipGpuMs, 0.0) << "a mip pass ran";
   render::HeadlessRenderer a(*ctx, lossless, {kW, kH}), b(*ctx, blocks, {kW, kH});
   for (int mode : {VIEW_ALBEDO, VIEW_SHADED, VIEW_MIP_LEVEL}) {
@@ -109,7 +111,8 @@ TEST_F(VulkanTest, BlockCompressedTexturesDrawNearTheLosslessOnes) {
       sum += std::abs(int(x.pixels[i]) - int(y.pixels[i]));
       differ += x.pixels[i] != y.pixels[i];
     }
-    std::printf("bc vs lossless, view %d: %zu of %zu bytes differ, mean %.3f LSB\n", mode, differ, x.pixels.size(), sum / double(x.pixels.size()));
+    std::printf("bc vs lossless, view %d: %zu of %zu bytes differ, mean %.3f LSB\n", mode, differ, x.pixels.size(),
+                sum / double(x.pixels.size()));
     // The same levels are sampled, but where BC3's alpha moves an alpha-tested edge (a few pixels).
     if (mode == VIEW_MIP_LEVEL) EXPECT_LT(differ, x.pixels.size() / 1000);
     else EXPECT_GT(differ, 0u) << "mode " << mode << ": BC textures were not used";

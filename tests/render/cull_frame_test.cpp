@@ -33,12 +33,11 @@ TEST_F(CullFrameTest, CulledFramesEqualUnculledOnesAlongACameraPath) {
 
   const Bounds b = scene.bounds();
   const CameraPose inside = scene.defaultView.value_or(CameraPose{b.center(), 0, 0});
-  std::vector<CameraPose> path = {orbitFrame(b, Lens{}, aspect, 200.0f, -5.0f),  // no history yet
-                                  orbitFrame(b, Lens{}, aspect, 200.0f, -5.0f),  // the same again
-                                  orbitFrame(b, Lens{}, aspect, 30.0f, -25.0f),
-                                  inside,
-                                  {inside.position, inside.yawDeg + 120.0f, inside.pitchDeg - 10.0f},
-                                  {inside.position, inside.yawDeg - 70.0f, -60.0f}};
+  std::vector<CameraPose> path = {
+      orbitFrame(b, Lens{}, aspect, 200.0f, -5.0f),  // no history yet
+      orbitFrame(b, Lens{}, aspect, 200.0f, -5.0f),  // the same again
+      orbitFrame(b, Lens{}, aspect, 30.0f, -25.0f),    inside, {inside.position, inside.yawDeg + 120.0f, inside.pitchDeg - 10.0f},
+      {inside.position, inside.yawDeg - 70.0f, -60.0f}};
   for (int step = 1; step <= 4; ++step)  // walking and turning, a little each frame
     path.push_back({inside.position + float(step) * glm::vec3(0.3f, 0.0f, 0.4f), inside.yawDeg + 10.0f * step, inside.pitchDeg});
   path.push_back(orbitFrame(b, Lens{}, aspect, 120.0f, -15.0f));
@@ -55,16 +54,14 @@ TEST_F(CullFrameTest, CulledFramesEqualUnculledOnesAlongACameraPath) {
     for (size_t i = 0; i < want.size(); ++i) differ += want[i] != got[i], covered += want[i] != VIS_EMPTY;
     EXPECT_EQ(differ, 0u) << "pixels whose id culling changed";
     EXPECT_EQ(imagesCulled.render(path[f], lens, on).image.pixels, reference.render(path[f], lens, off).image.pixels);
-    std::printf("culled frame %zu: %u clusters, early %u, late %u more; culled by frustum %u, cone %u, occlusion %u; "
-                "%zu px covered\n", f, c->clusters, c->early, c->late, c->frustum, c->cone, c->occlusion, covered);
+    std::printf(
+        "culled frame %zu: %u clusters, early %u, late %u more; culled by frustum %u, cone %u, occlusion %u; "
+        "%zu px covered\n",
+        f, c->clusters, c->early, c->late, c->frustum, c->cone, c->occlusion, covered);
     EXPECT_LE(c->early + c->late + c->frustum + c->cone, c->clusters + c->early) << "counted once per pass";
     EXPECT_LE(c->frustum + c->cone + c->occlusion, c->clusters);
-    if (f == 0) {
-      EXPECT_EQ(c->early, 0u) << "no history before the first frame";
-    }
-    if (f == 1) {
-      EXPECT_EQ(c->late, 0u) << "the same view again: the early phase drew all";
-    }
+    if (f == 0) { EXPECT_EQ(c->early, 0u) << "no history before the first frame"; }
+    if (f == 1) { EXPECT_EQ(c->late, 0u) << "the same view again: the early phase drew all"; }
     culled[0] += c->frustum, culled[1] += c->cone, culled[2] += c->occlusion;
   }
   // Every test must have culled something along the path, or equal frames prove little.

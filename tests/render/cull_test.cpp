@@ -104,7 +104,8 @@ class CullTest : public test::VulkanTest {
     std::memcpy(&r.counts, back.mapped(), 32);
     const uint32_t* ids = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(back.mapped()) + 32);
     EXPECT_LE(r.counts.listed, count);
-    for (uint32_t i = 0; i < std::min(r.counts.listed, count); ++i) EXPECT_TRUE(r.visible.insert(ids[i]).second) << "listed twice";
+    for (uint32_t i = 0; i < std::min(r.counts.listed, count); ++i)
+      EXPECT_TRUE(r.visible.insert(ids[i]).second) << "listed twice";
     // One workgroup per entry: {listed, 1, 1}, or two-dimensional past the device's (or 65 535) groups in x.
     const uint32_t maxX = std::min(ctx->properties().limits.maxComputeWorkGroupCount[0], 65535u);
     if (r.counts.listed <= maxX) {
@@ -138,11 +139,13 @@ class CullTest : public test::VulkanTest {
     vk::Buffer back(*ctx, total * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "pyramid back");
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
       auto layout = [&](VkImageLayout from, VkImageLayout to) {
-        vk::barrier(cb, {{p.image().handle(), from, to, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                          VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT}});
+        vk::barrier(cb, {{p.image().handle(), from, to, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+                          VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT}});
       };
       layout(VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-      vkCmdCopyImageToBuffer(cb, p.image().handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.handle(), uint32_t(regions.size()), regions.data());
+      vkCmdCopyImageToBuffer(cb, p.image().handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, back.handle(),
+                             uint32_t(regions.size()), regions.data());
       layout(VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
       vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     });
@@ -169,9 +172,11 @@ TEST_F(CullTest, GpuMatchesCpuForRandomClustersAndCameras) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   std::vector<float> depth(size_t(e.width) * e.height);
   for (uint32_t y = 0; y < e.height; ++y)  // blocky depths: walls at various distances, some far background
-    for (uint32_t x = 0; x < e.width; ++x) depth[size_t(y) * e.width + x] = ((x / 13 + y / 7) % 5 == 0) ? 1.0f : 0.9f + 0.1f * float((x * 7 + y * 3) % 11) / 11.0f;
+    for (uint32_t x = 0; x < e.width; ++x)
+      depth[size_t(y) * e.width + x] = ((x / 13 + y / 7) % 5 == 0) ? 1.0f : 0.9f + 0.1f * float((x * 7 + y * 3) % 11) / 11.0f;
   for (float& d : depth) d = std::min(d, 0.9f + 0.1f * u(rng));
-  vk::Image depthImage(*ctx, {e, VK_FORMAT_R32_SFLOAT, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, 0, "depth"});
+  vk::Image depthImage(*ctx,
+                       {e, VK_FORMAT_R32_SFLOAT, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, 0, "depth"});
   vk::Buffer up(*ctx, depth.size() * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "depth up");
   std::memcpy(up.mapped(), depth.data(), depth.size() * 4);
   up.flush();
@@ -197,8 +202,9 @@ TEST_F(CullTest, GpuMatchesCpuForRandomClustersAndCameras) {
     const bool occlusion = view % 2 == 0;
     const GpuResult got = cull(culler, buf, kCount, cam, occlusion ? &pyramid : nullptr, [&](VkCommandBuffer cb) {
       if (!occlusion) return;
-      vk::barrier(cb, {{depthImage.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                        VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+      vk::barrier(
+          cb, {{depthImage.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
       VkBufferImageCopy r{};
       r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
       r.imageExtent = {e.width, e.height, 1};
@@ -225,7 +231,8 @@ TEST_F(CullTest, GpuMatchesCpuForRandomClustersAndCameras) {
       GpuCluster grown = clusters[i], shrunk = clusters[i];
       grown.sphere.w = grown.sphere.w * 1.0001f + 1e-5f;
       shrunk.sphere.w = shrunk.sphere.w * 0.9999f;
-      const bool edge = cpuCull(grown, cam, occlusion ? &host : nullptr, e) != cpuCull(shrunk, cam, occlusion ? &host : nullptr, e);
+      const bool edge =
+          cpuCull(grown, cam, occlusion ? &host : nullptr, e) != cpuCull(shrunk, cam, occlusion ? &host : nullptr, e);
       EXPECT_TRUE(edge) << "view " << view << " cluster " << i << ": CPU says reason " << r;
       ++borderline;
     }
@@ -237,8 +244,8 @@ TEST_F(CullTest, GpuMatchesCpuForRandomClustersAndCameras) {
   // Every test must have culled something, or the comparison proves little.
   for (uint32_t r = 1; r < 4; ++r) EXPECT_GT(byReason[r], 50u) << "reason " << r;
   EXPECT_GT(byReason[CULL_VISIBLE], 50u);
-  std::printf("random clusters over 6 views: visible %u, frustum %u, cone %u, occlusion %u, borderline %u\n",
-              byReason[0], byReason[1], byReason[2], byReason[3], borderline);
+  std::printf("random clusters over 6 views: visible %u, frustum %u, cone %u, occlusion %u, borderline %u\n", byReason[0],
+              byReason[1], byReason[2], byReason[3], borderline);
 }
 
 // Draws a scene's clusters with the hardware rasteriser (one vkCmdDrawIndexed per cluster, firstInstance
@@ -275,9 +282,12 @@ class IdRenderer {
       d.depthFormat = VK_FORMAT_D32_SFLOAT;
       pipelines_[twoSided] = vk::makeGraphicsPipeline(ctx, d);
     }
-    ids_ = vk::Image(ctx, {extent, VK_FORMAT_R32G32_UINT, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0, "ids"});
-    depth_ = vk::Image(ctx, {extent, VK_FORMAT_D32_SFLOAT, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, 0, 0, "depth"});
-    readback_ = vk::Buffer(ctx, size_t(extent.width) * extent.height * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "ids back");
+    ids_ = vk::Image(ctx, {extent, VK_FORMAT_R32G32_UINT, 1,
+                           VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0, "ids"});
+    depth_ = vk::Image(ctx, {extent, VK_FORMAT_D32_SFLOAT, 1,
+                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, 0, 0, "depth"});
+    readback_ = vk::Buffer(ctx, size_t(extent.width) * extent.height * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                           vk::MemoryUse::Readback, "ids back");
   }
   size_t clusterCount() const { return clusters_.size(); }
 
@@ -288,11 +298,13 @@ class IdRenderer {
     const VkAccessFlags2 rw = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
     vk::barrier(cb, {{ids_.handle(), clear ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                       VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, rw, VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
+                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, rw,
+                      VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
                      {depth_.handle(), clear ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                       VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                       VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, rw,
-                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, 0, 1, VK_IMAGE_ASPECT_DEPTH_BIT}});
+                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, 0, 1,
+                      VK_IMAGE_ASPECT_DEPTH_BIT}});
     VkRenderingAttachmentInfo color{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     color.imageView = ids_.view();
     color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
@@ -334,12 +346,13 @@ class IdRenderer {
       vkCmdDrawIndexed(cb, r.indexCount, 1, r.firstIndex, r.vertexOffset, r.firstTriangle);
     }
     vkCmdEndRendering(cb);
-    vk::barrier(cb, {{ids_.handle(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                      VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_TRANSFER_READ_BIT},
-                     {depth_.handle(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_SHADER_READ_BIT, 0, 1, VK_IMAGE_ASPECT_DEPTH_BIT}});
+    vk::barrier(cb,
+                {{ids_.handle(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_TRANSFER_READ_BIT},
+                 {depth_.handle(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_ACCESS_2_SHADER_READ_BIT, 0, 1, VK_IMAGE_ASPECT_DEPTH_BIT}});
     vk::copyImageToHost(cb, ids_.handle(), extent_, readback_.handle());
   }
   std::vector<uint64_t> ids() const {
@@ -351,8 +364,17 @@ class IdRenderer {
   VkImageView depthView() const { return depth_.view(); }
 
  private:
-  struct Range { uint32_t draw, firstIndex, indexCount; int32_t vertexOffset; uint32_t firstTriangle; bool twoSided; };
-  struct Push { glm::mat4 viewProj; uint32_t draw; uint32_t pad[3]; };
+  struct Range {
+    uint32_t draw, firstIndex, indexCount;
+    int32_t vertexOffset;
+    uint32_t firstTriangle;
+    bool twoSided;
+  };
+  struct Push {
+    glm::mat4 viewProj;
+    uint32_t draw;
+    uint32_t pad[3];
+  };
   const vk::Context& ctx_;
   VkExtent2D extent_;
   std::vector<Range> clusters_;
@@ -446,10 +468,13 @@ TEST_F(CullTest, TwoPhaseNeverRemovesAVisibleClusterWhileTheCameraMoves) {
     const GpuResult early = cull(culler, buf, n, cam, nullptr, {}, render::CullPhase::Early);
     std::vector<bool> keep(n, false);
     for (uint32_t i : early.visible) keep[i] = true;
-    const GpuResult late = cull(culler, buf, n, cam, &pyramid, [&](VkCommandBuffer cb) {
-      ids.record(cb, cam.viewProj, keep);
-      pyramid.build(cb, ids.depthView(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-    }, render::CullPhase::Late);
+    const GpuResult late = cull(
+        culler, buf, n, cam, &pyramid,
+        [&](VkCommandBuffer cb) {
+          ids.record(cb, cam.viewProj, keep);
+          pyramid.build(cb, ids.depthView(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        },
+        render::CullPhase::Late);
     std::vector<bool> more(n, false);
     for (uint32_t i : late.visible) {
       EXPECT_FALSE(keep[i]) << "cluster " << i << " listed by both phases";
@@ -461,19 +486,13 @@ TEST_F(CullTest, TwoPhaseNeverRemovesAVisibleClusterWhileTheCameraMoves) {
     for (size_t p = 0; p < all.size(); ++p) differing += all[p] != twoPhase[p];
     EXPECT_EQ(differing, 0u) << "two-phase culling removed visible clusters";
     std::printf("two-phase frame %zu: early %u, late %u more; late culled by frustum %u, cone %u, occlusion %u\n", f,
-                early.counts.listed, late.counts.listed, late.counts.culled[0], late.counts.culled[1],
-                late.counts.culled[2]);
-    if (f == 0) {
-      EXPECT_EQ(early.counts.listed, 0u) << "no history before the first frame";
-    }
-    if (f == 1) {
-      EXPECT_EQ(late.counts.listed, 0u) << "the same view again: the early phase drew everything";
-    }
+                early.counts.listed, late.counts.listed, late.counts.culled[0], late.counts.culled[1], late.counts.culled[2]);
+    if (f == 0) { EXPECT_EQ(early.counts.listed, 0u) << "no history before the first frame"; }
+    if (f == 1) { EXPECT_EQ(late.counts.listed, 0u) << "the same view again: the early phase drew everything"; }
     occluded += late.counts.culled[2];
   }
   EXPECT_GT(occluded, 0u) << "nothing occluded: the test proves nothing about occlusion";
 }
-
 
 // More visible clusters than one dimension of workgroups holds: the indirect dispatch goes two-dimensional
 // and the list still holds every cluster once.

@@ -37,7 +37,8 @@ class EnvironmentMapsTest : public VulkanTest {
     const uint32_t size = std::max(img.extent().width >> level, 1u), layers = img.desc().cube ? 6 : 1;
     const uint32_t height = std::max(img.extent().height >> level, 1u);
     const uint32_t channels = img.format() == VK_FORMAT_R16G16_SFLOAT ? 2 : 4;
-    vk::Buffer out(*ctx, size_t(size) * height * layers * channels * 2, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
+    vk::Buffer out(*ctx, size_t(size) * height * layers * channels * 2, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                   vk::MemoryUse::Readback);
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
       vk::require(cb, img.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
       VkBufferImageCopy r{};
@@ -111,7 +112,8 @@ TEST_F(EnvironmentMapsTest, SplitSumTableIsTheSharedFunction) {
       for (uint32_t x = 0; x < n; x += 3) {
         const glm::vec3 cpu = shader::envBrdfLut(brdf, (x + 0.5f) / n, (y + 0.5f) / n, maps.settings().lutSamples);
         const glm::vec4 g = lut[(size_t(brdf) * n + y) * n + x];
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(g[c], cpu[c], 2e-3f + 1e-3f * cpu[c]) << brdf << ": " << x << "," << y << " " << c;
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(g[c], cpu[c], 2e-3f + 1e-3f * cpu[c]) << brdf << ": " << x << "," << y << " " << c;
         EXPECT_LE(cpu.x + cpu.y, 1.0f + 1e-3f);  // F0 = 1 reflects at most all the light
       }
 }
@@ -169,7 +171,8 @@ TEST_F(EnvironmentMapsTest, SunlitSkyGivesFiniteLevelsThatKeepTheEnergy) {
   glm::dvec3 m0(0.0);
   const ImageF& map = env.map();
   for (uint32_t y = 0; y < map.height; ++y) {
-    const double o = 2 * M_PI / map.width * (std::cos(double(y) / map.height * M_PI) - std::cos(double(y + 1) / map.height * M_PI));
+    const double o =
+        2 * M_PI / map.width * (std::cos(double(y) / map.height * M_PI) - std::cos(double(y + 1) / map.height * M_PI));
     for (uint32_t x = 0; x < map.width; ++x) m0 += glm::dvec3(glm::vec3(map.at(x, y))) * o;
   }
   m0 /= 4 * M_PI;

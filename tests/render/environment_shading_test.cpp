@@ -105,7 +105,8 @@ struct Path {
   render::RasterPath raster;
 };
 std::vector<Path> paths() {
-  return {{render::ShadingPath::Forward, render::RasterPath::Auto}, {render::ShadingPath::Visibility, render::RasterPath::Hardware}};
+  return {{render::ShadingPath::Forward, render::RasterPath::Auto},
+          {render::ShadingPath::Visibility, render::RasterPath::Hardware}};
 }
 
 render::RenderSettings envSettings(Path p, int brdf) {
@@ -126,7 +127,10 @@ class EnvironmentShadingTest : public test::VulkanTest {};
 
 // Where pixel (x, y)'s ray through its centre meets the grid's analytic spheres: the sphere (row * kCols +
 // col) and n.v there; none: -1.
-struct Hit { int sphere = -1; float nv = 0.0f; };
+struct Hit {
+  int sphere = -1;
+  float nv = 0.0f;
+};
 Hit hitOf(const View& v, uint32_t x, uint32_t y) {
   const glm::mat4 inv = glm::inverse(v.viewProj);
   const glm::vec4 h = inv * glm::vec4(2.0f * (x + 0.5f) / kE.width - 1.0f, 2.0f * (y + 0.5f) / kE.height - 1.0f, 0.5f, 1.0f);
@@ -176,7 +180,8 @@ TEST_F(EnvironmentShadingTest, WhiteFurnaceReflectsAtMostWhatComesIn) {
         (row ? metalMax : dielectricMax) = std::max(row ? metalMax : dielectricMax, value);
         if (h.nv < 0.15f) continue;  // the silhouette: the mesh's normals are not the sphere's there
         const glm::vec3 abc = shader::envBrdfLut(brdf, h.nv, roughnessOf(h.sphere % kCols), 1024);
-        const float want = shader::envSplitSum(brdf, glm::vec3(shader::BRDF_PI), glm::vec3(1.0f), abc, glm::vec3(1.0f), float(row)).g;
+        const float want =
+            shader::envSplitSum(brdf, glm::vec3(shader::BRDF_PI), glm::vec3(1.0f), abc, glm::vec3(1.0f), float(row)).g;
         worstErr = std::max(worstErr, std::abs(px.g - want));
         off += std::abs(px.g - want) > 0.03f;
       }
@@ -184,9 +189,10 @@ TEST_F(EnvironmentShadingTest, WhiteFurnaceReflectsAtMostWhatComesIn) {
       EXPECT_EQ(off, 0u) << "pixels off the BRDF's albedo by more than 0.03 (worst " << worstErr << ")";
       EXPECT_LE(metalMax, 1.01f);
       EXPECT_LE(dielectricMax, 1.9f);  // brdf.h's own albedo: 1.03 at n.v = 0.5, 1.55 at 0.1, 1.89 at 0 (roughness 0)
-      std::printf("furnace %s %s: brightest metal %.4f, dielectric %.4f; largest difference to the albedo %.4f;\n"
-                  "  the sphere centres (1 - value: the energy lost):\n",
-                  brdf == BRDF_GGX ? "ggx" : "beckmann", enumName(p.shading), metalMax, dielectricMax, worstErr);
+      std::printf(
+          "furnace %s %s: brightest metal %.4f, dielectric %.4f; largest difference to the albedo %.4f;\n"
+          "  the sphere centres (1 - value: the energy lost):\n",
+          brdf == BRDF_GGX ? "ggx" : "beckmann", enumName(p.shading), metalMax, dielectricMax, worstErr);
       for (int row = 0; row < 2; ++row) {
         std::printf("  metal %d:", row);
         for (int col = 0; col < kCols; ++col) {
@@ -315,7 +321,7 @@ TEST_F(EnvironmentShadingTest, EnvironmentLightsABlackModel) {
         continue;
       }
       ++model;
-      EXPECT_EQ(dark.pixels[i].g, 0.0f);  // black on grey
+      EXPECT_EQ(dark.pixels[i].g, 0.0f);    // black on grey
       litModel += lit.pixels[i].g > 0.01f;  // F0 A + B of radiance 2: 0.03 at roughness 1, more elsewhere
     }
     EXPECT_GT(model, dark.pixels.size() / 20);

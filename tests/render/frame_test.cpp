@@ -36,9 +36,8 @@ class FrameTest : public test::VulkanTest {
     gpu.reset();
     VulkanTest::TearDown();
   }
-  render::HeadlessFrame render(int mode, bool readColor = false,
-                               render::ShadingPath path = render::ShadingPath::Visibility, float lodBias = 0.0f,
-                               render::RasterPath raster = render::RasterPath::Auto) {
+  render::HeadlessFrame render(int mode, bool readColor = false, render::ShadingPath path = render::ShadingPath::Visibility,
+                               float lodBias = 0.0f, render::RasterPath raster = render::RasterPath::Auto) {
     RenderSettings s;
     s.raster = raster;
     s.mode = mode;
@@ -96,7 +95,8 @@ TEST_F(FrameTest, DrawsGoNearestFirst) {
   // The centres are the meshes' own: the nearest draw is the one whose mesh's box centre is nearest.
   float nearest = 1e30f;
   for (const Mesh& m : scene.meshes)
-    if (!m.indices.empty() && m.material == order.front()->material) nearest = std::min(nearest, glm::length(m.bounds.center() - pose.position));
+    if (!m.indices.empty() && m.material == order.front()->material)
+      nearest = std::min(nearest, glm::length(m.bounds.center() - pose.position));
   EXPECT_FLOAT_EQ(dist(order.front()), nearest);
   // Equal distances keep their order.
   std::vector<render::DrawItem> tied(3);
@@ -113,28 +113,26 @@ TEST_F(FrameTest, DrawsGoNearestFirst) {
 // where another triangle (or the background) shows: the bound on all pixels holds for hardware ids only.
 TEST_F(FrameTest, VisibilityPathMatchesForward) {
   for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
-  for (float bias : {0.0f, 1.5f}) {
-    SCOPED_TRACE(testing::Message() << "LOD bias " << bias << ", " << rtr::enumName(raster) << " raster");
-    auto fwd = render(VIEW_SHADED, false, render::ShadingPath::Forward, bias);
-    auto vis = render(VIEW_SHADED, false, render::ShadingPath::Visibility, bias, raster);
-    ASSERT_TRUE(ranPass(vis, "shade") && !ranPass(fwd, "shade"));
-    size_t over = 0, lit = 0;
-    int worst = 0;
-    for (size_t i = 0; i < fwd.image.pixels.size(); i += 4) {
-      int d = 0;
-      for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(fwd.image.pixels[i + c]) - int(vis.image.pixels[i + c])));
-      worst = std::max(worst, d);
-      over += d > 3;
-      lit += fwd.image.pixels[i] + fwd.image.pixels[i + 1] + fwd.image.pixels[i + 2] > 0;
+    for (float bias : {0.0f, 1.5f}) {
+      SCOPED_TRACE(testing::Message() << "LOD bias " << bias << ", " << rtr::enumName(raster) << " raster");
+      auto fwd = render(VIEW_SHADED, false, render::ShadingPath::Forward, bias);
+      auto vis = render(VIEW_SHADED, false, render::ShadingPath::Visibility, bias, raster);
+      ASSERT_TRUE(ranPass(vis, "shade") && !ranPass(fwd, "shade"));
+      size_t over = 0, lit = 0;
+      int worst = 0;
+      for (size_t i = 0; i < fwd.image.pixels.size(); i += 4) {
+        int d = 0;
+        for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(fwd.image.pixels[i + c]) - int(vis.image.pixels[i + c])));
+        worst = std::max(worst, d);
+        over += d > 3;
+        lit += fwd.image.pixels[i] + fwd.image.pixels[i + 1] + fwd.image.pixels[i + 2] > 0;
+      }
+      const size_t n = fwd.image.pixels.size() / 4;
+      std::printf("bias %.1f: %zu of %zu pixels differ by more than 3, worst %d\n", bias, over, n, worst);
+      EXPECT_GT(lit, n / 2) << "comparing mostly black images proves nothing";
+      EXPECT_LE(over, n / 200);
+      if (raster == render::RasterPath::Hardware) { EXPECT_LE(worst, 24); }
     }
-    const size_t n = fwd.image.pixels.size() / 4;
-    std::printf("bias %.1f: %zu of %zu pixels differ by more than 3, worst %d\n", bias, over, n, worst);
-    EXPECT_GT(lit, n / 2) << "comparing mostly black images proves nothing";
-    EXPECT_LE(over, n / 200);
-    if (raster == render::RasterPath::Hardware) {
-      EXPECT_LE(worst, 24);
-    }
-  }
 }
 
 // Along the image's centre column, the bottom 35% is floor: linear depth grows toward the horizon.
@@ -195,8 +193,9 @@ std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::M
   if (vis && computeIds) out.clear();
   if (vis) {
     if (!computeIds)
-      out.push_back("visibility: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> "
-                  "COMPUTE_SHADER/SHADER_SAMPLED_READ");
+      out.push_back(
+          "visibility: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> "
+          "COMPUTE_SHADER/SHADER_SAMPLED_READ");
     out.push_back("scene colour: UNDEFINED -> GENERAL, " + postRead + "/NONE -> COMPUTE_SHADER/SHADER_STORAGE_WRITE");
     out.push_back("scene colour: GENERAL -> SHADER_READ_ONLY, COMPUTE_SHADER/SHADER_STORAGE_WRITE -> " + postRead +
                   "/SHADER_SAMPLED_READ");
@@ -214,24 +213,24 @@ std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::M
 TEST_F(FrameTest, OneFrameRecordsExactlyTheBarriersItNeeds) {
   for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility})
     for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
-    for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics})
-    for (bool cull : {true, false}) {
-      SCOPED_TRACE(std::string(rtr::enumName(path)) + ", mosaic " + rtr::enumName(mosaic) + ", " +
-                   rtr::enumName(raster) + " raster, cull " + (cull ? "on" : "off"));
-      RenderSettings s;
-      s.cull = cull;
-      s.shading = path;
-      s.mosaic = mosaic;
-      s.raster = raster;
-      renderer->render(pose, lens, s);  // the previous frame, read back like the next
-      vk::beginBarrierLog();
-      renderer->render(pose, lens, s);
-      const std::vector<std::string> got = vk::endBarrierLog();
-      const std::vector<std::string> want = steadyFrameBarriers(path, mosaic, raster == render::RasterPath::Compute);
-      EXPECT_EQ(got.size(), want.size());
-      for (size_t i = 0; i < std::max(got.size(), want.size()); ++i)
-        EXPECT_EQ(i < got.size() ? got[i] : "(none)", i < want.size() ? want[i] : "(none)") << "barrier " << i;
-    }
+      for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics})
+        for (bool cull : {true, false}) {
+          SCOPED_TRACE(std::string(rtr::enumName(path)) + ", mosaic " + rtr::enumName(mosaic) + ", " + rtr::enumName(raster) +
+                       " raster, cull " + (cull ? "on" : "off"));
+          RenderSettings s;
+          s.cull = cull;
+          s.shading = path;
+          s.mosaic = mosaic;
+          s.raster = raster;
+          renderer->render(pose, lens, s);  // the previous frame, read back like the next
+          vk::beginBarrierLog();
+          renderer->render(pose, lens, s);
+          const std::vector<std::string> got = vk::endBarrierLog();
+          const std::vector<std::string> want = steadyFrameBarriers(path, mosaic, raster == render::RasterPath::Compute);
+          EXPECT_EQ(got.size(), want.size());
+          for (size_t i = 0; i < std::max(got.size(), want.size()); ++i)
+            EXPECT_EQ(i < got.size() ? got[i] : "(none)", i < want.size() ? want[i] : "(none)") << "barrier " << i;
+        }
 }
 
 }  // namespace

@@ -85,7 +85,9 @@ TEST_F(VulkanTest, GltfCutoffUnlitAndOcclusionInEveryPath) {
     lens.fovYDeg = 60.0f;
     const CameraPose pose{{0, 0, 3.0f}, 0.0f, 0.0f};
     // Pixel columns of the quads' centres: x = -1.1, 0 and 1.1 at distance 3 under a 60° field of view.
-    auto column = [](float x) { return uint32_t(std::lround((0.5f + 0.5f * x / (3.0f * std::tan(glm::radians(30.0f)))) * kSize)); };
+    auto column = [](float x) {
+      return uint32_t(std::lround((0.5f + 0.5f * x / (3.0f * std::tan(glm::radians(30.0f)))) * kSize));
+    };
     for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
                                 {render::ShadingPath::Visibility, render::RasterPath::Hardware},
                                 {render::ShadingPath::Visibility, render::RasterPath::Compute}}) {
@@ -215,7 +217,9 @@ TEST_F(VulkanTest, VertexColoursTextureTransformAndNormalMapInEveryPath) {
     Lens lens;
     lens.fovYDeg = 60.0f;
     const CameraPose pose{{0, 0, 3.0f}, 0.0f, 0.0f};
-    auto column = [](float x) { return uint32_t(std::lround((0.5f + 0.5f * x / (3.0f * std::tan(glm::radians(30.0f)))) * kSize)); };
+    auto column = [](float x) {
+      return uint32_t(std::lround((0.5f + 0.5f * x / (3.0f * std::tan(glm::radians(30.0f)))) * kSize));
+    };
     const uint32_t y = kSize / 2;
     for (auto [path, raster] : {std::pair{render::ShadingPath::Forward, render::RasterPath::Auto},
                                 {render::ShadingPath::Visibility, render::RasterPath::Hardware},
@@ -232,7 +236,8 @@ TEST_F(VulkanTest, VertexColoursTextureTransformAndNormalMapInEveryPath) {
       EXPECT_GT(left.b, 0.9f) << "the texture transform's offset was not applied";
       EXPECT_LT(left.r, 0.1f);
       // Lambert under a light along the flat normal: the bent one (45°) gets cos 45° of it.
-      const float bentR = f.sceneColor.pixels[y * kSize + column(1.1f)].r, flatR = g.sceneColor.pixels[y * kSize + column(1.1f)].r;
+      const float bentR = f.sceneColor.pixels[y * kSize + column(1.1f)].r,
+                  flatR = g.sceneColor.pixels[y * kSize + column(1.1f)].r;
       EXPECT_GT(flatR, 0.1f);
       EXPECT_NEAR(bentR / flatR, 0.707f, 0.08f) << "the normal map did not bend the normal";
     }

@@ -56,10 +56,12 @@ Scene instancedScene() {
   for (int i = 0; i < 20; ++i) {
     glm::mat4 t(1.0f);
     t = glm::translate(t, glm::vec3(float(i % 5) * 3.0f - 6.0f, float(i / 5) * 3.0f - 4.5f, float(i % 3) - 1.0f));
-    if (i % 4 == 1) t = t * glm::mat4(glm::vec4(0, 0, -1, 0), glm::vec4(0, 1, 0, 0), glm::vec4(1, 0, 0, 0), glm::vec4(0, 0, 0, 1));
+    if (i % 4 == 1)
+      t = t * glm::mat4(glm::vec4(0, 0, -1, 0), glm::vec4(0, 1, 0, 0), glm::vec4(1, 0, 0, 0), glm::vec4(0, 0, 0, 1));
     if (i % 4 == 2) t = glm::scale(t, glm::vec3(i % 8 == 2 ? 0.5f : 1.0f, 1.0f, 0.5f));  // uniform ones below
     if (i % 7 == 3) t = glm::scale(t, glm::vec3(0.5f));
-    if (i % 6 == 5) t = t * glm::mat4(glm::vec4(0, 1, 0, 0), glm::vec4(-1, 0, 0, 0), glm::vec4(0, 0, 1, 0), glm::vec4(0, 0, 0, 1));
+    if (i % 6 == 5)
+      t = t * glm::mat4(glm::vec4(0, 1, 0, 0), glm::vec4(-1, 0, 0, 0), glm::vec4(0, 0, 1, 0), glm::vec4(0, 0, 0, 1));
     if (i >= 16) t = glm::scale(t, glm::vec3(i % 2 ? -1.0f : 1.0f, i % 2 ? 1.0f : -2.0f, 1.0f));  // mirrors
     s.instances.push_back({0, t});
   }
@@ -91,7 +93,8 @@ constexpr VkExtent2D kE{240, 160};
 
 std::vector<CameraPose> views(const Bounds& b) {
   const float aspect = float(kE.width) / float(kE.height);
-  return {frameBounds(b, Lens{}, aspect), orbitFrame(b, Lens{}, aspect, 150.0f, -20.0f),
+  return {frameBounds(b, Lens{}, aspect),
+          orbitFrame(b, Lens{}, aspect, 150.0f, -20.0f),
           {glm::vec3(0.5f, 0.2f, 4.0f), 10.0f, 5.0f}};  // close, inside the grid: some instances off screen
 }
 
@@ -107,7 +110,11 @@ TEST_F(InstanceTest, InstancesDrawLikeTheFlattenedScene) {
   render::HeadlessRenderer ri(*ctx, gi, kE), rf(*ctx, gf, kE);
   ASSERT_EQ(ri.renderer().primitiveBits(), rf.renderer().primitiveBits());
 
-  struct Path { render::ShadingPath shading; render::RasterPath raster; bool cull; };
+  struct Path {
+    render::ShadingPath shading;
+    render::RasterPath raster;
+    bool cull;
+  };
   std::vector<Path> paths = {{render::ShadingPath::Forward, render::RasterPath::Auto, false},
                              {render::ShadingPath::Visibility, render::RasterPath::Hardware, false}};
   if (render::ComputeRaster::supported(*ctx))
@@ -152,9 +159,7 @@ TEST_F(InstanceTest, InstancesDrawLikeTheFlattenedScene) {
         mirroredSeen += a[i] != VIS_EMPTY && (a[i] >> bits) >= 16;
       }
       EXPECT_EQ(differ, 0u) << "visibility ids differ from the flattened scene's";
-      if (first) {
-        EXPECT_GT(mirroredSeen, 100u) << "the mirrored instances are not in view";
-      }
+      if (first) { EXPECT_GT(mirroredSeen, 100u) << "the mirrored instances are not in view"; }
     }
   }
 }

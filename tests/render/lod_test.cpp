@@ -43,7 +43,9 @@ size_t hierarchies(const Scene& s) {
 std::vector<CameraPose> templeViews(const Scene& scene, float aspect) {
   const Bounds b = scene.bounds();
   const CameraPose inside = scene.defaultView.value_or(CameraPose{b.center(), 0, 0});
-  return {orbitFrame(b, Lens{}, aspect, 30.0f, -25.0f), inside, {inside.position, inside.yawDeg + 120.0f, inside.pitchDeg - 10.0f},
+  return {orbitFrame(b, Lens{}, aspect, 30.0f, -25.0f),
+          inside,
+          {inside.position, inside.yawDeg + 120.0f, inside.pitchDeg - 10.0f},
           orbitFrame(b, Lens{}, aspect, 200.0f, -5.0f)};
 }
 
@@ -74,7 +76,8 @@ TEST_F(LodTest, CulledFramesEqualUnculledOnesWithACut) {
   uint32_t byLod = 0;
   for (const CameraPose& pose : templeViews(scene, 1.6f)) {
     const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
-    const std::vector<uint32_t> want = unculled.ids(pose, lens, settings(2.0f, false)), got = culled.ids(pose, lens, settings(2.0f, true));
+    const std::vector<uint32_t> want = unculled.ids(pose, lens, settings(2.0f, false)),
+                                got = culled.ids(pose, lens, settings(2.0f, true));
     size_t differ = 0;
     for (size_t i = 0; i < want.size(); ++i) differ += want[i] != got[i];
     EXPECT_EQ(differ, 0u);
@@ -105,11 +108,12 @@ TEST_F(LodTest, ImageErrorAgainstFullDetailIsSmall) {
       size_t large = 0, n = full.image.pixels.size() / 4;
       for (size_t i = 0; i < n; ++i) {
         int d = 0;
-        for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(int(full.image.pixels[4 * i + k]) - int(cut.image.pixels[4 * i + k])));
+        for (int k = 0; k < 3; ++k)
+          d = std::max(d, std::abs(int(full.image.pixels[4 * i + k]) - int(cut.image.pixels[4 * i + k])));
         sum += d, large += d > 64;
       }
-      std::printf("lod %.0f px: %u triangles listed, mean error %.3f, %.3f %% of pixels off by > 64\n", threshold,
-                  c->triangles, sum / double(n), 100.0 * double(large) / double(n));
+      std::printf("lod %.0f px: %u triangles listed, mean error %.3f, %.3f %% of pixels off by > 64\n", threshold, c->triangles,
+                  sum / double(n), 100.0 * double(large) / double(n));
       // Bounds from lavapipe's measurement (worst view: 0.094 and 0.018 % at 1 px, 0.28 and 0.077 % at 4 px)
       // with room for another device's rounding; projected errors 20 times too small fail the 1 px bounds.
       EXPECT_LT(sum / double(n), threshold <= 1.0f ? 0.15 : 0.5);

@@ -66,9 +66,9 @@ class MipsTest : public VulkanTest {
     for (const auto& image : images) batch.push_back(&image);
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
       for (size_t i = 0; i < images.size(); ++i) {
-        vk::barrier(cb, {{images[i].handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                          VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                          VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1}});
+        vk::barrier(
+            cb, {{images[i].handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                  VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0, 1}});
         VkBufferImageCopy c{};
         c.bufferOffset = uploadOffsets[i];
         c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -119,8 +119,8 @@ MaxDiff compare(const std::vector<std::vector<uint8_t>>& gpu, const MipChain& re
       if (d > m.value) {
         std::ostringstream s;
         const uint32_t w = ref.levels[l].width, texel = uint32_t(i / ref.channels);
-        s << "level " << l << " texel (" << texel % w << ", " << texel / w << ") channel " << i % ref.channels
-          << ": gpu " << int(gpu[l][i]) << " reference " << int(want[i]);
+        s << "level " << l << " texel (" << texel % w << ", " << texel / w << ") channel " << i % ref.channels << ": gpu "
+          << int(gpu[l][i]) << " reference " << int(want[i]);
         m = {d, s.str()};
       }
     }
@@ -131,14 +131,17 @@ MaxDiff compare(const std::vector<std::vector<uint8_t>>& gpu, const MipChain& re
 // 1 x 64: one axis copies while the other halves; 4 x 64, 256 x 2: an axis reaches 1 inside a dispatch;
 // 200 x 120 and 384 x 40: exact halvings first, then odd sizes; 33 x 256: odd first, then exact
 // halvings; 257 x 5: many 1D odd reductions.
-const VkExtent2D kSizes[] = {{1, 1},     {1, 37},    {37, 1},    {1, 64},    {4, 64},   {256, 2},  {64, 64}, {63, 63},
-                             {65, 65},   {256, 256}, {255, 129}, {200, 120}, {384, 40}, {33, 256}, {257, 5}};
+const VkExtent2D kSizes[] = {{1, 1},   {1, 37},    {37, 1},    {1, 64},    {4, 64},   {256, 2},  {64, 64}, {63, 63},
+                             {65, 65}, {256, 256}, {255, 129}, {200, 120}, {384, 40}, {33, 256}, {257, 5}};
 const VkFormat kFormats[] = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_R8_UNORM};
 
 std::string label(VkExtent2D e, VkFormat f, MipMode m) {
   std::ostringstream s;
   s << e.width << "x" << e.height << " "
-    << (f == VK_FORMAT_R8G8B8A8_SRGB ? "srgb" : f == VK_FORMAT_R8_UNORM ? "r8" : "unorm") << " " << rtr::enumName(m);
+    << (f == VK_FORMAT_R8G8B8A8_SRGB ? "srgb"
+        : f == VK_FORMAT_R8_UNORM    ? "r8"
+                                     : "unorm")
+    << " " << rtr::enumName(m);
   return s.str();
 }
 
@@ -161,7 +164,7 @@ TEST_F(MipsTest, ComputeWithinOneLsbOfReference) { expectWithinOneLsb(*this, Mip
 // all of them): each image's chain is as good as alone.
 TEST_F(MipsTest, BatchedImagesWithinOneLsbOfReference) {
   const std::vector<std::pair<VkExtent2D, VkFormat>> set = {
-      {{256, 256}, VK_FORMAT_R8G8B8A8_SRGB}, {{1, 1}, VK_FORMAT_R8G8B8A8_UNORM}, {{255, 129}, VK_FORMAT_R8G8B8A8_SRGB},
+      {{256, 256}, VK_FORMAT_R8G8B8A8_SRGB}, {{1, 1}, VK_FORMAT_R8G8B8A8_UNORM},   {{255, 129}, VK_FORMAT_R8G8B8A8_SRGB},
       {{257, 5}, VK_FORMAT_R8_UNORM},        {{64, 64}, VK_FORMAT_R8G8B8A8_UNORM}, {{1000, 600}, VK_FORMAT_R8G8B8A8_SRGB},
       {{37, 1}, VK_FORMAT_R8G8B8A8_SRGB}};
   {
@@ -228,7 +231,8 @@ TEST_F(MipsTest, AutoGivesEachImageTheChainOfItsSizesPath) {
   for (size_t i = 0; i < set.size(); ++i) {
     const bool small = uint64_t(set[i].first.width) * set[i].first.height <= render::kAutoSmallTexels;
     EXPECT_TRUE(autoChains[i] == (small ? compute[i] : blit[i]))
-        << label(set[i].first, set[i].second, MipMode::Auto) << ": not the chain of the " << (small ? "compute" : "blit") << " path";
+        << label(set[i].first, set[i].second, MipMode::Auto) << ": not the chain of the " << (small ? "compute" : "blit")
+        << " path";
     // Only a test that can tell the two paths apart for this image shows which one Auto took.
     if (blit[i] != compute[i]) blitted += !small;
   }
@@ -266,9 +270,7 @@ TEST_F(MipsTest, BlitChainDifferenceIsReported) {
       std::printf("max |blit - reference| %s: %d LSB%s%s\n", name.c_str(), d.value, d.value ? " at " : "", d.where.c_str());
       const bool pot = (e.width & (e.width - 1)) == 0 && (e.height & (e.height - 1)) == 0;
       // A wrong level or a broken readback is off by ~100; drivers round their blits differently.
-      if (pot) {
-        EXPECT_LE(d.value, 8) << name << ", worst at " << d.where;
-      }
+      if (pot) { EXPECT_LE(d.value, 8) << name << ", worst at " << d.where; }
     }
 }
 

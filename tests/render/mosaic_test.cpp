@@ -39,8 +39,8 @@ class MosaicTest : public VulkanTest {
     std::uniform_real_distribution<float> u(0.0f, 1.25f);
     halfs.resize(size_t(e.width) * e.height * 4);
     for (auto& h : halfs) h = glm::packHalf1x16(u(rng));
-    input = vk::Image(*ctx, {e, VK_FORMAT_R16G16B16A16_SFLOAT, 1,
-                             VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, 0, "scene colour"});
+    input = vk::Image(*ctx, {e, VK_FORMAT_R16G16B16A16_SFLOAT, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0,
+                             0, "scene colour"});
     vk::Buffer upload(*ctx, halfs.size() * 2, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
     std::memcpy(upload.mapped(), halfs.data(), halfs.size() * 2);
     upload.flush();
@@ -56,8 +56,8 @@ class MosaicTest : public VulkanTest {
   // Runs the pass into a fresh output image and reads it back (4 bytes per pixel, in memory order).
   std::vector<uint8_t> run(render::MosaicPass& pass, MosaicMode mode, VkFormat format = VK_FORMAT_R8G8B8A8_UNORM) {
     vk::Image out(*ctx, {extent, format, 1,
-                         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                         0, 0, "post output"});
+                         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0,
+                         "post output"});
     const size_t bytes = size_t(extent.width) * extent.height * 4;
     vk::Buffer readback(*ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {

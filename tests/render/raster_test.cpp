@@ -121,8 +121,9 @@ TEST_F(RasterTest, HardwareAndComputeIdsAgree) {
                               : std::abs(planeDepth(vp, decode.triangle(hw[i]), {320, 180}, {x + 0.5, y + 0.5}) -
                                          planeDepth(vp, decode.triangle(cs[i]), {320, 180}, {x + 0.5, y + 0.5}));
         if (d > 1.0 / 64 && dz > 1e-5) {
-          if (++offEdge < 10) ADD_FAILURE() << "pixel " << x << "," << y << ": hardware " << hw[i] << ", compute " << cs[i]
-                                            << ", " << d << " px from the nearest edge, depths " << dz << " apart";
+          if (++offEdge < 10)
+            ADD_FAILURE() << "pixel " << x << "," << y << ": hardware " << hw[i] << ", compute " << cs[i] << ", " << d
+                          << " px from the nearest edge, depths " << dz << " apart";
         }
       }
     std::printf("ids: %zu of %zu covered pixels agree (%.4f %%), %zu differing off an edge\n", same, covered,
@@ -237,8 +238,11 @@ TEST_F(RasterTest, ClosedMeshFromInsideLeavesNoHole) {
   lens.fovYDeg = 90.0f;
   lens.zNear = 0.05f;
   lens.zFar = 10.0f;
-  const CameraPose poses[] = {{{0, 0, 0}, 0, 0},          {{0, 0, 0}, 30, 20},          {{0, 0, 0}, -45, 60},
-                              {{0.7f, -0.6f, 0.5f}, 150, -30}, {{0.85f, 0.85f, -0.85f}, 45, 35}};
+  const CameraPose poses[] = {{{0, 0, 0}, 0, 0},
+                              {{0, 0, 0}, 30, 20},
+                              {{0, 0, 0}, -45, 60},
+                              {{0.7f, -0.6f, 0.5f}, 150, -30},
+                              {{0.85f, 0.85f, -0.85f}, 45, 35}};
   for (const CameraPose& pose : poses) {
     SCOPED_TRACE(testing::Message() << "yaw " << pose.yawDeg << ", pitch " << pose.pitchDeg);
     const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);

@@ -97,8 +97,7 @@ TEST_F(VulkanTest, AutoMipsMakeSmallTexturesChainsOnTheCpu) {
   EXPECT_EQ(ctx->pipelineCache().stats().created, before) << "a mip pipeline was made";
   EXPECT_EQ(host.stats().mipGpuMs, 0.0) << "a mip pass ran";
   const render::GpuScene compute(*ctx, scene, render::MipMode::Compute);
-  render::GpuScene deferred(*ctx, scene, render::MipMode::Auto, {}, render::GeometryUpload::Auto,
-                            render::TextureLoad::Deferred);
+  render::GpuScene deferred(*ctx, scene, render::MipMode::Auto, {}, render::GeometryUpload::Auto, render::TextureLoad::Deferred);
   deferred.updateTextures(true);
   render::HeadlessRenderer a(*ctx, host, {kW, kH}), b(*ctx, compute, {kW, kH}), c(*ctx, deferred, {kW, kH});
   for (int mode : {VIEW_ALBEDO, VIEW_SHADED}) {

@@ -46,8 +46,8 @@ TEST_F(VulkanTest, BlendedQuadsCompositeFarthestFirstInEveryPath) {
   // Seen from +z: the background at z = -1 over the left 3/4 of the view; the near blended quad (listed
   // first, so the scene's order is the wrong one) over the middle band, the far one over the top 3/4;
   // an opaque block in front of both at the right.
-  scene.meshes = {quad(-1.0f, 1.0f, -0.5f, 0.5f, 0.5f, 1), quad(-5, 1.0f, -5, 5, -1.0f, 0),
-                  quad(-1.0f, 1.0f, -0.5f, 5, 0.0f, 2), quad(0.3f, 5, 0.1f, 5, 1.0f, 3)};
+  scene.meshes = {quad(-1.0f, 1.0f, -0.5f, 0.5f, 0.5f, 1), quad(-5, 1.0f, -5, 5, -1.0f, 0), quad(-1.0f, 1.0f, -0.5f, 5, 0.0f, 2),
+                  quad(0.3f, 5, 0.1f, 5, 1.0f, 3)};
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
   ASSERT_EQ(gpu.blendDraws().size(), 2u);
   render::HeadlessRenderer r(*ctx, gpu, {kSize, kSize});
@@ -62,7 +62,11 @@ TEST_F(VulkanTest, BlendedQuadsCompositeFarthestFirstInEveryPath) {
     return img.at(uint32_t((0.5f + x / 4.0f) * kSize), uint32_t((0.5f - y / 4.0f) * kSize));
   };
   const glm::vec3 black(0.0f);
-  struct Probe { float x, y; glm::vec3 want; const char* what; };
+  struct Probe {
+    float x, y;
+    glm::vec3 want;
+    const char* what;
+  };
   const Probe probes[] = {
       {-0.5f, 0.0f, over(near, aNear, over(far, aFar, back)), "near over far over the background"},
       {-0.5f, 1.0f, over(far, aFar, back), "far over the background"},

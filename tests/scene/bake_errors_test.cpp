@@ -37,9 +37,7 @@ struct Fixture : ::testing::Test {
     o.warn = [](const std::string&) {};
     try {
       rtr::bake(o);
-    } catch (const rtr::Error& e) {
-      return e.what();
-    }
+    } catch (const rtr::Error& e) { return e.what(); }
     return "(no error)";
   }
   size_t filesIn(const fs::path& d) { return size_t(std::distance(fs::recursive_directory_iterator(d), {})); }
@@ -102,9 +100,7 @@ TEST_F(Fixture, OutputFolderNotWritable) {
   EXPECT_EQ(filesIn(out), 0u);
 }
 
-TEST_F(Fixture, UnknownOutputExtension) {
-  EXPECT_THAT(bakeError(out / "s.glb"), HasSubstr("unknown output format"));
-}
+TEST_F(Fixture, UnknownOutputExtension) { EXPECT_THAT(bakeError(out / "s.glb"), HasSubstr("unknown output format")); }
 
 // Disk full during a --force bake (a file size limit stands in for it: a write past it fails, EFBIG, as
 // ENOSPC would): the older scene and its textures stay as they were, and no temporary is left. Before,

@@ -26,7 +26,8 @@ std::string base64(const std::vector<uint8_t>& in) {
   static const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   for (size_t i = 0; i < in.size(); i += 3) {
-    const uint32_t n = uint32_t(in[i]) << 16 | (i + 1 < in.size() ? uint32_t(in[i + 1]) << 8 : 0) | (i + 2 < in.size() ? in[i + 2] : 0);
+    const uint32_t n =
+        uint32_t(in[i]) << 16 | (i + 1 < in.size() ? uint32_t(in[i + 1]) << 8 : 0) | (i + 2 < in.size() ? in[i + 2] : 0);
     for (size_t k = 0; k < 4; ++k) out += i + k <= in.size() ? abc[(n >> (18 - 6 * k)) & 63] : '=';
   }
   return out;
@@ -44,7 +45,8 @@ struct BakeGltf : ::testing::Test {
     fs::remove_all(dir);
     fs::create_directories(dir);
     ImageRGBA8 img{4, 4, {}};
-    for (uint32_t i = 0; i < 16; ++i) img.pixels.insert(img.pixels.end(), {uint8_t(i * 16), uint8_t(255 - i * 16), uint8_t(i * 5), 255});
+    for (uint32_t i = 0; i < 16; ++i)
+      img.pixels.insert(img.pixels.end(), {uint8_t(i * 16), uint8_t(255 - i * 16), uint8_t(i * 5), 255});
     savePng(dir / "img.png", img);
     png = readFileBytes(dir / "img.png");
     fs::remove(dir / "img.png");
@@ -70,8 +72,10 @@ struct BakeGltf : ::testing::Test {
                 "alphaMode": "MASK", "alphaCutoff": 0.4, "doubleSided": true}],
  "textures": [{"source": 0, "sampler": 0}, {"source": 0, "sampler": 1}],
  "samplers": [{"wrapS": 33071, "wrapT": 33648, "magFilter": 9728, "minFilter": 9984}, {}],
- "images": [{"uri": "data:image/png;base64,)" + base64(png) + R"("}],
- "buffers": [{"byteLength": 140, "uri": "data:application/octet-stream;base64,)" + base64(buf) + R"("}],
+ "images": [{"uri": "data:image/png;base64,)" +
+                                         base64(png) + R"("}],
+ "buffers": [{"byteLength": 140, "uri": "data:application/octet-stream;base64,)" +
+                                         base64(buf) + R"("}],
  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 128}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}],
  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
                {"bufferView": 0, "byteOffset": 48, "componentType": 5126, "count": 4, "type": "VEC3"},
@@ -89,9 +93,7 @@ struct BakeGltf : ::testing::Test {
   std::string bakeError(const fs::path& output) {
     try {
       bake(options(output));
-    } catch (const Error& e) {
-      return e.what();
-    }
+    } catch (const Error& e) { return e.what(); }
     return "(no error)";
   }
 };

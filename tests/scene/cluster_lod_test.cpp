@@ -86,9 +86,7 @@ TEST(ClusterLod, ErrorsAndSpheresGrowUpTheHierarchy) {
   size_t roots = 0;
   for (const LodCluster& c : lod.clusters) {
     EXPECT_LE(c.triangleCount, 124u);
-    if (c.level == 0) {
-      EXPECT_EQ(c.error, 0.0f);
-    }
+    if (c.level == 0) { EXPECT_EQ(c.error, 0.0f); }
     if (c.parentError >= shader::LOD_ERROR_INFINITE) {
       ++roots;
       continue;

@@ -60,7 +60,8 @@ void expectValidClusters(const Mesh& m) {
     EXPECT_EQ(c.firstTriangle, next);
     EXPECT_GE(c.triangleCount, 1u);
     EXPECT_LE(c.triangleCount, uint32_t(CLUSTER_MAX_TRIANGLES));
-    std::vector<uint32_t> verts(m.indices.begin() + c.firstTriangle * 3, m.indices.begin() + (c.firstTriangle + c.triangleCount) * 3);
+    std::vector<uint32_t> verts(m.indices.begin() + c.firstTriangle * 3,
+                                m.indices.begin() + (c.firstTriangle + c.triangleCount) * 3);
     std::sort(verts.begin(), verts.end());
     EXPECT_LE(std::unique(verts.begin(), verts.end()) - verts.begin(), CLUSTER_MAX_VERTICES);
     // The sphere bounds what can be drawn: degenerate triangles (no area, no pixels) may lie outside it.
@@ -110,7 +111,8 @@ TEST(Clusters, BigMeshesAreClusteredInPiecesKeepingEveryTriangle) {
   EXPECT_EQ(buildMissingClusters(s), 2u);
   EXPECT_EQ(s.meshes[0].indices, m.indices);
   ASSERT_EQ(s.meshes[0].clusters.size(), m.clusters.size());
-  for (size_t i = 0; i < m.clusters.size(); ++i) EXPECT_EQ(std::memcmp(&s.meshes[0].clusters[i], &m.clusters[i], sizeof(Cluster)), 0);
+  for (size_t i = 0; i < m.clusters.size(); ++i)
+    EXPECT_EQ(std::memcmp(&s.meshes[0].clusters[i], &m.clusters[i], sizeof(Cluster)), 0);
   expectValidClusters(s.meshes[1]);
 }
 
@@ -160,9 +162,7 @@ Scene gridScene() {
 std::string decodeError(const std::string& bytes) {
   try {
     decodeRtrScene({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "g.rtrscene");
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 

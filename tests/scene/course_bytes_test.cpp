@@ -24,7 +24,12 @@ struct Cursor {
     return v;
   }
   uint8_t u8() { return d.at(p++); }
-  float f32() { uint32_t u = u32(); float f; std::memcpy(&f, &u, 4); return f; }
+  float f32() {
+    uint32_t u = u32();
+    float f;
+    std::memcpy(&f, &u, 4);
+    return f;
+  }
 };
 
 fs::path tempDir(const char* tag) {
@@ -107,8 +112,7 @@ TEST(CourseBytes, TempleBakeFollowsTheTable) {
     for (uint32_t v = 0; v < V; ++v)
       for (int k = 0; k < 3; ++k) ASSERT_EQ(c.f32(), src.meshes[i].normals[v][k]);
     for (uint32_t v = 0; v < V; ++v)
-      for (int k = 0; k < 2; ++k)
-        ASSERT_EQ(c.f32(), src.meshes[i].texcoords.empty() ? 0.0f : src.meshes[i].texcoords[v][k]);
+      for (int k = 0; k < 2; ++k) ASSERT_EQ(c.f32(), src.meshes[i].texcoords.empty() ? 0.0f : src.meshes[i].texcoords[v][k]);
     for (uint32_t k = 0; k < I; ++k) ASSERT_EQ(c.u32(), src.meshes[i].indices[k]);
   }
   EXPECT_EQ(c.p, c.d.size()) << "a correct file ends right after the last mesh";

@@ -108,7 +108,8 @@ TEST(Environment, ShIrradianceMatchesDirectIntegrationOfASmoothMap) {
   for (uint32_t y = 0; y < 32; ++y)
     for (uint32_t x = 0; x < 64; ++x) {
       const glm::vec3 d = shader::envUvToDir({(x + 0.5f) / 64, (y + 0.5f) / 32}, 0.0f);
-      m.at(x, y) = glm::vec4(1.0f + d.y, 1.0f + 0.5f * d.x + 0.4f * d.x * d.z, 1.0f - 0.3f * d.z + 0.3f * d.x * d.y, 1.0f);  // bands 0-2: exact in SH
+      m.at(x, y) = glm::vec4(1.0f + d.y, 1.0f + 0.5f * d.x + 0.4f * d.x * d.z, 1.0f - 0.3f * d.z + 0.3f * d.x * d.y,
+                             1.0f);  // bands 0-2: exact in SH
     }
   const Environment env(std::move(m), 1.0f, 0.0f);
   for (const glm::vec3 n : {glm::vec3(0, 1, 0), glm::vec3(1, 0, 0), glm::normalize(glm::vec3(-1, -1, 2))}) {
@@ -118,7 +119,8 @@ TEST(Environment, ShIrradianceMatchesDirectIntegrationOfASmoothMap) {
       for (int x = 0; x < qw; ++x) {
         const float v = (y + 0.5f) / qh;
         const glm::vec3 d = shader::envUvToDir({(x + 0.5f) / qw, v}, 0.0f);
-        direct += glm::dvec3(env.lookup(d)) * double(std::max(glm::dot(d, n), 0.0f) * 2 * kPi / qw * kPi / qh * std::sin(v * kPi));
+        direct +=
+            glm::dvec3(env.lookup(d)) * double(std::max(glm::dot(d, n), 0.0f) * 2 * kPi / qw * kPi / qh * std::sin(v * kPi));
       }
     const glm::vec3 sh = env.irradianceSh(n);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(sh[c], direct[c], 0.02 * direct[c]) << c;
@@ -154,7 +156,8 @@ TEST(Environment, SkyIsPhysicallyPlausible) {
   for (uint32_t y = 0; y < sky.height / 2; ++y)
     for (uint32_t x = 0; x < sky.width; ++x) {
       const glm::vec3 d = shader::envUvToDir({(x + 0.5f) / sky.width, (y + 0.5f) / sky.height}, 0.0f);
-      const double omega = 2 * kPi / sky.width * (std::cos(double(y) / sky.height * kPi) - std::cos(double(y + 1) / sky.height * kPi));
+      const double omega =
+          2 * kPi / sky.width * (std::cos(double(y) / sky.height * kPi) - std::cos(double(y + 1) / sky.height * kPi));
       irr += glm::dot(glm::vec3(sky.at(x, y)), glm::vec3(0.2126f, 0.7152f, 0.0722f)) * d.y * omega;
     }
   EXPECT_NEAR(irr, kPi, 0.02 * kPi);

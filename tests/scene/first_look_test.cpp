@@ -60,7 +60,8 @@ TEST_F(FirstLook, NormalsAreSplitAtTheCreaseAngle) {
   ASSERT_EQ(hard.meshes.size(), 1u);
   EXPECT_EQ(hard.meshes[0].positions.size(), 24u);
   EXPECT_EQ(distinctNormals(hard.meshes[0]), 6u);
-  for (const glm::vec3& n : hard.meshes[0].normals) EXPECT_NEAR(std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)}), 1.0f, 1e-6f);
+  for (const glm::vec3& n : hard.meshes[0].normals)
+    EXPECT_NEAR(std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)}), 1.0f, 1e-6f);
   opt.creaseDeg = 180;  // smooth: one normal per corner, leaning into all three faces
   const Scene smooth = load(kCube);
   EXPECT_EQ(smooth.meshes[0].positions.size(), 8u);
@@ -84,8 +85,9 @@ TEST_F(FirstLook, NormalsAreSplitAtTheCreaseAngle) {
 
 TEST_F(FirstLook, IndicesThatPointNowhereAreDroppedForTheFace) {
   // Normal indices with no `vn` at all (as some exporters write), and a texcoord index past the end.
-  const Scene s = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\n"
-                       "f 1//1 2//1 3//1\nf 1/1/1 3/5/1 4/1/1\n");
+  const Scene s = load(
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\n"
+      "f 1//1 2//1 3//1\nf 1/1/1 3/5/1 4/1/1\n");
   ASSERT_EQ(s.meshes.size(), 1u);
   EXPECT_EQ(s.meshes[0].triangleCount(), 2u);
   for (const glm::vec3& n : s.meshes[0].normals) EXPECT_NEAR(n.z, 1.0f, 1e-6f);  // computed
@@ -102,8 +104,10 @@ TEST_F(FirstLook, VertexColoursAreRead) {
   ASSERT_EQ(m.colors.size(), m.positions.size());
   for (size_t i = 0; i < m.positions.size(); ++i) {
     const glm::vec3 p = m.positions[i];
-    const glm::vec4 want = p == glm::vec3(0, 0, 0) ? glm::vec4(1, 0, 0, 1) : p == glm::vec3(1, 0, 0) ? glm::vec4(0, 1, 0, 1)
-                         : p == glm::vec3(0, 1, 0) ? glm::vec4(0, 0, 1, 1) : glm::vec4(1);  // no colour: white
+    const glm::vec4 want = p == glm::vec3(0, 0, 0)   ? glm::vec4(1, 0, 0, 1)
+                           : p == glm::vec3(1, 0, 0) ? glm::vec4(0, 1, 0, 1)
+                           : p == glm::vec3(0, 1, 0) ? glm::vec4(0, 0, 1, 1)
+                                                     : glm::vec4(1);  // no colour: white
     EXPECT_EQ(m.colors[i], want) << i;
   }
   EXPECT_TRUE(load("v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 1\nf 1 2 3\n").meshes[0].colors.empty()) << "a 4th number is w";
@@ -136,8 +140,9 @@ const std::string kBox =
     "usemtl white\nf 1 4 3 2\nf 5 6 7 8\nf 4 8 7 3\n"
     "usemtl red\nf 1 5 8 4\nusemtl green\nf 2 3 7 6\n"
     "usemtl light\nf 9 10 11 12\n";
-const std::string kBoxMtl = "newmtl white\nKd 0.7 0.7 0.7\nnewmtl red\nKd 0.7 0.1 0.1\nnewmtl green\nKd 0.1 0.7 0.1\n"
-                            "newmtl light\nKd 1 1 1\n";
+const std::string kBoxMtl =
+    "newmtl white\nKd 0.7 0.7 0.7\nnewmtl red\nKd 0.7 0.1 0.1\nnewmtl green\nKd 0.1 0.7 0.1\n"
+    "newmtl light\nKd 1 1 1\n";
 
 TEST_F(FirstLook, AStagedBoxIsSeenFromItsOpenSide) {
   Scene s = load(kBox, kBoxMtl);
@@ -156,9 +161,10 @@ TEST_F(FirstLook, AStagedBoxIsSeenFromItsOpenSide) {
 
 TEST_F(FirstLook, ACourseSceneIsStillSeenDownMinusZ) {
   // A back plane at z = -1 and a light quad in front of it at z = 2: the course's triangle_backplane layout.
-  const Scene s = load("mtllib t.mtl\nv -2 -2 -1\nv 2 -2 -1\nv 2 2 -1\nv -2 2 -1\nv 0 1 2\nv 1 1 2\nv 1 1.5 2\nv 0 1.5 2\n"
-                       "usemtl grey\nf 1 2 3 4\nusemtl light1\nf 5 6 7 8\n",
-                       "newmtl grey\nKd 0.5 0.5 0.5\nnewmtl light1\nKe 1 1 1\n");
+  const Scene s = load(
+      "mtllib t.mtl\nv -2 -2 -1\nv 2 -2 -1\nv 2 2 -1\nv -2 2 -1\nv 0 1 2\nv 1 1 2\nv 1 1.5 2\nv 0 1.5 2\n"
+      "usemtl grey\nf 1 2 3 4\nusemtl light1\nf 5 6 7 8\n",
+      "newmtl grey\nKd 0.5 0.5 0.5\nnewmtl light1\nKe 1 1 1\n");
   const CameraPose p = framingPose(s, Lens{}, 1.0f);
   EXPECT_EQ(p.yawDeg, 0.0f);
   EXPECT_EQ(p.pitchDeg, 0.0f);
@@ -166,8 +172,8 @@ TEST_F(FirstLook, ACourseSceneIsStillSeenDownMinusZ) {
 }
 
 TEST(FirstLookUp, EachAxisTurnsToPlusY) {
-  const std::pair<const char*, glm::vec3> axes[] = {{"+X", {1, 0, 0}}, {"-X", {-1, 0, 0}}, {"+Y", {0, 1, 0}},
-                                                    {"-Y", {0, -1, 0}}, {"+Z", {0, 0, 1}}, {"-Z", {0, 0, -1}}};
+  const std::pair<const char*, glm::vec3> axes[] = {{"+X", {1, 0, 0}},  {"-X", {-1, 0, 0}}, {"+Y", {0, 1, 0}},
+                                                    {"-Y", {0, -1, 0}}, {"+Z", {0, 0, 1}},  {"-Z", {0, 0, -1}}};
   for (const auto& [name, axis] : axes) {
     const glm::mat3 r = upRotation(name);
     EXPECT_EQ(r * axis, glm::vec3(0, 1, 0)) << name;

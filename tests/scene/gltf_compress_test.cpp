@@ -46,9 +46,7 @@ std::string meshoptError(std::span<const uint8_t> src, size_t count, size_t stri
   std::vector<uint8_t> out(outBytes);
   try {
     gltf::decodeMeshopt(src, count, stride, mode, filter, out);
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -114,7 +112,8 @@ TEST(Meshopt, FiltersDecodeToTheEncodedValues) {
                         Case{"EXPONENTIAL", 12, &floats, 3, 1e-6}}) {
     SCOPED_TRACE(c.filter);
     std::vector<uint8_t> filtered(n * c.stride);
-    if (c.stride == 8 && std::string(c.filter) == "OCTAHEDRAL") meshopt_encodeFilterOct(filtered.data(), n, 8, 16, c.values->data());
+    if (c.stride == 8 && std::string(c.filter) == "OCTAHEDRAL")
+      meshopt_encodeFilterOct(filtered.data(), n, 8, 16, c.values->data());
     if (std::string(c.filter) == "QUATERNION") meshopt_encodeFilterQuat(filtered.data(), n, 8, 16, c.values->data());
     if (std::string(c.filter) == "EXPONENTIAL") meshopt_encodeFilterExp(filtered.data(), n, 12, 24, c.values->data());
     std::vector<uint8_t> src(meshopt_encodeVertexBufferBound(n, c.stride));
@@ -222,9 +221,7 @@ DracoSource dracoSource(int quantizationBits) {
 std::string dracoError(std::span<const uint8_t> src, const std::vector<std::pair<std::string, int>>& attributes) {
   try {
     gltf::decodeDraco(src, attributes);
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -250,7 +247,8 @@ std::vector<std::array<float, 9>> canonical(const std::vector<std::array<glm::ve
 
 TEST(Draco, MeshComesBackWithItsAttributes) {
   const DracoSource s = dracoSource(0);  // no quantization: lossless
-  const gltf::DracoMesh m = gltf::decodeDraco(s.bytes, {{"POSITION", s.positionId}, {"TEXCOORD_0", s.uvId}, {"NORMAL", s.normalId}});
+  const gltf::DracoMesh m =
+      gltf::decodeDraco(s.bytes, {{"POSITION", s.positionId}, {"TEXCOORD_0", s.uvId}, {"NORMAL", s.normalId}});
   ASSERT_EQ(m.attributes.size(), 3u);
   EXPECT_EQ(m.attributes[0].name, "POSITION");
   EXPECT_EQ(m.attributes[0].components, 3);

@@ -17,23 +17,20 @@ using ::testing::HasSubstr;
 namespace {
 
 const std::vector<glm::vec3> kTri = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-const std::string kMesh = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
+const std::string kMesh =
+    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
 
 std::string errorOf(const std::filesystem::path& file) {
   try {
     loadScene(file);
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
 std::string errorOfGlb(const std::string& bytes) {
   try {
     parseGltf({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "bad.glb", ".");
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -60,7 +57,8 @@ TEST_F(Errors, OverflowingOffsetsAndLengths) {
   c.view(kTri.data(), 36);
   c.views[0] = "{\"buffer\":0,\"byteOffset\":18446744073709551600,\"byteLength\":32}";
   c.accessor(0, 5126, 2, "VEC3");
-  EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)), HasSubstr("b.glb: /bufferViews/0: byteOffset 18446744073709551600 + byteLength 32 run past"));
+  EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)),
+              HasSubstr("b.glb: /bufferViews/0: byteOffset 18446744073709551600 + byteLength 32 run past"));
   GltfBuilder d;
   d.accessor(d.view(kTri.data(), 36), 5126, 4294967296ull, "VEC3");
   EXPECT_THAT(errorOf(d.writeGlb(dir, "c", kMesh)), HasSubstr("c.glb: /accessors/0/count: 4294967296 is not an element count"));
@@ -69,7 +67,8 @@ TEST_F(Errors, OverflowingOffsetsAndLengths) {
   const std::string json = e.json(kMesh, "e.bin");
   test::writeFile(dir / "e.bin", e.bin.substr(0, 20));
   test::writeFile(dir / "e.gltf", json);
-  EXPECT_THAT(errorOf(dir / "e.gltf"), HasSubstr("e.gltf: /buffers/0/byteLength: 36 bytes, but the buffer's data has only 20 bytes"));
+  EXPECT_THAT(errorOf(dir / "e.gltf"),
+              HasSubstr("e.gltf: /buffers/0/byteLength: 36 bytes, but the buffer's data has only 20 bytes"));
 }
 
 TEST_F(Errors, BadStride) {
@@ -78,14 +77,16 @@ TEST_F(Errors, BadStride) {
   EXPECT_THAT(errorOf(b.writeGlb(dir, "a", kMesh)), HasSubstr("a.glb: /bufferViews/0/byteStride: 6 is not a byte stride"));
   GltfBuilder c;
   c.accessor(c.view(kTri.data(), 36, "\"byteStride\":8"), 5126, 3, "VEC3");
-  EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)), HasSubstr("b.glb: /bufferViews/0/byteStride: 8 is less than the 12 bytes of one element"));
+  EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)),
+              HasSubstr("b.glb: /bufferViews/0/byteStride: 8 is less than the 12 bytes of one element"));
 }
 
 TEST_F(Errors, IndexOutOfRangeAndWrongTypes) {
   GltfBuilder b;
   b.floats(kTri, "VEC3");
   b.indices({0, 1, 3});
-  const std::string mesh = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],\"nodes\":[{\"mesh\":0}]";
+  const std::string mesh =
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],\"nodes\":[{\"mesh\":0}]";
   EXPECT_THAT(errorOf(b.writeGlb(dir, "a", mesh)),
               HasSubstr("a.glb: /meshes/0/primitives/0/indices: index 3 (element 2) is not below the vertex count 3"));
   GltfBuilder c;
@@ -93,8 +94,9 @@ TEST_F(Errors, IndexOutOfRangeAndWrongTypes) {
   EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)), HasSubstr("b.glb: /accessors/0/type: 'VEC2' where VEC3 is expected"));
   GltfBuilder d;
   d.floats(kTri, "VEC3");
-  EXPECT_THAT(errorOf(d.writeGlb(dir, "c", "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":7}}]}],\"nodes\":[{\"mesh\":0}]")),
-              HasSubstr("c.glb: /meshes/0/primitives/0/attributes/POSITION: 7 is not one of the 1 accessors"));
+  EXPECT_THAT(
+      errorOf(d.writeGlb(dir, "c", "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":7}}]}],\"nodes\":[{\"mesh\":0}]")),
+      HasSubstr("c.glb: /meshes/0/primitives/0/attributes/POSITION: 7 is not one of the 1 accessors"));
 }
 
 TEST_F(Errors, BadGlbContainer) {
@@ -125,8 +127,11 @@ TEST_F(Errors, BadGlbContainer) {
 TEST_F(Errors, UnknownRequiredExtensionIsNamed) {
   GltfBuilder b;
   b.floats(kTri, "VEC3");
-  EXPECT_THAT(errorOf(b.writeGlb(dir, "a", kMesh + ",\"extensionsRequired\":[\"KHR_texture_transform\",\"KHR_materials_pbrSpecularGlossiness\"]")),
-              HasSubstr("a.glb: /extensionsRequired/1: the file requires extension 'KHR_materials_pbrSpecularGlossiness', which rtr does not support"));
+  EXPECT_THAT(
+      errorOf(b.writeGlb(dir, "a",
+                         kMesh + ",\"extensionsRequired\":[\"KHR_texture_transform\",\"KHR_materials_pbrSpecularGlossiness\"]")),
+      HasSubstr(
+          "a.glb: /extensionsRequired/1: the file requires extension 'KHR_materials_pbrSpecularGlossiness', which rtr does not support"));
 }
 
 TEST_F(Errors, BadBase64AndMissingBuffer) {
@@ -144,8 +149,9 @@ TEST_F(Errors, BadBase64AndMissingBuffer) {
 TEST_F(Errors, CyclesVersionsAndJson) {
   GltfBuilder b;
   b.floats(kTri, "VEC3");
-  EXPECT_THAT(errorOf(b.writeGlb(dir, "a", "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-                                           "\"nodes\":[{\"mesh\":0,\"children\":[1]},{\"children\":[0]}],\"scenes\":[{\"nodes\":[0]}]")),
+  EXPECT_THAT(errorOf(b.writeGlb(dir, "a",
+                                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                                 "\"nodes\":[{\"mesh\":0,\"children\":[1]},{\"children\":[0]}],\"scenes\":[{\"nodes\":[0]}]")),
               HasSubstr("a.glb: /nodes/0: the node is reached twice"));
   test::writeFile(dir / "b.gltf", "{\"asset\":{\"version\":\"1.0\"}}");
   EXPECT_THAT(errorOf(dir / "b.gltf"), HasSubstr("b.gltf: /asset/version: glTF version '1.0' (rtr reads glTF 2.0)"));
@@ -160,14 +166,17 @@ TEST_F(Errors, CyclesVersionsAndJson) {
 TEST_F(Errors, NonFinitePositions) {
   GltfBuilder b;
   b.floats(std::vector<glm::vec3>{{0, 0, 0}, {std::numeric_limits<float>::infinity(), 0, 0}, {0, 1, 0}}, "VEC3");
-  EXPECT_THAT(errorOf(b.writeGlb(dir, "a", kMesh)), HasSubstr("a.glb: /meshes/0/primitives/0/attributes: POSITION element 1 is not finite"));
+  EXPECT_THAT(errorOf(b.writeGlb(dir, "a", kMesh)),
+              HasSubstr("a.glb: /meshes/0/primitives/0/attributes: POSITION element 1 is not finite"));
   // Found by fuzz_gltf: a coordinate of 4.5e30 made clustering lose the triangle (squared lengths overflow).
   GltfBuilder c;
   c.floats(std::vector<glm::vec3>{{0, 0, 0}, {2, 0, 4.5e30f}, {0, 1, 0}}, "VEC3");
-  EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)), HasSubstr("b.glb: /meshes/0/primitives/0/attributes: POSITION element 1 has a coordinate beyond"));
+  EXPECT_THAT(errorOf(c.writeGlb(dir, "b", kMesh)),
+              HasSubstr("b.glb: /meshes/0/primitives/0/attributes: POSITION element 1 has a coordinate beyond"));
   GltfBuilder d;
   d.floats(std::vector<glm::vec3>{{0, 0, 0}, {2, 0, std::nanf("")}, {0, 1, 0}}, "VEC3");
-  EXPECT_THAT(errorOf(d.writeGlb(dir, "c", kMesh)), HasSubstr("c.glb: /meshes/0/primitives/0/attributes: POSITION element 1 is not finite"));
+  EXPECT_THAT(errorOf(d.writeGlb(dir, "c", kMesh)),
+              HasSubstr("c.glb: /meshes/0/primitives/0/attributes: POSITION element 1 is not finite"));
 }
 
 }  // namespace

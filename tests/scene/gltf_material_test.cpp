@@ -68,8 +68,7 @@ TEST(GltfMaterials, MetallicRoughnessAllSlotsFactorsAndFlags) {
   // Base colour: embedded, sRGB, sampler 0.
   EXPECT_TRUE(tex(TextureSlot::BaseColor).bytes);
   EXPECT_TRUE(tex(TextureSlot::BaseColor).srgb);
-  EXPECT_EQ(tex(TextureSlot::BaseColor).sampler,
-            (SamplerDesc{Wrap::ClampToEdge, Wrap::MirroredRepeat, true, false, true}));
+  EXPECT_EQ(tex(TextureSlot::BaseColor).sampler, (SamplerDesc{Wrap::ClampToEdge, Wrap::MirroredRepeat, true, false, true}));
   // The mask: the base colour image's alpha.
   EXPECT_EQ(tex(TextureSlot::AlphaMask).bytes, tex(TextureSlot::BaseColor).bytes);
   EXPECT_EQ(tex(TextureSlot::AlphaMask).sourceChannel, 4);
@@ -113,9 +112,10 @@ TEST(GltfMaterials, MetallicRoughnessAllSlotsFactorsAndFlags) {
 TEST(GltfMaterials, DefaultMaterialBlendAndDataUriImage) {
   Fixture f("blend");
   const std::string png = pngBytes(f.dir);
-  const std::string rest = f.mesh +
-                           ",\"images\":[{\"uri\":\"data:image/png;base64," + test::base64(png) + "\"}],\"textures\":[{\"source\":0}],"
-                           "\"materials\":[{\"alphaMode\":\"BLEND\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}]";
+  const std::string rest =
+      f.mesh + ",\"images\":[{\"uri\":\"data:image/png;base64," + test::base64(png) +
+      "\"}],\"textures\":[{\"source\":0}],"
+      "\"materials\":[{\"alphaMode\":\"BLEND\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}]";
   const Scene s = loadScene(f.b.writeGltf(f.dir, "b", rest));
   const Material& m = s.materials.at(s.meshes.at(0).material);
   EXPECT_EQ(m.flags, kMaterialGltf | kMaterialBlend);
@@ -138,15 +138,17 @@ TEST(GltfMaterials, MissingImageFileIsAWarningNamingThePath) {
   std::vector<std::string> warnings;
   LoadOptions o;
   o.warn = [&](const std::string& s) { warnings.push_back(s); };
-  const std::string rest = f.mesh + ",\"images\":[{\"uri\":\"nothere.png\"}],\"textures\":[{\"source\":0}],"
-                                    "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}]";
+  const std::string rest = f.mesh +
+                           ",\"images\":[{\"uri\":\"nothere.png\"}],\"textures\":[{\"source\":0}],"
+                           "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}]";
   const Scene s = loadScene(f.b.writeGlb(f.dir, "w", rest), o);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_THAT(warnings[0], HasSubstr("w.glb: /images/0/uri: image file 'nothere.png' does not exist"));
   // The renderers show their checker for it (decodeTextures' warning names the file).
   std::vector<std::string> decodeWarnings;
   const uint32_t t = s.materials.at(0).texture(TextureSlot::BaseColor);
-  decodeTextures(s, std::vector<uint32_t>{t}, [](size_t, TexelData&&) {}, [&](const std::string& w) { decodeWarnings.push_back(w); });
+  decodeTextures(
+      s, std::vector<uint32_t>{t}, [](size_t, TexelData&&) {}, [&](const std::string& w) { decodeWarnings.push_back(w); });
   ASSERT_EQ(decodeWarnings.size(), 1u);
   EXPECT_THAT(decodeWarnings[0], HasSubstr("nothere.png"));
 }
@@ -154,10 +156,11 @@ TEST(GltfMaterials, MissingImageFileIsAWarningNamingThePath) {
 TEST(GltfScene, FirstCameraIsTheDefaultViewWithItsFieldOfView) {
   Fixture f("camera");
   // Camera node 1 under node 0 (translation 0,0,5), turned 90° left about y: looks down -x.
-  const std::string rest = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-                           "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}},{\"type\":\"perspective\",\"perspective\":{\"yfov\":1.0,\"znear\":0.1}}],"
-                           "\"nodes\":[{\"mesh\":0,\"translation\":[0,0,5],\"children\":[1]},{\"camera\":0,\"rotation\":[0,0.70710678,0,0.70710678]},{\"camera\":1}],"
-                           "\"scenes\":[{\"nodes\":[0,2]}]";
+  const std::string rest =
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+      "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}},{\"type\":\"perspective\",\"perspective\":{\"yfov\":1.0,\"znear\":0.1}}],"
+      "\"nodes\":[{\"mesh\":0,\"translation\":[0,0,5],\"children\":[1]},{\"camera\":0,\"rotation\":[0,0.70710678,0,0.70710678]},{\"camera\":1}],"
+      "\"scenes\":[{\"nodes\":[0,2]}]";
   const Scene s = loadScene(f.b.writeGlb(f.dir, "c", rest));
   ASSERT_TRUE(s.defaultView);
   EXPECT_EQ(s.defaultView->position, glm::vec3(0, 0, 5));

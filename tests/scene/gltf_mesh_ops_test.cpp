@@ -67,7 +67,8 @@ TEST(FlattenInstances, TransformsPositionsNormalsAndFlipsMirroredWinding) {
   s.meshes.push_back(m);
   s.meshes.push_back(m);  // not placed: dropped
   // A non-uniform scale (normals need the inverse transpose) and a mirror in x.
-  const glm::mat4 shear = glm::translate(glm::mat4(1), glm::vec3(0, 0, 5)) * glm::rotate(glm::mat4(1), float(M_PI / 2), glm::vec3(1, 0, 0)) *
+  const glm::mat4 shear = glm::translate(glm::mat4(1), glm::vec3(0, 0, 5)) *
+                          glm::rotate(glm::mat4(1), float(M_PI / 2), glm::vec3(1, 0, 0)) *
                           glm::scale(glm::mat4(1), glm::vec3(1, 3, 1));
   const glm::mat4 mirror = glm::scale(glm::mat4(1), glm::vec3(-1, 1, 1));
   s.instances = {{0, shear}, {0, mirror}};

@@ -44,7 +44,8 @@ TEST(GltfReader, SameTriangleFromGltfBinDataUriAndGlb) {
   const int idx = b.indices({0, 1, 2});
   const std::string rest = meshJson(pos, idx, ",\"NORMAL\":" + std::to_string(nrm)) + "," + kOneNode;
   std::filesystem::copy_file(b.writeGlb(dir, "bin", rest), dir / "UPPER.GLB");  // the extension in any case
-  for (const auto& file : {b.writeGltf(dir, "ext", rest), b.writeEmbedded(dir, "uri", rest), b.writeGlb(dir, "bin", rest), dir / "UPPER.GLB"}) {
+  for (const auto& file :
+       {b.writeGltf(dir, "ext", rest), b.writeEmbedded(dir, "uri", rest), b.writeGlb(dir, "bin", rest), dir / "UPPER.GLB"}) {
     SCOPED_TRACE(file.string());
     const Scene s = loadScene(file);
     ASSERT_EQ(s.meshes.size(), 1u);
@@ -82,10 +83,12 @@ TEST(GltfReader, InterleavedStrideNormalizedAndQuantizedComponents) {
   const int8_t uv1[3][2] = {{-128, -127}, {127, 64}, {0, -64}};
   const int uv1v = b.view(uv1, sizeof uv1);
   const int uv1a = b.accessor(uv1v, 5120, 3, "VEC2", "\"normalized\":true");
-  const Scene s = loadScene(b.writeGlb(dir, "q",
-                                       meshJson(pos, -1, ",\"TEXCOORD_0\":" + std::to_string(uv) + ",\"NORMAL\":" + std::to_string(nrm) +
-                                                             ",\"TEXCOORD_1\":" + std::to_string(uv1a)) +
-                                           ",\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"]," + kOneNode));
+  const Scene s = loadScene(b.writeGlb(
+      dir, "q",
+      meshJson(pos, -1,
+               ",\"TEXCOORD_0\":" + std::to_string(uv) + ",\"NORMAL\":" + std::to_string(nrm) +
+                   ",\"TEXCOORD_1\":" + std::to_string(uv1a)) +
+          ",\"extensionsUsed\":[\"KHR_mesh_quantization\"],\"extensionsRequired\":[\"KHR_mesh_quantization\"]," + kOneNode));
   const Mesh& m = s.meshes.at(0);
   EXPECT_EQ(m.positions[1], glm::vec3(300, 0, 0));
   EXPECT_EQ(m.positions[2], glm::vec3(0, -200, 7));
@@ -124,7 +127,8 @@ TEST(GltfReader, StripsAndFansBecomeListsPointsAndLinesAreSkippedWithOneNote) {
   const int pos = b.floats(std::vector<glm::vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}}, "VEC3");
   const int nrm = b.floats(std::vector<glm::vec3>(5, {0, 0, 1}), "VEC3");
   auto load = [&](int mode, const std::string& name, Notes& n) {
-    return loadScene(b.writeGlb(dir, name, meshJson(pos, -1, ",\"NORMAL\":" + std::to_string(nrm), mode) + "," + kOneNode), n.options());
+    return loadScene(b.writeGlb(dir, name, meshJson(pos, -1, ",\"NORMAL\":" + std::to_string(nrm), mode) + "," + kOneNode),
+                     n.options());
   };
   Notes n;
   // Strip: (0,1,2), (1,3,2), (2,3,4): every triangle keeps the first one's winding.
@@ -133,8 +137,10 @@ TEST(GltfReader, StripsAndFansBecomeListsPointsAndLinesAreSkippedWithOneNote) {
   EXPECT_EQ(load(6, "fan", n).meshes.at(0).indices, (std::vector<uint32_t>{1, 2, 0, 2, 3, 0, 3, 4, 0}));
   EXPECT_TRUE(n.notes.empty());
   // A mesh of points and one of triangles: the points are left out with one note.
-  const std::string two = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":0},{\"attributes\":{\"POSITION\":0},\"mode\":1},"
-                          "{\"attributes\":{\"POSITION\":0}}]}]," + kOneNode;
+  const std::string two =
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":0},{\"attributes\":{\"POSITION\":0},\"mode\":1},"
+      "{\"attributes\":{\"POSITION\":0}}]}]," +
+      kOneNode;
   const Scene s = loadScene(b.writeGlb(dir, "points", two), n.options());
   EXPECT_EQ(s.meshes.size(), 1u);
   ASSERT_EQ(n.notes.size(), 1u);
@@ -177,7 +183,8 @@ TEST(GltfReader, NodeHierarchyBecomesInstancesOfOneMesh) {
   EXPECT_NEAR(q.y, 3, 1e-6);
   EXPECT_NEAR(q.z, 3, 1e-6);
   // A rotation quaternion: 90° about y takes +x to -z.
-  const std::string rot = meshJson(pos) + ",\"nodes\":[{\"rotation\":[0,0.70710678,0,0.70710678],\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
+  const std::string rot =
+      meshJson(pos) + ",\"nodes\":[{\"rotation\":[0,0.70710678,0,0.70710678],\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
   const glm::vec3 r = apply(loadScene(b.writeGlb(dir, "r", rot)).instances.at(0).transform, {1, 0, 0});
   EXPECT_NEAR(r.x, 0, 1e-6);
   EXPECT_NEAR(r.z, -1, 1e-6);
@@ -190,7 +197,8 @@ TEST(GltfReader, AtMostTenWarningsThenTheCount) {
   b.floats(kTri, "VEC3");
   b.indices({0, 1, 2, 0});  // 4 indices: the last one is left out, with a warning
   std::string meshes = "\"meshes\":[";
-  for (int i = 0; i < 12; ++i) meshes += std::string(i ? "," : "") + "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}";
+  for (int i = 0; i < 12; ++i)
+    meshes += std::string(i ? "," : "") + "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}";
   std::string nodes = "],\"nodes\":[";
   for (int i = 0; i < 12; ++i) nodes += std::string(i ? "," : "") + "{\"mesh\":" + std::to_string(i) + "}";
   Notes n;
@@ -205,8 +213,9 @@ TEST(GltfReader, AnimationsSkinsAndMorphTargetsGetOneNote) {
   const auto dir = test::tempFolder("anim");
   GltfBuilder b;
   const int pos = b.floats(kTri, "VEC3");
-  const std::string rest = "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":0}]}]}],"
-                           "\"nodes\":[{\"mesh\":0,\"weights\":[0.5]}],\"scenes\":[{\"nodes\":[0]}],\"animations\":[{\"channels\":[],\"samplers\":[]}]";
+  const std::string rest =
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":0}]}]}],"
+      "\"nodes\":[{\"mesh\":0,\"weights\":[0.5]}],\"scenes\":[{\"nodes\":[0]}],\"animations\":[{\"channels\":[],\"samplers\":[]}]";
   (void)pos;
   Notes n;
   const Scene s = loadScene(b.writeGlb(dir, "a", rest), n.options());
@@ -220,8 +229,9 @@ TEST(GltfReader, UsedExtensionsGetANoteRequiredOnesAreRead) {
   GltfBuilder b;
   const int pos = b.floats(kTri, "VEC3");
   Notes n;
-  loadScene(b.writeGlb(dir, "e", meshJson(pos) + ",\"extensionsUsed\":[\"KHR_materials_sheen\",\"KHR_texture_transform\"]," + kOneNode),
-            n.options());
+  loadScene(
+      b.writeGlb(dir, "e", meshJson(pos) + ",\"extensionsUsed\":[\"KHR_materials_sheen\",\"KHR_texture_transform\"]," + kOneNode),
+      n.options());
   ASSERT_EQ(n.notes.size(), 1u);
   EXPECT_THAT(n.notes[0], HasSubstr("KHR_materials_sheen"));
   EXPECT_THAT(n.notes[0], ::testing::Not(HasSubstr("KHR_texture_transform")));

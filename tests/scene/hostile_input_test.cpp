@@ -35,9 +35,7 @@ struct Hostile : ::testing::Test {
   std::string loadError(const fs::path& file, const LoadOptions& o = {}) {
     try {
       loadScene(file, o);
-    } catch (const Error& e) {
-      return e.what();
-    }
+    } catch (const Error& e) { return e.what(); }
     return "(no error)";
   }
 };
@@ -63,9 +61,7 @@ TEST_F(Hostile, ClusteringRefusesWhatMeshoptimizerWouldAbortOn) {
   try {
     buildClusters(m, true);
     ADD_FAILURE() << "clustered";
-  } catch (const Error& e) {
-    EXPECT_THAT(e.what(), HasSubstr("mesh 'm': position 1 is not finite or beyond ±1e12"));
-  }
+  } catch (const Error& e) { EXPECT_THAT(e.what(), HasSubstr("mesh 'm': position 1 is not finite or beyond ±1e12")); }
   m.positions[1].y = std::numeric_limits<float>::quiet_NaN();
   EXPECT_THROW(buildClusters(m, true), Error);
 }
@@ -106,7 +102,8 @@ TEST_F(Hostile, CourseMeshCoordinateLimitNamesTheByte) {
   s.materials.emplace_back();
   const std::string bytes = encodeCourseMesh(s);
   std::ofstream(dir / "x.comp5892mesh", std::ios::binary) << bytes;
-  EXPECT_THAT(loadError(dir / "x.comp5892mesh"), ::testing::MatchesRegex(".*x\\.comp5892mesh: byte [0-9]+: mesh 0: position 2 is beyond.*"));
+  EXPECT_THAT(loadError(dir / "x.comp5892mesh"),
+              ::testing::MatchesRegex(".*x\\.comp5892mesh: byte [0-9]+: mesh 0: position 2 is beyond.*"));
 }
 
 // A FIFO as scene, as --mtl and as mtllib; /dev/zero as --mtl and as mtllib: errors at once, naming them.
@@ -122,7 +119,8 @@ TEST_F(Hostile, FifosAndDevicesAreRefusedPromptly) {
   // Without the fix the first would block forever: ctest's timeout then fails it.
   EXPECT_THAT(loadError(fifo), HasSubstr("pipe.obj: a FIFO (named pipe), not a regular file"));
   EXPECT_THAT(loadError(obj), HasSubstr("/dev/zero: a character device, not a regular file"));
-  EXPECT_THAT(loadError(write("u.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), devZero), HasSubstr("/dev/zero: a character device"));
+  EXPECT_THAT(loadError(write("u.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), devZero),
+              HasSubstr("/dev/zero: a character device"));
   EXPECT_THAT(loadError(fifoLib), HasSubstr("pipe.obj: a FIFO"));
   EXPECT_THAT(loadError(write("v.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), fifoMtl), HasSubstr("pipe.obj: a FIFO"));
   EXPECT_THAT(loadError("/dev/zero"), HasSubstr("/dev/zero"));

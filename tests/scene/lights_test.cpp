@@ -128,7 +128,9 @@ TEST(Lights, RtrSceneStoresLightsAndStillReadsVersion1) {
   s.lights.clear();
   std::string v1 = encodeRtrScene(s, 1);
   const uint32_t one = 1;
-  const auto view = [](const std::string& b) { return std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(b.data()), b.size()); };
+  const auto view = [](const std::string& b) {
+    return std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(b.data()), b.size());
+  };
   EXPECT_TRUE(decodeRtrScene(view(v1), "v1.rtrscene").lights.empty());
   std::memcpy(v1.data() + 28, &one, 4);
   EXPECT_THROW(decodeRtrScene(view(v1), "v1.rtrscene"), Error);
@@ -138,7 +140,9 @@ TEST(Lights, ALightCountTheFileCannotHoldIsRefused) {
   Scene s = bareScene();
   s.lights = {Light{}};
   const std::string good = encodeRtrScene(s);
-  const auto view = [](const std::string& b) { return std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(b.data()), b.size()); };
+  const auto view = [](const std::string& b) {
+    return std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(b.data()), b.size());
+  };
   // The light count beyond what the file holds, before anything is allocated.
   std::string big = good;
   const uint32_t huge = 0x10000000u;

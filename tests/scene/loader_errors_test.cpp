@@ -37,18 +37,14 @@ Scene sample() {
 std::string courseError(const std::string& bytes) {
   try {
     decodeCourseMesh({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "x.comp5892mesh");
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
 std::string rtrError(const std::string& bytes) {
   try {
     decodeRtrScene({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, "x.rtrscene");
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -68,7 +64,8 @@ TEST(CourseLoader, AcceptsTheSampleAndRefusesDamage) {
   const std::string good = encodeCourseMesh(sample());
   ASSERT_EQ(good.size(), 206u);
   EXPECT_EQ(courseError(good), "(no error)");
-  EXPECT_THAT(courseError(good.substr(0, 100)), HasSubstr("x.comp5892mesh: byte 90: mesh 0: 3 vertices and 3 indices cannot fit"));
+  EXPECT_THAT(courseError(good.substr(0, 100)),
+              HasSubstr("x.comp5892mesh: byte 90: mesh 0: 3 vertices and 3 indices cannot fit"));
   EXPECT_THAT(courseError(good + "x"), HasSubstr("1 bytes after the last mesh"));
   std::string b = good;
   b[3] = 'X';

@@ -92,7 +92,7 @@ TEST(Triangulate, ConcavePolygonsAreEarClipped) {
   std::vector<glm::vec3> lr(l.rbegin(), l.rend());
   expectCovers(lr, triangulate(lr), true);
   // A U with collinear corners along its bottom and sides, starting at a reflex corner.
-  const std::vector<glm::vec3> u{{2, 3, 0}, {2, 1, 0}, {1, 1, 0}, {1, 3, 0}, {0, 3, 0}, {0, 1.5f, 0},
+  const std::vector<glm::vec3> u{{2, 3, 0}, {2, 1, 0},    {1, 1, 0}, {1, 3, 0}, {0, 3, 0}, {0, 1.5f, 0},
                                  {0, 0, 0}, {1.5f, 0, 0}, {3, 0, 0}, {4, 0, 0}, {4, 3, 0}, {3, 3, 0}};
   const Tris tu = triangulate(u);
   expectCovers(u, tu, true);
@@ -121,8 +121,13 @@ TEST(Triangulate, AssimpConcavePolygonKeepsItsArea) {
     std::istringstream ls(line);
     std::string k;
     ls >> k;
-    if (k == "v") { glm::vec3 p; ls >> p.x >> p.y >> p.z; v.push_back(p); }
-    if (k == "f") for (std::string c; ls >> c;) poly.push_back(v.at(std::stoul(c) - 1));
+    if (k == "v") {
+      glm::vec3 p;
+      ls >> p.x >> p.y >> p.z;
+      v.push_back(p);
+    }
+    if (k == "f")
+      for (std::string c; ls >> c;) poly.push_back(v.at(std::stoul(c) - 1));
   }
   ASSERT_GT(poly.size(), 40u);
   LoadOptions o;
@@ -146,7 +151,8 @@ TEST(Triangulate, ObjReaderWarnsAboutSelfIntersectingFaces) {
   ObjOptions o;
   o.warn = [&](const std::string& w) { warnings.push_back(w); };
   auto src = memorySource("v 4 1 0\nv 4 4 0\nv 1 3 0\nv 0 3 0\nv 2 4 0\nf 1 2 3 4 5\n", "t.obj");
-  parseObj(*src, "t.obj", [](const std::string&) { return std::nullopt; }, o);
+  parseObj(
+      *src, "t.obj", [](const std::string&) { return std::nullopt; }, o);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_THAT(warnings[0], HasSubstr("t.obj:6: polygon of 5 corners crosses itself"));
 }
@@ -181,7 +187,10 @@ TEST(ClassicMtl, DissolveAndTransparencyAreRecorded) {
 TEST(TextureFallback, Checker) {
   const TexelData c = fallbackTexels(4);
   ASSERT_EQ(c.texels.size(), size_t(c.width) * c.height * 4);
-  auto px = [&](uint32_t x, uint32_t y) { const uint8_t* p = &c.texels[(size_t(y) * c.width + x) * 4]; return std::array<int, 4>{p[0], p[1], p[2], p[3]}; };
+  auto px = [&](uint32_t x, uint32_t y) {
+    const uint8_t* p = &c.texels[(size_t(y) * c.width + x) * 4];
+    return std::array<int, 4>{p[0], p[1], p[2], p[3]};
+  };
   EXPECT_EQ(px(0, 0), (std::array<int, 4>{255, 0, 255, 255}));
   EXPECT_EQ(px(8, 0), (std::array<int, 4>{0, 0, 0, 255}));
   EXPECT_EQ(px(8, 8), px(0, 0));
@@ -203,8 +212,12 @@ TEST(TextureFallback, MissingAndBrokenTexturesDecodeToTheChecker) {
   std::vector<std::string> warnings;
   std::mutex mu;
   const uint32_t which[] = {0, 1, 2};
-  decodeTextures(s, which, [&](size_t i, TexelData&& t) { got[i] = std::move(t); },
-                 [&](const std::string& w) { const std::lock_guard l(mu); warnings.push_back(w); });
+  decodeTextures(
+      s, which, [&](size_t i, TexelData&& t) { got[i] = std::move(t); },
+      [&](const std::string& w) {
+        const std::lock_guard l(mu);
+        warnings.push_back(w);
+      });
   EXPECT_EQ(got[0].texels, fallbackTexels(4).texels);
   EXPECT_EQ(got[1].texels, fallbackTexels(1).texels);
   EXPECT_NE(got[2].texels, fallbackTexels(4).texels);

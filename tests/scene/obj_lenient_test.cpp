@@ -39,9 +39,7 @@ struct Dir : ::testing::Test {
   std::string errorOf(const fs::path& file) {
     try {
       loadScene(file, opt);
-    } catch (const Error& e) {
-      return e.what();
-    }
+    } catch (const Error& e) { return e.what(); }
     return "(no error)";
   }
   const Material& materialOf(const Scene& s, size_t mesh) { return s.materials.at(s.meshes.at(mesh).material); }
@@ -132,7 +130,9 @@ TEST_F(Dir, EmptyMaterialNameWarnsAndWorks) {
 }
 
 TEST_F(Dir, NotAnObjIsAnErrorNamingTheFile) {
-  write("utf16.obj", std::string("\xFE\xFF\0v\0 \0" "0", 9));
+  write("utf16.obj", std::string("\xFE\xFF\0v\0 \0"
+                                 "0",
+                                 9));
   EXPECT_THAT(errorOf(dir / "utf16.obj"), HasSubstr("utf16.obj: UTF-16 text"));
   write("nul.obj", std::string("v 0 0 0\nv 1 0 0\0\0\0", 18));
   EXPECT_THAT(errorOf(dir / "nul.obj"), HasSubstr("nul.obj: byte 15: control byte 0x00"));
@@ -199,8 +199,6 @@ TEST(AssimpModels, ReadLikeOtherLoaders) {
     try {
       loadScene(kAssimp / f, o);
       ADD_FAILURE() << f << " accepted";
-    } catch (const Error& e) {
-      EXPECT_THAT(e.what(), HasSubstr((kAssimp / f).string())) << f;
-    }
+    } catch (const Error& e) { EXPECT_THAT(e.what(), HasSubstr((kAssimp / f).string())) << f; }
   }
 }

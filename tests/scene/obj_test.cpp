@@ -32,20 +32,21 @@ Parsed parse(const std::string& obj, std::map<std::string, std::string> mtls = {
   opt.warn = [&](const std::string& w) { r.warnings.push_back(w); };
   opt.threads = 2;
   auto src = memorySource(obj, "test.obj", zstd);
-  r.scene = parseObj(*src, "test.obj", [&](const std::string& n) -> std::optional<std::string> {
-    auto it = mtls.find(n);
-    if (it == mtls.end()) return std::nullopt;
-    return it->second;
-  }, opt, &r.stats);
+  r.scene = parseObj(
+      *src, "test.obj",
+      [&](const std::string& n) -> std::optional<std::string> {
+        auto it = mtls.find(n);
+        if (it == mtls.end()) return std::nullopt;
+        return it->second;
+      },
+      opt, &r.stats);
   return r;
 }
 
 std::string errorOf(const std::string& obj, std::map<std::string, std::string> mtls = {}) {
   try {
     parse(obj, mtls);
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -120,9 +121,11 @@ TEST(Obj, DegenerateTrianglesAreSkippedAndCounted) {
 
 TEST(Obj, OneMeshPerObjectAndMaterial) {
   const std::string mtl = "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n";
-  Parsed p = parse("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
-                   "o A\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 2 3\nusemtl red\nf 1 3 2\n"
-                   "o B\nf 1 2 3\n", {{"a.mtl", mtl}});
+  Parsed p = parse(
+      "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+      "o A\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 2 3\nusemtl red\nf 1 3 2\n"
+      "o B\nf 1 2 3\n",
+      {{"a.mtl", mtl}});
   ASSERT_EQ(p.scene.meshes.size(), 3u);
   EXPECT_EQ(p.scene.meshes[0].name, "A");
   EXPECT_EQ(p.scene.materials[p.scene.meshes[0].material].name, "red");
@@ -134,8 +137,10 @@ TEST(Obj, OneMeshPerObjectAndMaterial) {
 TEST(Obj, WithoutGroupsEachUsemtlRunIsAnObject) {
   // Two light quads with the same material and no o/g lines must stay two meshes (two area lights).
   const std::string mtl = "newmtl light\nKe 1 1 1\n";
-  Parsed p = parse("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-                   "usemtl light\nf 1 2 3 4\nusemtl light\nf 1 3 2\n", {{"a.mtl", mtl}});
+  Parsed p = parse(
+      "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+      "usemtl light\nf 1 2 3 4\nusemtl light\nf 1 3 2\n",
+      {{"a.mtl", mtl}});
   ASSERT_EQ(p.scene.meshes.size(), 2u);
   EXPECT_EQ(p.scene.meshes[0].triangleCount(), 2u);
   EXPECT_EQ(p.scene.meshes[1].triangleCount(), 1u);
@@ -163,7 +168,8 @@ TEST(Obj, MaterialFieldsTexturesAndFlags) {
   // Ids at first appearance, de-duplicated: stone_col 0, stone_r 1, stone_m 2, stone_n 3, leaf 4, fire 5.
   ASSERT_EQ(p.scene.textures.size(), 6u);
   EXPECT_EQ(ms[0].textures, (std::array<uint32_t, kTextureSlotCount>{0, 1, 2, kNoTexture, 3, kNoTexture, kNoTexture}));
-  EXPECT_EQ(ms[1].textures, (std::array<uint32_t, kTextureSlotCount>{4, kNoTexture, kNoTexture, 4, kNoTexture, kNoTexture, kNoTexture}));
+  EXPECT_EQ(ms[1].textures,
+            (std::array<uint32_t, kTextureSlotCount>{4, kNoTexture, kNoTexture, 4, kNoTexture, kNoTexture, kNoTexture}));
   EXPECT_EQ(ms[1].flags, kMaterialAlphaMasked | kMaterialDoubleSided);
   EXPECT_EQ(ms[2].flags, kMaterialLight);
   EXPECT_EQ(ms[2].emissive, glm::vec3(2, 1, 0.5f));
@@ -198,7 +204,8 @@ TEST(Obj, CrlfAndCommentsAndLastLineWithoutNewline) {
 TEST(Obj, ZstdStreamGivesTheSameScene) {
   std::string big = "o big\n";
   for (int i = 0; i < 20000; ++i) big += "v " + std::to_string(i) + " " + std::to_string(i % 7) + " 0.5\n";
-  for (int i = 1; i + 2 <= 20000; i += 2) big += "f " + std::to_string(i) + " " + std::to_string(i + 1) + " " + std::to_string(i + 2) + "\n";
+  for (int i = 1; i + 2 <= 20000; i += 2)
+    big += "f " + std::to_string(i) + " " + std::to_string(i + 1) + " " + std::to_string(i + 2) + "\n";
   Parsed plain = parse(big);
   Parsed z = parse(compress(big), {}, true);
   ASSERT_EQ(plain.scene.meshes.size(), 1u);

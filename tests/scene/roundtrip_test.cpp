@@ -169,9 +169,7 @@ TEST(RoundTrip, MappedFileLoadsWhatTheBytesDecodeTo) {
     try {
       loadRtrScene(dir / f);
       ADD_FAILURE() << f << " loaded";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
-    }
+    } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what(); }
   }
   std::filesystem::remove_all(dir);
 }

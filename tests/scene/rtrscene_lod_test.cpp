@@ -21,8 +21,7 @@ Scene wavyGrid(uint32_t n) {
   Mesh m;
   m.name = "grid";
   for (uint32_t y = 0; y <= n; ++y)
-    for (uint32_t x = 0; x <= n; ++x)
-      m.positions.push_back({float(x), 0.3f * std::sin(0.7f * x) * std::cos(0.5f * y), float(y)});
+    for (uint32_t x = 0; x <= n; ++x) m.positions.push_back({float(x), 0.3f * std::sin(0.7f * x) * std::cos(0.5f * y), float(y)});
   for (uint32_t y = 0; y < n; ++y)
     for (uint32_t x = 0; x < n; ++x) {
       const uint32_t a = y * (n + 1) + x;
@@ -129,8 +128,8 @@ TEST(RtrSceneLod, DamageIsRefusedWithItsOffset) {
     expectRefused(bad, e.expect);
   }
   // A repeated chunk.
-  expectRefused(good + good.substr(body - 16), "byte " + std::to_string(good.size()) +
-                                                   ": chunk 'CLOD' repeated (first at byte " + std::to_string(body - 16));
+  expectRefused(good + good.substr(body - 16),
+                "byte " + std::to_string(good.size()) + ": chunk 'CLOD' repeated (first at byte " + std::to_string(body - 16));
 }
 
 }  // namespace

@@ -64,9 +64,7 @@ Scene decode(const std::string& bytes, unsigned threads) {
 std::string decodeError(const std::string& bytes, unsigned threads) {
   try {
     decode(bytes, threads);
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -143,7 +141,8 @@ TEST(RtrSceneParallel, TheFirstFaultInTheFileIsReportedAtAnyThreadCount) {
   reseal(b);
   for (unsigned threads : {1u, 2u, 8u}) {
     SCOPED_TRACE(std::to_string(threads) + " threads");
-    EXPECT_THAT(decodeError(b, threads), HasSubstr("p.rtrscene: byte " + std::to_string(posAt) + ": mesh 0: position 7 is not finite"));
+    EXPECT_THAT(decodeError(b, threads),
+                HasSubstr("p.rtrscene: byte " + std::to_string(posAt) + ": mesh 0: position 7 is not finite"));
   }
 }
 
@@ -181,7 +180,8 @@ TEST(RtrSceneParallel, PieceChecksumIsItsDefinitionAtAnyThreadCount) {
     for (size_t at = 0; at < size; at += kChecksumPiece)
       sums.push_back(checksum64(d.subspan(at, std::min(kChecksumPiece, size - at))));
     const uint64_t want = checksum64({reinterpret_cast<const uint8_t*>(sums.data()), sums.size() * 8});
-    for (unsigned threads : {1u, 3u, 0u}) EXPECT_EQ(pieceChecksum64(d, threads), want) << size << " bytes, " << threads << " threads";
+    for (unsigned threads : {1u, 3u, 0u})
+      EXPECT_EQ(pieceChecksum64(d, threads), want) << size << " bytes, " << threads << " threads";
   }
   // Two pieces swapped: a different sum.
   std::vector<uint8_t> swapped = data;

@@ -78,9 +78,7 @@ std::string decodeError(const std::string& bytes) {
   try {
     const Scene s = decodeRtrScene(span(bytes), "t.rtrscene", 1);
     for (const Texture& t : s.textures) unpackAll(*t.baked);  // the pieces' own faults show on unpacking
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -163,8 +161,8 @@ TEST(RtrSceneTexs, DamagedChunksAreRefusedWithTheByteOffset) {
   std::memcpy(&firstPiece, good.data() + table, 8);
   frame[body + firstPiece + 40] ^= 0x5A;
   reseal(frame);
-  EXPECT_THAT(decodeError(frame), HasSubstr("t.rtrscene: byte " + std::to_string(body + firstPiece) +
-                                            ": baked texture piece 0 does not unpack"));
+  EXPECT_THAT(decodeError(frame),
+              HasSubstr("t.rtrscene: byte " + std::to_string(body + firstPiece) + ": baked texture piece 0 does not unpack"));
 }
 
 // BC4 as Vulkan's data format specification decodes it (values written out here from its formulas), and
@@ -189,7 +187,8 @@ TEST(RtrSceneTexs, BlockCompressedLevelsDecodeAsSpecifiedAndRoundTrip) {
   // Smooth texels: within (max − min) / 14 of the block, plus rounding.
   std::vector<uint8_t> smooth(21 * 10);
   for (size_t i = 0; i < smooth.size(); ++i) smooth[i] = uint8_t(40 + (i % 21) * 5 + (i / 21) * 3);
-  const std::vector<uint8_t> back = decodeBakedLevel(BakedFormat::Bc4, 21, 10, encodeBakedLevel(BakedFormat::Bc4, 21, 10, smooth.data()).data());
+  const std::vector<uint8_t> back =
+      decodeBakedLevel(BakedFormat::Bc4, 21, 10, encodeBakedLevel(BakedFormat::Bc4, 21, 10, smooth.data()).data());
   for (size_t i = 0; i < smooth.size(); ++i) EXPECT_LE(std::abs(int(back[i]) - int(smooth[i])), 2) << i;
 
   Scene s = bakedScene();

@@ -100,9 +100,7 @@ const std::span<const uint8_t> span(const std::string& b) { return {reinterpret_
 std::string decodeError(const std::string& bytes, unsigned threads = 1) {
   try {
     decodeRtrScene(span(bytes), "v5.rtrscene", threads);
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "(no error)";
 }
 
@@ -149,7 +147,8 @@ TEST(RtrSceneV5, KeepsEverythingTheSceneModelHolds) {
 TEST(RtrSceneV5, OlderVersionsStillLoadAsBefore) {
   const auto seeds = test::sourceDir() / "tests/fuzz/corpus/fuzz_rtrscene";
   std::set<uint32_t> versions;
-  for (const char* f : {"cornell_box.rtrscene", "textured.rtrscene", "cube_backplane-v3.rtrscene", "cube_backplane-v4.rtrscene"}) {
+  for (const char* f :
+       {"cornell_box.rtrscene", "textured.rtrscene", "cube_backplane-v3.rtrscene", "cube_backplane-v4.rtrscene"}) {
     SCOPED_TRACE(f);
     const auto raw = readFileBytes(seeds / f);
     const std::string bytes(raw.begin(), raw.end());

@@ -17,8 +17,7 @@ const float kMetalness[] = {0.0f, 0.5f, 1.0f};
 
 // Unit vector at polar angle theta from +z, azimuth phi, in double then rounded.
 glm::vec3 dir(double theta, double phi) {
-  return glm::vec3(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-                   float(std::cos(theta)));
+  return glm::vec3(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)));
 }
 
 // Rotates +z onto unit n (any orthonormal frame will do).
@@ -45,8 +44,8 @@ Cat classify(float c) {
 TEST(Brdf, DenseGridIsFiniteAndNonNegative) {
   // Polar angles hit exactly 0, tiny, grazing, exactly 90 deg (n.x = cos(pi/2) in float ~ -4e-8) and below.
   const double half = kPi / 2;
-  const double thetas[] = {0.0, 1e-7, 1e-3, 0.5, 1.2, half - 1e-2, half - 1e-4, half - 1e-6, half, half + 1e-6,
-                           half + 1e-3, 2.5, kPi};
+  const double thetas[] = {0.0,         1e-7, 1e-3,        0.5,         1.2, half - 1e-2, half - 1e-4,
+                           half - 1e-6, half, half + 1e-6, half + 1e-3, 2.5, kPi};
   const double phis[] = {0.0, 0.7, kPi / 2, kPi - 1e-6, kPi, 4.0};
   std::vector<glm::vec3> dirs;
   for (double t : thetas)
@@ -54,9 +53,9 @@ TEST(Brdf, DenseGridIsFiniteAndNonNegative) {
   dirs.push_back(glm::vec3(1, 0, 0));  // exactly in the tangent plane
   dirs.push_back(glm::vec3(-1, 0, 0));
 
-  const glm::vec3 normals[] = {glm::vec3(0, 0, 1), glm::normalize(glm::vec3(0.3f, -0.2f, 0.9f)),
-                               glm::vec3(0, 0, 1e-3f), glm::vec3(0, 0, 1e-20f), glm::vec3(0),
-                               glm::vec3(0, 0, -1)};
+  const glm::vec3 normals[] = {glm::vec3(0, 0, 1),     glm::normalize(glm::vec3(0.3f, -0.2f, 0.9f)),
+                               glm::vec3(0, 0, 1e-3f), glm::vec3(0, 0, 1e-20f),
+                               glm::vec3(0),           glm::vec3(0, 0, -1)};
   const glm::vec3 base(0.9f, 0.5f, 0.1f), light(1.0f), ambient(0.02f), emissive(0.0f);
 
   int cover[4][kCats] = {};  // n.l, n.v, n.h, v.h
@@ -67,7 +66,7 @@ TEST(Brdf, DenseGridIsFiniteAndNonNegative) {
       glm::vec3 v = toFrame(dirs[i], un);
       for (size_t j = 0; j < dirs.size() + 2; ++j) {
         // The two extra l's: exactly opposite v, and opposite v up to 1e-6 (the v.h -> 0 corner).
-        glm::vec3 l = j < dirs.size() ? toFrame(dirs[j], un)
+        glm::vec3 l = j < dirs.size()    ? toFrame(dirs[j], un)
                       : j == dirs.size() ? -v
                                          : glm::normalize(-v + 1e-6f * toFrame(glm::vec3(0, 0, 1), un));
         if (n == normals[0]) {
@@ -87,9 +86,9 @@ TEST(Brdf, DenseGridIsFiniteAndNonNegative) {
               ++evaluated;
               ASSERT_TRUE(finiteNonNeg(t.D) && finiteNonNeg(t.F) && finiteNonNeg(t.G) && finiteNonNeg(t.diffuse) &&
                           finiteNonNeg(t.specular) && finiteNonNeg(L))
-                  << "n " << n.x << ' ' << n.y << ' ' << n.z << " v " << v.x << ' ' << v.y << ' ' << v.z << " l "
-                  << l.x << ' ' << l.y << ' ' << l.z << " r " << r << " m " << m << " brdf " << brdf << ": D " << t.D
-                  << " G " << t.G << " spec " << t.specular.x << " L " << L.x;
+                  << "n " << n.x << ' ' << n.y << ' ' << n.z << " v " << v.x << ' ' << v.y << ' ' << v.z << " l " << l.x << ' '
+                  << l.y << ' ' << l.z << " r " << r << " m " << m << " brdf " << brdf << ": D " << t.D << " G " << t.G
+                  << " spec " << t.specular.x << " L " << L.x;
               ASSERT_LE(t.G, 1.0f);
               ASSERT_LE(t.F.x, 1.0f);
               // The sampling side on the same grid: the density of any l, and draws at extreme numbers.
@@ -168,9 +167,7 @@ TEST(Brdf, MatchesStraightforwardFormulasAtOrdinaryAngles) {
             EXPECT_LT(rel(t.G, r.G), 1e-5);
             for (int k = 0; k < 3; ++k) {
               EXPECT_LT(rel(t.F[k], r.F[k]), 1e-5);
-              if (metal < 1.0f) {
-                EXPECT_LT(rel(t.diffuse[k], r.diffuse[k]), 1e-5);
-              }
+              if (metal < 1.0f) { EXPECT_LT(rel(t.diffuse[k], r.diffuse[k]), 1e-5); }
               EXPECT_LT(rel(t.specular[k], r.specular[k]), 1e-5);
               EXPECT_LT(rel(L[k], r.L[k]), 1e-5);
             }
@@ -287,8 +284,7 @@ TEST(Brdf, RadianceGoesToZeroAsTheLightReachesTheHorizon) {
   const glm::vec3 n(0, 0, 1), v = dir(1.0, 0.0);
   float prev = 1e30f;
   for (double eps : {1e-1, 1e-2, 1e-3, 1e-5, 1e-7}) {
-    glm::vec3 L = shadePbr(n, v, dir(kPi / 2 - eps, kPi), glm::vec3(1), glm::vec3(0), glm::vec3(1), 0.3f, 1.0f,
-                           glm::vec3(0));
+    glm::vec3 L = shadePbr(n, v, dir(kPi / 2 - eps, kPi), glm::vec3(1), glm::vec3(0), glm::vec3(1), 0.3f, 1.0f, glm::vec3(0));
     EXPECT_LT(L.x, prev);
     prev = L.x;
   }
@@ -297,8 +293,8 @@ TEST(Brdf, RadianceGoesToZeroAsTheLightReachesTheHorizon) {
 
 // glTF 2.0 Appendix B as written, in double: D_GGX, the height-correlated V, and the metal-rough mix
 // material = mix(dielectric_brdf, metal_brdf, metallic) with its Fresnel mixes.
-Ref gltfReference(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, glm::dvec3 c, double rough, double metal,
-                  glm::dvec3 light, glm::dvec3 ambient, glm::dvec3 emit) {
+Ref gltfReference(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, glm::dvec3 c, double rough, double metal, glm::dvec3 light,
+                  glm::dvec3 ambient, glm::dvec3 emit) {
   Ref r{};
   n = glm::normalize(n), v = glm::normalize(v), l = glm::normalize(l);
   glm::dvec3 h = glm::normalize(v + l);
@@ -343,9 +339,7 @@ TEST(BrdfGgx, MatchesTheGltfSpecAtOrdinaryAngles) {
             EXPECT_LT(rel(t.G, r.G), 1e-5);
             for (int k = 0; k < 3; ++k) {
               EXPECT_LT(rel(t.F[k], r.F[k]), 1e-5);
-              if (metal < 1.0f) {
-                EXPECT_LT(rel(t.diffuse[k], r.diffuse[k]), 1e-5);
-              }
+              if (metal < 1.0f) { EXPECT_LT(rel(t.diffuse[k], r.diffuse[k]), 1e-5); }
               EXPECT_LT(rel(t.specular[k], r.specular[k]), tol);
               EXPECT_LT(rel(L[k], r.L[k]), tol);
             }
@@ -429,8 +423,8 @@ TEST(BrdfGgx, HardCasesStayFiniteAndHemispheresBehave) {
   // The light reaching the horizon: the radiance goes to zero, no flash at the terminator.
   float prev = 1e30f;
   for (double eps : {1e-1, 1e-2, 1e-3, 1e-5, 1e-7}) {
-    glm::vec3 L = shadePbr(BRDF_GGX, n, dir(1.0, 0.0), dir(kPi / 2 - eps, kPi), glm::vec3(1), glm::vec3(0),
-                           glm::vec3(1), 0.3f, 1.0f, glm::vec3(0));
+    glm::vec3 L = shadePbr(BRDF_GGX, n, dir(1.0, 0.0), dir(kPi / 2 - eps, kPi), glm::vec3(1), glm::vec3(0), glm::vec3(1), 0.3f,
+                           1.0f, glm::vec3(0));
     EXPECT_LT(L.x, prev);
     prev = L.x;
   }
@@ -449,7 +443,7 @@ TEST(BrdfGgx, SelectorPicksTheModel) {
   EXPECT_EQ(a.specular, b.specular);
   const BrdfTerms g = brdfTerms(BRDF_GGX, n, v, l, c, 0.4f, 0.3f);
   EXPECT_NE(g.D, a.D);
-  EXPECT_EQ(g.F, a.F);  // one Fresnel
+  EXPECT_EQ(g.F, a.F);              // one Fresnel
   EXPECT_NE(g.diffuse, a.diffuse);  // glTF weights the diffuse by the dielectric's Fresnel
 }
 

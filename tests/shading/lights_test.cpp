@@ -48,7 +48,9 @@ TEST(Lights, SpotEdgeIsTheSquaredRampInTheCosine) {
     prev = got;
   }
   // Continuous at both edges.
-  const auto factor = [&](float deg) { return lightSample(s, atAngle(deg)).radiance.x * glm::dot(atAngle(deg), atAngle(deg)) / kColor.x; };
+  const auto factor = [&](float deg) {
+    return lightSample(s, atAngle(deg)).radiance.x * glm::dot(atAngle(deg), atAngle(deg)) / kColor.x;
+  };
   EXPECT_NEAR(factor(19.999f), factor(20.001f), 3e-4f);
   EXPECT_NEAR(factor(29.999f), 0.0f, 1e-6f);
   // A spot pointing elsewhere turns the same way: the cone follows `direction`.

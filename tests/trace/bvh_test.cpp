@@ -19,7 +19,10 @@ Hit bruteForce(const std::vector<Triangle>& tris, Ray r, IntersectMethod m) {
   for (uint32_t i = 0; i < tris.size(); ++i) {
     float b1, b2;
     const float t = intersect(m, r, tris[i], b1, b2);
-    if (t > 0.0f) { best = {t, b1, b2, i}; r.tMax = t; }
+    if (t > 0.0f) {
+      best = {t, b1, b2, i};
+      r.tMax = t;
+    }
   }
   return best;
 }
@@ -38,25 +41,25 @@ TEST(Bvh, MatchesBruteForceOnATriangleSoup) {
   EXPECT_EQ(bvh.stats().triangles, tris.size());
   // Every traversal ISA (those the CPU lacks run as the best one below), every routine.
   for (BvhIsa isa : {BvhIsa::Avx512, BvhIsa::Avx2, BvhIsa::Sse})
-  for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::HalfPlane, IntersectMethod::MollerTrumbore}) {
-    Bvh::setIsa(isa);
-    int hits = 0;
-    for (int i = 0; i < 3000; ++i) {
-      Ray r{{u(rng) * 12, u(rng) * 12, u(rng) * 12}, {u(rng), u(rng), u(rng)}};
-      if (i % 3 == 0) r.direction.y = 0.0f;  // axis-parallel components exercise the slab test's zero case
-      if (i % 7 == 0) r.tMax = 5.0f;
-      const Hit a = bvh.closest(r, m), b = bruteForce(tris, r, m);
-      ASSERT_EQ(a.hit(), b.hit()) << i;
-      ASSERT_EQ(bvh.occluded(r, m), b.hit()) << i;
-      if (a.hit()) {
-        ++hits;
-        EXPECT_EQ(a.t, b.t) << i;
-        EXPECT_EQ(a.prim, b.prim) << i;
-        EXPECT_EQ(a.b1, b.b1) << i;
+    for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::HalfPlane, IntersectMethod::MollerTrumbore}) {
+      Bvh::setIsa(isa);
+      int hits = 0;
+      for (int i = 0; i < 3000; ++i) {
+        Ray r{{u(rng) * 12, u(rng) * 12, u(rng) * 12}, {u(rng), u(rng), u(rng)}};
+        if (i % 3 == 0) r.direction.y = 0.0f;  // axis-parallel components exercise the slab test's zero case
+        if (i % 7 == 0) r.tMax = 5.0f;
+        const Hit a = bvh.closest(r, m), b = bruteForce(tris, r, m);
+        ASSERT_EQ(a.hit(), b.hit()) << i;
+        ASSERT_EQ(bvh.occluded(r, m), b.hit()) << i;
+        if (a.hit()) {
+          ++hits;
+          EXPECT_EQ(a.t, b.t) << i;
+          EXPECT_EQ(a.prim, b.prim) << i;
+          EXPECT_EQ(a.b1, b.b1) << i;
+        }
       }
+      EXPECT_GT(hits, 300);
     }
-    EXPECT_GT(hits, 300);
-  }
   Bvh::setIsa(BvhIsa::Avx512);
 }
 
@@ -120,8 +123,8 @@ TEST(Bvh, AxisParallelRaysThroughVerticesMatchBruteForce) {
   const Mesh sphere = uvSphere({0.25f, -0.5f, 0.125f}, 1.5f, 16, 16);
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
-    tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]],
-                    sphere.positions[sphere.indices[i + 2]]});
+    tris.push_back(
+        {sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
   const Bvh bvh(tris, {}, 1);
   for (BvhIsa isa : {BvhIsa::Avx512, BvhIsa::Avx2, BvhIsa::Sse}) {
     Bvh::setIsa(isa);
@@ -137,9 +140,7 @@ TEST(Bvh, AxisParallelRaysThroughVerticesMatchBruteForce) {
           const Hit a = bvh.closest(r), b = bruteForce(tris, r, IntersectMethod::Watertight);
           ASSERT_EQ(a.hit(), b.hit()) << Bvh::isaName(isa) << " vertex " << v.x << "," << v.y << "," << v.z;
           // Through a vertex, several triangles give the same t up to rounding: any of them may win.
-          if (a.hit()) {
-            ASSERT_NEAR(a.t, b.t, 1e-6f * b.t);
-          }
+          if (a.hit()) { ASSERT_NEAR(a.t, b.t, 1e-6f * b.t); }
           ASSERT_EQ(bvh.occluded(r), b.hit());
           ++rays;
           hits += a.hit();
@@ -147,9 +148,7 @@ TEST(Bvh, AxisParallelRaysThroughVerticesMatchBruteForce) {
           // A vertex well inside the silhouette along this axis: the closed sphere cannot miss.
           glm::vec3 across = off;
           across[axis] = 0.0f;
-          if (glm::length(across) < 1.2f) {
-            EXPECT_TRUE(a.hit());
-          }
+          if (glm::length(across) < 1.2f) { EXPECT_TRUE(a.hit()); }
         }
     // From the centre along each axis and each diagonal of two axes (one or two parallel axes).
     for (int mask = 1; mask < 7; ++mask)
@@ -194,8 +193,8 @@ TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
   const Mesh sphere = uvSphere({0.5f, -0.25f, 2.0f}, 3.0f, 300, 600);  // big enough for parallel binning
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
-    tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]],
-                    sphere.positions[sphere.indices[i + 2]]});
+    tris.push_back(
+        {sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
   tris.insert(tris.end(), 1000, Triangle{{-1, -1, -1}, {1, -1, -1}, {0, 1, -1}});  // one centroid: median splits
   // Non-finite triangles in the first chunks of the parallel reference pass: the chunks after them must
   // close up.
@@ -216,10 +215,12 @@ TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
     EXPECT_EQ(a.root, b.root);
     for (uint32_t i = 0; i < one.stats().nodes; ++i)  // field by field: a Node has padding
       ASSERT_TRUE(!std::memcmp(a.nodes[i].box, b.nodes[i].box, sizeof a.nodes[i].box) &&
-                  !std::memcmp(a.nodes[i].child, b.nodes[i].child, sizeof a.nodes[i].child)) << "node " << i;
+                  !std::memcmp(a.nodes[i].child, b.nodes[i].child, sizeof a.nodes[i].child))
+          << "node " << i;
     for (uint32_t i = 0; i < one.stats().packs; ++i)
       ASSERT_TRUE(!std::memcmp(a.packs[i].v, b.packs[i].v, sizeof a.packs[i].v) &&
-                  !std::memcmp(a.packs[i].prim, b.packs[i].prim, sizeof a.packs[i].prim)) << "pack " << i;
+                  !std::memcmp(a.packs[i].prim, b.packs[i].prim, sizeof a.packs[i].prim))
+          << "pack " << i;
   }
   EXPECT_GT(one.stats().sahCost, 1.0);
   const Bvh::View b = many.view();

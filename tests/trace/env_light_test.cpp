@@ -108,8 +108,8 @@ TEST(EnvironmentLight, UniformSkyGivesTheDirectionalAlbedo) {
       const Mean got = meanOf(img, 0);
       const auto ref = shader::quadrature::directionalAlbedo(brdfId(c.brdf), tv, c.base, c.rough, c.metal);
       EXPECT_NEAR(got.mean, ref.value, 4 * got.se + ref.error + 1e-4)
-          << "brdf " << int(c.brdf) << " base " << c.base.x << " rough " << c.rough << " metal " << c.metal << " view "
-          << tv << " se " << got.se;
+          << "brdf " << int(c.brdf) << " base " << c.base.x << " rough " << c.rough << " metal " << c.metal << " view " << tv
+          << " se " << got.se;
     }
 }
 
@@ -176,7 +176,8 @@ TEST(EnvironmentLight, WhiteFurnaceGivesNoPixelAboveOne) {
     for (float metal : {0.0f, 1.0f})
       for (float rough : {0.0f, 0.25f, 0.5f, 0.75f, 1.0f}) {
         Scene scene;
-        addMesh(scene, uvSphere({0.0f, 0.0f, 0.0f}, 1.0f, 48, 96, addMaterial(scene, pbrMaterial(glm::vec3(1.0f), rough, metal))));
+        addMesh(scene,
+                uvSphere({0.0f, 0.0f, 0.0f}, 1.0f, 48, 96, addMaterial(scene, pbrMaterial(glm::vec3(1.0f), rough, metal))));
         const Tracer tracer(scene);
         TraceSettings ts = envSettings(uniformEnv(), brdf, 1024, 24);
         ts.pose = CameraPose{{0.0f, 0.0f, 4.0f}, 0.0f, 0.0f};
@@ -200,8 +201,8 @@ TEST(EnvironmentLight, WhiteFurnaceGivesNoPixelAboveOne) {
         EXPECT_GT(checked, 40);
         EXPECT_LE(mx, 1.02f) << "brdf " << int(brdf) << " metal " << metal << " rough " << rough;
         EXPECT_GT(mn, 0.25f) << "brdf " << int(brdf) << " metal " << metal << " rough " << rough;
-        std::printf("furnace %s metal %.0f rough %.2f: pixels %.4f .. %.4f\n", brdf == Brdf::Ggx ? "ggx" : "beckmann",
-                    metal, rough, mn, mx);
+        std::printf("furnace %s metal %.0f rough %.2f: pixels %.4f .. %.4f\n", brdf == Brdf::Ggx ? "ggx" : "beckmann", metal,
+                    rough, mn, mx);
       }
 }
 
@@ -256,7 +257,8 @@ TEST(EnvironmentLight, ErrorFallsAsOneOverTheSquareRootOfTheSampleCount) {
   Scene scene;
   const uint32_t ground = addMaterial(scene, pbrMaterial(glm::vec3(0.5f), 0.8f, 0.0f));
   addMesh(scene, quad({-4.0f, -1.0f, 4.0f}, {8.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -8.0f}, ground));
-  addMesh(scene, uvSphere({-1.1f, 0.0f, 0.0f}, 1.0f, 24, 48, addMaterial(scene, pbrMaterial(glm::vec3(0.9f, 0.7f, 0.5f), 0.3f, 1.0f))));
+  addMesh(scene,
+          uvSphere({-1.1f, 0.0f, 0.0f}, 1.0f, 24, 48, addMaterial(scene, pbrMaterial(glm::vec3(0.9f, 0.7f, 0.5f), 0.3f, 1.0f))));
   addMesh(scene, uvSphere({1.1f, 0.0f, 0.0f}, 1.0f, 24, 48, addMaterial(scene, pbrMaterial(glm::vec3(0.8f), 0.5f, 0.0f))));
   const Tracer tracer(scene);
   const auto env = std::make_shared<const Environment>(sunMap(64, 32), 1.0f, 0.3f);

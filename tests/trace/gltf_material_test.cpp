@@ -45,8 +45,8 @@ TEST(GltfMaterial, GltfUsesGgxAndTheRestBeckmannUnlessOverridden) {
   Light l;
   l.position = {0.3f, 0.5f, 2.0f};
   ts.lights = LightRig{{l}, glm::vec3(0.0f), ""};
-  const Ray left{{-0.5f, 0.2f, 3.0f}, glm::normalize(glm::vec3(-0.2f, -0.1f, -1.0f))};   // hits x = -1.1
-  const Ray right{{1.5f, 0.2f, 3.0f}, glm::normalize(glm::vec3(-0.2f, -0.1f, -1.0f))};   // hits x = 0.9
+  const Ray left{{-0.5f, 0.2f, 3.0f}, glm::normalize(glm::vec3(-0.2f, -0.1f, -1.0f))};  // hits x = -1.1
+  const Ray right{{1.5f, 0.2f, 3.0f}, glm::normalize(glm::vec3(-0.2f, -0.1f, -1.0f))};  // hits x = 0.9
   const glm::vec3 objDefault = t.traceAndShade(left, 0, ts), gltfDefault = t.traceAndShade(right, 0, ts);
   ts.brdf = Brdf::Ggx;
   const glm::vec3 objGgx = t.traceAndShade(left, 0, ts);
@@ -87,8 +87,7 @@ Material gltf(glm::vec3 base, uint32_t flags = 0) {
 
 // A 2×2 quad at z = -depth facing +z (or -z: `back`), uv = ((x + 1) / 2, (y + 1) / 2).
 Mesh facing(float depth, uint32_t material, bool back = false) {
-  return back ? quad({-1, -1, -depth}, {0, 2, 0}, {2, 0, 0}, material)
-              : quad({-1, -1, -depth}, {2, 0, 0}, {0, 2, 0}, material);
+  return back ? quad({-1, -1, -depth}, {0, 2, 0}, {2, 0, 0}, material) : quad({-1, -1, -depth}, {2, 0, 0}, {0, 2, 0}, material);
 }
 
 // Straight down -z from z = 0 onto quad point (x, y).
@@ -220,7 +219,8 @@ TEST(GltfMaterial, TextureTransformAndSecondUvSet) {
     q.texcoords1 = q.texcoords;
     // Set 0 is junk where set 1 is the one used; set 1 is the mirror of set 0.
     for (glm::vec2& t : (set == 1 ? q.texcoords1 : q.texcoords)) t = glm::vec2(1.0f) - t;
-    if (set == 1) for (glm::vec2& t : q.texcoords) t = glm::vec2(0.37f);
+    if (set == 1)
+      for (glm::vec2& t : q.texcoords) t = glm::vec2(0.37f);
     addMesh(s, std::move(q));
     const Tracer t(s);
     for (glm::vec2 p : {glm::vec2(0.1f, 0.2f), glm::vec2(-0.6f, 0.7f), glm::vec2(0.5f, -0.3f)}) {
@@ -245,7 +245,11 @@ TEST(GltfMaterial, TextureTransformAndSecondUvSet) {
 
 // glTF samplers' wrap modes address the texels (at texel centres: exactly one texel).
 TEST(GltfMaterial, SamplerWrapModes) {
-  struct Case { Wrap wrap; float u; uint32_t texel; };
+  struct Case {
+    Wrap wrap;
+    float u;
+    uint32_t texel;
+  };
   for (const Case c : {Case{Wrap::Repeat, 1.375f, 1}, Case{Wrap::ClampToEdge, 1.375f, 3}, Case{Wrap::ClampToEdge, 1.875f, 3},
                        Case{Wrap::MirroredRepeat, 1.125f, 3}, Case{Wrap::MirroredRepeat, 1.375f, 2}}) {
     Scene s;
@@ -272,8 +276,8 @@ TEST(GltfMaterial, NormalMapTiltsTheShadingNormalOnTheTangentFrame) {
     Material m = gltf(glm::vec3(0.7f, 0.6f, 0.5f));
     m.roughness = 0.5f;
     m.normalScale = 0.7f;
-    m.textures[uint32_t(TextureSlot::NormalMap)] =
-        addTexture(s, "normal", 4, 4, [&](uint32_t, uint32_t) { return texel; }, false, 4);
+    m.textures[uint32_t(TextureSlot::NormalMap)] = addTexture(
+        s, "normal", 4, 4, [&](uint32_t, uint32_t) { return texel; }, false, 4);
     Mesh q = facing(2, addMaterial(s, m));
     if (variant < 2) q.tangents.assign(q.positions.size(), glm::vec4(1, 0, 0, variant == 0 ? 1.0f : -1.0f));
     addMesh(s, std::move(q));
@@ -284,11 +288,12 @@ TEST(GltfMaterial, NormalMapTiltsTheShadingNormalOnTheTangentFrame) {
     ts.lights = LightRig{{l}, glm::vec3(0.0f), {}};
     const glm::vec3 p(0.1f, 0.2f, -2.0f);
     const float sign = variant == 1 ? -1.0f : 1.0f;
-    const glm::vec3 n = variant == 2 ? glm::vec3(0, 0, 1)
-                                     : glm::normalize(glm::vec3((2 * unorm(texel[0]) - 1) * 0.7f,
-                                                                sign * (2 * unorm(texel[1]) - 1) * 0.7f, 2 * unorm(texel[2]) - 1));
-    const glm::vec3 want = shader::pbrDirect(BRDF_GGX, n, glm::vec3(0, 0, 1), glm::normalize(l.position - p), l.color,
-                                             m.baseColor, 0.5f, 0.0f);
+    const glm::vec3 n = variant == 2
+                            ? glm::vec3(0, 0, 1)
+                            : glm::normalize(glm::vec3((2 * unorm(texel[0]) - 1) * 0.7f, sign * (2 * unorm(texel[1]) - 1) * 0.7f,
+                                                       2 * unorm(texel[2]) - 1));
+    const glm::vec3 want =
+        shader::pbrDirect(BRDF_GGX, n, glm::vec3(0, 0, 1), glm::normalize(l.position - p), l.color, m.baseColor, 0.5f, 0.0f);
     expectNear(at(t, ts), want, "variant " + std::to_string(variant), 2e-5f);
   }
 }
@@ -297,8 +302,12 @@ TEST(GltfMaterial, OcclusionScalesTheAmbientTermByItsStrength) {
   Scene s;
   Material m = gltf(glm::vec3(0.8f, 0.5f, 0.25f));
   m.occlusionStrength = 0.5f;
-  m.textures[uint32_t(TextureSlot::Occlusion)] =
-      addTexture(s, "occlusion", 4, 4, [](uint32_t, uint32_t) { return Texel{128, 128, 128, 255}; }, false, 1);
+  m.textures[uint32_t(TextureSlot::Occlusion)] = addTexture(
+      s, "occlusion", 4, 4,
+      [](uint32_t, uint32_t) {
+        return Texel{128, 128, 128, 255};
+      },
+      false, 1);
   addMesh(s, facing(2, addMaterial(s, m)));
   const Tracer t(s);
   const float ao = 1.0f + 0.5f * (unorm(128) - 1.0f);

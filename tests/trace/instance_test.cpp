@@ -34,8 +34,7 @@ Scene instancedScene() {
   const glm::mat4 I(1.0f);
   s.instances = {
       {0, glm::translate(I, {-2.0f, 0.0f, 0.0f})},
-      {0, glm::scale(glm::rotate(glm::translate(I, {0.0f, 0.3f, -1.0f}), 0.7f, glm::vec3(0.3f, 1.0f, 0.2f)),
-                     {1.3f, 0.6f, 0.9f})},
+      {0, glm::scale(glm::rotate(glm::translate(I, {0.0f, 0.3f, -1.0f}), 0.7f, glm::vec3(0.3f, 1.0f, 0.2f)), {1.3f, 0.6f, 0.9f})},
       {0, glm::scale(glm::translate(I, {2.2f, 0.0f, 0.5f}), {-1.0f, 1.0f, 1.0f})},  // mirrored
       {1, glm::rotate(glm::translate(I, {1.0f, -0.4f, 2.0f}), 0.5f, glm::vec3(0.0f, 1.0f, 0.0f))},
       {1, glm::scale(glm::translate(I, {-1.5f, 1.2f, 1.5f}), {0.5f, -0.7f, 0.5f})},  // mirrored

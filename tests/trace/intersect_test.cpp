@@ -16,8 +16,7 @@
 namespace rtr::trace {
 namespace {
 
-constexpr IntersectMethod kMethods[] = {IntersectMethod::HalfPlane, IntersectMethod::MollerTrumbore,
-                                        IntersectMethod::Watertight};
+constexpr IntersectMethod kMethods[] = {IntersectMethod::HalfPlane, IntersectMethod::MollerTrumbore, IntersectMethod::Watertight};
 const char* name(IntersectMethod m) {
   return m == IntersectMethod::HalfPlane ? "halfplane" : m == IntersectMethod::Watertight ? "watertight" : "moller";
 }
@@ -155,8 +154,8 @@ TEST(Intersect, SharedDiagonalIsHitByExactlyOneTriangle) {
         }
       }
     }
-    std::printf("[ diagonal, %zu rays ] %-10s no hit %zu, both hit %zu, closest-hit misses %zu\n", rays, name(m), zero,
-                two, closestMiss);
+    std::printf("[ diagonal, %zu rays ] %-10s no hit %zu, both hit %zu, closest-hit misses %zu\n", rays, name(m), zero, two,
+                closestMiss);
     if (m == IntersectMethod::Watertight) {
       // The quad's own corners lie on the open mesh's border: at most one owner there.
       for (const glm::vec3& corner : {glm::vec3{0, 0, 0}, glm::vec3{1, 1, 0}, glm::vec3{1, 0, 0}})
@@ -170,9 +169,9 @@ TEST(Intersect, SharedDiagonalIsHitByExactlyOneTriangle) {
 
 TEST(Intersect, GrazingParallelAndDegenerateGiveNoHitAndNoNaN) {
   const Triangle tri{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  const std::vector<Triangle> degenerate{{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}},    // collinear
-                                         {{1, 2, 3}, {1, 2, 3}, {1, 2, 3}},    // a point
-                                         {{0, 0, 0}, {1, 0, 0}, {1, 0, 0}}};   // two equal vertices
+  const std::vector<Triangle> degenerate{{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}},   // collinear
+                                         {{1, 2, 3}, {1, 2, 3}, {1, 2, 3}},   // a point
+                                         {{0, 0, 0}, {1, 0, 0}, {1, 0, 0}}};  // two equal vertices
   for (IntersectMethod m : kMethods) {
     float b1 = 0, b2 = 0;
     // In the triangle's plane, straight through it.

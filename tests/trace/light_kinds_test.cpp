@@ -87,7 +87,7 @@ TEST(LightKinds, SpotCastsShadows) {
   const Tracer t(s);
   TraceSettings ts = settings(Shading::Pbr, {spotLight({0, 0, 2}, 20, 30)});
   EXPECT_EQ(at(t, ts, 0.05f, 0.3f), glm::vec3(0));  // under the tile (seen past its side)
-  EXPECT_GT(at(t, ts, 0.6f, 0.0f).x, 0.01f);       // beside its shadow
+  EXPECT_GT(at(t, ts, 0.6f, 0.0f).x, 0.01f);        // beside its shadow
   ts.shadows = false;
   EXPECT_GT(at(t, ts, 0.05f, 0.3f).x, 0.01f);
 }
@@ -141,7 +141,7 @@ TEST(LightKinds, RangeCutsThePointLightOff) {
   for (Shading shading : {Shading::Phong, Shading::Pbr}) {
     const TraceSettings ts = settings(shading, {l});
     EXPECT_GT(at(t, ts, 1.0f, 0.0f).x, 0.0f);
-    EXPECT_GT(at(t, ts, 2.8f, 0.0f).x, 0.0f);                   // distance 2.97
+    EXPECT_GT(at(t, ts, 2.8f, 0.0f).x, 0.0f);                        // distance 2.97
     EXPECT_EQ(at(t, ts, 2.9f, 0.0f), glm::vec3(0)) << int(shading);  // distance 3.07
     EXPECT_EQ(at(t, ts, 6.0f, 3.0f), glm::vec3(0));
   }

@@ -18,8 +18,8 @@ namespace {
 std::vector<Triangle> trianglesOf(const Mesh& m, glm::vec3 offset = glm::vec3(0.0f)) {
   std::vector<Triangle> tris;
   for (size_t i = 0; i < m.indices.size(); i += 3)
-    tris.push_back({m.positions[m.indices[i]] + offset, m.positions[m.indices[i + 1]] + offset,
-                    m.positions[m.indices[i + 2]] + offset});
+    tris.push_back(
+        {m.positions[m.indices[i]] + offset, m.positions[m.indices[i + 1]] + offset, m.positions[m.indices[i + 2]] + offset});
   return tris;
 }
 
@@ -43,9 +43,10 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
         const Hit one = bvh.closest(rays[i + k]);
         const bool occ1 = bvh.occluded(rays[i + k]);
         if (h[k].prim != one.prim || h[k].t != one.t || h[k].b1 != one.b1 || h[k].b2 != one.b2 || (occ >> k & 1) != occ1) {
-          ADD_FAILURE() << what << " " << Bvh::isaName(isa) << (leafRays == 2 ? ", leaves all rays at once" : ", leaves ray by ray") << ", ray " << i + k << " of a packet of " << n
-                        << ": triangle " << h[k].prim << " t " << h[k].t << " b " << h[k].b1 << " " << h[k].b2
-                        << " occluded " << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b "
+          ADD_FAILURE() << what << " " << Bvh::isaName(isa)
+                        << (leafRays == 2 ? ", leaves all rays at once" : ", leaves ray by ray") << ", ray " << i + k
+                        << " of a packet of " << n << ": triangle " << h[k].prim << " t " << h[k].t << " b " << h[k].b1 << " "
+                        << h[k].b2 << " occluded " << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b "
                         << one.b1 << " " << one.b2 << " occluded " << occ1;
           Bvh::setIsa(BvhIsa::Avx512);
           Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
@@ -80,7 +81,11 @@ TEST(Packets, RandomPacketsMixingHitsAndMisses) {
     const float spread = p % 3 == 0 ? 0.01f : p % 3 == 1 ? 0.2f : 2.0f;
     for (int k = 0; k < 8; ++k) {
       Ray r{o, d + spread * glm::vec3{u(rng), u(rng), u(rng)}};
-      if (p % 4 == 1) { r.origin = o + 3.0f * glm::vec3{u(rng), u(rng), u(rng)}; r.direction = o - r.origin; r.tMax = 1.0f; }
+      if (p % 4 == 1) {
+        r.origin = o + 3.0f * glm::vec3{u(rng), u(rng), u(rng)};
+        r.direction = o - r.origin;
+        r.tMax = 1.0f;
+      }
       if (p % 13 == 2 && k == 3) r.direction = glm::vec3(0.0f);
       if (p % 17 == 3 && k == 5) r.tMax = 0.0f;
       if (p % 19 == 4 && k == 1) r.direction.y = 0.0f;
@@ -99,9 +104,9 @@ TEST(Packets, RandomPacketsMixingHitsAndMisses) {
 // no ray may miss, in coherent packets (a common origin, neighbouring directions, as a camera's) and in
 // packets aimed at every vertex and through the middle of every edge.
 TEST(Packets, ClosedSphereFromInsideNeverMisses) {
-  for (const auto& [centre, radius] : {std::pair{glm::vec3(0.1f, -0.2f, 0.3f), 1.3f},
-                                       std::pair{glm::vec3(3000.0f, -2000.0f, 1000.0f), 0.75f},
-                                       std::pair{glm::vec3(1e-4f, 2e-4f, -1e-4f), 3e-4f}}) {
+  for (const auto& [centre, radius] :
+       {std::pair{glm::vec3(0.1f, -0.2f, 0.3f), 1.3f}, std::pair{glm::vec3(3000.0f, -2000.0f, 1000.0f), 0.75f},
+        std::pair{glm::vec3(1e-4f, 2e-4f, -1e-4f), 3e-4f}}) {
     const Mesh sphere = uvSphere(centre, radius, 16, 16);
     const std::vector<Triangle> tris = trianglesOf(sphere);
     const Bvh bvh(tris, {}, 1);
@@ -117,7 +122,8 @@ TEST(Packets, ClosedSphereFromInsideNeverMisses) {
     for (const glm::vec3& v : sphere.positions) rays.push_back({o, v - o});
     for (size_t i = 0; i < sphere.indices.size(); i += 3)
       for (int e = 0; e < 3; ++e)
-        rays.push_back({o, 0.5f * (sphere.positions[sphere.indices[i + e]] + sphere.positions[sphere.indices[i + (e + 1) % 3]]) - o});
+        rays.push_back(
+            {o, 0.5f * (sphere.positions[sphere.indices[i + e]] + sphere.positions[sphere.indices[i + (e + 1) % 3]]) - o});
     EXPECT_EQ(expectPacketsMatchSingles(bvh, rays), rays.size()) << centre.x;
   }
 }
@@ -144,7 +150,8 @@ TEST(Packets, SharedEdgesVerticesAndExactTies) {
     }
   // Through the gaps between the quads, onto the coplanar copies below.
   for (int i = 0; i < 39; ++i)
-    for (int k = 0; k < 8; ++k) rays.push_back({{float(i) * 3.0f + 2.5f, 0.25f * float(k) / 7.0f + 0.5f, 4.0f}, {0.0001f * float(k), 0.0f, -1.0f}});
+    for (int k = 0; k < 8; ++k)
+      rays.push_back({{float(i) * 3.0f + 2.5f, 0.25f * float(k) / 7.0f + 0.5f, 4.0f}, {0.0001f * float(k), 0.0f, -1.0f}});
   // All but the rays at the quads' outer corners (an open mesh's corner may belong to neither triangle).
   EXPECT_GE(expectPacketsMatchSingles(bvh, rays), rays.size() - 80);
 }

@@ -53,7 +53,7 @@ TraceSettings baseColourView() {
   ts.shadows = false;
   ts.bounces = 0;
   ts.lights = LightRig{{}, glm::vec3(1.0f), {}};  // no light, ambient 1
-  ts.height = 32768;  // a tiny pixel: level 0 unless a test says otherwise
+  ts.height = 32768;                              // a tiny pixel: level 0 unless a test says otherwise
   return ts;
 }
 
@@ -65,16 +65,12 @@ Mesh facingQuad(float depth, uint32_t material, float uvScale = 1.0f) {
 }
 
 // The ray straight down -z onto texture coordinate uv of facingQuad(uvScale 1) from distance `dist`.
-Ray rayAt(glm::vec2 uv, float depth, float dist) {
-  return {{2.0f * uv.x - 1.0f, 2.0f * uv.y - 1.0f, dist - depth}, {0, 0, -1}};
-}
+Ray rayAt(glm::vec2 uv, float depth, float dist) { return {{2.0f * uv.x - 1.0f, 2.0f * uv.y - 1.0f, dist - depth}, {0, 0, -1}}; }
 
 float srgb(uint8_t b) { return float(decodeTexel(b, 0, TexelEncoding::Srgb)); }
 
 // A 4×4 texture of distinct colours.
-Texel pattern(uint32_t x, uint32_t y) {
-  return {uint8_t(40 + 60 * x), uint8_t(200 - 50 * y), uint8_t(17 * (x + 4 * y)), 255};
-}
+Texel pattern(uint32_t x, uint32_t y) { return {uint8_t(40 + 60 * x), uint8_t(200 - 50 * y), uint8_t(17 * (x + 4 * y)), 255}; }
 
 void expectNear(glm::vec3 a, glm::vec3 b, float tol, const std::string& what) {
   EXPECT_NEAR(a.x, b.x, tol) << what;
@@ -111,9 +107,7 @@ TEST(TracerTextures, RepeatWrapsCoordinatesOutsideZeroOne) {
   const Tracer t(s);
   const TraceSettings ts = baseColourView();
   // World point (x, y) has uv = 1.5·(x + 1) - 1; the same texel every whole period.
-  auto at = [&](float u, float v) {
-    return t.traceAndShade({{(u + 1) / 1.5f - 1, (v + 1) / 1.5f - 1, 0}, {0, 0, -1}}, 0, ts);
-  };
+  auto at = [&](float u, float v) { return t.traceAndShade({{(u + 1) / 1.5f - 1, (v + 1) / 1.5f - 1, 0}, {0, 0, -1}}, 0, ts); };
   const Texel p = pattern(1, 3);
   const glm::vec3 texel{srgb(p[0]), srgb(p[1]), srgb(p[2])};
   for (glm::vec2 uv : {glm::vec2(0.375f, 0.875f), glm::vec2(-0.625f, -0.125f), glm::vec2(1.375f, 1.875f)})
@@ -128,7 +122,10 @@ TEST(TracerTextures, RepeatWrapsCoordinatesOutsideZeroOne) {
 // read off the contrast: λ = log2(uv per scene unit · cone width / |n·d| · 8).
 TEST(TracerTextures, RayConeLodFollowsDistancePixelSizeAndProjection) {
   Scene s;
-  const auto checker = [](uint32_t x, uint32_t y) { const uint8_t c = (x + y) % 2 ? 255 : 0; return Texel{c, c, c, 255}; };
+  const auto checker = [](uint32_t x, uint32_t y) {
+    const uint8_t c = (x + y) % 2 ? 255 : 0;
+    return Texel{c, c, c, 255};
+  };
   addMesh(s, facingQuad(0, addMaterial(s, pbr(glm::vec3(1), addTexture(s, "checker", 8, 8, checker)))));
   const Tracer t(s);
   TraceSettings ts = baseColourView();
@@ -142,7 +139,7 @@ TEST(TracerTextures, RayConeLodFollowsDistancePixelSizeAndProjection) {
   EXPECT_NEAR(whiteAt(0.5f), 0.5f + 0.5f * grey, 1e-4f);
   EXPECT_NEAR(whiteAt(1.0f), grey, 1e-4f);
   EXPECT_NEAR(whiteAt(20.0f), grey, 1e-5f);  // far beyond the 1×1 level: clamped to it
-  ts.lodBias = 1.0f;                          // the GPU's LOD bias: one level up
+  ts.lodBias = 1.0f;                         // the GPU's LOD bias: one level up
   EXPECT_NEAR(whiteAt(-0.5f), 0.5f + 0.5f * grey, 1e-4f);
   ts.lodBias = 0.0f;
   float previous = 2.0f;
@@ -190,8 +187,12 @@ TEST(TracerTextures, FetchMultipliesEverySlotLikeTheGpu) {
   const auto grey = [](uint8_t v) { return [v](uint32_t, uint32_t) { return Texel{v, v, v, 255}; }; };
   m.textures[uint32_t(TextureSlot::Roughness)] = addTexture(s, "rough", 1, 1, grey(51), false, 1);
   m.textures[uint32_t(TextureSlot::Metalness)] = addTexture(s, "metal", 1, 1, grey(102), false, 1);
-  m.textures[uint32_t(TextureSlot::AlphaMask)] =
-      addTexture(s, "alpha", 1, 1, [](uint32_t, uint32_t) { return Texel{0, 0, 0, 77}; }, true, 4);
+  m.textures[uint32_t(TextureSlot::AlphaMask)] = addTexture(
+      s, "alpha", 1, 1,
+      [](uint32_t, uint32_t) {
+        return Texel{0, 0, 0, 77};
+      },
+      true, 4);
   m.textures[uint32_t(TextureSlot::Emissive)] = addTexture(s, "emit", 1, 1, grey(128));
   m.textures[uint32_t(TextureSlot::NormalMap)] = uint32_t(s.textures.size());  // never read: a missing file
   s.textures.push_back({"/nonexistent/normal.png", false, 3});
@@ -202,7 +203,7 @@ TEST(TracerTextures, FetchMultipliesEverySlotLikeTheGpu) {
   expectNear(in.baseColor, {0.5f * srgb(255), 0.25f * srgb(128), srgb(64)}, 1e-6f, "base");
   EXPECT_NEAR(in.roughness, 0.5f * 51 / 255.0f, 1e-6f);  // UNORM, not sRGB
   EXPECT_NEAR(in.metalness, 0.8f * 102 / 255.0f, 1e-6f);
-  EXPECT_NEAR(in.alpha, 77 / 255.0f, 1e-6f);               // alpha is never sRGB
+  EXPECT_NEAR(in.alpha, 77 / 255.0f, 1e-6f);  // alpha is never sRGB
   expectNear(in.emissive, glm::vec3(2, 3, 4) * srgb(128), 1e-5f, "emissive");
 }
 
@@ -211,8 +212,9 @@ Scene maskedPair() {
   Scene s;
   Material red = pbr({1, 0, 0});
   red.flags = kMaterialAlphaMasked | kMaterialDoubleSided;
-  red.textures[uint32_t(TextureSlot::AlphaMask)] =
-      addTexture(s, "half", 8, 1, [](uint32_t x, uint32_t) { return Texel{255, 255, 255, uint8_t(x < 4 ? 0 : 255)}; });
+  red.textures[uint32_t(TextureSlot::AlphaMask)] = addTexture(s, "half", 8, 1, [](uint32_t x, uint32_t) {
+    return Texel{255, 255, 255, uint8_t(x < 4 ? 0 : 255)};
+  });
   addMesh(s, facingQuad(2, addMaterial(s, red)));
   Mesh floor = quad({-6, -6, -4}, {12, 0, 0}, {0, 12, 0}, addMaterial(s, pbr({0, 0, 1})));
   addMesh(s, std::move(floor));
@@ -226,8 +228,8 @@ TEST(TracerTextures, AlphaMaskLetsPrimaryAndMirrorRaysThroughExactlyWhereCut) {
   Material mirror = pbr(glm::vec3(0.2f));
   mirror.mirror = 1.0f;
   addMesh(s, quad({-1, -11, 0}, {2, 0, 0}, {0, 2, -2}, addMaterial(s, mirror)));  // plane y + z = -11
-  addMesh(s, quad({-1, -8, 0}, {2, 0, 0}, {0, 0, -2}, 0));                       // masked, y = -8
-  addMesh(s, quad({-6, -7, 6}, {12, 0, 0}, {0, 0, -12}, 1));                     // blue, y = -7
+  addMesh(s, quad({-1, -8, 0}, {2, 0, 0}, {0, 0, -2}, 0));                        // masked, y = -8
+  addMesh(s, quad({-6, -7, 6}, {12, 0, 0}, {0, 0, -12}, 1));                      // blue, y = -7
   const Tracer t(s);
   const TraceSettings ts = baseColourView();
   int cut = 0, kept = 0;

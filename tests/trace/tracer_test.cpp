@@ -68,8 +68,8 @@ TEST(Tracer, LightsComeFromGeometry) {
   Material named = phong(glm::vec3(1));
   named.name = "ceiling_light";  // found by name, without the flag
   const uint32_t l2 = addMaterial(s, named);
-  addMesh(s, quad({-1, 3, -1}, {2, 0, 0}, {0, 0, 2}, l));       // two triangles: area light
-  addMesh(s, box({1, 1, 1}, {2, 3, 4}, l2));                     // twelve: point light at the centroid
+  addMesh(s, quad({-1, 3, -1}, {2, 0, 0}, {0, 0, 2}, l));  // two triangles: area light
+  addMesh(s, box({1, 1, 1}, {2, 3, 4}, l2));               // twelve: point light at the centroid
   const std::vector<Light> lights = resolveLights(s).lights;
   ASSERT_EQ(lights.size(), 2u);
   EXPECT_EQ(lights[0].kind, Light::Kind::Area);
@@ -179,7 +179,10 @@ TEST(Tracer, ShadowGivesAmbientAndEmissiveOnly) {
 // Far from the origin and tiny: spawned rays never find their own surface, and a lit plane has no acne
 // (with nothing else to cast shadows, shadows on must equal shadows off, pixel for pixel).
 TEST(Tracer, NoSelfIntersectionOrAcneAtAnyScale) {
-  struct Case { glm::vec3 centre; float size; };
+  struct Case {
+    glm::vec3 centre;
+    float size;
+  };
   for (const Case& k : {Case{{0, 0, 0}, 4.0f}, Case{{1e5f, -1e5f, 1e5f}, 10.0f}, Case{{1e5f, 1e5f, -1e5f}, 1000.0f},
                         Case{{0, 0, 0}, 1e-4f}, Case{{0.3f, 0.2f, 0.1f}, 1e-4f}}) {
     Scene s = litPlane(k.centre, k.size, 6);
@@ -193,8 +196,7 @@ TEST(Tracer, NoSelfIntersectionOrAcneAtAnyScale) {
       ts.threads = 2;
       CameraPose pose = t.resolvePose(ts);
       pose.yawDeg = yaw;
-      pose.position = k.centre + glm::vec3(std::sin(glm::radians(yaw)), 0.0f, std::cos(glm::radians(yaw))) *
-                                     (0.9f * k.size);
+      pose.position = k.centre + glm::vec3(std::sin(glm::radians(yaw)), 0.0f, std::cos(glm::radians(yaw))) * (0.9f * k.size);
       ts.pose = pose;
       ImageF on, off;
       t.render(ts, on);
@@ -202,8 +204,7 @@ TEST(Tracer, NoSelfIntersectionOrAcneAtAnyScale) {
       t.render(ts, off);
       int lit = 0;
       for (size_t i = 0; i < on.pixels.size(); ++i) {
-        ASSERT_EQ(on.pixels[i], off.pixels[i]) << "acne at pixel " << i << ", scale " << k.size << ", centre "
-                                               << k.centre.x;
+        ASSERT_EQ(on.pixels[i], off.pixels[i]) << "acne at pixel " << i << ", scale " << k.size << ", centre " << k.centre.x;
         lit += on.pixels[i].x > 0.2f;
       }
       EXPECT_GT(lit, 100) << k.size;
@@ -222,8 +223,7 @@ TEST(Tracer, NoSelfIntersectionOrAcneAtAnyScale) {
       EXPECT_FALSE(t.occluded(shadow)) << "scale " << k.size;
       const Ray mirror = reflectRay(primary, sp.geomNormal, sp.position, sp.geomNormal);
       const Hit again = t.closestTriangle(mirror);
-      EXPECT_TRUE(!again.hit() || t.scene().materials[t.scene().meshes[t.surface(mirror, again).mesh].material].name ==
-                                      "light")
+      EXPECT_TRUE(!again.hit() || t.scene().materials[t.scene().meshes[t.surface(mirror, again).mesh].material].name == "light")
           << "scale " << k.size;
       // From underneath too (rays leaving the back face).
       const Ray below = spawnRay(sp.position, sp.geomNormal, -sp.geomNormal + glm::vec3(0.3f, 0, 0));
@@ -261,7 +261,7 @@ TEST(Tracer, MirrorMixesLocalAndReflectedColour) {
     EXPECT_EQ(full, t.traceAndShade(refl, 2, ts));  // m = 1: exactly the reflection
     s.materials[mirrorMat].mirror = 0.0f;
     const glm::vec3 none = t.traceAndShade(r, 3, ts);
-    EXPECT_EQ(none, t.traceAndShade(r, 0, ts));     // m = 0: no reflection at all
+    EXPECT_EQ(none, t.traceAndShade(r, 0, ts));  // m = 0: no reflection at all
     s.materials[mirrorMat].mirror = 0.25f;
     const glm::vec3 mix = t.traceAndShade(r, 3, ts);
     const glm::vec3 expect = 0.75f * none + 0.25f * full;
@@ -337,7 +337,8 @@ TEST(Tracer, TilesCoverTheImageOnceAndThreadsAgree) {
   }
   // Cancel from the first tile's callback: the render stops early.
   std::atomic<bool> cancel{false};
-  const RenderStats cst = t.render(ts, b, [&](const TileRect&) { cancel = true; }, &cancel);
+  const RenderStats cst = t.render(
+      ts, b, [&](const TileRect&) { cancel = true; }, &cancel);
   EXPECT_TRUE(cst.cancelled);
   EXPECT_LT(cst.tilesDone, cst.tilesTotal);
   // Bad settings are errors, not crashes.

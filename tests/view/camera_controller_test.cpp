@@ -26,9 +26,9 @@ TEST(OrbitCamera, RotateDragTurnsAboutTheTarget) {
   const CameraPose before = c.pose();
   c.setDrag(Drag::Rotate);
   c.mouseMoved(160, 130);
-  EXPECT_LT(c.pose().yawDeg, before.yawDeg - 10.0f);    // right: the camera goes round to the left
+  EXPECT_LT(c.pose().yawDeg, before.yawDeg - 10.0f);  // right: the camera goes round to the left
   EXPECT_LT(c.pose().pitchDeg, before.pitchDeg - 5.0f);
-  expectNear(c.orbitTarget(), target);                  // still on the view axis, same distance
+  expectNear(c.orbitTarget(), target);  // still on the view axis, same distance
   EXPECT_NEAR(glm::length(c.pose().position - target), 8.0f, 1e-4f);
 }
 

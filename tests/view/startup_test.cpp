@@ -27,8 +27,8 @@ struct ViewRun {
 class StartupTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = fs::temp_directory_path() / ("rtr-startup-" + std::to_string(::getpid()) + "-" +
-                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir = fs::temp_directory_path() /
+          ("rtr-startup-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir);
     fs::create_directories(dir);
   }
@@ -65,10 +65,17 @@ TEST_F(StartupTest, TimingsPhasesAddUpToTheTotal) {
   const ViewRun r = view("--timings");
   ASSERT_EQ(r.status, 0) << r.out;
   const auto p = phases(r.out);
-  const std::vector<std::string> expected = {
-      "process start to Vulkan (exec, libraries, options)", "instance and device", "scene file read",
-      "texture decode", "geometry upload", "texture upload", "mips",
-      "renderer setup (start pose, targets)", "first frame complete (record, GPU, read-back)", "sum of the phases", "total from process start"};
+  const std::vector<std::string> expected = {"process start to Vulkan (exec, libraries, options)",
+                                             "instance and device",
+                                             "scene file read",
+                                             "texture decode",
+                                             "geometry upload",
+                                             "texture upload",
+                                             "mips",
+                                             "renderer setup (start pose, targets)",
+                                             "first frame complete (record, GPU, read-back)",
+                                             "sum of the phases",
+                                             "total from process start"};
   for (const auto& name : expected) EXPECT_TRUE(p.count(name)) << "no phase '" << name << "' in:\n" << r.out;
   double sum = 0;
   int pipelineRows = 0;

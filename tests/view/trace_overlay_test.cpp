@@ -25,7 +25,12 @@ TEST_F(TraceOverlayTest, EachFrameInFlightShowsItsOwnUpload) {
   view::TraceOverlay overlay(*ctx, scene);
   constexpr uint32_t kFrames = 3;
   vk::FrameRing ring(*ctx, kFrames);
-  struct Shown { vk::Image image; vk::Buffer readback; ImageRGBA8 expected; vk::Frame* frame; };
+  struct Shown {
+    vk::Image image;
+    vk::Buffer readback;
+    ImageRGBA8 expected;
+    vk::Frame* frame;
+  };
   std::vector<Shown> shown(kFrames);
   const trace::Shading shadings[kFrames] = {trace::Shading::Phong, trace::Shading::Normals, trace::Shading::Pbr};
   // Record every frame before submitting any: the earliest frames' copies run only after the later
@@ -40,15 +45,19 @@ TEST_F(TraceOverlayTest, EachFrameInFlightShowsItsOwnUpload) {
     overlay.wait();
     Shown& s = shown[i];
     s.expected = overlay.cpuImage();
-    s.image = vk::Image(*ctx, {{kW, kH}, VK_FORMAT_R8G8B8A8_UNORM, 1,
-                               VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                                   VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, 0, 0, "shown"});
+    s.image =
+        vk::Image(*ctx, {{kW, kH},
+                         VK_FORMAT_R8G8B8A8_UNORM,
+                         1,
+                         VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                         0,
+                         0,
+                         "shown"});
     s.readback = vk::Buffer(*ctx, VkDeviceSize(kW) * kH * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
     s.frame = &ring.begin();
     VkCommandBuffer cb = s.frame->cb;
-    vk::barrier(cb, {{s.image.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                      VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+    vk::barrier(cb, {{s.image.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
     overlay.recordCopy(*s.frame, s.image.handle(), VK_FORMAT_R8G8B8A8_UNORM, {kW, kH});
     vk::barrier(cb, {{s.image.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                       VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -59,9 +68,7 @@ TEST_F(TraceOverlayTest, EachFrameInFlightShowsItsOwnUpload) {
   ring.waitIdle();
   for (uint32_t i = 0; i < kFrames; ++i) {
     SCOPED_TRACE("frame " + std::to_string(i));
-    if (i > 0) {
-      ASSERT_NE(shown[i].expected.pixels, shown[i - 1].expected.pixels) << "the test needs differing images";
-    }
+    if (i > 0) { ASSERT_NE(shown[i].expected.pixels, shown[i - 1].expected.pixels) << "the test needs differing images"; }
     shown[i].readback.invalidate();
     const auto* got = static_cast<const uint8_t*>(shown[i].readback.mapped());
     // Tile by tile, so that a failure says where.
@@ -94,8 +101,13 @@ TEST_F(TraceOverlayTest, AFinishedTraceIsUploadedOnce) {
   vk::FrameRing ring(*ctx, 1);
   for (int i = 0; i < 3; ++i) {
     SCOPED_TRACE("frame " + std::to_string(i));
-    vk::Image target(*ctx, {{kW, kH}, VK_FORMAT_R8G8B8A8_UNORM, 1,
-                            VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0, "target"});
+    vk::Image target(*ctx, {{kW, kH},
+                            VK_FORMAT_R8G8B8A8_UNORM,
+                            1,
+                            VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                            0,
+                            0,
+                            "target"});
     vk::Buffer readback(*ctx, VkDeviceSize(kW) * kH * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
     vk::Frame& f = ring.begin();
     vk::require(f.cb, target.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT, true);

@@ -23,7 +23,7 @@ glm::vec3 direction(float theta, float phi) {
 
 std::vector<BrdfGridInput> makeGrid() {
   const glm::vec3 up(0, 1, 0);
-  const std::vector<glm::vec3> normals = {up, -up, glm::vec3(0), up * 1e-20f, glm::normalize(glm::vec3(0.3f, 1, 0.1f)),
+  const std::vector<glm::vec3> normals = {up,       -up, glm::vec3(0), up * 1e-20f, glm::normalize(glm::vec3(0.3f, 1, 0.1f)),
                                           up * 3.0f};
   // Polar angles include 0, grazing (90°), just past grazing and below the surface.
   const std::vector<float> thetas = {0.0f, 0.3f, 0.8f, 1.2f, 1.5f, 1.5707f, 1.5708f, 1.5709f, 1.7f, 2.5f, 3.14159f};
@@ -79,16 +79,16 @@ TEST_F(VulkanTest, GpuBrdfIsFiniteNonNegativeAndMatchesCpu) {
   for (size_t i = 0; i < grid.size(); ++i) {
     const BrdfGridInput& a = grid[i];
     const int brdf = int(a.params.z);
-    const shader::BrdfTerms t = shader::brdfTerms(brdf, glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l),
-                                                  glm::vec3(a.baseColor), a.params.x, a.params.y);
-    const glm::vec3 L = shader::shadePbr(brdf, glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l),
-                                         glm::vec3(a.lightColor), glm::vec3(a.ambient), glm::vec3(a.baseColor),
-                                         a.params.x, a.params.y, glm::vec3(a.emissive));
-    const float cpu[] = {t.D, t.G, t.F.x, t.F.y, t.F.z, t.diffuse.x, t.diffuse.y, t.diffuse.z,
-                         t.specular.x, t.specular.y, t.specular.z, L.x, L.y, L.z};
+    const shader::BrdfTerms t =
+        shader::brdfTerms(brdf, glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l), glm::vec3(a.baseColor), a.params.x, a.params.y);
+    const glm::vec3 L =
+        shader::shadePbr(brdf, glm::vec3(a.n), glm::vec3(a.v), glm::vec3(a.l), glm::vec3(a.lightColor), glm::vec3(a.ambient),
+                         glm::vec3(a.baseColor), a.params.x, a.params.y, glm::vec3(a.emissive));
+    const float cpu[] = {t.D,         t.G,          t.F.x,        t.F.y,        t.F.z, t.diffuse.x, t.diffuse.y,
+                         t.diffuse.z, t.specular.x, t.specular.y, t.specular.z, L.x,   L.y,         L.z};
     const BrdfGridOutput& g = gpu[i];
-    const float got[] = {g.DG.x, g.DG.y, g.F.x, g.F.y, g.F.z, g.diffuse.x, g.diffuse.y, g.diffuse.z,
-                         g.specular.x, g.specular.y, g.specular.z, g.radiance.x, g.radiance.y, g.radiance.z};
+    const float got[] = {g.DG.x,      g.DG.y,       g.F.x,        g.F.y,        g.F.z,        g.diffuse.x,  g.diffuse.y,
+                         g.diffuse.z, g.specular.x, g.specular.y, g.specular.z, g.radiance.x, g.radiance.y, g.radiance.z};
     for (int k = 0; k < 14; ++k) {
       ASSERT_TRUE(std::isfinite(got[k]) && got[k] >= 0.0f) << "GPU value " << k << " = " << got[k] << " at grid " << i;
       // exp and sqrt may differ by a few ulp on the GPU; Vulkan allows that. Relative 1e-3 plus a tiny floor.

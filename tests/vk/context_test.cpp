@@ -26,7 +26,9 @@ TEST_F(VulkanTest, ComputeDispatchWritesEveryValue) {
   out.flush();
   vk::DescriptorSets sets(*ctx, fill.layout, 1);
   vk::DescriptorWriter(*ctx, fill.layout, 0, sets.get(0)).buffer(0, out.handle()).commit();
-  struct { uint32_t count, offset; } push{kCount, kOffset};
+  struct {
+    uint32_t count, offset;
+  } push{kCount, kOffset};
   vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
     fill.bind(cb);
     fill.bindSet(cb, 0, sets.get(0));
@@ -43,7 +45,9 @@ TEST_F(VulkanTest, PushDescriptorsBindWithoutAPool) {
   options.pushDescriptorSets = {0};
   vk::Pipeline fill = vk::makeComputePipeline(*ctx, vk::loadShader("fill.comp"), options);
   vk::Buffer out(*ctx, kCount * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Readback);
-  struct { uint32_t count, offset; } push{kCount, 3};
+  struct {
+    uint32_t count, offset;
+  } push{kCount, 3};
   vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
     fill.bind(cb);
     vk::DescriptorWriter(*ctx, fill.layout, 0, VK_NULL_HANDLE).buffer(0, out.handle()).push(cb, fill);
@@ -60,7 +64,9 @@ TEST_F(VulkanTest, GpuTimerMeasuresAPass) {
   vk::Buffer out(*ctx, 1 << 20, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device);
   vk::DescriptorSets sets(*ctx, fill.layout, 1);
   vk::DescriptorWriter(*ctx, fill.layout, 0, sets.get(0)).buffer(0, out.handle()).commit();
-  struct { uint32_t count, offset; } push{1 << 18, 0};
+  struct {
+    uint32_t count, offset;
+  } push{1 << 18, 0};
   vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
     timer.reset(cb);
     timer.begin(cb);

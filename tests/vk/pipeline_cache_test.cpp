@@ -23,8 +23,8 @@ class PipelineCacheTest : public ::testing::Test {
   void SetUp() override {
     test::pinDriver();
     vk::Context::resetValidationMessageCount();
-    dir = fs::temp_directory_path() / ("rtr-pcache-" + std::to_string(::getpid()) + "-" +
-                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir = fs::temp_directory_path() /
+          ("rtr-pcache-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir);
   }
   void TearDown() override {

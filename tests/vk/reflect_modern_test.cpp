@@ -78,8 +78,7 @@ TEST(ReflectModern, SelfReferencingBufferReferencesAreNamedNotExpandedAgain) {
 }
 
 TEST(ReflectModern, RayTracingStagesMerge) {
-  const vk::PipelineInterface p =
-      vk::reflectPipeline({compile("raygen.rgen"), compile("hit.rchit"), compile("miss.rmiss")});
+  const vk::PipelineInterface p = vk::reflectPipeline({compile("raygen.rgen"), compile("hit.rchit"), compile("miss.rmiss")});
   ASSERT_EQ(p.stages.size(), 3u);
   EXPECT_EQ(p.stages[0].stage, VK_SHADER_STAGE_RAYGEN_BIT_KHR);
   EXPECT_EQ(p.stages[1].stage, VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR);
@@ -108,8 +107,10 @@ TEST(ReflectModern, RayQueryInComputeShader) {
 
 TEST(ReflectModern, ImageFormatsRuntimeArraysNestedPushConstantsAndSpecConstants) {
   const vk::PipelineInterface p = vk::reflectPipeline({compile("resources.comp")});
-  const std::pair<uint32_t, VkFormat> formats[] = {{0, VK_FORMAT_R8G8B8A8_UNORM}, {1, VK_FORMAT_R32_UINT},
-                                                   {2, VK_FORMAT_R16G16B16A16_SFLOAT}, {3, VK_FORMAT_R32G32_SFLOAT},
+  const std::pair<uint32_t, VkFormat> formats[] = {{0, VK_FORMAT_R8G8B8A8_UNORM},
+                                                   {1, VK_FORMAT_R32_UINT},
+                                                   {2, VK_FORMAT_R16G16B16A16_SFLOAT},
+                                                   {3, VK_FORMAT_R32G32_SFLOAT},
                                                    {4, VK_FORMAT_B10G11R11_UFLOAT_PACK32}};
   for (auto [binding, format] : formats) {
     EXPECT_EQ(findBinding(p, 0, binding).type, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
@@ -233,9 +234,7 @@ TEST(ReflectModern, ModuleCutInsideAnInstructionIsAnError) {
     try {
       vk::reflectSpirvBytes(m.code.data(), words * 4, true);
       ADD_FAILURE() << "a module cut at word " << words << " was reflected";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("<memory>: word "), std::string::npos) << e.what();
-    }
+    } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find("<memory>: word "), std::string::npos) << e.what(); }
   }
   EXPECT_GT(cuts, 100);
   EXPECT_THROW(vk::reflectSpirvBytes("abc", 3), Error);
@@ -257,7 +256,10 @@ TEST(ReflectModernTool, ModuleNewerThanSpirvValIsAWarningUnlessStrict) {
   const vk::SpirvModule m = compile("query.comp");
   std::vector<uint32_t> slang = m.code;
   for (size_t i = 5; i < slang.size() && (slang[i] >> 16) > 0; i += slang[i] >> 16)
-    if ((slang[i] & 0xffff) == 3 /* OpSource */) { slang[i + 1] = 11; break; }
+    if ((slang[i] & 0xffff) == 3 /* OpSource */) {
+      slang[i + 1] = 11;
+      break;
+    }
   std::vector<uint32_t> capability = m.code;
   capability.insert(capability.begin() + 5, {(2u << 16) | 17 /* OpCapability */, 6022});
   for (auto [name, code] : {std::pair{"slang.spv", slang}, {"capability.spv", capability}}) {
@@ -286,7 +288,8 @@ TEST(ReflectModernTool, ModuleSpirvReflectRefusesIsAnErrorNamingTheFile) {
 TEST(ReflectModernTool, EachIncludeOptionTakesOneFolder) {
   const std::string data = test::sourceDir().string() + "/tests/vk/data/";
   int status = -1;
-  std::string out = test::runTool("rtr-reflect", "-I " + data + " -I " + kData.string() + " " + data + "push_a.vert " + data + "push_ok.frag", &status);
+  std::string out = test::runTool(
+      "rtr-reflect", "-I " + data + " -I " + kData.string() + " " + data + "push_a.vert " + data + "push_ok.frag", &status);
   EXPECT_EQ(status, 0) << out;
   EXPECT_NE(out.find("stage vertex: push_a.vert"), std::string::npos) << out;
   EXPECT_NE(out.find("stage fragment: push_ok.frag"), std::string::npos) << out;

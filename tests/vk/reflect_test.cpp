@@ -15,15 +15,12 @@ namespace rtr {
 namespace {
 
 const std::filesystem::path kData = test::sourceDir() / "tests/vk/data";
-const std::vector<std::filesystem::path> kIncludes = {test::sourceDir() / "shaders",
-                                                      test::sourceDir() / "shaders/shared"};
+const std::vector<std::filesystem::path> kIncludes = {test::sourceDir() / "shaders", test::sourceDir() / "shaders/shared"};
 
 std::string errorOf(const std::function<void()>& f) {
   try {
     f();
-  } catch (const Error& e) {
-    return e.what();
-  }
+  } catch (const Error& e) { return e.what(); }
   return "";
 }
 
@@ -40,8 +37,7 @@ TEST(Reflect, GroupCountCoversEveryItemWithTheReflectedSize) {
   EXPECT_EQ(groups(65), (std::array<uint32_t, 3>{2, 1, 1}));
   EXPECT_EQ(groups(1000, 3), (std::array<uint32_t, 3>{16, 3, 1}));
   EXPECT_EQ(groups(UINT32_MAX), (std::array<uint32_t, 3>{(UINT32_MAX >> 6) + 1, 1, 1})) << "no overflow";
-  const vk::PipelineInterface graphics =
-      vk::reflectPipeline({vk::loadShader("mosaic.vert"), vk::loadShader("mosaic.frag")});
+  const vk::PipelineInterface graphics = vk::reflectPipeline({vk::loadShader("mosaic.vert"), vk::loadShader("mosaic.frag")});
   EXPECT_NE(errorOf([&] { vk::groupCount(graphics, 1); }).find("not a compute pipeline"), std::string::npos);
 }
 
@@ -65,8 +61,8 @@ TEST(Reflect, FillShaderLayout) {
 }
 
 TEST(Reflect, StagesMergeAndVertexInputsAreReflected) {
-  vk::PipelineInterface p = vk::reflectPipeline({vk::compileGlsl(kData / "push_a.vert", kIncludes),
-                                                 vk::compileGlsl(kData / "push_ok.frag", kIncludes)});
+  vk::PipelineInterface p = vk::reflectPipeline(
+      {vk::compileGlsl(kData / "push_a.vert", kIncludes), vk::compileGlsl(kData / "push_ok.frag", kIncludes)});
   ASSERT_EQ(p.stages.size(), 2u);
   ASSERT_EQ(p.stages[0].inputs.size(), 2u);
   EXPECT_EQ(p.stages[0].inputs[0].format, VK_FORMAT_R32G32B32_SFLOAT);

@@ -72,11 +72,12 @@ TEST(Specialization, EachVariantHasOnlyTheInterfaceItUses) {
     EXPECT_EQ(forward.stages[0].inputs.size(), textured ? 3u : 2u);  // positions, normals (, texcoords)
     EXPECT_EQ(hasBinding(forward, 1, 0), bool(textured));
     for (uint32_t buffer : {0u, 1u}) {
-      const vk::PipelineInterface shade = reflect({"vis_shade.comp"}, {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, buffer}});
+      const vk::PipelineInterface shade =
+          reflect({"vis_shade.comp"}, {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, buffer}});
       EXPECT_EQ(hasBinding(shade, 1, 0), bool(textured));
-      EXPECT_EQ(hasBinding(shade, 0, 9), bool(textured));   // texcoords
-      EXPECT_EQ(hasBinding(shade, 0, 7), !buffer);          // the id image
-      EXPECT_EQ(hasBinding(shade, 0, 14), bool(buffer));    // the compute rasteriser's buffer
+      EXPECT_EQ(hasBinding(shade, 0, 9), bool(textured));  // texcoords
+      EXPECT_EQ(hasBinding(shade, 0, 7), !buffer);         // the id image
+      EXPECT_EQ(hasBinding(shade, 0, 14), bool(buffer));   // the compute rasteriser's buffer
     }
   }
   for (uint32_t alpha : {0u, 1u}) {

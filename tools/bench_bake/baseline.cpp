@@ -62,7 +62,8 @@ rtr::Scene baselineLoad(const std::filesystem::path& obj) {
       auto pos = [&](int i) { return glm::vec3(P[3 * i], P[3 * i + 1], P[3 * i + 2]); };
       for (size_t f : facesOf[mid]) {
         const auto* idx = &shape.mesh.indices[f * 3];
-        glm::vec3 x = glm::cross(pos(idx[1].vertex_index) - pos(idx[0].vertex_index), pos(idx[2].vertex_index) - pos(idx[0].vertex_index));
+        glm::vec3 x =
+            glm::cross(pos(idx[1].vertex_index) - pos(idx[0].vertex_index), pos(idx[2].vertex_index) - pos(idx[0].vertex_index));
         if (glm::dot(x, x) == 0.0f) continue;
         for (int k = 0; k < 3; ++k)
           if (idx[k].normal_index < 0) gen[idx[k].vertex_index] += x;
@@ -71,7 +72,8 @@ rtr::Scene baselineLoad(const std::filesystem::path& obj) {
       bool hasTex = false;
       for (size_t f : facesOf[mid]) {
         const auto* idx = &shape.mesh.indices[f * 3];
-        glm::vec3 x = glm::cross(pos(idx[1].vertex_index) - pos(idx[0].vertex_index), pos(idx[2].vertex_index) - pos(idx[0].vertex_index));
+        glm::vec3 x =
+            glm::cross(pos(idx[1].vertex_index) - pos(idx[0].vertex_index), pos(idx[2].vertex_index) - pos(idx[0].vertex_index));
         if (glm::dot(x, x) == 0.0f) continue;
         for (int k = 0; k < 3; ++k) {
           Key key{};

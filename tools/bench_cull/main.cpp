@@ -23,7 +23,9 @@ using namespace rtr;
 
 namespace {
 
-struct Times { double minMs = 0, medianMs = 0; };
+struct Times {
+  double minMs = 0, medianMs = 0;
+};
 Times stats(std::vector<double> ms) {
   std::sort(ms.begin(), ms.end());
   return {ms.front(), ms.size() % 2 ? ms[ms.size() / 2] : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2])};
@@ -50,7 +52,8 @@ int main(int argc, char** argv) {
     const uint32_t n = uint32_t(clusters.size());
     const size_t bytes = std::max<size_t>(4, n * sizeof(shader::GpuCluster));
     vk::Buffer stage(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "clusters staging");
-    vk::Buffer buf(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, "clusters");
+    vk::Buffer buf(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device,
+                   "clusters");
     std::memcpy(stage.mapped(), clusters.data(), n * sizeof(shader::GpuCluster));
     stage.flush();
     vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
@@ -61,15 +64,18 @@ int main(int argc, char** argv) {
     render::ClusterCuller culler(ctx, n);
     vk::Buffer back(ctx, sizeof(shader::CullCounts), VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "counts back");
     std::printf("%s: %zu triangles, %u clusters; device %s\n\n", file.c_str(), triangles, n, ctx.deviceName().c_str());
-    std::printf("| size | view | pyramid ms (min / median) | cull ms (min / median) | visible | frustum | cone | occlusion |\n|---|---|---|---|---:|---:|---:|---:|\n");
+    std::printf(
+        "| size | view | pyramid ms (min / median) | cull ms (min / median) | visible | frustum | cone | occlusion |\n|---|---|---|---|---:|---:|---:|---:|\n");
     for (const std::string& size : sizes) {
       VkExtent2D e{};
       if (std::sscanf(size.c_str(), "%ux%u", &e.width, &e.height) != 2 || !e.width || !e.height)
         throw rtr::Error("--size " + size + ": expected WxH");
-      vk::Image depth(ctx, {e, VK_FORMAT_R32_SFLOAT, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, 0, "depth"});
+      vk::Image depth(ctx,
+                      {e, VK_FORMAT_R32_SFLOAT, 1, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, 0, "depth"});
       vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-        vk::barrier(cb, {{depth.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
-                          VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+        vk::barrier(cb,
+                    {{depth.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                      VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
         const VkClearColorValue far{{1.0f, 0, 0, 0}};
         const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
         vkCmdClearColorImage(cb, depth.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &far, 1, &all);

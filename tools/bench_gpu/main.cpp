@@ -29,7 +29,7 @@ struct Row {
   std::string pass, size, mode;
   double minMs = 0, medianMs = 0;
   int runs = 0;
-  int maxLsb = -1;  // mips: largest |GPU - reference| over every texel of levels >= 1; -1: not checked
+  int maxLsb = -1;          // mips: largest |GPU - reference| over every texel of levels >= 1; -1: not checked
   std::string error = "–";  // the error side: against a reference, or against the other path
 };
 
@@ -93,9 +93,12 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
     vk::barrier(cb, bs);
   };
   std::vector<Row> rows;
-  const std::string size = std::to_string(count) + " x " + std::to_string(extent.width) + "x" + std::to_string(extent.height) + " sRGB";
+  const std::string size =
+      std::to_string(count) + " x " + std::to_string(extent.width) + "x" + std::to_string(extent.height) + " sRGB";
   // Every texture's levels 1.. back to the host after a mode's last run, against the float64 reference.
-  const TexelData level0{extent.width, extent.height, 4,
+  const TexelData level0{extent.width,
+                         extent.height,
+                         4,
                          {static_cast<const uint8_t*>(upload.mapped()), static_cast<const uint8_t*>(upload.mapped()) + bytes}};
   const MipChain ref = buildMipReference(level0, TexelEncoding::Srgb, MipSource::PreviousLevel);
   std::vector<std::vector<uint8_t>> want;
@@ -115,8 +118,7 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
                           VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
                           VK_ACCESS_2_TRANSFER_READ_BIT});
         back.push_back({t.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
-                        VK_ACCESS_2_NONE});
+                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_NONE});
       }
       vk::barrier(cb, toCopy);
       for (size_t i = 0; i < textures.size(); ++i) {
@@ -152,7 +154,8 @@ std::vector<Row> benchMips(const vk::Context& ctx, VkExtent2D extent, int count,
   for (render::MipMode mode : {render::MipMode::Blit, render::MipMode::Compute}) {
     Row r = measure(ctx, warmup, runs, prepare, [&](VkCommandBuffer cb, std::vector<render::MipViews>& keep) {
       if (batched) keep.push_back(gen.record(cb, batch, mode));
-      else for (auto& t : textures) keep.push_back(gen.record(cb, t, mode));
+      else
+        for (auto& t : textures) keep.push_back(gen.record(cb, t, mode));
     });
     r.pass = "mips";
     r.size = size;
@@ -202,11 +205,13 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
   std::vector<uint8_t> computeBytes;
   const std::string size = std::to_string(extent.width) + "x" + std::to_string(extent.height);
   for (render::MosaicMode mode : {render::MosaicMode::Compute, render::MosaicMode::Graphics, render::MosaicMode::Off}) {
-    Row r = measure(ctx, warmup, runs, [](VkCommandBuffer) {}, [&](VkCommandBuffer cb, std::vector<render::MipViews>&) {
-      // The pass alone: the layout change for the read-back is made after the timed runs (with it inside,
-      // each run paid that layout change too).
-      pass.record(cb, input.tracked(), input.view(), output.tracked(), output.view(), VK_FORMAT_R8G8B8A8_UNORM, extent, mode);
-    });
+    Row r = measure(
+        ctx, warmup, runs, [](VkCommandBuffer) {},
+        [&](VkCommandBuffer cb, std::vector<render::MipViews>&) {
+          // The pass alone: the layout change for the read-back is made after the timed runs (with it inside,
+          // each run paid that layout change too).
+          pass.record(cb, input.tracked(), input.view(), output.tracked(), output.view(), VK_FORMAT_R8G8B8A8_UNORM, extent, mode);
+        });
     r.pass = "mosaic 5x3";
     r.size = size;
     r.mode = enumName(mode);
@@ -218,8 +223,8 @@ std::vector<Row> benchMosaic(const vk::Context& ctx, VkExtent2D extent, int warm
       const auto diff = std::mismatch(bytes.begin(), bytes.end(), computeBytes.begin());
       const size_t at = size_t(diff.first - bytes.begin()) / 4;
       r.error = diff.first == bytes.end() ? "bit-identical to compute (" + std::to_string(texels) + " bytes)"
-                                          : "DIFFERS from compute at pixel (" + std::to_string(at % extent.width) +
-                                                ", " + std::to_string(at / extent.width) + ")";
+                                          : "DIFFERS from compute at pixel (" + std::to_string(at % extent.width) + ", " +
+                                                std::to_string(at / extent.width) + ")";
     } else {
       r.error = "plain copy (no mosaic)";
     }
@@ -254,8 +259,8 @@ std::vector<Row> benchEnvironment(const vk::Context& ctx, VkExtent2D extent, int
   }
   std::vector<Row> rows;
   const std::string size = std::to_string(extent.width) + "x" + std::to_string(extent.height);
-  const std::string mode = "cube " + std::to_string(used.sourceSize) + " specular " + std::to_string(used.specularSize) +
-                           "x" + std::to_string(used.specularLevels) + " levels " + std::to_string(used.samples) + " samples";
+  const std::string mode = "cube " + std::to_string(used.sourceSize) + " specular " + std::to_string(used.specularSize) + "x" +
+                           std::to_string(used.specularLevels) + " levels " + std::to_string(used.samples) + " samples";
   for (size_t p = 0; p < ms.size(); ++p) {
     std::sort(ms[p].begin(), ms[p].end());
     Row r;
@@ -295,7 +300,8 @@ int main(int argc, char** argv) {
     if (only.empty() || only == "mips") {
       for (const std::string& s : sizes) {
         unsigned w = 0, h = 0;
-        if (std::sscanf(s.c_str(), "%ux%u", &w, &h) != 2 || !w || !h) throw std::runtime_error("--mip-sizes " + s + ": expected WxH");
+        if (std::sscanf(s.c_str(), "%ux%u", &w, &h) != 2 || !w || !h)
+          throw std::runtime_error("--mip-sizes " + s + ": expected WxH");
         add(benchMips(ctx, {w, h}, textures, warmup, runs, !perTexture));
       }
     }
@@ -311,8 +317,8 @@ int main(int argc, char** argv) {
                   r.medianMs, r.runs, r.error.c_str());
     std::printf("\n");
     for (const Row& r : rows)
-      std::printf("csv,%s,%s,%s,%.4f,%.4f,%d,%d\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs, r.medianMs,
-                  r.runs, r.maxLsb);
+      std::printf("csv,%s,%s,%s,%.4f,%.4f,%d,%d\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs, r.medianMs, r.runs,
+                  r.maxLsb);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rtr-bench-gpu: %s\n", e.what());
     return 1;

@@ -71,7 +71,11 @@ struct MeshoptView {
 // The meshopt views of a GLB whose compressed data lies in its BIN chunk (what gltfpack -cc writes).
 std::vector<MeshoptView> meshoptViews(const std::vector<uint8_t>& glb) {
   std::vector<MeshoptView> views;
-  auto u32 = [&](size_t at) { uint32_t v; std::memcpy(&v, glb.data() + at, 4); return v; };
+  auto u32 = [&](size_t at) {
+    uint32_t v;
+    std::memcpy(&v, glb.data() + at, 4);
+    return v;
+  };
   if (glb.size() < 20 || std::memcmp(glb.data(), "glTF", 4) != 0) return views;
   const size_t jsonLen = u32(12), binAt = 20 + jsonLen + 8;
   if (binAt > glb.size()) return views;
@@ -165,8 +169,9 @@ int main(int argc, char** argv) {
   quiet.warn = quiet.note = [](const std::string&) {};
   // Per run: the reader alone, then the clusters loadScene builds for formats that store none (the scene
   // in memory as rtr-view gets it is the sum).
-  std::printf("| file | MB | triangles | instances | read s (median, min) | + clusters s | scene in memory s | vs .rtrscene |\n"
-              "|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "| file | MB | triangles | instances | read s (median, min) | + clusters s | scene in memory s | vs .rtrscene |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|\n");
   double rtrscene = 0;
   for (const std::string& f : files) {
     std::vector<double> reads, clusters, totals;
@@ -217,10 +222,8 @@ int main(int argc, char** argv) {
     }
     double peak = 0;
     const double s = runAssimp(assimp, f, peak);
-    if (s < 0)
-      std::printf("\nassimp info %s: failed (it cannot read this file)\n", fs::path(f).filename().c_str());
-    else
-      std::printf("\nassimp info %s: %.3f s, peak %.0f MB\n", fs::path(f).filename().c_str(), s, peak);
+    if (s < 0) std::printf("\nassimp info %s: failed (it cannot read this file)\n", fs::path(f).filename().c_str());
+    else std::printf("\nassimp info %s: %.3f s, peak %.0f MB\n", fs::path(f).filename().c_str(), s, peak);
   }
   return 0;
 }

@@ -72,7 +72,9 @@ struct Embree {
       std::memcpy(v + i * 9, &tris[i].v0, 12);
       std::memcpy(v + i * 9 + 3, &tris[i].v1, 12);
       std::memcpy(v + i * 9 + 6, &tris[i].v2, 12);
-      idx[i * 3] = unsigned(i * 3); idx[i * 3 + 1] = unsigned(i * 3 + 1); idx[i * 3 + 2] = unsigned(i * 3 + 2);
+      idx[i * 3] = unsigned(i * 3);
+      idx[i * 3 + 1] = unsigned(i * 3 + 1);
+      idx[i * 3 + 2] = unsigned(i * 3 + 2);
     }
     rtcCommitGeometry(g);
     rtcAttachGeometry(scene, g);
@@ -81,14 +83,23 @@ struct Embree {
     rtcCommitScene(scene);
     buildSeconds = seconds(start);
   }
-  ~Embree() { rtcReleaseScene(scene); rtcReleaseDevice(device); }
+  ~Embree() {
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+  }
   Hit closest(const Ray& r) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh{};
-    rh.ray.org_x = r.origin.x; rh.ray.org_y = r.origin.y; rh.ray.org_z = r.origin.z;
-    rh.ray.dir_x = r.direction.x; rh.ray.dir_y = r.direction.y; rh.ray.dir_z = r.direction.z;
-    rh.ray.tnear = 0.0f; rh.ray.tfar = r.tMax; rh.ray.mask = ~0u;
+    rh.ray.org_x = r.origin.x;
+    rh.ray.org_y = r.origin.y;
+    rh.ray.org_z = r.origin.z;
+    rh.ray.dir_x = r.direction.x;
+    rh.ray.dir_y = r.direction.y;
+    rh.ray.dir_z = r.direction.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = r.tMax;
+    rh.ray.mask = ~0u;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene, &ctx, &rh);
     Hit h;
@@ -101,9 +112,17 @@ struct Embree {
     for (int k = 0; k < 8; ++k) {
       const Ray& q = r[k < n ? k : 0];
       valid[k] = k < n ? -1 : 0;
-      ray.org_x[k] = q.origin.x; ray.org_y[k] = q.origin.y; ray.org_z[k] = q.origin.z;
-      ray.dir_x[k] = q.direction.x; ray.dir_y[k] = q.direction.y; ray.dir_z[k] = q.direction.z;
-      ray.tnear[k] = 0.0f; ray.tfar[k] = q.tMax; ray.mask[k] = ~0u; ray.time[k] = 0.0f; ray.flags[k] = 0;
+      ray.org_x[k] = q.origin.x;
+      ray.org_y[k] = q.origin.y;
+      ray.org_z[k] = q.origin.z;
+      ray.dir_x[k] = q.direction.x;
+      ray.dir_y[k] = q.direction.y;
+      ray.dir_z[k] = q.direction.z;
+      ray.tnear[k] = 0.0f;
+      ray.tfar[k] = q.tMax;
+      ray.mask[k] = ~0u;
+      ray.time[k] = 0.0f;
+      ray.flags[k] = 0;
     }
   }
   uint32_t closest8(const Ray* r, int n) const {
@@ -133,9 +152,15 @@ struct Embree {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay ray{};
-    ray.org_x = r.origin.x; ray.org_y = r.origin.y; ray.org_z = r.origin.z;
-    ray.dir_x = r.direction.x; ray.dir_y = r.direction.y; ray.dir_z = r.direction.z;
-    ray.tnear = 0.0f; ray.tfar = r.tMax; ray.mask = ~0u;
+    ray.org_x = r.origin.x;
+    ray.org_y = r.origin.y;
+    ray.org_z = r.origin.z;
+    ray.dir_x = r.direction.x;
+    ray.dir_y = r.direction.y;
+    ray.dir_z = r.direction.z;
+    ray.tnear = 0.0f;
+    ray.tfar = r.tMax;
+    ray.mask = ~0u;
     rtcOccluded1(scene, &ctx, &ray);
     return ray.tfar < 0.0f;
   }
@@ -149,7 +174,6 @@ std::vector<Triangle> trianglesOf(const Scene& s) {
   return t;
 }
 
-
 // Why a hit/miss disagreement happens: the triangle that one side hit, the watertight test's edge
 // functions for it (in float, as the scalar routine computes them), the edge the ray passes nearest and
 // whether another triangle shares that edge (same vertex positions). Counted by kind in `kinds`.
@@ -162,7 +186,9 @@ bool meetsInDouble(const Ray& r, const Triangle& t) {
   const glm::vec3 v[3] = {t.v0, t.v1, t.v2};
   for (int i = 0; i < 3; ++i) {
     const glm::dvec3 a = glm::dvec3(v[i]) - o;
-    x[i] = a[w.kx] - sx * a[w.kz]; y[i] = a[w.ky] - sy * a[w.kz]; z[i] = a[w.kz] / d[w.kz];
+    x[i] = a[w.kx] - sx * a[w.kz];
+    y[i] = a[w.ky] - sy * a[w.kz];
+    z[i] = a[w.kz] / d[w.kz];
   }
   const double e0 = x[2] * y[1] - y[2] * x[1], e1 = x[0] * y[2] - y[0] * x[2], e2 = x[1] * y[0] - y[1] * x[0];
   const double det = e0 + e1 + e2;
@@ -183,7 +209,8 @@ void explain(const Ray& r, const Hit& ours, const Hit& theirs, const std::vector
   const glm::vec3 v[3] = {t.v0, t.v1, t.v2};
   const float sum = std::fabs(e[0]) + std::fabs(e[1]) + std::fabs(e[2]);
   int k = 0;
-  for (int i = 1; i < 3; ++i) if (std::fabs(e[i]) < std::fabs(e[k])) k = i;
+  for (int i = 1; i < 3; ++i)
+    if (std::fabs(e[i]) < std::fabs(e[k])) k = i;
   const float rel = std::fabs(e[k]) / sum;  // 0: exactly on the edge in float
   const glm::vec3 p = v[(k + 1) % 3], q = v[(k + 2) % 3];
   int neighbours = 0;
@@ -206,7 +233,11 @@ void explain(const Ray& r, const Hit& ours, const Hit& theirs, const std::vector
     std::printf("    triangle %u, t %.9g, edge functions %.3g %.3g %.3g: %s\n", h.prim, h.t, e[0], e[1], e[2], kind.c_str());
 }
 
-struct RaySet { const char* name; const std::vector<Ray>* rays; bool any; };
+struct RaySet {
+  const char* name;
+  const std::vector<Ray>* rays;
+  bool any;
+};
 
 // What each ray costs in work, single rays and packets of eight (BvhCounters, the counting traversal on
 // one thread; the counts do not depend on the machine): where a row stays below Embree's packets, these
@@ -214,12 +245,13 @@ struct RaySet { const char* name; const std::vector<Ray>* rays; bool any; };
 // boxes or a pack's eight triangles, or one box or triangle against a packet's eight lanes.
 void printCounters(const Bvh& bvh, const std::vector<RaySet>& sets) {
   Bvh::setCounting(true);
-  std::printf("\nWork per ray (counted; a pass: one 8-wide box or triangle test, lanes = boxes or triangles for one ray, "
-              "or lanes = rays for a packet; `live`: the share of a packet's 8 lanes with a ray):\n\n"
-              "| rays | single: node visits | packs | triangles | packets: node visits a packet | box tests a node visit | "
-              "live at box tests | leaf visits a packet | live at leaves | box passes a ray: single / packets | "
-              "triangle passes a ray: single / packets (of them lanes = rays) | walks alone a ray | retried |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\nWork per ray (counted; a pass: one 8-wide box or triangle test, lanes = boxes or triangles for one ray, "
+      "or lanes = rays for a packet; `live`: the share of a packet's 8 lanes with a ray):\n\n"
+      "| rays | single: node visits | packs | triangles | packets: node visits a packet | box tests a node visit | "
+      "live at box tests | leaf visits a packet | live at leaves | box passes a ray: single / packets | "
+      "triangle passes a ray: single / packets (of them lanes = rays) | walks alone a ray | retried |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const RaySet& s : sets) {
     const std::vector<Ray>& rays = *s.rays;
     const double n = double(std::max<size_t>(1, rays.size()));
@@ -230,18 +262,20 @@ void printCounters(const Bvh& bvh, const std::vector<RaySet>& sets) {
     for (size_t i = 0; i < rays.size(); i += 8) {
       const int k = int(std::min<size_t>(8, rays.size() - i));
       Hit h[8];
-      if (s.any) bvh.occluded8(&rays[i], k); else bvh.closest8(&rays[i], k, h);
+      if (s.any) bvh.occluded8(&rays[i], k);
+      else bvh.closest8(&rays[i], k, h);
     }
     const BvhCounters p = Bvh::counters();
     auto share = [](uint64_t live, uint64_t visits) { return visits ? double(live) / (8.0 * double(visits)) : 0.0; };
     // Packets' passes: their box and triangle tests plus the single-ray work of rays walking alone, retried,
     // or testing a leaf ray by ray.
-    std::printf("| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.2f | %.0f %% | %.2f / %.2f | %.2f / %.2f (%.2f) | %.3f | %.4f |\n",
-                s.name, one.nodes / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
-                p.packetNodes ? double(p.childTests) / double(p.packetNodes) : 0.0, 100.0 * share(p.childTestRays, p.childTests),
-                8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), one.nodes / n,
-                (p.intervalTests + p.childTests + p.nodes) / n, one.packs / n, (p.triangleTests + p.packs) / n, p.triangleTests / n, p.lone / n,
-                p.retries / n);
+    std::printf(
+        "| %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.2f | %.0f %% | %.2f / %.2f | %.2f / %.2f (%.2f) | %.3f | %.4f |\n",
+        s.name, one.nodes / n, one.packs / n, one.triangles / n, 8.0 * p.packetNodes / n,
+        p.packetNodes ? double(p.childTests) / double(p.packetNodes) : 0.0, 100.0 * share(p.childTestRays, p.childTests),
+        8.0 * p.packetLeaves / n, 100.0 * share(p.packetLeafRays, p.packetLeaves), one.nodes / n,
+        (p.intervalTests + p.childTests + p.nodes) / n, one.packs / n, (p.triangleTests + p.packs) / n, p.triangleTests / n,
+        p.lone / n, p.retries / n);
   }
   Bvh::counters() = {};
   Bvh::setCounting(false);
@@ -264,8 +298,14 @@ uint64_t treeHash(const Bvh& bvh) {
   };
   const Bvh::View v = bvh.view();
   add(&v.root, sizeof v.root);
-  for (uint32_t i = 0; i < bvh.stats().nodes; ++i) { add(v.nodes[i].box, sizeof v.nodes[i].box); add(v.nodes[i].child, sizeof v.nodes[i].child); }
-  for (uint32_t i = 0; i < bvh.stats().packs; ++i) { add(v.packs[i].v, sizeof v.packs[i].v); add(v.packs[i].prim, sizeof v.packs[i].prim); }
+  for (uint32_t i = 0; i < bvh.stats().nodes; ++i) {
+    add(v.nodes[i].box, sizeof v.nodes[i].box);
+    add(v.nodes[i].child, sizeof v.nodes[i].child);
+  }
+  for (uint32_t i = 0; i < bvh.stats().packs; ++i) {
+    add(v.packs[i].v, sizeof v.packs[i].v);
+    add(v.packs[i].prim, sizeof v.packs[i].prim);
+  }
   return h;
 }
 
@@ -277,10 +317,11 @@ void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
     const double ours = seconds(t0);
     const Embree em(tris, o.threads);
     const BvhStats& st = bvh.stats();
-    std::printf("build %u threads: ours %.4f s (references %.4f, tree %.4f, copy-out %.4f), Embree %.4f s, ratio %.2f; "
-                "SAH cost %.4f, %u nodes, %u packs, tree hash %016llx\n", o.threads, ours, st.refSeconds, st.treeSeconds,
-                st.buildSeconds - st.refSeconds - st.treeSeconds, em.buildSeconds, ours / em.buildSeconds, st.sahCost, st.nodes,
-                st.packs, (unsigned long long)treeHash(bvh));
+    std::printf(
+        "build %u threads: ours %.4f s (references %.4f, tree %.4f, copy-out %.4f), Embree %.4f s, ratio %.2f; "
+        "SAH cost %.4f, %u nodes, %u packs, tree hash %016llx\n",
+        o.threads, ours, st.refSeconds, st.treeSeconds, st.buildSeconds - st.refSeconds - st.treeSeconds, em.buildSeconds,
+        ours / em.buildSeconds, st.sahCost, st.nodes, st.packs, (unsigned long long)treeHash(bvh));
   }
 }
 
@@ -290,7 +331,9 @@ void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
 struct Rays {
   std::vector<Ray> primary, ortho, shadow, mirror;
   std::vector<RaySet> sets() const {
-    return {{"primary", &primary, false}, {"primary, orthographic", &ortho, false}, {"shadow (any hit)", &shadow, true},
+    return {{"primary", &primary, false},
+            {"primary, orthographic", &ortho, false},
+            {"shadow (any hit)", &shadow, true},
             {"mirror", &mirror, false}};
   }
 };
@@ -344,44 +387,54 @@ void printBuilds(const std::vector<Triangle>& tris, const Bvh& bvh, double ourBu
     oneThread = seconds(t1);
   }
   const BvhStats& st = bvh.stats();
-  std::printf("BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
-              "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
-              ourBuild, st.nodes, st.packs, st.maxDepth, st.sahCost, st.refSeconds, st.treeSeconds,
-              st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
+  std::printf(
+      "BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
+      "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
+      ourBuild, st.nodes, st.packs, st.maxDepth, st.sahCost, st.refSeconds, st.treeSeconds,
+      st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
 }
 
 // Hit/miss and distance agreement with Embree on the primary, orthographic and mirror rays (and shadow rays).
 void printAgreement(const std::vector<Triangle>& tris, const Bvh& bvh, const Embree& em, const Rays& rays, bool explainAll) {
-  const std::vector<Ray>& primary = rays.primary, &ortho = rays.ortho, &mirror = rays.mirror, &shadow = rays.shadow;
+  const std::vector<Ray>&primary = rays.primary, &ortho = rays.ortho, &mirror = rays.mirror, &shadow = rays.shadow;
   for (auto* set : {&primary, &ortho, &mirror}) {
     size_t disagree = 0, otherTriangle = 0, farOff = 0;
     double maxRel = 0, maxRelSame = 0;
     std::map<std::string, size_t> kinds;
     for (const Ray& r : *set) {
       const Hit a = bvh.closest(r), b = em.closest(r);
-      if (a.hit() != b.hit()) { explain(r, a, b, tris, explainAll, kinds); ++disagree; continue; }
+      if (a.hit() != b.hit()) {
+        explain(r, a, b, tris, explainAll, kinds);
+        ++disagree;
+        continue;
+      }
       if (!a.hit()) continue;
       const double rel = std::fabs(double(a.t) - double(b.t)) / std::max(1e-30, double(b.t));
       maxRel = std::max(maxRel, rel);
       farOff += rel > 1e-4;
-      if (a.prim != b.prim) ++otherTriangle; else maxRelSame = std::max(maxRelSame, rel);
+      if (a.prim != b.prim) ++otherTriangle;
+      else maxRelSame = std::max(maxRelSame, rel);
     }
     for (const auto& [kind, n] : kinds) std::printf("  (%zu: %s)\n", n, kind.c_str());
-    std::printf("  (%zu rays hit another triangle than Embree's; %zu differ in t by more than 1e-4 relative; "
-                "same triangle: largest relative t difference %.3g)\n", otherTriangle, farOff, maxRelSame);
+    std::printf(
+        "  (%zu rays hit another triangle than Embree's; %zu differ in t by more than 1e-4 relative; "
+        "same triangle: largest relative t difference %.3g)\n",
+        otherTriangle, farOff, maxRelSame);
     size_t shadowDisagree = 0;
     if (set == &primary)
       for (const Ray& r : shadow) shadowDisagree += bvh.occluded(r) != em.occluded(r);
     std::printf("agreement with Embree, %s rays: %zu hit/miss disagreements of %zu, largest relative t difference %.3g%s\n",
-                set == &primary ? "primary" : set == &ortho ? "orthographic primary" : "mirror", disagree, set->size(), maxRel,
+                set == &primary ? "primary"
+                : set == &ortho ? "orthographic primary"
+                                : "mirror",
+                disagree, set->size(), maxRel,
                 set == &primary ? (", shadow rays: " + std::to_string(shadowDisagree) + " disagreements").c_str() : "");
   }
-
 }
 
 // Our packets and Embree's against single rays: the same answers, bit for bit.
 void printPacketAgreement(const Bvh& bvh, const Embree& em, const Rays& rays, int leafRays) {
-  const std::vector<Ray>& primary = rays.primary, &ortho = rays.ortho, &mirror = rays.mirror, &shadow = rays.shadow;
+  const std::vector<Ray>&primary = rays.primary, &ortho = rays.ortho, &mirror = rays.mirror, &shadow = rays.shadow;
   if (em.packets()) {  // the packets give the same answers as rtcIntersect1/Occluded1 (summed per packet)
     size_t differ = 0, total = 0;
     for (auto* set : {&primary, &shadow, &mirror})
@@ -405,13 +458,18 @@ void printPacketAgreement(const Bvh& bvh, const Embree& em, const Rays& rays, in
         if (set != &shadow) bvh.closest8(&(*set)[i], n, h);
         const unsigned occ = set == &shadow ? bvh.occluded8(&(*set)[i], n) : 0u;
         for (int k = 0; k < n; ++k, ++total) {
-          if (set == &shadow) { differ += ((occ >> k) & 1) != unsigned(bvh.occluded((*set)[i + k])); continue; }
+          if (set == &shadow) {
+            differ += ((occ >> k) & 1) != unsigned(bvh.occluded((*set)[i + k]));
+            continue;
+          }
           const Hit one = bvh.closest((*set)[i + k]);
           differ += std::memcmp(&one, &h[k], sizeof one) != 0;
         }
       }
-    std::printf("Our packets of 8 (leaves all rays at once from %d live rays) against our single rays (primary, orthographic, "
-                "shadow, mirror): %zu of %zu rays differ\n", lr, differ, total);
+    std::printf(
+        "Our packets of 8 (leaves all rays at once from %d live rays) against our single rays (primary, orthographic, "
+        "shadow, mirror): %zu of %zu rays differ\n",
+        lr, differ, total);
   }
 }
 
@@ -422,9 +480,11 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
   const unsigned threads = o.threads;
   const int reps = o.reps, leafRays = o.leafRays;
   const bool packets = em.packets();
-  std::printf("\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8, leaves ray by ray "
-              "| ours, packets of 8 (leaves all rays at once from %d live) | Embree rtcIntersect1/Occluded1 "
-              "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n", leafRays);
+  std::printf(
+      "\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8, leaves ray by ray "
+      "| ours, packets of 8 (leaves all rays at once from %d live) | Embree rtcIntersect1/Occluded1 "
+      "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n",
+      leafRays);
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<unsigned> counts{1};
   if (threads > 1) counts.push_back(threads);
@@ -436,16 +496,21 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
       // runs twice, so that the best run finds its own BVH in the caches, not the other's.
       double single = 1e30, paired = 1e30, ours8 = 1e30, ours8r = 1e30, theirs = 1e30, theirs8 = 1e30;
       for (int r = 0; r < reps; ++r) {
-        if (!o.packetsOnly) single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
-          return s.any ? uint32_t(bvh.occluded(rays[i])) : bvh.closest(rays[i]).prim;
-        }));
-        if (!o.packetsOnly) paired = std::min(paired, timed(pairs + rays.size() % 2, th, 2, [&](size_t i) {
-          if (i == pairs) return s.any ? uint32_t(bvh.occluded(rays[2 * i])) : bvh.closest(rays[2 * i]).prim;
-          const std::array<Ray, 2> two{rays[2 * i], rays[2 * i + 1]};
-          if (s.any) { const auto o = bvh.occludedPair(two); return uint32_t(o[0]) + uint32_t(o[1]); }
-          const auto h = bvh.closestPair(two);
-          return h[0].prim + h[1].prim;
-        }));
+        if (!o.packetsOnly)
+          single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
+                              return s.any ? uint32_t(bvh.occluded(rays[i])) : bvh.closest(rays[i]).prim;
+                            }));
+        if (!o.packetsOnly)
+          paired = std::min(paired, timed(pairs + rays.size() % 2, th, 2, [&](size_t i) {
+                              if (i == pairs) return s.any ? uint32_t(bvh.occluded(rays[2 * i])) : bvh.closest(rays[2 * i]).prim;
+                              const std::array<Ray, 2> two{rays[2 * i], rays[2 * i + 1]};
+                              if (s.any) {
+                                const auto o = bvh.occludedPair(two);
+                                return uint32_t(o[0]) + uint32_t(o[1]);
+                              }
+                              const auto h = bvh.closestPair(two);
+                              return h[0].prim + h[1].prim;
+                            }));
         auto packets8 = [&](size_t i) {
           const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
           if (s.any) return uint32_t(__builtin_popcount(bvh.occluded8(&rays[8 * i], n)));
@@ -459,14 +524,15 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
         Bvh::setPacketLeafRays(9);  // every leaf ray by ray (lanes = triangles), as before round 8
         if (!o.packetsOnly) ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
         Bvh::setPacketLeafRays(leafRays);
-        if (!o.packetsOnly) theirs = std::min(theirs, timed(rays.size(), th, 2, [&](size_t i) {
-          return s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
-        }));
+        if (!o.packetsOnly)
+          theirs = std::min(theirs, timed(rays.size(), th, 2, [&](size_t i) {
+                              return s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
+                            }));
         if (packets)
           theirs8 = std::min(theirs8, timed((rays.size() + 7) / 8, th, 2, [&](size_t i) {
-            const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
-            return s.any ? em.occluded8(&rays[8 * i], n) : em.closest8(&rays[8 * i], n);
-          }));
+                               const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
+                               return s.any ? em.occluded8(&rays[8 * i], n) : em.closest8(&rays[8 * i], n);
+                             }));
       }
       char t8[32] = "not built in", r8[32] = "–";
       if (packets) {
@@ -481,8 +547,9 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
       };
       const double n = double(rays.size()) * 1e-6;
       std::printf("| %s | %u | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", s.name, th, fmt(n, single, "%.2f").c_str(),
-                  fmt(n, paired, "%.2f").c_str(), fmt(n, ours8r, "%.2f").c_str(), fmt(n, ours8, "%.2f").c_str(), fmt(n, theirs, "%.2f").c_str(),
-                  t8, fmt(theirs, single, "%.2f×").c_str(), fmt(theirs, paired, "%.2f×").c_str(), r8);
+                  fmt(n, paired, "%.2f").c_str(), fmt(n, ours8r, "%.2f").c_str(), fmt(n, ours8, "%.2f").c_str(),
+                  fmt(n, theirs, "%.2f").c_str(), t8, fmt(theirs, single, "%.2f×").c_str(), fmt(theirs, paired, "%.2f×").c_str(),
+                  r8);
     }
   }
 }
@@ -492,7 +559,10 @@ void printRoutines(const Bvh& bvh, const std::vector<Ray>& primary) {
   std::printf("\nPrimary rays through our BVH with the other routines (1 thread):\n\n| routine | Mrays/s |\n|---|---|\n");
   for (IntersectMethod m : {IntersectMethod::Watertight, IntersectMethod::MollerTrumbore, IntersectMethod::HalfPlane}) {
     const double t = timed(primary.size(), 1, 2, [&](size_t i) { return bvh.closest(primary[i], m).prim; });
-    std::printf("| %s | %.2f |\n", m == IntersectMethod::Watertight ? "watertight (8-wide)" : m == IntersectMethod::HalfPlane ? "half-plane (scalar)" : "Möller–Trumbore (scalar)",
+    std::printf("| %s | %.2f |\n",
+                m == IntersectMethod::Watertight  ? "watertight (8-wide)"
+                : m == IntersectMethod::HalfPlane ? "half-plane (scalar)"
+                                                  : "Möller–Trumbore (scalar)",
                 primary.size() / t * 1e-6);
   }
 }
@@ -534,11 +604,20 @@ void benchRoutines() {
   const Mesh sphere = uvSphere({0.3f, -0.2f, 0.1f}, 3.7f, 16, 16);
   std::vector<Triangle> st;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
-    st.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
+    st.push_back(
+        {sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
   std::vector<Ray> inside;
-  auto in = [&] { glm::vec3 p; do p = {u(rng), u(rng), u(rng)}; while (glm::length(p) > 0.8f); return glm::vec3(0.3f, -0.2f, 0.1f) + p * 2.5f; };
+  auto in = [&] {
+    glm::vec3 p;
+    do p = {u(rng), u(rng), u(rng)};
+    while (glm::length(p) > 0.8f);
+    return glm::vec3(0.3f, -0.2f, 0.1f) + p * 2.5f;
+  };
   for (int i = 0; i < 100000; ++i) inside.push_back({in(), {u(rng), u(rng), u(rng)}});
-  for (const glm::vec3& v : sphere.positions) { const glm::vec3 o = in(); inside.push_back({o, v - o}); }
+  for (const glm::vec3& v : sphere.positions) {
+    const glm::vec3 o = in();
+    inside.push_back({o, v - o});
+  }
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
     for (int k = 0; k < 3; ++k) {
       const glm::vec3 a = sphere.positions[sphere.indices[i + k]], b = sphere.positions[sphere.indices[i + (k + 1) % 3]];
@@ -562,7 +641,9 @@ void benchRoutines() {
     size_t misses = 0;
     for (const Ray& r : inside) misses += !sb.closest(r, m).hit();
     std::printf("| %s | %.1f | %zu (%.3f %%) |\n",
-                m == IntersectMethod::Watertight ? "watertight" : m == IntersectMethod::HalfPlane ? "half-plane" : "Möller–Trumbore",
+                m == IntersectMethod::Watertight  ? "watertight"
+                : m == IntersectMethod::HalfPlane ? "half-plane"
+                                                  : "Möller–Trumbore",
                 8.0 * rays.size() * 16 / t * 1e-6, misses, 100.0 * double(misses) / double(inside.size()));
   }
   if (sink == 12345.0f) std::printf(" ");  // keeps the timed loops from being optimised away
@@ -594,24 +675,33 @@ int main(int argc, char** argv) {
     else if (a == "--explain") explainAll = true;
     else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
     else if (a == "--avx2") Bvh::setIsa(BvhIsa::Avx2);
-    else { std::fprintf(stderr, "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only] [--packets-only] [--build-only] [--no-sphere]\n"
-                              "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
-                              "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
-                              "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
-                              "  --explain: one line per hit/miss disagreement with Embree\n"
-                              "  --count-only: builds, agreement and work per ray (counted), no timing\n"
-                              "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"
-                              "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
-                              "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
-                              "  --no-sphere: only the --scene files\n"); return 2; }
+    else {
+      std::fprintf(
+          stderr,
+          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only] [--packets-only] [--build-only] [--no-sphere]\n"
+          "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
+          "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
+          "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
+          "  --explain: one line per hit/miss disagreement with Embree\n"
+          "  --count-only: builds, agreement and work per ray (counted), no timing\n"
+          "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"
+          "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
+          "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
+          "  --no-sphere: only the --scene files\n");
+      return 2;
+    }
   }
-  if (threads == 0 || res <= 0 || rings < 2 || reps < 1) { std::fprintf(stderr, "bench-trace: bad argument\n"); return 2; }
+  if (threads == 0 || res <= 0 || rings < 2 || reps < 1) {
+    std::fprintf(stderr, "bench-trace: bad argument\n");
+    return 2;
+  }
   Bvh::setPacketLeafRays(leafRays);
   if (!quick) benchRoutines();
   const Mesh sphere = uvSphere({0, 0, 0}, 1.0f, rings, rings + 1);
   std::vector<Triangle> tris;
   for (size_t i = 0; i < sphere.indices.size(); i += 3)
-    tris.push_back({sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
+    tris.push_back(
+        {sphere.positions[sphere.indices[i]], sphere.positions[sphere.indices[i + 1]], sphere.positions[sphere.indices[i + 2]]});
   if (!noSphere) benchScene("UV sphere", tris, sphere.bounds, true, o);
   for (const std::string& f : scenes) {
     try {

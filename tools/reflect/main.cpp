@@ -36,9 +36,7 @@ rtr::vk::SpecializationConstant parseSpec(const std::string& text) {
     unsigned long long v = 0;
     try {
       v = std::stoull(t, &used, 0);
-    } catch (const std::exception&) {
-      used = 0;
-    }
+    } catch (const std::exception&) { used = 0; }
     if (t.empty() || used != t.size() || t[0] == '-' || v > UINT32_MAX)
       throw rtr::UsageError("--spec '" + text + "': expected ID=VALUE, whole numbers of 32 bits (a bool: 0 or 1)");
     return uint32_t(v);
@@ -47,30 +45,28 @@ rtr::vk::SpecializationConstant parseSpec(const std::string& text) {
   return {part(text.substr(0, eq)), part(text.substr(eq + 1))};
 }
 
-int reflectAll(const std::vector<std::string>& files, const std::vector<std::string>& includes, bool json,
-               bool noValidate, bool strict, const std::vector<rtr::vk::SpecializationConstant>& specs) {
+int reflectAll(const std::vector<std::string>& files, const std::vector<std::string>& includes, bool json, bool noValidate,
+               bool strict, const std::vector<rtr::vk::SpecializationConstant>& specs) {
   try {
     return rtr::stage("reflecting " + joined(files), [&] {
-    std::vector<std::filesystem::path> dirs(includes.begin(), includes.end());
-    std::vector<rtr::vk::SpirvModule> modules;
-    for (const auto& f : files) {
-      modules.push_back(rtr::vk::isGlslPath(f) ? rtr::vk::compileGlsl(f, dirs) : rtr::vk::readSpirv(f));
-      if (noValidate) continue;
-      try {
-        rtr::vk::validateSpirv(modules.back());
-      } catch (const rtr::Error& e) {
-        if (strict) throw;
-        std::fprintf(stderr, "rtr-reflect: warning: %s\n  (reflecting it anyway; --strict makes this an error)\n", e.what());
+      std::vector<std::filesystem::path> dirs(includes.begin(), includes.end());
+      std::vector<rtr::vk::SpirvModule> modules;
+      for (const auto& f : files) {
+        modules.push_back(rtr::vk::isGlslPath(f) ? rtr::vk::compileGlsl(f, dirs) : rtr::vk::readSpirv(f));
+        if (noValidate) continue;
+        try {
+          rtr::vk::validateSpirv(modules.back());
+        } catch (const rtr::Error& e) {
+          if (strict) throw;
+          std::fprintf(stderr, "rtr-reflect: warning: %s\n  (reflecting it anyway; --strict makes this an error)\n", e.what());
+        }
       }
-    }
-    for (auto& m : modules) m = rtr::vk::specialize(m, specs);
-    const auto iface = rtr::vk::reflectPipeline(modules);
-    std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
-    return 0;
+      for (auto& m : modules) m = rtr::vk::specialize(m, specs);
+      const auto iface = rtr::vk::reflectPipeline(modules);
+      std::cout << (json ? rtr::vk::toJson(iface) : rtr::vk::toText(iface));
+      return 0;
     });
-  } catch (const std::exception& e) {
-    return rtr::cli::fail("rtr-reflect", e);
-  }
+  } catch (const std::exception& e) { return rtr::cli::fail("rtr-reflect", e); }
 }
 
 }  // namespace
@@ -116,7 +112,7 @@ int main(int argc, char** argv) {
   const pid_t pid = fork();
   if (pid == 0) {
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (getppid() != parent) _exit(1);  // the parent died before the line above took effect
+    if (getppid() != parent) _exit(1);                               // the parent died before the line above took effect
 #if !defined(__SANITIZE_ADDRESS__) && !defined(RTR_NO_WORKER_LIMIT)  // ASan reserves terabytes of shadow
     rlimit limit{};
     if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur > kWorkerMemory) {  // only ever lowered
@@ -132,7 +128,9 @@ int main(int argc, char** argv) {
   int status = 0;
   if (pid < 0 || waitpid(pid, &status, 0) != pid) return reflectAll(files, includes, json, noValidate, strict, specs);
   if (WIFEXITED(status)) return WEXITSTATUS(status);
-  std::fprintf(stderr, "rtr-reflect: error: %s: SPIRV-Reflect crashed reading it (signal %d); the module is "
-               "malformed in a way SPIRV-Reflect does not check\n", joined(files).c_str(), WTERMSIG(status));
+  std::fprintf(stderr,
+               "rtr-reflect: error: %s: SPIRV-Reflect crashed reading it (signal %d); the module is "
+               "malformed in a way SPIRV-Reflect does not check\n",
+               joined(files).c_str(), WTERMSIG(status));
   return 1;
 }

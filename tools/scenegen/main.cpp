@@ -50,70 +50,95 @@ void writeTextures(const fs::path& dir) {
   fs::create_directories(dir);
   // floor: RGB tiles; roughness: 8-bit grey; normal map: RGB bumps.
   scenegen::writePng8(dir / "floor_col.png", 120, 90, 3, image(120, 90, 3, [](int x, int y, uint8_t* p) {
-    bool grout = x % 40 < 2 || y % 30 < 2;
-    float n = 0.85f + 0.15f * hash2(x / 3, y / 3);
-    p[0] = q(grout ? 0.35f : 0.78f * n); p[1] = q(grout ? 0.33f : 0.70f * n); p[2] = q(grout ? 0.3f : 0.58f * n);
-  }));
-  scenegen::writePng8(dir / "floor_rough.png", 100, 75, 1, image(100, 75, 1, [](int x, int y, uint8_t* p) {
-    p[0] = q(0.55f + 0.4f * hash2(x / 4, y / 4));
-  }));
+                        bool grout = x % 40 < 2 || y % 30 < 2;
+                        float n = 0.85f + 0.15f * hash2(x / 3, y / 3);
+                        p[0] = q(grout ? 0.35f : 0.78f * n);
+                        p[1] = q(grout ? 0.33f : 0.70f * n);
+                        p[2] = q(grout ? 0.3f : 0.58f * n);
+                      }));
+  scenegen::writePng8(dir / "floor_rough.png", 100, 75, 1,
+                      image(100, 75, 1, [](int x, int y, uint8_t* p) { p[0] = q(0.55f + 0.4f * hash2(x / 4, y / 4)); }));
   scenegen::writePng8(dir / "floor_norm.png", 96, 72, 3, image(96, 72, 3, [](int x, int y, uint8_t* p) {
-    float nx = 0.25f * std::sin(x * 0.26f), ny = 0.25f * std::cos(y * 0.35f);
-    p[0] = q(nx * 0.5f + 0.5f); p[1] = q(ny * 0.5f + 0.5f); p[2] = q(0.5f + 0.5f * std::sqrt(1 - nx * nx - ny * ny));
-  }));
+                        float nx = 0.25f * std::sin(x * 0.26f), ny = 0.25f * std::cos(y * 0.35f);
+                        p[0] = q(nx * 0.5f + 0.5f);
+                        p[1] = q(ny * 0.5f + 0.5f);
+                        p[2] = q(0.5f + 0.5f * std::sqrt(1 - nx * nx - ny * ny));
+                      }));
   // column: palette base colour (stone bands), 1-bit roughness.
   std::vector<uint8_t> pal;
   for (int i = 0; i < 16; ++i) pal.insert(pal.end(), {q(0.6f + 0.02f * i), q(0.56f + 0.02f * i), q(0.5f + 0.015f * i)});
-  scenegen::writePalettePng(dir / "column_col.png", 72, 130, image(72, 130, 1, [](int x, int y, uint8_t* p) {
-    p[0] = uint8_t((int(8 + 7 * std::sin(y * 0.2f + x * 0.02f)) + int(hash2(x / 2, y / 5) * 3)) % 16);
-  }), pal);
-  scenegen::writeBitPng(dir / "column_rough.png", 64, 100, image(64, 100, 1, [](int x, int y, uint8_t* p) {
-    p[0] = hash2(x / 8, y / 8) > 0.3f;
-  }));
-  scenegen::writeBitPng(dir / "wall_rough.png", 37, 23, image(37, 23, 1, [](int x, int y, uint8_t* p) { p[0] = (x + y) % 5 != 0; }));
+  scenegen::writePalettePng(
+      dir / "column_col.png", 72, 130,
+      image(72, 130, 1,
+            [](int x, int y, uint8_t* p) {
+              p[0] = uint8_t((int(8 + 7 * std::sin(y * 0.2f + x * 0.02f)) + int(hash2(x / 2, y / 5) * 3)) % 16);
+            }),
+      pal);
+  scenegen::writeBitPng(dir / "column_rough.png", 64, 100,
+                        image(64, 100, 1, [](int x, int y, uint8_t* p) { p[0] = hash2(x / 8, y / 8) > 0.3f; }));
+  scenegen::writeBitPng(dir / "wall_rough.png", 37, 23,
+                        image(37, 23, 1, [](int x, int y, uint8_t* p) { p[0] = (x + y) % 5 != 0; }));
   scenegen::writePng8(dir / "wall_col.png", 160, 100, 3, image(160, 100, 3, [](int x, int y, uint8_t* p) {
-    int row = y / 20;
-    bool mortar = y % 20 < 2 || (x + (row % 2) * 20) % 40 < 2;
-    float n = 0.8f + 0.2f * hash2(x / 5 + row * 17, y / 5);
-    p[0] = q(mortar ? 0.5f : 0.72f * n); p[1] = q(mortar ? 0.48f : 0.55f * n); p[2] = q(mortar ? 0.45f : 0.42f * n);
-  }));
+                        int row = y / 20;
+                        bool mortar = y % 20 < 2 || (x + (row % 2) * 20) % 40 < 2;
+                        float n = 0.8f + 0.2f * hash2(x / 5 + row * 17, y / 5);
+                        p[0] = q(mortar ? 0.5f : 0.72f * n);
+                        p[1] = q(mortar ? 0.48f : 0.55f * n);
+                        p[2] = q(mortar ? 0.45f : 0.42f * n);
+                      }));
   // metals: an all-one metalness map (grey), gold base colour (RGB), shields (palette + 1-bit metalness).
   scenegen::writePng8(dir / "metal_full.png", 17, 13, 1, std::vector<uint8_t>(17 * 13, 255));
   scenegen::writePng8(dir / "gold_col.png", 50, 50, 3, image(50, 50, 3, [](int x, int y, uint8_t* p) {
-    float n = 0.9f + 0.1f * hash2(x / 2, y / 2);
-    p[0] = q(1.0f * n); p[1] = q(0.77f * n); p[2] = q(0.34f * n);
-  }));
+                        float n = 0.9f + 0.1f * hash2(x / 2, y / 2);
+                        p[0] = q(1.0f * n);
+                        p[1] = q(0.77f * n);
+                        p[2] = q(0.34f * n);
+                      }));
   std::vector<uint8_t> shieldPal = {200, 160, 60, 150, 40, 30, 90, 90, 100, 230, 210, 150};
-  scenegen::writePalettePng(dir / "shield_col.png", 90, 90, image(90, 90, 1, [](int x, int y, uint8_t* p) {
-    float r = std::hypot(x - 44.5f, y - 44.5f);
-    p[0] = r < 8 ? 3 : r < 30 ? 1 : r < 38 ? 0 : 2;
-  }), shieldPal);
+  scenegen::writePalettePng(dir / "shield_col.png", 90, 90,
+                            image(90, 90, 1,
+                                  [](int x, int y, uint8_t* p) {
+                                    float r = std::hypot(x - 44.5f, y - 44.5f);
+                                    p[0] = r < 8 ? 3 : r < 30 ? 1 : r < 38 ? 0 : 2;
+                                  }),
+                            shieldPal);
   scenegen::writeBitPng(dir / "shield_metal.png", 33, 33, image(33, 33, 1, [](int x, int y, uint8_t* p) {
-    float r = std::hypot(x - 16.0f, y - 16.0f);
-    p[0] = r < 3 || r > 11;
-  }));
+                          float r = std::hypot(x - 16.0f, y - 16.0f);
+                          p[0] = r < 3 || r > 11;
+                        }));
   // foliage: RGBA leaves with cut-outs (base colour and alpha mask are the same file).
   scenegen::writePng8(dir / "leaves.png", 110, 140, 4, image(110, 140, 4, [](int x, int y, uint8_t* p) {
-    float u = (x + 0.5f) / 110, v = (y + 0.5f) / 140;
-    float leaf = std::fabs(std::sin(v * 18.0f + u * 3.0f)) * (1.0f - std::fabs(u - 0.5f) * 1.6f) - v * 0.25f;
-    p[0] = q(0.15f + 0.2f * hash2(x / 3, y / 3)); p[1] = q(0.45f + 0.3f * leaf); p[2] = q(0.1f);
-    p[3] = leaf > 0.2f ? 255 : 0;
-  }));
+                        float u = (x + 0.5f) / 110, v = (y + 0.5f) / 140;
+                        float leaf = std::fabs(std::sin(v * 18.0f + u * 3.0f)) * (1.0f - std::fabs(u - 0.5f) * 1.6f) - v * 0.25f;
+                        p[0] = q(0.15f + 0.2f * hash2(x / 3, y / 3));
+                        p[1] = q(0.45f + 0.3f * leaf);
+                        p[2] = q(0.1f);
+                        p[3] = leaf > 0.2f ? 255 : 0;
+                      }));
   // fire: RGB base colour, RGBA emissive.
   scenegen::writePng8(dir / "fire_col.png", 40, 60, 3, image(40, 60, 3, [](int x, int y, uint8_t* p) {
-    p[0] = q(0.3f + 0.1f * hash2(x, y)); p[1] = q(0.15f); p[2] = q(0.08f);
-  }));
+                        p[0] = q(0.3f + 0.1f * hash2(x, y));
+                        p[1] = q(0.15f);
+                        p[2] = q(0.08f);
+                      }));
   scenegen::writePng8(dir / "fire_emit.png", 48, 80, 4, image(48, 80, 4, [](int x, int y, uint8_t* p) {
-    float heat = std::fmax(0.0f, 1.0f - std::hypot(x - 23.5f, (y - 40.0f) * 0.6f) / 24.0f) * (0.7f + 0.3f * hash2(x / 2, y / 2));
-    p[0] = q(heat * 1.5f); p[1] = q(heat * heat); p[2] = q(heat * heat * heat * 0.5f); p[3] = 255;
-  }));
+                        float heat = std::fmax(0.0f, 1.0f - std::hypot(x - 23.5f, (y - 40.0f) * 0.6f) / 24.0f) *
+                                     (0.7f + 0.3f * hash2(x / 2, y / 2));
+                        p[0] = q(heat * 1.5f);
+                        p[1] = q(heat * heat);
+                        p[2] = q(heat * heat * heat * 0.5f);
+                        p[3] = 255;
+                      }));
 }
 
 void writeMtl(const fs::path& file) {
   std::ofstream m(file);
   m << "# Temple courtyard materials (Sun Temple keys: map_Kd map_Pr map_Pm map_d norm map_Ke; Kd Pr Pm)\n";
-  auto mat = [&](const char* name, const char* body) { m << "\nnewmtl " << name << "\nNs 250\nKa 1 1 1\nKs 0.5 0.5 0.5\nNi 1.45\nd 1\nillum 2\n" << body; };
-  mat("floor", "Kd 0.8 0.8 0.8\nPr 1\nPm 0\nmap_Kd textures/floor_col.png\nmap_Pr textures/floor_rough.png\nnorm textures/floor_norm.png\n");
+  auto mat = [&](const char* name, const char* body) {
+    m << "\nnewmtl " << name << "\nNs 250\nKa 1 1 1\nKs 0.5 0.5 0.5\nNi 1.45\nd 1\nillum 2\n" << body;
+  };
+  mat("floor",
+      "Kd 0.8 0.8 0.8\nPr 1\nPm 0\nmap_Kd textures/floor_col.png\nmap_Pr textures/floor_rough.png\nnorm textures/floor_norm.png\n");
   mat("steps", "Kd 0.9 0.85 0.8\nPr 1\nPm 0\nmap_Kd textures/floor_col.png\nmap_Pr textures/floor_rough.png\n");
   mat("wall", "Kd 1 1 1\nPr 1\nPm 0\nmap_Kd textures/wall_col.png\nmap_Pr textures/wall_rough.png\n");
   mat("column", "Kd 1 1 1\nPr 1\nPm 0\nmap_Kd textures/column_col.png\nmap_Pr textures/column_rough.png\n");
@@ -146,10 +171,11 @@ void writeTextureSet(const fs::path& dir, int count, ObjWriter& o, std::ofstream
     const int tile = 64 << (i % 3);
     const float tint[3] = {0.55f + 0.4f * hash2(i, 1), 0.5f + 0.4f * hash2(i, 2), 0.45f + 0.4f * hash2(i, 3)};
     scenegen::writePng8(dir / (name + ".png"), size, size, 3, image(size, size, 3, [&](int x, int y, uint8_t* p) {
-      const bool grout = x % tile < 3 || y % tile < 3;
-      const float n = 0.55f * smoothNoise(float(x), float(y), 96.0f, i) + 0.3f * smoothNoise(float(x), float(y), 13.0f, i + 1000);
-      for (int c = 0; c < 3; ++c) p[c] = q(grout ? 0.3f : tint[c] * (0.45f + n));
-    }));
+                          const bool grout = x % tile < 3 || y % tile < 3;
+                          const float n = 0.55f * smoothNoise(float(x), float(y), 96.0f, i) +
+                                          0.3f * smoothNoise(float(x), float(y), 13.0f, i + 1000);
+                          for (int c = 0; c < 3; ++c) p[c] = q(grout ? 0.3f : tint[c] * (0.45f + n));
+                        }));
     mtl << "\nnewmtl " << name << "\nKd 1 1 1\nPr 0.8\nPm 0\nmap_Kd textures/" << name << ".png\n";
     // Panels on a wall behind the courtyard, 20 to a row.
     o.object("panel_" + std::to_string(i), name);
@@ -255,7 +281,5 @@ int main(int argc, char** argv) {
       bakeGrid(dir, dir / (plain ? "temple.obj" : "temple.obj.zst"), instances);
       std::printf("wrote %s: %d instances of the temple\n", (dir / "temple-grid.rtrscene").c_str(), instances);
     }
-  } catch (const std::exception& e) {
-    return rtr::cli::fail("scenegen", e);
-  }
+  } catch (const std::exception& e) { return rtr::cli::fail("scenegen", e); }
 }

@@ -109,8 +109,8 @@ void ObjWriter::cylinder(glm::vec3 base, float r, float h, int seg, int rings) {
     for (int i = 0; i < seg; ++i) {
       size_t a = j * (seg + 1) + i + 1, b = a + 1, c = a + seg + 2, d = a + seg + 1;
       size_t na = i + 1, nb = i + 2;
-      EMIT("f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu", v0 + a, t0 + a, n0 + na, v0 + d, t0 + d, n0 + na,
-           v0 + c, t0 + c, n0 + nb, v0 + b, t0 + b, n0 + nb);
+      EMIT("f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu", v0 + a, t0 + a, n0 + na, v0 + d, t0 + d, n0 + na, v0 + c, t0 + c,
+           n0 + nb, v0 + b, t0 + b, n0 + nb);
     }
   // Caps: one polygon each, sharing the ring's vertices, with their own normals.
   line("vn 0 1 0");

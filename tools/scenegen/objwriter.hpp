@@ -11,7 +11,7 @@
 namespace scenegen {
 
 class ObjWriter {
-public:
+ public:
   ObjWriter(const std::filesystem::path& file, int zstdLevel);
   ~ObjWriter();
   void line(const std::string& s);
@@ -31,7 +31,7 @@ public:
   size_t vertices() const { return v_; }
   void finish();
 
-private:
+ private:
   void flush(bool end);
   std::FILE* f_ = nullptr;
   ZSTD_CCtx* z_ = nullptr;

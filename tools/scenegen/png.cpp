@@ -43,7 +43,10 @@ std::vector<uint8_t> zlibStored(const std::vector<uint8_t>& d) {
     i += n;
   } while (i < d.size());
   uint32_t a = 1, b = 0;
-  for (uint8_t c : d) { a = (a + c) % 65521; b = (b + a) % 65521; }
+  for (uint8_t c : d) {
+    a = (a + c) % 65521;
+    b = (b + a) % 65521;
+  }
   be32(o, (b << 16) | a);
   return o;
 }

@@ -14,9 +14,9 @@ enum class CameraMode { Fly, Orbit };
 enum class Drag { None, Rotate, Pan };
 
 struct CameraSpeeds {
-  float base = 1.7f;             // units per second
-  float fastFactor = 5.0f;       // Shift
-  float slowFactor = 0.05f;      // Ctrl
+  float base = 1.7f;                   // units per second
+  float fastFactor = 5.0f;             // Shift
+  float slowFactor = 0.05f;            // Ctrl
   float degreesPerPixel = 0.5729578f;  // 0.01 rad per pixel of mouse motion
 };
 
@@ -25,16 +25,22 @@ class CameraController {
   CameraController(CameraPose pose, CameraSpeeds speeds) : pose_(pose), speeds_(speeds) {}
 
   void setKey(Move m, bool down) { keys_[size_t(m)] = down; }
-  void toggleMouseLook() { mouseLook_ = !mouseLook_; firstMouse_ = true; }
+  void toggleMouseLook() {
+    mouseLook_ = !mouseLook_;
+    firstMouse_ = true;
+  }
   bool mouseLook() const { return mouseLook_; }
   void mouseMoved(double x, double y);  // cursor position in pixels
   void update(float seconds);           // applies held keys for `seconds` of motion
 
   // Orbit: the target lies `distance` along the view direction; keys move camera and target together.
   CameraMode mode() const { return mode_; }
-  void setMode(CameraMode m) { mode_ = m; drag_ = Drag::None; }
-  void setDrag(Drag d) { drag_ = d; }   // mouse button held (orbit mode only)
-  void scrolled(double steps);          // + towards the target
+  void setMode(CameraMode m) {
+    mode_ = m;
+    drag_ = Drag::None;
+  }
+  void setDrag(Drag d) { drag_ = d; }  // mouse button held (orbit mode only)
+  void scrolled(double steps);         // + towards the target
   float orbitDistance() const { return distance_; }
   void setOrbitDistance(float d) { distance_ = d > 1e-6f ? d : 1e-6f; }
   glm::vec3 orbitTarget() const;

@@ -97,8 +97,8 @@ void checkMemoryFits(const ViewOptions& o, const vk::Context& ctx, const Scene& 
   }
   throw Error("out of memory before uploading " + o.scene + ": needs about " + mb(geometry) + " for its geometry and " +
               mb(targets) + " for the " + std::to_string(o.width) + "x" + std::to_string(o.height) + " frame; " +
-              ctx.deviceName() + " has " + mb(left) + (left < heap ? " (the address space left under ulimit -v)" : "") +
-              ": " + fits);
+              ctx.deviceName() + " has " + mb(left) + (left < heap ? " (the address space left under ulimit -v)" : "") + ": " +
+              fits);
 }
 
 }  // namespace
@@ -145,16 +145,15 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   if (wait) timeline.add("texture upload", st.textureUploadMs), timeline.add("mips", st.mipsMs);
   last = Clock::now();
   const double pipelineMsBefore = ctx.pipelineCache().stats().ms;
-  std::fprintf(stderr, "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
+  std::fprintf(stderr,
+               "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
                "geometry %.0f ms (%.2f GB/s)",
-               o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16,
-               st.triangles, st.textures, st.geometryMs,
-               st.geometryMs > 0 ? double(st.geometryBytes) / st.geometryMs * 1e-6 : 0.0);
+               o.scene.c_str(), ctx.deviceName().c_str(), ctx.driverInfo().c_str(), st.meshes, st.meshes16, st.triangles,
+               st.textures, st.geometryMs, st.geometryMs > 0 ? double(st.geometryBytes) / st.geometryMs * 1e-6 : 0.0);
   if (wait)
     std::fprintf(stderr, ", decode %.0f ms, texture upload %.0f ms, mips %.3f ms GPU", st.decodeMs, st.textureUploadMs,
                  st.mipGpuMs);
-  else if (st.textures)
-    std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
+  else if (st.textures) std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
   std::fprintf(stderr, "\n");
   const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(startLens(o, scene), scene.bounds(), pose);
@@ -175,32 +174,33 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     char name[120];
     if (ps.reported == ps.created)
       std::snprintf(name, sizeof name, "pipeline creation (%u, %u from the cache)", ps.created, ps.cacheHits);
-    else
-      std::snprintf(name, sizeof name, "pipeline creation (%u, cache hits not reported)", ps.created);
+    else std::snprintf(name, sizeof name, "pipeline creation (%u, cache hits not reported)", ps.created);
     timeline.add(name, ps.ms);
     phase("first frame complete (record, GPU, read-back)", ps.ms - pipelineMsBefore - setupPipelineMs);
     std::fprintf(stderr, "rtr-view: %s", timeline.format(totalMs).c_str());
   }
   if (gpuScene.updateTextures(true) && o.timings)  // how long the textures took, after the first frame
-    std::fprintf(stderr, "rtr-view: textures in at %.0f ms from process start: decode %.0f ms (worker threads), "
-                 "upload and mips %.0f ms (mips %.3f ms GPU)\n", render::msSinceProcessStart(), st.decodeMs,
-                 st.textureUploadMs, st.mipGpuMs);
+    std::fprintf(stderr,
+                 "rtr-view: textures in at %.0f ms from process start: decode %.0f ms (worker threads), "
+                 "upload and mips %.0f ms (mips %.3f ms GPU)\n",
+                 render::msSinceProcessStart(), st.decodeMs, st.textureUploadMs, st.mipGpuMs);
   if (o.bench > 0) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
     if (const auto c = renderer.renderer().cullStats(0)) {
       const double n = std::max(1u, c->clusters);
-      std::printf("cull: %u clusters; listed early %u, late %u; culled by frustum %u (%.1f %%), cone %u (%.1f %%), "
-                  "occlusion %u (%.1f %%), not in the level-of-detail cut %u; %u triangles listed\n", c->clusters, c->early,
-                  c->late, c->frustum, 100 * c->frustum / n, c->cone, 100 * c->cone / n, c->occlusion,
-                  100 * c->occlusion / n, c->lod, c->triangles);
+      std::printf(
+          "cull: %u clusters; listed early %u, late %u; culled by frustum %u (%.1f %%), cone %u (%.1f %%), "
+          "occlusion %u (%.1f %%), not in the level-of-detail cut %u; %u triangles listed\n",
+          c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone, 100 * c->cone / n, c->occlusion,
+          100 * c->occlusion / n, c->lod, c->triangles);
     }
   }
   if (!o.screenshot.empty()) {
-    render::HeadlessFrame frame = first && o.frames <= 1 ? std::move(*first)
-                                                         : renderer.render(pose, lens, settings, std::max(1, o.frames));
-    const std::string empty = emptyImageWarning(scene, pose, lens, float(o.width) / float(o.height), anyLit(frame.image, settings),
-                                                settings.lights.lights.size());
+    render::HeadlessFrame frame =
+        first && o.frames <= 1 ? std::move(*first) : renderer.render(pose, lens, settings, std::max(1, o.frames));
+    const std::string empty = emptyImageWarning(scene, pose, lens, float(o.width) / float(o.height),
+                                                anyLit(frame.image, settings), settings.lights.lights.size());
     if (!empty.empty()) std::fprintf(stderr, "rtr-view: warning: %s\n", empty.c_str());
     // Compressed on all cores while the renderer, the scene and the device are torn down: the two overlap.
     writing = std::async(std::launch::async, [&o, image = std::move(frame.image)] {
@@ -218,9 +218,7 @@ int runHeadless(const ViewOptions& o) {
   int status = 0;
   try {
     status = stage("uploading or rendering " + o.scene, [&] { return renderHeadless(o, writing); });
-  } catch (const vk::OutOfMemory& e) {
-    throw Error("out of memory while uploading or rendering " + o.scene + ": " + e.what());
-  }
+  } catch (const vk::OutOfMemory& e) { throw Error("out of memory while uploading or rendering " + o.scene + ": " + e.what()); }
   if (writing.valid()) {
     writing.get();  // rethrows a write error
     std::printf("%s\n", std::filesystem::absolute(o.screenshot).c_str());

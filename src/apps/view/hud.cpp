@@ -28,19 +28,27 @@ std::string windowTitle(const ViewState& s, const std::vector<std::pair<std::str
 const std::vector<std::pair<const char*, const char*>>& keyList() {
   // The labels are those of docs/viewer.md's key table (tests/first_minute/docs_test.py compares them).
   static const std::vector<std::pair<const char*, const char*>> keys{
-      {"W / S", "move forward / back"}, {"A / D", "move left / right"}, {"E / Q", "move up / down"},
+      {"W / S", "move forward / back"},
+      {"A / D", "move left / right"},
+      {"E / Q", "move up / down"},
       {"Shift, Ctrl (held)", "move faster (x5), slower (x0.05)"},
       {"right mouse button", "mouse-look on/off (fly mode)"},
       {"left / middle drag, scroll", "orbit mode: turn about the target, pan, zoom"},
       {"1-7", "views: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, 5 normal, 6 view dir, 7 light dir"},
-      {"8 / 9 / 0", "views 8-10: BRDF terms D, F, G"}, {"- / =", "views 11-12: diffuse, specular term"},
-      {"M", "mosaic post-process off / compute / graphics"}, {"[ / ]", "LOD bias -/+ 0.5"},
-      {"F", "frame the scene"}, {"Home", "back to the start pose"}, {"C", "print the camera pose (--camera)"},
-      {"Left / Right", "previous / next file of the command line or folder"}, {"F5", "read the scene file again"},
+      {"8 / 9 / 0", "views 8-10: BRDF terms D, F, G"},
+      {"- / =", "views 11-12: diffuse, specular term"},
+      {"M", "mosaic post-process off / compute / graphics"},
+      {"[ / ]", "LOD bias -/+ 0.5"},
+      {"F", "frame the scene"},
+      {"Home", "back to the start pose"},
+      {"C", "print the camera pose (--camera)"},
+      {"Left / Right", "previous / next file of the command line or folder"},
+      {"F5", "read the scene file again"},
       {"R", "ray-trace this view on the CPU (again: hide)"},
       {"T / Y / U / O", "CPU trace: shading phong/pbr/normals, shadows, reflections, orthographic"},
       {"X", "error map: this frame against a CPU trace (again: hide)"},
-      {"F1 or H", "settings panel and legend on / off"}, {"Esc", "quit"}};
+      {"F1 or H", "settings panel and legend on / off"},
+      {"Esc", "quit"}};
   return keys;
 }
 
@@ -50,8 +58,9 @@ void drawLegend(const ViewState& s, const PanelFacts& facts) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(8, display.y - 8), ImGuiCond_Always, ImVec2(0, 1));
   ImGui::SetNextWindowBgAlpha(0.6f);
-  ImGui::Begin("legend", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
-                                      ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs);
+  ImGui::Begin("legend", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoFocusOnAppearing |
+                   ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs);
   auto swatch = [](ImVec4 c, const char* label) {
     ImGui::ColorButton(label, c, ImGuiColorEditFlags_NoTooltip, ImVec2(12, 12));
     ImGui::SameLine();
@@ -75,7 +84,7 @@ void drawLegend(const ViewState& s, const PanelFacts& facts) {
     ImGui::SameLine();
     swatch(ImVec4(1, 0, 0, 1), "red: more, beyond a 3x3 neighbourhood");
   } else if (mode == VIEW_MIP_LEVEL) {  // shaders/debug.frag's mipColor
-    static const ImVec4 k[] = {{0, 0, 1, 1}, {0, 1, 1, 1}, {0, 1, 0, 1}, {1, 1, 0, 1},
+    static const ImVec4 k[] = {{0, 0, 1, 1},    {0, 1, 1, 1}, {0, 1, 0, 1}, {1, 1, 0, 1},
                                {1, 0.5f, 0, 1}, {1, 0, 0, 1}, {1, 0, 1, 1}, {1, 1, 1, 1}};
     static const char* names[] = {"0", "1", "2", "3", "4", "5", "6", "7+"};
     ImGui::Text("mip level:");

@@ -23,23 +23,27 @@ ImGuiPass::ImGuiPass(const vk::Context& ctx, uint32_t framesInFlight) : ctx_(ctx
   unsigned char* pixels = nullptr;
   int w = 0, h = 0;
   ImGui::GetIO().Fonts->GetTexDataAsRGBA32(&pixels, &w, &h);
-  font_ = vk::Image(ctx, {{uint32_t(w), uint32_t(h)}, VK_FORMAT_R8G8B8A8_UNORM, 1,
-                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, 0, 0, "imgui font"});
+  font_ = vk::Image(ctx, {{uint32_t(w), uint32_t(h)},
+                          VK_FORMAT_R8G8B8A8_UNORM,
+                          1,
+                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                          0,
+                          0,
+                          "imgui font"});
   const size_t bytes = size_t(w) * h * 4;
   vk::Buffer stage(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "imgui font staging");
   std::memcpy(stage.mapped(), pixels, bytes);
   stage.flush();
   vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-    vk::barrier(cb, {{font_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                      VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+    vk::barrier(cb, {{font_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {uint32_t(w), uint32_t(h), 1};
     vkCmdCopyBufferToImage(cb, stage.handle(), font_.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
     vk::barrier(cb, {{font_.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                      VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
+                      VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
   });
   VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   si.magFilter = si.minFilter = VK_FILTER_LINEAR;
@@ -73,8 +77,8 @@ std::optional<double> ImGuiPass::gpuMs(uint32_t frame) const {
   return r[0].second;
 }
 
-void ImGuiPass::record(vk::Frame& frame, const ImDrawData& data, vk::TrackedImage image, VkImageView view,
-                       VkFormat format, VkExtent2D extent) {
+void ImGuiPass::record(vk::Frame& frame, const ImDrawData& data, vk::TrackedImage image, VkImageView view, VkFormat format,
+                       VkExtent2D extent) {
   drawn_[frame.index] = false;
   if (data.TotalVtxCount == 0) return;
   // One vertex and one index array for all lists, in this frame's arena.

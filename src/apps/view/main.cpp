@@ -76,9 +76,8 @@ DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
   const render::DeviceDefaults d = render::deviceDefaults(ctx.deviceType());
   DeviceChoice c{o.shadingGiven ? o.settings.shading : d.shading, o.mipsGiven ? o.mips : d.mips};
   // No " on " in this line: scripts take the first line with one for the device line below.
-  std::fprintf(stderr, "rtr-view: %s: %s shading (%s), %s mips (%s)", ctx.deviceName().c_str(),
-               enumName(c.shading), o.shadingGiven ? "--shading-path" : "default",
-               enumName(c.mips), o.mipsGiven ? "--mips" : "default");
+  std::fprintf(stderr, "rtr-view: %s: %s shading (%s), %s mips (%s)", ctx.deviceName().c_str(), enumName(c.shading),
+               o.shadingGiven ? "--shading-path" : "default", enumName(c.mips), o.mipsGiven ? "--mips" : "default");
   if (!o.shadingGiven || !o.mipsGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
   std::fprintf(stderr, "\n");
   if (const float max = render::maxAnisotropy(ctx); o.settings.sampler.anisotropy > max)
@@ -115,85 +114,110 @@ std::vector<std::string> sceneFiles(const std::vector<std::string>& given) {
 int main(int argc, char** argv) {
   using namespace rtr;
   view::ViewOptions o;
-  std::string description = "rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
-                            "Keys in the window (the panel's Keys section; docs/viewer.md):\n";
+  std::string description =
+      "rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
+      "Keys in the window (the panel's Keys section; docs/viewer.md):\n";
   for (const auto& [key, what] : view::keyList()) description += "  " + std::string(key) + ": " + what + "\n";
   description += "View 13 (albedo) has no key: --mode 13 or the panel.";
-  CLI::App app{description,
-               "rtr-view"};
+  CLI::App app{description, "rtr-view"};
   std::string camera, size = "1280x720", mips = enumName(o.mips), mosaic = "off", mtl,
-              filter = enumName(o.settings.sampler.filter);
+                      filter = enumName(o.settings.sampler.filter);
   bool waitTextures = true;
   std::string shadingPath = enumName(o.settings.shading), raster = enumName(o.settings.raster);
   std::vector<std::string> given;
-  app.add_option("scene", given, "scene files (.rtrscene, .comp5892mesh, .obj, .obj.zst) or folders of them; the window "
-                 "shows the first, Left/Right the others (--headless: one file)")->required();
+  app.add_option("scene", given,
+                 "scene files (.rtrscene, .comp5892mesh, .obj, .obj.zst) or folders of them; the window "
+                 "shows the first, Left/Right the others (--headless: one file)")
+      ->required();
   app.add_option("--mtl", mtl, "OBJ: take the materials from this MTL (default: the OBJ's mtllib, else NAME.mtl beside it)");
   app.add_flag("--headless", o.headless, "render offscreen: no window, no display needed");
-  app.add_option("--size", size, "image size WxH")->capture_default_str()
+  app.add_option("--size", size, "image size WxH")
+      ->capture_default_str()
       ->check(cli::checked([](const std::string& t) { cli::parseSize("--size", t, view::kMaxSize); }, "WxH"));
   app.add_option("--camera", camera, "start pose x,y,z,yaw,pitch (degrees)")
       ->check(cli::checked([](const std::string& t) { cli::parsePose("--camera", t); }, "X,Y,Z,YAW,PITCH"));
-  CLI::Option* fovOpt = app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")->capture_default_str()
-      ->check(cli::number(0, 180, true));
-  app.add_option("--mode", o.settings.mode, "view mode 1-13: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, "
+  CLI::Option* fovOpt = app.add_option("--fov", o.lens.fovYDeg, "vertical field of view in degrees")
+                            ->capture_default_str()
+                            ->check(cli::number(0, 180, true));
+  app.add_option("--mode", o.settings.mode,
+                 "view mode 1-13: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, "
                  "5 normal, 6 view dir, 7 light dir, 8 BRDF D, 9 BRDF F, 10 BRDF G, 11 diffuse, 12 specular, 13 albedo")
-      ->check(cli::integer(1, VIEW_COUNT))->capture_default_str();
+      ->check(cli::integer(1, VIEW_COUNT))
+      ->capture_default_str();
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(cli::integer(1, 100000));
   app.add_option("-o,--output,--screenshot", o.screenshot,
                  "write the rendered frame (not the overlay): .png, .jpg, .exr or .hdr");
   app.add_flag("--force", o.force, "overwrite an existing screenshot");
-  CLI::Option* mipsOpt = app.add_option("--mips", mips, "mip generation: compute (several levels per dispatch) | blit | auto (per texture: compute "
-                                        "when small, blit when large) "
-                                        "(default: the device's fastest, docs/startup.md)")
-                         ->check(cli::oneOf<render::MipMode>());
-  app.add_option("--mosaic", mosaic, "post process: off (the scene plainly) | compute | graphics (the 5x3 mosaic "
-                 "filter the course's assignment asks for, in a compute or a graphics pass)")
-      ->check(cli::oneOf<render::MosaicMode>())->capture_default_str();
-  CLI::Option* shadingOpt =
-      app.add_option("--shading-path", shadingPath, "shaded view: visibility (ids rasterised, BRDF in compute) | forward "
+  CLI::Option* mipsOpt =
+      app.add_option("--mips", mips,
+                     "mip generation: compute (several levels per dispatch) | blit | auto (per texture: compute "
+                     "when small, blit when large) "
                      "(default: the device's fastest, docs/startup.md)")
-          ->check(cli::oneOf<render::ShadingPath>());
+          ->check(cli::oneOf<render::MipMode>());
+  app.add_option("--mosaic", mosaic,
+                 "post process: off (the scene plainly) | compute | graphics (the 5x3 mosaic "
+                 "filter the course's assignment asks for, in a compute or a graphics pass)")
+      ->check(cli::oneOf<render::MosaicMode>())
+      ->capture_default_str();
+  CLI::Option* shadingOpt = app.add_option("--shading-path", shadingPath,
+                                           "shaded view: visibility (ids rasterised, BRDF in compute) | forward "
+                                           "(default: the device's fastest, docs/startup.md)")
+                                ->check(cli::oneOf<render::ShadingPath>());
   app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
-      ->check(cli::oneOf<render::RasterPath>())->capture_default_str();
+      ->check(cli::oneOf<render::RasterPath>())
+      ->capture_default_str();
   std::string cull = "off";
   app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
-      ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   // Default 0 (full detail): measured on the GPU machine, a cut at 1 pixel still costs more than it saves
   // up to 1M triangles (simplified flat surfaces become large triangles; docs/virtual-geometry.md).
-  app.add_option("--lod-error", o.settings.lodError, "compute raster, a scene with a cluster hierarchy: the level of "
+  app.add_option("--lod-error", o.settings.lodError,
+                 "compute raster, a scene with a cluster hierarchy: the level of "
                  "detail's projected error in pixels (0: full detail, the default; docs/virtual-geometry.md)")
-      ->check(cli::number(0, 1024))->capture_default_str();
+      ->check(cli::number(0, 1024))
+      ->capture_default_str();
   app.add_option("--lod-bias", o.settings.lodBias, "mipmap LOD bias")->check(cli::number(-16, 16));
-  app.add_option("--filter", filter, "texture filter: trilinear | nearest-mip (nearest level, bilinear in it) | nearest "
+  app.add_option("--filter", filter,
+                 "texture filter: trilinear | nearest-mip (nearest level, bilinear in it) | nearest "
                  "(nearest texel of the nearest level)")
-      ->check(cli::oneOf<render::TextureFilter>())->capture_default_str();
+      ->check(cli::oneOf<render::TextureFilter>())
+      ->capture_default_str();
   app.add_option("--anisotropy", o.settings.sampler.anisotropy,
                  "anisotropic filtering, 1 (off) up to the device's maxSamplerAnisotropy (more is clamped, with a note)")
-      ->check(cli::number(1, 64))->capture_default_str();
+      ->check(cli::number(1, 64))
+      ->capture_default_str();
   cli::addLightOptions(app, o.lightOptions);
   bool noPipelineCache = false, noWaitTextures = false;
   std::string up = "+Y";
   cli::addEnvironmentOptions(app, o.env, true);
   std::string brdf;
-  app.add_option("--brdf", brdf, "beckmann | ggx for every material (default: ggx for glTF materials, beckmann for the "
-                 "rest), as rtr-trace's")->check(cli::oneOf<trace::Brdf>());
+  app.add_option("--brdf", brdf,
+                 "beckmann | ggx for every material (default: ggx for glTF materials, beckmann for the "
+                 "rest), as rtr-trace's")
+      ->check(cli::oneOf<trace::Brdf>());
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
       ->capture_default_str();
-  app.add_option("--crease", o.load.creaseDeg, "OBJ faces without normals: normals split where faces meet at more "
-                 "than DEG degrees (0 flat, 180 smooth)")->capture_default_str()->check(cli::number(0, 180));
+  app.add_option("--crease", o.load.creaseDeg,
+                 "OBJ faces without normals: normals split where faces meet at more "
+                 "than DEG degrees (0 flat, 180 smooth)")
+      ->capture_default_str()
+      ->check(cli::number(0, 180));
   app.add_option("--bench", o.bench, "time N frames after 10 warm-up frames; print per-pass GPU min/median")
       ->check(cli::integer(0, 1000000));
   app.add_flag("--watch", o.watch, "recompile edited shaders at run time (windowed)");
-  app.add_flag("--orbit", o.orbit, "start in orbit camera mode: left-drag turns about a target, scroll zooms, middle-drag pans (windowed)");
+  app.add_flag("--orbit", o.orbit,
+               "start in orbit camera mode: left-drag turns about a target, scroll zooms, middle-drag pans (windowed)");
   app.add_option("--device", o.device, "Vulkan device index or name substring (default: discrete GPU first)");
   app.add_flag("--validation", o.validation, "enable the Vulkan validation layer");
-  CLI::Option* waitOpt = app.add_flag("--wait-textures", waitTextures,
-               "the first frame waits for the textures (default: yes with --headless; in the window materials show "
-               "their factors until their textures are in)");
+  CLI::Option* waitOpt =
+      app.add_flag("--wait-textures", waitTextures,
+                   "the first frame waits for the textures (default: yes with --headless; in the window materials show "
+                   "their factors until their textures are in)");
   app.add_flag("--no-wait-textures", noWaitTextures, "the first frame shows the materials' factors; textures come later")
       ->excludes(waitOpt);
-  app.add_flag("--timings", o.timings, "print the start-up phases in ms, from process start to the first frame (the window's panel shows them too)");
+  app.add_flag("--timings", o.timings,
+               "print the start-up phases in ms, from process start to the first frame (the window's panel shows them too)");
   app.add_flag("--no-pipeline-cache", noPipelineCache,
                "neither read nor write the pipeline cache ($XDG_CACHE_HOME/rtr or ~/.cache/rtr; RTR_PIPELINE_CACHE=DIR|off)");
   // Test-only seams of the window (tests/view/panel_test.py), hidden from --help.
@@ -217,7 +241,8 @@ int main(int argc, char** argv) {
     // The environment is the light: no headlight and no flat ambient stand in for it unless asked for (as rtr-trace).
     if (o.env.hasEnvironment()) o.lightOptions.defaultLight = false;
     if (o.env.hasEnvironment() && app.count("--ambient") == 0) o.lightOptions.ambient = glm::vec3(0.0f);
-    if (!brdf.empty()) o.settings.brdf = cli::enumOption<trace::Brdf>("--brdf", brdf) == trace::Brdf::Ggx ? BRDF_GGX : BRDF_BECKMANN;
+    if (!brdf.empty())
+      o.settings.brdf = cli::enumOption<trace::Brdf>("--brdf", brdf) == trace::Brdf::Ggx ? BRDF_GGX : BRDF_BECKMANN;
     if (o.headless && o.screenshot.empty() && o.bench == 0)
       throw UsageError("--headless needs --screenshot FILE or --bench N: there is nothing to write or measure");
     if (!o.screenshot.empty()) cli::checkImageOutput("--screenshot", o.screenshot, o.force);
@@ -233,7 +258,5 @@ int main(int argc, char** argv) {
     o.settings.raster = cli::enumOption<render::RasterPath>("--raster", raster);
     o.settings.cull = cull == "on";
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
-  } catch (const std::exception& e) {
-    return cli::fail("rtr-view", e);
-  }
+  } catch (const std::exception& e) { return cli::fail("rtr-view", e); }
 }

@@ -25,27 +25,27 @@ struct ViewOptions {
   bool headless = false;
   uint32_t width = 1280, height = 720;
   std::optional<CameraPose> camera;
-  bool fovGiven = false;           // --fov
+  bool fovGiven = false;  // --fov
   Lens lens;
   render::RenderSettings settings;  // settings.lights: resolved from lightOptions once the scene is loaded
   LightOptions lightOptions;
-  cli::EnvironmentOptions env;             // --env, --env-intensity, --env-rotation, --env-blur, --background
+  cli::EnvironmentOptions env;  // --env, --env-intensity, --env-rotation, --env-blur, --background
   render::MipMode mips = render::MipMode::Compute;
-  int frames = 1;                  // frames to render before the screenshot
-  std::string screenshot;          // image path (.png, .jpg, .exr, .hdr); empty: none
-  bool force = false;              // overwrite an existing screenshot
-  int bench = 0;                   // frames to time after warm-up; 0: no benchmark
-  bool watch = false;              // hot-reload shaders
-  bool orbit = false;              // start in orbit camera mode (windowed)
+  int frames = 1;          // frames to render before the screenshot
+  std::string screenshot;  // image path (.png, .jpg, .exr, .hdr); empty: none
+  bool force = false;      // overwrite an existing screenshot
+  int bench = 0;           // frames to time after warm-up; 0: no benchmark
+  bool watch = false;      // hot-reload shaders
+  bool orbit = false;      // start in orbit camera mode (windowed)
   std::string device;
   bool validation = false;
   bool shadingGiven = false, mipsGiven = false;  // --shading-path / --mips given: no per-device default
-  bool timings = false;            // print the start-up phases
-  bool pipelineCache = true;       // keep compiled pipelines in the user's cache folder
+  bool timings = false;                          // print the start-up phases
+  bool pipelineCache = true;                     // keep compiled pipelines in the user's cache folder
   // The first frame waits for the textures (deterministic captures); unless given, on for --headless
   // (--screenshot, --bench), off in the window, whose frames show the factors until the textures are in.
   std::optional<bool> waitTextures;
-  bool panel = true;               // the window's settings panel shown at start
+  bool panel = true;  // the window's settings panel shown at start
   // Test-only seams of the window (hidden options): each panel widget's rectangle on stdout when it
   // changes (--test-ui), and a file whose lines are taken as dropped paths once it appears (--test-drop).
   bool testUi = false;

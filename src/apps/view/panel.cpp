@@ -41,7 +41,8 @@ void graph(const char* label, const std::deque<float>& values) {
   std::sort(sorted.begin(), sorted.end());
   char overlay[96];
   std::snprintf(overlay, sizeof overlay, "%s: min %.3f, median %.3f ms", label, sorted.front(), sorted[sorted.size() / 2]);
-  ImGui::PlotLines("##graph", v.data(), int(v.size()), 0, overlay, 0.0f, sorted.back() * 1.2f + 1e-3f, ImVec2(ImGui::GetContentRegionAvail().x, 40));
+  ImGui::PlotLines("##graph", v.data(), int(v.size()), 0, overlay, 0.0f, sorted.back() * 1.2f + 1e-3f,
+                   ImVec2(ImGui::GetContentRegionAvail().x, 40));
 }
 
 void lightsSection(ViewState& s) {
@@ -120,8 +121,8 @@ void setPanelTracking(bool on) { tracking = on; }
 bool panelTracking() { return tracking; }
 
 const char* modeName(int m) {
-  static const char* names[] = {"", "shaded", "mip level", "linear depth", "depth derivatives", "normal", "view dir",
-                                "light dir", "BRDF D", "BRDF F", "BRDF G", "diffuse", "specular", "albedo"};
+  static const char* names[] = {"",          "shaded", "mip level", "linear depth", "depth derivatives", "normal",   "view dir",
+                                "light dir", "BRDF D", "BRDF F",    "BRDF G",       "diffuse",           "specular", "albedo"};
   return m >= 1 && m <= VIEW_COUNT ? names[m] : "?";
 }
 
@@ -179,7 +180,11 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::Text("BRDF term:");
     for (int m : {VIEW_BRDF_D, VIEW_BRDF_F, VIEW_BRDF_G, VIEW_DIFFUSE, VIEW_SPECULAR}) {
       ImGui::SameLine();
-      radio(m == VIEW_BRDF_D ? "D" : m == VIEW_BRDF_F ? "F" : m == VIEW_BRDF_G ? "G" : m == VIEW_DIFFUSE ? "diff" : "spec",
+      radio(m == VIEW_BRDF_D    ? "D"
+            : m == VIEW_BRDF_F  ? "F"
+            : m == VIEW_BRDF_G  ? "G"
+            : m == VIEW_DIFFUSE ? "diff"
+                                : "spec",
             s.settings.mode, m);
     }
     ImGui::Text("mosaic (M):");
@@ -223,8 +228,9 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::TextWrapped("%s", facts.scenePath.c_str());
     ImGui::Text("%u meshes, %u materials, %u textures, %u triangles", facts.meshes, facts.materials, facts.textures,
                 facts.triangles);
-    ImGui::TextDisabled("drop an .obj, .obj.zst, .rtrscene or .comp5892mesh on the window to load it; Left/Right: the "
-                        "other files of the command line or folder; F5 reads the file again");
+    ImGui::TextDisabled(
+        "drop an .obj, .obj.zst, .rtrscene or .comp5892mesh on the window to load it; Left/Right: the "
+        "other files of the command line or folder; F5 reads the file again");
   }
   if (ImGui::CollapsingHeader("Timing", ImGuiTreeNodeFlags_DefaultOpen)) {
     graph("CPU frame", history.cpuMs);

@@ -29,8 +29,8 @@ void startScene(ViewState& app, const ViewOptions& o, const Scene& scene) {
   const render::RenderSettings s = sceneSettings(o, scene);
   app.settings.lights = s.lights;
   // Course scenes light themselves with "*light*" geometry (Blinn-Phong); others use the renderer's light.
-  const bool geometryLights = std::any_of(scene.materials.begin(), scene.materials.end(),
-                                          [](const Material& m) { return m.flags & kMaterialLight; });
+  const bool geometryLights =
+      std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.flags & kMaterialLight; });
   app.traceShading = geometryLights ? trace::Shading::Phong : trace::Shading::Pbr;
   // The speed depends on the scene; printed so that users (and the window test) know what W does.
   std::fprintf(stderr, "rtr-view: move speed %.9g units/s (Shift x%g, Ctrl x%g)\n", speeds.base, speeds.fastFactor,

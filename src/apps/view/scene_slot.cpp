@@ -8,10 +8,15 @@
 
 namespace rtr::view {
 
-SceneSlot::SceneSlot(const vk::Context& ctx, VkSurfaceKHR surface, std::unique_ptr<Scene> scene,
-                     std::vector<std::string> files, bool waitTextures, Loader load)
-    : ctx_(ctx), surface_(surface), waitTextures_(waitTextures), load_(std::move(load)), scene_(std::move(scene)),
-      files_(std::move(files)), path_(files_.at(0)) {}
+SceneSlot::SceneSlot(const vk::Context& ctx, VkSurfaceKHR surface, std::unique_ptr<Scene> scene, std::vector<std::string> files,
+                     bool waitTextures, Loader load)
+    : ctx_(ctx),
+      surface_(surface),
+      waitTextures_(waitTextures),
+      load_(std::move(load)),
+      scene_(std::move(scene)),
+      files_(std::move(files)),
+      path_(files_.at(0)) {}
 
 void SceneSlot::release() {
   VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
@@ -46,9 +51,7 @@ bool SceneSlot::update(ViewState& app) {
       dropped = std::make_unique<Scene>(loading_.get());
       path_ = loadingPath_;
       app.message = "loaded " + loadingPath_, app.messageIsError = false;
-    } catch (const std::exception& e) {
-      app.message = std::string("cannot load: ") + e.what(), app.messageIsError = true;
-    }
+    } catch (const std::exception& e) { app.message = std::string("cannot load: ") + e.what(), app.messageIsError = true; }
     std::fprintf(stderr, "rtr-view: %s\n", app.message.c_str());
   }
   const bool replaced = dropped != nullptr;
@@ -65,8 +68,8 @@ bool SceneSlot::update(ViewState& app) {
   if (gpu_->updateTextures()) {
     const auto& st = gpu_->stats();
     if (texturesInAt_ == 0) texturesInAt_ = render::msSinceProcessStart();
-    std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload and mips %.0f ms\n",
-                 st.textures, st.decodeMs, st.textureUploadMs);
+    std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload and mips %.0f ms\n", st.textures,
+                 st.decodeMs, st.textureUploadMs);
     std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", enumName(app.mips), st.mipGpuMs);
   }
   return replaced;
@@ -86,9 +89,7 @@ void ShaderReload::update(float dt, ViewFrames& frames) {
       frames.rebuildPipelines();
       error_.clear();
       std::fprintf(stderr, "rtr-view: shaders reloaded\n");
-    } catch (const std::exception& e) {
-      err = e.what();
-    }
+    } catch (const std::exception& e) { err = e.what(); }
   }
   if (!err.empty()) {
     error_ = err;

@@ -21,8 +21,8 @@ class SceneSlot {
  public:
   using Loader = std::function<Scene(const std::string& path)>;  // called on a worker thread
   // `files`: the command line's scene files, the first one loaded as `scene`; Left/Right step through them.
-  SceneSlot(const vk::Context& ctx, VkSurfaceKHR surface, std::unique_ptr<Scene> scene,
-            std::vector<std::string> files, bool waitTextures, Loader load);
+  SceneSlot(const vk::Context& ctx, VkSurfaceKHR surface, std::unique_ptr<Scene> scene, std::vector<std::string> files,
+            bool waitTextures, Loader load);
   ~SceneSlot() { release(); }  // the device idle, children first; before the surface and the device go
 
   void build(VkExtent2D extent, render::MipMode mips);

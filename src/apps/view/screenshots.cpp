@@ -46,9 +46,7 @@ void Screenshots::collect(ViewState& app) {
   if (!saving_.valid() || saving_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
   try {
     app.message = "saved " + saving_.get(), app.messageIsError = false;
-  } catch (const std::exception& ex) {
-    app.message = std::string("screenshot failed: ") + ex.what(), app.messageIsError = true;
-  }
+  } catch (const std::exception& ex) { app.message = std::string("screenshot failed: ") + ex.what(), app.messageIsError = true; }
   std::fprintf(stderr, "rtr-view: %s\n", app.message.c_str());
 }
 

@@ -28,8 +28,8 @@ class StartupClock {
     phase("first frame (record, GPU, present)");
     totalMs_ = render::msSinceProcessStart();
     const vk::PipelineStats ps = ctx_->pipelineCache().stats();
-    timeline_.add("pipeline creation (" + std::to_string(ps.created) + ", " + std::to_string(ps.cacheHits) +
-                      " from the cache)", ps.ms);
+    timeline_.add("pipeline creation (" + std::to_string(ps.created) + ", " + std::to_string(ps.cacheHits) + " from the cache)",
+                  ps.ms);
     if (print) std::fprintf(stderr, "rtr-view: %s", timeline_.format(totalMs_).c_str());
     done_ = true;
   }

@@ -32,7 +32,13 @@ void TraceOverlay::start(const trace::TraceSettings& settings, std::optional<Ima
     std::lock_guard lock(mutex_);
     trace::RenderStats st;
     try {  // a texture file gone since the GPU loaded it: say so instead of ending the viewer
-      st = tracer_->render(settings, image_, [this](const trace::TileRect&) { ++tilesDone_; dirty_ = true; }, &cancel_);
+      st = tracer_->render(
+          settings, image_,
+          [this](const trace::TileRect&) {
+            ++tilesDone_;
+            dirty_ = true;
+          },
+          &cancel_);
     } catch (const std::exception& e) {
       errorText_ = std::string("ray trace failed: ") + e.what();
       errorMap_ = toSrgb8(image_);  // shown in place of an error map: same size as the overlay
@@ -79,8 +85,8 @@ void TraceOverlay::recordCopy(vk::Frame& frame, VkImage image, VkFormat format, 
   if (dirty_.exchange(false) || resized) {
     if (resized) {  // the old image may still be read by a frame in flight: free it with this one
       frame.defer([old = std::make_shared<vk::Image>(std::move(shown_))] {});
-      shown_ = vk::Image(ctx_, {size, format, 1, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                0, 0, "traced image"});
+      shown_ = vk::Image(
+          ctx_, {size, format, 1, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0, 0, "traced image"});
     }
     // Tiles still being written may show half done; the next refresh completes them.
     ImageRGBA8 bytes = cpuImage();
@@ -99,8 +105,8 @@ void TraceOverlay::recordCopy(vk::Frame& frame, VkImage image, VkFormat format, 
   VkImageCopy region{};
   region.srcSubresource = region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.extent = {w, h, 1};
-  vkCmdCopyImage(frame.cb, shown_.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image,
-                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  vkCmdCopyImage(frame.cb, shown_.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                 &region);
 }
 
 }  // namespace rtr::view

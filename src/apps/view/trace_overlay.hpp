@@ -42,7 +42,9 @@ class TraceOverlay {
   // the earlier frame's read). A steady overlay costs one GPU-side image copy a frame.
   void recordCopy(vk::Frame& frame, VkImage image, VkFormat format, VkExtent2D extent);
   // Waits for the trace to finish (or be cancelled); then cpuImage() is final.
-  void wait() { if (worker_.joinable()) worker_.join(); }
+  void wait() {
+    if (worker_.joinable()) worker_.join();
+  }
   // The image the overlay shows, as sRGB bytes (RGBA): the trace, or its error map.
   ImageRGBA8 cpuImage();
 
@@ -54,7 +56,7 @@ class TraceOverlay {
   std::atomic<bool> cancel_{false}, dirty_{false}, visible_{false};
   std::atomic<uint32_t> tilesDone_{0}, tilesTotal_{0};
   std::atomic<bool> showError_{false}, errorMapShown_{false};  // errorMap_ and errorText_ are final once this is set
-  std::mutex mutex_;  // guards image_ against a concurrent restart
+  std::mutex mutex_;                                           // guards image_ against a concurrent restart
   ImageF image_;
   ImageRGBA8 errorMap_;
   std::string errorText_;

@@ -6,8 +6,7 @@
 
 namespace rtr::view {
 
-ViewFrames::ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent,
-                       const render::GpuScene& scene)
+ViewFrames::ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent, const render::GpuScene& scene)
     : ctx_(ctx),
       swapchain_(ctx, surface, windowExtent),
       renderer_(ctx, scene, kFramesInFlight),

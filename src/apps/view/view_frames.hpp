@@ -17,9 +17,9 @@ struct ViewFrameInput {
   CameraPose pose;
   Lens lens;
   render::RenderSettings settings;
-  TraceOverlay* trace = nullptr;          // drawn over the frame while visible
-  const ImDrawData* panel = nullptr;      // the settings panel; none: hidden
-  bool readBack = false;                  // return the frame (before the panel is drawn)
+  TraceOverlay* trace = nullptr;      // drawn over the frame while visible
+  const ImDrawData* panel = nullptr;  // the settings panel; none: hidden
+  bool readBack = false;              // return the frame (before the panel is drawn)
 };
 
 class ViewFrames {

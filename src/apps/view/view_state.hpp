@@ -14,8 +14,8 @@ namespace rtr::view {
 
 struct ViewState {
   CameraController camera{{}, {}};
-  CameraPose startPose;            // Home returns here
-  Lens lens;                       // fov from the panel
+  CameraPose startPose;  // Home returns here
+  Lens lens;             // fov from the panel
   render::RenderSettings settings;
   render::MipMode mips = render::MipMode::Compute;
   bool panel = true, resized = false;
@@ -28,7 +28,7 @@ struct ViewState {
   // Ray tracer (the course framework's toggles, docs/formats.md, on keys that do not clash with the view modes).
   trace::Shading traceShading = trace::Shading::Phong;
   bool traceShadows = true, traceReflections = true, traceOrtho = false;
-  std::string message;             // the last load / screenshot outcome, shown in the panel
+  std::string message;  // the last load / screenshot outcome, shown in the panel
   bool messageIsError = false;
 };
 
@@ -38,13 +38,13 @@ struct PanelFacts {
   uint32_t meshes = 0, materials = 0, textures = 0, triangles = 0;
   double mipGpuMs = 0;
   std::string traceStatus, shaderError;
-  float maxAnisotropy = 1;  // the device's; 1: no anisotropic filtering
-  size_t texturesDecoded = 0;     // of `textures`
-  bool texturesLoading = false;   // not all in yet: materials show their factors
+  float maxAnisotropy = 1;                                               // the device's; 1: no anisotropic filtering
+  size_t texturesDecoded = 0;                                            // of `textures`
+  bool texturesLoading = false;                                          // not all in yet: materials show their factors
   const std::vector<std::pair<std::string, double>>* startup = nullptr;  // phases in ms; empty before the first frame
   double startupTotalMs = 0, texturesInAtMs = 0;                         // from process start; 0: not yet
-  float depthFar = 0;             // the linear depth view's white (its far plane)
-  bool errorMap = false;          // the error map is on screen: its scale is shown
+  float depthFar = 0;                                                    // the linear depth view's white (its far plane)
+  bool errorMap = false;                                                 // the error map is on screen: its scale is shown
 };
 
 // The last kFrames frames' CPU time and per-pass GPU times, for the panel's graphs.

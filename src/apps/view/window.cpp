@@ -25,15 +25,17 @@ void onKey(GLFWwindow* w, int key, int, int action, int) {
   if (action == GLFW_REPEAT) return;
   const bool down = action == GLFW_PRESS;
   if (down && ImGui::GetIO().WantCaptureKeyboard) return;  // typing into the panel (releases still count)
-  switch (key) {  // held keys: state from press/release events
+  switch (key) {                                           // held keys: state from press/release events
     case GLFW_KEY_W: app.camera.setKey(Move::Forward, down); return;
     case GLFW_KEY_S: app.camera.setKey(Move::Back, down); return;
     case GLFW_KEY_A: app.camera.setKey(Move::Left, down); return;
     case GLFW_KEY_D: app.camera.setKey(Move::Right, down); return;
     case GLFW_KEY_E: app.camera.setKey(Move::Up, down); return;
     case GLFW_KEY_Q: app.camera.setKey(Move::Down, down); return;
-    case GLFW_KEY_LEFT_SHIFT: case GLFW_KEY_RIGHT_SHIFT: app.camera.setKey(Move::Fast, down); return;
-    case GLFW_KEY_LEFT_CONTROL: case GLFW_KEY_RIGHT_CONTROL: app.camera.setKey(Move::Slow, down); return;
+    case GLFW_KEY_LEFT_SHIFT:
+    case GLFW_KEY_RIGHT_SHIFT: app.camera.setKey(Move::Fast, down); return;
+    case GLFW_KEY_LEFT_CONTROL:
+    case GLFW_KEY_RIGHT_CONTROL: app.camera.setKey(Move::Slow, down); return;
     default: break;
   }
   if (!down) return;
@@ -58,8 +60,7 @@ void onKey(GLFWwindow* w, int key, int, int action, int) {
       std::printf("orbit target %.9g,%.9g,%.9g distance %.9g\n", t.x, t.y, t.z, app.camera.orbitDistance());
     }
     std::fflush(stdout);
-  }
-  else if (key == GLFW_KEY_F1 || key == GLFW_KEY_H) app.panel = !app.panel;
+  } else if (key == GLFW_KEY_F1 || key == GLFW_KEY_H) app.panel = !app.panel;
   else if (key == GLFW_KEY_R) app.traceRequested = true;
   else if (key == GLFW_KEY_X) app.errorMapRequested = true;
   else if (key == GLFW_KEY_T) app.traceShading = trace::Shading((int(app.traceShading) + 1) % 3);  // phong, pbr, normals

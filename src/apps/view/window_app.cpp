@@ -132,18 +132,29 @@ int runWindowed(const ViewOptions& opts) {
     ImGui::NewFrame();
     if (app.panel) {
       const auto& st = slot.gpu().stats();
-      PanelFacts facts{slot.path(), st.meshes, uint32_t(slot.scene().materials.size()), st.textures, st.triangles,
-                       st.mipGpuMs, slot.traced().visible() ? slot.traced().status() : std::string(), shaders.error(),
-                       render::maxAnisotropy(ctx), slot.gpu().texturesDecoded(), !slot.gpu().texturesReady(),
-                       clock.phases(), clock.totalMs(), slot.texturesInAtMs(), lens.zFar,
+      PanelFacts facts{slot.path(),
+                       st.meshes,
+                       uint32_t(slot.scene().materials.size()),
+                       st.textures,
+                       st.triangles,
+                       st.mipGpuMs,
+                       slot.traced().visible() ? slot.traced().status() : std::string(),
+                       shaders.error(),
+                       render::maxAnisotropy(ctx),
+                       slot.gpu().texturesDecoded(),
+                       !slot.gpu().texturesReady(),
+                       clock.phases(),
+                       clock.totalMs(),
+                       slot.texturesInAtMs(),
+                       lens.zFar,
                        slot.traced().errorMapShown()};
       drawPanel(app, facts, history);
       drawLegend(app, facts);
     }
     ImGui::Render();
 
-    ViewFrameInput in{app.camera.pose(), lens, app.settings, &slot.traced(),
-                      app.panel ? ImGui::GetDrawData() : nullptr, errorMap || shots.readBack()};
+    ViewFrameInput in{app.camera.pose(),           lens, app.settings, &slot.traced(), app.panel ? ImGui::GetDrawData() : nullptr,
+                      errorMap || shots.readBack()};
     if (errorMap) {
       in.settings.mode = VIEW_SHADED;
       in.settings.mosaic = render::MosaicMode::Off;
