@@ -5,8 +5,8 @@
 // red, green and blue (680, 550, 440 nm); the result is linear radiance relative to the sun's irradiance.
 #include <algorithm>
 #include <cmath>
-#include <thread>
 
+#include "core/parallel.hpp"
 #include "scene/environment.hpp"
 #include "environment.h"
 
@@ -97,18 +97,13 @@ ImageF makeSky(const SkySettings& s) {
   const uint32_t upper = (h + 1) / 2;  // rows whose centre is above the horizon (or on it)
 
   // The upper hemisphere's rows on all cores; rows are independent.
-  const unsigned threads = std::max(1u, std::min(std::thread::hardware_concurrency(), 16u));
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t)
-    pool.emplace_back([&, t] {
-      for (uint32_t y = t; y < upper; y += threads)
-        for (uint32_t x = 0; x < w; ++x) {
-          glm::dvec3 d = glm::dvec3(shader::envUvToDir({(x + 0.5f) / w, (y + 0.5f) / h}, 0.0f));
-          d.y = std::max(d.y, 1e-4);  // the row at the horizon looks along it
-          img.at(x, y) = glm::vec4(glm::vec3(inscatter(eye, glm::normalize(d), sun, haze)), 1.0f);
-        }
-    });
-  for (std::thread& t : pool) t.join();
+  parallelFor(upper, threadCount(), [&](size_t y) {
+    for (uint32_t x = 0; x < w; ++x) {
+      glm::dvec3 d = glm::dvec3(shader::envUvToDir({(x + 0.5f) / w, (y + 0.5f) / h}, 0.0f));
+      d.y = std::max(d.y, 1e-4);  // the row at the horizon looks along it
+      img.at(x, uint32_t(y)) = glm::vec4(glm::vec3(inscatter(eye, glm::normalize(d), sun, haze)), 1.0f);
+    }
+  });
 
   // The sun: its irradiance after the atmosphere, put into the texel that holds its centre (the disk is
   // smaller than a texel at any usual size), so the map carries the sun's energy exactly.
