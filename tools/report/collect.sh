@@ -7,7 +7,7 @@
 #     --runner CMD  how to start a binary: "CMD NAME ARGS" (e.g. .device/run.sh on the GPU machine);
 #                   default: build/release/bin/NAME
 #     --quick       fewer frames and runs (lavapipe at 4K takes about a second a frame)
-#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake,startup,load
+#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake,startup,load,textures
 # The rows and their exact arguments are fixed here, so a rerun measures the same thing (fixed seeds and
 # poses: tests/reference/poses.txt, the generated scenes).
 set -uo pipefail
@@ -118,6 +118,22 @@ if ! skipped startup; then  # start-up phases (--timings) at 4K: the default tem
         --screenshot "$work/startup.png" --force
     done
   done
+fi
+if ! skipped textures; then  # start-up of a 200-texture scene (issue 29): PNG files, lossless and BC
+  # baked chains (rtr-bake --textures), first frame with the textures in, warm pipeline cache
+  tx=$work/tex
+  if bin scenegen --out "$tx" --textures $((quick ? 4 : 200)) >/dev/null 2>&1; then
+    for form in files lossless bc; do
+      mkdir -p "$tx/$form"
+      row "textures-bake-$form" rtr-bake "$tx/temple.obj.zst" "$tx/$form/temple.rtrscene" --textures $form
+      du -sb "$tx/$form" >>"$out/textures-bake-$form.txt" 2>/dev/null || true
+      [[ -f $tx/$form/temple.rtrscene ]] || continue
+      for run in 1 2 3; do
+        RTR_PIPELINE_CACHE=$tx/cache row "textures-$form-$run" rtr-view "$tx/$form/temple.rtrscene" --headless \
+          --size 1920x1080 --timings --wait-textures --screenshot "$work/tex-$form.png" --force
+      done
+    done
+  fi
 fi
 if ! skipped load; then  # time to the scene in memory: the 1M-triangle temple as .rtrscene, OBJ, GLB and
   # meshopt GLB (gltfpack -cc), the meshopt decode rate, and `assimp info` on the GLBs, in one run
