@@ -93,7 +93,13 @@ bool parseIndex(const char*& s, const char* e, int64_t& v) {
 void face(Piece& p, std::string_view rest, uint64_t line) {
   if (p.events.empty() || p.events.back().kind != EventKind::Faces)
     p.events.push_back({EventKind::Faces, line, {}, p.faces.size(), p.faces.size()});
-  RawFace f{line, p.raw.size(), 0, p.positions.size(), p.texcoords.size(), p.normals.size(), false};
+  RawFace f{uint32_t(line),
+            uint32_t(p.raw.size()),
+            0,
+            uint32_t(p.positions.size()),
+            uint32_t(p.texcoords.size()),
+            uint32_t(p.normals.size()),
+            false};
   auto stop = [&](const char* what) {  // the corners before the fault still get resolved (their errors come first)
     f.broken = true;
     p.faces.push_back(f);

@@ -35,12 +35,12 @@ struct Event {
   size_t first = 0, end = 0;
 };
 
-struct RawFace {
-  uint64_t line;
-  size_t first;  // into Piece::raw, 3 per corner (v, vt, vn)
+struct RawFace {   // 32 bytes: a piece is at most one batch of text, so its counts fit 32 bits
+  uint32_t line;   // as Event::line
+  uint32_t first;  // into Piece::raw, 3 per corner (v, vt, vn)
   uint32_t corners;
-  size_t positions, texcoords, normals;  // the piece's records before the line
-  bool broken;                           // its line has an error after these corners
+  uint32_t positions, texcoords, normals;  // the piece's records before the line
+  bool broken;                             // its line has an error after these corners
 };
 
 struct Piece {
