@@ -39,6 +39,7 @@ struct MeshBuild {
   std::string name;
   uint32_t material = 0;
   std::vector<Corner> corners;
+  size_t queued = 0;  // corners given a place so far
 };
 
 class ObjParser {
@@ -127,32 +128,54 @@ class ObjParser {
   // replays their events in file order.
   void parseBatch(std::vector<objpiece::Piece>& pieces) {
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) { objpiece::parsePiece(pieces[i]); });
+    // Where each piece's records go (serial, a few numbers a piece), then copied there on all cores.
     std::vector<objpiece::Counts> before(pieces.size());
+    objpiece::Counts end{positions_.size(), texcoords_.size(), normals_.size()};
     for (size_t i = 0; i < pieces.size(); ++i) {
+      before[i] = end;
+      end.positions += pieces[i].positions.size();
+      end.texcoords += pieces[i].texcoords.size();
+      end.normals += pieces[i].normals.size();
+      coloured_ = coloured_ || !pieces[i].colors.empty();
+    }
+    positions_.resize(end.positions);
+    texcoords_.resize(end.texcoords);
+    normals_.resize(end.normals);
+    if (coloured_) colors_.resize(end.positions, glm::vec4(1.0f));  // white where a `v` had no colour
+    parallelFor(pieces.size(), opt_.threads, [&](size_t i) {
       objpiece::Piece& p = pieces[i];
-      before[i] = {positions_.size(), texcoords_.size(), normals_.size()};
-      if (!p.colors.empty() && !coloured_) colors_.assign(positions_.size(), glm::vec4(1.0f));
-      coloured_ = coloured_ || !p.colors.empty();
-      if (coloured_) {
-        if (p.colors.empty()) colors_.resize(colors_.size() + p.positions.size(), glm::vec4(1.0f));
-        else colors_.insert(colors_.end(), p.colors.begin(), p.colors.end());
-      }
-      positions_.insert(positions_.end(), p.positions.begin(), p.positions.end());
-      texcoords_.insert(texcoords_.end(), p.texcoords.begin(), p.texcoords.end());
-      normals_.insert(normals_.end(), p.normals.begin(), p.normals.end());
+      std::copy(p.positions.begin(), p.positions.end(), positions_.begin() + ptrdiff_t(before[i].positions));
+      std::copy(p.texcoords.begin(), p.texcoords.end(), texcoords_.begin() + ptrdiff_t(before[i].texcoords));
+      std::copy(p.normals.begin(), p.normals.end(), normals_.begin() + ptrdiff_t(before[i].normals));
+      std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
       std::vector<glm::vec3>().swap(p.positions);
       std::vector<glm::vec4>().swap(p.colors);
       std::vector<glm::vec2>().swap(p.texcoords);
       std::vector<glm::vec3>().swap(p.normals);
-    }
+    });
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) { objpiece::resolvePiece(pieces[i], before[i], positions_); });
-    for (objpiece::Piece& p : pieces) {
-      replay(p);
-      std::vector<Corner>().swap(p.corners);
+    // The events in file order (serial: state, warnings, the first error); each run's corners are given
+    // their place in their mesh and copied there on all cores.
+    struct Copy {
+      size_t piece, first, end, mesh, at;
+    };
+    std::vector<Copy> copies;
+    for (size_t i = 0; i < pieces.size(); ++i) replay(pieces[i], i, copies);
+    for (const Copy& c : copies) {  // grown geometrically: a mesh spread over many batches is moved rarely
+      std::vector<Corner>& v = builds_[c.mesh].corners;
+      if (v.capacity() < c.at + (c.end - c.first)) v.reserve(std::max(c.at + (c.end - c.first), 2 * v.capacity()));
+      if (v.size() < c.at + (c.end - c.first)) v.resize(c.at + (c.end - c.first));
     }
+    parallelFor(copies.size(), opt_.threads, [&](size_t k) {
+      const Copy& c = copies[k];
+      const std::vector<Corner>& from = pieces[c.piece].corners;
+      std::copy(from.begin() + ptrdiff_t(c.first), from.begin() + ptrdiff_t(c.end),
+                builds_[c.mesh].corners.begin() + ptrdiff_t(c.at));
+    });
   }
 
-  void replay(const objpiece::Piece& p) {
+  template <class Copies>
+  void replay(const objpiece::Piece& p, size_t piece, Copies& copies) {
     using objpiece::EventKind;
     const size_t first = line_;
     for (const objpiece::Event& e : p.events) {
@@ -161,8 +184,8 @@ class ObjParser {
         case EventKind::Faces: break;  // resolved into the kinds below
         case EventKind::Run: {
           if (mesh_ == kAbsent) mesh_ = currentMesh();
-          auto& corners = builds_[mesh_].corners;
-          corners.insert(corners.end(), p.corners.begin() + ptrdiff_t(e.first), p.corners.begin() + ptrdiff_t(e.end));
+          copies.push_back({piece, e.first, e.end, mesh_, builds_[mesh_].queued});
+          builds_[mesh_].queued += e.end - e.first;
           break;
         }
         case EventKind::Object: objectLine(e.text); break;
