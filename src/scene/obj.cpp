@@ -56,17 +56,20 @@ class ObjParser {
     }
     const size_t pieceBytes = opt_.pieceBytes ? opt_.pieceBytes : kPieceBytes;
     // Small inputs (tests, fuzzing) get a small buffer; it grows for long lines.
-    std::vector<char> buf(std::min<uint64_t>(kBatch, std::max<uint64_t>(65536, src.fileSize())));
+    std::vector<char> buf(std::min<uint64_t>(kBatch, std::max<uint64_t>(65536, src.fileSize()))), next;
     size_t have = 0;
     bool atEnd = false, fileStart = true;
-    while (!atEnd || have) {
-      while (!atEnd && have < buf.size()) {  // full batches: where pieces end depends on the text only
-        const size_t got = src.read(buf.data() + have, buf.size() - have);
-        if (stats_.textBytes < kSniffBytes) sniff(std::string_view(buf.data() + have, got), stats_.textBytes);
+    auto fill = [&](std::vector<char>& b, size_t& n) {  // full batches: where pieces end depends on the text only
+      while (!atEnd && n < b.size()) {
+        const size_t got = src.read(b.data() + n, b.size() - n);
+        if (stats_.textBytes < kSniffBytes) sniff(std::string_view(b.data() + n, got), stats_.textBytes);
         stats_.textBytes += got;
-        have += got;
+        n += got;
         atEnd = got == 0;
       }
+    };
+    fill(buf, have);
+    while (have) {
       const std::string_view text(buf.data(), have);
       size_t end = have;  // the batch: whole lines (a continued line is one)
       if (!atEnd) {
@@ -74,6 +77,7 @@ class ObjParser {
         if (end == 0) {
           if (buf.size() >= kMaxLine) throw error("line longer than " + std::to_string(kMaxLine) + " bytes");
           buf.resize(std::min(buf.size() * 2, kMaxLine));
+          fill(buf, have);
           continue;
         }
       }
@@ -86,9 +90,16 @@ class ObjParser {
         at = e;
       }
       fileStart = false;
-      parseBatch(pieces);
-      std::memmove(buf.data(), buf.data() + end, have - end);
-      have -= end;
+      // The next batch is read while this one is parsed; the parse is index 0, so its error comes first.
+      next.resize(buf.size());
+      size_t nextHave = have - end;
+      std::memcpy(next.data(), buf.data() + end, nextHave);
+      parallelFor(2, opt_.threads, [&](size_t i) {
+        if (i == 0) parseBatch(pieces);
+        else fill(next, nextHave);
+      });
+      std::swap(buf, next);
+      have = nextHave;
       if (opt_.progress) opt_.progress(src.consumed(), src.fileSize());
     }
   }

@@ -6,6 +6,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <zstd.h>
 
 #include "core/error.hpp"
 #include "scene/obj.hpp"
@@ -33,10 +34,16 @@ ObjOptions options(Outcome& r, unsigned threads, size_t pieceBytes) {
   return opt;
 }
 
-Outcome parseText(const std::string& obj, const std::map<std::string, std::string>& mtls, unsigned threads, size_t pieceBytes) {
+Outcome parseText(const std::string& obj, const std::map<std::string, std::string>& mtls, unsigned threads, size_t pieceBytes,
+                  bool zstd = false) {
   Outcome r;
   const ObjOptions opt = options(r, threads, pieceBytes);
-  auto src = memorySource(obj, "t.obj");
+  std::string bytes = obj;
+  if (zstd) {
+    bytes.resize(ZSTD_compressBound(obj.size()));
+    bytes.resize(ZSTD_compress(bytes.data(), bytes.size(), obj.data(), obj.size(), 1));
+  }
+  auto src = memorySource(bytes, "t.obj", zstd);
   auto readMtl = [&](const std::string& n) -> std::optional<std::string> {
     auto it = mtls.find(n);
     if (it == mtls.end()) return std::nullopt;
@@ -87,12 +94,12 @@ void expectStitchedAsOne(const std::string& obj, const std::map<std::string, std
 // OBJ text with everything whose meaning depends on lines before it: relative indices, o/g/usemtl state,
 // an mtllib in the middle, vertex colours that start late, continued lines, CRLF, dangling indices and
 // self-crossing polygons (more warnings than are shown).
-std::string generated(unsigned seed) {
+std::string generated(unsigned seed, int lines = 1500) {
   std::mt19937 rng(seed);
   auto pick = [&](int n) { return int(rng() % unsigned(n)); };
   std::string s = "\xEF\xBB\xBF# generated\n";
   int v = 0, vt = 0, vn = 0;
-  for (int line = 0; line < 1500; ++line) {
+  for (int line = 0; line < lines; ++line) {
     const int k = pick(40);
     const std::string eol = pick(5) == 0 ? "\r\n" : "\n";
     if (k < 10 || v < 4) {
@@ -155,6 +162,23 @@ TEST(ObjPieces, GeneratedTextStitchesAsOnePiece) {
     ASSERT_FALSE(one.scene.meshes[0].colors.empty());
     expectStitchedAsOne(obj, kMtls);
   }
+}
+
+// A zstd stream is read in batches of about its compressed size (the text is larger): the pieces of one
+// batch are parsed while the next is read, and the stitch carries across batches as across pieces.
+TEST(ObjPieces, BatchesStitchAsOne) {
+  const std::string obj = generated(4, 12000);
+  const Outcome one = parseText(obj, kMtls, 1, size_t(1) << 30);
+  ASSERT_EQ(one.error, "");
+  const Outcome zstd = parseText(obj, kMtls, 1, size_t(1) << 30, true);
+  ASSERT_GT(obj.size(), 3 * std::max<size_t>(65536, ZSTD_compressBound(obj.size()) / 4)) << "several batches";
+  expectSame(one, zstd);
+  expectSame(one, parseText(obj, kMtls, 3, 700, true));
+  const size_t half = obj.find('\n', obj.size() / 2) + 1;
+  const std::string bad = obj.substr(0, half) + "\nf 1 2 x\n" + obj.substr(half) + "\nf 99999999 1 2\n";
+  const Outcome badOne = parseText(bad, kMtls, 1, size_t(1) << 30);
+  EXPECT_NE(badOne.error.find(": face corner is not an index"), std::string::npos) << badOne.error;
+  expectSame(badOne, parseText(bad, kMtls, 3, 700, true));
 }
 
 // Small cases after the ones other readers' test suites are known for.
