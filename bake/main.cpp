@@ -2,6 +2,7 @@
 // .rtrscene / .comp5892mesh, glTF (.gltf, .glb) to .rtrscene.
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 
@@ -10,6 +11,7 @@
 #include "bake.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "scene/first_look.hpp"
 
 int main(int argc, char** argv) {
@@ -34,6 +36,8 @@ int main(int argc, char** argv) {
       ->check(checked([](const std::string& t) { rtr::cli::parseColor("--light-color", t); }, "R,G,B"));
   bool noLod = false;
   app.add_flag("--no-lod", noLod, "store no cluster hierarchy (level of detail; docs/virtual-geometry.md)");
+  bool progress = false;
+  app.add_flag("--progress", progress, "show the progress line on stderr also when it is not a terminal");
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
   std::string up = "+Y";
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
@@ -58,10 +62,13 @@ int main(int argc, char** argv) {
   opt.output = output;
   opt.warn = [](const std::string& w) { std::cerr << "\rwarning: " << w << "\n"; };
   opt.note = [](const std::string& n) { std::cerr << "\rnote: " << n << "\n"; };
-  const bool tty = ::isatty(2);
+  // The progress line: on a terminal, or when asked (a log of a long bake); one line, rewritten.
+  const bool tty = ::isatty(2) || progress;
+  const auto started = std::chrono::steady_clock::now();
   if (tty)
-    opt.progress = [](const char* phase, double f) {
-      std::fprintf(stderr, "\r%-18s %5.1f%%", phase, f * 100.0);
+    opt.progress = [started](const char* phase, double f) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      std::fprintf(stderr, "\r%-18s %5.1f%%  %7.1f s", phase, f * 100.0, s);
       std::fflush(stderr);
     };
   try {
@@ -75,7 +82,7 @@ int main(int argc, char** argv) {
       opt.lights = {l};
     }
     const rtr::BakeReport r = rtr::bake(opt);
-    if (tty) std::fprintf(stderr, "\r%40s\r", "");
+    if (tty) std::fprintf(stderr, "\r%40s\r", "");  // the progress line cleared
     const auto& o = r.obj;
     const double mb = double(o.textBytes) / 1e6;
     std::printf("%s -> %s\n", input.c_str(), output.c_str());
@@ -100,9 +107,9 @@ int main(int argc, char** argv) {
     std::printf("  vertices %zu before welding, %zu after\n", o.verticesBeforeWeld, o.verticesAfterWeld);
     std::printf("  warnings %zu, output %.2f MB\n", o.warnings, double(r.outputBytes) / 1e6);
     std::printf(
-        "  time: parse %.3f s (%.0f MB/s of OBJ text), weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n",
-        r.parseSeconds, r.parseSeconds > 0 ? mb / r.parseSeconds : 0.0, r.weldSeconds, r.textureSeconds, r.clusterSeconds,
-        r.lodSeconds, r.writeSeconds, r.totalSeconds);
+        "  time: parse %.3f s (%.0f MB/s of OBJ text, %u threads), weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s, total %.3f s\n",
+        r.parseSeconds, r.parseSeconds > 0 ? mb / r.parseSeconds : 0.0, rtr::threadCount(opt.threads), r.weldSeconds,
+        r.textureSeconds, r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.totalSeconds);
     return 0;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");

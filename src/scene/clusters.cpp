@@ -23,9 +23,33 @@ struct Piece {
 
 Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone) {
   constexpr size_t kMaxV = CLUSTER_MAX_VERTICES, kMaxT = CLUSTER_MAX_TRIANGLES;
-  const float* pos = &mesh.positions[0].x;
-  const size_t nv = mesh.positions.size(), count = (end - first) * 3;
-  const uint32_t* in = mesh.indices.data() + first * 3;
+  const size_t count = (end - first) * 3;
+  // meshoptimizer allocates and clears per-vertex arrays over the whole vertex range it is given, so each
+  // piece is handed only its own vertices (else a mesh of n pieces costs n times its vertex count: the
+  // clusters of a 100 M-triangle mesh took 48 times those of 10 M). The local numbering keeps the global
+  // order, so the clusters are the same as over the whole range: the span the piece uses when it is
+  // narrow (welded meshes number vertices as their triangles come), else its sorted distinct vertices.
+  const uint32_t* src = mesh.indices.data() + first * 3;
+  const auto [lo, hi] = std::minmax_element(src, src + count);
+  std::vector<uint32_t> global, local(count);
+  std::vector<glm::vec3> gathered;
+  const float* pos = &mesh.positions[*lo].x;
+  size_t nv = size_t(*hi - *lo) + 1;
+  if (nv <= 8 * count) {
+    for (size_t k = 0; k < count; ++k) local[k] = src[k] - *lo;
+  } else {
+    global.assign(src, src + count);
+    std::sort(global.begin(), global.end());
+    global.erase(std::unique(global.begin(), global.end()), global.end());
+    for (size_t k = 0; k < count; ++k)
+      local[k] = uint32_t(std::lower_bound(global.begin(), global.end(), src[k]) - global.begin());
+    gathered.resize(global.size());
+    for (size_t v = 0; v < global.size(); ++v) gathered[v] = mesh.positions[global[v]];
+    pos = &gathered[0].x;
+    nv = gathered.size();
+  }
+  auto toGlobal = [&, base = *lo](uint32_t v) { return global.empty() ? v + base : global[v]; };
+  const uint32_t* in = local.data();
   std::vector<meshopt_Meshlet> meshlets(meshopt_buildMeshletsBound(count, kMaxV, kMaxT));
   std::vector<unsigned> vertices(meshlets.size() * kMaxV);
   std::vector<unsigned char> triangles(meshlets.size() * kMaxT * 3);
@@ -44,6 +68,7 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
       out.indices.push_back(vertices[m.vertex_offset + triangles[m.triangle_offset + k]]);
     const meshopt_Bounds b =
         meshopt_computeClusterBounds(out.indices.data() + at, size_t(m.triangle_count) * 3, pos, nv, sizeof(glm::vec3));
+    for (size_t k = at; k < out.indices.size(); ++k) out.indices[k] = toGlobal(out.indices[k]);
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
     c.coneAxis = {b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};

@@ -16,8 +16,8 @@
 #include "core/input_file.hpp"
 #include "core/parallel.hpp"
 #include "scene/mtl.hpp"
+#include "scene/obj_piece.hpp"
 #include "scene/text.hpp"
-#include "scene/triangulate.hpp"
 #include "scene/weld.hpp"
 
 namespace rtr {
@@ -26,9 +26,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-constexpr size_t kChunk = size_t(4) << 20;
+// The text is read in batches of whole lines and parsed in pieces of about kPieceBytes on all cores.
+// Both are fixed, so the pieces do not depend on the thread count (and a wrong stitch shows with any).
+constexpr size_t kBatch = size_t(64) << 20;
+constexpr size_t kPieceBytes = size_t(1) << 20;
 constexpr size_t kMaxLine = size_t(64) << 20;
-constexpr size_t kMaxName = 32767;
 constexpr uint64_t kMaxMtlBytes = uint64_t(64) << 20;  // real ones are kilobytes; /dev/zero is refused anyway
 constexpr size_t kShownWarnings = 10;
 constexpr size_t kSniffBytes = 8192;  // how much of the start is checked for being text, as git does
@@ -37,6 +39,7 @@ struct MeshBuild {
   std::string name;
   uint32_t material = 0;
   std::vector<Corner> corners;
+  size_t queued = 0;  // corners given a place so far
 };
 
 class ObjParser {
@@ -51,36 +54,52 @@ class ObjParser {
       if (!loadMtl(given, given)) throw fileError(given, "", "MTL file given for '" + name_ + "' does not exist");
       mtlSeen_ = true;
     }
+    const size_t pieceBytes = opt_.pieceBytes ? opt_.pieceBytes : kPieceBytes;
     // Small inputs (tests, fuzzing) get a small buffer; it grows for long lines.
-    std::vector<char> buf(std::min<uint64_t>(kChunk, std::max<uint64_t>(65536, src.fileSize())));
+    std::vector<char> buf(std::min<uint64_t>(kBatch, std::max<uint64_t>(65536, src.fileSize()))), next;
     size_t have = 0;
-    for (;;) {
-      if (have == buf.size()) {
-        if (buf.size() >= kMaxLine) throw error("line longer than " + std::to_string(kMaxLine) + " bytes");
-        buf.resize(buf.size() * 2);
+    bool atEnd = false, fileStart = true;
+    auto fill = [&](std::vector<char>& b, size_t& n) {  // full batches: where pieces end depends on the text only
+      while (!atEnd && n < b.size()) {
+        const size_t got = src.read(b.data() + n, b.size() - n);
+        if (stats_.textBytes < kSniffBytes) sniff(std::string_view(b.data() + n, got), stats_.textBytes);
+        stats_.textBytes += got;
+        n += got;
+        atEnd = got == 0;
       }
-      const size_t got = src.read(buf.data() + have, buf.size() - have);
-      if (stats_.textBytes < kSniffBytes) sniff(std::string_view(buf.data() + have, got), stats_.textBytes);
-      stats_.textBytes += got;
-      have += got;
-      size_t start = 0;
-      for (;;) {
-        const void* nl = std::memchr(buf.data() + start, '\n', have - start);
-        if (!nl) break;
-        const size_t end = size_t(static_cast<const char*>(nl) - buf.data());
-        ++line_;
-        onLine(std::string_view(buf.data() + start, end - start));
-        start = end + 1;
-      }
-      if (got == 0) {
-        if (start < have) {
-          ++line_;
-          onLine(std::string_view(buf.data() + start, have - start));
+    };
+    fill(buf, have);
+    while (have) {
+      const std::string_view text(buf.data(), have);
+      size_t end = have;  // the batch: whole lines (a continued line is one)
+      if (!atEnd) {
+        end = objpiece::lastLineEnd(text);
+        if (end == 0) {
+          if (buf.size() >= kMaxLine) throw error("line longer than " + std::to_string(kMaxLine) + " bytes");
+          buf.resize(std::min(buf.size() * 2, kMaxLine));
+          fill(buf, have);
+          continue;
         }
-        break;
       }
-      std::memmove(buf.data(), buf.data() + start, have - start);
-      have -= start;
+      std::vector<objpiece::Piece> pieces;
+      for (size_t at = 0; at < end;) {
+        const size_t e = std::min(end, objpiece::pieceEnd(text, std::min(end, at + pieceBytes)));
+        pieces.emplace_back();
+        pieces.back().text = text.substr(at, e - at);
+        pieces.back().fileStart = fileStart && at == 0;
+        at = e;
+      }
+      fileStart = false;
+      // The next batch is read while this one is parsed; the parse is index 0, so its error comes first.
+      next.resize(buf.size());
+      size_t nextHave = have - end;
+      std::memcpy(next.data(), buf.data() + end, nextHave);
+      parallelFor(2, opt_.threads, [&](size_t i) {
+        if (i == 0) parseBatch(pieces);
+        else fill(next, nextHave);
+      });
+      std::swap(buf, next);
+      have = nextHave;
       if (opt_.progress) opt_.progress(src.consumed(), src.fileSize());
     }
   }
@@ -116,112 +135,127 @@ class ObjParser {
     }
   }
 
-  // Names are bytes in whatever encoding the exporter used; only their length is limited.
-  std::string checkedName(std::string_view what, std::string_view s) {
-    s = text::trim(s);
-    if (s.size() > kMaxName) throw error(std::string(what) + " longer than " + std::to_string(kMaxName) + " bytes");
-    return std::string(s);
+  // Parses the pieces on all cores, appends their records, resolves their faces on all cores, then
+  // replays their events in file order.
+  void parseBatch(std::vector<objpiece::Piece>& pieces) {
+    parallelFor(pieces.size(), opt_.threads, [&](size_t i) { objpiece::parsePiece(pieces[i]); });
+    // Where each piece's records go (serial, a few numbers a piece), then copied there on all cores.
+    std::vector<objpiece::Counts> before(pieces.size());
+    objpiece::Counts end{positions_.size(), texcoords_.size(), normals_.size()};
+    for (size_t i = 0; i < pieces.size(); ++i) {
+      before[i] = end;
+      end.positions += pieces[i].positions.size();
+      end.texcoords += pieces[i].texcoords.size();
+      end.normals += pieces[i].normals.size();
+      coloured_ = coloured_ || !pieces[i].colors.empty();
+    }
+    positions_.resize(end.positions);
+    texcoords_.resize(end.texcoords);
+    normals_.resize(end.normals);
+    if (coloured_) colors_.resize(end.positions, glm::vec4(1.0f));  // white where a `v` had no colour
+    parallelFor(pieces.size(), opt_.threads, [&](size_t i) {
+      objpiece::Piece& p = pieces[i];
+      std::copy(p.positions.begin(), p.positions.end(), positions_.begin() + ptrdiff_t(before[i].positions));
+      std::copy(p.texcoords.begin(), p.texcoords.end(), texcoords_.begin() + ptrdiff_t(before[i].texcoords));
+      std::copy(p.normals.begin(), p.normals.end(), normals_.begin() + ptrdiff_t(before[i].normals));
+      std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
+      std::vector<glm::vec3>().swap(p.positions);
+      std::vector<glm::vec4>().swap(p.colors);
+      std::vector<glm::vec2>().swap(p.texcoords);
+      std::vector<glm::vec3>().swap(p.normals);
+    });
+    parallelFor(pieces.size(), opt_.threads, [&](size_t i) { objpiece::resolvePiece(pieces[i], before[i], positions_); });
+    // The events in file order (serial: state, warnings, the first error); each run's corners are given
+    // their place in their mesh and copied there on all cores.
+    struct Copy {
+      size_t piece, first, end, mesh, at;
+    };
+    std::vector<Copy> copies;
+    for (size_t i = 0; i < pieces.size(); ++i) replay(pieces[i], i, copies);
+    for (const Copy& c : copies) {  // grown geometrically: a mesh spread over many batches is moved rarely
+      std::vector<Corner>& v = builds_[c.mesh].corners;
+      if (v.capacity() < c.at + (c.end - c.first)) v.reserve(std::max(c.at + (c.end - c.first), 2 * v.capacity()));
+      if (v.size() < c.at + (c.end - c.first)) v.resize(c.at + (c.end - c.first));
+    }
+    parallelFor(copies.size(), opt_.threads, [&](size_t k) {
+      const Copy& c = copies[k];
+      const std::vector<Corner>& from = pieces[c.piece].corners;
+      std::copy(from.begin() + ptrdiff_t(c.first), from.begin() + ptrdiff_t(c.end),
+                builds_[c.mesh].corners.begin() + ptrdiff_t(c.at));
+    });
   }
 
-  template <int N, class V>
-  void vec(std::string_view rest, std::vector<V>& out, const char* key, int required) {
-    V v(0.0f);
-    for (int i = 0; i < N; ++i) {
-      float f = 0;
-      switch (text::nextFloat(rest, f)) {
-        case text::NumResult::Ok: v[i] = f; break;
-        case text::NumResult::Missing:
-          if (i < required) throw error(std::string("'") + key + "' needs " + std::to_string(required) + " numbers");
-          i = N;
+  template <class Copies>
+  void replay(const objpiece::Piece& p, size_t piece, Copies& copies) {
+    using objpiece::EventKind;
+    const size_t first = line_;
+    for (const objpiece::Event& e : p.events) {
+      line_ = first + e.line;
+      switch (e.kind) {
+        case EventKind::Faces: break;  // resolved into the kinds below
+        case EventKind::Run: {
+          if (mesh_ == kAbsent) mesh_ = currentMesh();
+          copies.push_back({piece, e.first, e.end, mesh_, builds_[mesh_].queued});
+          builds_[mesh_].queued += e.end - e.first;
           break;
-        case text::NumResult::NotFinite: throw error(std::string("'") + key + "' coordinate is NaN or infinite");
-        default: throw error(std::string("'") + key + "' coordinate is not a number");
+        }
+        case EventKind::Object: objectLine(e.text); break;
+        case EventKind::Usemtl: usemtlLine(e.text); break;
+        case EventKind::Mtllib: mtllibLine(e.text); break;
+        case EventKind::Unknown:
+          if (std::find(unknown_.begin(), unknown_.end(), e.text) == unknown_.end()) {
+            unknown_.push_back(e.text);
+            warn("unknown OBJ keyword '" + e.text + "' ignored");
+          }
+          break;
+        case EventKind::Warn: warn(e.text); break;
+        case EventKind::Dangling:
+          if (!danglingWarned_) warn(e.text);
+          danglingWarned_ = true;
+          break;
+        case EventKind::Error: throw error(e.text);
       }
     }
-    if constexpr (N == 3)
-      if (key[1] == '\0' && !coordinateOk(v))  // 'v': the limit every reader applies
-        throw error("vertex coordinate beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
-    out.push_back(v);
+    line_ = first + p.lines;
+    stats_.faces += p.faceCount;
+    stats_.degenerateSkipped += p.degenerate;
+    stats_.warnings += p.silentWarnings;
+    pointsAndLines_ += p.pointsAndLines;
   }
 
-  // `v x y z`, or `v x y z r g b` (vertex colours, as other readers take them; a lone 4th number is w).
-  // What follows the third number is read only as colour: anything else there is ignored, as before.
-  void vertex(std::string_view rest) {
-    float f[6] = {};
-    int n = 0;
-    for (; n < 6; ++n) {
-      const text::NumResult r = text::nextFloat(rest, f[n]);
-      if (r == text::NumResult::Ok) continue;
-      if (n >= 3) break;
-      if (r == text::NumResult::Missing) throw error("'v' needs 3 numbers");
-      if (r == text::NumResult::NotFinite) throw error("'v' coordinate is NaN or infinite");
-      throw error("'v' coordinate is not a number");
-    }
-    if (!coordinateOk(glm::vec3(f[0], f[1], f[2])))  // the limit every reader applies
-      throw error("vertex coordinate beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
-    positions_.push_back({f[0], f[1], f[2]});
-    const bool coloured = n == 6;
-    if (coloured && colors_.size() < positions_.size() - 1) colors_.assign(positions_.size() - 1, glm::vec4(1.0f));
-    if (coloured || !colors_.empty()) colors_.push_back(coloured ? glm::vec4(f[3], f[4], f[5], 1.0f) : glm::vec4(1.0f));
+  void objectLine(std::string n) {
+    if (n.empty()) n = "default";
+    groupsSeen_ = true;
+    auto [it, added] = objectIds_.try_emplace(n, uint32_t(objectNames_.size()));
+    if (added) objectNames_.push_back(n);
+    object_ = it->second;
+    mesh_ = kAbsent;
   }
 
-  void onLine(std::string_view l) {
-    if (line_ == 1 && l.substr(0, 3) == "\xEF\xBB\xBF") l.remove_prefix(3);  // UTF-8 byte order mark
-    size_t i = 0;
-    while (i < l.size() && text::isSpace(l[i])) ++i;
-    if (i == l.size()) return;
-    const char c0 = l[i];
-    const char c1 = i + 1 < l.size() ? l[i + 1] : '\0';
-    const bool sep1 = c1 == '\0' || text::isSpace(c1);
-    if (c0 == 'v' && sep1) return vertex(l.substr(i + 1));
-    if (c0 == 'f' && sep1) return face(l.substr(i + 1));
-    if (c0 == 'v' && c1 == 'n' && (i + 2 == l.size() || text::isSpace(l[i + 2])))
-      return vec<3>(l.substr(i + 2), normals_, "vn", 3);
-    if (c0 == 'v' && c1 == 't' && (i + 2 == l.size() || text::isSpace(l[i + 2])))
-      return vec<2>(l.substr(i + 2), texcoords_, "vt", 1);
-    if (c0 == '#') return;
-    std::string_view rest = l.substr(i);
-    const std::string_view key = text::nextToken(rest);
-    if (key == "o" || key == "g") {
-      std::string n = checkedName("object name", rest);
-      if (n.empty()) n = "default";
-      groupsSeen_ = true;
-      auto [it, added] = objectIds_.try_emplace(n, uint32_t(objectNames_.size()));
-      if (added) objectNames_.push_back(n);
-      object_ = it->second;
-      mesh_ = kAbsent;
-    } else if (key == "usemtl") {
-      if (!mtlSeen_ && !besideMtl_.empty()) {  // no mtllib: the course's NAME.mtl convention
-        mtlSeen_ = true;
-        if (loadMtl(besideMtl_, mtlLabel(besideMtl_)))
-          note(name_ + ": no 'mtllib' line; using '" + mtlLabel(besideMtl_) + "' beside it");
-      }
-      material_ = materialId(checkedName("material name", rest), true);
-      if (!groupsSeen_) {  // no o/g lines: each usemtl run is an object (the ray tracer's lights)
-        object_ = uint32_t(objectNames_.size());
-        objectNames_.push_back(materials_[material_].material.name);
-      }
-      mesh_ = kAbsent;
-    } else if (key == "mtllib") {
-      const std::string file = checkedName("mtllib file name", rest);
-      if (file.empty()) throw error("'mtllib' names no file");
-      if (opt_.mtl) {
-        if (!mtllibIgnored_)
-          note(name_ + ":" + std::to_string(line_) + ": 'mtllib " + file + "' ignored; using '" + opt_.mtl->string() +
-               "' as given");
-        mtllibIgnored_ = true;
-      } else if (!loadMtl(file, mtlLabel(file))) {
-        warn("material library '" + mtlLabel(file) + "' named by 'mtllib' does not exist; its materials get default values");
-      }
+  void usemtlLine(const std::string& name) {
+    if (!mtlSeen_ && !besideMtl_.empty()) {  // no mtllib: the course's NAME.mtl convention
       mtlSeen_ = true;
-    } else if (key == "l" || key == "p") {
-      ++pointsAndLines_;  // nothing to draw for triangle meshes; one note at the end
-    } else if (key == "s" || key == "cstype" || key == "vp") {
-      // smoothing groups and free-form data carry nothing for triangle meshes
-    } else if (std::find(unknown_.begin(), unknown_.end(), key) == unknown_.end()) {
-      unknown_.emplace_back(key.substr(0, 64));
-      warn("unknown OBJ keyword '" + std::string(key.substr(0, 64)) + "' ignored");
+      if (loadMtl(besideMtl_, mtlLabel(besideMtl_)))
+        note(name_ + ": no 'mtllib' line; using '" + mtlLabel(besideMtl_) + "' beside it");
     }
+    material_ = materialId(name, true);
+    if (!groupsSeen_) {  // no o/g lines: each usemtl run is an object (the ray tracer's lights)
+      object_ = uint32_t(objectNames_.size());
+      objectNames_.push_back(materials_[material_].material.name);
+    }
+    mesh_ = kAbsent;
+  }
+
+  void mtllibLine(const std::string& file) {
+    if (opt_.mtl) {
+      if (!mtllibIgnored_)
+        note(name_ + ":" + std::to_string(line_) + ": 'mtllib " + file + "' ignored; using '" + opt_.mtl->string() +
+             "' as given");
+      mtllibIgnored_ = true;
+    } else if (!loadMtl(file, mtlLabel(file))) {
+      warn("material library '" + mtlLabel(file) + "' named by 'mtllib' does not exist; its materials get default values");
+    }
+    mtlSeen_ = true;
   }
 
   uint32_t materialId(const std::string& n, bool warnIfNew) {
@@ -259,96 +293,6 @@ class ObjParser {
     return true;
   }
 
-  // Parses one signed index; returns false at the end of the token.
-  static bool parseIndex(const char*& p, const char* e, int64_t& v) {
-    bool neg = false;
-    if (p < e && *p == '-') {
-      neg = true;
-      ++p;
-    }
-    const char* s = p;
-    int64_t x = 0;
-    while (p < e && unsigned(*p - '0') < 10u) {
-      x = x * 10 + (*p - '0');
-      if (x > (int64_t(1) << 40)) return false;
-      ++p;
-    }
-    if (p == s) return false;
-    v = neg ? -x : x;
-    return true;
-  }
-
-  // A texcoord or normal index that points nowhere: kAbsent (the face loses that attribute; one warning).
-  uint32_t resolveLenient(int64_t idx, size_t count, const char* what, bool& dropped) {
-    const int64_t r = idx > 0 ? idx - 1 : int64_t(count) + idx;
-    if (idx != 0 && r >= 0 && r < int64_t(count)) return uint32_t(r);
-    if (!dropped && ++danglingFaces_ == 1)
-      warn(std::string("face ") + what + " index " + std::to_string(idx) + " points nowhere (" + std::to_string(count) + " " +
-           what + "s defined so far): the face's " + what + "s are dropped" +
-           (std::string(what) == "normal" ? " and computed" : "") + " (so for every such face; no more warnings)");
-    dropped = true;
-    return kAbsent;
-  }
-
-  uint32_t resolve(int64_t idx, size_t count, const char* what) {
-    if (idx == 0) throw error(std::string("face ") + what + " index 0 is invalid (OBJ indices start at 1)");
-    int64_t r = idx > 0 ? idx - 1 : int64_t(count) + idx;
-    if (r < 0 || r >= int64_t(count))
-      throw error(std::string("face ") + what + " index " + std::to_string(idx) + " out of range (" + std::to_string(count) +
-                  " " + what + "s defined so far)");
-    return uint32_t(r);
-  }
-
-  void face(std::string_view rest) {
-    poly_.clear();
-    bool dropT = false, dropN = false;
-    const char* p = rest.data();
-    const char* e = p + rest.size();
-    for (;;) {
-      while (p < e && text::isSpace(*p)) ++p;
-      if (p == e) break;
-      Corner c{kAbsent, kAbsent, kAbsent};
-      int64_t v;
-      if (!parseIndex(p, e, v)) throw error("face corner is not an index (expected v, v/vt, v//vn or v/vt/vn)");
-      c.p = resolve(v, positions_.size(), "position");
-      if (p < e && *p == '/') {
-        ++p;
-        if (p < e && *p != '/') {
-          if (!parseIndex(p, e, v)) throw error("face texture coordinate index is not a number");
-          c.t = resolveLenient(v, texcoords_.size(), "texcoord", dropT);
-        }
-        if (p < e && *p == '/') {
-          ++p;
-          if (!parseIndex(p, e, v)) throw error("face normal index is not a number");
-          c.n = resolveLenient(v, normals_.size(), "normal", dropN);
-        }
-      }
-      if (p < e && !text::isSpace(*p)) throw error("unexpected character in face corner");
-      poly_.push_back(c);
-    }
-    for (Corner& c : poly_) {
-      if (dropT) c.t = kAbsent;
-      if (dropN) c.n = kAbsent;
-    }
-    ++stats_.faces;
-    if (poly_.size() < 3) {
-      stats_.degenerateSkipped += 1;
-      return;
-    }
-    if (mesh_ == kAbsent) mesh_ = currentMesh();
-    auto& corners = builds_[mesh_].corners;
-    if (poly_.size() == 3) {
-      corners.insert(corners.end(), poly_.begin(), poly_.end());
-      return;
-    }
-    polyPos_.clear();
-    for (const Corner& c : poly_) polyPos_.push_back(positions_[c.p]);
-    tris_.clear();
-    if (!triangulatePolygon(polyPos_, tris_))
-      warn("polygon of " + std::to_string(poly_.size()) + " corners crosses itself; part of it fan-triangulated");
-    for (const auto& t : tris_) corners.insert(corners.end(), {poly_[t[0]], poly_[t[1]], poly_[t[2]]});
-  }
-
   uint32_t currentMesh() {
     if (material_ == kAbsent) material_ = materialId("default", false);
     if (object_ == kAbsent) {
@@ -370,9 +314,6 @@ class ObjParser {
   std::vector<glm::vec3> positions_, normals_;
   std::vector<glm::vec4> colors_;  // one per position once a `v` line has a colour; empty before
   std::vector<glm::vec2> texcoords_;
-  std::vector<Corner> poly_;
-  std::vector<glm::vec3> polyPos_;
-  std::vector<std::array<uint32_t, 3>> tris_;
   std::vector<MeshBuild> builds_;
   std::unordered_map<uint64_t, uint32_t> meshIds_;
   std::vector<std::string> objectNames_;
@@ -382,8 +323,8 @@ class ObjParser {
   std::vector<std::string> mtlFiles_, unknown_;
   std::string besideMtl_;
   uint32_t object_ = kAbsent, material_ = kAbsent, mesh_ = kAbsent;
-  bool groupsSeen_ = false, mtlSeen_ = false, mtllibIgnored_ = false;
-  size_t pointsAndLines_ = 0, danglingFaces_ = 0;
+  bool groupsSeen_ = false, mtlSeen_ = false, mtllibIgnored_ = false, danglingWarned_ = false, coloured_ = false;
+  size_t pointsAndLines_ = 0;
 };
 
 Scene ObjParser::finish() {

@@ -19,7 +19,8 @@ namespace rtr {
 struct ObjOptions : LoadOptions {
   // Called now and then while reading with (bytes consumed from the file, file size).
   std::function<void(uint64_t, uint64_t)> progress;
-  unsigned threads = 0;  // welding workers; 0 = hardware concurrency
+  unsigned threads = 0;   // parse and weld workers; 0 = all cores
+  size_t pieceBytes = 0;  // text parsed as one piece (0: 1 MiB); tests force tiny pieces to put boundaries everywhere
 };
 
 struct ObjStats {

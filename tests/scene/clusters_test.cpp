@@ -116,6 +116,31 @@ TEST(Clusters, BigMeshesAreClusteredInPiecesKeepingEveryTriangle) {
   expectValidClusters(s.meshes[1]);
 }
 
+// Each piece is clustered over its own vertices only: a mesh whose vertices are numbered with gaps (the
+// same order, unused vertices far away between them) gets the same clusters, its indices in the gapped
+// numbering, whether a piece's vertices lie close together or are spread over the whole mesh.
+TEST(Clusters, PiecesSeeOnlyTheirOwnVertices) {
+  Mesh plain = bumpyGrid(200);  // two pieces; the second one's vertices start far from 0
+  plain.indices.resize(plain.indices.size() - 6);
+  for (uint32_t gap : {2u, 100u}) {
+    SCOPED_TRACE("gap " + std::to_string(gap));
+    Mesh gapped = plain;
+    gapped.positions.assign(plain.positions.size() * gap, glm::vec3(1e6f, -1e6f, 1e6f));
+    for (size_t v = 0; v < plain.positions.size(); ++v) gapped.positions[v * gap] = plain.positions[v];
+    gapped.normals.assign(gapped.positions.size(), glm::vec3(0, 1, 0));
+    for (uint32_t& i : gapped.indices) i *= gap;
+    Mesh a = plain;
+    buildClusters(a, true);
+    buildClusters(gapped, true);
+    ASSERT_EQ(canonicalTriangles(a.indices), canonicalTriangles(plain.indices));
+    ASSERT_EQ(gapped.indices.size(), a.indices.size());
+    for (size_t k = 0; k < a.indices.size(); ++k) ASSERT_EQ(gapped.indices[k], a.indices[k] * gap) << k;
+    ASSERT_EQ(gapped.clusters.size(), a.clusters.size());
+    for (size_t i = 0; i < a.clusters.size(); ++i)
+      EXPECT_EQ(std::memcmp(&gapped.clusters[i], &a.clusters[i], sizeof(Cluster)), 0) << "cluster " << i;
+  }
+}
+
 TEST(Clusters, ConesOnlyCullClustersFacingAway) {
   Mesh m = bumpyGrid(40);
   buildClusters(m, true);

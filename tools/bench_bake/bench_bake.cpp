@@ -8,6 +8,7 @@
 
 #include "bake.hpp"
 #include "baseline.hpp"
+#include "core/parallel.hpp"
 #include "scene/binio.hpp"
 #include "scene/obj.hpp"
 #include "scene/rtrscene.hpp"
@@ -56,6 +57,28 @@ void oursBake(benchmark::State& st, bool zstd) {
 void BM_OursBake(benchmark::State& st) { oursBake(st, false); }
 void BM_OursBakeZstd(benchmark::State& st) { oursBake(st, true); }
 
+// The OBJ parse (and weld) alone on 1, 2, 4, … threads up to all cores: the parse rate against the thread count.
+void BM_OursParse(benchmark::State& st) {
+  rtr::ObjOptions o;
+  o.threads = unsigned(st.range(0));
+  o.warn = [](const std::string&) {};
+  rtr::ObjStats stats;
+  double parse = 0;
+  for (auto _ : st) {
+    rtr::Scene s = rtr::loadObj(input(false), o, &stats);
+    parse += stats.parseSeconds;
+  }
+  st.counters["threads"] = double(o.threads);
+  st.counters["parse_MB/s"] = double(stats.textBytes) / 1e6 / (parse / double(st.iterations()));
+  st.counters["text_MB"] = double(stats.textBytes) / 1e6;
+}
+
+void threadCounts(benchmark::internal::Benchmark* b) {
+  const unsigned all = rtr::threadCount();
+  for (unsigned t = 1; t < all; t *= 2) b->Arg(t);
+  b->Arg(all);
+}
+
 void BM_BaselineBake(benchmark::State& st) {
   const fs::path out = fs::temp_directory_path() / "rtr_bench_base.rtrscene";
   size_t verts = 0;
@@ -72,5 +95,6 @@ void BM_BaselineBake(benchmark::State& st) {
 
 BENCHMARK(BM_OursBake)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_OursBakeZstd)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
+BENCHMARK(BM_OursParse)->Apply(threadCounts)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_BaselineBake)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
 BENCHMARK_MAIN();
