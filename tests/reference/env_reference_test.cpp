@@ -57,7 +57,7 @@ class EnvReferenceTest : public test::VulkanTest {
     const std::string id = std::string(kCase) + "_" + edit.name;
     const CompareResult r = compareEdgeTolerant(pair.gpu, pair.cpu, 3);
     writeOutputs(id, pair, r, limits(View::Shaded));
-    std::printf("%s: %zu pixels, mean per-pixel error %.2f %% (bound %.0f %%), mean abs %.4f of mean pixel %.3f\n", id.c_str(),
+    std::printf("%s: %zu pixels, mean per-pixel error %.2f %% (bound %.1f %%), mean abs %.4f of mean pixel %.3f\n", id.c_str(),
                 e.pixels, 100.0 * e.meanPixelRelative, 100.0 * kBound, e.meanAbs, e.meanRef);
     EXPECT_GT(e.pixels, 1000u);
     return e;

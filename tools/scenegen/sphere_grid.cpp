@@ -32,8 +32,9 @@ void writeSphereGrid(const std::filesystem::path& file, int n) {
   auto at = [&](int i, int j) { return uint32_t(j * (slices + 1) + i); };
   for (int j = 0; j < stacks; ++j)
     for (int i = 0; i < slices; ++i) {  // counter-clockwise seen from outside
-      if (j > 0) idx.insert(idx.end(), {at(i, j), at(i, j + 1), at(i + 1, j + 1)});
-      if (j + 1 < stacks) idx.insert(idx.end(), {at(i, j), at(i + 1, j + 1), at(i + 1, j)});
+      // The first uses one vertex of row j, the second two: at a pole row (all one point) that one is empty.
+      if (j + 1 < stacks) idx.insert(idx.end(), {at(i, j), at(i, j + 1), at(i + 1, j + 1)});
+      if (j > 0) idx.insert(idx.end(), {at(i, j), at(i + 1, j + 1), at(i + 1, j)});
     }
   std::string bin;
   append(bin, pos.data(), pos.size() * 4);
