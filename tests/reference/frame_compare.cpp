@@ -1,8 +1,12 @@
 // rtr-frame-compare: the whole frame both ways — GPU raster time against CPU trace time, beside the image
 // error between them — for the reference cases of tests/reference/poses.txt at a real image size. The
 // shading model is the reference tests' (PBR, no shadows, no reflections); docs/reference-tests.md.
+// --env-cases: the environment-lit cases instead, the GPU's split sum against the tracer's Monte Carlo at
+// --spp sample pairs (docs/environment.md); --spp-curve CASE: the tracer's error against its sample count.
 #include <cstdio>
+#include <cmath>
 #include <filesystem>
+#include <map>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -13,6 +17,105 @@
 
 using namespace rtr;
 using namespace rtr::reftest;
+
+namespace {
+
+const PoseEntry& poseOf(const std::map<std::string, PoseEntry>& poses, const std::string& name) {
+  if (!poses.count(name)) throw Error(posesFile().string() + ": no case named '" + name + "'");
+  return poses.at(name);
+}
+
+// Linear radiance as the PNG a person looks at; the uncovered marker shows black.
+void saveLinear(const std::filesystem::path& file, const ImageF& img) { savePng(file, toSrgb8(img)); }
+
+int environmentCases(const vk::Context& ctx, const std::map<std::string, PoseEntry>& poses, const std::vector<std::string>& cases,
+                     uint32_t w, uint32_t h, unsigned threads, int frames, int spp, const std::filesystem::path& work,
+                     bool save) {
+  std::printf(
+      "| case | size | spp | GPU frame ms (median of %d) | GPU prefilter ms | CPU trace s (%u threads) | mean pixel "
+      "| mean abs error | %% of mean pixel | mean per-pixel error %% | max abs error | tracer noise per-pixel %% (est.) "
+      "| sRGB mean steps | sRGB max steps |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+      frames, threads);
+  std::string perPart;
+  for (const std::string& name : cases) {
+    if (!isEnvironmentCase(name)) throw Error("--env-cases: '" + name + "' is not an environment case (env_*)");
+    const ReferenceScene rs = makeScene(name, work);
+    const PoseEntry& pose = poseOf(poses, name);
+    const PairOptions o{.width = w, .height = h, .threads = threads, .benchFrames = frames, .spp = spp};
+    const CasePair p = renderPair(ctx, rs, pose, View::Shaded, o);
+    // The tracer's own noise at spp: its first spp/4 pairs are a prefix of the spp run's (per-pixel
+    // sequences), so I(spp/4) - I(spp) has 3x the variance of I(spp)'s error: noise ~ that / sqrt(3).
+    PairOptions quarter = o;
+    quarter.spp = spp / 4;
+    const ImageF q = traceCase(rs, pose, View::Shaded, quarter);
+    const EnvError e = envError(p.gpuLinear, p.cpuLinear), noise = envError(q, p.cpuLinear);
+    double prefilter = 0;
+    for (const auto& [pass, ms] : p.prefilterMs) prefilter += ms;
+    const CompareResult r = compareEdgeTolerant(p.gpu, p.cpu, 3);
+    std::printf("| %s | %ux%u | %d | %.3f | %.1f | %.1f | %.3f | %.4f | %.1f | %.1f | %.2f | %.1f | %.2f | %.0f |\n",
+                name.c_str(), w, h, spp, p.gpuMs, prefilter, p.cpuMs / 1e3, e.meanRef, e.meanAbs, 100.0 * e.relative(),
+                100.0 * e.meanPixelRelative, e.maxAbs, 100.0 * noise.meanPixelRelative / std::sqrt(3.0), r.meanAbsError,
+                r.maxAbsError);
+    std::fflush(stdout);
+    const std::vector<int> part = partOfPixels(rs, pose, w, h, p.cpuLinear);
+    for (size_t k = 0; k < rs.parts.size(); ++k) {
+      std::vector<bool> mask(part.size());
+      for (size_t i = 0; i < part.size(); ++i) mask[i] = part[i] == int(k);
+      const EnvError pe = envError(p.gpuLinear, p.cpuLinear, &mask), pn = envError(q, p.cpuLinear, &mask);
+      char line[256];
+      std::snprintf(line, sizeof line, "| %s | %s | %zu | %.3f | %.4f | %.1f | %.1f | %.2f | %.1f |\n", name.c_str(),
+                    rs.parts[k].name.c_str(), pe.pixels, pe.meanRef, pe.meanAbs, 100.0 * pe.relative(),
+                    100.0 * pe.meanPixelRelative, pe.maxAbs, 100.0 * pn.meanPixelRelative / std::sqrt(3.0));
+      perPart += line;
+    }
+    if (save) {
+      saveLinear(work / (name + "_gpu.png"), p.gpuLinear);
+      saveLinear(work / (name + "_cpu.png"), p.cpuLinear);
+      saveImage(work / (name + "_gpu.exr"), p.gpuLinear);
+      saveImage(work / (name + "_cpu.exr"), p.cpuLinear);
+      savePng(work / (name + "_err.png"), r.errorMap);
+    }
+  }
+  if (!perPart.empty())
+    std::printf(
+        "\nPer sphere:\n\n| case | sphere | pixels | mean pixel | mean abs error | %% of mean pixel | mean per-pixel "
+        "error %% | max abs error | tracer noise per-pixel %% (est.) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n%s",
+        perPart.c_str());
+  return 0;
+}
+
+// The tracer's error against its sample count: spp 1, 4, 16, ... below the reference's count, each
+// against the reference (whose own error, at 4x the largest count, adds at most ~1/8 to that one's).
+int sppCurve(const std::map<std::string, PoseEntry>& poses, const std::string& name, uint32_t w, uint32_t h, unsigned threads,
+             int refSpp, const std::filesystem::path& work, bool save) {
+  const ReferenceScene rs = makeScene(name, work);
+  if (!rs.environment) throw Error("--spp-curve: '" + name + "' is not an environment case (env_*)");
+  const PoseEntry& pose = poseOf(poses, name);
+  trace::RenderStats st, refStats;
+  const ImageF ref = traceCase(rs, pose, View::Shaded, {.width = w, .height = h, .threads = threads, .spp = refSpp}, &refStats);
+  std::printf(
+      "| case | size | spp | mean abs error | %% of mean pixel | mean per-pixel error %% | RMS error | max abs error "
+      "| trace s (%u threads) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+      threads);
+  for (int spp = 1; spp < refSpp; spp *= 4) {
+    const ImageF img = traceCase(rs, pose, View::Shaded, {.width = w, .height = h, .threads = threads, .spp = spp}, &st);
+    const EnvError e = envError(img, ref);
+    double sq = 0;
+    for (size_t i = 0; i < img.pixels.size(); ++i)
+      if (img.pixels[i].r != kUncovered && ref.pixels[i].r != kUncovered)
+        for (int c = 0; c < 3; ++c) sq += double(img.pixels[i][c] - ref.pixels[i][c]) * (img.pixels[i][c] - ref.pixels[i][c]);
+    std::printf("| %s | %ux%u | %d | %.4f | %.2f | %.2f | %.4f | %.3f | %.2f |\n", name.c_str(), w, h, spp, e.meanAbs,
+                100.0 * e.relative(), 100.0 * e.meanPixelRelative, std::sqrt(sq / (3.0 * double(std::max<size_t>(e.pixels, 1)))),
+                e.maxAbs, st.seconds);
+    std::fflush(stdout);
+    if (save) saveLinear(work / (name + "_spp" + std::to_string(spp) + ".png"), img);
+  }
+  std::printf("\nreference: %d spp (%.1f s)\n", refSpp, refStats.seconds);
+  if (save) saveLinear(work / (name + "_spp" + std::to_string(refSpp) + ".png"), ref);
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"GPU raster vs CPU trace of the reference cases: time and image error"};
@@ -26,6 +129,12 @@ int main(int argc, char** argv) {
   app.add_option("--case", cases, "cases of poses.txt (default: all)");
   app.add_option("--out", out, "folder for <case>_gpu.png, _cpu.png, _err.png");
   app.add_option("--device", device, "Vulkan device index or name substring");
+  bool envCases = false;
+  int spp = 256;
+  std::string curve;
+  app.add_flag("--env-cases", envCases, "the environment-lit cases (env_*): split sum vs the tracer at --spp");
+  app.add_option("--spp", spp, "the tracer's sample pairs a pixel in environment cases")->check(CLI::Range(4, 65536));
+  app.add_option("--spp-curve", curve, "an environment case traced at 1, 4, ... spp/4 against --spp: the error curve");
   CLI11_PARSE(app, argc, argv);
   try {
     uint32_t w = 0, h = 0;
@@ -37,10 +146,14 @@ int main(int argc, char** argv) {
     const vk::Context ctx(co);
     const auto poses = loadPoses(posesFile());
     if (cases.empty())
-      for (const auto& [name, pose] : poses) cases.push_back(name);
+      for (const auto& [name, pose] : poses)
+        if (isEnvironmentCase(name) == envCases) cases.push_back(name);
     const std::filesystem::path work =
         out.empty() ? std::filesystem::temp_directory_path() / "rtr-frame-compare" : std::filesystem::path(out);
     std::filesystem::create_directories(work);
+    std::fprintf(stderr, "rtr-frame-compare: device %s\n", ctx.deviceName().c_str());
+    if (!curve.empty()) return sppCurve(poses, curve, w, h, threads, spp, work, !out.empty());
+    if (envCases) return environmentCases(ctx, poses, cases, w, h, threads, frames, spp, work, !out.empty());
     const Limits lim = limits(View::Shaded);
     std::printf(
         "| case | size | GPU frame ms (median of %d) | CPU trace ms (%u threads) | CPU / GPU | CPU Mrays/s "
@@ -62,7 +175,6 @@ int main(int argc, char** argv) {
         savePng(work / (name + "_err.png"), r.errorMap);
       }
     }
-    std::fprintf(stderr, "rtr-frame-compare: device %s\n", ctx.deviceName().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rtr-frame-compare: %s\n", e.what());
     return 1;

@@ -41,7 +41,15 @@ struct CasePair {
   // tracer's wall time for the same image.
   double gpuMs = 0, cpuMs = 0;
   uint64_t cpuRays = 0;
+  // Linear images (the scene colour and the tracer's radiance); environment cases mark the pixels no
+  // surface covers with kUncovered on both sides.
+  ImageF gpuLinear, cpuLinear;
+  std::vector<std::pair<std::string, double>> prefilterMs;  // the environment's GPU passes (environment cases)
 };
+
+// Environment cases: what the pixels that no surface covers hold on both sides (no shading writes a
+// negative value), so that only surfaces are compared.
+constexpr float kUncovered = -1.0f;
 
 struct PairOptions {
   uint32_t width = kW, height = kH;
@@ -51,11 +59,43 @@ struct PairOptions {
   // renderer's pipeline creation); used by the broken-BRDF test.
   std::optional<std::filesystem::path> shaderDir;
   render::RasterPath raster = render::RasterPath::Auto;  // who rasterises the shaded view's visibility ids
+  int spp = 256;                                         // the tracer's sample pairs a pixel in environment cases
 };
 
 // Renders a case on both sides.
 CasePair renderPair(const vk::Context& ctx, const ReferenceScene& rs, const PoseEntry& pose, View view,
                     const PairOptions& options = {});
+
+// The GPU's split sum against the tracer over the pixels both cover (environment cases), linear RGB.
+struct EnvError {
+  size_t pixels = 0;
+  double meanAbs = 0, maxAbs = 0;  // |gpu - cpu| per channel, radiance units
+  double meanRef = 0;              // the reference's mean value: meanAbs / meanRef is the error relative to it
+  // The mean over pixels of |gpu - cpu| / cpu (channel sums; cpu at least 5 % of the mean pixel, so black
+  // pixels do not divide by zero): the error "as a share of the pixel value".
+  double meanPixelRelative = 0;
+  double relative() const { return meanRef > 0 ? meanAbs / meanRef : 0.0; }
+};
+// Over the pixels both images cover; `mask` (optional, one entry a pixel) limits it to where it is true.
+EnvError envError(const ImageF& test, const ImageF& ref, const std::vector<bool>* mask = nullptr);
+// The part (ReferenceScene::parts) each pixel belongs to: the nearest projected centre; -1 uncovered.
+std::vector<int> partOfPixels(const ReferenceScene& rs, const PoseEntry& pose, uint32_t width, uint32_t height,
+                              const ImageF& coverage);
+
+// The tracer's side of renderPair alone (its linear image), e.g. at other sample counts.
+ImageF traceCase(const ReferenceScene& rs, const PoseEntry& pose, View view, const PairOptions& options = {},
+                 trace::RenderStats* stats = nullptr);
+
+// A shader source edit for the tests that break the GPU side on purpose: in `file` (relative to shaders/),
+// the exact text `from` becomes `to`; an empty `from` is no edit (the control).
+struct ShaderEdit {
+  std::string name, file, from, to;
+};
+inline const ShaderEdit kNoEdit{"control", "", "", ""};
+// A shader folder (for PairOptions::shaderDir): every compiled shader of the build, with the shaded view's
+// shaders (pbr.frag, vis_shade.comp, every variant) recompiled from a copy of shaders/ with `edit` applied.
+// Throws rtr::Error when the text to edit is not found (the test would prove nothing).
+std::filesystem::path shaderFolderWith(const ShaderEdit& edit);
 
 std::filesystem::path posesFile();
 std::filesystem::path outDir();  // <build>/reference-out, created

@@ -1,7 +1,9 @@
 #include "reference_scenes.hpp"
 #include "test_paths.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -221,7 +223,69 @@ Scene texturedTemple(const Scene& temple, const std::filesystem::path& workDir) 
   return s;
 }
 
+bool isEnvironmentCase(const std::string& name) { return name.rfind("env_", 0) == 0; }
+
+std::shared_ptr<const Environment> skyEnvironment() {
+  static const auto sky = std::make_shared<const Environment>(Environment::load({.source = "sky"}));
+  return sky;
+}
+
+std::shared_ptr<const Environment> sunlessSkyEnvironment() {
+  static const auto sky = [] {
+    ImageF m = makeSky({});
+    size_t sun = 0;  // the sun's texel: the brightest by far (docs/environment.md, "Sources")
+    for (size_t i = 1; i < m.pixels.size(); ++i)
+      if (m.pixels[i].g > m.pixels[sun].g) sun = i;
+    const uint32_t x = uint32_t(sun % m.width), y = uint32_t(sun / m.width);
+    glm::vec4 around(0.0f);
+    for (const auto [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}})
+      around += m.at((x + m.width + uint32_t(dx)) % m.width, std::clamp(uint32_t(int(y) + dy), 0u, m.height - 1));
+    m.at(x, y) = around / 4.0f;
+    return std::make_shared<const Environment>(std::move(m), 1.0f, 0.0f);
+  }();
+  return sky;
+}
+
 ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir) {
+  if (isEnvironmentCase(name)) {
+    // Light from the generated sky alone (no lights, no ambient); glTF materials (GGX). The tracer's
+    // environment samples cast no shadow rays here (shadows off), as the GPU's split sum has none.
+    ReferenceScene r;
+    r.lights = LightRig{{}, glm::vec3(0.0f), {}};
+    r.environment = name.ends_with("_nosun") ? sunlessSkyEnvironment() : skyEnvironment();
+    Scene& s = r.scene;
+    if (name == "env_metal_spheres" || name == "env_dielectric_spheres") {
+      // Five spheres of roughness 0, 0.25, 0.5, 0.75, 1 in a row.
+      const bool metal = name == "env_metal_spheres";
+      for (int i = 0; i < 5; ++i) {
+        const float rough = 0.25f * float(i);
+        s.materials.push_back(gltfMaterial("r" + std::to_string(i),
+                                           metal ? glm::vec3(1.0f, 0.78f, 0.34f) : glm::vec3(0.2f, 0.4f, 0.8f), rough,
+                                           metal ? 1.0f : 0.0f));
+        const glm::vec3 c{2.2f * float(i - 2), 0.0f, -8.0f};
+        s.meshes.push_back(sphere("sphere", uint32_t(i), c, 1.0f, 96, 48));
+        char label[32];
+        std::snprintf(label, sizeof label, "rough %.2f", rough);
+        r.parts.push_back({label, c});
+      }
+      return r;
+    }
+    if (name == "env_sphere_grid" || name == "env_sphere_grid_nosun") {
+      r.scene = loadScene(assetDir() / "sphere-grid.gltf");
+      for (int row = 0; row < 5; ++row)  // tools/scenegen/sphere_grid.hpp's layout
+        for (int col = 0; col < 5; ++col) {
+          char label[48];
+          std::snprintf(label, sizeof label, "metal %.2f rough %.2f", 0.25f * float(row), 0.25f * float(col));
+          r.parts.push_back({label, glm::vec3(float(col) - 2.0f, 2.0f - float(row), 0.0f)});
+        }
+      return r;
+    }
+    if (name == "env_temple") {
+      r.scene = untexturedTemple(loadScene(assetDir() / "temple.rtrscene"));
+      return r;
+    }
+    throw Error("no reference scene named '" + name + "'");
+  }
   const std::filesystem::path rt = sourceDir() / "assets-src/rt";
   // The temple's stored light (the brief's standard light above the statue); the course scenes' own lights:
   // the GPU sees an area light as a point at its centre, as the tracer with one shadow sample does.

@@ -3,9 +3,11 @@
 // copy, and as baked), the ray tracer's course scenes, and synthetic hard views built in code.
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "core/camera.hpp"
+#include "scene/environment.hpp"
 #include "scene/lights.hpp"
 #include "scene/scene.hpp"
 #include "trace/tracer.hpp"
@@ -30,10 +32,28 @@ std::map<std::string, PoseEntry> loadPoses(const std::filesystem::path& file);
 struct ReferenceScene {
   Scene scene;
   LightRig lights;  // both renderers light the scene with exactly these
+  // Light from an environment (the env_* cases): the GPU's split sum against the tracer's Monte Carlo.
+  std::shared_ptr<const Environment> environment;
+  // The spheres of the sphere cases, for errors per sphere: each covered pixel belongs to the nearest
+  // centre on screen.
+  struct Part {
+    std::string name;
+    glm::vec3 centre;
+  };
+  std::vector<Part> parts;
 };
 
+// The environment-lit cases (poses.txt's env_*): lit by the environment alone, GGX (glTF materials).
+bool isEnvironmentCase(const std::string& name);
+// `rtr-view --env sky`'s environment (the generated sky, 512x256), made once.
+std::shared_ptr<const Environment> skyEnvironment();
+// The same sky with the sun's texel replaced by the mean of its four neighbours (the glow around it kept):
+// smooth light, where the split sum's own error is small (the *_nosun cases).
+std::shared_ptr<const Environment> sunlessSkyEnvironment();
+
 // Builds the scene of a case by name (the names in poses.txt). `workDir` receives generated files (the
-// back-face quad's alpha-mask texture). Throws rtr::Error for an unknown name.
+// back-face quad's alpha-mask texture). Throws rtr::Error for an unknown name. The env_sphere_grid case
+// loads `scenegen --sphere-grid`'s glTF from the assets (built with them).
 ReferenceScene makeScene(const std::string& name, const std::filesystem::path& workDir);
 
 // The default scene without textures: every texture slot cleared (both sides then use the material

@@ -95,15 +95,17 @@ TEST_P(ReferenceTest, GpuMatchesCpu) {
 INSTANTIATE_TEST_SUITE_P(Cases, ReferenceTest, ::testing::ValuesIn(allParams()),
                          [](const ::testing::TestParamInfo<Param>& i) { return i.param.label(); });
 
-// Every case in poses.txt is run, every run case has a pose, and each has its comment.
+// Every case in poses.txt is run (the environment cases by rtr-frame-compare --env-cases, which takes
+// every env_* case, and env_reference_test), every run case has a pose, and each has its comment.
 TEST(ReferencePoses, FileAndCasesAgree) {
   const auto poses = loadPoses(posesFile());
   std::set<std::string> run(std::begin(kCases), std::end(kCases));
   for (const auto& [name, e] : poses) {
-    EXPECT_TRUE(run.count(name)) << name << " is in poses.txt but no test runs it";
+    EXPECT_TRUE(run.count(name) || isEnvironmentCase(name)) << name << " is in poses.txt but no test runs it";
     EXPECT_FALSE(e.comment.empty()) << name;
   }
   for (const std::string& name : run) EXPECT_TRUE(poses.count(name)) << name << " has no pose";
+  EXPECT_TRUE(poses.count("env_sphere_grid")) << "env_reference_test's case";
 }
 
 // The untextured temple copy removes exactly the card meshes and keeps no texture reference.

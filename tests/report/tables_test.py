@@ -35,6 +35,18 @@ class MdTables(unittest.TestCase):
         self.assertLessEqual(raw, cases)
         self.assertTrue(all(num(r[2]) is not None for r in tables[0][1]))
 
+    def test_env_compare_has_every_environment_case_and_a_row_per_sphere(self):
+        # rtr-frame-compare --env-cases prints the cases' table, then one row per sphere: both are read, and
+        # the cases are the env_* cases of poses.txt (docs/environment.md's table is this file's).
+        with open(os.path.join(ROOT, "docs/bench/data/vm-lavapipe/env-compare.txt")) as f:
+            tables = md_tables(f.read())
+        with open(os.path.join(ROOT, "tests/reference/poses.txt")) as f:
+            cases = {line.split()[0] for line in f if line.startswith("env_")}
+        self.assertEqual(len(tables), 2)
+        self.assertEqual({r[0] for r in tables[0][1]}, cases)
+        self.assertEqual(len([r for r in tables[1][1] if r[0] == "env_sphere_grid"]), 25)
+        self.assertTrue(all(num(r[8]) is not None for r in tables[0][1]))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -7,7 +7,7 @@
 #     --runner CMD  how to start a binary: "CMD NAME ARGS" (e.g. .device/run.sh on the GPU machine);
 #                   default: build/release/bin/NAME
 #     --quick       fewer frames and runs (lavapipe at 4K takes about a second a frame)
-#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,trace,bake,startup,load,textures
+#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,env,trace,bake,startup,load,textures
 # The rows and their exact arguments are fixed here, so a rerun measures the same thing (fixed seeds and
 # poses: tests/reference/poses.txt, the generated scenes).
 set -uo pipefail
@@ -89,6 +89,12 @@ if ! skipped big; then  # the Sun-Temple-size version of the default scene
 fi
 if ! skipped compare; then  # GPU raster vs CPU trace, same view and shading model, with the image error
   row frame-compare rtr-frame-compare --size 1920x1080 --frames $cmpframes
+fi
+if ! skipped env; then  # light from the sky: the GPU's split sum vs the tracer converged (1024 sample pairs a
+  # pixel; its noise is in the table), and the tracer's error against its sample count (docs/environment.md)
+  if ((quick)); then envsize=320x180 envref=1024; else envsize=640x360 envref=4096; fi
+  row env-compare rtr-frame-compare --env-cases --size $envsize --spp 1024 --frames $cmpframes
+  row env-spp rtr-frame-compare --spp-curve env_sphere_grid --size $envsize --spp $envref
 fi
 if ! skipped trace; then  # tracer vs Embree on the 1M-triangle sphere and the Sun-Temple-size scene,
   # 1 thread and every core, plus the ray-triangle routines alone (one run of bench-trace does all)

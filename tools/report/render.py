@@ -61,7 +61,8 @@ class Machine:
         gpu = self.meta.get("gpu")
         return (f"{self.device}" + (f" (nvidia-smi: {gpu})" if gpu else "") +
                 f"; CPU {self.meta.get('cpu', '?')}; {self.meta.get('date', '?')}; commit {self.meta.get('commit', '?')}" +
-                (f"; tracer rows: commit {self.meta['trace-commit']}" if "trace-commit" in self.meta else ""))
+                (f"; tracer rows: commit {self.meta['trace-commit']}" if "trace-commit" in self.meta else "") +
+                (f"; environment rows: commit {self.meta['env-commit']}" if "env-commit" in self.meta else ""))
 
 
 # ---------------------------------------------------------------- the sections
@@ -433,6 +434,65 @@ class Report:
                           "speed: ms per 1920×1080 frame (red: GPU raster, blue: CPU trace; log)",
                           "error: mean |GPU − CPU| (8-bit steps)", xlog=True)
 
+    # 6b. environment light: the GPU's split sum against the tracer, and the tracer against its sample count
+    def env_compare(self):
+        self.w("## Light from an environment: split sum (GPU) against Monte Carlo (CPU)")
+        self.w()
+        self.w("`rtr-frame-compare --env-cases`: the `env_*` cases of `tests/reference/poses.txt` lit by the generated "
+               "sky alone (`--env sky`; `_nosun`: the same sky without its sun texel), GGX, no shadows on either side. "
+               "Errors in linear radiance over the pixels both sides cover; `% of mean pixel` = mean |GPU − CPU| / mean "
+               "CPU pixel (the goal's measure), per-pixel = the mean of |GPU − CPU| / CPU; the tracer's own noise is "
+               "estimated from its image at a quarter of the samples. Where the split sum itself is wrong and by how "
+               "much: docs/environment.md.")
+        self.w()
+        for m in self.m:
+            t = m.raw("env-compare")
+            if not t or m.failed("env-compare"):
+                self.missing("split sum vs tracer", m, "env-compare")
+                self.w()
+                continue
+            self.w(f"**{m.label}**")
+            self.w()
+            for header, rows in md_tables(t):
+                self.table(header, rows)
+                if col(header, "sphere") is None:
+                    cc, ce = col(header, "case"), col(header, "% of mean pixel")
+                    for r in rows:
+                        if r[cc] == "env_sphere_grid_nosun" and ce is not None:
+                            e = num(r[ce])
+                            self.goals.append((f"mean GPU-vs-converged-CPU error on the sphere grid ≤ 2 % of the pixel "
+                                               f"value (the sky without its sun, where the split sum's own error is "
+                                               f"least; docs/environment.md; {m.label})",
+                                               f"{e:.1f} %", e <= 2.0))
+            self.source(m, "env-compare")
+        fig, ax = plt.subplots(figsize=(6, 3.6))
+        plotted = False
+        for m in self.m:
+            t = m.raw("env-spp")
+            if not t or m.failed("env-spp"):
+                self.missing("the tracer's error against its sample count", m, "env-spp")
+                self.w()
+                continue
+            for header, rows in md_tables(t):
+                self.w(f"**{m.label}**: the tracer's error against its sample count (against its own image at the "
+                       "largest count)")
+                self.w()
+                self.table(header, rows)
+                cs, ce, cp = col(header, "spp"), col(header, "mean abs"), col(header, "per-pixel")
+                xs = [num(r[cs]) for r in rows]
+                ax.plot(xs, [num(r[ce]) for r in rows], "o-", label=f"{m.label}: mean abs error")
+                ax.plot(xs, [num(r[cp]) / 100 for r in rows], "s--", label=f"{m.label}: mean per-pixel relative")
+                y0 = num(rows[0][ce])
+                ax.plot(xs, [y0 / math.sqrt(x) for x in xs], color="0.6", lw=0.8, label="1/√N")
+                plotted = True
+            self.source(m, "env-spp")
+        if plotted:
+            ax.set_yscale("log")
+            ax.legend(fontsize=7)
+        self.scatter_done(fig, ax, plotted, "env_spp.png", "tracer error against samples per pixel",
+                          "Tracer (MIS) error against its sample count", "sample pairs per pixel (log)",
+                          "error (log)", xlog=True)
+
     # 7. bake
     def bake(self):
         self.w("## Bake: ours against a tinyobjloader baseline")
@@ -630,6 +690,7 @@ def main():
     rep.gpu_passes()
     rep.frames()
     rep.frame_compare()
+    rep.env_compare()
     rep.bake()
     rep.startup()
     rep.load()

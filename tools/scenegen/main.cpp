@@ -3,6 +3,7 @@
 // --scale N refines the tessellation for benchmarks (N = 100 gives about 1.6M vertices).
 // --instances N also bakes temple-grid.rtrscene: N instances of the temple in a grid (rtr-bake's work,
 // cluster hierarchy included; each mesh stored once, placed N times).
+// --sphere-grid FILE.gltf writes only the metallic x roughness sphere grid (sphere_grid.hpp) instead.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,6 +23,7 @@
 #include "scene/rtrscene.hpp"
 #include "objwriter.hpp"
 #include "png.hpp"
+#include "sphere_grid.hpp"
 
 namespace fs = std::filesystem;
 using scenegen::ObjWriter;
@@ -220,8 +222,20 @@ int main(int argc, char** argv) {
   int instances = 0;
   app.add_option("--instances", instances, "also bake temple-grid.rtrscene: N instances of the temple in a grid")
       ->check(rtr::cli::integer(0, 1000000));
+  std::string sphereGrid;
+  int gridSize = 5;
+  app.add_option("--sphere-grid", sphereGrid,
+                 "write only a glTF grid of spheres (metallic by row, roughness by column) to FILE.gltf (+ .bin)");
+  app.add_option("--sphere-grid-size", gridSize, "spheres a side of --sphere-grid")->check(rtr::cli::integer(2, 16));
   if (const int rc = rtr::cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
+    if (!sphereGrid.empty()) {
+      const fs::path file = sphereGrid;
+      if (file.has_parent_path()) fs::create_directories(file.parent_path());
+      scenegen::writeSphereGrid(file, gridSize);
+      std::printf("wrote %s: %d x %d spheres\n", sphereGrid.c_str(), gridSize, gridSize);
+      return 0;
+    }
     const fs::path dir = out;
     if (dir.empty()) throw rtr::UsageError("--out: empty folder name");
     std::error_code ec;
