@@ -35,9 +35,11 @@ class StartupTest : public ::testing::Test {
     fs::create_directories(dir);
   }
   void TearDown() override { fs::remove_all(dir); }
-  // rtr-view on the small temple, headless, with `args`; `env` are env(1)'s words in front.
+  // rtr-view on the small temple, headless, with `args`; `env` are env(1)'s words in front (the texture
+  // cache is off unless they say otherwise: no run writes into the user's cache folder).
   ViewRun view(const std::string& args, const std::string& env = "") {
-    const std::string cmd = "env " + env + " " + rtr::test::toolPath("rtr-view") + " " +
+    const std::string words = env.find("RTR_TEXTURE_CACHE") == std::string::npos ? env + " RTR_TEXTURE_CACHE=off" : env;
+    const std::string cmd = "env " + words + " " + rtr::test::toolPath("rtr-view") + " " +
                             (rtr::test::assetDir() / "temple.rtrscene").string() + " --headless --size 320x180 " +
                             "--screenshot " + (dir / "shot.png").string() + " --force " + args + " 2>&1";
     ViewRun r;
