@@ -15,6 +15,7 @@
 
 #include "scene/baked_texels.hpp"
 #include "scene/texture_cache.hpp"
+#include "test_paths.hpp"
 
 namespace rtr {
 namespace {
@@ -68,6 +69,25 @@ TEST_F(TextureCacheTest, AStoredChainIsFoundWithTheSameTexels) {
   EXPECT_EQ(cache.counts().hits, 1u);
   EXPECT_EQ(cache.counts().misses, 2u);
   EXPECT_EQ(cache.counts().stored, 1u);
+}
+
+// The fuzz target's seed, written byte by byte from the layout docs/startup.md gives (a 4x4 RGBA chain of
+// 96 bytes stored as they are, key {1, 2, "fuzz"}), is an entry the cache reads.
+TEST_F(TextureCacheTest, AnEntryLaidOutAsDocumentedIsRead) {
+  const fs::path seed = test::sourceDir() / "tests/fuzz/corpus/fuzz_texture_cache/rgba-4x4-stored.rtrtex";
+  ASSERT_TRUE(fs::exists(seed)) << seed;
+  const TextureCacheKey key{1, 2, "fuzz"};
+  fs::create_directories(dir);
+  fs::copy_file(seed, dir / key.fileName());
+  TextureCache cache(dir, uint64_t(1) << 30);
+  const auto got = cache.find(key, rgba());
+  ASSERT_NE(got, nullptr);
+  EXPECT_EQ(got->width, 4u);
+  EXPECT_EQ(got->levels(), 3u);
+  std::ifstream in(seed, std::ios::binary);
+  const std::string bytes(std::istreambuf_iterator<char>(in), {});
+  const std::vector<uint8_t> texels(bytes.end() - 96, bytes.end());
+  EXPECT_EQ(unpacked(*got), texels);
 }
 
 TEST_F(TextureCacheTest, TheKeyFollowsTheImageBytesAndTheSlot) {
