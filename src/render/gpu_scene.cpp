@@ -82,9 +82,17 @@ shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
 }  // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
-                   GeometryUpload upload, TextureLoad textureLoad)
-    : ctx_(ctx), mipMode_(mipMode), progress_(progress) {
+                   GeometryUpload upload, TextureLoad textureLoad, TextureCache* cache)
+    : ctx_(ctx), mipMode_(mipMode), progress_(progress), cache_(cache) {
   bounds_ = scene.bounds();
+  if (cache_) {  // a chain is the mip mode's on this device and driver (blits and shaders run by it)
+    const VkPhysicalDeviceProperties& p = ctx.properties();
+    char id[64];
+    std::snprintf(id, sizeof id, "%08x:%08x:%08x:", p.vendorID, p.deviceID, p.driverVersion);
+    cacheVariant_ = std::string("gpu ") + id;
+    for (uint8_t b : p.pipelineCacheUUID) std::snprintf(id, sizeof id, "%02x", b), cacheVariant_ += id;
+    cacheVariant_ += std::string("; mips ") + enumName(mipMode) + " " + std::to_string(kMipChainVersion);
+  }
   const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
   const auto t = Clock::now();
   const GeometryPlan plan = planGeometry(scene);
@@ -96,7 +104,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   uploadGeometry(plan, materials, upload);
   stats_.geometryMs = msSince(t);
-  if (!decoding_.valid()) finishTextures(), ready_ = true;
+  if (!decoding_.valid()) finishTextures(), storeInCache(), ready_ = true;
 }
 
 // Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
@@ -123,12 +131,24 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
       const size_t n = ++decoded_;
       if (progress_) progress_("decoding textures", n, staged_.size());
     };
-    // Baked texels (.rtrscene version 6): every chain unpacked piece by piece on all cores straight into
-    // its staging buffer, whole (no decode, no mip pass); the others decoded from their images.
+    // Baked texels (.rtrscene version 6) and the texture cache's hits: every chain unpacked piece by piece
+    // on all cores straight into its staging buffer, whole (no decode, no mip pass); the others decoded
+    // from their images (and, where the cache missed them, stored once their chains are made).
+    std::vector<std::shared_ptr<const BakedTexels>> chains(used.size());
+    std::vector<TextureCacheKey> keys(used.size());
+    std::vector<uint8_t> keyed(used.size(), 0);
+    parallelFor(used.size(), 0, [&](size_t i) {
+      const Texture& t = scene.textures[used[i]];
+      chains[i] = t.baked;
+      if (!chains[i] && cache_ && cache_->key(scene, t, cacheVariant_, keys[i]))
+        keyed[i] = 1, chains[i] = cache_->find(keys[i], t);
+    });
     std::vector<uint32_t> images;
     std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (GPU texture, piece)
     for (uint32_t i = 0; i < used.size(); ++i) {
-      const BakedTexels* b = scene.textures[used[i]].baked.get();
+      const BakedTexels* b = chains[i].get();
+      stats_.cacheHits += b && keyed[i];
+      stats_.cacheMisses += !b && keyed[i];
       if (!b) {
         images.push_back(i);
         continue;
@@ -144,25 +164,31 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
     for (const auto& [i, k] : pieces) ++left[i];
     parallelFor(pieces.size(), 0, [&](size_t p) {
       const auto [i, k] = pieces[p];
-      unpackBakedPiece(*scene.textures[used[i]].baked, k, static_cast<uint8_t*>(staged_[i].buffer.mapped()));
+      unpackBakedPiece(*chains[i], k, static_cast<uint8_t*>(staged_[i].buffer.mapped()));
       if (--left[i] == 0) staged_[i].buffer.flush(), done();
     });
     std::vector<uint32_t> decodeOnly;
     for (uint32_t i : images) decodeOnly.push_back(used[i]);
-    decodeTextures(scene, decodeOnly, [&](size_t j, TexelData&& texels) {
-      const size_t i = images[j];
-      Staged& s = staged_[i];
-      s.extent = {texels.width, texels.height};
-      // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
-      HostMipChain chain;
-      if (autoSmall(mipMode_, s.extent)) chain = hostMipChain(texels, formats_[i]);
-      const std::vector<uint8_t>& bytes = chain.offsets.empty() ? texels.texels : chain.bytes;
-      s.levels = std::move(chain.offsets);
-      s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
-      std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
-      s.buffer.flush();
-      done();
-    });
+    std::vector<uint8_t> fellBack;  // the checker stands in: nothing to store
+    decodeTextures(
+        scene, decodeOnly,
+        [&](size_t j, TexelData&& texels) {
+          const size_t i = images[j];
+          Staged& s = staged_[i];
+          s.extent = {texels.width, texels.height};
+          // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
+          HostMipChain chain;
+          if (autoSmall(mipMode_, s.extent)) chain = hostMipChain(texels, formats_[i]);
+          const std::vector<uint8_t>& bytes = chain.offsets.empty() ? texels.texels : chain.bytes;
+          s.levels = std::move(chain.offsets);
+          s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
+          std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
+          s.buffer.flush();
+          done();
+        },
+        {}, &fellBack);
+    for (size_t j = 0; j < images.size(); ++j)
+      if (keyed[images[j]] && !fellBack[j]) toStore_.emplace_back(images[j], std::move(keys[images[j]]));
     stats_.decodeMs = msSince(t);
   };
   if (load == TextureLoad::Deferred && !used.empty()) decoding_ = std::async(std::launch::async, decode);
@@ -415,6 +441,7 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
 
 GpuScene::~GpuScene() {
   if (decoding_.valid()) decoding_.wait();  // it writes into this object's staging buffers
+  if (storing_.valid()) storing_.wait();    // it reads this object's read-back buffers
 }  // a pending upload waits for its submission, before the images go
 
 bool GpuScene::updateTextures(bool wait) {
@@ -430,6 +457,7 @@ bool GpuScene::updateTextures(bool wait) {
   stats_.mipGpuMs = upload_->timer.results().at(0).second;
   upload_.reset();
   staged_.clear();
+  storeInCache();
   // Frames in flight read the material buffer: rewritten once none does (once per load).
   VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
   const size_t bytes = texturedMaterials_.size() * sizeof(shader::GpuMaterial);
@@ -473,6 +501,69 @@ void GpuScene::createTextures() {
     textures_.emplace_back(ctx_, desc);
     hostMips_.push_back(!staged_[i].levels.empty());
   }
+}
+
+// Every level of each texture the cache missed, copied into a buffer laid out as a baked chain; packed and
+// written on a worker thread (the destructor waits for it), then the cache trimmed to its bound.
+void GpuScene::storeInCache() {
+  if (!cache_ || toStore_.empty()) return;
+  const auto t = Clock::now();
+  struct Back {
+    BakedTexels layout;
+    vk::Buffer buffer;
+    TextureCacheKey key;
+  };
+  auto backs = std::make_shared<std::vector<Back>>();
+  std::vector<vk::ImageBarrier> toSrc, back;
+  for (auto& [i, key] : toStore_) {
+    Back b;
+    b.layout.format = formats_[i] == VK_FORMAT_R8_UNORM ? BakedFormat::R8 : BakedFormat::Rgba8;
+    b.layout.width = textures_[i].extent().width;
+    b.layout.height = textures_[i].extent().height;
+    b.buffer = vk::Buffer(ctx_, b.layout.bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "cache read-back");
+    b.key = std::move(key);
+    backs->push_back(std::move(b));
+    const uint32_t levels = textures_[i].mipLevels();
+    toSrc.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                     VK_ACCESS_2_TRANSFER_READ_BIT, 0, levels});
+    back.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                    VK_PIPELINE_STAGE_2_COPY_BIT,
+                    VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
+                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, levels});
+  }
+  vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
+    vk::barrier(cb, toSrc);
+    for (size_t k = 0; k < backs->size(); ++k) {
+      const Back& b = (*backs)[k];
+      const std::vector<uint64_t> at = b.layout.levelOffsets();
+      std::vector<VkBufferImageCopy> regions;
+      for (uint32_t l = 0; l < b.layout.levels(); ++l) {
+        VkBufferImageCopy r{};
+        r.bufferOffset = at[l];
+        r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, 1};
+        r.imageExtent = {std::max(1u, b.layout.width >> l), std::max(1u, b.layout.height >> l), 1};
+        regions.push_back(r);
+      }
+      vkCmdCopyImageToBuffer(cb, textures_[toStore_[k].first].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b.buffer.handle(),
+                             uint32_t(regions.size()), regions.data());
+    }
+    vk::barrier(cb, back);
+    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+  });
+  toStore_.clear();
+  stats_.cacheReadbackMs = msSince(t);
+  storing_ = std::async(std::launch::async, [cache = cache_, backs] {
+    parallelFor(backs->size(), 0, [&](size_t k) {
+      Back& b = (*backs)[k];
+      b.buffer.invalidate();
+      const auto* p = static_cast<const uint8_t*>(b.buffer.mapped());
+      cache->store(b.key, packBakedTexels(b.layout.format, b.layout.width, b.layout.height,
+                                          std::vector<uint8_t>(p, p + b.layout.bytes()), 1));
+      b.buffer = {};
+    });
+    cache->trim();
+  });
 }
 
 std::vector<const vk::Image*> GpuScene::gpuMipBatch() const {

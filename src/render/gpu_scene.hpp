@@ -18,6 +18,7 @@
 #include "frame.h"
 #include "render/mips.hpp"
 #include "scene/scene.hpp"
+#include "scene/texture_cache.hpp"
 #include "vk/commands.hpp"
 #include "vk/resources.hpp"
 
@@ -62,6 +63,9 @@ struct GpuSceneStats {
   double geometryMs = 0;            // vertex and index streams laid out, written and (where needed) copied
   double textureUploadMs = 0;       // staging memory to level 0 of each texture
   double mipsMs = 0, mipGpuMs = 0;  // mip chains: wall time, and the GPU's share of it
+  uint32_t cacheHits = 0;           // textures whose chains came from the texture cache (no decode, no mips)
+  uint32_t cacheMisses = 0;         // textures looked up and not found: their chains are read back and stored
+  double cacheReadbackMs = 0;       // reading those chains back (their packing and writing runs on a worker thread)
   size_t geometryBytes = 0;
 };
 
@@ -99,8 +103,11 @@ enum class TextureLoad { Wait, Deferred };
 class GpuScene {
  public:
   // `scene` and `progress` must outlive a Deferred texture load (or the object).
+  // `cache` (it too must outlive the object): textures read from files or glTF images are looked up there
+  // first (a hit: the chain as this device made it, uploaded whole), and the chains of those not found are
+  // stored once the GPU has made them (read back, then packed and written on a worker thread).
   GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {},
-           GeometryUpload upload = GeometryUpload::Auto, TextureLoad textures = TextureLoad::Wait);
+           GeometryUpload upload = GeometryUpload::Auto, TextureLoad textures = TextureLoad::Wait, TextureCache* cache = nullptr);
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
@@ -151,6 +158,7 @@ class GpuScene {
   void startUpload();     // the same in one submission, not waited for (a deferred load)
   void createTextures();
   void recordUpload(VkCommandBuffer cb) const;
+  void storeInCache();  // the chains of the textures the cache missed: read back, then stored
 
   const vk::Context& ctx_;
   MipMode mipMode_;
@@ -167,7 +175,11 @@ class GpuScene {
   std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in
   std::atomic<size_t> decoded_{0};
   std::future<void> decoding_;  // a deferred load's decode, until taken in
-  bool ready_ = false;          // the textures are on the GPU and the materials point at them
+  TextureCache* cache_ = nullptr;
+  std::string cacheVariant_;                                   // what makes this device's chains (the cache key)
+  std::vector<std::pair<uint32_t, TextureCacheKey>> toStore_;  // GPU texture, its key: the cache's misses
+  std::future<void> storing_;                                  // packing and writing them
+  bool ready_ = false;                                         // the textures are on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;

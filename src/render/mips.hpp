@@ -48,6 +48,10 @@ struct HostMipChain {
 };
 HostMipChain hostMipChain(const TexelData& level0, VkFormat format);
 
+// The version of the chains every MipMode makes (shaders, host chain): part of the texture cache's key, so
+// bump it whenever a mode's texels for the same level 0 change.
+constexpr uint32_t kMipChainVersion = 1;
+
 uint32_t mipLevelCount(VkExtent2D extent);  // floor(log2(max(w, h))) + 1
 
 // An image description for a texture of `format` (R8G8B8A8_SRGB, R8G8B8A8_UNORM, R8_UNORM) with its full

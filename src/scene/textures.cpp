@@ -65,10 +65,11 @@ TexelData fallbackTexels(int channels) {
 }
 
 void decodeTextures(const Scene& scene, std::span<const uint32_t> which, const std::function<void(size_t, TexelData&&)>& use,
-                    const std::function<void(const std::string&)>& warn) {
+                    const std::function<void(const std::string&)>& warn, std::vector<uint8_t>* fellBack) {
   std::mutex warnMutex;
+  if (fellBack) fellBack->assign(which.size(), 0);
   // A missing or broken texture must not stop a model from showing: warn, and show the checker instead.
-  auto load = [&](const Texture& t) {
+  auto load = [&](size_t i, const Texture& t) {
     std::string why;
     std::error_code ec;
     const std::filesystem::path file = t.path.is_absolute() ? t.path : scene.baseDir / t.path;
@@ -79,13 +80,14 @@ void decodeTextures(const Scene& scene, std::span<const uint32_t> which, const s
         return decodeTexture(scene, t);
       } catch (const Error& e) { why = e.what(); }
     }
+    if (fellBack) (*fellBack)[i] = 1;
     const std::lock_guard lock(warnMutex);
     const std::string msg = why + "; showing a magenta/black checker instead";
     if (warn) warn(msg);
     else std::cerr << "warning: " << msg << "\n";
     return fallbackTexels(decodeChannels(t));
   };
-  parallelFor(which.size(), 0, [&](size_t i) { use(i, load(scene.textures.at(which[i]))); });
+  parallelFor(which.size(), 0, [&](size_t i) { use(i, load(i, scene.textures.at(which[i]))); });
 }
 
 bool alphaTested(const Mesh& mesh, const Material& material) {

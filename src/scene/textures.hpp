@@ -42,9 +42,10 @@ TexelData decodeTexture(const Scene& scene, const Texture& t);
 // Decodes scene.textures[which[i]] for every i on all cores and hands the texels to use(i, texels) on the
 // thread that decoded them (so per-texture work after decoding runs in parallel too). A texture that is
 // missing or cannot be decoded gets fallbackTexels() and one message naming its file to `warn` (default:
-// "warning: ..." on stderr; calls are serialised).
+// "warning: ..." on stderr; calls are serialised). `fellBack`, when given, gets one entry per texture, set
+// (before use() is called for it) where the checker stands in.
 void decodeTextures(const Scene& scene, std::span<const uint32_t> which, const std::function<void(size_t, TexelData&&)>& use,
-                    const std::function<void(const std::string&)>& warn = {});
+                    const std::function<void(const std::string&)>& warn = {}, std::vector<uint8_t>* fellBack = nullptr);
 
 // Whether a mesh's fragments are alpha-tested (discarded where the mask's alpha < 0.5), as on the GPU: it
 // has texcoords and an alpha-mask texture, and its material is alpha-masked or double-sided (the GPU's

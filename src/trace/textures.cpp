@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/mip_reference.hpp"
+#include "core/parallel.hpp"
 #include "scene/textures.hpp"
 
 namespace rtr::trace {
@@ -67,6 +68,31 @@ MipTexture::MipTexture(const TexelData& image, bool srgb, const SamplerDesc& sam
   halfLog2Area_ = 0.5f * std::log2(float(width()) * float(height()));
 }
 
+MipTexture::MipTexture(const BakedTexels& chain, bool srgb, const SamplerDesc& sampler)
+    : channels_(bakedChannels(chain.format)), srgb_(srgb), sampler_(sampler) {
+  if (bakedBlocks(chain.format)) throw Error("texture: a block-compressed chain; the tracer takes lossless ones");
+  std::vector<uint8_t> bytes(chain.bytes());
+  for (size_t k = 0; k < chain.pieces.size(); ++k) unpackBakedPiece(chain, k, bytes.data());
+  const std::vector<uint64_t> at = chain.levelOffsets();
+  for (uint32_t l = 0; l < chain.levels(); ++l) {
+    const uint32_t w = mipLevelSize(chain.width, l), h = mipLevelSize(chain.height, l);
+    const auto* p = bytes.data() + at[l];
+    levels_.push_back({w, h, std::vector<uint8_t>(p, p + size_t(w) * h * channels_)});
+  }
+  halfLog2Area_ = 0.5f * std::log2(float(width()) * float(height()));
+}
+
+std::vector<uint8_t> MipTexture::chainBytes() const {
+  BakedTexels layout;
+  layout.format = channels_ == 1 ? BakedFormat::R8 : BakedFormat::Rgba8;
+  layout.width = width();
+  layout.height = height();
+  const std::vector<uint64_t> at = layout.levelOffsets();
+  std::vector<uint8_t> out(at.back());
+  for (size_t l = 0; l < levels_.size(); ++l) std::copy(levels_[l].texels.begin(), levels_[l].texels.end(), out.begin() + at[l]);
+  return out;
+}
+
 glm::vec4 MipTexture::bilinear(const Level& l, glm::vec2 uv) const {
   // Texel centres sit at half-integers.
   const Axis ax_ = address(uv.x, l.width, sampler_.wrapU), ay_ = address(uv.y, l.height, sampler_.wrapV);
@@ -96,15 +122,45 @@ float MipTexture::lod(float uvWidth) const { return std::log2(uvWidth) + halfLog
 
 SurfaceInputs materialFactors(const Material& m) { return {m.baseColor, m.roughness, m.metalness, m.emissive, 1.0f}; }
 
-SceneTextures::SceneTextures(const Scene& scene) : index_(scene.textures.size(), kNoTexture) {
+// The texture cache's variant of the tracer's chains: MipTexture's filter (float64 reference, each level
+// from the one before, rounded to 8 bits); bump the number when it changes.
+constexpr char kCacheVariant[] = "trace reference previous-level 1";
+
+SceneTextures::SceneTextures(const Scene& scene, TextureCache* cache) : index_(scene.textures.size(), kNoTexture) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<uint32_t> used = sampledTextures(scene);
   std::vector<std::optional<MipTexture>> built(used.size());
-  decodeTextures(scene, used, [&](size_t i, TexelData&& t) {
-    try {
-      built[i].emplace(t, decodeSrgb(scene.textures[used[i]]), scene.textures[used[i]].sampler);
-    } catch (const Error& e) { throw Error(scene.textures[used[i]].path.string() + ": " + e.what()); }
-  });
+  std::vector<TextureCacheKey> keys(used.size());
+  std::vector<uint8_t> keyed(used.size(), 0);
+  std::vector<uint32_t> decode;  // scene texture indices
+  std::vector<size_t> decodeAt;  // their places in `used`
+  if (cache) {
+    parallelFor(used.size(), 0, [&](size_t i) {
+      const Texture& t = scene.textures[used[i]];
+      if (t.baked || !cache->key(scene, t, kCacheVariant, keys[i])) return;
+      keyed[i] = 1;
+      if (auto chain = cache->find(keys[i], t)) built[i].emplace(*chain, decodeSrgb(t), t.sampler);
+    });
+  }
+  for (size_t i = 0; i < used.size(); ++i)
+    if (!built[i]) decode.push_back(used[i]), decodeAt.push_back(i);
+  cacheHits_ = uint32_t(used.size() - decode.size());
+  std::vector<uint8_t> fellBack;
+  decodeTextures(
+      scene, decode,
+      [&](size_t j, TexelData&& t) {
+        const size_t i = decodeAt[j];
+        try {
+          built[i].emplace(t, decodeSrgb(scene.textures[used[i]]), scene.textures[used[i]].sampler);
+        } catch (const Error& e) { throw Error(scene.textures[used[i]].path.string() + ": " + e.what()); }
+        if (keyed[i] && !fellBack[j]) {
+          const MipTexture& m = *built[i];
+          cache->store(keys[i], packBakedTexels(m.channels() == 1 ? BakedFormat::R8 : BakedFormat::Rgba8, m.width(), m.height(),
+                                                m.chainBytes(), 1));
+        }
+      },
+      {}, &fellBack);
+  if (cache && !decode.empty()) cache->trim();
   for (size_t i = 0; i < used.size(); ++i) {
     index_[used[i]] = uint32_t(i);
     textures_.push_back(std::move(*built[i]));

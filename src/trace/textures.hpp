@@ -11,7 +11,9 @@
 #include <glm/vec4.hpp>
 
 #include "core/image.hpp"
+#include "scene/baked_texels.hpp"
 #include "scene/scene.hpp"
+#include "scene/texture_cache.hpp"
 
 namespace rtr::trace {
 
@@ -23,6 +25,10 @@ class MipTexture {
   // Throws rtr::Error for an empty or malformed image. The sampler's wrap modes address texels (its
   // nearest filters are not modelled: always trilinear).
   MipTexture(const TexelData& image, bool srgb, const SamplerDesc& sampler = {});
+  // From a whole lossless chain made by this class before (the texture cache's entries): no filtering.
+  MipTexture(const BakedTexels& chain, bool srgb, const SamplerDesc& sampler = {});
+  // The chain laid out as a lossless baked texture's (BakedTexels::levelOffsets), for the texture cache.
+  std::vector<uint8_t> chainBytes() const;
 
   // Trilinear sample at uv (the sampler's wrap modes) at level of detail `lod` (clamped to the chain; NaN reads level
   // 0). A one-channel texture reads (r, 0, 0, 1), as R8_UNORM does.
@@ -68,10 +74,11 @@ struct SurfaceUv {
 glm::vec2 slotUv(const Material& m, TextureSlot slot, const SurfaceUv& uv, float* footprintScale = nullptr);
 
 // The textures a scene's PBR shading samples (only those scene/textures.hpp's sampledTextures lists),
-// decoded and mip-mapped on all cores. Throws rtr::Error naming a file that is missing or undecodable.
+// decoded and mip-mapped on all cores, or their chains taken from `cache` where it has them (those it had
+// not are stored). Throws rtr::Error naming a file that is missing or undecodable.
 class SceneTextures {
  public:
-  explicit SceneTextures(const Scene& scene);
+  explicit SceneTextures(const Scene& scene, TextureCache* cache = nullptr);
 
   // material.glsl's fetchSurface: factors × textures at uv. uvWidth: the ray cone's width at the hit in
   // texture-coordinate units (the level of detail follows from it and each texture's size).
@@ -82,13 +89,15 @@ class SceneTextures {
   glm::vec4 sample(const Material& m, TextureSlot slot, const SurfaceUv& uv, float uvWidth, glm::vec4 none) const;
 
   size_t count() const { return textures_.size(); }
-  double loadSeconds() const { return seconds_; }  // decoding and mip building, wall time
+  double loadSeconds() const { return seconds_; }    // decoding and mip building, wall time
+  uint32_t cacheHits() const { return cacheHits_; }  // of count(), chains taken from the texture cache
 
  private:
   const MipTexture* texture(const Material& m, TextureSlot slot) const;
   std::vector<uint32_t> index_;  // scene texture -> textures_ index (kNoTexture: not sampled)
   std::vector<MipTexture> textures_;
   double seconds_ = 0;
+  uint32_t cacheHits_ = 0;
 };
 
 }  // namespace rtr::trace

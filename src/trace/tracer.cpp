@@ -421,7 +421,7 @@ glm::vec3 Tracer::traceAndShade(const Ray& r, int bounces, const TraceSettings& 
 
 const SceneTextures& Tracer::textures() const {
   std::lock_guard lock(texturesMutex_);
-  if (!textures_) textures_ = std::make_unique<const SceneTextures>(scene_);
+  if (!textures_) textures_ = std::make_unique<const SceneTextures>(scene_, textureCache_);
   return *textures_;
 }
 

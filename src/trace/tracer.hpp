@@ -130,6 +130,9 @@ class Tracer {
   // The textures pbr shading samples, loaded on the first call (the first pbr render); no other shading
   // loads any. Thread-safe. Throws rtr::Error naming a texture file that is missing or undecodable.
   const SceneTextures& textures() const;
+  // Where textures() looks for chains first and stores those it makes (null: nowhere); set before the
+  // first pbr render, and it must outlive the tracer.
+  void setTextureCache(TextureCache* cache) { textureCache_ = cache; }
 
   // Each drawn mesh's triangles once (object space where the scene has instances).
   const std::vector<Triangle>& triangles() const { return tris_; }
@@ -216,6 +219,7 @@ class Tracer {
   bool instanced_ = false;
   mutable std::mutex texturesMutex_;
   mutable std::unique_ptr<const SceneTextures> textures_;
+  TextureCache* textureCache_ = nullptr;
 };
 
 }  // namespace rtr::trace

@@ -7,6 +7,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/input_file.hpp"
+#include "core/user_cache.hpp"
 #include "vk/check.hpp"
 
 namespace rtr::vk {
@@ -68,11 +69,7 @@ std::string whyNot(const std::vector<uint8_t>& bytes, const VkPhysicalDeviceProp
 
 }  // namespace
 
-std::filesystem::path defaultPipelineCacheDir() {
-  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x == '/') return std::filesystem::path(x) / "rtr";
-  if (const char* h = std::getenv("HOME"); h && *h) return std::filesystem::path(h) / ".cache" / "rtr";
-  return {};
-}
+std::filesystem::path defaultPipelineCacheDir() { return userCacheDir(); }
 
 PipelineCache::PipelineCache(VkDevice device, const VkPhysicalDeviceProperties& props, std::filesystem::path dir)
     : device_(device), props_(props) {

@@ -11,7 +11,7 @@
 set -eu
 seconds=${1:-15}
 [ $# -gt 0 ] && shift
-targets=${*:-fuzz_rtrscene fuzz_course fuzz_obj fuzz_mtl fuzz_texture fuzz_pose fuzz_spirv fuzz_gltf_compress fuzz_clusters fuzz_bake fuzz_gltf}
+targets=${*:-fuzz_rtrscene fuzz_course fuzz_obj fuzz_mtl fuzz_texture fuzz_pose fuzz_spirv fuzz_gltf_compress fuzz_clusters fuzz_bake fuzz_gltf fuzz_texture_cache}
 cores=${RTR_FUZZ_CORES:-}
 wrap=${RTR_FUZZ_WRAP:-}
 root=$(cd "$(dirname "$0")/../.." && pwd)

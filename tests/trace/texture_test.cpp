@@ -207,6 +207,39 @@ TEST(TracerTextures, FetchMultipliesEverySlotLikeTheGpu) {
   expectNear(in.emissive, glm::vec3(2, 3, 4) * srgb(128), 1e-5f, "emissive");
 }
 
+// The texture cache (scene/texture_cache.hpp) gives the tracer back the very chains it made: the second
+// load takes every texture from it and every sample is the same.
+TEST(TracerTextures, ChainsFromTheTextureCacheSampleAsDecodedOnes) {
+  const auto dir = tempDir() / "cache";
+  std::filesystem::remove_all(dir);
+  Scene s;
+  Material m = pbr(glm::vec3(1.0f), addTexture(s, "noise", 37, 23, [](uint32_t x, uint32_t y) {
+                     return Texel{uint8_t(x * 7 + y * 13), uint8_t(x * y), uint8_t(255 - x), uint8_t(y * 11)};
+                   }));
+  m.textures[uint32_t(TextureSlot::Roughness)] = addTexture(
+      s, "grey", 19, 40,
+      [](uint32_t x, uint32_t y) {
+        return Texel{uint8_t(x * 13 ^ y * 5), 0, 0, 255};
+      },
+      false, 1);
+  addMesh(s, facingQuad(0, addMaterial(s, m)));
+  TextureCache cache(dir, uint64_t(1) << 30);
+  const SceneTextures plain(s), first(s, &cache), second(s, &cache);
+  EXPECT_EQ(first.cacheHits(), 0u);
+  EXPECT_EQ(second.cacheHits(), 2u);
+  EXPECT_EQ(cache.counts().stored, 2u);
+  for (TextureSlot slot : {TextureSlot::BaseColor, TextureSlot::Roughness})
+    for (float lod : {0.0f, 0.7f, 1.5f, 2.2f, 4.0f, 9.0f})
+      for (float u = -0.3f; u < 1.3f; u += 0.0731f)
+        for (float v = -0.2f; v < 1.2f; v += 0.0917f) {
+          const float width = std::exp2(lod) / std::sqrt(37.0f * 23.0f);
+          const glm::vec4 want = plain.sample(s.materials[0], slot, {{u, v}}, width, glm::vec4(-1));
+          EXPECT_EQ(first.sample(s.materials[0], slot, {{u, v}}, width, glm::vec4(-1)), want);
+          ASSERT_EQ(second.sample(s.materials[0], slot, {{u, v}}, width, glm::vec4(-1)), want) << u << " " << v << " " << lod;
+        }
+  std::filesystem::remove_all(dir);
+}
+
 // A red quad at z = -2 whose left half (u < 0.5) is cut out by its mask, in front of a blue one at z = -4.
 Scene maskedPair() {
   Scene s;

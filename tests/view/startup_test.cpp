@@ -1,10 +1,12 @@
 // rtr-view's start-up as a user meets it: --timings phases that account for the whole time, the defaults
-// chosen for the device (and flags that override them), the pipeline cache kept where it is told.
+// chosen for the device (and flags that override them), the pipeline and texture caches kept where they are told.
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -33,9 +35,11 @@ class StartupTest : public ::testing::Test {
     fs::create_directories(dir);
   }
   void TearDown() override { fs::remove_all(dir); }
-  // rtr-view on the small temple, headless, with `args`; `env` are env(1)'s words in front.
+  // rtr-view on the small temple, headless, with `args`; `env` are env(1)'s words in front (the texture
+  // cache is off unless they say otherwise: no run writes into the user's cache folder).
   ViewRun view(const std::string& args, const std::string& env = "") {
-    const std::string cmd = "env " + env + " " + rtr::test::toolPath("rtr-view") + " " +
+    const std::string words = env.find("RTR_TEXTURE_CACHE") == std::string::npos ? env + " RTR_TEXTURE_CACHE=off" : env;
+    const std::string cmd = "env " + words + " " + rtr::test::toolPath("rtr-view") + " " +
                             (rtr::test::assetDir() / "temple.rtrscene").string() + " --headless --size 320x180 " +
                             "--screenshot " + (dir / "shot.png").string() + " --force " + args + " 2>&1";
     ViewRun r;
@@ -123,6 +127,56 @@ TEST_F(StartupTest, PipelineCacheGoesWhereItIsToldAndNowhereWhenOff) {
   const ViewRun on = view("", "-u RTR_PIPELINE_CACHE -u XDG_CACHE_HOME HOME=" + home.string());
   ASSERT_EQ(on.status, 0) << on.out;
   EXPECT_TRUE(fs::is_directory(home / ".cache/rtr")) << on.out;
+}
+
+std::string fileBytes(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+size_t cacheEntries(const fs::path& dir) {
+  size_t n = 0;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) n += e.path().extension() == ".rtrtex";
+  return n;
+}
+
+// The texture cache as a user meets it (docs/startup.md): the second open takes every texture from it and
+// draws the same image as the first and as one without the cache; --no-cache writes nothing anywhere.
+TEST_F(StartupTest, SecondOpenTakesEveryTextureFromTheCacheAndNoCacheWritesNothing) {
+  const fs::path cache = dir / "textures";
+  const std::string env = "RTR_TEXTURE_CACHE=" + cache.string();
+  const ViewRun first = view("--timings", env);
+  ASSERT_EQ(first.status, 0) << first.out;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(first.out, m, std::regex(R"(, (\d+) textures;)"))) << first.out;
+  const std::string textures = m[1];
+  EXPECT_THAT(first.out, HasSubstr("texture cache: 0 hits, " + textures + " misses"));
+  EXPECT_THAT(first.out, HasSubstr("  texture cache read-back "));
+  EXPECT_EQ(cacheEntries(cache), std::stoul(textures));
+  const std::string image = fileBytes(dir / "shot.png");
+  const ViewRun second = view("", env);
+  ASSERT_EQ(second.status, 0) << second.out;
+  EXPECT_THAT(second.out, HasSubstr("texture cache: " + textures + " hits, 0 misses"));
+  EXPECT_EQ(fileBytes(dir / "shot.png"), image) << "the cached open drew another image";
+
+  const fs::path home = dir / "home";
+  const std::string user = "-u RTR_TEXTURE_CACHE -u RTR_PIPELINE_CACHE -u XDG_CACHE_HOME HOME=" + home.string();
+  const ViewRun off = view("--no-cache", user);
+  ASSERT_EQ(off.status, 0) << off.out;
+  EXPECT_FALSE(fs::exists(home / ".cache/rtr")) << off.out;  // (Mesa keeps its own shader cache beside it)
+  EXPECT_EQ(fileBytes(dir / "shot.png"), image) << "the uncached open drew another image";
+  const std::string trace = "env " + user + " " + rtr::test::toolPath("rtr-trace") + " " +
+                            (rtr::test::assetDir() / "temple.rtrscene").string() + " --size 64x36 --force -o " +
+                            (dir / "traced.png").string();
+  ASSERT_EQ(std::system((trace + " --no-cache 2>/dev/null").c_str()), 0);
+  EXPECT_FALSE(fs::exists(home / ".cache/rtr")) << "rtr-trace --no-cache wrote into the user's cache folder";
+  // Without the flag both keep their textures in the user's cache folder.
+  ASSERT_EQ(std::system((trace + " 2>/dev/null").c_str()), 0);
+  EXPECT_EQ(cacheEntries(home / ".cache/rtr/textures"), std::stoul(textures)) << "rtr-trace stored no chains";
+  const ViewRun on = view("", user);
+  ASSERT_EQ(on.status, 0) << on.out;
+  EXPECT_EQ(cacheEntries(home / ".cache/rtr/textures"), 2 * std::stoul(textures)) << on.out;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/common/cache_options.hpp"
 #include "apps/common/environment_options.hpp"
 #include "apps/common/light_options.hpp"
 #include "core/camera.hpp"
@@ -105,6 +106,8 @@ int run(int argc, char** argv) {
       ->capture_default_str()
       ->check(cli::number(-16, 16));
   app.add_flag("-q,--quiet", quiet, "no progress or summary");
+  bool noCache = false;
+  cli::addCacheOptions(app, noCache);
   if (const int rc = cli::parse(app, argc, argv); rc >= 0) return rc;
 
   const cli::Size size2 = cli::parseSize("--size", size);
@@ -156,7 +159,9 @@ int run(int argc, char** argv) {
     s.lights->note = "lit by the environment (--env: no default headlight, no ambient unless --ambient)";
   if (!quiet && !s.lights->note.empty()) std::fprintf(stderr, "rtr-trace: note: %s\n", s.lights->note.c_str());
   gStage = "building the BVH of " + scenePath;
-  const Tracer tracer(scene, s.threads);
+  const std::unique_ptr<TextureCache> textureCache = cli::textureCache(noCache);
+  Tracer tracer(scene, s.threads);
+  tracer.setTextureCache(textureCache.get());
   gStage = "tracing " + scenePath + " at " + std::to_string(w) + "x" + std::to_string(h) + " (" +
            std::to_string((uint64_t(w) * h * sizeof(glm::vec4)) >> 20) + " MB of image)";
   const bool tty = !quiet && isatty(STDERR_FILENO);
@@ -179,9 +184,10 @@ int run(int argc, char** argv) {
   if (!quiet) {
     if (s.shading == Shading::Pbr)
       std::fprintf(stderr,
-                   "rtr-trace: %zu textures decoded and mip-mapped in %.3f s; %llu rays continued past "
-                   "cut-out texels\n",
-                   tracer.textures().count(), tracer.textures().loadSeconds(), (unsigned long long)st.alphaRays);
+                   "rtr-trace: %zu textures decoded and mip-mapped in %.3f s (%u from the texture cache); %llu rays "
+                   "continued past cut-out texels\n",
+                   tracer.textures().count(), tracer.textures().loadSeconds(), tracer.textures().cacheHits(),
+                   (unsigned long long)st.alphaRays);
     const uint64_t rays = st.primaryRays + st.shadowRays + st.reflectionRays + st.alphaRays;
     if (st.environmentRays)
       std::fprintf(stderr, "rtr-trace: environment light: %d samples per pixel, %llu shadow rays\n", s.spp,

@@ -11,6 +11,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "apps/common/cache_options.hpp"
 #include "options.hpp"
 #include "render/headless.hpp"
 #include "render/startup.hpp"
@@ -137,12 +138,14 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     lastShown = Clock::now();
   };
   const bool wait = o.waitTextures.value_or(true);
+  const std::unique_ptr<TextureCache> textureCache = cli::textureCache(!o.textureCache);
   render::GpuScene gpuScene(ctx, scene, choice.mips, progress, render::GeometryUpload::Auto,
-                            wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred);
+                            wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred, textureCache.get());
   const auto& st = gpuScene.stats();  // the texture phases: once they are in
   if (wait) timeline.add("texture decode", st.decodeMs);
   timeline.add("geometry upload", st.geometryMs);
   if (wait) timeline.add("texture upload", st.textureUploadMs), timeline.add("mips", st.mipsMs);
+  if (wait && st.cacheReadbackMs > 0) timeline.add("texture cache read-back", st.cacheReadbackMs);
   last = Clock::now();
   const double pipelineMsBefore = ctx.pipelineCache().stats().ms;
   std::fprintf(stderr,
@@ -153,6 +156,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   if (wait)
     std::fprintf(stderr, ", decode %.0f ms, texture upload %.0f ms, mips %.3f ms GPU", st.decodeMs, st.textureUploadMs,
                  st.mipGpuMs);
+  if (wait && textureCache)
+    std::fprintf(stderr, "; texture cache: %u hits, %u misses (%s)", st.cacheHits, st.cacheMisses, textureCache->dir().c_str());
   else if (st.textures) std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
   std::fprintf(stderr, "\n");
   const CameraPose pose = startPose(o, scene);
@@ -182,8 +187,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   if (gpuScene.updateTextures(true) && o.timings)  // how long the textures took, after the first frame
     std::fprintf(stderr,
                  "rtr-view: textures in at %.0f ms from process start: decode %.0f ms (worker threads), "
-                 "upload and mips %.0f ms (mips %.3f ms GPU)\n",
-                 render::msSinceProcessStart(), st.decodeMs, st.textureUploadMs, st.mipGpuMs);
+                 "upload and mips %.0f ms (mips %.3f ms GPU); texture cache: %u hits, %u misses\n",
+                 render::msSinceProcessStart(), st.decodeMs, st.textureUploadMs, st.mipGpuMs, st.cacheHits, st.cacheMisses);
   if (o.bench > 0) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());

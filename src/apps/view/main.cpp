@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/common/cache_options.hpp"
 #include "apps/common/light_options.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
@@ -188,7 +189,7 @@ int main(int argc, char** argv) {
       ->check(cli::number(1, 64))
       ->capture_default_str();
   cli::addLightOptions(app, o.lightOptions);
-  bool noPipelineCache = false, noWaitTextures = false;
+  bool noPipelineCache = false, noWaitTextures = false, noCache = false;
   std::string up = "+Y";
   cli::addEnvironmentOptions(app, o.env, true);
   std::string brdf;
@@ -220,6 +221,7 @@ int main(int argc, char** argv) {
                "print the start-up phases in ms, from process start to the first frame (the window's panel shows them too)");
   app.add_flag("--no-pipeline-cache", noPipelineCache,
                "neither read nor write the pipeline cache ($XDG_CACHE_HOME/rtr or ~/.cache/rtr; RTR_PIPELINE_CACHE=DIR|off)");
+  cli::addCacheOptions(app, noCache, "; nor the pipeline cache");
   // Test-only seams of the window (tests/view/panel_test.py), hidden from --help.
   app.add_flag("--test-ui", o.testUi)->group("");
   app.add_option("--test-drop", o.testDropFile)->group("");
@@ -236,7 +238,8 @@ int main(int argc, char** argv) {
     if (!camera.empty()) o.camera = cli::parsePose("--camera", camera);
     if (!mtl.empty()) o.load.mtl = mtl;
     o.up = upRotation(up);
-    o.pipelineCache = !noPipelineCache;
+    o.pipelineCache = !noPipelineCache && !noCache;
+    o.textureCache = !noCache;
     o.env.resolve();
     // The environment is the light: no headlight and no flat ambient stand in for it unless asked for (as rtr-trace).
     if (o.env.hasEnvironment()) o.lightOptions.defaultLight = false;

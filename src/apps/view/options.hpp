@@ -42,6 +42,7 @@ struct ViewOptions {
   bool shadingGiven = false, mipsGiven = false;  // --shading-path / --mips given: no per-device default
   bool timings = false;                          // print the start-up phases
   bool pipelineCache = true;                     // keep compiled pipelines in the user's cache folder
+  bool textureCache = true;                      // keep decoded, mipped textures there (--no-cache: neither)
   // The first frame waits for the textures (deterministic captures); unless given, on for --headless
   // (--screenshot, --bench), off in the window, whose frames show the factors until the textures are in.
   std::optional<bool> waitTextures;

@@ -27,7 +27,7 @@ void SceneSlot::release() {
 
 void SceneSlot::build(VkExtent2D extent, render::MipMode mips) {
   gpu_ = std::make_unique<render::GpuScene>(ctx_, *scene_, mips, render::LoadProgress{}, render::GeometryUpload::Auto,
-                                            waitTextures_ ? render::TextureLoad::Wait : render::TextureLoad::Deferred);
+                                            waitTextures_ ? render::TextureLoad::Wait : render::TextureLoad::Deferred, cache_);
   frames_ = std::make_unique<ViewFrames>(ctx_, surface_, extent, *gpu_);
   if (env_) frames_->renderer().setEnvironment(env_);
   traced_ = std::make_unique<TraceOverlay>(ctx_, *scene_);
@@ -68,8 +68,10 @@ bool SceneSlot::update(ViewState& app) {
   if (gpu_->updateTextures()) {
     const auto& st = gpu_->stats();
     if (texturesInAt_ == 0) texturesInAt_ = render::msSinceProcessStart();
-    std::fprintf(stderr, "rtr-view: %u textures in: decode %.0f ms (worker threads), upload and mips %.0f ms\n", st.textures,
-                 st.decodeMs, st.textureUploadMs);
+    std::fprintf(
+        stderr,
+        "rtr-view: %u textures in (%u from the texture cache): decode %.0f ms (worker threads), upload and mips %.0f ms\n",
+        st.textures, st.cacheHits, st.decodeMs, st.textureUploadMs);
     std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", enumName(app.mips), st.mipGpuMs);
   }
   return replaced;

@@ -26,6 +26,8 @@ class SceneSlot {
   ~SceneSlot() { release(); }  // the device idle, children first; before the surface and the device go
 
   void build(VkExtent2D extent, render::MipMode mips);
+  // The texture cache every scene of the slot uses (null: none); it must outlive the slot.
+  void setTextureCache(TextureCache* cache) { cache_ = cache; }
   // The environment every scene of the slot is lit by (kept across drops); null: none.
   void setEnvironment(std::shared_ptr<const render::EnvironmentMaps> env) {
     env_ = std::move(env);
@@ -52,6 +54,7 @@ class SceneSlot {
   std::vector<std::string> files_;
   size_t fileIndex_ = 0;
   std::string path_;
+  TextureCache* cache_ = nullptr;
   std::unique_ptr<render::GpuScene> gpu_;
   std::shared_ptr<const render::EnvironmentMaps> env_;
   std::unique_ptr<ViewFrames> frames_;

@@ -10,6 +10,7 @@
 #include <backends/imgui_impl_glfw.h>
 
 #include "brdf.h"
+#include "apps/common/cache_options.hpp"
 #include "options.hpp"
 #include "scene_camera.hpp"
 #include "scene_slot.hpp"
@@ -97,8 +98,10 @@ int runWindowed(const ViewOptions& opts) {
   const bool waitTextures = o.waitTextures.value_or(false);
   ViewOptions dropped = o;  // a dropped OBJ finds its own MTL
   dropped.load.mtl.reset();
+  const std::unique_ptr<TextureCache> textureCache = cli::textureCache(!o.textureCache);
   SceneSlot slot(ctx, window.surface(), std::move(scene), o.files, waitTextures,
                  [dropped](const std::string& path) { return loadForView(dropped, path); });
+  slot.setTextureCache(textureCache.get());
   slot.build({o.width, o.height}, app.mips);
   slot.setEnvironment(loadEnvironment(o, ctx));
   clock.phase(waitTextures ? "scene to the GPU (geometry, textures, mips), swapchain" : "geometry to the GPU, swapchain");
