@@ -3,6 +3,7 @@
 #include <meshoptimizer.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <unordered_map>
 
@@ -63,11 +64,16 @@ std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
   return out;
 }
 
-// Groups of up to four clusters that share the most edges, grown greedily in the clusters' order (which
-// split() makes spatially coherent). Neighbours by shared edges keep each group's outer border short,
-// so locking it still leaves most of the group free to simplify.
-std::vector<std::vector<uint32_t>> groupClusters(const std::vector<Indices>& clusters) {
-  const uint32_t n = uint32_t(clusters.size());
+// Groups of up to four of clusters [first, end) that share the most edges, grown greedily in the
+// clusters' order (which split() makes spatially coherent). Neighbours by shared edges keep each group's
+// outer border short, so locking it still leaves most of the group free to simplify. A level is grouped
+// in fixed pieces of kGroupPiece clusters, each on its own (all cores; the same groups for any thread
+// count): a cluster's neighbours in another piece are not considered.
+constexpr uint32_t kGroupPiece = 256;
+// The longest edge a simplification makes, in units of the error it reports (see buildClusterLod).
+constexpr float kEdgePerError = 8.0f;
+std::vector<std::vector<uint32_t>> groupClusters(const std::vector<Indices>& clusters, uint32_t first, uint32_t end) {
+  const uint32_t n = end - first;  // local numbering: cluster first + i is i
   std::unordered_map<uint64_t, uint32_t> edgeOwner;
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> shared(n);  // (neighbour, edges), per cluster
   auto addShared = [&](uint32_t a, uint32_t b) {
@@ -78,14 +84,16 @@ std::vector<std::vector<uint32_t>> groupClusters(const std::vector<Indices>& clu
       else ++it->second;
     }
   };
-  for (uint32_t c = 0; c < n; ++c)
-    for (size_t t = 0; t < clusters[c].size(); t += 3)
+  for (uint32_t c = 0; c < n; ++c) {
+    const Indices& tris = clusters[first + c];
+    for (size_t t = 0; t < tris.size(); t += 3)
       for (int e = 0; e < 3; ++e) {
-        const uint32_t u = clusters[c][t + e], v = clusters[c][t + (e + 1) % 3];
+        const uint32_t u = tris[t + e], v = tris[t + (e + 1) % 3];
         const uint64_t key = uint64_t(std::min(u, v)) << 32 | std::max(u, v);
         const auto [it, added] = edgeOwner.try_emplace(key, c);
         if (!added && it->second != c) addShared(it->second, c);
       }
+  }
   std::vector<int> group(n, -1);
   std::vector<std::vector<uint32_t>> groups;
   for (uint32_t seed = 0; seed < n; ++seed) {
@@ -124,7 +132,42 @@ std::vector<std::vector<uint32_t>> groupClusters(const std::vector<Indices>& clu
     groups[gi].clear();
   }
   std::erase_if(groups, [](const std::vector<uint32_t>& g) { return g.empty(); });
+  for (std::vector<uint32_t>& g : groups)
+    for (uint32_t& c : g) c += first;
   return groups;
+}
+
+// A level's groups: its pieces grouped on all cores, then taken in piece order.
+std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& clusters, unsigned threads) {
+  const uint32_t n = uint32_t(clusters.size()), pieces = (n + kGroupPiece - 1) / kGroupPiece;
+  std::vector<std::vector<std::vector<uint32_t>>> perPiece(pieces);
+  parallelFor(pieces, threads, [&](size_t p) {
+    const uint32_t first = uint32_t(p) * kGroupPiece;
+    perPiece[p] = groupClusters(clusters, first, std::min(n, first + kGroupPiece));
+  });
+  std::vector<std::vector<uint32_t>> groups;
+  for (auto& piece : perPiece)
+    for (auto& g : piece) groups.push_back(std::move(g));
+  return groups;
+}
+
+// The longest edge of the triangles of `out` that are not triangles of `in` (0 if none): what a
+// simplification made, as opposed to what it kept.
+float longestNewEdge(const Indices& in, const Indices& out, const Mesh& mesh) {
+  auto key = [](const uint32_t* t) {  // the same triangle, same winding, whatever vertex comes first
+    const int s = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
+    return std::array<uint32_t, 3>{t[s], t[(s + 1) % 3], t[(s + 2) % 3]};
+  };
+  std::vector<std::array<uint32_t, 3>> kept;
+  for (size_t t = 0; t < in.size(); t += 3) kept.push_back(key(&in[t]));
+  std::sort(kept.begin(), kept.end());
+  float longest = 0.0f;
+  for (size_t t = 0; t < out.size(); t += 3) {
+    if (std::binary_search(kept.begin(), kept.end(), key(&out[t]))) continue;
+    for (int e = 0; e < 3; ++e)
+      longest = std::max(longest, glm::distance(mesh.positions[out[t + e]], mesh.positions[out[t + (e + 1) % 3]]));
+  }
+  return longest;
 }
 
 // Simplifies a group's triangles towards half, its border locked, in a vertex buffer of its own (the
@@ -184,13 +227,11 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     const auto* t = mesh.indices.data() + size_t(mc.firstTriangle) * 3;
     current.emplace_back(t, t + size_t(mc.triangleCount) * 3);
   }
-  auto add = [&](const Indices& tris, uint32_t level, glm::vec4 sphere, float error) {
+  auto add = [&](const Indices& tris, const meshopt_Bounds& b, uint32_t level, glm::vec4 sphere, float error) {
     LodCluster c;
     c.firstTriangle = base + uint32_t(lod.indices.size() / 3);
     c.triangleCount = uint32_t(tris.size() / 3);
     c.level = level;
-    const meshopt_Bounds b =
-        meshopt_computeClusterBounds(tris.data(), tris.size(), &mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3));
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
     c.coneAxis = {b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};
@@ -206,12 +247,13 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
 
   lod.levels = 1;
   for (uint32_t level = 1; current.size() > 1; ++level) {
-    const std::vector<std::vector<uint32_t>> groups = groupClusters(current);
+    const std::vector<std::vector<uint32_t>> groups = groupLevel(current, threads);
     // Each group is simplified and split on its own (all cores); the results are taken in group order.
     struct Result {
       glm::vec4 sphere{0.0f};
       float error = 0.0f;
       std::vector<Indices> clusters;  // empty: the group stays as it is, its clusters roots
+      std::vector<meshopt_Bounds> bounds;
     };
     std::vector<Result> results(groups.size());
     parallelFor(groups.size(), threads, [&](size_t gi) {
@@ -228,8 +270,16 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       }
       const Indices simpler = simplifyGroup(tris, mesh, r.error);
       if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) return;  // stuck: these stay roots
-      r.error = std::max(r.error, childError + epsilon);                    // monotone up the hierarchy, strictly
+      // The error also bounds the size of the triangles the simplification made: where it moves no
+      // surface (a flat floor: error 0) it would otherwise make triangles that are drawn at any distance,
+      // however many pixels they cover. So a triangle of the cut spans at most kEdgePerError × the
+      // threshold in pixels (fewer where it is farther than its sphere's nearest point).
+      r.error = std::max(r.error, longestNewEdge(tris, simpler, mesh) / kEdgePerError);
+      r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
       r.clusters = split(simpler, mesh);
+      for (const Indices& c : r.clusters)
+        r.bounds.push_back(
+            meshopt_computeClusterBounds(c.data(), c.size(), &mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3)));
     });
     std::vector<Indices> next;
     std::vector<uint32_t> nextIds;
@@ -240,9 +290,9 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
         lod.clusters[ids[k]].parentError = r.error;
         lod.clusters[ids[k]].parentSphere = r.sphere;
       }
-      for (Indices& c : r.clusters) {
-        nextIds.push_back(add(c, level, r.sphere, r.error));
-        next.push_back(std::move(c));
+      for (size_t i = 0; i < r.clusters.size(); ++i) {
+        nextIds.push_back(add(r.clusters[i], r.bounds[i], level, r.sphere, r.error));
+        next.push_back(std::move(r.clusters[i]));
       }
     }
     if (next.empty()) break;

@@ -1,8 +1,11 @@
 // The level-of-detail hierarchy: levels halve, errors and their spheres grow monotonically up the
 // hierarchy, threshold 0 selects exactly the mesh's own triangles, and every cut (any eye, any
 // threshold) of a closed mesh is closed: each edge used by exactly two triangles, so no crack.
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -37,6 +40,21 @@ Mesh bumpySphere(uint32_t rings, uint32_t segments) {
     }
   m.normals = m.positions;
   buildClusters(m, true);  // level 0 of the hierarchy
+  return m;
+}
+
+// A flat square grid of n × n quads on y = 0 (nothing for the simplifier's error to see).
+Mesh flatGrid(uint32_t n) {
+  Mesh m;
+  for (uint32_t i = 0; i <= n; ++i)
+    for (uint32_t j = 0; j <= n; ++j) m.positions.push_back({2.0f * i / n - 1, 0, 2.0f * j / n - 1});
+  for (uint32_t i = 0; i < n; ++i)
+    for (uint32_t j = 0; j < n; ++j) {
+      const uint32_t a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+      m.indices.insert(m.indices.end(), {a, b, c, b, d, c});
+    }
+  m.normals.assign(m.positions.size(), {0, 1, 0});
+  buildClusters(m, true);
   return m;
 }
 
@@ -136,6 +154,60 @@ TEST(ClusterLod, SameMeshSameHierarchy) {
   EXPECT_EQ(a.indices, b.indices);
   ASSERT_EQ(a.clusters.size(), b.clusters.size());
   for (size_t i = 0; i < a.clusters.size(); ++i) EXPECT_EQ(a.clusters[i].parentError, b.clusters[i].parentError);
+}
+
+// Where simplifying moves no surface (a flat floor) its error alone would let it collapse into triangles
+// drawn at any distance, however many pixels they cover; the hierarchy's errors also bound the size of
+// what a simplification made: no triangle of a cut that the simplifier made spans more than 8 × the threshold in
+// pixels (docs/virtual-geometry.md; the mesh's own triangles, at any level, are as large as they are),
+// and coarse levels are still used.
+TEST(ClusterLod, CutTrianglesOfAFlatFloorStaySmallOnScreen) {
+  const Mesh m = flatGrid(200);  // 80 000 triangles
+  Mesh withLod = m;
+  withLod.lod = buildClusterLod(m);
+  ASSERT_GE(withLod.lod.levels, 4u);
+  auto key = [](const uint32_t* t) {  // a triangle whichever vertex comes first
+    std::array<uint32_t, 3> a{t[0], t[1], t[2]};
+    std::rotate(a.begin(), std::min_element(a.begin(), a.end()), a.end());
+    return a;
+  };
+  std::set<std::array<uint32_t, 3>> own;  // the mesh's triangles: their size is the mesh's
+  for (size_t k = 0; k < m.indices.size(); k += 3) own.insert(key(&m.indices[k]));
+  for (glm::vec3 eye : {glm::vec3(0, 0.3f, 0), glm::vec3(0.9f, 0.05f, -0.9f), glm::vec3(3, 2, 0), glm::vec3(0, 40, 0)})
+    for (float threshold : {0.5f, 1.0f, 4.0f}) {
+      size_t drawn = 0;
+      float largest = 0.0f;  // the longest edge the simplifier made, in pixels where it is nearest the eye
+      for (const LodCluster& c : withLod.lod.clusters) {
+        if (!shader::lodSelected(c.sphere, c.error, c.parentSphere, c.parentError, eye, 1000.0f, 0.01f, threshold)) continue;
+        const std::span<const uint32_t> t = lodTriangles(withLod, c);
+        drawn += t.size() / 3;
+        for (size_t k = 0; k < t.size(); ++k) {
+          if (own.contains(key(&t[k - k % 3]))) continue;
+          const glm::vec3 a = m.positions[t[k]], b = m.positions[t[k - k % 3 + (k + 1) % 3]];
+          const float s = std::clamp(glm::dot(eye - a, b - a) / glm::dot(b - a, b - a), 0.0f, 1.0f);
+          largest = std::max(largest, glm::distance(a, b) * 1000.0f / glm::distance(eye, a + s * (b - a)));
+        }
+      }
+      EXPECT_LE(largest, 8.0f * threshold * 1.001f)
+          << "eye " << eye.x << "," << eye.y << "," << eye.z << " threshold " << threshold;
+      if (eye.y > 10) {  // level-0 triangles a quarter of a pixel: coarse levels must be drawn
+        EXPECT_LT(drawn, m.indices.size() / 3 / 4) << "coarse levels unused, eye y " << eye.y;
+      }
+    }
+}
+
+// The hierarchy is the same, byte for byte, whatever the thread count: a level is grouped and simplified
+// in fixed pieces. The mesh has several pieces of clusters (kGroupPiece, 256) at level 0.
+TEST(ClusterLod, SameHierarchyOnOneThreadAndOnMany) {
+  const Mesh m = bumpySphere(160, 320);  // 101 760 triangles
+  ASSERT_GT(m.clusters.size(), 3 * 256u);
+  const ClusterLod one = buildClusterLod(m, true, 1), many = buildClusterLod(m, true, 7);
+  ASSERT_GE(one.levels, 5u);
+  EXPECT_EQ(one.levels, many.levels);
+  EXPECT_EQ(one.indices, many.indices);
+  ASSERT_EQ(one.clusters.size(), many.clusters.size());
+  static_assert(sizeof(LodCluster) == 21 * 4);  // no padding: memcmp compares every field
+  EXPECT_EQ(std::memcmp(one.clusters.data(), many.clusters.data(), one.clusters.size() * sizeof(LodCluster)), 0);
 }
 
 }  // namespace
