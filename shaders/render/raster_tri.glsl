@@ -127,7 +127,12 @@ void rasterPixel(Tri t, ivec2 px) {
   // the parts inside it (2CylinderEngine showed its inner parts); the differences keep them.
   const float z = t.z[0] + (float(e1) * (t.z[1] - t.z[0]) + float(e2) * (t.z[2] - t.z[0])) / float(t.area2);
   if (z < 0.0 || z > 1.0) return;  // the hardware's near and far clipping (w > 0 everywhere here)
-  if (kAlphaMask && t.material != NO_TEXTURE && cutOut(t, px, vec3(float(e0), float(e1), float(e2)))) return;
-  atomicMin(vis[px.y * int(pc.width) + px.x], packVis(z, t.id));
+  const int i = px.y * int(pc.width) + px.x;
+  if (kAlphaMask && t.material != NO_TEXTURE) {
+    // Behind what is drawn already (depths only fall): the mask's fetch would change nothing.
+    if (z > uintBitsToFloat(uint(vis[i] >> 32))) return;
+    if (cutOut(t, px, vec3(float(e0), float(e1), float(e2)))) return;
+  }
+  atomicMin(vis[i], packVis(z, t.id));
 }
 
