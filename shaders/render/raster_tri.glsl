@@ -63,7 +63,7 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
     if (any(greaterThan(abs(s - 0.5 * size), vec2(RASTER_GUARD_BAND)))) return kHardware;
     v[i] = ivec2(floor(s * float(kOne) + 0.5));
     t.z[i] = p[i].z / p[i].w;
-    t.invW[i] = 1.0 / p[i].w;
+    if (kAlphaMask) t.invW[i] = 1.0 / p[i].w;
   }
   // Vulkan's facing: counter-clockwise in framebuffer coordinates (y down) is front, i.e. area2 < 0 here;
   // the other way round for a mirrored instance (its draws' VK_FRONT_FACE_CLOCKWISE).
