@@ -34,9 +34,8 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   d.depthTest = d.depthWrite = false;
   hardware_ = vk::makeGraphicsPipeline(ctx, d, options);
   // Written by the renderer (Renderer::writeTextures).
-  const vk::Pipeline* textured[] = {&raster_, &large_, &hardware_};
   for (size_t i = 0; i < 3; ++i)
-    if (textured[i]->layout.setCount() > 1) textures_[i] = vk::DescriptorSets(ctx, textured[i]->layout, 1);
+    if (textured()[i]->layout.setCount() > 1) textures_[i] = vk::DescriptorSets(ctx, textured()[i]->layout, 1);
   // Every triangle at most once in the hand-off list, after its VkDrawIndirectCommand.
   uint64_t triangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
@@ -57,9 +56,8 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
 
 std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster::textureSets() const {
   std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> sets;
-  const vk::Pipeline* textured[] = {&raster_, &large_, &hardware_};
   for (size_t i = 0; i < 3; ++i)
-    if (textured[i]->layout.setCount() > 1) sets.emplace_back(&textured[i]->layout, textures_[i].get(1));
+    if (textured()[i]->layout.setCount() > 1) sets.emplace_back(&textured()[i]->layout, textures_[i].get(1));
   return sets;
 }
 
@@ -104,7 +102,6 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   culled_.at(frame) = culling;
   twoPhase_.at(frame) = twoPhase;
   const VkBuffer lods = lod ? scene_.clusterLods() : VK_NULL_HANDLE;
-  const vk::Pipeline* textured[] = {&raster_, &large_, &hardware_};
   auto bind = [&](const vk::Pipeline& p, bool fromList = false) {
     p.bind(cb);
     vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
@@ -131,7 +128,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     }
     w.push(cb, p);
     for (size_t i = 0; i < 3; ++i)
-      if (&p == textured[i] && p.layout.setCount() > 1) p.bindSet(cb, 1, textures_[i].get(1));
+      if (&p == textured()[i] && p.layout.setCount() > 1) p.bindSet(cb, 1, textures_[i].get(1));
     p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, clusterCount, fromList, 0, 0, 0});
   };
   // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.

@@ -6,6 +6,7 @@
 // the mask per pixel (docs/raster.md); others bind no texture.
 // RASTER_SHARED_AREA (raster.h, a specialization constant of both passes): the bounding-box area in pixels
 // above which a triangle is rasterised by tiles rather than by its own thread.
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -51,7 +52,8 @@ class ComputeRaster {
   const vk::Context& ctx_;
   const GpuScene& scene_;
   vk::Pipeline clear_, raster_, large_, hardware_;
-  vk::DescriptorSets textures_[3];  // set 1 of raster_, large_, hardware_ where they have one
+  vk::DescriptorSets textures_[3];  // set 1 of textured()'s pipelines where they have one
+  std::array<const vk::Pipeline*, 3> textured() const { return {&raster_, &large_, &hardware_}; }
   vk::Buffer vis_, hwList_, largeList_;
   VkExtent2D extent_{0, 0};
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
