@@ -2,9 +2,9 @@
 // Compute rasteriser (docs/raster.md): one workgroup per cluster, a thread per triangle. Vertices are
 // snapped to 1/256 pixel; integer edge functions with the top-left rule decide which pixel centres a
 // triangle covers, so a shared edge is covered exactly once; each covered pixel gets one 64-bit atomicMin
-// of (depth, id). Triangles with a bounding box over kSharedArea pixels go to the tile list (one entry per
-// RASTER_TILE² tile, raster_large.comp); those touching w <= 0 or leaving the guard band, and all of
-// alpha-masked clusters, go to the hardware hand-off list (raster_hw.vert/frag).
+// of (depth, id), alpha-masked ones after the mask's test (raster_tri.glsl). Triangles with a bounding box
+// over kSharedArea pixels go to the tile list (one entry per RASTER_TILE² tile, raster_large.comp); those
+// touching w <= 0 or leaving the guard band go to the hardware hand-off list (raster_hw.vert/frag).
 #extension GL_GOOGLE_include_directive : require
 // With culling (pc.fromList), workgroup k takes the k-th entry of the culling pass's visible list
 // (cull.comp; dispatched indirectly from its counts).

@@ -50,4 +50,15 @@ uvec3 triangleVertices(GpuCluster c, GpuDraw d, uint local) {
 // Clip-space position of vertex i placed by instance `inst`, computed as the vertex stages do.
 vec4 clipPosition(GpuInstance inst, uint i) { return frame.viewProj * (inst.transform * vec4(position(i), 1.0)); }
 
+// The alpha test of vis.frag given the mask texel: whether the material cuts the pixel out.
+bool maskCuts(GpuMaterial m, vec4 mask) {
+  return m.baseColor.a * ((m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a) < m.roughMetal.z;
+}
+
+// The mask's texcoords from set 0's (its KHR_texture_transform).
+vec2 maskTexcoord(GpuMaterial m, vec2 uv) {
+  const vec4 r0 = m.uvTransform[2 * SLOT_MASK], r1 = m.uvTransform[2 * SLOT_MASK + 1];
+  return vec2(dot(r0.xy, uv) + r0.z, dot(r1.xy, uv) + r1.z);
+}
+
 uint64_t packVis(float depth, uint id) { return (uint64_t(floatBitsToUint(depth)) << 32) | uint64_t(id); }

@@ -20,10 +20,8 @@ void main() {
   if ((inFlags & CLUSTER_ALPHA_MASKED) != 0u) {
     const GpuMaterial m = materials[inMaterial];
     if (m.textures.w != NO_TEXTURE) {
-      const vec4 r0 = m.uvTransform[2 * SLOT_MASK], r1 = m.uvTransform[2 * SLOT_MASK + 1];  // set 0's texcoords
-      const vec2 uv = vec2(dot(r0.xy, inTexcoord) + r0.z, dot(r1.xy, inTexcoord) + r1.z);
-      const vec4 mask = texture(textures[nonuniformEXT(m.textures.w)], uv, frame.params.y);
-      if (m.baseColor.a * ((m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a) < m.roughMetal.z) discard;
+      const vec2 uv = maskTexcoord(m, inTexcoord);  // set 0's texcoords
+      if (maskCuts(m, texture(textures[nonuniformEXT(m.textures.w)], uv, frame.params.y))) discard;
     }
   }
   const bool front = gl_FrontFacing != ((inFlags & CLUSTER_MIRRORED) != 0u);  // the pipeline's front is counter-clockwise

@@ -1,6 +1,6 @@
 #version 460
 // The compute rasteriser's hand-off (raster.comp): triangles it leaves to the hardware (crossing w = 0,
-// outside the guard band, alpha-masked), pulled from the list by gl_VertexIndex; the hardware clips them.
+// outside the guard band), pulled from the list by gl_VertexIndex; the hardware clips them.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #define RASTER_VIS_ACCESS readonly

@@ -2,7 +2,15 @@
 // thread each) and raster_large.comp (large ones, a workgroup per 32x32 tile).
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
+#extension GL_EXT_nonuniform_qualifier : require
 #include "raster_fetch.glsl"
+
+// Scenes with alpha-masked materials (ComputeRaster's variant) test the mask per pixel here, as vis.frag
+// does; without it a masked cluster's triangles go to the hardware hand-off. Only this variant reads:
+layout(constant_id = 1) const bool kAlphaMask = false;
+layout(set = 0, binding = 8, std430) readonly buffer Materials { GpuMaterial materials[]; };
+layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
+layout(set = 1, binding = 0) uniform sampler2D textures[];
 
 const int kOne = 1 << RASTER_SUBPIXEL_BITS;
 const uint kSkip = 0u, kSmall = 1u, kLarge = 2u, kHardware = 3u;
@@ -13,6 +21,11 @@ struct Tri {
   ivec4 box;   // pixels: min x, min y, max x, max y (inclusive)
   int64_t area2;
   uint id;
+  // The alpha test (kAlphaMask): the mask's texcoords and 1/w at each vertex, the material (NO_TEXTURE:
+  // no test).
+  vec2 uv[3];
+  vec3 invW;
+  uint material;
 };
 
 // Edge function of a -> b at p: twice the signed area of (a, b, p); the top-left rule's bias makes it
@@ -31,8 +44,10 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
   const GpuInstance inst = instances[c.instance];
   const GpuDraw d = draws[inst.info.x];
   t.id = (c.instance << pc.primitiveBits) | (c.firstTriangle + local);
-  if ((c.flags & CLUSTER_ALPHA_MASKED) != 0u) return kHardware;
-  const uvec3 tri = triangleVertices(c, d, local);
+  t.material = NO_TEXTURE;
+  const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
+  if (!kAlphaMask && masked) return kHardware;
+  uvec3 tri = triangleVertices(c, d, local);
   const vec4 p[3] = vec4[3](clipPosition(inst, tri.x), clipPosition(inst, tri.y), clipPosition(inst, tri.z));
   // Outside one plane of the view volume (behind the camera included): nothing to draw.
   for (int k = 0; k < 3; ++k) {
@@ -48,6 +63,7 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
     if (any(greaterThan(abs(s - 0.5 * size), vec2(RASTER_GUARD_BAND)))) return kHardware;
     v[i] = ivec2(floor(s * float(kOne) + 0.5));
     t.z[i] = p[i].z / p[i].w;
+    if (kAlphaMask) t.invW[i] = 1.0 / p[i].w;
   }
   // Vulkan's facing: counter-clockwise in framebuffer coordinates (y down) is front, i.e. area2 < 0 here;
   // the other way round for a mirrored instance (its draws' VK_FRONT_FACE_CLOCKWISE).
@@ -58,6 +74,8 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
     t.area2 = -t.area2;
     const ivec2 tv = v[1]; v[1] = v[2]; v[2] = tv;
     const float tz = t.z[1]; t.z[1] = t.z[2]; t.z[2] = tz;
+    const float tw = t.invW[1]; t.invW[1] = t.invW[2]; t.invW[2] = tw;
+    tri = tri.xzy;
   }
   t.v = v;
   // Pixels whose centres (x + 0.5) lie in the snapped bounding box, clipped to the image.
@@ -65,8 +83,38 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
   t.box.xy = max((lo - kOne / 2 + kOne - 1) >> RASTER_SUBPIXEL_BITS, ivec2(0));
   t.box.zw = min((hi - kOne / 2) >> RASTER_SUBPIXEL_BITS, ivec2(pc.width, pc.height) - 1);
   if (any(greaterThan(t.box.xy, t.box.zw))) return kSkip;
+  if (kAlphaMask && masked) {
+    const GpuMaterial m = materials[d.material];
+    if (m.textures.w != NO_TEXTURE) {
+      t.material = d.material;
+      for (int i = 0; i < 3; ++i) t.uv[i] = maskTexcoord(m, texcoords[tri[i]]);
+    }
+  }
   const ivec2 extent = t.box.zw - t.box.xy + 1;
   return uint(extent.x) * uint(extent.y) > kSharedArea ? kLarge : kSmall;
+}
+
+// Perspective-correct mask texcoords where the (unnormalised) screen-space weights are `e`.
+vec2 maskUv(Tri t, vec3 e) {
+  const vec3 q = e * t.invW;
+  return (q.x * t.uv[0] + q.y * t.uv[1] + q.z * t.uv[2]) / (q.x + q.y + q.z);
+}
+
+// The alpha test at pixel `px` (edge functions `e` at its centre), sampled at the level the hardware's
+// implicit LOD picks: the texcoords' differences to the other pixel of its 2x2 quad in x and in y (what
+// fine dFdx/dFdy give; extrapolated off the triangle as a helper invocation's are), scaled by 2^bias as
+// vis_shade.comp does, through textureGrad, so the device's own LOD formula and sampler decide the rest.
+bool cutOut(Tri t, ivec2 px, vec3 e) {
+  // The edge functions' steps per pixel in x and y (edge(a, b, p) = d.x (p.y - a.y) - d.y (p.x - a.x)).
+  const ivec2 d0 = t.v[2] - t.v[1], d1 = t.v[0] - t.v[2], d2 = t.v[1] - t.v[0];
+  const vec3 stepX = -float(kOne) * vec3(d0.y, d1.y, d2.y), stepY = float(kOne) * vec3(d0.x, d1.x, d2.x);
+  const vec2 side = vec2(1 - 2 * (px & 1));
+  const vec2 uv = maskUv(t, e);
+  const float scale = exp2(frame.params.y);
+  const vec2 gx = (maskUv(t, e + side.x * stepX) - uv) * (side.x * scale);
+  const vec2 gy = (maskUv(t, e + side.y * stepY) - uv) * (side.y * scale);
+  const GpuMaterial m = materials[t.material];
+  return maskCuts(m, textureGrad(textures[nonuniformEXT(m.textures.w)], uv, gx, gy));
 }
 
 void rasterPixel(Tri t, ivec2 px) {
@@ -79,6 +127,12 @@ void rasterPixel(Tri t, ivec2 px) {
   // the parts inside it (2CylinderEngine showed its inner parts); the differences keep them.
   const float z = t.z[0] + (float(e1) * (t.z[1] - t.z[0]) + float(e2) * (t.z[2] - t.z[0])) / float(t.area2);
   if (z < 0.0 || z > 1.0) return;  // the hardware's near and far clipping (w > 0 everywhere here)
-  atomicMin(vis[px.y * int(pc.width) + px.x], packVis(z, t.id));
+  const int i = px.y * int(pc.width) + px.x;
+  if (kAlphaMask && t.material != NO_TEXTURE) {
+    // Behind what is drawn already (depths only fall): the mask's fetch would change nothing.
+    if (z > uintBitsToFloat(uint(vis[i] >> 32))) return;
+    if (cutOut(t, px, vec3(float(e0), float(e1), float(e2)))) return;
+  }
+  atomicMin(vis[i], packVis(z, t.id));
 }
 

@@ -21,30 +21,51 @@ bool ComputeRaster::supported(const vk::Context& ctx) {
 ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), culled_(framesInFlight, false), twoPhase_(framesInFlight, false) {
   const vk::LayoutOptions push{.pushDescriptorSets = {0}};
+  vk::LayoutOptions options = push;
+  options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene.textureCount());
   clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
-  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), push, {{0, RASTER_SHARED_AREA}});
-  large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), push, {{0, RASTER_SHARED_AREA}});
+  // The alpha test in compute only where some material is masked (raster_tri.glsl's kAlphaMask).
+  const std::vector<vk::SpecializationConstant> constants{{0, RASTER_SHARED_AREA}, {1, scene.hasDraws(DrawKind::AlphaMasked)}};
+  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, constants);
+  large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), options, constants);
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader("raster_hw.vert"), vk::loadShader("raster_hw.frag")};
   d.cullMode = VK_CULL_MODE_NONE;  // the fragment stage culls by the cluster's flags
   d.depthTest = d.depthWrite = false;
-  vk::LayoutOptions options = push;
-  options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene.textureCount());
   hardware_ = vk::makeGraphicsPipeline(ctx, d, options);
-  textures_ = vk::DescriptorSets(ctx, hardware_.layout, 1);  // written by the renderer (Renderer::writeTextures)
+  // Written by the renderer (Renderer::writeTextures).
+  for (size_t i = 0; i < 3; ++i)
+    if (textured()[i]->layout.setCount() > 1) textures_[i] = vk::DescriptorSets(ctx, textured()[i]->layout, 1);
   // Every triangle at most once in the hand-off list, after its VkDrawIndirectCommand.
   uint64_t triangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
     for (const DrawItem& di : scene.draws(DrawKind(k))) triangles += uint64_t(di.primitives) * di.instanceCount;
-  hwList_ = vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
-                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryUse::Device,
-                       "raster hand-off");
+  hwList_ =
+      vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                 vk::MemoryUse::Device, "raster hand-off");
   largeList_ =
       vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                  vk::MemoryUse::Device, "raster tiles");
   cullReadback_ = vk::Buffer(ctx, 2 * sizeof(shader::CullCounts) * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryUse::Readback, "cull counts read-back");
+  handOffReadback_ =
+      vk::Buffer(ctx, 4 * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "hand-off count read-back");
+}
+
+std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster::textureSets() const {
+  std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> sets;
+  for (size_t i = 0; i < 3; ++i)
+    if (textured()[i]->layout.setCount() > 1) sets.emplace_back(&textured()[i]->layout, textures_[i].get(1));
+  return sets;
+}
+
+uint32_t ComputeRaster::handOffTriangles(uint32_t frame) const {
+  handOffReadback_.invalidate();
+  uint32_t vertices = 0;
+  std::memcpy(&vertices, static_cast<const char*>(handOffReadback_.mapped()) + 4 * frame, 4);
+  return vertices / 3;
 }
 
 std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame) const {
@@ -106,6 +127,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
       else w.buffer(b.binding, buffers[b.binding]);
     }
     w.push(cb, p);
+    for (size_t i = 0; i < 3; ++i)
+      if (&p == textured()[i] && p.layout.setCount() > 1) p.bindSet(cb, 1, textures_[i].get(1));
     p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, clusterCount, fromList, 0, 0, 0});
   };
   // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.
@@ -160,14 +183,16 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     timer.mark(cb, "cull");
   }
   if (clusterCount > 0) rasterise("raster", "raster large");
-  vk::bufferBarrier(cb, vk::kComputeWrite, kReaders);
+  vk::bufferBarrier(cb, vk::kComputeWrite, kReaders | vk::kCopyRead);
+  const VkBufferCopy handOffCount{0, 4 * VkDeviceSize(frame), 4};  // VkDrawIndirectCommand::vertexCount
+  vkCmdCopyBuffer(cb, hwList_.handle(), handOffReadback_.handle(), 1, &handOffCount);
+  vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};
   ri.layerCount = 1;
   vkCmdBeginRendering(cb, &ri);
   vk::setFullViewport(cb, extent_);
   bind(hardware_);
-  if (hardware_.layout.setCount() > 1) hardware_.bindSet(cb, 1, textures_.get(1));
   vkCmdDrawIndirect(cb, hwList_.handle(), 0, 1, sizeof(VkDrawIndirectCommand));
   vkCmdEndRendering(cb);
   timer.mark(cb, "raster hw");

@@ -2,9 +2,11 @@
 // The compute rasteriser of the visibility buffer (docs/raster.md): a clear pass, one workgroup per
 // cluster writing (depth << 32 | id) per pixel with 64-bit atomicMin, a pass over the large triangles'
 // tiles, and an indirect hardware draw of the triangles it hands off (crossing w = 0, outside the guard
-// band, alpha-masked) into the same buffer.
+// band) into the same buffer. A scene with alpha-masked materials gets the passes' variant that tests
+// the mask per pixel (docs/raster.md); others bind no texture.
 // RASTER_SHARED_AREA (raster.h, a specialization constant of both passes): the bounding-box area in pixels
 // above which a triangle is rasterised by tiles rather than by its own thread.
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -34,9 +36,8 @@ class ComputeRaster {
   void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer,
               uint32_t frame, const CullCamera& camera, bool cull);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
-  // The hand-off's texture array (set 1 of its layout), for the one writer of every texture set.
-  const vk::PipelineLayout& textureLayout() const { return hardware_.layout; }
-  VkDescriptorSet textureSet() const { return hardware_.layout.setCount() > 1 ? textures_.get(1) : VK_NULL_HANDLE; }
+  // The passes' texture arrays (set 1 of the layouts that have one), for the one writer of every texture set.
+  std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> textureSets() const;
   // The culling counts of the last completed use of `frame` (none if it did not cull).
   struct CullStats {
     uint32_t clusters = 0, early = 0, late = 0;              // listed by each phase (one pass: late)
@@ -44,17 +45,21 @@ class ComputeRaster {
     uint32_t triangles = 0;                                  // of the listed clusters, both phases
   };
   std::optional<CullStats> cullStats(uint32_t frame) const;
+  // Triangles handed to the hardware by the last completed use of `frame` (both phases).
+  uint32_t handOffTriangles(uint32_t frame) const;
 
  private:
   const vk::Context& ctx_;
   const GpuScene& scene_;
   vk::Pipeline clear_, raster_, large_, hardware_;
-  vk::DescriptorSets textures_;  // the hand-off's set 1
+  vk::DescriptorSets textures_[3];  // set 1 of textured()'s pipelines where they have one
+  std::array<const vk::Pipeline*, 3> textured() const { return {&raster_, &large_, &hardware_}; }
   vk::Buffer vis_, hwList_, largeList_;
   VkExtent2D extent_{0, 0};
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
   std::optional<DepthPyramid> pyramid_;
   vk::Buffer cullReadback_;     // per frame in flight: the early and the late CullCounts
+  vk::Buffer handOffReadback_;  // per frame in flight: the hand-off's vertex count
   std::vector<bool> culled_;    // per frame in flight: whether its last use culled
   std::vector<bool> twoPhase_;  // per frame in flight: whether that was in two phases
 };

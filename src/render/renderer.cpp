@@ -211,7 +211,7 @@ void Renderer::rebuildPipelines() {
     raster->resize(extent_);
     raster_.reset();
     raster_.emplace(std::move(*raster));
-    writeTextures(raster_->textureLayout(), raster_->textureSet());
+    for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set);
   }
 }
 
@@ -241,7 +241,8 @@ void Renderer::writeTextureSets() {
   }
   for (VisShade& v : shade_)
     if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1));
-  if (raster_) writeTextures(raster_->textureLayout(), raster_->textureSet());
+  if (raster_)
+    for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set);
   if (transparency_)
     for (const auto& [layout, set] : transparency_->textureSets()) writeTextures(*layout, set);
 }
@@ -361,7 +362,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute && !raster_) {
     raster_.emplace(ctx_, scene_, framesInFlight_);
     raster_->resize(extent_);
-    writeTextures(raster_->textureLayout(), raster_->textureSet());
+    for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set);
   }
   if (!compute) ensurePipelines(set);
   if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);

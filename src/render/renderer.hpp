@@ -124,6 +124,10 @@ class Renderer {
   std::optional<ComputeRaster::CullStats> cullStats(uint32_t frame) const {
     return raster_ ? raster_->cullStats(frame) : std::nullopt;
   }
+  // Triangles the compute rasteriser handed to the hardware in the last completed use of `frame`.
+  std::optional<uint32_t> handOffTriangles(uint32_t frame) const {
+    return raster_ ? std::optional(raster_->handOffTriangles(frame)) : std::nullopt;
+  }
 
  private:
   struct ScenePipelines {

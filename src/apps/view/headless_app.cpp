@@ -200,6 +200,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
           c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone, 100 * c->cone / n, c->occlusion,
           100 * c->occlusion / n, c->lod, c->triangles);
     }
+    if (settings.raster != render::RasterPath::Hardware)
+      if (const auto h = renderer.renderer().handOffTriangles(0)) std::printf("raster hw: %u triangles handed off\n", *h);
   }
   if (!o.screenshot.empty()) {
     render::HeadlessFrame frame =
