@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
       "rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
       "Keys in the window (the panel's Keys section; docs/viewer.md):\n";
   for (const auto& [key, what] : view::keyList()) description += "  " + std::string(key) + ": " + what + "\n";
-  description += "View 13 (albedo) has no key: --mode 13 or the panel.";
+  description += "Views 13-15 (albedo, environment diffuse, environment specular) have no key: --mode N or the panel.";
   CLI::App app{description, "rtr-view"};
   std::string camera, size = "1280x720", mips = enumName(o.mips), mosaic = "off", mtl,
                       filter = enumName(o.settings.sampler.filter);
@@ -140,8 +140,9 @@ int main(int argc, char** argv) {
                             ->capture_default_str()
                             ->check(cli::number(0, 180, true));
   app.add_option("--mode", o.settings.mode,
-                 "view mode 1-13: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, "
-                 "5 normal, 6 view dir, 7 light dir, 8 BRDF D, 9 BRDF F, 10 BRDF G, 11 diffuse, 12 specular, 13 albedo")
+                 "view mode 1-15: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, "
+                 "5 normal, 6 view dir, 7 light dir, 8 BRDF D, 9 BRDF F, 10 BRDF G, 11 diffuse, 12 specular, 13 albedo, "
+                 "14 environment diffuse, 15 environment specular (black without --env)")
       ->check(cli::integer(1, VIEW_COUNT))
       ->capture_default_str();
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(cli::integer(1, 100000));

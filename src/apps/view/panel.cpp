@@ -121,8 +121,10 @@ void setPanelTracking(bool on) { tracking = on; }
 bool panelTracking() { return tracking; }
 
 const char* modeName(int m) {
-  static const char* names[] = {"",          "shaded", "mip level", "linear depth", "depth derivatives", "normal",   "view dir",
-                                "light dir", "BRDF D", "BRDF F",    "BRDF G",       "diffuse",           "specular", "albedo"};
+  static const char* names[] = {
+      "",       "shaded", "mip level", "linear depth", "depth derivatives", "normal", "view dir",    "light dir",
+      "BRDF D", "BRDF F", "BRDF G",    "diffuse",      "specular",          "albedo", "env diffuse", "env specular"};
+  static_assert(std::size(names) == VIEW_COUNT + 1);
   return m >= 1 && m <= VIEW_COUNT ? names[m] : "?";
 }
 
