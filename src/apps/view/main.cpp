@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
       "rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
       "Keys in the window (the panel's Keys section; docs/viewer.md):\n";
   for (const auto& [key, what] : view::keyList()) description += "  " + std::string(key) + ": " + what + "\n";
-  description += "Views 13-15 (albedo, environment diffuse, environment specular) have no key: --mode N or the panel.";
+  description += "View 13 (albedo) and views 14-15 (environment diffuse, specular) have no key: --mode N or the panel.";
   CLI::App app{description, "rtr-view"};
   std::string camera, size = "1280x720", mips = enumName(o.mips), mosaic = "off", mtl,
                       filter = enumName(o.settings.sampler.filter);
