@@ -55,13 +55,18 @@ render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
   return s;
 }
 
-std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx) {
-  if (!o.env.hasEnvironment()) return nullptr;
-  auto maps = std::make_shared<const render::EnvironmentMaps>(ctx, Environment::load(o.env.settings));
-  std::fprintf(stderr, "rtr-view: environment %s prefiltered:", o.env.settings.source.c_str());
-  for (const auto& [name, ms] : maps->times()) std::fprintf(stderr, " %s %.3f ms", name.c_str(), ms);
+std::shared_ptr<const render::EnvironmentMaps> prefilterEnvironment(const Environment& env, const std::string& name,
+                                                                    const vk::Context& ctx) {
+  auto maps = std::make_shared<const render::EnvironmentMaps>(ctx, env);
+  std::fprintf(stderr, "rtr-view: environment %s prefiltered:", name.c_str());
+  for (const auto& [pass, ms] : maps->times()) std::fprintf(stderr, " %s %.3f ms", pass.c_str(), ms);
   std::fprintf(stderr, " GPU\n");
   return maps;
+}
+
+std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx) {
+  if (!o.env.hasEnvironment()) return nullptr;
+  return prefilterEnvironment(Environment::load(o.env.settings), o.env.settings.source, ctx);
 }
 
 vk::ContextOptions contextOptions(const ViewOptions& o) {
