@@ -1,9 +1,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Debug views (modes 2-12), in their own pipelines so the shaded path stays free of them. Values are
-// written so that the displayed 8-bit sRGB value is the quantity itself (the post pass encodes sRGB).
+// Debug views (modes 2-15), in their own pipelines so the shaded path stays free of them. Values are
+// written so that the displayed 8-bit sRGB value is the quantity itself (the post pass encodes sRGB),
+// except the radiances (albedo, the environment's terms), written linear like the shaded view.
 #include "material.glsl"
 #include "brdf.h"
+#include "env_light.glsl"
 
 layout(location = 0) out vec4 outColor;
 
@@ -64,6 +66,12 @@ void main() {
     c = l * 0.5 + 0.5;
   } else if (mode == VIEW_ALBEDO) {
     outColor = vec4(s.baseColor, 1.0);  // linear, like the shaded output
+    return;
+  } else if (mode == VIEW_ENV_DIFFUSE || mode == VIEW_ENV_SPECULAR) {
+    // The two terms the shaded view adds for the environment, so that they sum to its share (0 without one).
+    vec3 diffuse = vec3(0.0), specular = vec3(0.0);
+    if (HAS_ENV) envLightTerms(brdfOf(), n, v, s.baseColor, s.roughness, s.metalness, s.occlusion, diffuse, specular);
+    outColor = vec4(min(mode == VIEW_ENV_DIFFUSE ? diffuse : specular, vec3(60000.0)), 1.0);
     return;
   } else {
     BrdfTerms t = brdfTerms(brdfOf(), n, v, l, s.baseColor, s.roughness, s.metalness);

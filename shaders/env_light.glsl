@@ -18,16 +18,27 @@ vec3 envIrradiance(vec3 n) {
   return max(e, vec3(0.0));
 }
 
-// What the environment adds to a surface (before any cap): brdf.h's rules for a normal below the view
-// (diffuse kept, no specular) and a zero normal (nothing); `occlusion` (glTF's texture, 1 elsewhere)
-// scales both terms, as glTF viewers do for light from the environment.
-vec3 envLight(int brdf, vec3 n, vec3 v, vec3 baseColor, float roughness, float metalness, float occlusion) {
+// What the environment adds to a surface (before any cap), its diffuse and specular terms apart (the debug
+// views show each): brdf.h's rules for a normal below the view (diffuse kept, no specular) and a zero
+// normal (nothing); `occlusion` (glTF's texture, 1 elsewhere) scales both terms, as glTF viewers do for
+// light from the environment.
+void envLightTerms(int brdf, vec3 n, vec3 v, vec3 baseColor, float roughness, float metalness, float occlusion,
+                   out vec3 diffuse, out vec3 specular) {
+  diffuse = specular = vec3(0.0);
   const vec3 nn = brdfSafeNormal(n);
-  if (dot(nn, nn) == 0.0) return vec3(0.0);
+  if (dot(nn, nn) == 0.0) return;
   const float nv = dot(nn, v), rough = clamp(roughness, 0.0, 1.0);
   const vec3 abc = textureLod(envLut, envLutUv(brdf, clamp(nv, 0.0, 1.0), rough, frame.environment.z), 0.0).rgb;
   const vec3 pre = nv > 0.0 ? textureLod(envSpecular, reflect(-v, nn), rough * frame.environment.x).rgb : vec3(0.0);
-  return envSplitSum(brdf, envIrradiance(nn), pre, abc, baseColor, metalness) * occlusion;
+  // envSplitSum is linear in the irradiance and the prefiltered radiance: each term alone.
+  diffuse = envSplitSum(brdf, envIrradiance(nn), vec3(0.0), abc, baseColor, metalness) * occlusion;
+  specular = envSplitSum(brdf, vec3(0.0), pre, abc, baseColor, metalness) * occlusion;
+}
+
+vec3 envLight(int brdf, vec3 n, vec3 v, vec3 baseColor, float roughness, float metalness, float occlusion) {
+  vec3 diffuse, specular;
+  envLightTerms(brdf, n, v, baseColor, roughness, metalness, occlusion, diffuse, specular);
+  return diffuse + specular;
 }
 
 // The backdrop towards world direction d (any length), as frame.environment.y says; or the colour.

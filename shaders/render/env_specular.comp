@@ -1,5 +1,6 @@
 #version 460
-// Environment, step 3: one level of the GGX-prefiltered specular cube (split sum, with n = v = r): the
+// Environment, step 3: one level of the GGX-prefiltered specular cube (split sum, with n = v = r) whose
+// lobe is narrow (env_specular_sum.comp sums the wide ones over a small source level instead): the
 // radiance around each texel's direction weighted by the lobe of the level's roughness and n.l, from
 // half vectors drawn from D. Each sample reads the source cube at the mip whose texels cover about the
 // solid angle the sample stands for (filtered importance sampling), so a bright texel cannot show up as

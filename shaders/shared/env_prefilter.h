@@ -125,10 +125,12 @@ struct EnvPush {
   uint srcWidth;    // to the cube: the equirectangular map's size
   uint srcHeight;
   uint srcLevels;   // specular: mip levels of the source cube
-  uint level;       // spherical harmonics: the source level read
-  uint pad0, pad1, pad2;
+  uint level;       // spherical harmonics and the specular sum: the source level read
+  uint srcSize;     // specular sum: that level's face size
+  uint pad0, pad1;
 };
 #define ENV_GROUP 8
+#define ENV_SUM_SLICES 4  // env_specular_sum.comp: threads per output texel
 
 #ifdef __cplusplus
 }  // namespace rtr::shader

@@ -27,7 +27,9 @@ typedef uint32_t uint;
 #define VIEW_DIFFUSE 11
 #define VIEW_SPECULAR 12
 #define VIEW_ALBEDO 13      // unlit base colour: plain textured rasterisation, the speed baseline
-#define VIEW_COUNT 13
+#define VIEW_ENV_DIFFUSE 14   // the environment's diffuse term alone (env_light.glsl; black without one)
+#define VIEW_ENV_SPECULAR 15  // the environment's specular term alone
+#define VIEW_COUNT 15
 
 // Per-frame constants (uniform buffer, std140).
 struct FrameUniforms {

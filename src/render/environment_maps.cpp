@@ -17,9 +17,17 @@ namespace {
 
 constexpr VkFormat kSourceFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-constexpr uint32_t kShMaxFace = 64;  // the spherical harmonics read the first source level this small
+constexpr uint32_t kShMaxFace = 32;  // the spherical harmonics read the first source level this small
+constexpr uint32_t kSumFace = 16;    // env_specular_sum.comp reads the source level of faces this size
 
-uint32_t groups(uint32_t n) { return (n + ENV_GROUP - 1) / ENV_GROUP; }
+// Whether the specular level of `roughness` is summed over the source level of kSumFace faces rather than
+// importance-sampled: where GGX's reflected lobe (half its peak at about 1.29 alpha radians from the
+// centre) is at least two of that level's texels (2 / kSumFace radians at a face's centre) wide. Narrower
+// lobes would need finer levels, whose sums cost the square of their texel count.
+bool summed(float roughness) {
+  const float alpha = std::max(roughness * roughness, shader::BRDF_ALPHA_MIN);
+  return 1.29f * alpha >= 2.0f * 2.0f / float(kSumFace);
+}
 
 void checkDevice(const vk::Context& ctx) {
   VkFormatProperties p;
@@ -88,6 +96,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
   const vk::Pipeline toCube = vk::makeComputePipeline(ctx, vk::loadShader("env_to_cube.comp"), push);
   const vk::Pipeline down = vk::makeComputePipeline(ctx, vk::loadShader("env_cube_down.comp"), push);
   const vk::Pipeline spec = vk::makeComputePipeline(ctx, vk::loadShader("env_specular.comp"), push);
+  const vk::Pipeline specSum = vk::makeComputePipeline(ctx, vk::loadShader("env_specular_sum.comp"), push);
   const vk::Pipeline shPass = vk::makeComputePipeline(ctx, vk::loadShader("env_sh.comp"), push);
   const vk::Pipeline lut = vk::makeComputePipeline(ctx, vk::loadShader("env_brdf_lut.comp"), push);
 
@@ -122,7 +131,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
         .image(1, sourceLevelViews[0], VK_IMAGE_LAYOUT_GENERAL)
         .push(cb, toCube);
     toCube.push(cb, pc);
-    vkCmdDispatch(cb, groups(pc.size), groups(pc.size), 6);
+    toCube.dispatch(cb, pc.size, pc.size, 6);
     timer.mark(cb, "env cube");
 
     down.bind(cb);
@@ -134,28 +143,34 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
           .image(1, sourceLevelViews[l], VK_IMAGE_LAYOUT_GENERAL)
           .push(cb, down);
       down.push(cb, pc);
-      vkCmdDispatch(cb, groups(pc.size), groups(pc.size), 6);
+      down.dispatch(cb, pc.size, pc.size, 6);
     }
     timer.mark(cb, "env mips");
 
     vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kCompute},
                      {specular_.tracked(), vk::Use::Storage, kCompute, true},
                      {lut_.tracked(), vk::Use::Storage, kCompute, true}});
-    spec.bind(cb);
     pc.srcLevels = sourceLevels;
     pc.srcTexelSolidAngle = 4.0f * shader::BRDF_PI / (6.0f * float(s.sourceSize) * float(s.sourceSize));
     for (uint32_t l = 0; l < s.specularLevels; ++l) {
       pc.size = s.specularSize >> l;
       pc.roughness = float(l) / float(s.specularLevels - 1);
-      // Roughness 0's lobe is narrower than its texel: one sample. Rougher levels have 4 times fewer
-      // texels each and wider lobes over a bright sun: twice the samples of the level before.
-      pc.samples = l == 0 ? 1u : s.samples << (l - 1);
-      vk::DescriptorWriter(ctx, spec.layout, 0, VK_NULL_HANDLE)
-          .image(0, sourceCube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler_)
-          .image(1, specularLevelViews[l], VK_IMAGE_LAYOUT_GENERAL)
-          .push(cb, spec);
-      spec.push(cb, pc);
-      vkCmdDispatch(cb, groups(pc.size), groups(pc.size), 6);
+      pc.srcSize = summed(pc.roughness) ? kSumFace : 0;  // the source is at least 32² a face
+      const vk::Pipeline& p = pc.srcSize ? specSum : spec;
+      p.bind(cb);
+      vk::DescriptorWriter w(ctx, p.layout, 0, VK_NULL_HANDLE);
+      if (pc.srcSize) {  // a wide lobe: summed over a small source level
+        pc.level = uint32_t(std::countr_zero(s.sourceSize / pc.srcSize));
+        w.image(0, sourceFaces, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      } else {
+        // Roughness 0's lobe is narrower than its texel: one sample. Other narrow lobes: half vectors
+        // drawn from D, twice as many each level down (4 times fewer texels, wider lobes).
+        pc.samples = l == 0 ? 1u : s.samples << (l - 1);
+        w.image(0, sourceCube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler_);
+      }
+      w.image(1, specularLevelViews[l], VK_IMAGE_LAYOUT_GENERAL).push(cb, p);
+      p.push(cb, pc);
+      p.dispatch(cb, pc.size, pc.size, pc.srcSize ? 6 * ENV_SUM_SLICES : 6);  // the sum: slices of a texel in z
     }
     timer.mark(cb, "env specular");
 
@@ -168,7 +183,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
         .buffer(1, sh_.handle())
         .push(cb, shPass);
     shPass.push(cb, pc);
-    vkCmdDispatch(cb, 1, 1, 1);
+    vkCmdDispatch(cb, 1, 1, 1);  // one workgroup: a fixed order of sums
     timer.mark(cb, "env sh");
 
     pc.size = s.lutSize;
@@ -176,7 +191,7 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     lut.bind(cb);
     vk::DescriptorWriter(ctx, lut.layout, 0, VK_NULL_HANDLE).image(0, lut_.view(), VK_IMAGE_LAYOUT_GENERAL).push(cb, lut);
     lut.push(cb, pc);
-    vkCmdDispatch(cb, groups(pc.size), groups(2 * pc.size), 1);
+    lut.dispatch(cb, pc.size, 2 * pc.size);
     timer.mark(cb, "env lut");
 
     // Ready for shading in compute or fragment shaders.

@@ -131,7 +131,7 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
                  : makePipeline(kSceneVert, kFrag[set], kColorFormat, info.cull,
                                 {{VARIANT_TEXCOORDS, info.textured},
                                  {VARIANT_ALPHA_MASK, info.alphaMasked},
-                                 {VARIANT_ENV, set == kShaded && env_ != nullptr}});
+                                 {VARIANT_ENV, set != kVisibility && env_ != nullptr}});
     });
   }
   vk::inParallel(jobs);
@@ -157,6 +157,7 @@ void Renderer::setEnvironment(std::shared_ptr<const EnvironmentMaps> env) {
   VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
   env_ = std::move(env);
   pipelines_[kShaded].reset();
+  pipelines_[kDebug].reset();  // the environment's views
   shade_ = {};
   backdrop_.reset();
   if (transparency_) {  // blended surfaces are lit by the environment too

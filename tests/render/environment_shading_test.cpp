@@ -1,7 +1,8 @@
 // Light from an environment in the shading passes (forward and visibility): the white furnace (a white
 // sphere in uniform radiance 1 reflects at most all of it, and what the split sum says at normal
 // incidence), a sun 10^5 times brighter than the sky (finite, no fireflies), no environment is the image of
-// before, and environment light shows a black model. Lavapipe with validation: any message fails.
+// before, environment light shows a black model, and the debug views of its two terms sum to it. Lavapipe
+// with validation: any message fails.
 #include <cmath>
 #include <cstdio>
 
@@ -327,6 +328,61 @@ TEST_F(EnvironmentShadingTest, EnvironmentLightsABlackModel) {
     EXPECT_GT(model, dark.pixels.size() / 20);
     EXPECT_EQ(litModel, model);
   }
+}
+
+// The environment's debug views (modes 14, 15) are the two terms the shaded view adds for it: they sum to
+// the shaded image lit by the environment alone, the metals have no diffuse, both scale with the
+// environment's intensity, and without an environment both are black (forward path: the debug views').
+TEST_F(EnvironmentShadingTest, EnvironmentViewsAreTheShadedViewsTerms) {
+  const Scene scene = sphereGrid(glm::vec3(0.8f, 0.5f, 0.3f));
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  render::HeadlessRenderer r(*ctx, gpu, kE);
+  const View v = gridView(scene);
+  const Path forward = paths()[0];
+  const auto render = [&](int mode) {
+    render::RenderSettings s = envSettings(forward, BRDF_GGX);
+    s.mode = mode;
+    return r.render(v.pose, v.lens, s, 1, true).sceneColor;
+  };
+  size_t black = 0;
+  for (int mode : {VIEW_ENV_DIFFUSE, VIEW_ENV_SPECULAR})
+    for (const glm::vec4& px : render(mode).pixels) {
+      if (!covered(px)) continue;
+      ++black;
+      ASSERT_EQ(glm::vec3(px), glm::vec3(0.0f)) << "mode " << mode << " without an environment";
+    }
+  EXPECT_GT(black, 2 * kE.width * kE.height / 20);
+  std::vector<ImageF> diffuse, specular;
+  for (float intensity : {1.0f, 2.0f}) {
+    r.renderer().setEnvironment(std::make_shared<const render::EnvironmentMaps>(*ctx, Environment(sunMap(), intensity, 0.0f)));
+    diffuse.push_back(render(VIEW_ENV_DIFFUSE));
+    specular.push_back(render(VIEW_ENV_SPECULAR));
+    const ImageF shaded = render(VIEW_SHADED);
+    size_t n = 0, metal = 0;
+    for (uint32_t y = 0; y < kE.height; ++y)
+      for (uint32_t x = 0; x < kE.width; ++x) {
+        const glm::vec4 s = shaded.at(x, y), d = diffuse.back().at(x, y), p = specular.back().at(x, y);
+        if (!covered(s)) continue;
+        ++n;
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(d[c] + p[c], s[c], 2e-3f * std::max(1.0f, s[c])) << x << "," << y;
+        const Hit h = hitOf(v, x, y);
+        if (h.sphere >= kCols && h.nv > 0.15f) {  // the metal row, off the silhouette
+          ++metal;
+          EXPECT_EQ(d.g, 0.0f) << x << "," << y;
+          EXPECT_GT(p.g, 0.0f) << x << "," << y;
+        }
+      }
+    EXPECT_GT(n, kE.width * kE.height / 20);
+    EXPECT_GT(metal, n / 4);
+  }
+  size_t scaled = 0;
+  for (size_t i = 0; i < diffuse[0].pixels.size(); ++i) {
+    if (!covered(diffuse[0].pixels[i])) continue;
+    EXPECT_NEAR(diffuse[1].pixels[i].g, 2.0f * diffuse[0].pixels[i].g, 2e-3f * std::max(1.0f, diffuse[1].pixels[i].g));
+    EXPECT_NEAR(specular[1].pixels[i].g, 2.0f * specular[0].pixels[i].g, 2e-3f * std::max(1.0f, specular[1].pixels[i].g));
+    scaled += diffuse[0].pixels[i].g > 0.01f;
+  }
+  EXPECT_GT(scaled, kE.width * kE.height / 40);  // the dielectrics' diffuse
 }
 
 }  // namespace

@@ -59,7 +59,7 @@ def main():
                                   timeout=30).stdout.strip()
 
         viewer = Viewer([viewer_bin, scene, "--validation", "--orbit", "--timings", "--size", f"{SIZE[0]}x{SIZE[1]}",
-                         "--test-ui", "--test-drop", drop_file, second], env)
+                         "--test-ui", "--test-drop", drop_file, "--env", "sky", second], env)
         viewer.wait_line("err", r"move speed")
         # The textures load while frames go on (the materials show their factors meanwhile): every frame this
         # test compares comes after they are in.
@@ -343,6 +343,47 @@ def main():
         xdo("key", "Right")
         viewer.wait_line("err", r"rtr-view: loaded .*second\.obj", start=n_err)
         check(True, "Right loads the next file of the command line")
+
+        # The environment's controls (--env sky): the rotation slider prefilters the environment again when let go
+        # and turns what the view shows; the background blur changes the backdrop without prefiltering again.
+        def drag_slider(widget, fraction):
+            x0, y0, x1, y1 = latest_rect(widget)
+            xdo("mousemove", "--window", win, (x0 + x1) // 2, (y0 + y1) // 2)
+            time.sleep(0.3)
+            xdo("mousedown", "1")
+            time.sleep(0.3)
+            for i in range(1, 6):
+                xdo("mousemove", "--window", win, (x0 + x1) // 2 + int(i * fraction * (x1 - x0) / 5), (y0 + y1) // 2)
+                time.sleep(0.15)
+            xdo("mouseup", "1")
+
+        xdo("key", "1")
+        xdo("key", "F1")
+        wait_title("| shaded |")
+        panel_now = latest_rect("panel")
+        xdo("mousemove", "--window", win, (panel_now[0] + panel_now[2]) // 2, SIZE[1] // 2)
+        for _ in range(30):  # one notch at a time, until the section's header is near the top
+            if latest_rect("environment")[1] < 120:
+                break
+            xdo("click", "5")
+            time.sleep(0.4)
+        click("environment")
+        check(latest_rect("env-blur")[3] <= SIZE[1], f"the environment section opens in view ({latest_rect('env-blur')})")
+        right = latest_rect("panel")[2] + 20
+        settle()
+        unturned = screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1])
+        n_err = len(viewer.lines("err"))
+        drag_slider("env-rotation", 0.4)
+        viewer.wait_line("err", r"rtr-view: environment sky prefiltered", start=n_err)
+        settle(2.0)
+        turned = screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1])
+        check(turned != unturned, "the rotation slider, let go, prefilters the environment again and turns the view")
+        n_err = len(viewer.lines("err"))
+        drag_slider("env-blur", 0.4)
+        settle(2.0)
+        check(screen_pixels(fbdir, right, 0, SIZE[0], SIZE[1]) != turned, "the blur slider blurs the backdrop")
+        check(not any("prefiltered" in line for line in viewer.lines("err")[n_err:]),
+              "the blur needs no new prefiltering")
     except Fail as e:
         print("FAIL:", e, flush=True)
         return finish(viewer, xvfb, ok=False, t0=t0, xdo=None)

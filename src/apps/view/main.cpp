@@ -56,13 +56,18 @@ render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene) {
   return s;
 }
 
-std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx) {
-  if (!o.env.hasEnvironment()) return nullptr;
-  auto maps = std::make_shared<const render::EnvironmentMaps>(ctx, Environment::load(o.env.settings));
-  std::fprintf(stderr, "rtr-view: environment %s prefiltered:", o.env.settings.source.c_str());
-  for (const auto& [name, ms] : maps->times()) std::fprintf(stderr, " %s %.3f ms", name.c_str(), ms);
+std::shared_ptr<const render::EnvironmentMaps> prefilterEnvironment(const Environment& env, const std::string& name,
+                                                                    const vk::Context& ctx) {
+  auto maps = std::make_shared<const render::EnvironmentMaps>(ctx, env);
+  std::fprintf(stderr, "rtr-view: environment %s prefiltered:", name.c_str());
+  for (const auto& [pass, ms] : maps->times()) std::fprintf(stderr, " %s %.3f ms", pass.c_str(), ms);
   std::fprintf(stderr, " GPU\n");
   return maps;
+}
+
+std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx) {
+  if (!o.env.hasEnvironment()) return nullptr;
+  return prefilterEnvironment(Environment::load(o.env.settings), o.env.settings.source, ctx);
 }
 
 vk::ContextOptions contextOptions(const ViewOptions& o) {
@@ -119,7 +124,7 @@ int main(int argc, char** argv) {
       "rtr-view: real-time Vulkan viewer (PBR, alpha masking, compute mosaic, debug views).\n"
       "Keys in the window (the panel's Keys section; docs/viewer.md):\n";
   for (const auto& [key, what] : view::keyList()) description += "  " + std::string(key) + ": " + what + "\n";
-  description += "View 13 (albedo) has no key: --mode 13 or the panel.";
+  description += "View 13 (albedo) and views 14-15 (environment diffuse, specular) have no key: --mode N or the panel.";
   CLI::App app{description, "rtr-view"};
   std::string camera, size = "1280x720", mips = enumName(o.mips), mosaic = "off", mtl,
                       filter = enumName(o.settings.sampler.filter);
@@ -141,8 +146,9 @@ int main(int argc, char** argv) {
                             ->capture_default_str()
                             ->check(cli::number(0, 180, true));
   app.add_option("--mode", o.settings.mode,
-                 "view mode 1-13: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, "
-                 "5 normal, 6 view dir, 7 light dir, 8 BRDF D, 9 BRDF F, 10 BRDF G, 11 diffuse, 12 specular, 13 albedo")
+                 "view mode 1-15: 1 shaded, 2 mip level, 3 linear depth, 4 depth derivatives, "
+                 "5 normal, 6 view dir, 7 light dir, 8 BRDF D, 9 BRDF F, 10 BRDF G, 11 diffuse, 12 specular, 13 albedo, "
+                 "14 environment diffuse, 15 environment specular (black without --env)")
       ->check(cli::integer(1, VIEW_COUNT))
       ->capture_default_str();
   app.add_option("--frames", o.frames, "frames to render before the screenshot")->check(cli::integer(1, 100000));

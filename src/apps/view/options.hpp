@@ -85,6 +85,9 @@ DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx);
 // The environment's maps (--env), prefiltered on `ctx`'s device, their build times said on stderr; null
 // for --env none.
 std::shared_ptr<const render::EnvironmentMaps> loadEnvironment(const ViewOptions& o, const vk::Context& ctx);
+// `env` prefiltered, its build times said on stderr under `name`.
+std::shared_ptr<const render::EnvironmentMaps> prefilterEnvironment(const Environment& env, const std::string& name,
+                                                                    const vk::Context& ctx);
 
 int runHeadless(const ViewOptions& o);
 int runWindowed(const ViewOptions& o);

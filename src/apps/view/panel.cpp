@@ -35,6 +35,23 @@ bool radio(const char* label, Enum& value, Enum option) {
   return changed;
 }
 
+// Intensity and rotation take effect when the slider is let go: each change prefilters the environment
+// again (milliseconds on a GPU, seconds on lavapipe). The blur is a setting of every frame.
+void environmentSection(ViewState& s) {
+  ImGui::SliderFloat("intensity", &s.envIntensity, 0.0f, 100.0f, "%.3g", ImGuiSliderFlags_Logarithmic);
+  s.envChanged |= ImGui::IsItemDeactivatedAfterEdit();
+  track("env-intensity");
+  ImGui::SliderFloat("rotation", &s.envRotationDeg, -180.0f, 180.0f, "%.0f deg");
+  s.envChanged |= ImGui::IsItemDeactivatedAfterEdit();
+  track("env-rotation");
+  if (s.settings.backdropBlur >= 0.0f) {
+    ImGui::SliderFloat("background blur", &s.settings.backdropBlur, 0.0f, 1.0f, "%.2f");
+    track("env-blur");
+  } else {
+    ImGui::TextDisabled("background: the --background colour");
+  }
+}
+
 void graph(const char* label, const std::deque<float>& values) {
   if (values.empty()) return;
   std::vector<float> v(values.begin(), values.end()), sorted = v;
@@ -121,8 +138,10 @@ void setPanelTracking(bool on) { tracking = on; }
 bool panelTracking() { return tracking; }
 
 const char* modeName(int m) {
-  static const char* names[] = {"",          "shaded", "mip level", "linear depth", "depth derivatives", "normal",   "view dir",
-                                "light dir", "BRDF D", "BRDF F",    "BRDF G",       "diffuse",           "specular", "albedo"};
+  static const char* names[] = {
+      "",       "shaded", "mip level", "linear depth", "depth derivatives", "normal", "view dir",    "light dir",
+      "BRDF D", "BRDF F", "BRDF G",    "diffuse",      "specular",          "albedo", "env diffuse", "env specular"};
+  static_assert(std::size(names) == VIEW_COUNT + 1);
   return m >= 1 && m <= VIEW_COUNT ? names[m] : "?";
 }
 
@@ -222,6 +241,11 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     ImGui::Text("shading path: %s", enumName(s.settings.shading));
   }
   if (ImGui::CollapsingHeader("Lights")) lightsSection(s);
+  if (s.hasEnvironment) {
+    const bool open = ImGui::CollapsingHeader("Environment");
+    track("environment");
+    if (open) environmentSection(s);
+  }
   if (ImGui::CollapsingHeader("Camera")) cameraSection(s);
   if (ImGui::CollapsingHeader("Ray tracer")) tracerSection(s, facts);
   if (ImGui::CollapsingHeader("Scene")) {

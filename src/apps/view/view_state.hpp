@@ -28,6 +28,10 @@ struct ViewState {
   // Ray tracer (the course framework's toggles, docs/formats.md, on keys that do not clash with the view modes).
   trace::Shading traceShading = trace::Shading::Phong;
   bool traceShadows = true, traceReflections = true, traceOrtho = false;
+  // The environment's controls (the panel; the backdrop's blur is settings.backdropBlur): the render loop
+  // prefilters the environment again (Renderer::setEnvironment) when a slider is let go (envChanged).
+  bool hasEnvironment = false, envChanged = false;
+  float envIntensity = 1.0f, envRotationDeg = 0.0f;
   std::string message;  // the last load / screenshot outcome, shown in the panel
   bool messageIsError = false;
 };

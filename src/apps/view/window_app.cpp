@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <memory>
 
+#include <glm/trigonometric.hpp>
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 
@@ -103,7 +104,22 @@ int runWindowed(const ViewOptions& opts) {
                  [dropped](const std::string& path) { return loadForView(dropped, path); });
   slot.setTextureCache(textureCache.get());
   slot.build({o.width, o.height}, app.mips);
-  slot.setEnvironment(loadEnvironment(o, ctx));
+  // The environment as loaded, at intensity 1 and not turned: the panel's controls prefilter it again from this.
+  ImageF envRadiance;
+  const auto environment = [&] {
+    const Environment env(envRadiance, app.envIntensity, glm::radians(app.envRotationDeg));
+    return prefilterEnvironment(env, o.env.settings.source, ctx);
+  };
+  if (o.env.hasEnvironment()) {
+    EnvironmentSettings plain = o.env.settings;
+    plain.intensity = 1.0f;
+    plain.rotationDeg = 0.0f;
+    envRadiance = Environment::load(plain).map();
+    app.hasEnvironment = true;
+    app.envIntensity = o.env.settings.intensity;
+    app.envRotationDeg = o.env.settings.rotationDeg;
+    slot.setEnvironment(environment());
+  }
   clock.phase(waitTextures ? "scene to the GPU (geometry, textures, mips), swapchain" : "geometry to the GPU, swapchain");
 
   ShaderReload shaders(o.watch);
@@ -120,6 +136,14 @@ int runWindowed(const ViewOptions& opts) {
     last = now;
     if (!shown) continue;
     if (slot.update(app)) startScene(app, o, slot.scene());
+    if (std::exchange(app.envChanged, false)) {
+      try {
+        slot.setEnvironment(environment());
+      } catch (const Error& e) {  // the environment of before stays
+        app.message = e.what();
+        app.messageIsError = true;
+      }
+    }
     if (std::exchange(app.resized, false)) slot.frames().markStale();
     cpuFrameMs = 0.9 * cpuFrameMs + 0.1 * dt * 1000.0;
     app.camera.update(dt);
