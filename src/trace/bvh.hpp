@@ -112,10 +112,11 @@ class Bvh {
   static constexpr int kPacketLeafRays = 5;
   static void setPacketLeafRays(int n);
   // A packet with this many live rays or fewer walks on as single rays, two at a time: two interleaved
-  // single walks beat a packet of few live lanes once its rays have parted (docs/bench/trace.md, rounds
-  // 10-12). Per kind: closest hit coherent, closest hit scattered, any hit (shadow rays to one light).
-  // For tests and benchmarks: setPacketAloneRays.
-  static constexpr int kPacketAloneRays[3] = {4, 4, 4};
+  // single walks beat a packet of few live lanes once its rays have parted. Per kind: closest hit
+  // coherent (a view's rays stay together: only a last ray walks alone), closest hit scattered, any hit
+  // (shadow rays to one light); from the 16-core host's runs of rounds 10-11 (docs/bench/trace.md,
+  // round 12). For tests and benchmarks: setPacketAloneRays.
+  static constexpr int kPacketAloneRays[3] = {1, 4, 4};
   static void setPacketAloneRays(int coherent, int scattered, int shadow);
   // Counting (tests and benchmarks): while on, every query of this process runs the counting traversal
   // (the AVX2 code, slower; no counting on a CPU without AVX2) and adds to its thread's counters.
