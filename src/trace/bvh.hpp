@@ -69,6 +69,11 @@ class HugeArray {
 // runs the AVX2 code with 32 vector registers instead of 16 (no spills in the traversal loop).
 enum class BvhIsa { Sse, Avx2, Avx512 };
 
+// What a closest-hit packet's rays are: a view's rays (neighbours stay together down to the leaves) or
+// scattered secondary rays (reflections: they part after a few nodes). It chooses when the packet's last
+// live rays walk on as single rays (Bvh::kPacketAloneRays); the results are the same either way.
+enum class PacketKind { Coherent, Scattered };
+
 class Bvh {
  public:
   static constexpr uint32_t kLeafBit = 0x80000000u;
@@ -96,7 +101,8 @@ class Bvh {
   // exactly its single-ray result: the boxes are tested for all rays at once, the leaves too or ray by ray, and
   // a ray left alone in a subtree walks on as a single ray (bvh_packet.inl). Rays that run parallel to
   // different axes, or another method than Watertight, go one at a time. n > 8 is taken as 8.
-  void closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method = IntersectMethod::Watertight) const;
+  void closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method = IntersectMethod::Watertight,
+                PacketKind kind = PacketKind::Coherent) const;
   // Bit i set: ray i is occluded.
   unsigned occluded8(const Ray* rays, int n, IntersectMethod method = IntersectMethod::Watertight) const;
 
@@ -105,6 +111,13 @@ class Bvh {
   // (lanes = triangles). For tests and benchmarks: setPacketLeafRays(9) = always ray by ray.
   static constexpr int kPacketLeafRays = 5;
   static void setPacketLeafRays(int n);
+  // A packet with this many live rays or fewer walks on as single rays, two at a time: two interleaved
+  // single walks beat a packet of few live lanes once its rays have parted. Per kind: closest hit
+  // coherent (a view's rays stay together: only a last ray walks alone), closest hit scattered, any hit
+  // (shadow rays to one light); from the 16-core host's runs of rounds 10-11 (docs/bench/trace.md,
+  // round 12). For tests and benchmarks: setPacketAloneRays.
+  static constexpr int kPacketAloneRays[3] = {1, 4, 4};
+  static void setPacketAloneRays(int coherent, int scattered, int shadow);
   // Counting (tests and benchmarks): while on, every query of this process runs the counting traversal
   // (the AVX2 code, slower; no counting on a CPU without AVX2) and adds to its thread's counters.
   static void setCounting(bool on);

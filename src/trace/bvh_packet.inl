@@ -71,12 +71,6 @@ RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
 }
 
 constexpr float kTieWindow = 0x1p-10f;
-// A packet with this many live rays or fewer walks on as single rays, two at a time (alonePair): two
-// interleaved single walks beat a packet of few live lanes. Shadow and mirror packets lose their
-// coherence on the temple (shadow: 63 % of lanes live at box tests, 93 % with this, +9-14 %, round 10;
-// mirror: 68 → 93 %, box passes a ray 5.18 → 4.23, round 11 of docs/bench/trace.md).
-constexpr int kAloneRays = 4;
-
 struct PacketEntry {
   F tNear;  // per ray; a ray whose entry is beyond its cull distance when popped drops out
   uint32_t ref, mask;
@@ -103,7 +97,7 @@ struct PacketWalker {
   F shO[3], shS[3];
   int kx = 0, ky = 0, kz = 0;
   bool sameShear = true, sheared = false;
-  const int nRays, leafRays;
+  const int nRays, leafRays, aloneRays;  // aloneRays: Bvh::kPacketAloneRays
 #if RTR_BVH_AVX2
   // The packet's interval: per axis, bounds over its rays of the slab constants, for one conservative
   // test of a node's eight children at once (lanes = children) before each child is tested against the
@@ -129,8 +123,8 @@ struct PacketWalker {
   }
 
   RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, const PacketRays& pr, Hit* h, IntersectMethod m,
-                          int minLeafRays)
-      : bvh(view), rays(r), hits(h), nRays(n), leafRays(minLeafRays), method(m) {
+                          int minLeafRays, int maxAloneRays)
+      : bvh(view), rays(r), hits(h), nRays(n), leafRays(minLeafRays), aloneRays(maxAloneRays), method(m) {
     store(tMax, pr.tMax);
     store(cull, pr.tMax);
     store(best, set1(kInf));
@@ -556,7 +550,7 @@ struct PacketWalker {
     unsigned done = 0;  // any hit: the rays already occluded
     for (;;) {
       for (;;) {
-        if (__builtin_popcount(active) <= kAloneRays) {  // too few rays to share the work
+        if (__builtin_popcount(active) <= aloneRays) {  // too few rays to share the work
           while (active) {
             const int i = ctz(active);
             active &= active - 1;
@@ -613,9 +607,9 @@ struct PacketWalker {
 
 template <bool AnyHit, unsigned Parallel>
 unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, const PacketRays& pr, IntersectMethod method, Hit* hits,
-                    int leafRays) {
+                    int leafRays, int aloneRays) {
   RTR_COUNT(c.packets += 1);
-  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays);
+  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays, aloneRays);
   return p.run((1u << n) - 1);
 }
 

@@ -24,40 +24,48 @@ std::vector<Triangle> trianglesOf(const Mesh& m, glm::vec3 offset = glm::vec3(0.
 }
 
 // Every group of `width` consecutive rays as one packet against each ray alone, on every ISA, with leaves
-// tested all rays at once wherever two or more rays reach them, and always ray by ray; returns the
-// number of hits (of the last pass) so callers can check the case is not vacuous.
+// tested all rays at once wherever two or more rays reach them, and always ray by ray, closest hit as
+// coherent and as scattered rays, with hand-offs to single rays from 0 (never) to 8 (at once) live rays;
+// returns the number of hits (of the last pass) so callers can check the case is not vacuous.
 size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, int width = 8, const char* what = "") {
   size_t hits = 0;
   for (int pass = 0; pass < 6; ++pass) {
     const BvhIsa isa = pass % 3 == 0 ? BvhIsa::Avx512 : pass % 3 == 1 ? BvhIsa::Avx2 : BvhIsa::Sse;
     const int leafRays = pass < 3 ? 2 : 9;
+    constexpr int kAlone[6][3] = {{4, 4, 4}, {1, 6, 2}, {0, 8, 4}, {8, 1, 0}, {2, 0, 8}, {6, 3, 1}};
     Bvh::setIsa(isa);
     Bvh::setPacketLeafRays(leafRays);
+    Bvh::setPacketAloneRays(kAlone[pass][0], kAlone[pass][1], kAlone[pass][2]);
     hits = 0;
     for (size_t i = 0; i < rays.size(); i += width) {
       const int n = int(std::min<size_t>(width, rays.size() - i));
-      Hit h[8];
+      Hit h[8], hs[8];
       bvh.closest8(&rays[i], n, h);
+      bvh.closest8(&rays[i], n, hs, IntersectMethod::Watertight, PacketKind::Scattered);
       const unsigned occ = bvh.occluded8(&rays[i], n);
       for (int k = 0; k < n; ++k) {
         const Hit one = bvh.closest(rays[i + k]);
         const bool occ1 = bvh.occluded(rays[i + k]);
-        if (h[k].prim != one.prim || h[k].t != one.t || h[k].b1 != one.b1 || h[k].b2 != one.b2 || (occ >> k & 1) != occ1) {
+        const bool same = std::memcmp(&h[k], &one, sizeof one) == 0 && std::memcmp(&hs[k], &one, sizeof one) == 0;
+        if (!same || (occ >> k & 1) != occ1) {
           ADD_FAILURE() << what << " " << Bvh::isaName(isa)
-                        << (leafRays == 2 ? ", leaves all rays at once" : ", leaves ray by ray") << ", ray " << i + k
+                        << (leafRays == 2 ? ", leaves all rays at once" : ", leaves ray by ray") << ", alone from "
+                        << kAlone[pass][0] << "/" << kAlone[pass][1] << "/" << kAlone[pass][2] << ", ray " << i + k
                         << " of a packet of " << n << ": triangle " << h[k].prim << " t " << h[k].t << " b " << h[k].b1 << " "
-                        << h[k].b2 << " occluded " << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b "
-                        << one.b1 << " " << one.b2 << " occluded " << occ1;
-          Bvh::setIsa(BvhIsa::Avx512);
-          Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
-          return 0;
+                        << h[k].b2 << " (scattered: triangle " << hs[k].prim << " t " << hs[k].t << ") occluded "
+                        << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b " << one.b1 << " " << one.b2
+                        << " occluded " << occ1;
+          break;
         }
         hits += one.hit();
       }
+      if (::testing::Test::HasFailure()) break;
     }
+    if (::testing::Test::HasFailure()) break;
   }
   Bvh::setIsa(BvhIsa::Avx512);
   Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
+  Bvh::setPacketAloneRays(Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]);
   return hits;
 }
 
@@ -249,6 +257,36 @@ TEST(Packets, CountersCountTheWorkAndChangeNoResult) {
   EXPECT_EQ(p.packetLeafRays, 8 * p.packetLeaves);
   EXPECT_EQ(p.lone, 0u);
   EXPECT_EQ(p.packetTriangles + p.triangles, 8 * one.triangles) << "each ray tests what it tests alone";
+}
+
+// Each kind of packet hands off at its own threshold: eight copies of one ray stay a packet to the end
+// with a threshold of 0, and walk alone from the root with 8.
+TEST(Packets, HandOffFollowsTheKindOfRays) {
+  const Mesh sphere = uvSphere({0.0f, 0.0f, 0.0f}, 1.0f, 48, 96);
+  const Bvh bvh(trianglesOf(sphere), {}, 1);
+  Ray rays[8];
+  for (Ray& r : rays) r = {{0.01f, 0.02f, 5.0f}, {0.0f, 0.0f, -1.0f}};
+  for (int k = 0; k < 3; ++k) {
+    int alone[3] = {0, 0, 0};
+    alone[k] = 8;
+    Bvh::setPacketAloneRays(alone[0], alone[1], alone[2]);
+    Bvh::setCounting(true);
+    uint64_t lone[3];
+    Hit h[8];
+    Bvh::counters() = {};
+    bvh.closest8(rays, 8, h);
+    lone[0] = Bvh::counters().lone;
+    Bvh::counters() = {};
+    bvh.closest8(rays, 8, h, IntersectMethod::Watertight, PacketKind::Scattered);
+    lone[1] = Bvh::counters().lone;
+    Bvh::counters() = {};
+    EXPECT_EQ(bvh.occluded8(rays, 8), 0xFFu);
+    lone[2] = Bvh::counters().lone;
+    Bvh::setCounting(false);
+    Bvh::counters() = {};
+    for (int j = 0; j < 3; ++j) EXPECT_EQ(lone[j], j == k ? 8u : 0u) << "threshold 8 for kind " << k << ", kind " << j;
+  }
+  Bvh::setPacketAloneRays(Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]);
 }
 
 TEST(Packets, EmptyBvh) {

@@ -237,6 +237,7 @@ struct RaySet {
   const char* name;
   const std::vector<Ray>* rays;
   bool any;
+  PacketKind kind;  // closest hit: what our packets are told the rays are
 };
 
 // What each ray costs in work, single rays and packets of eight (BvhCounters, the counting traversal on
@@ -263,7 +264,7 @@ void printCounters(const Bvh& bvh, const std::vector<RaySet>& sets) {
       const int k = int(std::min<size_t>(8, rays.size() - i));
       Hit h[8];
       if (s.any) bvh.occluded8(&rays[i], k);
-      else bvh.closest8(&rays[i], k, h);
+      else bvh.closest8(&rays[i], k, h, IntersectMethod::Watertight, s.kind);
     }
     const BvhCounters p = Bvh::counters();
     auto share = [](uint64_t live, uint64_t visits) { return visits ? double(live) / (8.0 * double(visits)) : 0.0; };
@@ -284,6 +285,8 @@ void printCounters(const Bvh& bvh, const std::vector<RaySet>& sets) {
 struct Options {
   unsigned threads = threadCount();
   int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
+  int aloneRays[3] = {Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]};
+  std::vector<int> aloneSweep;  // --alone-sweep: our packets timed with each of these, same turns
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
   bool buildOnly = false;    // time only the builds, ours and Embree's alternately
@@ -331,10 +334,10 @@ void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
 struct Rays {
   std::vector<Ray> primary, ortho, shadow, mirror;
   std::vector<RaySet> sets() const {
-    return {{"primary", &primary, false},
-            {"primary, orthographic", &ortho, false},
-            {"shadow (any hit)", &shadow, true},
-            {"mirror", &mirror, false}};
+    return {{"primary", &primary, false, PacketKind::Coherent},
+            {"primary, orthographic", &ortho, false, PacketKind::Coherent},
+            {"shadow (any hit)", &shadow, true, PacketKind::Coherent},
+            {"mirror", &mirror, false, PacketKind::Scattered}};
   }
 };
 
@@ -455,7 +458,9 @@ void printPacketAgreement(const Bvh& bvh, const Embree& em, const Rays& rays, in
       for (size_t i = 0; i < set->size(); i += 8) {
         const int n = int(std::min<size_t>(8, set->size() - i));
         Hit h[8];
-        if (set != &shadow) bvh.closest8(&(*set)[i], n, h);
+        if (set != &shadow)
+          bvh.closest8(&(*set)[i], n, h, IntersectMethod::Watertight,
+                       set == &mirror ? PacketKind::Scattered : PacketKind::Coherent);
         const unsigned occ = set == &shadow ? bvh.occluded8(&(*set)[i], n) : 0u;
         for (int k = 0; k < n; ++k, ++total) {
           if (set == &shadow) {
@@ -482,12 +487,14 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
   const bool packets = em.packets();
   std::printf(
       "\n| rays | threads | ours, 1 ray at a time (Mrays/s) | ours, 2 rays in flight | ours, packets of 8, leaves ray by ray "
-      "| ours, packets of 8 (leaves all rays at once from %d live) | Embree rtcIntersect1/Occluded1 "
+      "| ours, packets of 8 (leaves all rays at once from %d live; single rays from %d / %d / %d live: coherent / "
+      "scattered / any hit) | Embree rtcIntersect1/Occluded1 "
       "| Embree rtcIntersect8/Occluded8 | 1 at a time / Embree | ours / Embree | our packets / Embree packets |\n",
-      leafRays);
+      leafRays, o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<unsigned> counts{1};
   if (threads > 1) counts.push_back(threads);
+  std::string sweepLines;  // --alone-sweep, printed after the table
   for (unsigned th : counts) {
     for (const RaySet& s : all.sets()) {
       const auto& rays = *s.rays;
@@ -495,6 +502,7 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
       // Alternate the four, best of each: a machine that slows down for a while slows all. Each turn
       // runs twice, so that the best run finds its own BVH in the caches, not the other's.
       double single = 1e30, paired = 1e30, ours8 = 1e30, ours8r = 1e30, theirs = 1e30, theirs8 = 1e30;
+      std::vector<double> sweep(o.aloneSweep.size(), 1e30);
       for (int r = 0; r < reps; ++r) {
         if (!o.packetsOnly)
           single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
@@ -515,12 +523,19 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
           const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
           if (s.any) return uint32_t(__builtin_popcount(bvh.occluded8(&rays[8 * i], n)));
           Hit h[8];
-          bvh.closest8(&rays[8 * i], n, h);
+          bvh.closest8(&rays[8 * i], n, h, IntersectMethod::Watertight, s.kind);
           uint32_t acc = 0;
           for (int k = 0; k < n; ++k) acc += h[k].prim;
           return acc;
         };
         ours8 = std::min(ours8, timed((rays.size() + 7) / 8, th, 2, packets8));
+        for (size_t k = 0; k < o.aloneSweep.size(); ++k) {  // this set's hand-off threshold set to each value
+          int a[3] = {o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]};
+          a[s.any ? 2 : int(s.kind)] = o.aloneSweep[k];
+          Bvh::setPacketAloneRays(a[0], a[1], a[2]);
+          sweep[k] = std::min(sweep[k], timed((rays.size() + 7) / 8, th, 2, packets8));
+          Bvh::setPacketAloneRays(o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
+        }
         Bvh::setPacketLeafRays(9);  // every leaf ray by ray (lanes = triangles), as before round 8
         if (!o.packetsOnly) ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
         Bvh::setPacketLeafRays(leafRays);
@@ -550,8 +565,20 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
                   fmt(n, paired, "%.2f").c_str(), fmt(n, ours8r, "%.2f").c_str(), fmt(n, ours8, "%.2f").c_str(),
                   fmt(n, theirs, "%.2f").c_str(), t8, fmt(theirs, single, "%.2f×").c_str(), fmt(theirs, paired, "%.2f×").c_str(),
                   r8);
+      if (!sweep.empty()) {  // our packets / Embree's packets with each hand-off threshold, same turns
+        char b[96];
+        std::snprintf(b, sizeof b, "\n- %s, %u threads:", s.name, th);
+        sweepLines += b;
+        for (size_t k = 0; k < sweep.size(); ++k) {
+          std::snprintf(b, sizeof b, " from %d live %.2f×", o.aloneSweep[k], theirs8 / sweep[k]);
+          sweepLines += b;
+        }
+      }
     }
   }
+  if (!sweepLines.empty())
+    std::printf("\nOur packets / Embree's packets, single rays from this many live rays (--alone-sweep):%s\n",
+                sweepLines.c_str());
 }
 
 // Primary rays through our BVH with each intersection routine, one thread.
@@ -667,7 +694,12 @@ int main(int argc, char** argv) {
     else if (a == "--scene" && i + 1 < argc) scenes.push_back(argv[++i]);
     else if (a == "--reps" && i + 1 < argc) reps = std::atoi(argv[++i]);
     else if (a == "--leaf-rays" && i + 1 < argc) leafRays = std::atoi(argv[++i]);
-    else if (a == "--quick") quick = true;
+    else if (a == "--alone-rays" && i + 1 < argc) {
+      if (std::sscanf(argv[++i], "%d,%d,%d", &o.aloneRays[0], &o.aloneRays[1], &o.aloneRays[2]) != 3) o.aloneRays[0] = -1;
+    } else if (a == "--alone-sweep" && i + 1 < argc) {
+      for (const char* p = argv[++i]; *p; ++p)
+        if (p == argv[i] || p[-1] == ',') o.aloneSweep.push_back(std::atoi(p));
+    } else if (a == "--quick") quick = true;
     else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--packets-only") quick = o.packetsOnly = true;
     else if (a == "--no-sphere") noSphere = true;
@@ -678,24 +710,31 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(
           stderr,
-          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--count-only] [--packets-only] [--build-only] [--no-sphere]\n"
+          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere]\n"
           "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
           "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
           "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
           "  --explain: one line per hit/miss disagreement with Embree\n"
           "  --count-only: builds, agreement and work per ray (counted), no timing\n"
           "  --leaf-rays N: our packets test a leaf all rays at once from N live rays (9: never)\n"
+          "  --alone-rays C,S,A: our packets walk on as single rays from this many live rays or fewer: closest hit\n"
+          "    coherent (primary, orthographic), closest hit scattered (mirror), any hit (shadow)\n"
+          "  --alone-sweep N,...: our packets also timed with each set's threshold at each N (same turns)\n"
           "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
           "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
           "  --no-sphere: only the --scene files\n");
       return 2;
     }
   }
-  if (threads == 0 || res <= 0 || rings < 2 || reps < 1) {
+  bool badAlone = false;
+  for (int n : o.aloneRays) badAlone |= n < 0 || n > 8;
+  for (int n : o.aloneSweep) badAlone |= n < 0 || n > 8;
+  if (threads == 0 || res <= 0 || rings < 2 || reps < 1 || badAlone) {
     std::fprintf(stderr, "bench-trace: bad argument\n");
     return 2;
   }
   Bvh::setPacketLeafRays(leafRays);
+  Bvh::setPacketAloneRays(o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
   if (!quick) benchRoutines();
   const Mesh sphere = uvSphere({0, 0, 0}, 1.0f, rings, rings + 1);
   std::vector<Triangle> tris;

@@ -97,9 +97,10 @@ if ! skipped env; then  # light from the sky: the GPU's split sum vs the tracer 
   row env-spp rtr-frame-compare --spp-curve env_sphere_grid --size $envsize --spp $envref
 fi
 if ! skipped trace; then  # tracer vs Embree on the 1M-triangle sphere and the Sun-Temple-size scene,
-  # 1 thread and every core, plus the ray-triangle routines alone (one run of bench-trace does all)
+  # 1 thread and every core, plus the ray-triangle routines alone (one run of bench-trace does all);
+  # --alone-sweep: our packets also timed with each hand-off threshold (docs/bench/trace.md, round 12)
   bin scenegen --out "$work/plain" --scale 100 --plain >/dev/null 2>&1 &&
-    row trace bench-trace --threads "$(nproc)" --scene "$work/plain/temple.obj"
+    row trace bench-trace --threads "$(nproc)" --scene "$work/plain/temple.obj" --alone-sweep 1,2,4,6
 fi
 if ! skipped bake; then  # ours vs tinyobjloader on the 175 MB temple (scale 300)
   if bin scenegen --out "$work/bake" --scale 300 --plain >/dev/null 2>&1 &&
