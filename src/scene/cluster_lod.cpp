@@ -235,7 +235,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
     c.coneAxis = {b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};
-    c.coneCutoff = backfaceCone ? b.cone_cutoff : 1.0f;
+    c.coneCutoff = b.cone_cutoff;
     c.sphere = sphere;
     c.error = error;
     c.parentSphere = c.sphere;
@@ -278,8 +278,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
       r.clusters = split(simpler, mesh);
       for (const Indices& c : r.clusters)
-        r.bounds.push_back(
-            meshopt_computeClusterBounds(c.data(), c.size(), &mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3)));
+        r.bounds.push_back(clusterBounds(c.data(), c.size(), mesh.positions.data(), mesh.positions.size(), backfaceCone));
     });
     std::vector<Indices> next;
     std::vector<uint32_t> nextIds;

@@ -3,6 +3,7 @@
 #include <meshoptimizer.h>
 
 #include <algorithm>
+#include <cmath>
 #include <span>
 
 #include "cluster.h"
@@ -66,13 +67,13 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
     const size_t at = out.indices.size();
     for (size_t k = 0; k < size_t(m.triangle_count) * 3; ++k)
       out.indices.push_back(vertices[m.vertex_offset + triangles[m.triangle_offset + k]]);
-    const meshopt_Bounds b =
-        meshopt_computeClusterBounds(out.indices.data() + at, size_t(m.triangle_count) * 3, pos, nv, sizeof(glm::vec3));
+    const meshopt_Bounds b = clusterBounds(out.indices.data() + at, size_t(m.triangle_count) * 3,
+                                           reinterpret_cast<const glm::vec3*>(pos), nv, backfaceCone);
     for (size_t k = at; k < out.indices.size(); ++k) out.indices[k] = toGlobal(out.indices[k]);
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
     c.coneAxis = {b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};
-    c.coneCutoff = backfaceCone ? b.cone_cutoff : 1.0f;
+    c.coneCutoff = b.cone_cutoff;
     out.clusters.push_back(c);
   }
   // meshoptimizer keeps every triangle, degenerate ones included; a mismatch would lose geometry.
@@ -123,6 +124,23 @@ void buildClusters(Mesh& mesh, bool backfaceCone) {
   if (mesh.indices.empty()) return;
   Mesh* one = &mesh;
   clusterMeshes({&one, 1}, {backfaceCone});
+}
+
+meshopt_Bounds clusterBounds(const uint32_t* indices, size_t count, const glm::vec3* positions, size_t vertexCount,
+                             bool backfaceCone) {
+  meshopt_Bounds b = meshopt_computeClusterBounds(indices, count, &positions[0].x, vertexCount, sizeof(glm::vec3));
+  const glm::vec3 center{b.center[0], b.center[1], b.center[2]};
+  float far2 = b.radius * b.radius;
+  for (size_t k = 0; k < count; ++k) {
+    const glm::vec3 d = positions[indices[k]] - center;
+    far2 = std::max(far2, glm::dot(d, d));
+  }
+  b.radius = std::sqrt(far2);
+  const float length =
+      std::sqrt(b.cone_axis[0] * b.cone_axis[0] + b.cone_axis[1] * b.cone_axis[1] + b.cone_axis[2] * b.cone_axis[2]);
+  const bool cone = b.cone_cutoff >= 0.0f && b.cone_cutoff < 1.0f && std::abs(length - 1.0f) <= 1e-3f;  // false for NaN
+  if (!backfaceCone || !cone) b.cone_cutoff = 1.0f;
+  return b;
 }
 
 bool conesCull(const Material& material) { return !(material.flags & (kMaterialAlphaMasked | kMaterialDoubleSided)); }

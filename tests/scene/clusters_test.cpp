@@ -226,6 +226,21 @@ TEST(Clusters, RtrSceneStoresThemAndOlderVersionsLoadWithout) {
   EXPECT_EQ(old.meshes[0].indices, gridScene().meshes[0].indices);
 }
 
+// meshoptimizer leaves a cluster of zero-area triangles with a zero cone axis and cutoff 0, which the
+// loaders refuse: such a cluster gets a cone that never culls (seen in the 100M-triangle temple's bake).
+TEST(Clusters, ZeroAreaTrianglesGetAConeThatNeverCullsAndLoad) {
+  Scene s;
+  s.materials.push_back(Material{});
+  Mesh m = bumpyGrid(4);
+  for (size_t i = 0; i + 2 < m.indices.size(); i += 3) m.indices[i + 2] = m.indices[i + 1];  // every triangle a line
+  s.meshes.push_back(m);
+  buildMissingClusters(s);
+  ASSERT_FALSE(s.meshes[0].clusters.empty());
+  for (const Cluster& c : s.meshes[0].clusters) EXPECT_EQ(c.coneCutoff, 1.0f);
+  const std::string bytes = encodeRtrScene(s);
+  EXPECT_EQ(decodeError(bytes), "(no error)");
+}
+
 TEST(Clusters, RtrSceneRefusesDamagedClusters) {
   Scene s = gridScene();
   buildMissingClusters(s);
