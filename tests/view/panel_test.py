@@ -63,7 +63,7 @@ def main():
         viewer.wait_line("err", r"move speed")
         # The textures load while frames go on (the materials show their factors meanwhile): every frame this
         # test compares comes after they are in.
-        viewer.wait_line("err", r"rtr-view: 13 textures in: ")
+        viewer.wait_line("err", r"rtr-view: 13 textures in\b")
         # --timings in the window: the start-up phases tile the time to the first frame on screen.
         viewer.wait_line("err", r"^  total from process start ")
         err = viewer.lines("err")
