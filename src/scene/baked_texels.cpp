@@ -167,17 +167,13 @@ void unpackBakedPiece(const BakedTexels& t, size_t k, uint8_t* chain) {
     std::memcpy(dst, src, n);
     return;
   }
-  // One context per thread: creating one per piece costs more than a small piece's unpacking. The piece
-  // is unpacked into cached memory, then copied: `chain` is often a GPU staging buffer, write-combined
-  // and uncached, and zstd reads back what it wrote (its matches), which there is slow.
+  // One context per thread: creating one per piece costs more than a small piece's unpacking.
   thread_local std::unique_ptr<ZSTD_DCtx, size_t (*)(ZSTD_DCtx*)> ctx(ZSTD_createDCtx(), ZSTD_freeDCtx);
-  thread_local std::vector<uint8_t> scratch(kBakedPiece);
-  const size_t got = ZSTD_decompressDCtx(ctx.get(), scratch.data(), n, src, p.stored);
+  const size_t got = ZSTD_decompressDCtx(ctx.get(), dst, n, src, p.stored);
   if (ZSTD_isError(got) || got != n)
     throw fileError(t.file, "byte " + std::to_string(t.fileOffset + p.at),
                     "baked texture piece " + std::to_string(k) + " does not unpack to its " + std::to_string(n) + " bytes (" +
                         (ZSTD_isError(got) ? ZSTD_getErrorName(got) : std::to_string(got) + " bytes") + ")");
-  std::memcpy(dst, scratch.data(), n);
 }
 
 TexelData unpackBakedLevel0(const BakedTexels& t) {
