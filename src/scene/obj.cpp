@@ -158,7 +158,7 @@ class ObjParser {
       std::copy(p.positions.begin(), p.positions.end(), positions_.begin() + ptrdiff_t(before[i].positions));
       std::copy(p.texcoords.begin(), p.texcoords.end(), texcoords_.begin() + ptrdiff_t(before[i].texcoords));
       std::copy(p.normals.begin(), p.normals.end(), normals_.begin() + ptrdiff_t(before[i].normals));
-      std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
+      if (coloured_) std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
       std::vector<glm::vec3>().swap(p.positions);
       std::vector<glm::vec4>().swap(p.colors);
       std::vector<glm::vec2>().swap(p.texcoords);

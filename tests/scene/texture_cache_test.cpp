@@ -202,7 +202,7 @@ TEST_F(TextureCacheTest, TwoProcessesWritingOneEntryAtOnceLeaveAValidEntry) {
   while (std::find(done.begin(), done.end(), false) != done.end()) {
     for (size_t k = 0; k < writers.size(); ++k)
       if (!done[k] && ::waitpid(writers[k], &status[k], WNOHANG) == writers[k]) done[k] = true;
-    if (const auto got = reader.find(keyOf(6), rgba())) EXPECT_EQ(unpacked(*got), unpacked(*chain));
+    if (const auto got = reader.find(keyOf(6), rgba())) { EXPECT_EQ(unpacked(*got), unpacked(*chain)); }
     ++reads;
   }
   EXPECT_EQ(reader.counts().damaged, 0u) << "a reader saw a partial entry in " << reads << " reads";
