@@ -241,8 +241,7 @@ int main(int argc, char** argv) {
       }
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rtr-frame-compare: %s\n", e.what());
-    return 1;
+    return cli::fail("rtr-frame-compare", e);  // "rtr-frame-compare: error: ...", exit 1 (2 for usage)
   }
   return 0;
 }
