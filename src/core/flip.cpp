@@ -73,24 +73,30 @@ double compress(double e) {
   return e < knee ? e * kPt / knee : kPt + (e - knee) / (kCmax - knee) * (1.0 - kPt);
 }
 
-Kernel gaussian(double sigmaPx) {
+// Taps in double: a detector narrower than a pixel has side taps far below float's range (e^−297 at 1 ppd).
+std::vector<double> gaussian(double sigmaPx) {
   const int r = std::max(1, int(std::ceil(3.0 * sigmaPx)));
-  Kernel k(2 * r + 1);
-  for (int x = -r; x <= r; ++x) k[x + r] = float(std::exp(-x * x / (2.0 * sigmaPx * sigmaPx)));
+  std::vector<double> k(2 * r + 1);
+  for (int x = -r; x <= r; ++x) k[x + r] = std::exp(-x * x / (2.0 * sigmaPx * sigmaPx));
   return k;
 }
-double sum(const Kernel& k) {
+Kernel normalised(const std::vector<double>& k) {
   double s = 0;
-  for (float v : k) s += v;
-  return s;
+  for (double v : k) s += v;
+  Kernel out(k.size());
+  for (size_t i = 0; i < k.size(); ++i) out[i] = float(k[i] / s);
+  return out;
 }
 // Positive taps scaled to sum 1 and negative ones to −1: a detector answers 0 to a flat image, and its
-// response to an image in [0, 1] is within [−1, 1].
-Kernel balanced(Kernel k) {
+// response to an image in [0, 1] is within [−1, 1]. One with no taps on a side (narrower than a pixel) sees
+// nothing: all 0.
+Kernel balanced(const std::vector<double>& k) {
   double pos = 0, neg = 0;
-  for (float v : k) (v > 0 ? pos : neg) += v;
-  for (float& v : k) v = float(v > 0 ? v / pos : v / -neg);
-  return k;
+  for (double v : k) (v > 0 ? pos : neg) += v;
+  Kernel out(k.size(), 0.0f);
+  if (pos > 0 && neg < 0)
+    for (size_t i = 0; i < k.size(); ++i) out[i] = float(k[i] > 0 ? k[i] / pos : k[i] / -neg);
+  return out;
 }
 
 // `in` correlated with kx along rows, then ky along columns; outside the image the border pixel repeats.
@@ -136,11 +142,12 @@ Plane csfFilter(const Plane& in, uint32_t w, uint32_t h, const Csf& c, double pp
   Kernel kernels[2];
   for (int i = 0; i < 2; ++i) {
     if (terms[i][0] == 0) continue;
-    kernels[i] = gaussian(std::sqrt(terms[i][1] / (2.0 * kPi * kPi)) * ppd);
-    const double s = sum(kernels[i]);
+    const std::vector<double> g = gaussian(std::sqrt(terms[i][1] / (2.0 * kPi * kPi)) * ppd);
+    double s = 0;
+    for (double v : g) s += v;
     weights[i] = terms[i][0] * kPi / terms[i][1] * s * s;  // the term's sum over the 2-D kernel
     total += weights[i];
-    for (float& v : kernels[i]) v = float(v / s);
+    kernels[i] = normalised(g);
   }
   for (int i = 0; i < 2; ++i) {
     if (weights[i] == 0) continue;
@@ -175,17 +182,15 @@ struct Features {
   Plane edge, point;
 };
 Features features(const Plane& y, uint32_t w, uint32_t h, double ppd, unsigned threads) {
-  Kernel g = gaussian(0.5 * kFeatureWidthDeg * ppd), d1 = g, d2 = g;
-  const int r = int(g.size() / 2);
-  const double s2 = std::pow(0.5 * kFeatureWidthDeg * ppd, 2);
+  const double sigma = 0.5 * kFeatureWidthDeg * ppd;
+  const std::vector<double> gd = gaussian(sigma);
+  std::vector<double> first = gd, second = gd;
+  const int r = int(gd.size() / 2);
   for (int x = -r; x <= r; ++x) {
-    d1[x + r] = float(-x / s2 * g[x + r]);
-    d2[x + r] = float((x * x / s2 - 1.0) / s2 * g[x + r]);
+    first[x + r] = -x / (sigma * sigma) * gd[x + r];
+    second[x + r] = (x * x / (sigma * sigma) - 1.0) / (sigma * sigma) * gd[x + r];
   }
-  const double s = sum(g);
-  for (float& v : g) v = float(v / s);
-  d1 = balanced(d1);
-  d2 = balanced(d2);
+  const Kernel g = normalised(gd), d1 = balanced(first), d2 = balanced(second);
   Features f{convolve(y, w, h, d1, g, threads), convolve(y, w, h, d2, g, threads)};
   const Plane ey = convolve(y, w, h, g, d1, threads), py = convolve(y, w, h, g, d2, threads);
   for (size_t i = 0; i < y.size(); ++i) {

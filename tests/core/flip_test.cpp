@@ -143,9 +143,16 @@ TEST(Flip, ValuesStayInZeroToOneAndGreenAgainstBlueIsTheLargest) {
   EXPECT_NEAR(largest, 1.0, 1e-4);
   ImageF wild = noise(40, 40, 4), other = noise(40, 40, 5);
   for (glm::vec4& p : wild.pixels) p = glm::round(p);  // saturated corners: the largest edges
-  for (float e : flip(wild, other).error) {
-    ASSERT_GE(e, 0.0f);
-    ASSERT_LE(e, 1.0f);
+  // Any viewing distance: detectors narrower than a pixel (1 ppd) or wider than the image (1000 ppd);
+  // flat images have no features to differ in at any of them (float rounding of the detectors' zero sum,
+  // about 1e-8, shows as 1e-4 through the feature error's square root).
+  for (double ppd : {1.0, 67.0, 1000.0}) {
+    for (float e : flip(wild, other, {.ppd = ppd}).error) {
+      ASSERT_GE(e, 0.0f) << ppd;
+      ASSERT_LE(e, 1.0f) << ppd;
+    }
+    for (float f : flipFeatureError(uniform(6, 6, {0.1f, 0.2f, 0.3f}), uniform(6, 6, {0.9f, 0.5f, 0.1f}), {.ppd = ppd}))
+      ASSERT_LT(f, 1e-3f) << ppd;
   }
 }
 
