@@ -411,7 +411,9 @@ class Report:
         self.w()
         self.w("`rtr-frame-compare`: every case of `tests/reference/poses.txt` at 1920×1080, the same shading "
                "model on both sides (PBR, no shadows, no reflections). Error: 8-bit sRGB steps, GPU against the "
-               "CPU reference; failing = beyond 3 steps even against the 3×3 neighbours (docs/reference-tests.md).")
+               "CPU reference; failing = beyond 3 steps even against the 3×3 neighbours (docs/reference-tests.md); "
+               "ꟻLIP: the ꟻLIP-style perceptual error in [0, 1] at 67 pixels per degree, mean / 99th percentile / "
+               "max over the image (docs/flip.md).")
         self.w()
         fig, ax = plt.subplots(figsize=(6.5, 3.8))
         plotted = False
@@ -470,9 +472,13 @@ class Report:
                "sky alone (`--env sky`; `_nosun`: the same sky without its sun texel), GGX, no shadows on either side. "
                "Errors in linear radiance over the pixels both sides cover; `% of mean pixel` = mean |GPU − CPU| / mean "
                "CPU pixel (the goal's measure), per-pixel = the mean of |GPU − CPU| / CPU; the tracer's own noise is "
-               "estimated from its image at a quarter of the samples. Where the split sum itself is wrong and by how "
-               "much: docs/environment.md.")
+               "estimated from its image at a quarter of the samples; ꟻLIP: the ꟻLIP-style perceptual error in [0, 1] "
+               "of what a display shows (both clamped to [0, 1]) over the same pixels, at 67 pixels per degree "
+               "(docs/flip.md; older raw files have no such columns). Where the split sum itself is wrong and by "
+               "how much: docs/environment.md.")
         self.w()
+        # Where the split sum is visibly wrong: the ꟻLIP-style mean per sphere against roughness.
+        curves = {}
         for m in self.m:
             t = m.raw("env-compare")
             if not t or m.failed("env-compare"):
@@ -483,8 +489,23 @@ class Report:
             self.w()
             for header, rows in md_tables(t):
                 self.table(header, rows)
+                cs, cf = col(header, "sphere"), col(header, "ꟻLIP mean")
+                for r in rows if cs is not None and cf is not None else []:
+                    rough, metal = re.search(r"rough ([\d.]+)", r[cs]), re.search(r"metal ([\d.]+)", r[cs])
+                    if rough and (r[0] in ("env_metal_spheres", "env_dielectric_spheres") or
+                                  (r[0] == "env_sphere_grid_nosun" and metal and metal.group(1) in ("0.00", "1.00"))):
+                        key = f"{m.label}: {r[0]}" + (f" metal {metal.group(1)}" if metal else "")
+                        curves.setdefault(key, []).append((float(rough.group(1)), num(r[cf])))
                 self.env_goal(m, header, rows)
             self.source(m, "env-compare")
+        fig, ax = plt.subplots(figsize=(6, 3.6))
+        for key, pts in curves.items():
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label=key)
+        if curves:
+            ax.legend(fontsize=6)
+        self.scatter_done(fig, ax, bool(curves), "env_flip.png", "ꟻLIP-style mean per sphere against roughness",
+                          "Split sum against the tracer: ꟻLIP-style mean per sphere", "roughness",
+                          "ꟻLIP-style mean (0-1)")
         fig, ax = plt.subplots(figsize=(6, 3.6))
         plotted = False
         for m in self.m:
