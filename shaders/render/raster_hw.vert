@@ -21,7 +21,7 @@ void main() {
   const GpuDraw d = draws[inst.info.x];
   const uint local = entry & ((1u << RASTER_LOCAL_BITS) - 1u);
   const uint v = triangleVertices(c, d, local)[gl_VertexIndex % 3];
-  outId = (c.instance << pc.primitiveBits) | (c.firstTriangle + local);
+  outId = inst.info.z + c.firstTriangle + local;
   outMaterial = d.material;
   outFlags = c.flags;
   outTexcoord = (c.flags & CLUSTER_ALPHA_MASKED) != 0u ? texcoords[v] : vec2(0.0);

@@ -1,6 +1,6 @@
 // The compute rasteriser's constants and push block, shared by render/raster.cpp and its shaders
 // (docs/raster.md). Visibility buffer: one uint64 per pixel, (floatBitsToUint(depth) << 32) | id, id as in
-// frame.h (draw << primitiveBits | primitive); RASTER_CLEAR (id VIS_EMPTY) where nothing was drawn.
+// frame.h (the instance's first id + primitive); RASTER_CLEAR (id VIS_EMPTY) where nothing was drawn.
 #ifndef RTR_SHADERS_SHARED_RASTER_H
 #define RTR_SHADERS_SHARED_RASTER_H
 
@@ -23,10 +23,9 @@ typedef uint32_t uint;
 struct RasterPush {
   uint width;
   uint height;
-  uint primitiveBits;  // of an id: the primitive index (frame.h)
   uint clusterCount;
   uint fromList;       // raster.comp: clusters from the culling pass's visible list, not all of them
-  uint pad0, pad1, pad2;
+  uint pad0, pad1, pad2, pad3;
 };
 
 #ifdef __cplusplus

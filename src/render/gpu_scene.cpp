@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cstring>
 #include <functional>
@@ -65,6 +66,7 @@ struct GeometryPlan {
   std::vector<shader::GpuInstance> instances;
   std::vector<shader::GpuCluster> clusters;
   std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
+  std::vector<uint32_t> idPages;            // visIdPages(): the instance holding each page's first id
   size_t baseClusters = 0;
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
@@ -274,6 +276,25 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     if (!box.empty()) list.back().center = box.center();
   }
   p.baseClusters = p.clusters.size();
+  // Visibility ids (frame.h): each drawn instance its own range, as long as its draw's primitives, in order.
+  uint64_t ids = 0;
+  firstIds_.clear();
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    firstIds_.push_back(ids);
+    p.instances[i].info.z = uint32_t(ids);
+    if (!scene.materials.at(m.material).blended()) ids += meshDraw[instances[i].mesh]->item.primitives;
+  }
+  visIdCount_ = ids;
+  // Pages of 2^shift ids, at most 2^16 + 1 of them: page k's entry is the last instance whose range
+  // starts at or before k << shift, so the instance of id lies between the entries of id's page and the next.
+  idPageShift_ = uint32_t(std::max(6, int(std::bit_width(std::max<uint64_t>(ids, 1))) - 16));
+  if (ids <= kMaxVisIds)
+    for (uint64_t page = 0, i = 0; page <= ((std::max<uint64_t>(ids, 1) - 1) >> idPageShift_) + 1; ++page) {
+      while (i + 1 < firstIds_.size() && firstIds_[i + 1] <= page << idPageShift_) ++i;
+      p.idPages.push_back(uint32_t(i));
+    }
+  if (p.idPages.empty()) p.idPages.push_back(0);
   for (uint32_t i = 0; lods && i < instances.size(); ++i) {  // the hierarchies' clusters after all full-detail ones
     const Mesh& m = scene.meshes[instances[i].mesh];
     if (scene.materials.at(m.material).blended()) continue;  // drawn by the transparency pass, no clusters
@@ -335,7 +356,7 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kLod, kTargets };
+  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kLod, kIds, kTargets };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
@@ -349,13 +370,14 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&texcoords1_, plan.anyUv1 ? vertices * 8 : 0},
                                         {&tangents_, plan.anyTangents ? vertices * 16 : 0},
                                         {&colors_, plan.anyColors ? vertices * 16 : 0},
-                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()}}};
+                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()},
+                                        {&visIdPages_, bytes(plan.idPages), plan.idPages.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
   const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage, kStorage,
-                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions", "normals",  "texcoords",  "indices16", "indices32", "materials",   "draws",
-                                 "instances", "clusters", "texcoords1", "tangents",  "colours",   "cluster lods"};
+                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions", "normals",  "texcoords",  "indices16", "indices32", "materials",    "draws",
+                                 "instances", "clusters", "texcoords1", "tangents",  "colours",   "cluster lods", "id pages"};
   clusterCount_ = uint32_t(plan.clusters.size());
   baseClusterCount_ = uint32_t(plan.baseClusters);
   size_t stagingSize = 0;
@@ -437,6 +459,13 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     });
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
+}
+
+std::pair<uint32_t, uint32_t> GpuScene::decodeVisId(uint32_t id) const {
+  const auto next = std::upper_bound(firstIds_.begin(), firstIds_.end(), uint64_t(id));
+  if (next == firstIds_.begin() || id >= visIdCount_) throw Error("visibility id " + std::to_string(id) + " names no instance");
+  const uint32_t instance = uint32_t(next - firstIds_.begin() - 1);
+  return {instance, uint32_t(id - firstIds_[instance])};
 }
 
 GpuScene::~GpuScene() {

@@ -87,8 +87,8 @@ void ComputeRaster::resize(VkExtent2D extent) {
   extent_ = extent;
 }
 
-void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits,
-                           vk::GpuTimer& timer, uint32_t frame, const CullCamera& camera, bool cull) {
+void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
+                           const CullCamera& camera, bool cull) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
@@ -129,7 +129,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     w.push(cb, p);
     for (size_t i = 0; i < 3; ++i)
       if (&p == textured()[i] && p.layout.setCount() > 1) p.bindSet(cb, 1, textures_[i].get(1));
-    p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, clusterCount, fromList, 0, 0, 0});
+    p.push(cb, shader::RasterPush{extent_.width, extent_.height, clusterCount, fromList, 0, 0, 0, 0});
   };
   // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.
   constexpr vk::BufferUse kReaders = vk::kComputeReadWrite | vk::kFragmentReadWrite | vk::kVertexReadWrite | vk::kIndirectRead;

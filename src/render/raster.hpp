@@ -33,8 +33,8 @@ class ComputeRaster {
   // Level of detail (docs/virtual-geometry.md): with a scene hierarchy and camera.lodThreshold > 0, the
   // culling pass picks each instance's clusters of the cut (without `cull`: one pass, "cull", testing
   // nothing else); otherwise only the full-detail clusters are drawn.
-  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer,
-              uint32_t frame, const CullCamera& camera, bool cull);
+  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
+              const CullCamera& camera, bool cull);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
   // The passes' texture arrays (set 1 of the layouts that have one), for the one writer of every texture set.
   std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> textureSets() const;

@@ -165,6 +165,9 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   render::RenderSettings settings = sceneSettings(o, scene);
   settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  if (settings.shading == render::ShadingPath::Visibility && !renderer.renderer().visibilityRefusal().empty())
+    std::fprintf(stderr, "rtr-view: warning: %s: frames take the forward path\n",
+                 renderer.renderer().visibilityRefusal().c_str());
   const auto env = loadEnvironment(o, ctx);
   renderer.renderer().setEnvironment(env);
   const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
