@@ -15,6 +15,11 @@ layout(location = 2) flat out uint outFlags;     // CLUSTER_*
 layout(location = 3) out vec2 outTexcoord;
 
 void main() {
+  if (uint(gl_VertexIndex) / 3u >= pc.handOffCapacity) {  // dropped (raster.h): a point, no fragment
+    gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
+    outId = 0u, outMaterial = NO_TEXTURE, outFlags = 0u, outTexcoord = vec2(0.0);
+    return;
+  }
   const uint entry = hwTriangles[gl_VertexIndex / 3];
   const GpuCluster c = clusters[entry >> RASTER_LOCAL_BITS];
   const GpuInstance inst = instances[c.instance];

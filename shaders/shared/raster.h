@@ -19,13 +19,18 @@ typedef uint32_t uint;
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
 #define RASTER_LARGE_GROUPS 1024u         // raster_large.comp's persistent workgroups
 #define RASTER_LOCAL_BITS 7u     // hardware list entry: cluster << RASTER_LOCAL_BITS | triangle in cluster
+// Hand-off list entries at most (64 MiB): the near-plane and guard-band triangles of a frame, not every
+// triangle of a billion-triangle scene (a storage buffer's range is 4 GiB at most on many devices). Past
+// it, triangles are dropped and counted (ComputeRaster::handOffTriangles, which rtr-view prints).
+#define RASTER_HANDOFF_CAPACITY (1u << 24)
 
 struct RasterPush {
   uint width;
   uint height;
   uint clusterCount;
   uint fromList;       // raster.comp: clusters from the culling pass's visible list, not all of them
-  uint pad0, pad1, pad2, pad3;
+  uint handOffCapacity;  // entries of the hand-off list (at most RASTER_HANDOFF_CAPACITY)
+  uint pad0, pad1, pad2;
 };
 
 #ifdef __cplusplus

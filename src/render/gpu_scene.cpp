@@ -67,6 +67,8 @@ struct GeometryPlan {
   std::vector<shader::GpuCluster> clusters;
   std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
   std::vector<uint32_t> idPages;            // visIdPages(): the instance holding each page's first id
+  std::vector<shader::GpuCullInstance> cullInstances;
+  std::vector<shader::GpuCullLevel> cullLevels;
   size_t baseClusters = 0;
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
@@ -247,7 +249,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   }
   const std::vector<Instance> instances = gpuInstances(scene);
   const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
-  Bounds box;  // of the draw being extended
+  std::vector<uint32_t> cullIndex(instances.size(), UINT32_MAX);  // its GpuCullInstance
+  std::vector<std::array<glm::uvec2, 2>> runs(instances.size());  // per GpuCullInstance: full detail, levels above
+  Bounds box;                                                     // of the draw being extended
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
     const Mesh& m = scene.meshes[in.mesh];
@@ -264,6 +268,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     }
     const size_t first = p.clusters.size();
     appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
+    cullIndex[i] = uint32_t(p.cullInstances.size());
+    p.cullInstances.push_back({glm::vec4(0.0f), glm::vec4(0.0f), glm::uvec4(0)});
+    runs[cullIndex[i]] = {glm::uvec2(first, p.clusters.size() - first), glm::uvec2(0)};
     if (lods) appendClusterLods(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), false, first, p.clusters, p.lods);
     std::vector<DrawItem>& list = draws_[size_t(md.kind)];
     if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
@@ -299,7 +306,51 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     const Mesh& m = scene.meshes[instances[i].mesh];
     if (scene.materials.at(m.material).blended()) continue;  // drawn by the transparency pass, no clusters
     const uint32_t flags = meshDraw[instances[i].mesh]->flags | (mirrored(instances[i].transform) ? CLUSTER_MIRRORED : 0u);
+    const size_t first = p.clusters.size();
     appendClusterLods(m, instances[i].transform, i, flags, true, 0, p.clusters, p.lods);
+    if (cullIndex[i] != UINT32_MAX) runs[cullIndex[i]][1] = glm::uvec2(first, p.clusters.size() - first);
+  }
+  // Each instance's spheres (around the box of the spheres they hold, holding each) and levels.
+  auto enclose = [&](const std::array<glm::uvec2, 2>& rs, auto&& spheres) {
+    Bounds b;
+    for (const glm::uvec2 run : rs)
+      for (size_t c = run.x; c < run.x + run.y; ++c)
+        spheres(c, [&](glm::vec4 s) { b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w); });
+    float r = 0.0f;
+    for (const glm::uvec2 run : rs)
+      for (size_t c = run.x; c < run.x + run.y; ++c)
+        spheres(c, [&](glm::vec4 s) { r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w); });
+    return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
+  };
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    if (cullIndex[i] == UINT32_MAX) continue;
+    shader::GpuCullInstance& ci = p.cullInstances[cullIndex[i]];
+    const std::array<glm::uvec2, 2>& rs = runs[cullIndex[i]];
+    ci.sphere = enclose(rs, [&](size_t c, auto&& add) { add(p.clusters[c].sphere); });
+    ci.lodSphere = p.lods.empty() ? ci.sphere : enclose(rs, [&](size_t c, auto&& add) {
+      add(p.lods[c].sphere);
+      if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) add(p.lods[c].parentSphere);
+    });
+    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level).
+    ci.levels = glm::uvec4(p.cullLevels.size(), 0, 0, 0);
+    auto level = [&](uint32_t first, uint32_t count) {
+      shader::GpuCullLevel v{first, count, shader::LOD_ERROR_INFINITE, 0.0f};
+      for (size_t c = first; c < first + count; ++c) {
+        v.minError = std::min(v.minError, p.lods.empty() ? 0.0f : p.lods[c].error.x);
+        v.maxParentError = std::max(v.maxParentError, p.lods.empty() ? shader::LOD_ERROR_INFINITE : p.lods[c].error.y);
+      }
+      p.cullLevels.push_back(v);
+      ++ci.levels.y;
+    };
+    level(rs[0].x, rs[0].y);
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    uint32_t c = rs[1].x, run = 0, at = 0;
+    for (size_t k = 0; k < m.lod.clusters.size() && rs[1].y > 0; ++k) {
+      if (m.lod.clusters[k].level == 0) continue;
+      if (run > 0 && m.lod.clusters[k].level != at) level(c - run, run), run = 0;
+      at = m.lod.clusters[k].level, ++run, ++c;
+    }
+    if (run > 0) level(c - run, run);
   }
   stats_.instances = uint32_t(instances.size());
   stats_.vertices = uint32_t(p.vertices);
@@ -356,7 +407,25 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kLod, kIds, kTargets };
+  enum {
+    kPos,
+    kNrm,
+    kUv,
+    kI16,
+    kI32,
+    kMat,
+    kDraw,
+    kInst,
+    kCluster,
+    kUv1,
+    kTan,
+    kCol,
+    kLod,
+    kIds,
+    kCullInst,
+    kCullLevel,
+    kTargets
+  };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
@@ -371,15 +440,20 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&tangents_, plan.anyTangents ? vertices * 16 : 0},
                                         {&colors_, plan.anyColors ? vertices * 16 : 0},
                                         {&clusterLods_, bytes(plan.lods), plan.lods.data()},
-                                        {&visIdPages_, bytes(plan.idPages), plan.idPages.data()}}};
+                                        {&visIdPages_, bytes(plan.idPages), plan.idPages.data()},
+                                        {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()},
+                                        {&cullLevels_, bytes(plan.cullLevels), plan.cullLevels.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
-  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage, kStorage,
-                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions", "normals",  "texcoords",  "indices16", "indices32", "materials",    "draws",
-                                 "instances", "clusters", "texcoords1", "tangents",  "colours",   "cluster lods", "id pages"};
+  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
+                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage,
+                                                       kStorage, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32", "materials",
+                                 "draws",        "instances", "clusters",       "texcoords1", "tangents",  "colours",
+                                 "cluster lods", "id pages",  "cull instances", "cull levels"};
   clusterCount_ = uint32_t(plan.clusters.size());
   baseClusterCount_ = uint32_t(plan.baseClusters);
+  cullInstanceCount_ = uint32_t(plan.cullInstances.size());
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {
     Target& tg = targets[i];

@@ -140,6 +140,10 @@ class GpuScene {
   VkBuffer clusters() const { return clusters_.handle(); }
   uint32_t clusterCount() const { return clusterCount_; }
   uint32_t baseClusterCount() const { return baseClusterCount_; }
+  // GpuCullInstance (cluster.h) per instance with clusters: its sphere and its runs of clusters.
+  VkBuffer cullInstances() const { return cullInstances_.handle(); }
+  uint32_t cullInstanceCount() const { return cullInstanceCount_; }
+  VkBuffer cullLevels() const { return cullLevels_.handle(); }  // GpuCullLevel: each instance's, level 0 first
   // GpuClusterLod per GpuCluster where some mesh has a hierarchy (docs/virtual-geometry.md); else null.
   VkBuffer clusterLods() const { return clusterLods_.handle(); }
   // Visibility ids (frame.h): instance i names the ids [firstId(i), firstId(i) + its draw's primitives),
@@ -194,8 +198,8 @@ class GpuScene {
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
-  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_;
-  uint32_t clusterCount_ = 0, baseClusterCount_ = 0;
+  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_, cullInstances_, cullLevels_;
+  uint32_t clusterCount_ = 0, baseClusterCount_ = 0, cullInstanceCount_ = 0;
   std::vector<uint64_t> firstIds_;  // per instance
   uint64_t visIdCount_ = 0;
   uint32_t idPageShift_ = 0;

@@ -129,6 +129,7 @@ class Renderer {
   std::optional<uint32_t> handOffTriangles(uint32_t frame) const {
     return raster_ ? std::optional(raster_->handOffTriangles(frame)) : std::nullopt;
   }
+  uint32_t handOffCapacity() const { return raster_ ? raster_->handOffCapacity() : 0; }
 
  private:
   struct ScenePipelines {

@@ -203,6 +203,39 @@ TEST_F(InstanceTest, ComputeIdsEqualHardwareIdsAndCullingChangesNothing) {
   EXPECT_GT(cone, 0u);
 }
 
+// An instance outside the frustum is culled whole: none of its clusters is visited (the culling pass's
+// counter), and the frame is the unculled one (ComputeIdsEqualHardwareIdsAndCullingChangesNothing).
+TEST_F(InstanceTest, CulledInstancesCostNoClusterTests) {
+  if (!render::ComputeRaster::supported(*ctx)) GTEST_SKIP() << "no 64-bit buffer atomics";
+  const Scene inst = instancedScene();
+  render::GpuScene g(*ctx, inst, render::MipMode::Compute);
+  const uint32_t perInstance = uint32_t(inst.meshes[0].clusters.size()), instances = uint32_t(inst.instances.size());
+  ASSERT_EQ(g.cullInstanceCount(), instances);
+  render::HeadlessRenderer r(*ctx, g, kE);
+  render::RenderSettings s;
+  s.mosaic = render::MosaicMode::Off;
+  s.raster = render::RasterPath::Compute;
+  s.cull = true;
+  const Bounds b = inst.bounds();
+  // Looking away from the grid: every instance culled, no cluster tested, nothing drawn.
+  const CameraPose away{glm::vec3(0.0f, 0.0f, 20.0f), 180.0f, 0.0f};
+  const std::vector<uint32_t> none = r.ids(away, fitDepthRange(Lens{}, b, away), s);
+  auto stats = r.renderer().cullStats(0);
+  ASSERT_TRUE(stats.has_value());
+  EXPECT_EQ(stats->instancesCulled, instances);
+  EXPECT_EQ(stats->tested, 0u);
+  EXPECT_EQ(std::count(none.begin(), none.end(), VIS_EMPTY), ptrdiff_t(none.size()));
+  // Close, inside the grid: some instances culled, the others' clusters tested in both phases.
+  const CameraPose close = views(b)[2];
+  r.ids(close, fitDepthRange(Lens{}, b, close), s);
+  stats = r.renderer().cullStats(0);
+  std::printf("close view: %u of %u instances culled whole, %u cluster tests\n", stats->instancesCulled, instances,
+              stats->tested);
+  EXPECT_GT(stats->instancesCulled, 0u);
+  EXPECT_LT(stats->instancesCulled, instances);
+  EXPECT_EQ(stats->tested, 2 * (instances - stats->instancesCulled) * perInstance);
+}
+
 // Past the old id budget (instance << bits | primitive, bits = 32 - bit_width(instances)): one mesh of
 // 40 000 triangles beside 65 536 instances of a one-triangle mesh (a carpet behind it) needs 17 bits
 // for the instance and 16 for the primitive. The ids of each instance's range (frame.h) take 105 536:
