@@ -407,7 +407,7 @@ Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& rea
 }
 
 Scene loadObj(const std::filesystem::path& file, const ObjOptions& options, ObjStats* stats) {
-  auto src = openSource(file);
+  auto src = openSource(file, options.threads);
   const std::filesystem::path dir = file.parent_path();
   MtlReader readMtl = [&](const std::string& mtl) -> std::optional<std::string> {
     const std::filesystem::path p = options.mtl && mtl == options.mtl->string() ? *options.mtl : dir / mtl;
