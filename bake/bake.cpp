@@ -246,8 +246,10 @@ BakeReport bake(const BakeOptions& opt) {
   if (opt.progress) opt.progress("writing", 0.0);
   const std::string bytes = stage("encoding " + opt.output.string(),
                                   [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
+  rep.encodeSeconds = since(t0);
   AtomicFile sceneFile(opt.output);
   sceneFile.write(bytes.data(), bytes.size());
+  rep.fileWriteSeconds = since(t0) - rep.encodeSeconds;
   sceneFile.sync();
   for (size_t k = 0; k < textures.size(); ++k) {
     const bool existed = std::filesystem::exists(textures[k]->target(), ec);
