@@ -140,8 +140,10 @@ BakeReport bake(const BakeOptions& opt) {
     oo.threads = threads;
     oo.mtl = opt.mtl;
     oo.creaseDeg = opt.creaseDeg;
-    if (opt.progress)
+    if (opt.progress) {
       oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
+      oo.weldProgress = [&](double f) { opt.progress("welding", f); };
+    }
     scene = stage("reading " + opt.input.string(), [&] { return loadObj(opt.input, oo, &rep.obj); });
     rep.parseSeconds = rep.obj.parseSeconds;
     rep.weldSeconds = rep.obj.weldSeconds;

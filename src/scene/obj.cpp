@@ -358,11 +358,24 @@ Scene ObjParser::finish() {
     std::vector<Corner>().swap(builds_[i].corners);
   };
   const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };
+  double all = 0, done = 0;  // corners
+  for (const MeshBuild& b : builds_) all += double(b.corners.size());
+  auto progress = [&](double corners) {
+    done += corners;
+    if (opt_.weldProgress) opt_.weldProgress(all > 0 ? done / all : 1.0);
+  };
+  progress(0);
   parallelFor(builds_.size(), opt_.threads, [&](size_t i) {
     if (!large(i)) weld(i, 1);
   });
+  for (size_t i = 0; i < builds_.size(); ++i) done += large(i) ? 0.0 : double(counts[i].triangles + counts[i].degenerate) * 3;
+  progress(0);
   for (size_t i = 0; i < builds_.size(); ++i)
-    if (large(i)) weld(i, opt_.threads);
+    if (large(i)) {
+      const double corners = double(builds_[i].corners.size());
+      weld(i, opt_.threads);
+      progress(corners);
+    }
 
   for (size_t i = 0; i < builds_.size(); ++i) {
     stats_.verticesBeforeWeld += (counts[i].triangles + counts[i].degenerate) * 3;
