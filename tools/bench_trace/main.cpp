@@ -634,9 +634,11 @@ void printProfile(const Bvh& bvh, const Embree& em, const Rays& all, const Optio
       "| our passes a packet: box / triangle | ours again at once, less a call's: ns a pass |\n|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<RaySet> sets = all.sets();
   sets.insert(sets.begin(), RaySet{"turned round (miss the root: a call's fixed cost)", &away, false, PacketKind::Coherent});
+  std::vector<double> box(sets.size()), tri(sets.size());  // passes a packet, counted once a set
   for (unsigned th : counts) {
     double fixedAgain = 0.0;  // ours, a packet that misses the root, again at once
-    for (const RaySet& s : sets) {
+    for (size_t k = 0; k < sets.size(); ++k) {
+      const RaySet& s = sets[k];
       const std::vector<Ray>& rays = *s.rays;
       const size_t packets = (rays.size() + 7) / 8;
       auto ours = [&](size_t i) {
@@ -659,21 +661,22 @@ void printProfile(const Bvh& bvh, const Embree& em, const Rays& all, const Optio
       }
       const double ns = 1e9 * double(th) / double(packets);
       const double oursOnce = t[0] * ns, oursAgain = (t[1] - t[0]) * ns, emOnce = t[2] * ns, emAgain = (t[3] - t[2]) * ns;
-      // Passes a packet, counted (one thread, the counting traversal: the same decisions).
-      Bvh::setCounting(true);
-      Bvh::counters() = {};
-      for (size_t i = 0; i < packets; ++i) ours(i);
-      const BvhCounters c = Bvh::counters();
-      Bvh::counters() = {};
-      Bvh::setCounting(false);
-      const double box = double(c.intervalTests + c.childTests + c.nodes) / double(packets);
-      const double tri = double(c.triangleTests + c.packs) / double(packets);
+      if (th == counts[0]) {  // passes a packet, counted (one thread, the counting traversal: the same decisions)
+        Bvh::setCounting(true);
+        Bvh::counters() = {};
+        for (size_t i = 0; i < packets; ++i) ours(i);
+        const BvhCounters c = Bvh::counters();
+        Bvh::counters() = {};
+        Bvh::setCounting(false);
+        box[k] = double(c.intervalTests + c.childTests + c.nodes) / double(packets);
+        tri[k] = double(c.triangleTests + c.packs) / double(packets);
+      }
       char perPass[32] = "–";
       if (s.rays == &away) fixedAgain = oursAgain;
-      else std::snprintf(perPass, sizeof perPass, "%.1f", (oursAgain - fixedAgain) / std::max(1e-9, box + tri));
+      else std::snprintf(perPass, sizeof perPass, "%.1f", (oursAgain - fixedAgain) / std::max(1e-9, box[k] + tri[k]));
       std::printf("| %s | %u | %.0f | %.0f | %.0f (%.0f %%) | %.0f | %.0f | %.0f (%.0f %%) | %.1f / %.1f | %s |\n", s.name, th,
                   oursOnce, oursAgain, oursOnce - oursAgain, 100.0 * (oursOnce - oursAgain) / oursOnce, emOnce, emAgain,
-                  emOnce - emAgain, 100.0 * (emOnce - emAgain) / emOnce, box, tri, perPass);
+                  emOnce - emAgain, 100.0 * (emOnce - emAgain) / emOnce, box[k], tri[k], perPass);
     }
   }
 }
