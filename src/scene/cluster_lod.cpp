@@ -70,8 +70,6 @@ std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
 // in fixed pieces of kGroupPiece clusters, each on its own (all cores; the same groups for any thread
 // count): a cluster's neighbours in another piece are not considered.
 constexpr uint32_t kGroupPiece = 256;
-// The longest edge a simplification makes, in units of the error it reports (see buildClusterLod).
-constexpr float kEdgePerError = 8.0f;
 std::vector<std::vector<uint32_t>> groupClusters(const std::vector<Indices>& clusters, uint32_t first, uint32_t end) {
   const uint32_t n = end - first;  // local numbering: cluster first + i is i
   std::unordered_map<uint64_t, uint32_t> edgeOwner;
@@ -276,9 +274,9 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       r.stats.trianglesOut = uint32_t(simpler.size() / 3);
       // The error also bounds the size of the triangles the simplification made: where it moves no
       // surface (a flat floor: error 0) it would otherwise make triangles that are drawn at any distance,
-      // however many pixels they cover. So a triangle of the cut spans at most kEdgePerError × the
+      // however many pixels they cover. So a triangle of the cut spans at most kLodEdgePerError × the
       // threshold in pixels (fewer where it is farther than its sphere's nearest point).
-      r.stats.edgeError = longestNewEdge(tris, simpler, mesh) / kEdgePerError;
+      r.stats.edgeError = longestNewEdge(tris, simpler, mesh) / kLodEdgePerError;
       r.error = std::max(r.error, r.stats.edgeError);
       r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
       r.clusters = split(simpler, mesh);

@@ -187,7 +187,7 @@ void printCut(const Scene& scene, const View& v, float threshold) {
 
 int main(int argc, char** argv) {
   CLI::App app{"rtr-lod-cut: the level-of-detail cut rtr-view would draw, per level of the hierarchy (CPU)"};
-  std::string file, camera, size = "3840x2160";
+  std::string file, camera, size = "3840x2160", only;
   std::vector<float> thresholds{1.0f};
   float fov = 0.0f;
   bool rebuild = false;
@@ -197,23 +197,12 @@ int main(int argc, char** argv) {
   app.add_option("--fov", fov, "vertical field of view, degrees (default: as rtr-view)")->check(cli::number(1, 179));
   app.add_option("--size", size, "WxH of the image");
   app.add_option("--lod-error", thresholds, "thresholds in pixels, repeatable")->check(cli::number(0, 1e6));
+  app.add_option("--mesh", only, "only the mesh of this name (a scene without instances)");
   app.add_flag("--rebuild", rebuild, "build the hierarchy again (prints the build per level)");
   app.add_option("--threads", threads, "for --rebuild (0: all cores)")->check(cli::integer(0, 1024));
   return cli::run(app, argc, argv, [&] {
     const cli::Size wh = cli::parseSize("--size", size);
     Scene scene = loadScene(file);
-    if (rebuild || std::all_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels == 0; })) {
-      buildMissingClusters(scene);
-      std::vector<LodGroupStats> stats;
-      const auto t0 = std::chrono::steady_clock::now();
-      for (Mesh& m : scene.meshes) {
-        if (m.clusters.empty()) continue;
-        const bool cones = m.material >= scene.materials.size() || conesCull(scene.materials[m.material]);
-        m.lod = buildClusterLod(m, cones, threads, &stats);
-      }
-      std::printf("hierarchy built in %.3f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      printBuild(stats);
-    }
     Lens lens;
     if (fov > 0) lens.fovYDeg = fov;
     else if (camera.empty() && scene.defaultView && scene.defaultFovYDeg > 0.0f) lens.fovYDeg = scene.defaultFovYDeg;
@@ -228,6 +217,23 @@ int main(int argc, char** argv) {
                  lens.zNear,
                  wh.width,
                  wh.height};
+    if (!only.empty()) {  // the view stays that of the whole scene
+      if (!scene.instances.empty()) throw UsageError("--mesh: " + file + " places its meshes by instances");
+      std::erase_if(scene.meshes, [&](const Mesh& m) { return m.name != only; });
+      if (scene.meshes.empty()) throw UsageError("--mesh: " + file + " has no mesh named '" + only + "'");
+    }
+    if (rebuild || std::all_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels == 0; })) {
+      buildMissingClusters(scene);
+      std::vector<LodGroupStats> stats;
+      const auto t0 = std::chrono::steady_clock::now();
+      for (Mesh& m : scene.meshes) {
+        if (m.clusters.empty()) continue;
+        const bool cones = m.material >= scene.materials.size() || conesCull(scene.materials[m.material]);
+        m.lod = buildClusterLod(m, cones, threads, &stats);
+      }
+      std::printf("hierarchy built in %.3f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      printBuild(stats);
+    }
     size_t triangles = 0;
     for (const Mesh& m : scene.meshes) triangles += m.triangleCount();
     std::printf("%s: %zu meshes, %zu triangles; eye %s, fovY %g, %ux%u, %.1f px a unit at distance 1, near %g\n", file.c_str(),
