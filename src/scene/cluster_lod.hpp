@@ -14,11 +14,10 @@ namespace rtr {
 
 // The longest edge a simplification makes, in units of the error it reports: a triangle the simplifier
 // made spans at most this many times the threshold in pixels where it is drawn. Its geometric error
-// alone lets flat and ruled surfaces (floors, walls, columns) collapse into triangles of any size; 8 kept
-// them under the compute rasteriser's 256-pixel box at 1 px, but the slivers a simplification with
-// locked borders makes span its group, so the whole group had to be under 8 px and a 4K cut of the
-// 100M-triangle temple kept its floor and columns whole (docs/virtual-geometry.md, measured by
-// rtr-lod-cut); at 32 the tile pass's work stayed the same there.
+// alone lets flat and ruled surfaces (floors, walls, columns) collapse into triangles of any size. With 8
+// the slivers a simplification with locked borders makes (they span its group) held whole groups under
+// a few pixels, and the temple's floor and columns stayed at full detail; 32 halves the 10M temple's 4K
+// cut with the tile pass's work within 2 % (docs/virtual-geometry.md, measured with rtr-lod-cut).
 constexpr float kLodEdgePerError = 32.0f;
 
 // What the build did with one group of clusters (rtr-lod-cut prints them per level): how far it simplified
