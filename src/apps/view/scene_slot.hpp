@@ -61,7 +61,7 @@ class SceneSlot {
   std::unique_ptr<TraceOverlay> traced_;
   std::future<Scene> loading_;
   std::string loadingPath_;
-  double texturesInAt_ = 0;  // from process start; 0: not yet
+  double texturesInAt_ = 0, firstTextureAt_ = 0;  // from process start; 0: not yet
 };
 
 // --watch: edited shaders recompiled twice a second; a failure keeps the running pipelines and is shown.

@@ -169,6 +169,7 @@ int runWindowed(const ViewOptions& opts) {
                        shaders.error(),
                        render::maxAnisotropy(ctx),
                        slot.gpu().texturesDecoded(),
+                       slot.gpu().texturesIn(),
                        !slot.gpu().texturesReady(),
                        clock.phases(),
                        clock.totalMs(),
