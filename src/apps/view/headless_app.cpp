@@ -158,7 +158,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
                  st.mipGpuMs);
   if (wait && textureCache)
     std::fprintf(stderr, "; texture cache: %u hits, %u misses (%s)", st.cacheHits, st.cacheMisses, textureCache->dir().c_str());
-  else if (st.textures) std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
+  else if (!wait && st.textures)
+    std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
   std::fprintf(stderr, "\n");
   const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(startLens(o, scene), scene.bounds(), pose);
@@ -189,20 +190,21 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   int rendered = first ? 1 : 0;
   double firstTexturedAt = 0, allInAt = 0;
   while (!wait && !gpuScene.texturesReady() && (rendered < o.frames || o.timings)) {
-    if (gpuScene.updateTextures()) allInAt = render::msSinceProcessStart();
+    gpuScene.updateTextures();
     const size_t in = gpuScene.texturesIn();
     const auto t = Clock::now();
     first = renderer.render(pose, lens, settings, 1);
     ++rendered;
     if (in > 0 && firstTexturedAt == 0) firstTexturedAt = render::msSinceProcessStart();
+    if (in == st.textures) allInAt = render::msSinceProcessStart();  // the frame with every texture is done
     if (o.timings)
       std::fprintf(stderr, "rtr-view: frame %d done at %.0f ms: %.1f ms, textures in %zu/%u\n", rendered,
                    render::msSinceProcessStart(), since(t), in, st.textures);
   }
-  if (gpuScene.updateTextures(true)) allInAt = render::msSinceProcessStart();
+  if (gpuScene.updateTextures(true) && allInAt == 0) allInAt = render::msSinceProcessStart();
   if (!wait && o.timings && st.textures)  // how long the textures took, after the first frame
     std::fprintf(stderr,
-                 "rtr-view: textures in at %.0f ms from process start (the first frame with some at %.0f ms): decode %.0f "
+                 "rtr-view: textures in at %.0f ms from process start (the first frame with some done at %.0f ms): decode %.0f "
                  "ms (worker threads), upload and mips %.0f ms (mips %.3f ms GPU); texture cache: %u hits, %u misses\n",
                  allInAt, firstTexturedAt, st.decodeMs, st.textureUploadMs, st.mipGpuMs, st.cacheHits, st.cacheMisses);
   if (o.bench > 0) {
