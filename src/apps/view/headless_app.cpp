@@ -141,6 +141,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   const std::unique_ptr<TextureCache> textureCache = cli::textureCache(!o.textureCache);
   render::GpuScene gpuScene(ctx, scene, choice.mips, progress, render::GeometryUpload::Auto,
                             wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred, textureCache.get());
+  gpuScene.setUploadBudget(size_t(o.textureBatchMb) << 20);
   const auto& st = gpuScene.stats();  // the texture phases: once they are in
   if (wait) timeline.add("texture decode", st.decodeMs);
   timeline.add("geometry upload", st.geometryMs);
