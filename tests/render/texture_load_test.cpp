@@ -114,7 +114,6 @@ TEST_F(VulkanTest, StreamedTexturesArriveOneByOneShowingFactorsUntilThen) {
   std::vector<uint32_t> gpuIndex(scene.textures.size(), UINT32_MAX);
   const std::vector<uint32_t> used = sampledTextures(scene);
   for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
-  const uint32_t bits = b.renderer().primitiveBits();
   while (streamed.texturesDecoded() < streamed.textureCount()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
 
   size_t mixedFrames = 0, before = 0;
@@ -129,7 +128,7 @@ TEST_F(VulkanTest, StreamedTexturesArriveOneByOneShowingFactorsUntilThen) {
     size_t shownIn = 0, shownFactor = 0, wrong = 0;
     for (uint32_t i = 0; i < kW * kH; ++i) {
       if (ids[i] == VIS_EMPTY) continue;
-      const Material& m = scene.materials.at(drawMaterial.at(ids[i] >> bits));
+      const Material& m = scene.materials.at(drawMaterial.at(streamed.decodeVisId(ids[i]).first));
       if (m.texture(TextureSlot::BaseColor) == kNoTexture) continue;
       if (streamed.textureIn(gpuIndex.at(m.texture(TextureSlot::BaseColor)))) {
         ++shownIn;
