@@ -41,7 +41,7 @@ std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const
 }
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), texturesBound_(scene.texturesReady()), post_(ctx) {
+    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), arrivalsSeen_(scene.textureArrivals()), post_(ctx) {
   makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 13);  // at most: ComputeRaster::record's nine passes, shade, transparent, post
@@ -229,23 +229,36 @@ void Renderer::makeTextureInfos() {
   }
 }
 
-void Renderer::writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set) const {
-  if (set && !textureInfos_.empty()) vk::DescriptorWriter(ctx_, layout, 1, set).images(0, textureInfos_).commit();
+// The textures that are in (a view), or of those only the ones in `only`: runs of consecutive elements.
+void Renderer::writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set, const std::vector<uint8_t>* only) const {
+  if (!set) return;
+  vk::DescriptorWriter w(ctx_, layout, 1, set);
+  for (size_t i = 0; i < textureInfos_.size();) {
+    auto wanted = [&](size_t k) { return textureInfos_[k].imageView && (!only || (*only)[k]); };
+    if (!wanted(i)) {
+      ++i;
+      continue;
+    }
+    const size_t first = i;
+    while (i < textureInfos_.size() && wanted(i)) ++i;
+    w.images(0, {textureInfos_.begin() + first, textureInfos_.begin() + i}, uint32_t(first));
+  }
+  w.commit();
 }
 
-void Renderer::writeTextureSets() {
+void Renderer::writeTextureSets(const std::vector<uint8_t>* only) {
   for (auto& set : pipelines_) {
     if (!set) continue;
     for (ScenePipelines& p : *set)
       if (p.pipeline && p.pipeline->layout.setCount() > 1)
-        for (uint32_t frame = 0; frame < framesInFlight_; ++frame) writeTextures(p.pipeline->layout, p.sets.get(1, frame));
+        for (uint32_t frame = 0; frame < framesInFlight_; ++frame) writeTextures(p.pipeline->layout, p.sets.get(1, frame), only);
   }
   for (VisShade& v : shade_)
-    if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1));
+    if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1), only);
   if (raster_)
-    for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set);
+    for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set, only);
   if (transparency_)
-    for (const auto& [layout, set] : transparency_->textureSets()) writeTextures(*layout, set);
+    for (const auto& [layout, set] : transparency_->textureSets()) writeTextures(*layout, set, only);
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -344,15 +357,25 @@ void Renderer::frame(FrameContext& fc) {
   const Lens& lens = fc.lens;
   const RenderSettings& s = fc.settings;
   const RenderTarget& target = fc.target;
-  // Every texture set is written again once no frame uses them, for new samplers (samplers are cheap; a
-  // user's change in the panel) or the textures of a deferred load arriving.
-  const bool arrived = scene_.texturesReady() && !texturesBound_;
-  if (s.sampler != samplerSettings_ || arrived) {
+  // Every texture set is written again once no frame uses them for new samplers (samplers are cheap; a
+  // user's change in the panel). Textures of a deferred load that came in since the last frame: only their
+  // elements are written, which no pending frame uses (their materials' slots pointed at none until the
+  // copy GpuScene submitted after those frames), so frames in flight go on; where the device does not
+  // allow that, once they are done.
+  if (s.sampler != samplerSettings_) {
     VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
     samplerSettings_ = s.sampler;
-    texturesBound_ = scene_.texturesReady();
+    arrivalsSeen_ = scene_.textureArrivals();
     makeTextureInfos();
     writeTextureSets();
+  } else if (scene_.textureArrivals() != arrivalsSeen_) {
+    if (!ctx_.updateUnusedWhilePending()) VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+    arrivalsSeen_ = scene_.textureArrivals();
+    const std::vector<VkImageView> views = scene_.textureViews();
+    std::vector<uint8_t> fresh(views.size(), 0);
+    for (size_t i = 0; i < views.size(); ++i)
+      if (views[i] && !textureInfos_[i].imageView) fresh[i] = 1, textureInfos_[i].imageView = views[i];
+    writeTextureSets(&fresh);
   }
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
   const RasterPath raster = visibility ? rasterFor(s) : RasterPath::Auto;

@@ -156,8 +156,9 @@ class Renderer {
   // The scene's texture array, as every pipeline that samples it binds it (set 1, binding 0): each
   // texture with a sampler made from its own SamplerDesc and the settings (one per distinct pair).
   void makeTextureInfos();
-  void writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set) const;  // the one writer
-  void writeTextureSets();  // every pipeline built: after a settings change or the textures' arrival
+  // The one writer: every texture that is in, or those of them marked in `only`.
+  void writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set, const std::vector<uint8_t>* only = nullptr) const;
+  void writeTextureSets(const std::vector<uint8_t>* only = nullptr);  // of every pipeline built
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
@@ -165,7 +166,7 @@ class Renderer {
   SamplerSettings samplerSettings_;
   std::vector<vk::Sampler> samplers_;  // made from samplerSettings_, one per distinct SamplerDesc
   std::vector<VkDescriptorImageInfo> textureInfos_;
-  bool texturesBound_;               // the scene's textures were ready when the texture sets were written
+  uint64_t arrivalsSeen_;            // the scene's textureArrivals() when the texture sets were last written
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   std::array<VisShade, 3> shade_;        // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
