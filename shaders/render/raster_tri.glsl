@@ -179,6 +179,19 @@ bool cutOut(Tri t, ivec2 px, vec3 e) {
   return maskCuts(m, textureGrad(textures[nonuniformEXT(m.textures.w)], uv, gx, gy));
 }
 
+// Whether the tile at `lo` (RASTER_TILE² pixels, clipped to the box) holds a pixel centre inside all three
+// edges. Each edge function is affine, so its largest value over the tile's centres is at a corner: a tile
+// all of whose corners lie outside one edge has nothing to draw (large triangles' boxes are up to half empty).
+bool tileTouches(Tri t, ivec2 lo) {
+  const ivec2 c0 = lo * kOne + kOne / 2, c1 = min(lo + RASTER_TILE - 1, t.box.zw) * kOne + kOne / 2;
+  for (int k = 0; k < 3; ++k) {
+    const ivec2 a = t.v[k == 2 ? 0 : k + 1], b = t.v[k == 0 ? 2 : k - 1];
+    if (max(max(edge(a, b, c0), edge(a, b, ivec2(c1.x, c0.y))), max(edge(a, b, ivec2(c0.x, c1.y)), edge(a, b, c1))) < 0l)
+      return false;
+  }
+  return true;
+}
+
 void rasterPixel(Tri t, ivec2 px) {
   const ivec2 c = px * kOne + kOne / 2;
   const int64_t e0 = edge(t.v[1], t.v[2], c), e1 = edge(t.v[2], t.v[0], c), e2 = edge(t.v[0], t.v[1], c);
