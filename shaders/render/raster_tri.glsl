@@ -84,7 +84,7 @@ uint setup(uint clusterIndex, uint local, uint piece, out Tri t, out uint pieces
   const GpuCluster c = clusters[clusterIndex];
   const GpuInstance inst = instances[c.instance];
   const GpuDraw d = draws[inst.info.x];
-  t.id = (c.instance << pc.primitiveBits) | (c.firstTriangle + local);
+  t.id = inst.info.z + c.firstTriangle + local;
   t.material = NO_TEXTURE;
   const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
   if (!kAlphaMask && masked) return kHardware;

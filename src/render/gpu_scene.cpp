@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cstring>
 #include <functional>
@@ -65,6 +66,9 @@ struct GeometryPlan {
   std::vector<shader::GpuInstance> instances;
   std::vector<shader::GpuCluster> clusters;
   std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
+  std::vector<uint32_t> idPages;            // visIdPages(): the instance holding each page's first id
+  std::vector<shader::GpuCullInstance> cullInstances;
+  std::vector<shader::GpuCullLevel> cullLevels;
   size_t baseClusters = 0;
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
@@ -253,7 +257,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   }
   const std::vector<Instance> instances = gpuInstances(scene);
   const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
-  Bounds box;  // of the draw being extended
+  std::vector<uint32_t> cullIndex(instances.size(), UINT32_MAX);  // its GpuCullInstance
+  std::vector<std::array<glm::uvec2, 2>> runs(instances.size());  // per GpuCullInstance: full detail, levels above
+  Bounds box;                                                     // of the draw being extended
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
     const Mesh& m = scene.meshes[in.mesh];
@@ -270,6 +276,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     }
     const size_t first = p.clusters.size();
     appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
+    cullIndex[i] = uint32_t(p.cullInstances.size());
+    p.cullInstances.push_back({glm::vec4(0.0f), glm::vec4(0.0f), glm::uvec4(0)});
+    runs[cullIndex[i]] = {glm::uvec2(first, p.clusters.size() - first), glm::uvec2(0)};
     if (lods) appendClusterLods(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), false, first, p.clusters, p.lods);
     std::vector<DrawItem>& list = draws_[size_t(md.kind)];
     if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
@@ -282,11 +291,74 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     if (!box.empty()) list.back().center = box.center();
   }
   p.baseClusters = p.clusters.size();
+  // Visibility ids (frame.h): each drawn instance its own range, as long as its draw's primitives, in order.
+  uint64_t ids = 0;
+  firstIds_.clear();
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    firstIds_.push_back(ids);
+    p.instances[i].info.z = uint32_t(ids);
+    if (!scene.materials.at(m.material).blended()) ids += meshDraw[instances[i].mesh]->item.primitives;
+  }
+  visIdCount_ = ids;
+  // Pages of 2^shift ids, at most 2^16 + 1 of them: page k's entry is the last instance whose range
+  // starts at or before k << shift, so the instance of id lies between the entries of id's page and the next.
+  idPageShift_ = uint32_t(std::max(6, int(std::bit_width(std::max<uint64_t>(ids, 1))) - 16));
+  if (ids <= kMaxVisIds)
+    for (uint64_t page = 0, i = 0; page <= ((std::max<uint64_t>(ids, 1) - 1) >> idPageShift_) + 1; ++page) {
+      while (i + 1 < firstIds_.size() && firstIds_[i + 1] <= page << idPageShift_) ++i;
+      p.idPages.push_back(uint32_t(i));
+    }
+  if (p.idPages.empty()) p.idPages.push_back(0);
   for (uint32_t i = 0; lods && i < instances.size(); ++i) {  // the hierarchies' clusters after all full-detail ones
     const Mesh& m = scene.meshes[instances[i].mesh];
     if (scene.materials.at(m.material).blended()) continue;  // drawn by the transparency pass, no clusters
     const uint32_t flags = meshDraw[instances[i].mesh]->flags | (mirrored(instances[i].transform) ? CLUSTER_MIRRORED : 0u);
+    const size_t first = p.clusters.size();
     appendClusterLods(m, instances[i].transform, i, flags, true, 0, p.clusters, p.lods);
+    if (cullIndex[i] != UINT32_MAX) runs[cullIndex[i]][1] = glm::uvec2(first, p.clusters.size() - first);
+  }
+  // Each instance's spheres (around the box of the spheres they hold, holding each) and levels.
+  auto enclose = [&](const std::array<glm::uvec2, 2>& rs, auto&& spheres) {
+    Bounds b;
+    for (const glm::uvec2 run : rs)
+      for (size_t c = run.x; c < run.x + run.y; ++c)
+        spheres(c, [&](glm::vec4 s) { b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w); });
+    float r = 0.0f;
+    for (const glm::uvec2 run : rs)
+      for (size_t c = run.x; c < run.x + run.y; ++c)
+        spheres(c, [&](glm::vec4 s) { r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w); });
+    return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
+  };
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    if (cullIndex[i] == UINT32_MAX) continue;
+    shader::GpuCullInstance& ci = p.cullInstances[cullIndex[i]];
+    const std::array<glm::uvec2, 2>& rs = runs[cullIndex[i]];
+    ci.sphere = enclose(rs, [&](size_t c, auto&& add) { add(p.clusters[c].sphere); });
+    ci.lodSphere = p.lods.empty() ? ci.sphere : enclose(rs, [&](size_t c, auto&& add) {
+      add(p.lods[c].sphere);
+      if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) add(p.lods[c].parentSphere);
+    });
+    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level).
+    ci.levels = glm::uvec4(p.cullLevels.size(), 0, 0, 0);
+    auto level = [&](uint32_t first, uint32_t count) {
+      shader::GpuCullLevel v{first, count, shader::LOD_ERROR_INFINITE, 0.0f};
+      for (size_t c = first; c < first + count; ++c) {
+        v.minError = std::min(v.minError, p.lods.empty() ? 0.0f : p.lods[c].error.x);
+        v.maxParentError = std::max(v.maxParentError, p.lods.empty() ? shader::LOD_ERROR_INFINITE : p.lods[c].error.y);
+      }
+      p.cullLevels.push_back(v);
+      ++ci.levels.y;
+    };
+    level(rs[0].x, rs[0].y);
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    uint32_t c = rs[1].x, run = 0, at = 0;
+    for (size_t k = 0; k < m.lod.clusters.size() && rs[1].y > 0; ++k) {
+      if (m.lod.clusters[k].level == 0) continue;
+      if (run > 0 && m.lod.clusters[k].level != at) level(c - run, run), run = 0;
+      at = m.lod.clusters[k].level, ++run, ++c;
+    }
+    if (run > 0) level(c - run, run);
   }
   stats_.instances = uint32_t(instances.size());
   stats_.vertices = uint32_t(p.vertices);
@@ -343,7 +415,25 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kLod, kTargets };
+  enum {
+    kPos,
+    kNrm,
+    kUv,
+    kI16,
+    kI32,
+    kMat,
+    kDraw,
+    kInst,
+    kCluster,
+    kUv1,
+    kTan,
+    kCol,
+    kLod,
+    kIds,
+    kCullInst,
+    kCullLevel,
+    kTargets
+  };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
@@ -357,15 +447,21 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&texcoords1_, plan.anyUv1 ? vertices * 8 : 0},
                                         {&tangents_, plan.anyTangents ? vertices * 16 : 0},
                                         {&colors_, plan.anyColors ? vertices * 16 : 0},
-                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()}}};
+                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()},
+                                        {&visIdPages_, bytes(plan.idPages), plan.idPages.data()},
+                                        {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()},
+                                        {&cullLevels_, bytes(plan.cullLevels), plan.cullLevels.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
-  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage, kStorage,
-                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions", "normals",  "texcoords",  "indices16", "indices32", "materials",   "draws",
-                                 "instances", "clusters", "texcoords1", "tangents",  "colours",   "cluster lods"};
+  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
+                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage,
+                                                       kStorage, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32", "materials",
+                                 "draws",        "instances", "clusters",       "texcoords1", "tangents",  "colours",
+                                 "cluster lods", "id pages",  "cull instances", "cull levels"};
   clusterCount_ = uint32_t(plan.clusters.size());
   baseClusterCount_ = uint32_t(plan.baseClusters);
+  cullInstanceCount_ = uint32_t(plan.cullInstances.size());
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {
     Target& tg = targets[i];
@@ -445,6 +541,13 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     });
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
+}
+
+std::pair<uint32_t, uint32_t> GpuScene::decodeVisId(uint32_t id) const {
+  const auto next = std::upper_bound(firstIds_.begin(), firstIds_.end(), uint64_t(id));
+  if (next == firstIds_.begin() || id >= visIdCount_) throw Error("visibility id " + std::to_string(id) + " names no instance");
+  const uint32_t instance = uint32_t(next - firstIds_.begin() - 1);
+  return {instance, uint32_t(id - firstIds_[instance])};
 }
 
 GpuScene::~GpuScene() {

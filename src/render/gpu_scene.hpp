@@ -143,8 +143,23 @@ class GpuScene {
   VkBuffer clusters() const { return clusters_.handle(); }
   uint32_t clusterCount() const { return clusterCount_; }
   uint32_t baseClusterCount() const { return baseClusterCount_; }
+  // GpuCullInstance (cluster.h) per instance with clusters: its sphere and its runs of clusters.
+  VkBuffer cullInstances() const { return cullInstances_.handle(); }
+  uint32_t cullInstanceCount() const { return cullInstanceCount_; }
+  VkBuffer cullLevels() const { return cullLevels_.handle(); }  // GpuCullLevel: each instance's, level 0 first
   // GpuClusterLod per GpuCluster where some mesh has a hierarchy (docs/virtual-geometry.md); else null.
   VkBuffer clusterLods() const { return clusterLods_.handle(); }
+  // Visibility ids (frame.h): instance i names the ids [firstId(i), firstId(i) + its draw's primitives),
+  // instances in order, blended ones none. They fit a frame's 32 bits while visIdCount() <= kMaxVisIds;
+  // visIdPages() (uint per page of 2^visIdPageShift() ids, the instance holding the page's first id, then
+  // one more) finds an id's instance in a few steps.
+  static constexpr uint64_t kMaxVisIds = 0xFFFFFFFFu;  // VIS_EMPTY is no id
+  uint64_t visIdCount() const { return visIdCount_; }
+  uint64_t firstId(uint32_t instance) const { return firstIds_.at(instance); }
+  VkBuffer visIdPages() const { return visIdPages_.handle(); }
+  uint32_t visIdPageShift() const { return idPageShift_; }
+  // The instance and the primitive (of its draw) an id names (the CPU's decode, for tests and tools).
+  std::pair<uint32_t, uint32_t> decodeVisId(uint32_t id) const;
   uint32_t textureCount() const { return stats_.textures; }  // also while they load
   // Every texture's view; none until texturesReady(). The renderer pairs them with samplers (TextureSet).
   std::vector<VkImageView> textureViews() const;
@@ -187,8 +202,11 @@ class GpuScene {
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
-  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_;
-  uint32_t clusterCount_ = 0, baseClusterCount_ = 0;
+  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_, cullInstances_, cullLevels_;
+  uint32_t clusterCount_ = 0, baseClusterCount_ = 0, cullInstanceCount_ = 0;
+  std::vector<uint64_t> firstIds_;  // per instance
+  uint64_t visIdCount_ = 0;
+  uint32_t idPageShift_ = 0;
   std::vector<vk::Image> textures_;
   std::vector<SamplerDesc> samplers_;  // of each texture (Texture::sampler)
   struct PendingUpload {               // alive until its submission completed

@@ -1,11 +1,11 @@
 #include "render/renderer.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cstdio>
 #include <cstring>
 
 #include "core/error.hpp"
+#include "raster.h"
 #include "variants.h"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
@@ -48,15 +48,8 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
-  // Instance index in the high bits (just enough that no id is VIS_EMPTY), primitive index in the rest.
-  uint32_t maxTriangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& d : scene.draws(DrawKind(k))) {
-      maxTriangles = std::max(maxTriangles, d.primitives);
-      triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
-    }
-  const uint32_t instances = scene.instanceCount();
-  primitiveBits_ = 32 - uint32_t(std::bit_width(instances));
+    for (const DrawItem& d : scene.draws(DrawKind(k))) triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
   cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   canHardware_ = features.geometryShader;
   canCompute_ = ComputeRaster::supported(ctx);
@@ -64,7 +57,14 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
     transparency_.emplace(ctx, scene);
     writeTextureSets();
   }
-  canUseVisibility_ = (canHardware_ || canCompute_) && instances > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
+  // The compute rasteriser's hand-off and tile lists name a cluster record in the bits above a triangle's.
+  canCompute_ = canCompute_ && scene.clusterCount() < (1u << (32 - RASTER_LOCAL_BITS));
+  if (scene.visIdCount() > GpuScene::kMaxVisIds)
+    visibilityRefusal_ = "the scene's " + std::to_string(scene.visIdCount()) +
+                         " triangle ids (each instance's triangles, hierarchy included) do not fit the visibility "
+                         "buffer's 32 bits";
+  else if (!canHardware_ && !canCompute_) visibilityRefusal_ = "the device has neither rasteriser of the visibility path";
+  canUseVisibility_ = scene.instanceCount() > 0 && visibilityRefusal_.empty();
 }
 
 ShadingPath Renderer::pathFor(const RenderSettings& s) const {
@@ -299,7 +299,7 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
         vkCmdBindIndexBuffer(cb, d.indexType == VK_INDEX_TYPE_UINT16 ? scene_.indices16() : scene_.indices32(), 0, d.indexType);
         bound = d.indexType;
       }
-      pl.push(cb, shader::DrawPush{d.material, primitiveBits_});
+      if (!pl.layout.interface().pushConstants.empty()) pl.push(cb, shader::DrawPush{d.material, 0});  // vis: masked only
       vkCmdSetFrontFace(cb, d.mirrored ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE);
       vkCmdDrawIndexed(cb, d.indexCount, d.instanceCount, d.firstIndex, d.vertexOffset, d.firstInstance);
     }
@@ -322,6 +322,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(5, i32)
       .buffer(6, i16)
       .buffer(10, scene_.instances())
+      .buffer(15, scene_.visIdPages())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
   // glTF's streams, in the MATERIAL_EXTRAS variant only: any buffer where the scene has none (nothing reads it).
   if (c.layout.hasBinding(0, 13)) w.buffer(13, scene_.colors() ? scene_.colors() : scene_.positions());
@@ -334,7 +335,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
     if (c.layout.hasBinding(0, 12)) w.buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions());
   }
   w.push(cb, c);
-  c.push(cb, shader::VisShadePush{primitiveBits_});
+  c.push(cb, shader::VisShadePush{scene_.visIdPageShift()});
   if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade.textures.get(1));
   c.dispatch(cb, extent_.width, extent_.height);  // one thread per pixel
 }
@@ -427,7 +428,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute) {
     const float pixelsPerUnit = float(target.extent.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
     const CullCamera cam{u.viewProj, pose.position, lens.orthographic, s.lodError, pixelsPerUnit, lens.zNear};
-    raster_->record(cb, uniforms_, primitiveBits_, timer, frame, cam, s.cull);
+    raster_->record(cb, uniforms_, timer, frame, cam, s.cull);
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
   } else {
     rasterPass(cb, frame, set, pose.position, s.background, backdrop);

@@ -119,7 +119,8 @@ class Renderer {
   // Records a copy of the last frame's visibility ids into `dst` (host-visible, 8 bytes a pixel at most);
   // returns the bytes per pixel written: 4 (hardware: the id) or 8 (compute: id in the low half).
   uint32_t copyIds(VkCommandBuffer cb, VkBuffer dst);
-  uint32_t primitiveBits() const { return primitiveBits_; }
+  // Why the scene cannot take the visibility path on this device (frames are forward); empty if it can.
+  const std::string& visibilityRefusal() const { return visibilityRefusal_; }
   // The culling counts of the last completed use of `frame`; none where it did not cull.
   std::optional<ComputeRaster::CullStats> cullStats(uint32_t frame) const {
     return raster_ ? raster_->cullStats(frame) : std::nullopt;
@@ -128,6 +129,7 @@ class Renderer {
   std::optional<uint32_t> handOffTriangles(uint32_t frame) const {
     return raster_ ? std::optional(raster_->handOffTriangles(frame)) : std::nullopt;
   }
+  uint32_t handOffCapacity() const { return raster_ ? raster_->handOffCapacity() : 0; }
 
  private:
   struct ScenePipelines {
@@ -174,7 +176,7 @@ class Renderer {
   RasterPath lastRaster_ = RasterPath::Auto;
   bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
   uint64_t triangles_ = 0;
-  uint32_t primitiveBits_ = 0;  // low bits of a visibility id: the primitive index
+  std::string visibilityRefusal_;
   MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;
   vk::Image color_, depth_, vis_;  // vis_ only once the visibility path ran

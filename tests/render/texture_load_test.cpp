@@ -48,11 +48,10 @@ TEST_F(VulkanTest, DeferredTexturesShowFactorsThenMatchAWaitedLoad) {
       if (d.id >= drawMaterial.size()) drawMaterial.resize(d.id + 1, UINT32_MAX);
       drawMaterial[d.id] = d.material;
     }
-  const uint32_t bits = b.renderer().primitiveBits();
   size_t texturedPixels = 0, factorPixels = 0, differFromTextured = 0;
   for (uint32_t i = 0; i < kW * kH; ++i) {
     if (ids[i] == VIS_EMPTY) continue;
-    const Material& m = scene.materials.at(drawMaterial.at(ids[i] >> bits));
+    const Material& m = scene.materials.at(drawMaterial.at(deferred.decodeVisId(ids[i]).first));
     if (m.texture(TextureSlot::BaseColor) == kNoTexture) continue;
     ++texturedPixels;
     bool factor = true, same = true;

@@ -165,6 +165,9 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   render::RenderSettings settings = sceneSettings(o, scene);
   settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  if (settings.shading == render::ShadingPath::Visibility && !renderer.renderer().visibilityRefusal().empty())
+    std::fprintf(stderr, "rtr-view: warning: %s: frames take the forward path\n",
+                 renderer.renderer().visibilityRefusal().c_str());
   const auto env = loadEnvironment(o, ctx);
   renderer.renderer().setEnvironment(env);
   const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
@@ -199,9 +202,15 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
           "occlusion %u (%.1f %%), not in the level-of-detail cut %u; %u triangles listed\n",
           c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone, 100 * c->cone / n, c->occlusion,
           100 * c->occlusion / n, c->lod, c->triangles);
+      std::printf("cull: %u cluster tests (both phases), %u instances culled whole\n", c->tested, c->instancesCulled);
     }
     if (settings.raster != render::RasterPath::Hardware)
-      if (const auto h = renderer.renderer().handOffTriangles(0)) std::printf("raster hw: %u triangles handed off\n", *h);
+      if (const auto h = renderer.renderer().handOffTriangles(0)) {
+        std::printf("raster hw: %u triangles handed off\n", *h);
+        if (*h > renderer.renderer().handOffCapacity())
+          std::fprintf(stderr, "rtr-view: warning: the hand-off list holds %u triangles: %u were not drawn\n",
+                       renderer.renderer().handOffCapacity(), *h - renderer.renderer().handOffCapacity());
+      }
   }
   if (!o.screenshot.empty()) {
     render::HeadlessFrame frame =
