@@ -4,6 +4,8 @@
 // ray with it for perspective-correct barycentrics, and shades with the same brdf.h as pbr.frag.
 // Texture LOD: the texcoord differences to the quad neighbour, like the rasteriser's fine derivatives
 // (docs/shading.md, "Visibility path").
+// MATERIAL_EXTRAS (variants.h): only a scene with glTF's material extras gets the code for them; the
+// others (OBJ, the course's format) sample set 0's texcoords untransformed, as the identity would.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_nonuniform_qualifier : require
 #extension GL_EXT_samplerless_texture_functions : require
@@ -61,6 +63,7 @@ vec3 barycentrics(vec3 dir, vec3 a, vec3 b, vec3 n) {
 // Texcoords of both sets and their differences to the quad neighbours (x, y): uv[0..2] set 0, uv[3..5] set 1.
 vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec2 uv[6], vec4 fallback) {
   if (index == NO_TEXTURE) return fallback;
+  if (!MATERIAL_EXTRAS) return textureGrad(textures[nonuniformEXT(index)], uv[0], uv[1], uv[2]);  // set 0, identity
   const vec4 r0 = m.uvTransform[2 * slot], r1 = m.uvTransform[2 * slot + 1];
   const int k = r0.w > 0.5 ? 3 : 0;
   const mat2 a = mat2(r0.x, r1.x, r0.y, r1.y);  // the transform's linear part (columns)
@@ -113,7 +116,7 @@ void main() {
   const GpuMaterial m = materials[d.material];
   vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
   float roughness = m.roughMetal.x, metalness = m.roughMetal.y, occlusion = 1.0;
-  if ((d.flags & DRAW_COLORS) != 0u) baseColor *= (colors[tri.x] * w.x + colors[tri.y] * w.y + colors[tri.z] * w.z).rgb;
+  if (MATERIAL_EXTRAS && (d.flags & DRAW_COLORS) != 0u) baseColor *= (colors[tri.x] * w.x + colors[tri.y] * w.y + colors[tri.z] * w.z).rgb;
   if (HAS_TEXCOORDS && (d.flags & DRAW_TEXTURED) != 0u) {
     const vec2 t0 = texcoords[tri.x], t1 = texcoords[tri.y], t2 = texcoords[tri.z];
     const vec2 uv = t0 * w.x + t1 * w.y + t2 * w.z;
@@ -126,7 +129,7 @@ void main() {
     const vec2 gx = (t0 * wx.x + t1 * wx.y + t2 * wx.z - uv) * (side.x * scale);
     const vec2 gy = (t0 * wy.x + t1 * wy.y + t2 * wy.z - uv) * (side.y * scale);
     vec2 uvs[6] = vec2[6](uv, gx, gy, uv, gx, gy);
-    if ((d.flags & DRAW_UV1) != 0u) {
+    if (MATERIAL_EXTRAS && (d.flags & DRAW_UV1) != 0u) {
       const vec2 s0 = texcoords1[tri.x], s1 = texcoords1[tri.y], s2 = texcoords1[tri.z];
       uvs[3] = s0 * w.x + s1 * w.y + s2 * w.z;
       uvs[4] = (s0 * wx.x + s1 * wx.y + s2 * wx.z - uvs[3]) * (side.x * scale);
@@ -136,8 +139,8 @@ void main() {
     roughness *= sampleOr(m, m.textures.y, SLOT_ROUGHNESS, uvs, vec4(1.0)).r;
     metalness *= sampleOr(m, m.textures.z, SLOT_METALNESS, uvs, vec4(1.0)).r;
     emissive *= sampleOr(m, m.textures2.x, SLOT_EMISSIVE, uvs, vec4(1.0)).rgb;
-    if (m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m, m.textures2.y, SLOT_OCCLUSION, uvs, vec4(1.0)).r - 1.0);
-    if (m.textures2.z != NO_TEXTURE && (d.flags & DRAW_TANGENTS) != 0u) {
+    if (MATERIAL_EXTRAS && m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m, m.textures2.y, SLOT_OCCLUSION, uvs, vec4(1.0)).r - 1.0);
+    if (MATERIAL_EXTRAS && m.textures2.z != NO_TEXTURE && (d.flags & DRAW_TANGENTS) != 0u) {
       // As material.glsl: t, b = w (n x t), n; the map's xy scaled by normalScale.
       const vec4 tg = tangents[tri.x] * w.x + tangents[tri.y] * w.y + tangents[tri.z] * w.z;
       const vec3 tn = (sampleOr(m, m.textures2.z, SLOT_NORMAL, uvs, vec4(0.5, 0.5, 1.0, 1.0)).xyz * 2.0 - 1.0) *
@@ -149,13 +152,15 @@ void main() {
       if (back) nrm = -nrm;
     }
   }
-  if ((m.textures2.w & MATERIAL_UNLIT) != 0u) {
+  if (MATERIAL_EXTRAS && (m.textures2.w & MATERIAL_UNLIT) != 0u) {
     imageStore(sceneColor, p, vec4(min(baseColor, vec3(kMaxRadiance)), 1.0));
     return;
   }
 
   const vec3 v = normalize(frame.cameraPos.xyz - worldPos);
-  const int brdf = frame.options.x != 0u ? int(frame.options.x) - 1 : (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX : BRDF_BECKMANN;
+  const int brdf = frame.options.x != 0u                                         ? int(frame.options.x) - 1
+                   : MATERIAL_EXTRAS && (m.textures2.w & MATERIAL_GGX) != 0u ? BRDF_GGX
+                                                                              : BRDF_BECKMANN;
   vec3 c = frame.ambient.rgb * clamp(baseColor, vec3(0.0), vec3(1.0)) * occlusion + emissive;
   for (uint i = 0u; i < frame.lightCount.x; ++i) {
     const LightSample ls = lightSample(frame.lights[i], worldPos);  // point, spot or directional (lights.h)

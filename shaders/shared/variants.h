@@ -9,6 +9,8 @@
 #define VARIANT_VIS_BUFFER 2  // vis_shade reads the compute rasteriser's 64-bit buffer, not the id image
 #define VARIANT_ENV 3         // the shaded view adds an environment's light (env_light.glsl) and shows its backdrop
 #define VARIANT_BLEND 4       // pbr.frag in the transparency pass: alpha out, the compute raster's depth tested
+#define VARIANT_MATERIAL_EXTRAS 5  // vis_shade: some draw has glTF's extras (texture transforms, the second uv set,
+                                   // vertex colours, tangents, normal and occlusion maps, unlit, GGX; GpuScene)
 
 #ifndef __cplusplus
 layout(constant_id = VARIANT_TEXCOORDS) const bool HAS_TEXCOORDS = true;
@@ -16,5 +18,6 @@ layout(constant_id = VARIANT_ALPHA_MASK) const bool ALPHA_MASK = false;
 layout(constant_id = VARIANT_VIS_BUFFER) const bool VIS_BUFFER = false;
 layout(constant_id = VARIANT_ENV) const bool HAS_ENV = false;
 layout(constant_id = VARIANT_BLEND) const bool BLEND = false;
+layout(constant_id = VARIANT_MATERIAL_EXTRAS) const bool MATERIAL_EXTRAS = true;
 #endif
 #endif

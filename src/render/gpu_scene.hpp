@@ -143,6 +143,9 @@ class GpuScene {
   VkBuffer texcoords1() const { return texcoords1_.handle(); }
   VkBuffer tangents() const { return tangents_.handle(); }
   VkBuffer colors() const { return colors_.handle(); }
+  // Whether some draw needs what glTF adds to a material (texture transforms, the second uv set, vertex
+  // colours, tangents, normal and occlusion maps, unlit, GGX): the shading pass's MATERIAL_EXTRAS variant.
+  bool materialExtras() const { return materialExtras_; }
   VkBuffer indices16() const { return indices16_.handle(); }
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }
@@ -221,6 +224,7 @@ class GpuScene {
   std::string cacheVariant_;                               // what makes this device's chains (the cache key)
   std::vector<std::optional<TextureCacheKey>> storeKeys_;  // per texture: a cache miss, stored once its chain is made
   std::vector<std::future<void>> storing_;                 // packing and writing them
+  bool materialExtras_ = false;
   bool ready_ = false;                                     // every texture is on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;

@@ -143,9 +143,11 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
   vk::LayoutOptions options{.pushDescriptorSets = {0}};
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
   VisShade v;
-  v.pipeline.emplace(
-      vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
-                              {{VARIANT_TEXCOORDS, textured}, {VARIANT_VIS_BUFFER, fromBuffer}, {VARIANT_ENV, env_ != nullptr}}));
+  v.pipeline.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
+                                             {{VARIANT_TEXCOORDS, textured},
+                                              {VARIANT_VIS_BUFFER, fromBuffer},
+                                              {VARIANT_ENV, env_ != nullptr},
+                                              {VARIANT_MATERIAL_EXTRAS, scene_.materialExtras()}}));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
@@ -333,16 +335,17 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(5, i32)
       .buffer(6, i16)
       .buffer(10, scene_.instances())
-      .buffer(13, scene_.colors() ? scene_.colors() : scene_.positions())
       .buffer(15, scene_.visIdPages())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
+  // glTF's streams, in the MATERIAL_EXTRAS variant only: any buffer where the scene has none (nothing reads it).
+  if (c.layout.hasBinding(0, 13)) w.buffer(13, scene_.colors() ? scene_.colors() : scene_.positions());
   writeEnvironment(w, c.layout, env_.get());
   if (raster == RasterPath::Compute) w.buffer(14, raster_->ids());
   else w.image(7, vis_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   if (c.layout.hasBinding(0, 9)) {  // the textured variant's
     w.buffer(9, scene_.texcoords());
-    w.buffer(11, scene_.texcoords1() ? scene_.texcoords1() : scene_.positions());
-    w.buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions());
+    if (c.layout.hasBinding(0, 11)) w.buffer(11, scene_.texcoords1() ? scene_.texcoords1() : scene_.positions());
+    if (c.layout.hasBinding(0, 12)) w.buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions());
   }
   w.push(cb, c);
   c.push(cb, shader::VisShadePush{scene_.visIdPageShift()});

@@ -79,6 +79,14 @@ TEST(Specialization, EachVariantHasOnlyTheInterfaceItUses) {
       EXPECT_EQ(hasBinding(shade, 0, 7), !buffer);         // the id image
       EXPECT_EQ(hasBinding(shade, 0, 14), bool(buffer));   // the compute rasteriser's buffer
     }
+    // glTF's streams (second uv set, tangents, vertex colours) only in the MATERIAL_EXTRAS variant.
+    for (uint32_t extras : {0u, 1u}) {
+      const vk::PipelineInterface shade =
+          reflect({"vis_shade.comp"}, {{VARIANT_TEXCOORDS, textured}, {VARIANT_MATERIAL_EXTRAS, extras}});
+      EXPECT_EQ(hasBinding(shade, 0, 11), textured && extras);
+      EXPECT_EQ(hasBinding(shade, 0, 12), textured && extras);
+      EXPECT_EQ(hasBinding(shade, 0, 13), bool(extras));
+    }
   }
   for (uint32_t alpha : {0u, 1u}) {
     const vk::PipelineInterface vis = reflect({"vis.vert", "vis.frag"}, {{VARIANT_ALPHA_MASK, alpha}});
