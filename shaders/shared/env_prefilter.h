@@ -127,7 +127,8 @@ struct EnvPush {
   uint srcLevels;   // specular: mip levels of the source cube
   uint level;       // spherical harmonics and the specular sum: the source level read
   uint srcSize;     // specular sum: that level's face size
-  uint pad0, pad1;
+  float nearAngle;  // specular sum: how far from a texel's direction the lobe is summed at that level (radians)
+  uint pad0;
 };
 #define ENV_GROUP 8
 #define ENV_SUM_SLICES 4  // env_specular_sum.comp: threads per output texel
