@@ -5,8 +5,9 @@
 // tiles of 2x2 texels of the 16²-a-face level; each tile within nearAngle (plus the tile's and the
 // workgroup's own radii) of the workgroup's direction is summed over its texels of the fine level
 // (pc.srcSize a face, whose texels are several times smaller than the lobe: EnvironmentMaps picks it),
-// the others over their 16 coarse texels, which are means of the fine ones: every texel of the sphere
-// counts once, the lobe's peak at the fine level's resolution, its tail at the coarse one's.
+// the others over their 4 coarse texels, which are means of the fine ones: every texel of the sphere
+// counts once, the lobe's peak at the fine level's resolution, its tail at the coarse one's; tiles behind
+// every output texel's hemisphere of the workgroup (weight 0) are not read.
 // Entries are gathered in a fixed order into shared memory and summed chunk by chunk; ENV_SUM_SLICES
 // threads share each output texel, each summing a part of every chunk, so that small outputs still fill
 // a GPU.
@@ -27,7 +28,7 @@ layout(push_constant) uniform Push { EnvPush pc; };
 shared vec4 texDir[CHUNK];       // direction, solid angle
 shared vec3 texRadiance[CHUNK];  // radiance x solid angle
 shared vec4 partial[THREADS];
-shared bool fine[6u * TILES * TILES];
+shared uint kind[6u * TILES * TILES];  // of each tile: 0 behind every texel's hemisphere, 1 coarse, 2 fine
 
 vec3 faceDir(uint f, vec2 texel, float size) { return envCubeDir(f, texel / size * 2.0 - 1.0); }
 
@@ -46,7 +47,7 @@ void main() {
   const vec3 n = faceDir(id.z, vec2(id.xy) + 0.5, float(pc.size));
   const float alpha = max(pc.roughness * pc.roughness, BRDF_ALPHA_MIN), a2 = alpha * alpha;
 
-  // Which tiles this workgroup reads at the fine level.
+  // Which tiles this workgroup reads at the fine level, and which not at all (n.l <= 0: weight 0).
   const vec2 wlo = vec2(gl_WorkGroupID.xy * ENV_GROUP), whi = min(wlo + float(ENV_GROUP), vec2(pc.size));
   const vec3 wc = faceDir(id.z, 0.5 * (wlo + whi), float(pc.size));
   const float wr = radius(wc, id.z, wlo, whi, float(pc.size));
@@ -54,18 +55,18 @@ void main() {
     const uint f = i / (TILES * TILES), t = i % (TILES * TILES);
     const vec2 tlo = vec2(t % TILES, t / TILES), thi = tlo + 1.0;
     const vec3 tc = faceDir(f, tlo + 0.5, float(TILES));
-    const float reach = pc.nearAngle + wr + radius(tc, f, tlo, thi, float(TILES));
-    fine[i] = pc.srcSize > COARSE && dot(wc, tc) > cos(min(reach, BRDF_PI));
+    const float tr = radius(tc, f, tlo, thi, float(TILES)), apart = acos(clamp(dot(wc, tc), -1.0, 1.0));
+    kind[i] = apart >= 0.5 * BRDF_PI + wr + tr ? 0u : pc.srcSize > COARSE && apart < pc.nearAngle + wr + tr ? 2u : 1u;
   }
   barrier();
 
   const uint per = pc.srcSize / TILES;  // a tile's fine texels a side
   const uint coarseLevel = pc.level + uint(findMSB(pc.srcSize / COARSE));
   vec4 acc = vec4(0.0);  // rgb: radiance x weight, a: weight
-  uint fill = 0u;        // the same in every thread: `fine` is shared
+  uint fill = 0u;        // the same in every thread: `kind` is shared
   for (uint tile = 0u; tile <= 6u * TILES * TILES; ++tile) {
-    const bool last = tile == 6u * TILES * TILES, isFine = !last && fine[tile];
-    const uint side = last ? 0u : isFine ? per : COARSE / TILES, count = side * side;
+    const bool last = tile == 6u * TILES * TILES, isFine = !last && kind[tile] == 2u;
+    const uint side = last || kind[tile] == 0u ? 0u : isFine ? per : COARSE / TILES, count = side * side;
     if (last || fill + count > CHUNK) {  // sum what is gathered
       barrier();
       for (uint i = slice; i < fill; i += ENV_SUM_SLICES) {
