@@ -140,8 +140,10 @@ BakeReport bake(const BakeOptions& opt) {
     oo.threads = threads;
     oo.mtl = opt.mtl;
     oo.creaseDeg = opt.creaseDeg;
-    if (opt.progress)
+    if (opt.progress) {
       oo.progress = [&](uint64_t done, uint64_t total) { opt.progress("reading", total ? double(done) / double(total) : 0.0); };
+      oo.weldProgress = [&](double f) { opt.progress("welding", f); };
+    }
     scene = stage("reading " + opt.input.string(), [&] { return loadObj(opt.input, oo, &rep.obj); });
     rep.parseSeconds = rep.obj.parseSeconds;
     rep.weldSeconds = rep.obj.weldSeconds;
@@ -246,8 +248,10 @@ BakeReport bake(const BakeOptions& opt) {
   if (opt.progress) opt.progress("writing", 0.0);
   const std::string bytes = stage("encoding " + opt.output.string(),
                                   [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
+  rep.encodeSeconds = since(t0);
   AtomicFile sceneFile(opt.output);
   sceneFile.write(bytes.data(), bytes.size());
+  rep.fileWriteSeconds = since(t0) - rep.encodeSeconds;
   sceneFile.sync();
   for (size_t k = 0; k < textures.size(); ++k) {
     const bool existed = std::filesystem::exists(textures[k]->target(), ec);

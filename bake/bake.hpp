@@ -62,6 +62,8 @@ struct BakeReport {
   std::vector<LevelError> bcError;                // --textures bc: per level
   double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, lodSeconds = 0, writeSeconds = 0,
          totalSeconds = 0;
+  double encodeSeconds = 0, fileWriteSeconds = 0;  // parts of writeSeconds: bytes made in memory, handed to the file
+                                                   // (the rest: fsync, textures put in place)
 };
 
 // Throws rtr::Error naming the file and place; on failure nothing it created is left behind.

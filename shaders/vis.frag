@@ -1,6 +1,6 @@
 #version 460
-// Visibility pass fragment stage: stores which triangle is visible (instance index and gl_PrimitiveID, which
-// needs the geometryShader feature, in one uint); the compute pass vis_shade.comp shades it. Alpha-masked materials
+// Visibility pass fragment stage: stores which triangle is visible (the instance's first id plus gl_PrimitiveID,
+// which needs the geometryShader feature, frame.h); the compute pass vis_shade.comp shades it. Alpha-masked materials
 // discard here exactly like pbr.frag (same texture, same implicit LOD and bias).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_nonuniform_qualifier : require
@@ -9,7 +9,7 @@
 
 layout(push_constant) uniform Push { DrawPush draw; };
 layout(location = 0) out uint outId;
-layout(location = 1) flat in uint inInstance;
+layout(location = 1) flat in uint inFirstId;  // of the instance (frame.h)
 
 // ALPHA_MASK only:
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
@@ -26,5 +26,5 @@ void main() {
       if (m.baseColor.a * ((m.textures2.w & MATERIAL_MASK_RED) != 0u ? mask.r : mask.a) < m.roughMetal.z) discard;
     }
   }
-  outId = (inInstance << draw.primitiveBits) | uint(gl_PrimitiveID);
+  outId = inFirstId + uint(gl_PrimitiveID);
 }

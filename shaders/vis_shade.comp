@@ -33,6 +33,7 @@ layout(set = 0, binding = 10, std430) readonly buffer Instances { GpuInstance in
 layout(set = 0, binding = 11, std430) readonly buffer Texcoords1 { vec2 texcoords1[]; };
 layout(set = 0, binding = 12, std430) readonly buffer Tangents { vec4 tangents[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Colors { vec4 colors[]; };
+layout(set = 0, binding = 15, std430) readonly buffer IdPages { uint idPages[]; };  // GpuScene::visIdPages
 layout(push_constant) uniform Push { VisShadePush pc; };
 #include "env_light.glsl"
 
@@ -66,6 +67,18 @@ vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec2 uv[6], vec4 fallback) {
   return textureGrad(textures[nonuniformEXT(index)], a * uv[k] + vec2(r0.z, r1.z), a * uv[k + 1], a * uv[k + 2]);
 }
 
+// The instance whose id range holds `id` (frame.h): between its page's entry and the next page's.
+uint instanceOf(uint id) {
+  const uint page = id >> pc.idPageShift;
+  uint lo = idPages[page], hi = idPages[page + 1u];
+  while (lo < hi) {
+    const uint mid = (lo + hi + 1u) >> 1u;
+    if (instances[mid].info.z <= id) lo = mid;
+    else hi = mid - 1u;
+  }
+  return lo;
+}
+
 void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(p, imageSize(sceneColor)))) return;
@@ -77,9 +90,9 @@ void main() {
     imageStore(sceneColor, p, vec4(HAS_ENV ? min(envBackdrop(dir), vec3(kMaxRadiance)) : frame.background.rgb, 1.0));
     return;
   }
-  const GpuInstance inst = instances[packed >> pc.primitiveBits];
+  const GpuInstance inst = instances[instanceOf(packed)];
   const GpuDraw d = draws[inst.info.x];
-  const uint first = 3u * (packed & ((1u << pc.primitiveBits) - 1u));  // primitiveBits < 32
+  const uint first = 3u * (packed - inst.info.z);
   const uvec3 tri = uvec3(vertexIndex(d, first), vertexIndex(d, first + 1u), vertexIndex(d, first + 2u)) + d.vertexOffset;
   // Scene space, computed as the vertex stages do.
   const vec3 p0 = (inst.transform * vec4(position(tri.x), 1.0)).xyz, p1 = (inst.transform * vec4(position(tri.y), 1.0)).xyz,

@@ -1,5 +1,6 @@
 #version 460
-// Cluster culling: one thread per cluster; the level-of-detail cut, frustum, back-face cone, then
+// Cluster culling, second step: one workgroup per chunk of clusters that cull_instances.comp kept, a
+// thread per cluster; the level-of-detail cut, frustum, back-face cone, then
 // occlusion against the depth pyramid (shaders/shared/cull.h has the tests and the phases). Visible clusters are appended to a compact list whose
 // length is the size of an indirect dispatch (one workgroup per visible cluster; cull.h); culled ones are counted by
 // reason. The caller zeroes the counts (x = 0, y = z = 1) before the pass.
@@ -15,6 +16,7 @@ layout(set = 0, binding = 2, std430) writeonly buffer Visible { uint visible[]; 
 layout(set = 0, binding = 3) uniform texture2D pyramid;  // R32F, farthest depth per texel (hiz.comp)
 layout(set = 0, binding = 4, std430) buffer History { uint history[]; };  // 1: visible in the last LATE pass
 layout(set = 0, binding = 5, std430) readonly buffer Lods { GpuClusterLod lods[]; };  // read with CULL_LOD
+layout(set = 0, binding = 7, std430) readonly buffer Chunks { uvec2 chunks[]; };      // first cluster, count
 
 layout(push_constant) uniform Push { CullPush pc; };
 
@@ -31,8 +33,11 @@ bool occluded(vec4 sphere) {
 }
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
-  if (i >= pc.count) return;
+  const uint k = gl_WorkGroupID.y * max(pc.maxGroupsX, 1u) + gl_WorkGroupID.x;
+  if (k >= counts.chunks) return;
+  const uvec2 chunk = chunks[k];
+  if (gl_LocalInvocationID.x >= chunk.y) return;
+  const uint i = chunk.x + gl_LocalInvocationID.x;
   const bool wasVisible = pc.phase != CULL_SINGLE && history[i] != 0u;
   if (pc.phase == CULL_EARLY && !wasVisible) return;
   const GpuCluster c = clusters[i];

@@ -16,6 +16,12 @@ layout(local_size_x = RASTER_GROUP) in;
 layout(set = 0, binding = 11, std430) readonly buffer VisibleClusters { uint visibleClusters[]; };
 layout(set = 0, binding = 12, std430) readonly buffer Counts { CullCounts cullCounts; };
 
+// Past the list's capacity a triangle is counted, not stored (the draw skips those entries).
+void handOff(uint ref) {
+  const uint n = atomicAdd(vertexCount, 3u) / 3u;
+  if (n < pc.handOffCapacity) hwTriangles[n] = ref;
+}
+
 void main() {
   const uint k = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   if (k >= (pc.fromList != 0u ? cullCounts.listed : pc.clusterCount)) return;
@@ -33,8 +39,8 @@ void main() {
     // A full list hands the triangle to the hardware; its reserved entries that fit are marked empty.
     const bool fits = first + n <= RASTER_LARGE_CAPACITY;
     for (uint i = 0u; i < n && first + i < RASTER_LARGE_CAPACITY; ++i) largeTiles[first + i] = uvec2(fits ? ref : ~0u, i);
-    if (!fits) hwTriangles[atomicAdd(vertexCount, 3u) / 3u] = ref;
+    if (!fits) handOff(ref);
   } else if (kind == kHardware) {
-    hwTriangles[atomicAdd(vertexCount, 3u) / 3u] = ref;
+    handOff(ref);
   }
 }

@@ -15,13 +15,18 @@ layout(location = 2) flat out uint outFlags;     // CLUSTER_*
 layout(location = 3) out vec2 outTexcoord;
 
 void main() {
+  if (uint(gl_VertexIndex) / 3u >= pc.handOffCapacity) {  // dropped (raster.h): a point, no fragment
+    gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
+    outId = 0u, outMaterial = NO_TEXTURE, outFlags = 0u, outTexcoord = vec2(0.0);
+    return;
+  }
   const uint entry = hwTriangles[gl_VertexIndex / 3];
   const GpuCluster c = clusters[entry >> RASTER_LOCAL_BITS];
   const GpuInstance inst = instances[c.instance];
   const GpuDraw d = draws[inst.info.x];
   const uint local = entry & ((1u << RASTER_LOCAL_BITS) - 1u);
   const uint v = triangleVertices(c, d, local)[gl_VertexIndex % 3];
-  outId = (c.instance << pc.primitiveBits) | (c.firstTriangle + local);
+  outId = inst.info.z + c.firstTriangle + local;
   outMaterial = d.material;
   outFlags = c.flags;
   outTexcoord = (c.flags & CLUSTER_ALPHA_MASKED) != 0u ? texcoords[v] : vec2(0.0);

@@ -43,7 +43,7 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
   const GpuCluster c = clusters[clusterIndex];
   const GpuInstance inst = instances[c.instance];
   const GpuDraw d = draws[inst.info.x];
-  t.id = (c.instance << pc.primitiveBits) | (c.firstTriangle + local);
+  t.id = inst.info.z + c.firstTriangle + local;
   t.material = NO_TEXTURE;
   const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
   if (!kAlphaMask && masked) return kHardware;

@@ -39,8 +39,26 @@ struct GpuClusterLod {
   vec4 error;         // x its error, y its parent's (LOD_ERROR_INFINITE: a root), zw 0
 };
 
+// One per instance that has clusters (storage buffer, std430, 48 bytes): what the culling pass tests
+// before the instance's clusters (docs/culling.md).
+struct GpuCullInstance {
+  vec4 sphere;     // scene space: holds the culling sphere of every one of its clusters
+  vec4 lodSphere;  // scene space: holds every level-of-detail sphere of its clusters (own and parent's)
+  uvec4 levels;    // x: its first GpuCullLevel, y: how many (level 0, its full-detail records, first)
+};
+
+// One level of an instance's clusters (storage buffer, std430, 16 bytes), errors in scene space: the
+// level window (docs/virtual-geometry.md) skips a level none of whose clusters can be in the cut.
+struct GpuCullLevel {
+  uint firstCluster;     // its records, contiguous; the levels above 0 follow one another
+  uint clusterCount;
+  float minError;        // the least error of its clusters
+  float maxParentError;  // the largest error of their parents (LOD_ERROR_INFINITE where one is a root)
+};
+
 #ifdef __cplusplus
-static_assert(sizeof(GpuCluster) == 48 && sizeof(GpuClusterLod) == 48);
+static_assert(sizeof(GpuCluster) == 48 && sizeof(GpuClusterLod) == 48 && sizeof(GpuCullInstance) == 48 &&
+              sizeof(GpuCullLevel) == 16);
 }  // namespace rtr::shader
 #endif
 #endif

@@ -39,18 +39,24 @@ namespace rtr::shader {
 // The counts buffer: VkDispatchIndirectCommand {visible clusters, 1, 1}, then the culled counts by reason.
 // Over CullPush::maxGroupsX visible clusters the dispatch is two-dimensional, {maxGroupsX, rows, 1}: a
 // workgroup's list entry is then gl_WorkGroupID.y * maxGroupsX + gl_WorkGroupID.x (below `listed`).
+// The pass runs in two steps: instances (cull_instances.comp), then the chunks of clusters of the
+// instances kept (cull.comp), dispatched from chunkDispatch the same way.
 struct CullCounts {
   uint dispatch[3];
-  uint culled[4];  // frustum, cone (back-facing), occlusion, level of detail
-  uint listed;     // entries in the visible list
-  uint triangles;  // of the listed clusters
-  uint pad[3];
+  uint culled[4];         // frustum, cone (back-facing), occlusion, level of detail
+  uint listed;            // entries in the visible list
+  uint triangles;         // of the listed clusters
+  uint tested;            // clusters the cluster step visited: those of the instances kept
+  uint instancesCulled;   // instances culled whole by the frustum (one test each, none of their clusters)
+  uint chunks;            // runs of up to CULL_GROUP_SIZE clusters: the cluster step's workgroups
+  uint chunkDispatch[3];  // its indirect dispatch
+  uint pad;
 };
 
 struct CullPush {  // 128 bytes
   mat4 viewProj;
   vec4 eye;          // xyz
-  uint count;        // clusters in the input buffer
+  uint count;        // instances (GpuCullInstance) to test
   uint flags;        // CULL_*
   uint width;        // the depth source's size in pixels (the pyramid's level 0 is half of it, rounded up)
   uint height;
@@ -143,7 +149,7 @@ RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {
 }
 
 #ifdef __cplusplus
-static_assert(sizeof(CullPush) == 128 && sizeof(CullCounts) == 48);
+static_assert(sizeof(CullPush) == 128 && sizeof(CullCounts) == 64);
 }  // namespace rtr::shader
 #endif
 #endif

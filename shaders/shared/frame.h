@@ -85,7 +85,6 @@ struct GpuMaterial {
 // Per-draw push constants.
 struct DrawPush {
   uint material;
-  uint primitiveBits; // visibility pass: id = gl_InstanceIndex << primitiveBits | gl_PrimitiveID
   uint opaqueWidth;   // transparency pass: the compute rasteriser's row length (its depth tests), else 0
 };
 
@@ -97,7 +96,7 @@ struct GpuInstance {
   vec4 normalX;       // columns of the inverse transpose of transform's upper 3x3 (normals)
   vec4 normalY;
   vec4 normalZ;
-  uvec4 info;         // x: its GpuDraw, y: INSTANCE_* flags
+  uvec4 info;         // x: its GpuDraw, y: INSTANCE_* flags, z: its first visibility id (below), w: 0
 };
 #define INSTANCE_MIRRORED 1u  // negative determinant: the winding flips (front = clockwise on screen)
 
@@ -114,11 +113,14 @@ struct GpuDraw {
 #define DRAW_TANGENTS 8u  // has tangents (xyz, w the bitangent's sign): normal maps apply
 #define DRAW_UV1 16u      // has a second texcoord set
 
-// Visibility target (R32_UINT): instance index << primitiveBits | gl_PrimitiveID; VIS_EMPTY where
-// nothing was drawn. The renderer gives the instance index just enough bits that no id equals VIS_EMPTY.
+// Visibility target (R32_UINT): the instance's first id (GpuInstance::info.z) + gl_PrimitiveID; VIS_EMPTY
+// where nothing was drawn. Instances take consecutive ranges, each as long as its draw's primitives
+// (hierarchy included), so the ids count the triangles the scene can draw: 32 bits hold 4 G of them,
+// whatever the instance count and mesh sizes. An id's instance is found through a page table
+// (GpuScene::visIdPages: per 2^idPageShift ids, the instance holding the first), then a few steps.
 #define VIS_EMPTY 0xFFFFFFFFu
 struct VisShadePush {
-  uint primitiveBits;
+  uint idPageShift;
 };
 #define VIS_GROUP_X 8     // shading pass workgroup
 #define VIS_GROUP_Y 8

@@ -1,6 +1,6 @@
 // The compute rasteriser's constants and push block, shared by render/raster.cpp and its shaders
 // (docs/raster.md). Visibility buffer: one uint64 per pixel, (floatBitsToUint(depth) << 32) | id, id as in
-// frame.h (draw << primitiveBits | primitive); RASTER_CLEAR (id VIS_EMPTY) where nothing was drawn.
+// frame.h (the instance's first id + primitive); RASTER_CLEAR (id VIS_EMPTY) where nothing was drawn.
 #ifndef RTR_SHADERS_SHARED_RASTER_H
 #define RTR_SHADERS_SHARED_RASTER_H
 
@@ -19,13 +19,17 @@ typedef uint32_t uint;
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
 #define RASTER_LARGE_GROUPS 1024u         // raster_large.comp's persistent workgroups
 #define RASTER_LOCAL_BITS 7u     // hardware list entry: cluster << RASTER_LOCAL_BITS | triangle in cluster
+// Hand-off list entries at most (64 MiB): the near-plane and guard-band triangles of a frame, not every
+// triangle of a billion-triangle scene (a storage buffer's range is 4 GiB at most on many devices). Past
+// it, triangles are dropped and counted (ComputeRaster::handOffTriangles, which rtr-view prints).
+#define RASTER_HANDOFF_CAPACITY (1u << 24)
 
 struct RasterPush {
   uint width;
   uint height;
-  uint primitiveBits;  // of an id: the primitive index (frame.h)
   uint clusterCount;
   uint fromList;       // raster.comp: clusters from the culling pass's visible list, not all of them
+  uint handOffCapacity;  // entries of the hand-off list (at most RASTER_HANDOFF_CAPACITY)
   uint pad0, pad1, pad2;
 };
 

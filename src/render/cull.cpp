@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <functional>
 #include <string>
 
@@ -220,6 +221,14 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
   history_ =
       vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, "cluster history");
+  // Every chunk holds at least one cluster.
+  chunks_ = vk::Buffer(ctx, std::max<VkDeviceSize>(8, VkDeviceSize(maxClusters) * 8), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                       vk::MemoryUse::Device, "cluster chunks");
+  whole_ = vk::Buffer(ctx, sizeof(shader::GpuCullInstance), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                      vk::MemoryUse::Device, "all clusters as one instance");
+  wholeLevel_ =
+      vk::Buffer(ctx, sizeof(shader::GpuCullLevel), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                 vk::MemoryUse::Device, "all clusters as one level");
   vk::ImageDesc d;
   d.format = kPyramidFormat;
   d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
@@ -232,23 +241,33 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_READ_BIT}});
   });
   pipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("cull.comp"), {.pushDescriptorSets = {0}});
+  instancePipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("cull_instances.comp"), {.pushDescriptorSets = {0}});
 }
 
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
-                           const DepthPyramid* pyramid, CullTests tests, CullPhase phase, VkBuffer lods) {
+                           const DepthPyramid* pyramid, CullTests tests, CullPhase phase, VkBuffer lods, VkBuffer instances,
+                           uint32_t instanceCount, VkBuffer levels) {
   if (count > maxClusters_)
     throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
   vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);
-  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, {0, 0, 0}};  // the indirect dispatch's y and z are 1
+  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, 0, 0, 0, {0, 1, 1}, 0};  // indirect dispatches' y, z: 1
   vkCmdUpdateBuffer(cb, counts_.handle(), 0, sizeof(zero), &zero);
+  if (!instances) {  // one level that is always in the window (error 0, parents' infinite)
+    const shader::GpuCullInstance all{glm::vec4(0.0f, 0.0f, 0.0f, 1e30f), glm::vec4(0.0f, 0.0f, 0.0f, 1e30f),
+                                      glm::uvec4(0, 1, 0, 0)};
+    const shader::GpuCullLevel level{0, count, 0.0f, shader::LOD_ERROR_INFINITE};
+    vkCmdUpdateBuffer(cb, whole_.handle(), 0, sizeof(all), &all);
+    vkCmdUpdateBuffer(cb, wholeLevel_.handle(), 0, sizeof(level), &level);
+    instances = whole_.handle(), levels = wholeLevel_.handle(), instanceCount = 1;
+  }
   vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
 
   shader::CullPush push{};
   push.viewProj = camera.viewProj;
   push.eye = glm::vec4(camera.eye, 1.0f);
-  push.count = count;
+  push.count = instanceCount;
   push.flags = (tests.frustum ? CULL_FRUSTUM : 0u) | (tests.cone && !camera.orthographic ? CULL_CONE : 0u) |
                (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u) |
                (tests.lod && lods && camera.lodThreshold > 0.0f && !camera.orthographic ? CULL_LOD : 0u);
@@ -262,6 +281,16 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
     push.height = pyramid->depthExtent().height;
     push.pyramidLevels = pyramid->levels();
   }
+  instancePipeline_.bind(cb);
+  vk::DescriptorWriter(ctx_, instancePipeline_.layout, 0, VK_NULL_HANDLE)
+      .buffer(1, counts_.handle())
+      .buffer(6, instances)
+      .buffer(7, chunks_.handle())
+      .buffer(8, levels)
+      .push(cb, instancePipeline_);
+  instancePipeline_.push(cb, push);
+  instancePipeline_.dispatch(cb, instanceCount);
+  vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
   pipeline_.bind(cb);
   vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
       .buffer(0, clusters)
@@ -270,9 +299,10 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
       .image(3, pyramid ? pyramid->view() : noPyramid_.view(), VK_IMAGE_LAYOUT_GENERAL)
       .buffer(4, history_.handle())
       .buffer(5, lods ? lods : clusters)  // not read without CULL_LOD
+      .buffer(7, chunks_.handle())
       .push(cb, pipeline_);
   pipeline_.push(cb, push);
-  pipeline_.dispatch(cb, count);
+  vkCmdDispatchIndirect(cb, counts_.handle(), offsetof(shader::CullCounts, chunkDispatch));
   vk::bufferBarrier(cb, vk::kComputeWrite, kConsumers | vk::kComputeWrite);
 }
 

@@ -109,8 +109,12 @@ class ClusterCuller {
   // too: a cluster whose every point lies behind that depth image there cannot be seen above it. Ends with
   // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
   // `lods`: the clusters' GpuClusterLod records (cluster.h), for the level-of-detail cut, tested first.
+  // `instances`: GpuCullInstances (cluster.h), tested first (frustum, and the level window with `levels`,
+  // their GpuCullLevels): a culled instance's clusters, and those of levels outside its window, are not
+  // visited. None: one instance of the first `count` clusters that is never culled.
   void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera, const DepthPyramid* pyramid,
-              CullTests tests = {}, CullPhase phase = CullPhase::Single, VkBuffer lods = VK_NULL_HANDLE);
+              CullTests tests = {}, CullPhase phase = CullPhase::Single, VkBuffer lods = VK_NULL_HANDLE,
+              VkBuffer instances = VK_NULL_HANDLE, uint32_t instanceCount = 0, VkBuffer levels = VK_NULL_HANDLE);
   VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
   VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
   uint32_t maxClusters() const { return maxClusters_; }
@@ -118,9 +122,10 @@ class ClusterCuller {
  private:
   const vk::Context& ctx_;
   uint32_t maxClusters_;
-  vk::Buffer visible_, counts_, history_;
-  vk::Image noPyramid_;  // 1×1 stand-in so the pass always has a valid binding
-  vk::Pipeline pipeline_;
+  vk::Buffer visible_, counts_, history_, chunks_;
+  vk::Buffer whole_, wholeLevel_;  // the one GpuCullInstance and level of a record() without instances
+  vk::Image noPyramid_;            // 1×1 stand-in so the pass always has a valid binding
+  vk::Pipeline instancePipeline_, pipeline_;
 };
 
 }  // namespace rtr::render

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cstring>
 #include <functional>
@@ -65,6 +66,9 @@ struct GeometryPlan {
   std::vector<shader::GpuInstance> instances;
   std::vector<shader::GpuCluster> clusters;
   std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
+  std::vector<uint32_t> idPages;            // visIdPages(): the instance holding each page's first id
+  std::vector<shader::GpuCullInstance> cullInstances;
+  std::vector<shader::GpuCullLevel> cullLevels;
   size_t baseClusters = 0;
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
@@ -101,10 +105,18 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     texturedMaterials_ = materials;
     for (shader::GpuMaterial& g : materials)
       g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
+    shownMaterials_ = materials;
   }
   uploadGeometry(plan, materials, upload);
   stats_.geometryMs = msSince(t);
-  if (!decoding_.valid()) finishTextures(), storeInCache(), ready_ = true;
+  if (!decoding_.valid()) {
+    finishTextures();
+    std::vector<std::pair<uint32_t, TextureCacheKey>> misses;
+    for (uint32_t i = 0; i < storeKeys_.size(); ++i)
+      if (storeKeys_[i]) misses.emplace_back(i, std::move(*storeKeys_[i]));
+    storeInCache(std::move(misses), true);
+    in_.assign(textures_.size(), 1), texturesIn_ = textures_.size(), ready_ = true;
+  }
 }
 
 // Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
@@ -117,6 +129,10 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
   for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
   for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i])), samplers_.push_back(scene.textures[i].sampler);
   staged_.resize(used.size());
+  textures_.resize(used.size());
+  hostMips_.assign(used.size(), false);
+  in_.assign(used.size(), 0);
+  storeKeys_.resize(used.size());
   stats_.textures = uint32_t(used.size());
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx_.physicalDevice(), &features);
@@ -126,11 +142,26 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
   auto decode = [this, &scene, used] {
     const auto t = Clock::now();
     std::mutex progressMutex;
-    auto done = [&] {
+    auto done = [&](uint32_t i) {  // texture i is staged: a deferred load may take it in
+      {
+        const std::lock_guard lock(decodedMutex_);
+        decodedQueue_.push_back(i);
+      }
+      decodedChanged_.notify_all();
       const std::lock_guard lock(progressMutex);
       const size_t n = ++decoded_;
       if (progress_) progress_("decoding textures", n, staged_.size());
     };
+    struct Finished {  // also when the decode throws: a waiting updateTextures() then rethrows
+      GpuScene* self;
+      ~Finished() {
+        {
+          const std::lock_guard lock(self->decodedMutex_);
+          self->decodeFinished_ = true;
+        }
+        self->decodedChanged_.notify_all();
+      }
+    } finished{this};
     // Baked texels (.rtrscene version 6) and the texture cache's hits: every chain unpacked piece by piece
     // on all cores straight into its staging buffer, whole (no decode, no mip pass); the others decoded
     // from their images (and, where the cache missed them, stored once their chains are made).
@@ -157,6 +188,7 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
       s.extent = {b->width, b->height};
       s.levels = b->levelOffsets();
       s.buffer = vk::Buffer(ctx_, s.levels.back(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
+      s.bytes = s.levels.back();
       s.levels.pop_back();
       for (uint32_t k = 0; k < b->pieces.size(); ++k) pieces.emplace_back(i, k);
     }
@@ -165,7 +197,7 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
     parallelFor(pieces.size(), 0, [&](size_t p) {
       const auto [i, k] = pieces[p];
       unpackBakedPiece(*chains[i], k, static_cast<uint8_t*>(staged_[i].buffer.mapped()));
-      if (--left[i] == 0) staged_[i].buffer.flush(), done();
+      if (--left[i] == 0) staged_[i].buffer.flush(), done(i);
     });
     std::vector<uint32_t> decodeOnly;
     for (uint32_t i : images) decodeOnly.push_back(used[i]);
@@ -173,7 +205,8 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
     decodeTextures(
         scene, decodeOnly,
         [&](size_t j, TexelData&& texels) {
-          const size_t i = images[j];
+          const uint32_t i = images[j];
+          if (keyed[i] && !fellBack[j]) storeKeys_[i] = std::move(keys[i]);
           Staged& s = staged_[i];
           s.extent = {texels.width, texels.height};
           // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
@@ -184,11 +217,10 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
           s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
           std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
           s.buffer.flush();
-          done();
+          s.bytes = bytes.size();
+          done(i);
         },
         {}, &fellBack);
-    for (size_t j = 0; j < images.size(); ++j)
-      if (keyed[images[j]] && !fellBack[j]) toStore_.emplace_back(images[j], std::move(keys[images[j]]));
     stats_.decodeMs = msSince(t);
   };
   if (load == TextureLoad::Deferred && !used.empty()) decoding_ = std::async(std::launch::async, decode);
@@ -245,7 +277,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   }
   const std::vector<Instance> instances = gpuInstances(scene);
   const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
-  Bounds box;  // of the draw being extended
+  std::vector<uint32_t> cullIndex(instances.size(), UINT32_MAX);  // its GpuCullInstance
+  std::vector<std::array<glm::uvec2, 2>> runs(instances.size());  // per GpuCullInstance: full detail, levels above
+  Bounds box;                                                     // of the draw being extended
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
     const Mesh& m = scene.meshes[in.mesh];
@@ -262,6 +296,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     }
     const size_t first = p.clusters.size();
     appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
+    cullIndex[i] = uint32_t(p.cullInstances.size());
+    p.cullInstances.push_back({glm::vec4(0.0f), glm::vec4(0.0f), glm::uvec4(0)});
+    runs[cullIndex[i]] = {glm::uvec2(first, p.clusters.size() - first), glm::uvec2(0)};
     if (lods) appendClusterLods(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), false, first, p.clusters, p.lods);
     std::vector<DrawItem>& list = draws_[size_t(md.kind)];
     if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
@@ -274,11 +311,74 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     if (!box.empty()) list.back().center = box.center();
   }
   p.baseClusters = p.clusters.size();
+  // Visibility ids (frame.h): each drawn instance its own range, as long as its draw's primitives, in order.
+  uint64_t ids = 0;
+  firstIds_.clear();
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    firstIds_.push_back(ids);
+    p.instances[i].info.z = uint32_t(ids);
+    if (!scene.materials.at(m.material).blended()) ids += meshDraw[instances[i].mesh]->item.primitives;
+  }
+  visIdCount_ = ids;
+  // Pages of 2^shift ids, at most 2^16 + 1 of them: page k's entry is the last instance whose range
+  // starts at or before k << shift, so the instance of id lies between the entries of id's page and the next.
+  idPageShift_ = uint32_t(std::max(6, int(std::bit_width(std::max<uint64_t>(ids, 1))) - 16));
+  if (ids <= kMaxVisIds)
+    for (uint64_t page = 0, i = 0; page <= ((std::max<uint64_t>(ids, 1) - 1) >> idPageShift_) + 1; ++page) {
+      while (i + 1 < firstIds_.size() && firstIds_[i + 1] <= page << idPageShift_) ++i;
+      p.idPages.push_back(uint32_t(i));
+    }
+  if (p.idPages.empty()) p.idPages.push_back(0);
   for (uint32_t i = 0; lods && i < instances.size(); ++i) {  // the hierarchies' clusters after all full-detail ones
     const Mesh& m = scene.meshes[instances[i].mesh];
     if (scene.materials.at(m.material).blended()) continue;  // drawn by the transparency pass, no clusters
     const uint32_t flags = meshDraw[instances[i].mesh]->flags | (mirrored(instances[i].transform) ? CLUSTER_MIRRORED : 0u);
+    const size_t first = p.clusters.size();
     appendClusterLods(m, instances[i].transform, i, flags, true, 0, p.clusters, p.lods);
+    if (cullIndex[i] != UINT32_MAX) runs[cullIndex[i]][1] = glm::uvec2(first, p.clusters.size() - first);
+  }
+  // Each instance's spheres (around the box of the spheres they hold, holding each) and levels.
+  auto enclose = [&](const std::array<glm::uvec2, 2>& rs, auto&& spheres) {
+    Bounds b;
+    for (const glm::uvec2 run : rs)
+      for (size_t c = run.x; c < run.x + run.y; ++c)
+        spheres(c, [&](glm::vec4 s) { b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w); });
+    float r = 0.0f;
+    for (const glm::uvec2 run : rs)
+      for (size_t c = run.x; c < run.x + run.y; ++c)
+        spheres(c, [&](glm::vec4 s) { r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w); });
+    return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
+  };
+  for (uint32_t i = 0; i < instances.size(); ++i) {
+    if (cullIndex[i] == UINT32_MAX) continue;
+    shader::GpuCullInstance& ci = p.cullInstances[cullIndex[i]];
+    const std::array<glm::uvec2, 2>& rs = runs[cullIndex[i]];
+    ci.sphere = enclose(rs, [&](size_t c, auto&& add) { add(p.clusters[c].sphere); });
+    ci.lodSphere = p.lods.empty() ? ci.sphere : enclose(rs, [&](size_t c, auto&& add) {
+      add(p.lods[c].sphere);
+      if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) add(p.lods[c].parentSphere);
+    });
+    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level).
+    ci.levels = glm::uvec4(p.cullLevels.size(), 0, 0, 0);
+    auto level = [&](uint32_t first, uint32_t count) {
+      shader::GpuCullLevel v{first, count, shader::LOD_ERROR_INFINITE, 0.0f};
+      for (size_t c = first; c < first + count; ++c) {
+        v.minError = std::min(v.minError, p.lods.empty() ? 0.0f : p.lods[c].error.x);
+        v.maxParentError = std::max(v.maxParentError, p.lods.empty() ? shader::LOD_ERROR_INFINITE : p.lods[c].error.y);
+      }
+      p.cullLevels.push_back(v);
+      ++ci.levels.y;
+    };
+    level(rs[0].x, rs[0].y);
+    const Mesh& m = scene.meshes[instances[i].mesh];
+    uint32_t c = rs[1].x, run = 0, at = 0;
+    for (size_t k = 0; k < m.lod.clusters.size() && rs[1].y > 0; ++k) {
+      if (m.lod.clusters[k].level == 0) continue;
+      if (run > 0 && m.lod.clusters[k].level != at) level(c - run, run), run = 0;
+      at = m.lod.clusters[k].level, ++run, ++c;
+    }
+    if (run > 0) level(c - run, run);
   }
   stats_.instances = uint32_t(instances.size());
   stats_.vertices = uint32_t(p.vertices);
@@ -335,7 +435,25 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum { kPos, kNrm, kUv, kI16, kI32, kMat, kDraw, kInst, kCluster, kUv1, kTan, kCol, kLod, kTargets };
+  enum {
+    kPos,
+    kNrm,
+    kUv,
+    kI16,
+    kI32,
+    kMat,
+    kDraw,
+    kInst,
+    kCluster,
+    kUv1,
+    kTan,
+    kCol,
+    kLod,
+    kIds,
+    kCullInst,
+    kCullLevel,
+    kTargets
+  };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
@@ -349,15 +467,21 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&texcoords1_, plan.anyUv1 ? vertices * 8 : 0},
                                         {&tangents_, plan.anyTangents ? vertices * 16 : 0},
                                         {&colors_, plan.anyColors ? vertices * 16 : 0},
-                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()}}};
+                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()},
+                                        {&visIdPages_, bytes(plan.idPages), plan.idPages.data()},
+                                        {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()},
+                                        {&cullLevels_, bytes(plan.cullLevels), plan.cullLevels.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
-  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage, kStorage,
-                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions", "normals",  "texcoords",  "indices16", "indices32", "materials",   "draws",
-                                 "instances", "clusters", "texcoords1", "tangents",  "colours",   "cluster lods"};
+  const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
+                                                       kStorage, kStorage, kStorage, kStorage, kStorage, kStorage,
+                                                       kStorage, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32", "materials",
+                                 "draws",        "instances", "clusters",       "texcoords1", "tangents",  "colours",
+                                 "cluster lods", "id pages",  "cull instances", "cull levels"};
   clusterCount_ = uint32_t(plan.clusters.size());
   baseClusterCount_ = uint32_t(plan.baseClusters);
+  cullInstanceCount_ = uint32_t(plan.cullInstances.size());
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {
     Target& tg = targets[i];
@@ -439,74 +563,123 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
 }
 
+std::pair<uint32_t, uint32_t> GpuScene::decodeVisId(uint32_t id) const {
+  const auto next = std::upper_bound(firstIds_.begin(), firstIds_.end(), uint64_t(id));
+  if (next == firstIds_.begin() || id >= visIdCount_) throw Error("visibility id " + std::to_string(id) + " names no instance");
+  const uint32_t instance = uint32_t(next - firstIds_.begin() - 1);
+  return {instance, uint32_t(id - firstIds_[instance])};
+}
+
 GpuScene::~GpuScene() {
   if (decoding_.valid()) decoding_.wait();  // it writes into this object's staging buffers
-  if (storing_.valid()) storing_.wait();    // it reads this object's read-back buffers
-}  // a pending upload waits for its submission, before the images go
+  for (auto& f : storing_) f.wait();        // they read this object's read-back buffers
+}  // a pending upload and material updates wait for their submissions, before the images and buffers go
 
 bool GpuScene::updateTextures(bool wait) {
   if (ready_) return false;
-  if (!upload_) {  // still decoding
-    if (!wait && decoding_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
-    decoding_.get();  // rethrows a decoding error
-    startUpload();
+  std::erase_if(materialUpdates_, [](const MaterialUpdate& u) { return u.submission->done(); });
+  for (;;) {
+    if (upload_) {
+      if (!wait && !upload_->submission->done()) return false;
+      takeIn();
+    }
+    if (texturesIn_ == textures_.size()) {
+      decoding_.get();  // its statistics are written
+      ready_ = true;
+      return true;
+    }
+    const std::vector<uint32_t> batch = nextBatch(wait);
+    if (batch.empty()) return false;
+    startUpload(batch);
+    if (!wait) return false;
   }
-  if (!wait && !upload_->submission->done()) return false;
-  upload_->submission->wait();
-  stats_.textureUploadMs = msSince(upload_->start);
-  stats_.mipGpuMs = upload_->timer.results().at(0).second;
-  upload_.reset();
-  staged_.clear();
-  storeInCache();
-  // Frames in flight read the material buffer: rewritten once none does (once per load).
-  VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
-  const size_t bytes = texturedMaterials_.size() * sizeof(shader::GpuMaterial);
-  if (materials_.mapped()) {
-    std::memcpy(materials_.mapped(), texturedMaterials_.data(), bytes);
-    materials_.flush();
-  } else {
-    vk::Buffer staging(ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "materials staging");
-    std::memcpy(staging.mapped(), texturedMaterials_.data(), bytes);
-    staging.flush();
-    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
-      const VkBufferCopy region{0, 0, bytes};
-      vkCmdCopyBuffer(cb, staging.handle(), materials_.handle(), 1, &region);
-      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kFragmentRead | vk::kComputeRead);
-    });
-  }
-  texturedMaterials_ = {};
-  ready_ = true;
-  return true;
 }
 
-// A deferred load's upload and mips: one submission, polled by updateTextures() while frames go on.
-void GpuScene::startUpload() {
-  createTextures();
+// The textures decoded first, up to the budget (at least one); none while none is decoded and not `wait`.
+std::vector<uint32_t> GpuScene::nextBatch(bool wait) {
+  std::unique_lock lock(decodedMutex_);
+  if (wait) decodedChanged_.wait(lock, [&] { return !decodedQueue_.empty() || decodeFinished_; });
+  if (decodedQueue_.empty()) {
+    if (!decodeFinished_) return {};
+    lock.unlock();
+    decoding_.get();  // rethrows the decode's error; else every texture was queued
+    throw Error("texture streaming: textures missing after the decode");
+  }
+  size_t n = 0, bytes = 0;
+  while (n < decodedQueue_.size() && (n == 0 || bytes + staged_[decodedQueue_[n]].bytes <= uploadBudget_))
+    bytes += staged_[decodedQueue_[n++]].bytes;
+  std::vector<uint32_t> batch(decodedQueue_.begin(), decodedQueue_.begin() + n);
+  decodedQueue_.erase(decodedQueue_.begin(), decodedQueue_.begin() + n);
+  return batch;
+}
+
+// A deferred load's batch: upload and mips in one submission, polled by updateTextures() while frames go on.
+void GpuScene::startUpload(const std::vector<uint32_t>& batch) {
+  for (uint32_t i : batch) createTexture(i);
+  if (!mipGen_) mipGen_ = std::make_unique<MipGenerator>(ctx_);
   upload_ = std::make_unique<PendingUpload>(ctx_);
+  upload_->batch = batch;
   upload_->start = Clock::now();
   upload_->submission.emplace(ctx_, [&](VkCommandBuffer cb) {
-    recordUpload(cb);
+    recordUpload(cb, batch);
     upload_->timer.reset(cb);
     upload_->timer.begin(cb);
-    upload_->views = upload_->mips.record(cb, gpuMipBatch(), mipMode_);  // its barriers wait for the copies
+    upload_->views = mipGen_->record(cb, gpuMipBatch(batch), mipMode_);  // its barriers wait for the copies
     upload_->timer.mark(cb, "mips");
   });
 }
 
-void GpuScene::createTextures() {
-  for (size_t i = 0; i < staged_.size(); ++i) {
-    vk::ImageDesc desc = textureDesc(staged_[i].extent, formats_[i]);
-    if (blockCompressed(formats_[i]))  // baked with its chain: copied into, sampled, nothing else
-      desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, desc.flags = 0, desc.viewUsage = 0;
-    textures_.emplace_back(ctx_, desc);
-    hostMips_.push_back(!staged_[i].levels.empty());
+// The batch's submission has completed: its chains stored where the cache missed them (read back before any
+// frame samples them), then the materials' slots pointed at its textures by a copy that the queue orders
+// after the frames submitted so far (they read the old slots) and before the next.
+void GpuScene::takeIn() {
+  upload_->submission->wait();
+  stats_.textureUploadMs += msSince(upload_->start);
+  stats_.mipGpuMs += upload_->timer.results().at(0).second;
+  const std::vector<uint32_t> batch = std::move(upload_->batch);
+  upload_.reset();
+  std::vector<std::pair<uint32_t, TextureCacheKey>> misses;
+  for (uint32_t i : batch) {
+    staged_[i] = {};
+    if (storeKeys_[i]) misses.emplace_back(i, std::move(*storeKeys_[i])), storeKeys_[i].reset();
+    in_[i] = 1;
   }
+  texturesIn_ += batch.size();
+  storeInCache(std::move(misses), texturesIn_ == textures_.size());
+  for (size_t m = 0; m < shownMaterials_.size(); ++m) {
+    auto show = [&](uint32_t& shown, uint32_t full) {
+      if (full != NO_TEXTURE && in_[full]) shown = full;
+    };
+    for (int k = 0; k < 4; ++k) show(shownMaterials_[m].textures[k], texturedMaterials_[m].textures[k]);
+    for (int k = 0; k < 3; ++k) show(shownMaterials_[m].textures2[k], texturedMaterials_[m].textures2[k]);
+  }
+  const size_t bytes = shownMaterials_.size() * sizeof(shader::GpuMaterial);
+  MaterialUpdate& u = materialUpdates_.emplace_back();
+  u.staging = vk::Buffer(ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "materials staging");
+  std::memcpy(u.staging.mapped(), shownMaterials_.data(), bytes);
+  u.staging.flush();
+  constexpr vk::BufferUse kReaders = vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead;
+  u.submission.emplace(ctx_, [&](VkCommandBuffer cb) {
+    vk::bufferBarrier(cb, kReaders, vk::kCopyWrite);  // the frames before read the old slots first
+    const VkBufferCopy region{0, 0, bytes};
+    vkCmdCopyBuffer(cb, u.staging.handle(), materials_.handle(), 1, &region);
+    vk::bufferBarrier(cb, vk::kCopyWrite, kReaders);
+  });
+  ++arrivals_;
+}
+
+void GpuScene::createTexture(uint32_t i) {
+  vk::ImageDesc desc = textureDesc(staged_[i].extent, formats_[i]);
+  if (blockCompressed(formats_[i]))  // baked with its chain: copied into, sampled, nothing else
+    desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, desc.flags = 0, desc.viewUsage = 0;
+  textures_[i] = vk::Image(ctx_, desc);
+  hostMips_[i] = !staged_[i].levels.empty();
 }
 
 // Every level of each texture the cache missed, copied into a buffer laid out as a baked chain; packed and
 // written on a worker thread (the destructor waits for it), then the cache trimmed to its bound.
-void GpuScene::storeInCache() {
-  if (!cache_ || toStore_.empty()) return;
+void GpuScene::storeInCache(std::vector<std::pair<uint32_t, TextureCacheKey>> which, bool last) {
+  if (!cache_ || which.empty()) return;
   const auto t = Clock::now();
   struct Back {
     BakedTexels layout;
@@ -515,7 +688,7 @@ void GpuScene::storeInCache() {
   };
   auto backs = std::make_shared<std::vector<Back>>();
   std::vector<vk::ImageBarrier> toSrc, back;
-  for (auto& [i, key] : toStore_) {
+  for (auto& [i, key] : which) {
     Back b;
     b.layout.format = formats_[i] == VK_FORMAT_R8_UNORM ? BakedFormat::R8 : BakedFormat::Rgba8;
     b.layout.width = textures_[i].extent().width;
@@ -545,15 +718,14 @@ void GpuScene::storeInCache() {
         r.imageExtent = {std::max(1u, b.layout.width >> l), std::max(1u, b.layout.height >> l), 1};
         regions.push_back(r);
       }
-      vkCmdCopyImageToBuffer(cb, textures_[toStore_[k].first].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b.buffer.handle(),
+      vkCmdCopyImageToBuffer(cb, textures_[which[k].first].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b.buffer.handle(),
                              uint32_t(regions.size()), regions.data());
     }
     vk::barrier(cb, back);
     vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
   });
-  toStore_.clear();
-  stats_.cacheReadbackMs = msSince(t);
-  storing_ = std::async(std::launch::async, [cache = cache_, backs] {
+  stats_.cacheReadbackMs += msSince(t);
+  storing_.push_back(std::async(std::launch::async, [cache = cache_, backs, last] {
     parallelFor(backs->size(), 0, [&](size_t k) {
       Back& b = (*backs)[k];
       b.buffer.invalidate();
@@ -562,22 +734,22 @@ void GpuScene::storeInCache() {
                                           std::vector<uint8_t>(p, p + b.layout.bytes()), 1));
       b.buffer = {};
     });
-    cache->trim();
-  });
+    if (last) cache->trim();
+  }));
 }
 
-std::vector<const vk::Image*> GpuScene::gpuMipBatch() const {
+std::vector<const vk::Image*> GpuScene::gpuMipBatch(const std::vector<uint32_t>& which) const {
   std::vector<const vk::Image*> batch;
-  for (size_t i = 0; i < textures_.size(); ++i)
+  for (uint32_t i : which)
     if (!hostMips_[i]) batch.push_back(&textures_[i]);
   return batch;
 }
 
 // Staging memory to level 0 of every texture (every level of those with their chain made on the CPU,
 // which are then ready for shaders: the mip generator's layout contract).
-void GpuScene::recordUpload(VkCommandBuffer cb) const {
+void GpuScene::recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& which) const {
   std::vector<vk::ImageBarrier> toDst, ready;
-  for (size_t i = 0; i < textures_.size(); ++i) {
+  for (uint32_t i : which) {
     const uint32_t levels = hostMips_[i] ? textures_[i].mipLevels() : 1;
     toDst.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                      VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0,
@@ -589,7 +761,7 @@ void GpuScene::recordUpload(VkCommandBuffer cb) const {
                        VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, levels});
   }
   vk::barrier(cb, toDst);
-  for (size_t i = 0; i < textures_.size(); ++i) {
+  for (uint32_t i : which) {
     const Staged& st = staged_[i];
     std::vector<VkBufferImageCopy> regions;
     for (uint32_t l = 0; l < (hostMips_[i] ? st.levels.size() : 1); ++l) {
@@ -610,15 +782,16 @@ void GpuScene::finishTextures() {
   vk::PipelineCache& pipelines = ctx.pipelineCache();
   // Texture upload: one submission of copies into level 0.
   auto t = Clock::now();
-  createTextures();
-  if (!textures_.empty()) vk::submitAndWait(ctx, [&](VkCommandBuffer cb) { recordUpload(cb); });
+  std::vector<uint32_t> all(textures_.size());
+  for (uint32_t i = 0; i < all.size(); ++i) createTexture(all[i] = i);
+  if (!textures_.empty()) vk::submitAndWait(ctx, [&](VkCommandBuffer cb) { recordUpload(cb, all); });
   staged_.clear();
   stats_.textureUploadMs = msSince(t);
 
   // Mips, in a submission of their own (their pipelines' creation is counted as pipeline creation).
   t = Clock::now();
   const double pipelineMs = pipelines.stats().ms;
-  if (const std::vector<const vk::Image*> batch = gpuMipBatch(); !batch.empty()) {
+  if (const std::vector<const vk::Image*> batch = gpuMipBatch(all); !batch.empty()) {
     MipGenerator mipGen(ctx);
     MipViews views;  // alive until the submission has completed
     vk::GpuTimer timer(ctx, 1);
@@ -665,8 +838,7 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings,
 
 std::vector<VkImageView> GpuScene::textureViews() const {
   std::vector<VkImageView> out;
-  if (!ready_) return out;  // a deferred load's images exist before their upload completed
-  for (const auto& t : textures_) out.push_back(t.view());
+  for (size_t i = 0; i < textures_.size(); ++i) out.push_back(in_[i] ? textures_[i].view() : VK_NULL_HANDLE);
   return out;
 }
 

@@ -8,10 +8,13 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <future>
 #include <functional>
+#include <list>
 #include <vector>
 
 #include "core/enum_names.hpp"
@@ -97,7 +100,8 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings,
 enum class GeometryUpload { Auto, Staging };
 
 // Whether the constructor returns with the textures on the GPU (Wait), or leaves them decoding on worker
-// threads (Deferred): until updateTextures() takes them in, every material shows its factors alone.
+// threads (Deferred): updateTextures() takes them in as they are decoded, a batch at a time; until its
+// texture is in, a material's slot shows its factor alone.
 enum class TextureLoad { Wait, Deferred };
 
 class GpuScene {
@@ -112,12 +116,22 @@ class GpuScene {
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
 
-  // Deferred load, between frames: once the textures are decoded, submits their upload and mips; once
-  // those completed, waits for the device to be idle and points the materials at the textures: true then
-  // (once). `wait`: blocks until then. Renderers notice by texturesReady() and write their texture sets.
+  // Deferred load, between frames. Takes in the textures decoded so far, a batch at a time: at most one
+  // batch in flight, of the textures decoded first, up to uploadBudget() bytes of staged texels (at least
+  // one texture); its upload and mips go in a submission of their own. Once that has completed, the
+  // materials' slots point at its textures: a copy into the material buffer, submitted before the next
+  // frame (frames in flight keep reading the old slots; no wait). Renderers see textureArrivals() change
+  // and write the new textures' descriptors, which no pending frame uses. True once, when the last texture
+  // is in; `wait`: blocks until then.
   bool updateTextures(bool wait = false);
   bool texturesReady() const { return ready_; }
   size_t texturesDecoded() const { return decoded_; }  // of textureCount(), while loading
+  size_t texturesIn() const { return texturesIn_; }    // on the GPU, their materials pointing at them
+  bool textureIn(uint32_t gpuIndex) const { return in_.at(gpuIndex) != 0; }
+  uint64_t textureArrivals() const { return arrivals_; }  // changes whenever textures came in
+  // The per-batch budget of a deferred load (bytes of staged texels, every level included).
+  static constexpr size_t kDefaultUploadBudget = size_t(16) << 20;
+  void setUploadBudget(size_t bytes) { uploadBudget_ = bytes; }
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
   bool hasDraws(DrawKind k) const { return !draws_[size_t(k)].empty(); }
@@ -140,10 +154,25 @@ class GpuScene {
   VkBuffer clusters() const { return clusters_.handle(); }
   uint32_t clusterCount() const { return clusterCount_; }
   uint32_t baseClusterCount() const { return baseClusterCount_; }
+  // GpuCullInstance (cluster.h) per instance with clusters: its sphere and its runs of clusters.
+  VkBuffer cullInstances() const { return cullInstances_.handle(); }
+  uint32_t cullInstanceCount() const { return cullInstanceCount_; }
+  VkBuffer cullLevels() const { return cullLevels_.handle(); }  // GpuCullLevel: each instance's, level 0 first
   // GpuClusterLod per GpuCluster where some mesh has a hierarchy (docs/virtual-geometry.md); else null.
   VkBuffer clusterLods() const { return clusterLods_.handle(); }
+  // Visibility ids (frame.h): instance i names the ids [firstId(i), firstId(i) + its draw's primitives),
+  // instances in order, blended ones none. They fit a frame's 32 bits while visIdCount() <= kMaxVisIds;
+  // visIdPages() (uint per page of 2^visIdPageShift() ids, the instance holding the page's first id, then
+  // one more) finds an id's instance in a few steps.
+  static constexpr uint64_t kMaxVisIds = 0xFFFFFFFFu;  // VIS_EMPTY is no id
+  uint64_t visIdCount() const { return visIdCount_; }
+  uint64_t firstId(uint32_t instance) const { return firstIds_.at(instance); }
+  VkBuffer visIdPages() const { return visIdPages_.handle(); }
+  uint32_t visIdPageShift() const { return idPageShift_; }
+  // The instance and the primitive (of its draw) an id names (the CPU's decode, for tests and tools).
+  std::pair<uint32_t, uint32_t> decodeVisId(uint32_t id) const;
   uint32_t textureCount() const { return stats_.textures; }  // also while they load
-  // Every texture's view; none until texturesReady(). The renderer pairs them with samplers (TextureSet).
+  // Every texture's view; null where it is not in yet. The renderer pairs them with samplers.
   std::vector<VkImageView> textureViews() const;
   const std::vector<SamplerDesc>& textureSamplers() const { return samplers_; }  // per texture, its own
   const Bounds& bounds() const { return bounds_; }
@@ -154,48 +183,70 @@ class GpuScene {
   GeometryPlan planGeometry(const Scene& scene);                              // draws_, stats_ and the records
   std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
   void uploadGeometry(const GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials, GeometryUpload upload);
-  void finishTextures();  // staging buffers to images, mips (a waited load)
-  void startUpload();     // the same in one submission, not waited for (a deferred load)
-  void createTextures();
-  void recordUpload(VkCommandBuffer cb) const;
-  void storeInCache();  // the chains of the textures the cache missed: read back, then stored
+  void finishTextures();                                 // staging buffers to images, mips (a waited load)
+  std::vector<uint32_t> nextBatch(bool wait);            // a deferred load's next textures, by the budget
+  void startUpload(const std::vector<uint32_t>& batch);  // the same in one submission, not waited for
+  void takeIn();                                         // its submission completed: the materials point at them
+  void createTexture(uint32_t i);
+  void recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& which) const;
+  // The chains of the textures the cache missed: read back, then stored (the cache trimmed after the last).
+  void storeInCache(std::vector<std::pair<uint32_t, TextureCacheKey>> which, bool last);
 
   const vk::Context& ctx_;
   MipMode mipMode_;
   LoadProgress progress_;
   struct Staged {
     vk::Buffer buffer;
+    size_t bytes = 0;
     VkExtent2D extent;
     std::vector<VkDeviceSize> levels;  // a chain made on the CPU: each level's offset; else empty
   };
-  std::vector<bool> hostMips_;                          // per texture: its chain was made on the CPU (uploaded whole)
-  std::vector<const vk::Image*> gpuMipBatch() const;    // the textures whose chains the GPU makes
-  std::vector<Staged> staged_;                          // decoded texels, until uploaded
-  std::vector<VkFormat> formats_;                       // of each texture
-  std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, until the textures are in
+  std::vector<bool> hostMips_;  // per texture: its chain was made on the CPU (uploaded whole)
+  std::vector<const vk::Image*> gpuMipBatch(const std::vector<uint32_t>& which) const;  // chains the GPU makes
+  std::vector<Staged> staged_;                                                          // decoded texels, until uploaded
+  std::vector<VkFormat> formats_;                                                       // of each texture
+  std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, as they will be
+  std::vector<shader::GpuMaterial> shownMaterials_;     // and as the material buffer holds them meanwhile
   std::atomic<size_t> decoded_{0};
   std::future<void> decoding_;  // a deferred load's decode, until taken in
+  std::mutex decodedMutex_;     // guards the two below, written by the decoding threads
+  std::condition_variable decodedChanged_;
+  std::vector<uint32_t> decodedQueue_;  // decoded and staged, not yet in a batch, in decode order
+  bool decodeFinished_ = false;
+  std::vector<uint8_t> in_;  // per texture: on the GPU and in the materials
+  size_t texturesIn_ = 0;
+  uint64_t arrivals_ = 0;
+  size_t uploadBudget_ = kDefaultUploadBudget;
   TextureCache* cache_ = nullptr;
-  std::string cacheVariant_;                                   // what makes this device's chains (the cache key)
-  std::vector<std::pair<uint32_t, TextureCacheKey>> toStore_;  // GPU texture, its key: the cache's misses
-  std::future<void> storing_;                                  // packing and writing them
-  bool ready_ = false;                                         // the textures are on the GPU and the materials point at them
+  std::string cacheVariant_;                               // what makes this device's chains (the cache key)
+  std::vector<std::optional<TextureCacheKey>> storeKeys_;  // per texture: a cache miss, stored once its chain is made
+  std::vector<std::future<void>> storing_;                 // packing and writing them
+  bool ready_ = false;                                     // every texture is on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
-  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_;
-  uint32_t clusterCount_ = 0, baseClusterCount_ = 0;
+  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_, cullInstances_, cullLevels_;
+  uint32_t clusterCount_ = 0, baseClusterCount_ = 0, cullInstanceCount_ = 0;
+  std::vector<uint64_t> firstIds_;  // per instance
+  uint64_t visIdCount_ = 0;
+  uint32_t idPageShift_ = 0;
   std::vector<vk::Image> textures_;
-  std::vector<SamplerDesc> samplers_;  // of each texture (Texture::sampler)
-  struct PendingUpload {               // alive until its submission completed
-    explicit PendingUpload(const vk::Context& ctx) : mips(ctx), timer(ctx, 1) {}
-    MipGenerator mips;
+  std::vector<SamplerDesc> samplers_;     // of each texture (Texture::sampler)
+  std::unique_ptr<MipGenerator> mipGen_;  // a deferred load's, for all its batches
+  struct PendingUpload {                  // alive until its submission completed
+    explicit PendingUpload(const vk::Context& ctx) : timer(ctx, 1) {}
+    std::vector<uint32_t> batch;
     MipViews views;
     vk::GpuTimer timer;
     std::optional<vk::Submission> submission;
     std::chrono::steady_clock::time_point start;
   };
   std::unique_ptr<PendingUpload> upload_;  // after textures_: destroyed (waited for) first
+  struct MaterialUpdate {                  // the material buffer rewritten by a copy, alive until done
+    vk::Buffer staging;
+    std::optional<vk::Submission> submission;
+  };
+  std::list<MaterialUpdate> materialUpdates_;  // after materials_: waited for first
   Bounds bounds_;
   GpuSceneStats stats_;
 };

@@ -40,8 +40,9 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   uint64_t triangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
     for (const DrawItem& di : scene.draws(DrawKind(k))) triangles += uint64_t(di.primitives) * di.instanceCount;
+  handOffCapacity_ = uint32_t(std::clamp<uint64_t>(triangles, 1, RASTER_HANDOFF_CAPACITY));
   hwList_ =
-      vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::max<uint64_t>(triangles, 1),
+      vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::clamp<uint64_t>(triangles, 1, RASTER_HANDOFF_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                  vk::MemoryUse::Device, "raster hand-off");
   largeList_ =
@@ -74,8 +75,11 @@ std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame)
   shader::CullCounts c[2];
   std::memcpy(c, static_cast<const char*>(cullReadback_.mapped()) + sizeof c * frame, sizeof c);
   const uint32_t early = twoPhase_.at(frame) ? c[0].listed : 0, earlyTriangles = twoPhase_.at(frame) ? c[0].triangles : 0;
-  return CullStats{scene_.clusterCount(), early,          c[1].listed,    c[1].culled[0],
-                   c[1].culled[1],        c[1].culled[2], c[1].culled[3], earlyTriangles + c[1].triangles};
+  CullStats s{scene_.clusterCount(), early,          c[1].listed,    c[1].culled[0],
+              c[1].culled[1],        c[1].culled[2], c[1].culled[3], earlyTriangles + c[1].triangles};
+  s.tested = (twoPhase_.at(frame) ? c[0].tested : 0) + c[1].tested;
+  s.instancesCulled = c[1].instancesCulled;
+  return s;
 }
 
 void ComputeRaster::resize(VkExtent2D extent) {
@@ -87,8 +91,8 @@ void ComputeRaster::resize(VkExtent2D extent) {
   extent_ = extent;
 }
 
-void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits,
-                           vk::GpuTimer& timer, uint32_t frame, const CullCamera& camera, bool cull) {
+void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
+                           const CullCamera& camera, bool cull) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
@@ -129,7 +133,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     w.push(cb, p);
     for (size_t i = 0; i < 3; ++i)
       if (&p == textured()[i] && p.layout.setCount() > 1) p.bindSet(cb, 1, textures_[i].get(1));
-    p.push(cb, shader::RasterPush{extent_.width, extent_.height, primitiveBits, clusterCount, fromList, 0, 0, 0});
+    p.push(cb, shader::RasterPush{extent_.width, extent_.height, clusterCount, fromList, handOffCapacity_, 0, 0, 0});
   };
   // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.
   constexpr vk::BufferUse kReaders = vk::kComputeReadWrite | vk::kFragmentReadWrite | vk::kVertexReadWrite | vk::kIndirectRead;
@@ -160,13 +164,15 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     timer.mark(cb, largeName);
   };
   if (culling && !twoPhase) {  // the level-of-detail cut alone
-    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {false, false, false, true}, CullPhase::Single, lods);
+    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {false, false, false, true}, CullPhase::Single, lods,
+                    scene_.cullInstances(), scene_.cullInstanceCount(), scene_.cullLevels());
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
     vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     timer.mark(cb, "cull");
   }
   if (twoPhase) {
-    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {}, CullPhase::Early, lods);
+    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {}, CullPhase::Early, lods, scene_.cullInstances(),
+                    scene_.cullInstanceCount(), scene_.cullLevels());
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[0]);
     timer.mark(cb, "cull early");
     rasterise("raster early", "raster large early");
@@ -177,7 +183,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     pyramid_->buildFromBuffer(cb, vis_.handle());
     timer.mark(cb, "pyramid");
     // Its first barrier orders the copies above before its reset, its second makes them visible to compute.
-    culler_->record(cb, scene_.clusters(), clusterCount, camera, &*pyramid_, {}, CullPhase::Late, lods);
+    culler_->record(cb, scene_.clusters(), clusterCount, camera, &*pyramid_, {}, CullPhase::Late, lods, scene_.cullInstances(),
+                    scene_.cullInstanceCount(), scene_.cullLevels());
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
     vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     timer.mark(cb, "cull");

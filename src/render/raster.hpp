@@ -33,8 +33,8 @@ class ComputeRaster {
   // Level of detail (docs/virtual-geometry.md): with a scene hierarchy and camera.lodThreshold > 0, the
   // culling pass picks each instance's clusters of the cut (without `cull`: one pass, "cull", testing
   // nothing else); otherwise only the full-detail clusters are drawn.
-  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, uint32_t primitiveBits, vk::GpuTimer& timer,
-              uint32_t frame, const CullCamera& camera, bool cull);
+  void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
+              const CullCamera& camera, bool cull);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
   // The passes' texture arrays (set 1 of the layouts that have one), for the one writer of every texture set.
   std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> textureSets() const;
@@ -43,10 +43,14 @@ class ComputeRaster {
     uint32_t clusters = 0, early = 0, late = 0;              // listed by each phase (one pass: late)
     uint32_t frustum = 0, cone = 0, occlusion = 0, lod = 0;  // culled, by the late phase (every cluster tested)
     uint32_t triangles = 0;                                  // of the listed clusters, both phases
+    uint32_t tested = 0;                                     // clusters visited, both phases (those of the instances not culled)
+    uint32_t instancesCulled = 0;                            // by the late phase's frustum test, whole
   };
   std::optional<CullStats> cullStats(uint32_t frame) const;
-  // Triangles handed to the hardware by the last completed use of `frame` (both phases).
+  // Triangles handed to the hardware by the last completed use of `frame` (both phases); those past
+  // handOffCapacity() were not drawn.
   uint32_t handOffTriangles(uint32_t frame) const;
+  uint32_t handOffCapacity() const { return handOffCapacity_; }
 
  private:
   const vk::Context& ctx_;
@@ -55,6 +59,7 @@ class ComputeRaster {
   vk::DescriptorSets textures_[3];  // set 1 of textured()'s pipelines where they have one
   std::array<const vk::Pipeline*, 3> textured() const { return {&raster_, &large_, &hardware_}; }
   vk::Buffer vis_, hwList_, largeList_;
+  uint32_t handOffCapacity_ = 1;
   VkExtent2D extent_{0, 0};
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
   std::optional<DepthPyramid> pyramid_;

@@ -1,11 +1,11 @@
 #include "render/renderer.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cstdio>
 #include <cstring>
 
 #include "core/error.hpp"
+#include "raster.h"
 #include "variants.h"
 #include "vk/check.hpp"
 #include "vk/context.hpp"
@@ -41,22 +41,15 @@ std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const
 }
 
 Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), texturesBound_(scene.texturesReady()), post_(ctx) {
+    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), arrivalsSeen_(scene.textureArrivals()), post_(ctx) {
   makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 13);  // at most: ComputeRaster::record's nine passes, shade, transparent, post
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
-  // Instance index in the high bits (just enough that no id is VIS_EMPTY), primitive index in the rest.
-  uint32_t maxTriangles = 0;
   for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& d : scene.draws(DrawKind(k))) {
-      maxTriangles = std::max(maxTriangles, d.primitives);
-      triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
-    }
-  const uint32_t instances = scene.instanceCount();
-  primitiveBits_ = 32 - uint32_t(std::bit_width(instances));
+    for (const DrawItem& d : scene.draws(DrawKind(k))) triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
   cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   canHardware_ = features.geometryShader;
   canCompute_ = ComputeRaster::supported(ctx);
@@ -64,7 +57,14 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
     transparency_.emplace(ctx, scene);
     writeTextureSets();
   }
-  canUseVisibility_ = (canHardware_ || canCompute_) && instances > 0 && uint64_t(maxTriangles) <= (uint64_t(1) << primitiveBits_);
+  // The compute rasteriser's hand-off and tile lists name a cluster record in the bits above a triangle's.
+  canCompute_ = canCompute_ && scene.clusterCount() < (1u << (32 - RASTER_LOCAL_BITS));
+  if (scene.visIdCount() > GpuScene::kMaxVisIds)
+    visibilityRefusal_ = "the scene's " + std::to_string(scene.visIdCount()) +
+                         " triangle ids (each instance's triangles, hierarchy included) do not fit the visibility "
+                         "buffer's 32 bits";
+  else if (!canHardware_ && !canCompute_) visibilityRefusal_ = "the device has neither rasteriser of the visibility path";
+  canUseVisibility_ = scene.instanceCount() > 0 && visibilityRefusal_.empty();
 }
 
 ShadingPath Renderer::pathFor(const RenderSettings& s) const {
@@ -229,23 +229,36 @@ void Renderer::makeTextureInfos() {
   }
 }
 
-void Renderer::writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set) const {
-  if (set && !textureInfos_.empty()) vk::DescriptorWriter(ctx_, layout, 1, set).images(0, textureInfos_).commit();
+// The textures that are in (a view), or of those only the ones in `only`: runs of consecutive elements.
+void Renderer::writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set, const std::vector<uint8_t>* only) const {
+  if (!set) return;
+  vk::DescriptorWriter w(ctx_, layout, 1, set);
+  for (size_t i = 0; i < textureInfos_.size();) {
+    auto wanted = [&](size_t k) { return textureInfos_[k].imageView && (!only || (*only)[k]); };
+    if (!wanted(i)) {
+      ++i;
+      continue;
+    }
+    const size_t first = i;
+    while (i < textureInfos_.size() && wanted(i)) ++i;
+    w.images(0, {textureInfos_.begin() + first, textureInfos_.begin() + i}, uint32_t(first));
+  }
+  w.commit();
 }
 
-void Renderer::writeTextureSets() {
+void Renderer::writeTextureSets(const std::vector<uint8_t>* only) {
   for (auto& set : pipelines_) {
     if (!set) continue;
     for (ScenePipelines& p : *set)
       if (p.pipeline && p.pipeline->layout.setCount() > 1)
-        for (uint32_t frame = 0; frame < framesInFlight_; ++frame) writeTextures(p.pipeline->layout, p.sets.get(1, frame));
+        for (uint32_t frame = 0; frame < framesInFlight_; ++frame) writeTextures(p.pipeline->layout, p.sets.get(1, frame), only);
   }
   for (VisShade& v : shade_)
-    if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1));
+    if (v.pipeline && v.pipeline->layout.setCount() > 1) writeTextures(v.pipeline->layout, v.textures.get(1), only);
   if (raster_)
-    for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set);
+    for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set, only);
   if (transparency_)
-    for (const auto& [layout, set] : transparency_->textureSets()) writeTextures(*layout, set);
+    for (const auto& [layout, set] : transparency_->textureSets()) writeTextures(*layout, set, only);
 }
 
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
@@ -297,7 +310,7 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
         vkCmdBindIndexBuffer(cb, d.indexType == VK_INDEX_TYPE_UINT16 ? scene_.indices16() : scene_.indices32(), 0, d.indexType);
         bound = d.indexType;
       }
-      pl.push(cb, shader::DrawPush{d.material, primitiveBits_});
+      if (!pl.layout.interface().pushConstants.empty()) pl.push(cb, shader::DrawPush{d.material, 0});  // vis: masked only
       vkCmdSetFrontFace(cb, d.mirrored ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE);
       vkCmdDrawIndexed(cb, d.indexCount, d.instanceCount, d.firstIndex, d.vertexOffset, d.firstInstance);
     }
@@ -321,6 +334,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(6, i16)
       .buffer(10, scene_.instances())
       .buffer(13, scene_.colors() ? scene_.colors() : scene_.positions())
+      .buffer(15, scene_.visIdPages())
       .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
   writeEnvironment(w, c.layout, env_.get());
   if (raster == RasterPath::Compute) w.buffer(14, raster_->ids());
@@ -331,7 +345,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
     w.buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions());
   }
   w.push(cb, c);
-  c.push(cb, shader::VisShadePush{primitiveBits_});
+  c.push(cb, shader::VisShadePush{scene_.visIdPageShift()});
   if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade.textures.get(1));
   c.dispatch(cb, extent_.width, extent_.height);  // one thread per pixel
 }
@@ -343,15 +357,25 @@ void Renderer::frame(FrameContext& fc) {
   const Lens& lens = fc.lens;
   const RenderSettings& s = fc.settings;
   const RenderTarget& target = fc.target;
-  // Every texture set is written again once no frame uses them, for new samplers (samplers are cheap; a
-  // user's change in the panel) or the textures of a deferred load arriving.
-  const bool arrived = scene_.texturesReady() && !texturesBound_;
-  if (s.sampler != samplerSettings_ || arrived) {
+  // Every texture set is written again once no frame uses them for new samplers (samplers are cheap; a
+  // user's change in the panel). Textures of a deferred load that came in since the last frame: only their
+  // elements are written, which no pending frame uses (their materials' slots pointed at none until the
+  // copy GpuScene submitted after those frames), so frames in flight go on; where the device does not
+  // allow that, once they are done.
+  if (s.sampler != samplerSettings_) {
     VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
     samplerSettings_ = s.sampler;
-    texturesBound_ = scene_.texturesReady();
+    arrivalsSeen_ = scene_.textureArrivals();
     makeTextureInfos();
     writeTextureSets();
+  } else if (scene_.textureArrivals() != arrivalsSeen_) {
+    if (!ctx_.updateUnusedWhilePending()) VK_CHECK(vkDeviceWaitIdle(ctx_.device()));
+    arrivalsSeen_ = scene_.textureArrivals();
+    const std::vector<VkImageView> views = scene_.textureViews();
+    std::vector<uint8_t> fresh(views.size(), 0);
+    for (size_t i = 0; i < views.size(); ++i)
+      if (views[i] && !textureInfos_[i].imageView) fresh[i] = 1, textureInfos_[i].imageView = views[i];
+    writeTextureSets(&fresh);
   }
   const bool visibility = pathFor(s) == ShadingPath::Visibility;
   const RasterPath raster = visibility ? rasterFor(s) : RasterPath::Auto;
@@ -424,7 +448,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute) {
     const float pixelsPerUnit = float(target.extent.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
     const CullCamera cam{u.viewProj, pose.position, lens.orthographic, s.lodError, pixelsPerUnit, lens.zNear};
-    raster_->record(cb, uniforms_, primitiveBits_, timer, frame, cam, s.cull);
+    raster_->record(cb, uniforms_, timer, frame, cam, s.cull);
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
   } else {
     rasterPass(cb, frame, set, pose.position, s.background, backdrop);

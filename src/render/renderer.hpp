@@ -119,7 +119,8 @@ class Renderer {
   // Records a copy of the last frame's visibility ids into `dst` (host-visible, 8 bytes a pixel at most);
   // returns the bytes per pixel written: 4 (hardware: the id) or 8 (compute: id in the low half).
   uint32_t copyIds(VkCommandBuffer cb, VkBuffer dst);
-  uint32_t primitiveBits() const { return primitiveBits_; }
+  // Why the scene cannot take the visibility path on this device (frames are forward); empty if it can.
+  const std::string& visibilityRefusal() const { return visibilityRefusal_; }
   // The culling counts of the last completed use of `frame`; none where it did not cull.
   std::optional<ComputeRaster::CullStats> cullStats(uint32_t frame) const {
     return raster_ ? raster_->cullStats(frame) : std::nullopt;
@@ -128,6 +129,7 @@ class Renderer {
   std::optional<uint32_t> handOffTriangles(uint32_t frame) const {
     return raster_ ? std::optional(raster_->handOffTriangles(frame)) : std::nullopt;
   }
+  uint32_t handOffCapacity() const { return raster_ ? raster_->handOffCapacity() : 0; }
 
  private:
   struct ScenePipelines {
@@ -154,8 +156,9 @@ class Renderer {
   // The scene's texture array, as every pipeline that samples it binds it (set 1, binding 0): each
   // texture with a sampler made from its own SamplerDesc and the settings (one per distinct pair).
   void makeTextureInfos();
-  void writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set) const;  // the one writer
-  void writeTextureSets();  // every pipeline built: after a settings change or the textures' arrival
+  // The one writer: every texture that is in, or those of them marked in `only`.
+  void writeTextures(const vk::PipelineLayout& layout, VkDescriptorSet set, const std::vector<uint8_t>* only = nullptr) const;
+  void writeTextureSets(const std::vector<uint8_t>* only = nullptr);  // of every pipeline built
 
   const vk::Context& ctx_;
   const GpuScene& scene_;
@@ -163,7 +166,7 @@ class Renderer {
   SamplerSettings samplerSettings_;
   std::vector<vk::Sampler> samplers_;  // made from samplerSettings_, one per distinct SamplerDesc
   std::vector<VkDescriptorImageInfo> textureInfos_;
-  bool texturesBound_;               // the scene's textures were ready when the texture sets were written
+  uint64_t arrivalsSeen_;            // the scene's textureArrivals() when the texture sets were last written
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
   std::array<VisShade, 3> shade_;        // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
@@ -174,7 +177,7 @@ class Renderer {
   RasterPath lastRaster_ = RasterPath::Auto;
   bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
   uint64_t triangles_ = 0;
-  uint32_t primitiveBits_ = 0;  // low bits of a visibility id: the primitive index
+  std::string visibilityRefusal_;
   MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;
   vk::Image color_, depth_, vis_;  // vis_ only once the visibility path ran

@@ -105,7 +105,7 @@ void TransparencyPass::record(VkCommandBuffer cb, const vk::UploadArena::Slice& 
     }
     const DrawItem& d = bd->item;
     vkCmdBindIndexBuffer(cb, d.indexType == VK_INDEX_TYPE_UINT16 ? scene_.indices16() : scene_.indices32(), 0, d.indexType);
-    pl.push(cb, shader::DrawPush{d.material, 0, opaqueIds ? extent.width : 0u});
+    pl.push(cb, shader::DrawPush{d.material, opaqueIds ? extent.width : 0u});
     vkCmdSetFrontFace(cb, d.mirrored ? VK_FRONT_FACE_CLOCKWISE : VK_FRONT_FACE_COUNTER_CLOCKWISE);
     vkCmdDrawIndexed(cb, d.indexCount, 1, d.firstIndex, d.vertexOffset, d.firstInstance);
   }

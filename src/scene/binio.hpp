@@ -34,6 +34,7 @@ class ByteWriter {
   }
   void pad(size_t align) { out_.append((align - out_.size() % align) % align, '\0'); }
   size_t size() const { return out_.size(); }
+  void reserve(size_t n) { out_.reserve(n); }  // a large file grown by doubling copies itself again and again
   std::string& data() { return out_; }
 
  private:

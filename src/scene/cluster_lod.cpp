@@ -70,8 +70,6 @@ std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
 // in fixed pieces of kGroupPiece clusters, each on its own (all cores; the same groups for any thread
 // count): a cluster's neighbours in another piece are not considered.
 constexpr uint32_t kGroupPiece = 256;
-// The longest edge a simplification makes, in units of the error it reports (see buildClusterLod).
-constexpr float kEdgePerError = 8.0f;
 std::vector<std::vector<uint32_t>> groupClusters(const std::vector<Indices>& clusters, uint32_t first, uint32_t end) {
   const uint32_t n = end - first;  // local numbering: cluster first + i is i
   std::unordered_map<uint64_t, uint32_t> edgeOwner;
@@ -200,7 +198,7 @@ std::span<const uint32_t> lodTriangles(const Mesh& mesh, const LodCluster& c) {
   return {mesh.lod.indices.data() + (first - base * 3), n};
 }
 
-ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads) {
+ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads, std::vector<LodGroupStats>* stats) {
   ClusterLod lod;
   if (mesh.indices.empty() || mesh.positions.empty()) return lod;
   if (mesh.clusters.empty()) throw Error("mesh '" + mesh.name + "': a cluster hierarchy needs the mesh's clusters");
@@ -254,13 +252,15 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       float error = 0.0f;
       std::vector<Indices> clusters;  // empty: the group stays as it is, its clusters roots
       std::vector<meshopt_Bounds> bounds;
+      LodGroupStats stats;
     };
     std::vector<Result> results(groups.size());
     parallelFor(groups.size(), threads, [&](size_t gi) {
       const std::vector<uint32_t>& g = groups[gi];
+      Result& r = results[gi];
+      r.stats = {level - 1, 1, uint32_t(current[g[0]].size() / 3)};
       if (g.size() < 2) return;  // alone: nothing around it to share a border with; a root
       Indices tris;
-      Result& r = results[gi];
       r.sphere = lod.clusters[ids[g[0]]].sphere;
       float childError = 0.0f;
       for (uint32_t k : g) {
@@ -269,12 +269,15 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
         childError = std::max(childError, lod.clusters[ids[k]].error);
       }
       const Indices simpler = simplifyGroup(tris, mesh, r.error);
+      r.stats = {level - 1, uint32_t(g.size()), uint32_t(tris.size() / 3), 0, r.error, 0.0f, r.sphere.w};
       if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) return;  // stuck: these stay roots
+      r.stats.trianglesOut = uint32_t(simpler.size() / 3);
       // The error also bounds the size of the triangles the simplification made: where it moves no
       // surface (a flat floor: error 0) it would otherwise make triangles that are drawn at any distance,
-      // however many pixels they cover. So a triangle of the cut spans at most kEdgePerError × the
+      // however many pixels they cover. So a triangle of the cut spans at most kLodEdgePerError × the
       // threshold in pixels (fewer where it is farther than its sphere's nearest point).
-      r.error = std::max(r.error, longestNewEdge(tris, simpler, mesh) / kEdgePerError);
+      r.stats.edgeError = longestNewEdge(tris, simpler, mesh) / kLodEdgePerError;
+      r.error = std::max(r.error, r.stats.edgeError);
       r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
       r.clusters = split(simpler, mesh);
       for (const Indices& c : r.clusters)
@@ -284,6 +287,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     std::vector<uint32_t> nextIds;
     for (size_t gi = 0; gi < groups.size(); ++gi) {
       Result& r = results[gi];
+      if (stats) stats->push_back(r.stats);
       if (r.clusters.empty()) continue;
       for (uint32_t k : groups[gi]) {
         lod.clusters[ids[k]].parentError = r.error;

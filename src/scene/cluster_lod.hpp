@@ -6,16 +6,38 @@
 // is, so a view chooses its cut with shaders/shared/cluster_lod.h's rule and no CPU work. No GPU here.
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "scene/scene.hpp"
 
 namespace rtr {
 
+// The longest edge a simplification makes, in units of the error it reports: a triangle the simplifier
+// made spans at most this many times the threshold in pixels where it is drawn. Its geometric error
+// alone lets flat and ruled surfaces (floors, walls, columns) collapse into triangles of any size. With 8
+// the slivers a simplification with locked borders makes (they span its group) held whole groups under
+// a few pixels, and the temple's floor and columns stayed at full detail; 32 halves the 10M temple's 4K
+// cut with the tile pass's work within 2 % (docs/virtual-geometry.md, measured with rtr-lod-cut).
+constexpr float kLodEdgePerError = 32.0f;
+
+// What the build did with one group of clusters (rtr-lod-cut prints them per level): how far it simplified
+// and which of the error's two terms decided (docs/virtual-geometry.md).
+struct LodGroupStats {
+  uint32_t level = 0;  // of the clusters grouped; the result is level + 1
+  uint32_t clusters = 0, trianglesIn = 0;
+  uint32_t trianglesOut = 0;     // 0: stuck (the group's clusters stay roots)
+  float simplifierError = 0.0f;  // object space, what the simplifier reports
+  float edgeError = 0.0f;        // the size term: longest new edge / kEdgePerError
+  float radius = 0.0f;           // of the group's sphere
+};
+
 // The hierarchy of `mesh` (positions, indices and its clusters, which become level 0: build them first,
 // scene/clusters.hpp). Deterministic, whatever the thread count (0: one per core). Groups whose
 // simplification cannot remove a sixth of their triangles (locked borders everywhere) stop as roots.
 // `backfaceCone` as buildClusters' (false: the clusters above level 0 get cones that never cull).
-ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone = true, unsigned threads = 0);
+// `stats`, where given, receives one record per group, level by level.
+ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone = true, unsigned threads = 0,
+                           std::vector<LodGroupStats>* stats = nullptr);
 // Builds the hierarchy of every mesh that has clusters and none (rtr-bake); returns how many.
 size_t buildMissingClusterLods(Scene& scene, unsigned threads = 0);
 

@@ -33,7 +33,8 @@ constexpr size_t kPieceBytes = size_t(1) << 20;
 constexpr size_t kMaxLine = size_t(64) << 20;
 constexpr uint64_t kMaxMtlBytes = uint64_t(64) << 20;  // real ones are kilobytes; /dev/zero is refused anyway
 constexpr size_t kShownWarnings = 10;
-constexpr size_t kSniffBytes = 8192;  // how much of the start is checked for being text, as git does
+constexpr size_t kLargeMesh = size_t(1) << 20;  // corners: a mesh welded on all cores
+constexpr size_t kSniffBytes = 8192;            // how much of the start is checked for being text, as git does
 
 struct MeshBuild {
   std::string name;
@@ -349,13 +350,32 @@ Scene ObjParser::finish() {
     scene.materials.push_back(std::move(m.material));
   }
 
-  // Weld meshes on a few threads; big meshes dominate, so hand them out one at a time.
+  // Weld: small meshes one per thread, then each large one on all threads (the same meshes either way).
   std::vector<Mesh> meshes(builds_.size());
   std::vector<WeldCounts> counts(builds_.size());
-  parallelFor(builds_.size(), opt_.threads, [&](size_t i) {
-    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_);
+  auto weld = [&](size_t i, unsigned threads) {
+    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads);
     std::vector<Corner>().swap(builds_[i].corners);
+  };
+  const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };
+  double all = 0, done = 0;  // corners
+  for (const MeshBuild& b : builds_) all += double(b.corners.size());
+  auto progress = [&](double corners) {
+    done += corners;
+    if (opt_.weldProgress) opt_.weldProgress(all > 0 ? done / all : 1.0);
+  };
+  progress(0);
+  parallelFor(builds_.size(), opt_.threads, [&](size_t i) {
+    if (!large(i)) weld(i, 1);
   });
+  for (size_t i = 0; i < builds_.size(); ++i) done += large(i) ? 0.0 : double(counts[i].triangles + counts[i].degenerate) * 3;
+  progress(0);
+  for (size_t i = 0; i < builds_.size(); ++i)
+    if (large(i)) {
+      const double corners = double(builds_[i].corners.size());
+      weld(i, opt_.threads);
+      progress(corners);
+    }
 
   for (size_t i = 0; i < builds_.size(); ++i) {
     stats_.verticesBeforeWeld += (counts[i].triangles + counts[i].degenerate) * 3;
@@ -400,7 +420,7 @@ Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& rea
 }
 
 Scene loadObj(const std::filesystem::path& file, const ObjOptions& options, ObjStats* stats) {
-  auto src = openSource(file);
+  auto src = openSource(file, options.threads);
   const std::filesystem::path dir = file.parent_path();
   MtlReader readMtl = [&](const std::string& mtl) -> std::optional<std::string> {
     const std::filesystem::path p = options.mtl && mtl == options.mtl->string() ? *options.mtl : dir / mtl;

@@ -19,6 +19,8 @@ namespace rtr {
 struct ObjOptions : LoadOptions {
   // Called now and then while reading with (bytes consumed from the file, file size).
   std::function<void(uint64_t, uint64_t)> progress;
+  // Called now and then while welding with the fraction of the corners welded.
+  std::function<void(double)> weldProgress;
   unsigned threads = 0;   // parse and weld workers; 0 = all cores
   size_t pieceBytes = 0;  // text parsed as one piece (0: 1 MiB); tests force tiny pieces to put boundaries everywhere
 };

@@ -14,6 +14,7 @@
 #include "scene/binio.hpp"
 #include "scene/rtrscene_lod.hpp"
 #include "core/parallel.hpp"
+#include "scene/baked_texels.hpp"
 #include "scene/rtrscene_texs.hpp"
 
 namespace rtr {
@@ -391,6 +392,25 @@ std::optional<ChunkSpan> readChunks(ByteReader& r, std::span<const uint8_t> byte
   return clod;
 }
 
+// At least the bytes encodeRtrScene writes (records and padding generously counted), so that its buffer is
+// allocated once: a 4 GB scene grown by doubling copied itself about once more and held two buffers at
+// the last step.
+size_t sizeBound(const Scene& scene) {
+  size_t n = 4096 + scene.lights.size() * 128 + scene.instances.size() * 80;
+  for (const Texture& t : scene.textures) {
+    n += 64 + t.path.native().size();
+    if (t.baked) n += 64 + t.baked->pieces.size() * 16 + t.baked->data.size();
+  }
+  for (const Material& m : scene.materials) n += 1024 + m.name.size();
+  for (const Mesh& m : scene.meshes) {
+    auto bytes = [](const auto& a) { return a.size() * sizeof(a[0]); };
+    n += 512 + m.name.size() + bytes(m.positions) + bytes(m.normals) + bytes(m.texcoords) + bytes(m.texcoords1) +
+         bytes(m.tangents) + bytes(m.colors) + bytes(m.indices) + m.clusters.size() * 40;
+    n += 64 + m.lod.clusters.size() * 96 + m.lod.indices.size() * 4;
+  }
+  return n;
+}
+
 }  // namespace
 
 std::string encodeRtrScene(const Scene& scene, uint32_t version) {
@@ -406,6 +426,7 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
     if (i.mesh >= scene.meshes.size())
       throw Error("cannot encode an instance of mesh " + std::to_string(i.mesh) + ": no such mesh");
   ByteWriter w;
+  w.reserve(sizeBound(scene));
   w.bytes(kMagic, 8);
   w.u32(version);
   w.u32(scene.defaultView ? kHasView : 0);

@@ -21,9 +21,10 @@ class ByteSource {
 
 // True for .obj.zst, .obj-zstd and .zst names.
 bool isZstdName(const std::filesystem::path& file);
-// Opens `file`, decompressing when its name says zstd. Throws rtr::Error naming the file.
-std::unique_ptr<ByteSource> openSource(const std::filesystem::path& file);
-// A source over memory (tests, fuzzing); `zstd` decompresses it as a stream.
-std::unique_ptr<ByteSource> memorySource(std::string data, std::string name, bool zstd = false);
+// Opens `file`, decompressing when its name says zstd (a series of sized frames on `threads`, 0: all
+// cores). Throws rtr::Error naming the file.
+std::unique_ptr<ByteSource> openSource(const std::filesystem::path& file, unsigned threads = 0);
+// A source over memory (tests, fuzzing); `zstd` decompresses it.
+std::unique_ptr<ByteSource> memorySource(std::string data, std::string name, bool zstd = false, unsigned threads = 0);
 
 }  // namespace rtr

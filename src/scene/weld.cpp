@@ -1,10 +1,15 @@
 #include "scene/weld.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
+
+#include "core/parallel.hpp"
 
 namespace rtr {
 namespace {
@@ -45,195 +50,359 @@ inline bool near(const Vertex& a, const Vertex& b) {
          c(a.t.x, b.t.x) && c(a.t.y, b.t.y) && a.c == b.c;
 }
 
+// The cells a vertex looks in for its neighbours: its own, and the next one along an axis where it lies
+// within the tolerance of that face.
+struct Around {
+  int64_t cell[3], lo[3], hi[3];
+  explicit Around(const glm::vec3& p) {
+    const float edge = kWeldTolerance * kCellScale;
+    for (int d = 0; d < 3; ++d) {
+      cell[d] = cellOf(p[d]);
+      const float f = p[d] * kCellScale - float(cell[d]);
+      lo[d] = f < edge ? cell[d] - 1 : cell[d];
+      hi[d] = f > 1.0f - edge ? cell[d] + 1 : cell[d];
+    }
+  }
+  template <class Fn>  // fn(hash) per cell in a fixed order until it returns true
+  bool any(Fn&& fn) const {
+    for (int64_t x = lo[0]; x <= hi[0]; ++x)
+      for (int64_t y = lo[1]; y <= hi[1]; ++y)
+        for (int64_t z = lo[2]; z <= hi[2]; ++z)
+          if (fn(cellHash(x, y, z))) return true;
+    return false;
+  }
+};
+
+// Every step runs over fixed pieces of kPiece elements, so the result does not depend on the thread count.
+constexpr size_t kPiece = size_t(1) << 16;
+size_t piecesOf(size_t n) { return (n + kPiece - 1) / kPiece; }
+template <class Fn>  // fn(piece, begin, end)
+void forPieces(size_t n, unsigned threads, Fn&& fn) {
+  parallelFor(piecesOf(n), threads, [&](size_t p) { fn(p, p * kPiece, std::min(n, (p + 1) * kPiece)); });
+}
+template <class T>  // large arrays every element of which is written before it is read: not cleared first
+std::unique_ptr<T[]> uninitialised(size_t n) {
+  return std::unique_ptr<T[]>(new T[n]);
+}
+
+// Items grouped by key, each group's items in increasing order: group g holds items[start[g], start[g + 1]).
+struct Groups {
+  std::vector<uint32_t> start{0}, items;
+  size_t count() const { return start.size() - 1; }
+};
+
+// Items i < n with key(i) < keys (kAbsent: left out). Dense: one group per key (empty ones too), so start
+// is indexed by key; else, when the keys are few against their range, only the keys that occur.
+template <class Key>
+Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool dense) {
+  Groups g;
+  if (!dense && keys > 4 * n + kPiece) {  // sparse: sorted (key, item) pairs
+    std::vector<uint64_t> pairs;
+    for (size_t i = 0; i < n; ++i)
+      if (const uint32_t k = key(i); k != kAbsent) pairs.push_back(uint64_t(k) << 32 | i);
+    std::sort(pairs.begin(), pairs.end());
+    g.items.resize(pairs.size());
+    for (size_t j = 0; j < pairs.size(); ++j) {
+      if (j > 0 && pairs[j] >> 32 != pairs[j - 1] >> 32) g.start.push_back(uint32_t(j));
+      g.items[j] = uint32_t(pairs[j]);
+    }
+    if (!pairs.empty()) g.start.push_back(uint32_t(pairs.size()));
+    return g;
+  }
+  // Counting sort: items to shards of kPiece keys (piece by piece, in order), then each shard by key.
+  const size_t shards = std::max<size_t>(1, (keys + kPiece - 1) / kPiece), pieces = piecesOf(n);
+  std::vector<uint32_t> at(pieces * shards, 0);
+  forPieces(n, threads, [&](size_t p, size_t b, size_t e) {
+    uint32_t* c = &at[p * shards];
+    for (size_t i = b; i < e; ++i)
+      if (const uint32_t k = key(i); k != kAbsent) ++c[k / kPiece];
+  });
+  std::vector<uint32_t> shardStart(shards + 1);
+  uint32_t sum = 0;
+  for (size_t s = 0; s < shards; ++s) {
+    shardStart[s] = sum;
+    for (size_t p = 0; p < pieces; ++p) sum += std::exchange(at[p * shards + s], sum);
+  }
+  shardStart[shards] = sum;
+  std::vector<uint32_t> byShard(sum);
+  forPieces(n, threads, [&](size_t p, size_t b, size_t e) {
+    uint32_t* c = &at[p * shards];
+    for (size_t i = b; i < e; ++i)
+      if (const uint32_t k = key(i); k != kAbsent) byShard[c[k / kPiece]++] = uint32_t(i);
+  });
+  g.start.resize(keys + 1);
+  g.items.resize(sum);
+  parallelFor(shards, threads, [&](size_t s) {
+    const size_t k0 = s * kPiece, k1 = std::min(keys, k0 + kPiece);
+    std::vector<uint32_t> c(k1 - k0, 0);
+    for (uint32_t j = shardStart[s]; j < shardStart[s + 1]; ++j) ++c[key(byShard[j]) - k0];
+    uint32_t off = shardStart[s];
+    for (size_t x = 0; x < c.size(); ++x) g.start[k0 + x] = off, off += std::exchange(c[x], off);
+    for (uint32_t j = shardStart[s]; j < shardStart[s + 1]; ++j) g.items[c[key(byShard[j]) - k0]++] = byShard[j];
+  });
+  g.start[keys] = sum;
+  return g;
+}
+
+// Exclusive prefix sum of per-piece counts; returns the total.
+size_t prefix(std::vector<size_t>& v) {
+  size_t sum = 0;
+  for (size_t& x : v) sum += std::exchange(x, sum);
+  return sum;
+}
+
 }  // namespace
 
 WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                    std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors) {
+                    std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors,
+                    unsigned threads) {
   WeldCounts counts;
-  const size_t triCount = corners.size() / 3;
+  const size_t triCount = corners.size() / 3, cornerCount = triCount * 3;
 
   // 1. Drop triangles with a repeated corner position or zero area.
   std::vector<uint8_t> keep(triCount, 0);
+  struct Piece {
+    size_t kept = 0;
+    bool needNormals = false, hasTex = false;
+    uint32_t pmin = kAbsent, pmax = 0;
+  };
+  std::vector<Piece> pieces(piecesOf(triCount));
+  forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
+    Piece& s = pieces[p];
+    for (size_t t = b; t < e; ++t) {
+      const Corner* c = &corners[t * 3];
+      const glm::vec3 a = positions[c[0].p], bb = positions[c[1].p], d = positions[c[2].p];
+      const glm::vec3 x = glm::cross(bb - a, d - a);
+      if (c[0].p == c[1].p || c[1].p == c[2].p || c[0].p == c[2].p || !(glm::dot(x, x) > 0.0f)) continue;
+      keep[t] = 1;
+      ++s.kept;
+      for (int k = 0; k < 3; ++k) {
+        s.needNormals |= c[k].n == kAbsent;
+        s.hasTex |= c[k].t != kAbsent;
+        s.pmin = std::min(s.pmin, c[k].p);
+        s.pmax = std::max(s.pmax, c[k].p);
+      }
+    }
+  });
   bool needNormals = false, hasTex = false;
-  for (size_t t = 0; t < triCount; ++t) {
-    const Corner* c = &corners[t * 3];
-    const glm::vec3 a = positions[c[0].p], b = positions[c[1].p], d = positions[c[2].p];
-    const glm::vec3 x = glm::cross(b - a, d - a);
-    const float area2 = glm::dot(x, x);
-    if (c[0].p == c[1].p || c[1].p == c[2].p || c[0].p == c[2].p || !(area2 > 0.0f)) {
-      ++counts.degenerate;
-      continue;
-    }
-    keep[t] = 1;
-    ++counts.triangles;
-    for (int k = 0; k < 3; ++k) {
-      needNormals |= c[k].n == kAbsent;
-      hasTex |= c[k].t != kAbsent;
-    }
+  uint32_t pmin = kAbsent, pmax = 0;
+  for (const Piece& s : pieces) {
+    counts.triangles += s.kept;
+    needNormals |= s.needNormals;
+    hasTex |= s.hasTex;
+    pmin = std::min(pmin, s.pmin);
+    pmax = std::max(pmax, s.pmax);
   }
+  counts.degenerate = triCount - counts.triangles;
+  out.positions.clear();
+  out.normals.clear();
+  out.texcoords.clear();
+  out.colors.clear();
+  out.indices.clear();
+  out.bounds = Bounds{};
+  if (counts.triangles == 0) return counts;
+
+  // The kept corners at each position, in order.
+  const Groups atPos = groupBy(
+      cornerCount, size_t(pmax - pmin) + 1, threads, [&](size_t c) { return keep[c / 3] ? corners[c].p - pmin : kAbsent; },
+      false);
 
   // 2. Normals where a corner has none: the area-weighted sum of the faces around its position whose normals
   // lie within `creaseDeg` of its own face's (180: every face, one smooth normal per position; 0: its own
-  // face only, flat). The unnormalised cross product is twice the area times the normal. Such corners get
-  // the id normals.size() + k of generated normal k; equal sums at a position share an id.
-  // Per-thread tables over all positions, reset after each mesh: neighbouring faces share nearby
-  // positions, so direct indexing stays in cache where a hash table would not.
-  thread_local std::vector<uint32_t> headByPos, normalOfPos;
-  if (headByPos.size() < positions.size()) headByPos.assign(positions.size(), kAbsent);
-  if (needNormals && normalOfPos.size() < positions.size()) normalOfPos.assign(positions.size(), kAbsent);
+  // face only, flat). The unnormalised cross product is twice the area times the normal. Such a corner
+  // gets the id normals.size() + genOf[c] of a generated normal; equal sums at a position share an id.
   std::vector<glm::vec3> gen;
-  std::vector<uint32_t> accumPos;  // positions with an entry in normalOfPos (a local id)
-  std::vector<Corner> filled;
+  std::unique_ptr<uint32_t[]> genOf;
   if (needNormals) {
     std::vector<glm::vec3> cross(triCount);
-    std::vector<uint32_t> start(1, 0);  // faces around local position i: around[start[i], start[i + 1])
-    for (size_t t = 0; t < triCount; ++t) {
-      if (!keep[t]) continue;
-      const Corner* c = &corners[t * 3];
-      const glm::vec3 a = positions[c[0].p];
-      cross[t] = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
-      for (int k = 0; k < 3; ++k) {
-        uint32_t& id = normalOfPos[c[k].p];
-        if (id == kAbsent) id = uint32_t(accumPos.size()), accumPos.push_back(c[k].p), start.push_back(0);
-        ++start[id + 1];
+    forPieces(triCount, threads, [&](size_t, size_t b, size_t e) {
+      for (size_t t = b; t < e; ++t) {
+        const Corner* c = &corners[t * 3];
+        const glm::vec3 a = positions[c[0].p];
+        if (keep[t]) cross[t] = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
       }
-    }
-    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-    std::vector<uint32_t> around(start.back()), fill(start.begin(), start.end() - 1);
-    for (size_t t = 0; t < triCount; ++t)
-      if (keep[t])
-        for (int k = 0; k < 3; ++k) around[fill[normalOfPos[corners[t * 3 + k].p]]++] = uint32_t(t);
+    });
     const float cosCrease = creaseDeg >= 180.0f ? -2.0f : std::cos(glm::radians(std::max(creaseDeg, 0.0f))) - 1e-6f;
     auto unit = [](glm::vec3 n) {
       const float l = glm::length(n);
       return l > 0.0f && std::isfinite(l) ? n / l : glm::vec3(0, 0, 1);
     };
-    std::vector<uint32_t> firstGen(accumPos.size(), kAbsent), nextGen;  // generated normals per position
-    filled.assign(corners.begin(), corners.end());
-    for (size_t t = 0; t < triCount; ++t) {
-      if (!keep[t]) continue;
-      const glm::vec3 own = unit(cross[t]);
-      for (int k = 0; k < 3; ++k) {
-        Corner& c = filled[t * 3 + k];
-        if (c.n != kAbsent) continue;
-        const uint32_t lp = normalOfPos[c.p];
-        glm::vec3 sum(0.0f);
-        for (uint32_t i = start[lp]; i < start[lp + 1]; ++i)
-          if (around[i] == t || (creaseDeg > 0.0f && glm::dot(own, unit(cross[around[i]])) >= cosCrease)) sum += cross[around[i]];
-        const glm::vec3 n = unit(sum);
-        uint32_t g = firstGen[lp];
-        while (g != kAbsent && gen[g] != n) g = nextGen[g];
-        if (g == kAbsent) {
-          g = uint32_t(gen.size());
-          gen.push_back(n);
-          nextGen.push_back(firstGen[lp]);
-          firstGen[lp] = g;
+    genOf = uninitialised<uint32_t>(cornerCount);
+    std::vector<std::vector<glm::vec3>> made(piecesOf(atPos.count()));
+    forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
+      for (size_t g = b; g < e; ++g) {
+        const uint32_t *first = atPos.items.data() + atPos.start[g], *last = atPos.items.data() + atPos.start[g + 1];
+        const size_t here = made[p].size();  // the normals made at this position so far
+        for (const uint32_t* c = first; c != last; ++c) {
+          if (corners[*c].n != kAbsent) continue;
+          const size_t t = *c / 3;
+          const glm::vec3 own = unit(cross[t]);
+          glm::vec3 sum(0.0f);
+          for (const uint32_t* o = first; o != last; ++o)
+            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, unit(cross[*o / 3])) >= cosCrease)) sum += cross[*o / 3];
+          const glm::vec3 n = unit(sum);
+          size_t k = here;
+          while (k < made[p].size() && made[p][k] != n) ++k;
+          if (k == made[p].size()) made[p].push_back(n);
+          genOf[*c] = uint32_t(k);
         }
-        c.n = uint32_t(normals.size()) + g;
+      }
+    });
+    std::vector<size_t> base(made.size());
+    for (size_t p = 0; p < made.size(); ++p) base[p] = made[p].size();
+    gen.resize(prefix(base));
+    forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
+      std::copy(made[p].begin(), made[p].end(), gen.begin() + ptrdiff_t(base[p]));
+      for (uint32_t i = atPos.start[b]; i < atPos.start[e]; ++i)
+        if (corners[atPos.items[i]].n == kAbsent) genOf[atPos.items[i]] += uint32_t(base[p]);
+    });
+  }
+  auto cornerAt = [&](size_t c) {
+    Corner x = corners[c];
+    if (x.n == kAbsent) x.n = uint32_t(normals.size()) + genOf[c];
+    return x;
+  };
+
+  // 3. Identical corners become one vertex (numbered as they first appear): each kept corner gets its
+  // vertex id in idOf, found through its position's group.
+  auto idOf = uninitialised<uint32_t>(cornerCount);  // the first equal corner, then the vertex id
+  forPieces(atPos.count(), threads, [&](size_t, size_t b, size_t e) {
+    std::vector<uint32_t> distinct;
+    for (size_t g = b; g < e; ++g) {
+      distinct.clear();
+      for (uint32_t i = atPos.start[g]; i < atPos.start[g + 1]; ++i) {
+        const uint32_t c = atPos.items[i];
+        const Corner x = cornerAt(c);
+        size_t k = 0;
+        while (k < distinct.size() && !(cornerAt(distinct[k]) == x)) ++k;
+        if (k == distinct.size()) distinct.push_back(c);
+        idOf[c] = distinct[k];
       }
     }
-    corners = filled;
-  }
+  });
+  const size_t cornerPieces = piecesOf(cornerCount);
+  std::vector<size_t> firsts(cornerPieces, 0);
+  forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t c = b; c < e; ++c) firsts[p] += keep[c / 3] && idOf[c] == c;
+  });
+  const size_t uniqCount = prefix(firsts);
+  auto uniq = uninitialised<uint32_t>(uniqCount);  // each vertex's first corner
+  auto vertexOf = uninitialised<uint32_t>(cornerCount);
+  forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t c = b, id = firsts[p]; c < e; ++c)
+      if (keep[c / 3] && idOf[c] == c) uniq[id] = uint32_t(c), vertexOf[c] = uint32_t(id++);
+  });
+  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the ids of first corners only
+    for (size_t c = b; c < e; ++c)
+      if (keep[c / 3] && idOf[c] != c) vertexOf[c] = vertexOf[idOf[c]];
+  });
+  idOf.reset();
 
-  // 3. Identical corners become one vertex; 4. vertices within the tolerance are merged (greedy,
-  // first come first kept, so the result does not depend on hashing).
-  // Corners are found through their position index (headByPos), chained when they differ in t or n.
-  std::vector<Corner> uniq;
-  std::vector<uint32_t> nextSame;  // chain of corners sharing a position
-  uniq.reserve(counts.triangles + 16);
-  nextSame.reserve(counts.triangles + 16);
-  std::vector<uint32_t> cornerVertex(counts.triangles * 3);
-  size_t ci = 0;
-  for (size_t t = 0; t < triCount; ++t) {
-    if (!keep[t]) continue;
-    for (int k = 0; k < 3; ++k) {
-      const Corner& c = corners[t * 3 + k];
-      uint32_t id = headByPos[c.p];
-      while (id != kAbsent && !(uniq[id] == c)) id = nextSame[id];
-      if (id == kAbsent) {
-        id = uint32_t(uniq.size());
-        uniq.push_back(c);
-        nextSame.push_back(headByPos[c.p]);
-        headByPos[c.p] = id;
-      }
-      cornerVertex[ci++] = id;
+  // 4. Vertices within the tolerance are merged, greedy as one thread would do it: in order, each joins
+  // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
+  // else is kept. A vertex with no earlier vertex near it at all is kept for sure, which all cores decide
+  // at once; the rest (rare: near but not equal) are decided in order afterwards.
+  std::vector<Vertex> verts(uniqCount);
+  std::vector<uint32_t> slotOf(uniqCount);
+  size_t cap = 16;  // the hash slots one thread would use: their collisions decide which vertex is found first
+  while (cap < uniqCount * 2) cap <<= 1;
+  const size_t mask = cap - 1, buckets = std::max<size_t>(16, cap / 4);
+  forPieces(uniqCount, threads, [&](size_t, size_t b, size_t e) {
+    for (size_t u = b; u < e; ++u) {
+      const Corner c = cornerAt(uniq[u]);
+      Vertex& v = verts[u];
+      v.p = positions[c.p];
+      v.n = c.n < normals.size() ? normals[c.n] : gen[c.n - normals.size()];
+      v.t = c.t != kAbsent ? texcoords[c.t] : glm::vec2(0.0f);
+      v.c = colors.empty() ? glm::vec4(0.0f) : colors[c.p];
+      const Around a(v.p);
+      slotOf[u] = uint32_t(cellHash(a.cell[0], a.cell[1], a.cell[2]) & mask);
     }
-  }
-  for (const Corner& c : uniq) headByPos[c.p] = kAbsent;
-
-  std::vector<uint32_t> slots;
-  size_t cap = 16;
-  while (cap < uniq.size() * 2) cap <<= 1;
-  slots.assign(cap, kAbsent);
-  const size_t mask = cap - 1;
-  std::vector<uint32_t> next;  // chain of representatives per bucket
-  std::vector<Vertex> reps;
-  std::vector<uint32_t> remap(uniq.size());
-  reps.reserve(uniq.size());
-  next.reserve(uniq.size());
-  const float edge = kWeldTolerance * kCellScale;
-
-  for (size_t u = 0; u < uniq.size(); ++u) {
-    const Corner& c = uniq[u];
-    Vertex v;
-    v.p = positions[c.p];
-    v.n = c.n < normals.size() ? normals[c.n] : gen[c.n - normals.size()];
-    v.t = c.t != kAbsent ? texcoords[c.t] : glm::vec2(0.0f);
-    v.c = colors.empty() ? glm::vec4(0.0f) : colors[c.p];
-    int64_t cell[3], lo[3], hi[3];
-    for (int d = 0; d < 3; ++d) {
-      cell[d] = cellOf(v.p[d]);
-      float f = v.p[d] * kCellScale - float(cell[d]);
-      lo[d] = f < edge ? cell[d] - 1 : cell[d];
-      hi[d] = f > 1.0f - edge ? cell[d] + 1 : cell[d];
+  });
+  uniq.reset();
+  const Groups inBucket = groupBy(
+      uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
+  std::vector<uint8_t> kept(uniqCount);
+  auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
+  std::vector<std::vector<uint32_t>> open(piecesOf(uniqCount));
+  forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t u = b; u < e; ++u) {
+      const bool near_ = Around(verts[u].p).any([&](uint64_t h) {
+        const size_t k = h & (buckets - 1);
+        for (uint32_t i = inBucket.start[k]; i < inBucket.start[k + 1] && inBucket.items[i] < u; ++i)
+          if (near(verts[inBucket.items[i]], verts[u])) return true;
+        return false;
+      });
+      if (near_) open[p].push_back(uint32_t(u));
+      else kept[u] = 1, target[u] = uint32_t(u);
     }
-    uint32_t found = kAbsent;
-    for (int64_t x = lo[0]; x <= hi[0] && found == kAbsent; ++x)
-      for (int64_t y = lo[1]; y <= hi[1] && found == kAbsent; ++y)
-        for (int64_t z = lo[2]; z <= hi[2] && found == kAbsent; ++z)
-          for (uint32_t r = slots[cellHash(x, y, z) & mask]; r != kAbsent; r = next[r])
-            if (near(reps[r], v)) {
-              found = r;
-              break;
-            }
-    if (found == kAbsent) {
-      found = uint32_t(reps.size());
-      uint32_t& head = slots[cellHash(cell[0], cell[1], cell[2]) & mask];
-      next.push_back(head);
-      head = found;
-      reps.push_back(v);
+  });
+  for (const std::vector<uint32_t>& list : open)
+    for (const uint32_t u : list) {
+      uint32_t found = kAbsent;
+      Around(verts[u].p).any([&](uint64_t h) {
+        const uint32_t slot = uint32_t(h & mask);
+        const size_t k = slot & (buckets - 1);
+        for (uint32_t i = inBucket.start[k + 1]; i-- > inBucket.start[k];) {
+          const uint32_t w = inBucket.items[i];
+          if (w < u && kept[w] && slotOf[w] == slot && near(verts[w], verts[u])) return found = w, true;
+        }
+        return false;
+      });
+      if (found == kAbsent) kept[u] = 1, found = u;
+      target[u] = found;
     }
-    remap[u] = found;
-  }
-
-  for (uint32_t p : accumPos) normalOfPos[p] = kAbsent;
+  std::vector<size_t> keptBefore(piecesOf(uniqCount), 0);
+  forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t u = b; u < e; ++u) keptBefore[p] += kept[u];
+  });
+  counts.vertices = prefix(keptBefore);
+  auto keptId = uninitialised<uint32_t>(uniqCount);
+  forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t u = b, id = keptBefore[p]; u < e; ++u)
+      if (kept[u]) keptId[u] = uint32_t(id++);
+  });
 
   // 5. Emit.
-  out.positions.resize(reps.size());
-  out.normals.resize(reps.size());
-  out.texcoords.resize(hasTex ? reps.size() : 0);
-  out.colors.resize(colors.empty() ? 0 : reps.size());
-  out.bounds = Bounds{};
-  for (size_t r = 0; r < reps.size(); ++r) {
-    out.positions[r] = reps[r].p;
-    out.normals[r] = reps[r].n;
-    if (hasTex) out.texcoords[r] = reps[r].t;
-    if (!colors.empty()) out.colors[r] = reps[r].c;
-    out.bounds.extend(reps[r].p);
-  }
-  // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
-  out.indices.clear();
-  out.indices.reserve(cornerVertex.size());
-  for (size_t i = 0; i < cornerVertex.size(); i += 3) {
-    uint32_t a = remap[cornerVertex[i]], b = remap[cornerVertex[i + 1]], c = remap[cornerVertex[i + 2]];
-    if (a == b || b == c || a == c) {
-      ++counts.degenerate;
-      --counts.triangles;
-      continue;
+  const size_t n = counts.vertices;
+  out.positions.resize(n);
+  out.normals.resize(n);
+  out.texcoords.resize(hasTex ? n : 0);
+  out.colors.resize(colors.empty() ? 0 : n);
+  std::vector<Bounds> bounds(piecesOf(uniqCount));
+  forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t u = b; u < e; ++u) {
+      if (!kept[u]) continue;
+      const size_t r = keptId[u];
+      out.positions[r] = verts[u].p;
+      out.normals[r] = verts[u].n;
+      if (hasTex) out.texcoords[r] = verts[u].t;
+      if (!colors.empty()) out.colors[r] = verts[u].c;
+      bounds[p].extend(verts[u].p);
     }
-    out.indices.insert(out.indices.end(), {a, b, c});
-  }
-  counts.vertices = reps.size();
+  });
+  for (const Bounds& b : bounds) out.bounds.extend(b);
+  // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
+  auto corner = [&](size_t c) { return keptId[target[vertexOf[c]]]; };
+  std::vector<size_t> written(pieces.size(), 0);
+  forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t t = b; t < e; ++t) {
+      if (!keep[t]) continue;
+      const uint32_t x = corner(t * 3), y = corner(t * 3 + 1), z = corner(t * 3 + 2);
+      written[p] += x != y && y != z && x != z;
+    }
+  });
+  const size_t triangles = prefix(written);
+  counts.degenerate += counts.triangles - triangles;
+  counts.triangles = triangles;
+  out.indices.resize(triangles * 3);
+  forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t t = b, at = written[p] * 3; t < e; ++t) {
+      if (!keep[t]) continue;
+      const uint32_t x = corner(t * 3), y = corner(t * 3 + 1), z = corner(t * 3 + 2);
+      if (x != y && y != z && x != z) out.indices[at] = x, out.indices[at + 1] = y, out.indices[at + 2] = z, at += 3;
+    }
+  });
   return counts;
 }
 

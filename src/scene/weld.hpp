@@ -28,9 +28,10 @@ constexpr float kDefaultCreaseDeg = 40.0f;
 
 // `corners` holds 3 per triangle. Fills out.positions/normals/texcoords/colors/indices/bounds (not name or
 // material). A generated normal averages the faces at its position within `creaseDeg` of its own face (0:
-// flat, 180: smooth). `colors`: one per position, or empty.
+// flat, 180: smooth). `colors`: one per position, or empty. Runs on `threads` (0: all cores) in fixed
+// pieces: the mesh is the same for any thread count.
 WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg = kDefaultCreaseDeg,
-                    std::span<const glm::vec4> colors = {});
+                    std::span<const glm::vec4> colors = {}, unsigned threads = 1);
 
 }  // namespace rtr

@@ -218,6 +218,8 @@ Context::Context(const ContextOptions& options) {
     vkGetPhysicalDeviceFeatures2(physical_, &s2);
     if (supported.shaderInt64 && supported.fragmentStoresAndAtomics && s12.shaderBufferInt64Atomics)
       f2.features.shaderInt64 = f2.features.fragmentStoresAndAtomics = f12.shaderBufferInt64Atomics = VK_TRUE;
+    f12.descriptorBindingUpdateUnusedWhilePending = s12.descriptorBindingUpdateUnusedWhilePending;
+    updateUnusedWhilePending_ = s12.descriptorBindingUpdateUnusedWhilePending;
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

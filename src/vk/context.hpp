@@ -56,6 +56,9 @@ class Context {
 
   PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn() const { return pushDescriptorFn_; }
   VkPhysicalDeviceType deviceType() const { return properties_.deviceType; }
+  // Runtime descriptor arrays may have elements written that no pending command buffer uses
+  // (descriptorBindingUpdateUnusedWhilePending, enabled where supported): textures arriving while frames run.
+  bool updateUnusedWhilePending() const { return updateUnusedWhilePending_; }
   // The largest device-local memory heap, in bytes: what one scene and its targets must fit in.
   VkDeviceSize deviceHeapBytes() const;
   // Every pipeline is created through it (vk/pipeline.cpp), which also counts them and their time.
@@ -78,6 +81,7 @@ class Context {
   VmaAllocator allocator_ = nullptr;
   std::unique_ptr<PipelineCache> pipelineCache_;
   PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn_ = nullptr;
+  bool updateUnusedWhilePending_ = false;
 };
 
 }  // namespace rtr::vk

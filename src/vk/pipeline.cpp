@@ -83,8 +83,12 @@ PipelineLayout::PipelineLayout(const Context& ctx, PipelineInterface interface, 
       if (b.set != set) continue;
       bindings.push_back({b.binding, b.type, arrayCount(b), b.stages, nullptr});
       // Only the highest binding of a set may have a variable count; runtime arrays are declared last.
-      flags.push_back(
-          b.count == 0 ? VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT : 0);
+      // Where the device allows it, elements no pending frame uses may be written (textures arriving).
+      const VkDescriptorBindingFlags pending =
+          ctx.updateUnusedWhilePending() ? VK_DESCRIPTOR_BINDING_UPDATE_UNUSED_WHILE_PENDING_BIT : 0;
+      flags.push_back(b.count == 0 ? VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT |
+                                         VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT | pending
+                                   : 0);
       variable |= b.count == 0;
     }
     VkDescriptorSetLayoutBindingFlagsCreateInfo fi{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO};
@@ -385,11 +389,12 @@ DescriptorWriter& DescriptorWriter::image(uint32_t binding, VkImageView view, Vk
   return images(binding, {{sampler, view, layout}});
 }
 
-DescriptorWriter& DescriptorWriter::images(uint32_t binding, const std::vector<VkDescriptorImageInfo>& infos) {
+DescriptorWriter& DescriptorWriter::images(uint32_t binding, const std::vector<VkDescriptorImageInfo>& infos, uint32_t first) {
   imageInfos_.push_back(infos);
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstSet = ds_;
   w.dstBinding = binding;
+  w.dstArrayElement = first;
   w.descriptorCount = uint32_t(infos.size());
   w.descriptorType = layout_.binding(set_, binding).type;
   w.pImageInfo = imageInfos_.back().data();

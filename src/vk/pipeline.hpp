@@ -134,7 +134,8 @@ class DescriptorWriter {
   DescriptorWriter(const Context& ctx, const PipelineLayout& layout, uint32_t set, VkDescriptorSet ds);
   DescriptorWriter& buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE);
   DescriptorWriter& image(uint32_t binding, VkImageView view, VkImageLayout layout, VkSampler sampler = VK_NULL_HANDLE);
-  DescriptorWriter& images(uint32_t binding, const std::vector<VkDescriptorImageInfo>& infos);
+  // Elements first, first + 1, ... of an array binding.
+  DescriptorWriter& images(uint32_t binding, const std::vector<VkDescriptorImageInfo>& infos, uint32_t first = 0);
   void commit();  // updates an allocated set
   // Records the writes as push descriptors for `set` of `pipeline` (its layout must list the set in
   // LayoutOptions::pushDescriptorSets); the writer was made with ds = VK_NULL_HANDLE.

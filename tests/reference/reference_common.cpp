@@ -87,7 +87,6 @@ std::filesystem::path outDir() {
   return d;
 }
 
-namespace {
 trace::TraceSettings traceSettings(const ReferenceScene& rs, const PoseEntry& pe, View view, const PairOptions& o) {
   trace::TraceSettings ts;
   ts.width = o.width;
@@ -109,7 +108,6 @@ trace::TraceSettings traceSettings(const ReferenceScene& rs, const PoseEntry& pe
   }
   return ts;
 }
-}  // namespace
 
 ImageF traceCase(const ReferenceScene& rs, const PoseEntry& pe, View view, const PairOptions& o, trace::RenderStats* stats) {
   const trace::Tracer tracer(rs.scene, o.threads);

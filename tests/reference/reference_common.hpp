@@ -86,6 +86,14 @@ std::vector<int> partOfPixels(const ReferenceScene& rs, const PoseEntry& pose, u
 ImageF traceCase(const ReferenceScene& rs, const PoseEntry& pose, View view, const PairOptions& options = {},
                  trace::RenderStats* stats = nullptr);
 
+// The tracer's settings for a case (the pose, lens, shading and light both sides use).
+trace::TraceSettings traceSettings(const ReferenceScene& rs, const PoseEntry& pose, View view, const PairOptions& options);
+
+// Environment cases without textures: the split sum evaluated exactly on the CPU (env_split.cpp): every
+// texel of the map summed for the prefiltered radiance, the table's integrals by 4096 samples, the SH of
+// the whole map. Against the tracer: the approximation's own error; against the GPU: the implementation's.
+ImageF splitSumCase(const ReferenceScene& rs, const PoseEntry& pose, const PairOptions& options);
+
 // A shader source edit for the tests that break the GPU side on purpose: in `file` (relative to shaders/),
 // the exact text `from` becomes `to`; an empty `from` is no edit (the control).
 struct ShaderEdit {

@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "cluster_lod.h"
 #include "core/bounds.hpp"
 #include "core/camera.hpp"
 #include "render/headless.hpp"
@@ -62,7 +65,17 @@ TEST_F(LodTest, ThresholdZeroIsExactlyTheImageWithoutAHierarchy) {
   for (const CameraPose& pose : templeViews(scene, 1.6f))
     for (bool cull : {false, true}) {
       const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
-      EXPECT_EQ(a.ids(pose, lens, settings(0.0f, cull)), b.ids(pose, lens, settings(0.0f, cull)));
+      // The same (instance, triangle) at every pixel; the ids themselves differ (the hierarchy's triangles
+      // lengthen each instance's id range, frame.h).
+      const std::vector<uint32_t> withIds = a.ids(pose, lens, settings(0.0f, cull)),
+                                  plainIds = b.ids(pose, lens, settings(0.0f, cull));
+      ASSERT_EQ(withIds.size(), plainIds.size());
+      size_t differ = 0;
+      for (size_t i = 0; i < withIds.size(); ++i)
+        differ += withIds[i] == VIS_EMPTY || plainIds[i] == VIS_EMPTY
+                      ? withIds[i] != plainIds[i]
+                      : gpu.decodeVisId(withIds[i]) != gpuPlain.decodeVisId(plainIds[i]);
+      EXPECT_EQ(differ, 0u);
       EXPECT_EQ(a.render(pose, lens, settings(0.0f, cull)).image.pixels, b.render(pose, lens, settings(0.0f, cull)).image.pixels);
     }
 }
@@ -87,6 +100,47 @@ TEST_F(LodTest, CulledFramesEqualUnculledOnesWithACut) {
     EXPECT_EQ(c->frustum + c->cone + c->occlusion, 0u) << "without --cull only the cut is chosen";
   }
   EXPECT_GT(byLod, 0u);
+}
+
+// The level window (cull_instances.comp): the temple placed 36 times in a 6 x 6 grid, seen from beside it
+// at 2 px. Far instances skip their full-detail clusters (fewer clusters are visited than the instances
+// hold), and the cut is the one each cluster's own test picks: the triangles listed equal the CPU's sum
+// over every (instance, cluster) of cluster_lod.h's lodSelected (up to rounding at the threshold).
+TEST_F(LodTest, LevelWindowVisitsFewerClustersAndKeepsTheCut) {
+  if (!render::ComputeRaster::supported(*ctx)) GTEST_SKIP() << "no 64-bit buffer atomics";
+  Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  const Bounds one = scene.bounds();
+  const glm::vec3 step = (one.max - one.min) * 1.5f;
+  scene.instances.clear();
+  for (int i = 0; i < 36; ++i)
+    for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+      scene.instances.push_back(
+          {m, glm::translate(glm::mat4(1.0f), glm::vec3(step.x * float(i % 6), 0.0f, -step.z * float(i / 6)))});
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  const VkExtent2D e{320, 200};
+  render::HeadlessRenderer r(*ctx, gpu, e);
+  const Bounds b = scene.bounds();
+  for (const CameraPose& pose : {orbitFrame(b, Lens{}, 1.6f, 200.0f, -10.0f), CameraPose{one.center(), 200.0f, -5.0f}}) {
+    const Lens lens = fitDepthRange(Lens{}, b, pose);
+    r.ids(pose, lens, settings(2.0f, false));
+    const auto c = r.renderer().cullStats(0);
+    ASSERT_TRUE(c);
+    const float ppu = float(e.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
+    uint64_t want = 0;
+    for (const Instance& in : scene.instances) {
+      const Mesh& m = scene.meshes[in.mesh];
+      if (m.indices.empty() || scene.materials[m.material].blended()) continue;
+      if (m.lod.levels == 0) want += m.indices.size() / 3;  // no hierarchy: always in the cut
+      const glm::vec4 t(glm::vec3(in.transform[3]), 0.0f);
+      for (const LodCluster& k : m.lod.clusters)
+        if (shader::lodSelected(k.sphere + t, k.error, k.parentSphere + t, k.parentError, pose.position, ppu, lens.zNear, 2.0f))
+          want += k.triangleCount;
+    }
+    std::printf("%u of %u clusters visited, %u instances skipped whole; %u triangles listed, CPU %llu\n", c->tested,
+                gpu.clusterCount(), c->instancesCulled, c->triangles, (unsigned long long)want);
+    EXPECT_LT(c->tested, gpu.clusterCount() / 2) << "the window skips little";
+    EXPECT_NEAR(double(c->triangles), double(want), double(want) / 1000);
+  }
 }
 
 // The rendered error of a cut against full detail: the mean over pixels of the largest channel difference

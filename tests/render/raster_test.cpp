@@ -19,22 +19,23 @@ namespace {
 
 using render::RasterPath;
 
-// Where a visibility id's triangle is: its mesh (draws are the meshes with indices, in order) and index.
+// Where a visibility id's triangle is: its mesh (a scene without instances: one per mesh with indices, in
+// order) and index.
 struct IdDecoder {
+  const render::GpuScene& gpu;
   std::vector<const Mesh*> draws;
   std::vector<bool> maskedDraws;  // its triangles are alpha-tested
-  uint32_t primitiveBits;
-  IdDecoder(const Scene& s, uint32_t bits) : primitiveBits(bits) {
+  IdDecoder(const Scene& s, const render::GpuScene& g) : gpu(g) {
     for (const Mesh& m : s.meshes)
       if (!m.indices.empty()) {
         draws.push_back(&m);
         maskedDraws.push_back(!m.texcoords.empty() && alphaTested(m, s.materials[m.material]));
       }
   }
-  bool masked(uint32_t id) const { return id != VIS_EMPTY && maskedDraws.at(id >> primitiveBits); }
+  bool masked(uint32_t id) const { return id != VIS_EMPTY && maskedDraws.at(gpu.decodeVisId(id).first); }
   std::array<glm::vec3, 3> triangle(uint32_t id) const {
-    const Mesh& m = *draws.at(id >> primitiveBits);
-    const uint32_t t = id & ((1u << primitiveBits) - 1u);
+    const Mesh& m = *draws.at(gpu.decodeVisId(id).first);
+    const uint32_t t = gpu.decodeVisId(id).second;
     return {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
   }
 };
@@ -104,7 +105,7 @@ TEST_F(RasterTest, HardwareAndComputeIdsAgree) {
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
   const VkExtent2D extent{320, 180};
   render::HeadlessRenderer r(*ctx, gpu, extent);
-  const IdDecoder decode(scene, r.renderer().primitiveBits());
+  const IdDecoder decode(scene, gpu);
   const CameraPose framed = scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 320.0f / 180.0f));
   const glm::vec3 c = scene.bounds().center();
   // Framed; inside, low, turned (floor and walls cross the near plane); close to a pillar, steep.

@@ -158,8 +158,8 @@ TEST(ClusterLod, SameMeshSameHierarchy) {
 
 // Where simplifying moves no surface (a flat floor) its error alone would let it collapse into triangles
 // drawn at any distance, however many pixels they cover; the hierarchy's errors also bound the size of
-// what a simplification made: no triangle of a cut that the simplifier made spans more than 8 × the threshold in
-// pixels (docs/virtual-geometry.md; the mesh's own triangles, at any level, are as large as they are),
+// what a simplification made: no triangle of a cut that the simplifier made spans more than kLodEdgePerError × the
+// threshold in pixels (docs/virtual-geometry.md; the mesh's own triangles, at any level, are as large as they are),
 // and coarse levels are still used.
 TEST(ClusterLod, CutTrianglesOfAFlatFloorStaySmallOnScreen) {
   const Mesh m = flatGrid(200);  // 80 000 triangles
@@ -188,12 +188,81 @@ TEST(ClusterLod, CutTrianglesOfAFlatFloorStaySmallOnScreen) {
           largest = std::max(largest, glm::distance(a, b) * 1000.0f / glm::distance(eye, a + s * (b - a)));
         }
       }
-      EXPECT_LE(largest, 8.0f * threshold * 1.001f)
+      EXPECT_LE(largest, kLodEdgePerError * threshold * 1.001f)
           << "eye " << eye.x << "," << eye.y << "," << eye.z << " threshold " << threshold;
       if (eye.y > 10) {  // level-0 triangles a quarter of a pixel: coarse levels must be drawn
         EXPECT_LT(drawn, m.indices.size() / 3 / 4) << "coarse levels unused, eye y " << eye.y;
       }
     }
+}
+
+// A closed box of side 2 whose six faces are flat n × n grids, welded along the edges (no border for the
+// simplifier to lock: only the groups' borders are).
+Mesh flatBox(uint32_t n) {
+  Mesh m;
+  std::map<std::array<int, 3>, uint32_t> index;  // welded by integer grid coordinates
+  auto vertex = [&](glm::ivec3 p) {
+    const auto [it, added] = index.try_emplace({p.x, p.y, p.z}, uint32_t(m.positions.size()));
+    if (added) m.positions.push_back(glm::vec3(p) * (2.0f / float(n)) - 1.0f);
+    return it->second;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      glm::ivec3 u(0), v(0), o(0);
+      u[(axis + 1) % 3] = 1, v[(axis + 2) % 3] = 1, o[axis] = side * int(n);
+      if (side == 0) std::swap(u, v);  // outward winding on both sides
+      for (uint32_t i = 0; i < n; ++i)
+        for (uint32_t j = 0; j < n; ++j) {
+          const glm::ivec3 p = o + int(i) * u + int(j) * v;
+          const uint32_t a = vertex(p), b = vertex(p + u), c = vertex(p + v), d = vertex(p + u + v);
+          m.indices.insert(m.indices.end(), {a, b, d, a, d, c});
+        }
+    }
+  m.normals = m.positions;
+  buildClusters(m, true);
+  return m;
+}
+
+// Pixels the triangles facing `eye` cover in a view of 1000 px a unit at distance 1 towards `target`
+// (a convex mesh: the front faces do not overlap).
+double coveredPixels(const Mesh& m, std::span<const uint32_t> tris, glm::vec3 eye, glm::vec3 target) {
+  const glm::vec3 f = glm::normalize(target - eye), r = glm::normalize(glm::cross(f, glm::vec3(0, 1, 0))), u = glm::cross(r, f);
+  double area = 0.0;
+  for (size_t t = 0; t < tris.size(); t += 3) {
+    glm::vec2 p[3];
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 d = m.positions[tris[t + k]] - eye;
+      p[k] = glm::vec2(glm::dot(d, r), glm::dot(d, u)) / glm::dot(d, f) * 1000.0f;
+    }
+    area += std::max(0.0, 0.5 * double((p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y)));
+  }
+  return area;
+}
+
+// A 1-pixel error leaves about one triangle per covered pixel or fewer: a dense closed box of flat faces
+// (307 200 triangles, 4-28 a pixel where it is seen from; no surface for the simplifier's error to see)
+// lists at most one triangle (front and back) per pixel its front covers, face on and at grazing angles.
+// With the size term's edge at 8 × the threshold it listed 2.7-4.6 a pixel: the slivers a simplification
+// with locked borders makes span its group, so the longest edge it made says little about how many
+// triangles a pixel holds. Farther away the cut is bounded by the hierarchy's roots (groups that stuck:
+// 12 000 triangles here; docs/virtual-geometry.md), not by the error.
+TEST(ClusterLod, ADenseFlatBoxListsAtMostOneTriangleAPixel) {
+  Mesh m = flatBox(160);
+  ASSERT_EQ(openEdges(m.indices), 0u);
+  m.lod = buildClusterLod(m);
+  for (glm::vec3 eye :
+       {glm::vec3(0, 0, 8), glm::vec3(0, 0, 12), glm::vec3(9, 6, 12), glm::vec3(14, 1, 2), glm::vec3(12, 0.3f, 0.3f)}) {
+    std::vector<uint32_t> tris;
+    for (const LodCluster& c : m.lod.clusters)
+      if (shader::lodSelected(c.sphere, c.error, c.parentSphere, c.parentError, eye, 1000.0f, 0.01f, 1.0f)) {
+        const std::span<const uint32_t> t = lodTriangles(m, c);
+        tris.insert(tris.end(), t.begin(), t.end());
+      }
+    const double pixels = coveredPixels(m, m.indices, eye, {0, 0, 0});
+    EXPECT_LE(double(tris.size() / 3), pixels)
+        << "eye " << eye.x << "," << eye.y << "," << eye.z << ": " << tris.size() / 3 << " triangles for " << pixels
+        << " pixels (the mesh's own: " << m.indices.size() / 3 << ")";
+  }
 }
 
 // The hierarchy is the same, byte for byte, whatever the thread count: a level is grouped and simplified

@@ -34,16 +34,12 @@ ObjOptions options(Outcome& r, unsigned threads, size_t pieceBytes) {
   return opt;
 }
 
-Outcome parseText(const std::string& obj, const std::map<std::string, std::string>& mtls, unsigned threads, size_t pieceBytes,
-                  bool zstd = false) {
+// `bytes`: OBJ text, or zstd frames of it.
+Outcome parseBytes(const std::string& bytes, const std::map<std::string, std::string>& mtls, unsigned threads, size_t pieceBytes,
+                   bool zstd) {
   Outcome r;
   const ObjOptions opt = options(r, threads, pieceBytes);
-  std::string bytes = obj;
-  if (zstd) {
-    bytes.resize(ZSTD_compressBound(obj.size()));
-    bytes.resize(ZSTD_compress(bytes.data(), bytes.size(), obj.data(), obj.size(), 1));
-  }
-  auto src = memorySource(bytes, "t.obj", zstd);
+  auto src = memorySource(bytes, "t.obj", zstd, threads);
   auto readMtl = [&](const std::string& n) -> std::optional<std::string> {
     auto it = mtls.find(n);
     if (it == mtls.end()) return std::nullopt;
@@ -53,6 +49,16 @@ Outcome parseText(const std::string& obj, const std::map<std::string, std::strin
     r.scene = parseObj(*src, "t.obj", readMtl, opt, &r.stats, mtls.count("t.mtl") ? "t.mtl" : "");
   } catch (const Error& e) { r.error = e.what(); }
   return r;
+}
+
+Outcome parseText(const std::string& obj, const std::map<std::string, std::string>& mtls, unsigned threads, size_t pieceBytes,
+                  bool zstd = false) {
+  std::string bytes = obj;
+  if (zstd) {
+    bytes.resize(ZSTD_compressBound(obj.size()));
+    bytes.resize(ZSTD_compress(bytes.data(), bytes.size(), obj.data(), obj.size(), 1));
+  }
+  return parseBytes(bytes, mtls, threads, pieceBytes, zstd);
 }
 
 Outcome parseFile(const fs::path& file, unsigned threads, size_t pieceBytes) {
@@ -182,6 +188,54 @@ TEST(ObjPieces, BatchesStitchAsOne) {
 }
 
 // Small cases after the ones other readers' test suites are known for.
+// zstd frames that say their size are decoded on all cores as they fit the batch; a frame larger than the
+// batch, one that does not say its size and a skippable frame are read in between; a damaged frame names
+// its first byte.
+TEST(ObjPieces, ZstdFramesReadAsOneStream) {
+  const std::string obj = generated(5, 40000);
+  const Outcome one = parseText(obj, kMtls, 1, size_t(1) << 30);
+  ASSERT_EQ(one.error, "");
+  ZSTD_CCtx* z = ZSTD_createCCtx();
+  ZSTD_CCtx_setParameter(z, ZSTD_c_checksumFlag, 1);
+  auto frame = [&](std::string_view text, bool sized) {
+    std::string out(ZSTD_compressBound(text.size()) + 64, '\0');
+    ZSTD_CCtx_reset(z, ZSTD_reset_session_only);
+    if (sized) return out.substr(0, ZSTD_compress2(z, out.data(), out.size(), text.data(), text.size()));
+    ZSTD_inBuffer in{text.data(), text.size(), 0};  // streamed: the frame does not record its size
+    ZSTD_outBuffer o{out.data(), out.size(), 0};
+    while (ZSTD_compressStream2(z, &o, &in, ZSTD_e_end) != 0) {}
+    return out.substr(0, o.pos);
+  };
+  std::string bytes;
+  std::vector<size_t> starts;  // where each frame begins
+  const size_t cuts[] = {0, 1, 100, 5000, 9000, 300000, 300001, obj.size() / 2, obj.size() / 2 + 70000, obj.size()};
+  for (size_t i = 0; i + 1 < std::size(cuts); ++i) {
+    starts.push_back(bytes.size());
+    bytes += frame(std::string_view(obj).substr(cuts[i], cuts[i + 1] - cuts[i]), i != 6);
+    if (i == 2)
+      bytes += std::string(
+          "\x50\x2A\x4D\x18\x03\x00\x00\x00"
+          "abc",
+          11);  // skippable, 3 bytes
+  }
+  ZSTD_freeCCtx(z);
+  for (unsigned threads : {1u, 3u}) {
+    SCOPED_TRACE(threads);
+    expectSame(one, parseBytes(bytes, kMtls, threads, size_t(1) << 30, true));
+  }
+  // A damaged checksum: the frame decoded whole names its first byte; damage in its blocks is found by
+  // the stream, which names a byte inside the frame.
+  for (const size_t at : {starts[6] - 1, starts[5] + 40}) {
+    std::string bad = bytes;
+    bad[at] ^= 0x20;
+    const std::string error = parseBytes(bad, kMtls, 3, size_t(1) << 30, true).error;
+    const size_t named = error.rfind("t.obj: byte ", 0) == 0 ? std::stoul(error.substr(12)) : 0;
+    EXPECT_NE(error.find("corrupt zstd stream"), std::string::npos) << error;
+    if (at == starts[6] - 1) { EXPECT_EQ(named, starts[5]) << error; }
+    EXPECT_TRUE(named >= starts[5] && named <= starts[6]) << error;
+  }
+}
+
 TEST(ObjPieces, CornerCasesStitchAsOnePiece) {
   const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   const char* cases[] = {

@@ -2,8 +2,9 @@
 # Level of detail against speed (docs/virtual-geometry.md): the temple at scales S baked with and without
 # its cluster hierarchy (bake times), then per size, view and --lod-error one rtr-view run that times FRAMES
 # frames (per pass, clusters and triangles listed) and writes a screenshot, whose error against
-# --lod-error 0 pngdiff.py prints (the shaded image: debug views such as normals are drawn by the forward
-# path, always at full detail).
+# --lod-error 0 `rtr-frame-compare --flip` prints: the ꟻLIP-style mean (docs/flip.md) and the largest channel
+# difference's mean and max (the shaded image: debug views such as normals are drawn by the forward path,
+# always at full detail).
 #   tools/bench_cull/lod.sh DIR > out.txt    DIR: a bundle (tools/bundle_device.sh, has run.sh) or a build
 #                                            folder (has bin/rtr-view)
 # Settings (environment), fast by default (a few minutes on the GPU machine):
@@ -12,7 +13,6 @@
 set -u
 if [ -x "$1/run.sh" ]; then R=("$1/run.sh"); else R=(); B="$1/bin/"; fi
 run() { "${R[@]}" "${B:-}$1" "${@:2}"; }
-D=$(dirname "$0")
 OUT=${OUT:-/tmp/lod}
 for S in ${SCALES:-100}; do
   run scenegen --scale $S --out $OUT/s$S >/dev/null 2>&1
@@ -33,6 +33,6 @@ for S in ${SCALES:-100}; do for size in ${SIZES:-3840x2160}; do for view in ${VI
     run rtr-view $OUT/s$S/t.rtrscene --headless --size $size --bench ${FRAMES:-30} --raster compute \
       --shading-path visibility --cull $cull --lod-error $lod "${cam[@]}" --screenshot $out --force 2>&1 | grep -v -E "^csv|^/|^rtr-view|ms GPU$"
     base=$OUT/s$S-$size-$view-$cull-0.png
-    [ "$lod" != 0 ] && [ -f $base ] && echo "image error shaded: $(python3 $D/pngdiff.py $base $out)"
+    [ "$lod" != 0 ] && [ -f $base ] && echo "image error shaded: $(run rtr-frame-compare --flip $base $out 2>&1)"
   done; done
 done; done; done

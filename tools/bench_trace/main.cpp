@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <functional>
 #include <initializer_list>
 #include <map>
@@ -35,6 +36,17 @@ namespace {
 
 double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
 
+// --cpu-time: time by the threads' CPU time (summed, divided by the thread count) instead of the wall
+// clock. For A/B runs on a shared, oversubscribed machine (the project VM): the time a thread waits
+// for a core is left out; its caches shared with other work are not.
+bool gCpuTime = false;
+
+double threadSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 // Runs f(i) for i in [0, n) over `threads` threads in pieces of 256; returns the best of `reps` wall times.
 // Each piece sums f's results privately: one shared sink written per ray would bounce its cache line
 // between the cores and cap both tracers at the same rate.
@@ -44,13 +56,16 @@ double timed(size_t n, unsigned threads, int reps, const std::function<uint32_t(
   double best = 1e30;
   for (int r = 0; r < reps; ++r) {
     const auto start = Clock::now();
+    std::atomic<int64_t> cpuNs{0};
     parallelFor((n + kPiece - 1) / kPiece, threads, [&](size_t p) {
       const FlushDenormals flush;
+      const double t0 = gCpuTime ? threadSeconds() : 0.0;
       uint32_t acc = 0;
       for (size_t i = p * kPiece; i < std::min(n, (p + 1) * kPiece); ++i) acc += f(i);
       sink.fetch_add(acc, std::memory_order_relaxed);
+      if (gCpuTime) cpuNs.fetch_add(int64_t((threadSeconds() - t0) * 1e9), std::memory_order_relaxed);
     });
-    best = std::min(best, seconds(start));
+    best = std::min(best, gCpuTime ? 1e-9 * double(cpuNs.load()) / double(threads) : seconds(start));
   }
   return best;
 }
@@ -287,9 +302,12 @@ struct Options {
   int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
   int aloneRays[3] = {Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]};
   std::vector<int> aloneSweep;  // --alone-sweep: our packets timed with each of these, same turns
+  int inFlight = Bvh::kPacketAloneInFlight;
+  std::vector<int> inFlightSweep;  // --in-flight-sweep: the same for the lone walks in flight
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
   bool buildOnly = false;    // time only the builds, ours and Embree's alternately
+  bool profile = false;      // where a packet's time goes (printProfile)
 };
 
 // FNV-1a over the tree's nodes and packs (field by field: a Node has padding): equal hashes from two
@@ -494,7 +512,7 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<unsigned> counts{1};
   if (threads > 1) counts.push_back(threads);
-  std::string sweepLines;  // --alone-sweep, printed after the table
+  std::string sweepLines, flightLines;  // --alone-sweep, --in-flight-sweep, printed after the table
   for (unsigned th : counts) {
     for (const RaySet& s : all.sets()) {
       const auto& rays = *s.rays;
@@ -502,7 +520,7 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
       // Alternate the four, best of each: a machine that slows down for a while slows all. Each turn
       // runs twice, so that the best run finds its own BVH in the caches, not the other's.
       double single = 1e30, paired = 1e30, ours8 = 1e30, ours8r = 1e30, theirs = 1e30, theirs8 = 1e30;
-      std::vector<double> sweep(o.aloneSweep.size(), 1e30);
+      std::vector<double> sweep(o.aloneSweep.size(), 1e30), flightSweep(o.inFlightSweep.size(), 1e30);
       for (int r = 0; r < reps; ++r) {
         if (!o.packetsOnly)
           single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
@@ -535,6 +553,11 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
           Bvh::setPacketAloneRays(a[0], a[1], a[2]);
           sweep[k] = std::min(sweep[k], timed((rays.size() + 7) / 8, th, 2, packets8));
           Bvh::setPacketAloneRays(o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
+        }
+        for (size_t k = 0; k < o.inFlightSweep.size(); ++k) {
+          Bvh::setPacketAloneInFlight(o.inFlightSweep[k]);
+          flightSweep[k] = std::min(flightSweep[k], timed((rays.size() + 7) / 8, th, 2, packets8));
+          Bvh::setPacketAloneInFlight(o.inFlight);
         }
         Bvh::setPacketLeafRays(9);  // every leaf ray by ray (lanes = triangles), as before round 8
         if (!o.packetsOnly) ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
@@ -574,11 +597,88 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
           sweepLines += b;
         }
       }
+      if (!flightSweep.empty()) {  // the same with each number of lone walks in flight
+        char b[96];
+        std::snprintf(b, sizeof b, "\n- %s, %u threads:", s.name, th);
+        flightLines += b;
+        for (size_t k = 0; k < flightSweep.size(); ++k) {
+          std::snprintf(b, sizeof b, " %d in flight %.2f×", o.inFlightSweep[k], theirs8 / flightSweep[k]);
+          flightLines += b;
+        }
+      }
     }
   }
   if (!sweepLines.empty())
     std::printf("\nOur packets / Embree's packets, single rays from this many live rays (--alone-sweep):%s\n",
                 sweepLines.c_str());
+  if (!flightLines.empty())
+    std::printf("\nOur packets / Embree's packets, this many lone walks in flight (--in-flight-sweep):%s\n", flightLines.c_str());
+}
+
+// --profile: where a packet's time goes, ours and Embree's, each kind of rays, 1 and N threads. Per
+// packet (thread time: wall time × threads / packets): its first pass as timed above; the same packet
+// again at once (each packet traced twice in a row, minus one pass: its nodes and triangles in the
+// caches, its branches just seen), so first pass − again = what first touching its data costs; and the
+// fixed cost of a call (primary rays turned round: they miss the root). With the counted passes a
+// packet (box tests and triangle tests, 8-wide, printCounters' columns) the in-cache time a pass.
+void printProfile(const Bvh& bvh, const Embree& em, const Rays& all, const Options& o) {
+  if (!em.packets()) return;
+  std::vector<unsigned> counts{1};
+  if (o.threads > 1) counts.push_back(o.threads);
+  std::vector<Ray> away = all.primary;
+  for (Ray& r : away) r.direction = -r.direction;
+  std::printf(
+      "\nWhere a packet's time goes (--profile; ns of thread time a packet of 8: first pass, the same packet again at once "
+      "with its data in the caches, and their difference, the first touch of its nodes and triangles):\n\n"
+      "| rays | threads | ours: ns a packet | again at once | first touch | Embree: ns a packet | again at once | first touch "
+      "| our passes a packet: box / triangle | ours again at once, less a call's: ns a pass |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  std::vector<RaySet> sets = all.sets();
+  sets.insert(sets.begin(), RaySet{"turned round (miss the root: a call's fixed cost)", &away, false, PacketKind::Coherent});
+  std::vector<double> box(sets.size()), tri(sets.size());  // passes a packet, counted once a set
+  for (unsigned th : counts) {
+    double fixedAgain = 0.0;  // ours, a packet that misses the root, again at once
+    for (size_t k = 0; k < sets.size(); ++k) {
+      const RaySet& s = sets[k];
+      const std::vector<Ray>& rays = *s.rays;
+      const size_t packets = (rays.size() + 7) / 8;
+      auto ours = [&](size_t i) {
+        const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
+        if (s.any) return uint32_t(bvh.occluded8(&rays[8 * i], n));
+        Hit h[8];
+        bvh.closest8(&rays[8 * i], n, h, IntersectMethod::Watertight, s.kind);
+        return h[0].prim + h[n - 1].prim;
+      };
+      auto theirs = [&](size_t i) {
+        const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
+        return s.any ? em.occluded8(&rays[8 * i], n) : em.closest8(&rays[8 * i], n);
+      };
+      double t[4] = {1e30, 1e30, 1e30, 1e30};  // ours once, twice; Embree once, twice
+      for (int r = 0; r < o.reps; ++r) {
+        t[0] = std::min(t[0], timed(packets, th, 2, ours));
+        t[1] = std::min(t[1], timed(packets, th, 2, [&](size_t i) { return ours(i) + ours(i); }));
+        t[2] = std::min(t[2], timed(packets, th, 2, theirs));
+        t[3] = std::min(t[3], timed(packets, th, 2, [&](size_t i) { return theirs(i) + theirs(i); }));
+      }
+      const double ns = 1e9 * double(th) / double(packets);
+      const double oursOnce = t[0] * ns, oursAgain = (t[1] - t[0]) * ns, emOnce = t[2] * ns, emAgain = (t[3] - t[2]) * ns;
+      if (th == counts[0]) {  // passes a packet, counted (one thread, the counting traversal: the same decisions)
+        Bvh::setCounting(true);
+        Bvh::counters() = {};
+        for (size_t i = 0; i < packets; ++i) ours(i);
+        const BvhCounters c = Bvh::counters();
+        Bvh::counters() = {};
+        Bvh::setCounting(false);
+        box[k] = double(c.intervalTests + c.childTests + c.nodes) / double(packets);
+        tri[k] = double(c.triangleTests + c.packs) / double(packets);
+      }
+      char perPass[32] = "–";
+      if (s.rays == &away) fixedAgain = oursAgain;
+      else std::snprintf(perPass, sizeof perPass, "%.1f", (oursAgain - fixedAgain) / std::max(1e-9, box[k] + tri[k]));
+      std::printf("| %s | %u | %.0f | %.0f | %.0f (%.0f %%) | %.0f | %.0f | %.0f (%.0f %%) | %.1f / %.1f | %s |\n", s.name, th,
+                  oursOnce, oursAgain, oursOnce - oursAgain, 100.0 * (oursOnce - oursAgain) / oursOnce, emOnce, emAgain,
+                  emOnce - emAgain, 100.0 * (emOnce - emAgain) / emOnce, box[k], tri[k], perPass);
+    }
+  }
 }
 
 // Primary rays through our BVH with each intersection routine, one thread.
@@ -615,6 +715,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
     return;
   }
   printSpeeds(bvh, em, rays, o);
+  if (o.profile) printProfile(bvh, em, rays, o);
   if (!o.quick) printRoutines(bvh, rays.primary);
 }
 
@@ -699,18 +800,24 @@ int main(int argc, char** argv) {
     } else if (a == "--alone-sweep" && i + 1 < argc) {
       for (const char* p = argv[++i]; *p; ++p)
         if (p == argv[i] || p[-1] == ',') o.aloneSweep.push_back(std::atoi(p));
-    } else if (a == "--quick") quick = true;
+    } else if (a == "--in-flight-sweep" && i + 1 < argc) {
+      for (const char* p = argv[++i]; *p; ++p)
+        if (p == argv[i] || p[-1] == ',') o.inFlightSweep.push_back(std::atoi(p));
+    } else if (a == "--in-flight" && i + 1 < argc) o.inFlight = std::atoi(argv[++i]);
+    else if (a == "--quick") quick = true;
     else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--packets-only") quick = o.packetsOnly = true;
     else if (a == "--no-sphere") noSphere = true;
     else if (a == "--build-only") quick = o.buildOnly = true;
     else if (a == "--explain") explainAll = true;
+    else if (a == "--cpu-time") gCpuTime = true;
+    else if (a == "--profile") o.profile = true;
     else if (a == "--sse") Bvh::setIsa(BvhIsa::Sse);
     else if (a == "--avx2") Bvh::setIsa(BvhIsa::Avx2);
     else {
       std::fprintf(
           stderr,
-          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere]\n"
+          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--in-flight 2|4] [--in-flight-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile]\n"
           "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
           "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
           "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
@@ -720,21 +827,28 @@ int main(int argc, char** argv) {
           "  --alone-rays C,S,A: our packets walk on as single rays from this many live rays or fewer: closest hit\n"
           "    coherent (primary, orthographic), closest hit scattered (mirror), any hit (shadow)\n"
           "  --alone-sweep N,...: our packets also timed with each set's threshold at each N (same turns)\n"
+          "  --in-flight 2|4: a packet's lone rays walk interleaved in pairs (2, default) or fours\n"
+          "  --in-flight-sweep N,...: our packets also timed with each of these (2, 4) in flight (same turns)\n"
           "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
           "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
-          "  --no-sphere: only the --scene files\n");
+          "  --no-sphere: only the --scene files\n"
+          "  --profile: where our and Embree's packets spend their time (first pass, again in cache, set-up)\n"
+          "  --cpu-time: time by the threads' CPU time, not the wall clock (A/B runs on a shared machine)\n");
       return 2;
     }
   }
   bool badAlone = false;
   for (int n : o.aloneRays) badAlone |= n < 0 || n > 8;
   for (int n : o.aloneSweep) badAlone |= n < 0 || n > 8;
+  for (int n : o.inFlightSweep) badAlone |= n != 2 && n != 4;
+  badAlone |= o.inFlight != 2 && o.inFlight != 4;
   if (threads == 0 || res <= 0 || rings < 2 || reps < 1 || badAlone) {
     std::fprintf(stderr, "bench-trace: bad argument\n");
     return 2;
   }
   Bvh::setPacketLeafRays(leafRays);
   Bvh::setPacketAloneRays(o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
+  Bvh::setPacketAloneInFlight(o.inFlight);
   if (!quick) benchRoutines();
   const Mesh sphere = uvSphere({0, 0, 0}, 1.0f, rings, rings + 1);
   std::vector<Triangle> tris;

@@ -53,6 +53,10 @@ class Machine:
         return os.path.relpath(os.path.join(self.folder, row + ".txt"), os.path.join(ROOT, "docs"))
 
     @property
+    def gpu(self):  # a lent GPU machine (the goals were set for the H200; an H100 is measured against them too)
+        return self.label.startswith(("h200", "h100"))
+
+    @property
     def device(self):
         m = re.search(r" on (.+?): \d+ meshes", self.meta.get("vulkan", ""))
         return m.group(1) if m else "unknown Vulkan device"
@@ -159,7 +163,7 @@ class Report:
                     pct = re.search(r"\(([\d.]+) %\)", r[cm])
                     x, y = num(r[ci]), float(pct.group(1)) if pct else None
                     if x is not None and y is not None:
-                        ax.scatter(x, y, marker="o" if m.label.startswith("h200") else "s")
+                        ax.scatter(x, y, marker="o" if m.gpu else "s")
                         ax.annotate(f"{r[0]} ({m.label})", (x, y), fontsize=7, xytext=(4, 4), textcoords="offset points")
                         any_point = True
                 self.w()
@@ -294,14 +298,14 @@ class Report:
                     ax.annotate(f"{r[2]}, {'POT' if '1024' in r[1] else 'NPOT'}, {m.label}", (x, y),
                                 fontsize=7, xytext=(4, 3), textcoords="offset points")
                     plotted = True
-            if m.label.startswith("h200"):
+            if m.gpu:
                 for size in ("1024x1024", "1000x600"):
                     by = {r[2]: num(r[cmed]) for r in mips if size in r[1]}
                     blit = by.get("blit")
                     comp = min((v for k, v in by.items() if k != "blit" and v is not None), default=None)
                     if blit and comp:
                         goal = 0.1 if size == "1024x1024" else 1.0
-                        self.goals.append((f"compute mips ≤ {goal}× blit, 64 × {size} sRGB (H200)",
+                        self.goals.append((f"compute mips ≤ {goal}× blit, 64 × {size} sRGB ({m.label})",
                                            f"{comp:.3f} vs {blit:.3f} ms = {comp / blit:.3f}×", comp / blit <= goal))
         if not self.scatter_done(fig, ax, plotted, "mips.png", "mip chains: GPU time vs max error",
                                  "Mip chains: time vs error", "speed: GPU ms per set of 64 chains (log)",
@@ -331,11 +335,11 @@ class Report:
             for (size, mode), v in sorted(by.items()):
                 if mode in ("compute", "graphics"):
                     bars.append((f"{mode}\n{size}\n{m.label}", v))
-            if m.label.startswith("h200") and by.get(("3840x2160", "compute")) and by.get(("3840x2160", "graphics")):
+            if m.gpu and by.get(("3840x2160", "compute")) and by.get(("3840x2160", "graphics")):
                 c, g = by[("3840x2160", "compute")], by[("3840x2160", "graphics")]
-                self.goals.append(("mosaic compute ≤ 0.05× graphics at 4K (H200)", f"{c:.3f} vs {g:.3f} ms = {c / g:.3f}×",
+                self.goals.append((f"mosaic compute ≤ 0.05× graphics at 4K ({m.label})", f"{c:.3f} vs {g:.3f} ms = {c / g:.3f}×",
                                    c / g <= 0.05))
-                self.goals.append(("mosaic compute ≤ 0.04 ms at 4K (H200)", f"{c:.3f} ms", c <= 0.04))
+                self.goals.append((f"mosaic compute ≤ 0.04 ms at 4K ({m.label})", f"{c:.3f} ms", c <= 0.04))
         if bars:
             ax.bar(range(len(bars)), [b[1] for b in bars], color="tab:blue")
             ax.set_yscale("log")
@@ -388,17 +392,17 @@ class Report:
                        " |" + (f" {fail}" if fail else ""))
             self.w()
             self.source(m, rows[0])
-            if m.label.startswith("h200"):
+            if m.gpu:
                 for scene in ("default", "big"):
                     tot = {(s, v): vals.get("total") for s_, s, v, vals, _ in [(x[0], x[1], x[2], x[3], 0) for x in table]
                            if s_ == scene}
                     pbr, tex = tot.get(("3840x2160", "pbr")), tot.get(("3840x2160", "textured"))
                     env = tot.get(("3840x2160", "pbr-env"))
                     if pbr and env and scene == "default":
-                        self.goals.append(("environment on adds ≤ 0.05 ms to the 4K default-scene frame (H200)",
+                        self.goals.append((f"environment on adds ≤ 0.05 ms to the 4K default-scene frame ({m.label})",
                                            f"{env:.3f} vs {pbr:.3f} ms: +{env - pbr:.3f} ms", env - pbr <= 0.05))
                     if pbr and tex:
-                        self.goals.append((f"whole frame ≤ 1.1× plain textured at 4K, {scene} scene (H200)",
+                        self.goals.append((f"whole frame ≤ 1.1× plain textured at 4K, {scene} scene ({m.label})",
                                            f"{pbr:.3f} vs {tex:.3f} ms = {pbr / tex:.2f}×", pbr / tex <= 1.1))
 
     # 6. GPU raster vs CPU trace
@@ -407,7 +411,9 @@ class Report:
         self.w()
         self.w("`rtr-frame-compare`: every case of `tests/reference/poses.txt` at 1920×1080, the same shading "
                "model on both sides (PBR, no shadows, no reflections). Error: 8-bit sRGB steps, GPU against the "
-               "CPU reference; failing = beyond 3 steps even against the 3×3 neighbours (docs/reference-tests.md).")
+               "CPU reference; failing = beyond 3 steps even against the 3×3 neighbours (docs/reference-tests.md); "
+               "ꟻLIP: the ꟻLIP-style perceptual error in [0, 1] at 67 pixels per degree, mean / 99th percentile / "
+               "max over the image (docs/flip.md).")
         self.w()
         fig, ax = plt.subplots(figsize=(6.5, 3.8))
         plotted = False
@@ -434,6 +440,30 @@ class Report:
                           "speed: ms per 1920×1080 frame (red: GPU raster, blue: CPU trace; log)",
                           "error: mean |GPU − CPU| (8-bit steps)", xlog=True)
 
+    # The goal, sphere by sphere of the grid (with and without the sun): within 2 % of the converged tracer,
+    # or the split sum itself is the cause — the exactly evaluated split sum is > 2 % off the tracer while
+    # the GPU is within 2 % of that exact split sum (env_split.cpp; docs/environment.md).
+    def env_goal(self, m, header, rows):
+        cc, cs, ce = col(header, "case"), col(header, "sphere"), col(header, "% of mean pixel")
+        co, ci = col(header, "exact split sum vs tracer"), col(header, "GPU vs exact split sum")
+        if cs is None or None in (co, ci, ce):
+            return
+        grid = [r for r in rows if r[cc].startswith("env_sphere_grid")]
+        if not grid:
+            return
+        within = [r for r in grid if num(r[ce]) <= 2.0]
+        rest = [r for r in grid if num(r[ce]) > 2.0]
+        caused = [r for r in rest if num(r[co]) > 2.0 and num(r[ci]) <= 2.0]
+        text = f"{len(within)} of {len(grid)} spheres ≤ 2 %"
+        if rest:
+            text += (f"; the other {len(rest)} ({min(num(r[ce]) for r in rest):.1f}–{max(num(r[ce]) for r in rest):.1f} %): "
+                     f"split sum's own error {min(num(r[co]) for r in rest):.1f}–{max(num(r[co]) for r in rest):.1f} %, "
+                     f"GPU vs exact split sum ≤ {max(num(r[ci]) for r in rest):.1f} %")
+        self.goals.append((f"mean GPU-vs-converged-CPU error ≤ 2 % of the pixel value on every sphere of the grid "
+                           f"(with and without the sun) where the split sum itself is not the cause (it is where the "
+                           f"exact split sum is > 2 % off the tracer and the GPU within 2 % of it; docs/environment.md; "
+                           f"{m.label})", text, len(within) + len(caused) == len(grid)))
+
     # 6b. environment light: the GPU's split sum against the tracer, and the tracer against its sample count
     def env_compare(self):
         self.w("## Light from an environment: split sum (GPU) against Monte Carlo (CPU)")
@@ -442,9 +472,13 @@ class Report:
                "sky alone (`--env sky`; `_nosun`: the same sky without its sun texel), GGX, no shadows on either side. "
                "Errors in linear radiance over the pixels both sides cover; `% of mean pixel` = mean |GPU − CPU| / mean "
                "CPU pixel (the goal's measure), per-pixel = the mean of |GPU − CPU| / CPU; the tracer's own noise is "
-               "estimated from its image at a quarter of the samples. Where the split sum itself is wrong and by how "
-               "much: docs/environment.md.")
+               "estimated from its image at a quarter of the samples; ꟻLIP: the ꟻLIP-style perceptual error in [0, 1] "
+               "of what a display shows (both clamped to [0, 1]) over the same pixels, at 67 pixels per degree "
+               "(docs/flip.md; older raw files have no such columns). Where the split sum itself is wrong and by "
+               "how much: docs/environment.md.")
         self.w()
+        # Where the split sum is visibly wrong: the ꟻLIP-style mean per sphere against roughness.
+        curves = {}
         for m in self.m:
             t = m.raw("env-compare")
             if not t or m.failed("env-compare"):
@@ -455,16 +489,23 @@ class Report:
             self.w()
             for header, rows in md_tables(t):
                 self.table(header, rows)
-                if col(header, "sphere") is None:
-                    cc, ce = col(header, "case"), col(header, "% of mean pixel")
-                    for r in rows:
-                        if r[cc] == "env_sphere_grid_nosun" and ce is not None:
-                            e = num(r[ce])
-                            self.goals.append((f"mean GPU-vs-converged-CPU error on the sphere grid ≤ 2 % of the pixel "
-                                               f"value (the sky without its sun, where the split sum's own error is "
-                                               f"least; docs/environment.md; {m.label})",
-                                               f"{e:.1f} %", e <= 2.0))
+                cs, cf = col(header, "sphere"), col(header, "ꟻLIP mean")
+                for r in rows if cs is not None and cf is not None else []:
+                    rough, metal = re.search(r"rough ([\d.]+)", r[cs]), re.search(r"metal ([\d.]+)", r[cs])
+                    if rough and (r[0] in ("env_metal_spheres", "env_dielectric_spheres") or
+                                  (r[0] == "env_sphere_grid_nosun" and metal and metal.group(1) in ("0.00", "1.00"))):
+                        key = f"{m.label}: {r[0]}" + (f" metal {metal.group(1)}" if metal else "")
+                        curves.setdefault(key, []).append((float(rough.group(1)), num(r[cf])))
+                self.env_goal(m, header, rows)
             self.source(m, "env-compare")
+        fig, ax = plt.subplots(figsize=(6, 3.6))
+        for key, pts in curves.items():
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label=key)
+        if curves:
+            ax.legend(fontsize=6)
+        self.scatter_done(fig, ax, bool(curves), "env_flip.png", "ꟻLIP-style mean per sphere against roughness",
+                          "Split sum against the tracer: ꟻLIP-style mean per sphere", "roughness",
+                          "ꟻLIP-style mean (0-1)")
         fig, ax = plt.subplots(figsize=(6, 3.6))
         plotted = False
         for m in self.m:
@@ -578,12 +619,12 @@ class Report:
                 self.w(f"| {names.get(scene, scene)} | {run} | " + " | ".join(cells) + f" | {gb.group(1) if gb else '–'} |" +
                        (f" {fail}" if fail else ""))
                 total = phases.get("total from process start")
-                if m.label.startswith("h200") and total and run == "warm" and scene in ("100", "1000"):
+                if m.gpu and total and run == "warm" and scene in ("100", "1000"):
                     goal = 500 if scene == "100" else 1000
-                    self.goals.append((f"first frame ≤ {goal / 1000:.1f} s from process start, {names[scene]}, warm (H200)",
+                    self.goals.append((f"first frame ≤ {goal / 1000:.1f} s from process start, {names[scene]}, warm ({m.label})",
                                        f"{total:.0f} ms", total <= goal))
                     if scene == "1000" and gb:
-                        self.goals.append(("geometry upload ≥ 10 GB/s, 10M triangles (H200)", f"{gb.group(1)} GB/s",
+                        self.goals.append((f"geometry upload ≥ 10 GB/s, 10M triangles ({m.label})", f"{gb.group(1)} GB/s",
                                            float(gb.group(1)) >= 10))
             self.w()
             self.source(m, rows[0])
@@ -622,9 +663,9 @@ class Report:
                         self.goals.append((f"GLB scene in memory ≥ 10× faster than assimp ({m.label})", f"{speedup:.1f}×",
                                            speedup >= 10))
             mo = re.search(r"^meshopt decode .*?: ([\d.]+) GB/s on 1 core, ([\d.]+) GB/s on (\d+) cores", t, flags=re.M)
-            if mo and m.label.startswith("h200"):
+            if mo and m.gpu:
                 best = max(float(mo.group(1)), float(mo.group(2)))
-                self.goals.append(("meshopt GLB decoded at ≥ 1 GB/s of output (H200)", f"{best:.2f} GB/s", best >= 1))
+                self.goals.append((f"meshopt GLB decoded at ≥ 1 GB/s of output ({m.label})", f"{best:.2f} GB/s", best >= 1))
             for line in t.splitlines():
                 if line.startswith("meshopt decode") or line.startswith("assimp") or line.startswith("# gltfpack"):
                     self.w(f"- {line.lstrip('# ')}")
@@ -670,8 +711,32 @@ class Report:
                     total = best["total from process start"]
                     self.goals.append((f"200-texture scene, first frame with textures ≤ 0.35 s ({m.label}, bc)",
                                        f"{total:.0f} ms", total <= 350))
+            self.direct_open(m)
             self.w()
             self.source(m, "textures-bc-1")
+
+    # The OBJ opened directly, first open (decodes, fills the texture cache) against the second (reads it).
+    def direct_open(self, m):
+        part_keys = ("texture decode", "texture upload", "mips", "texture cache read-back")
+        rows = {}
+        for open_ in ("first", "second"):
+            for k in (1, 2, 3):
+                t = m.raw(f"textures-direct-{open_}-{k}") or ""
+                ph = dict((n.strip(), float(v)) for n, v in re.findall(r"^  (\S.*?\S) +(-?[\d.]+)$", t, flags=re.M))
+                if "total from process start" in ph:
+                    rows.setdefault(open_, []).append((sum(ph.get(key, 0.0) for key in part_keys), ph["total from process start"]))
+        if len(rows) < 2:
+            return
+        for open_, what in (("first", "OBJ opened directly, first open (decoded, cache filled)"),
+                            ("second", "OBJ opened directly, second open (texture cache read)")):
+            parts = [p for p, _ in rows[open_]]
+            totals = [t for _, t in rows[open_]]
+            self.w(f"| {what} | – | – | texture part {min(parts):.0f}–{max(parts):.0f} | | | {min(totals):.0f} |")
+        first, second = min(p for p, _ in rows["first"]), min(p for p, _ in rows["second"])
+        if second > 0:
+            self.goals.append((f"second direct open of a textured OBJ ≥ 3× faster than the first (texture part: decode, "
+                               f"upload, mips, cache read-back; best of 3 each; {m.label})",
+                               f"{first:.0f} vs {second:.0f} ms = {first / second:.1f}×", first / second >= 3))
 
     def goals_has(self, word):
         return any(word in g[0] for g in self.goals)

@@ -23,19 +23,16 @@ ObjWriter::~ObjWriter() {
   if (f_) std::fclose(f_);
 }
 
-void ObjWriter::flush(bool end) {
+// Compressed, each flush is a frame of its own that records its size, so a reader can decode frames
+// on all cores (src/scene/stream.cpp).
+void ObjWriter::flush() {
   if (!z_) {
     if (std::fwrite(buf_.data(), 1, buf_.size(), f_) != buf_.size()) throw std::runtime_error("write failed");
-  } else {
-    std::vector<char> out(ZSTD_CStreamOutSize());
-    ZSTD_inBuffer in{buf_.data(), buf_.size(), 0};
-    for (;;) {
-      ZSTD_outBuffer o{out.data(), out.size(), 0};
-      size_t left = ZSTD_compressStream2(z_, &o, &in, end ? ZSTD_e_end : ZSTD_e_continue);
-      if (ZSTD_isError(left)) throw std::runtime_error(ZSTD_getErrorName(left));
-      std::fwrite(out.data(), 1, o.pos, f_);
-      if (end ? left == 0 : in.pos == in.size) break;
-    }
+  } else if (!buf_.empty()) {
+    std::vector<char> out(ZSTD_compressBound(buf_.size()));
+    const size_t n = ZSTD_compress2(z_, out.data(), out.size(), buf_.data(), buf_.size());
+    if (ZSTD_isError(n)) throw std::runtime_error(ZSTD_getErrorName(n));
+    if (std::fwrite(out.data(), 1, n, f_) != n) throw std::runtime_error("write failed");
   }
   buf_.clear();
 }
@@ -43,11 +40,11 @@ void ObjWriter::flush(bool end) {
 void ObjWriter::line(const std::string& s) {
   buf_ += s;
   buf_ += '\n';
-  if (buf_.size() > (1u << 20)) flush(false);
+  if (buf_.size() > (z_ ? kFrameBytes : size_t(1) << 20)) flush();
 }
 
 void ObjWriter::finish() {
-  flush(true);
+  flush();
   std::fclose(f_);
   f_ = nullptr;
 }

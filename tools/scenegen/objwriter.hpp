@@ -1,5 +1,6 @@
 #pragma once
-// Writes OBJ text, zstd-compressed as a stream when the name ends in .zst, with a few primitives.
+// Writes OBJ text, zstd-compressed in frames of about 4 MiB of text when the name ends in .zst, with a few
+// primitives.
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -32,7 +33,8 @@ class ObjWriter {
   void finish();
 
  private:
-  void flush(bool end);
+  static constexpr size_t kFrameBytes = size_t(4) << 20;  // text per zstd frame
+  void flush();
   std::FILE* f_ = nullptr;
   ZSTD_CCtx* z_ = nullptr;
   std::string buf_;

@@ -141,6 +141,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   const std::unique_ptr<TextureCache> textureCache = cli::textureCache(!o.textureCache);
   render::GpuScene gpuScene(ctx, scene, choice.mips, progress, render::GeometryUpload::Auto,
                             wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred, textureCache.get());
+  gpuScene.setUploadBudget(size_t(o.textureBatchMb) << 20);
   const auto& st = gpuScene.stats();  // the texture phases: once they are in
   if (wait) timeline.add("texture decode", st.decodeMs);
   timeline.add("geometry upload", st.geometryMs);
@@ -158,13 +159,17 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
                  st.mipGpuMs);
   if (wait && textureCache)
     std::fprintf(stderr, "; texture cache: %u hits, %u misses (%s)", st.cacheHits, st.cacheMisses, textureCache->dir().c_str());
-  else if (st.textures) std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
+  else if (!wait && st.textures)
+    std::fprintf(stderr, ", textures decoding (frames show the materials' factors: --no-wait-textures)");
   std::fprintf(stderr, "\n");
   const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(startLens(o, scene), scene.bounds(), pose);
   render::RenderSettings settings = sceneSettings(o, scene);
   settings.shading = choice.shading;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  if (settings.shading == render::ShadingPath::Visibility && !renderer.renderer().visibilityRefusal().empty())
+    std::fprintf(stderr, "rtr-view: warning: %s: frames take the forward path\n",
+                 renderer.renderer().visibilityRefusal().c_str());
   const auto env = loadEnvironment(o, ctx);
   renderer.renderer().setEnvironment(env);
   const double setupPipelineMs = ctx.pipelineCache().stats().ms - pipelineMsBefore;
@@ -184,11 +189,28 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     phase("first frame complete (record, GPU, read-back)", ps.ms - pipelineMsBefore - setupPipelineMs);
     std::fprintf(stderr, "rtr-view: %s", timeline.format(totalMs).c_str());
   }
-  if (gpuScene.updateTextures(true) && o.timings)  // how long the textures took, after the first frame
+  // Then frames 2..K (--frames K) take in, between frames, the textures that came in (GpuScene::updateTextures),
+  // as the window does; with --timings frames go on until the last is in, each one's line printed.
+  int rendered = first ? 1 : 0;
+  double firstTexturedAt = 0, allInAt = 0;
+  while (!wait && !gpuScene.texturesReady() && (rendered < o.frames || o.timings)) {
+    gpuScene.updateTextures();
+    const size_t in = gpuScene.texturesIn();
+    const auto t = Clock::now();
+    first = renderer.render(pose, lens, settings, 1);
+    ++rendered;
+    if (in > 0 && firstTexturedAt == 0) firstTexturedAt = render::msSinceProcessStart();
+    if (in == st.textures) allInAt = render::msSinceProcessStart();  // the frame with every texture is done
+    if (o.timings)
+      std::fprintf(stderr, "rtr-view: frame %d done at %.0f ms: %.1f ms, textures in %zu/%u\n", rendered,
+                   render::msSinceProcessStart(), since(t), in, st.textures);
+  }
+  if (gpuScene.updateTextures(true) && allInAt == 0) allInAt = render::msSinceProcessStart();
+  if (!wait && o.timings && st.textures)  // how long the textures took, after the first frame
     std::fprintf(stderr,
-                 "rtr-view: textures in at %.0f ms from process start: decode %.0f ms (worker threads), "
-                 "upload and mips %.0f ms (mips %.3f ms GPU); texture cache: %u hits, %u misses\n",
-                 render::msSinceProcessStart(), st.decodeMs, st.textureUploadMs, st.mipGpuMs, st.cacheHits, st.cacheMisses);
+                 "rtr-view: textures in at %.0f ms from process start (the first frame with some done at %.0f ms): decode %.0f "
+                 "ms (worker threads), upload and mips %.0f ms (mips %.3f ms GPU); texture cache: %u hits, %u misses\n",
+                 allInAt, firstTexturedAt, st.decodeMs, st.textureUploadMs, st.mipGpuMs, st.cacheHits, st.cacheMisses);
   if (o.bench > 0) {
     renderer.bench(pose, lens, settings, 10);  // warm-up
     printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
@@ -199,13 +221,20 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
           "occlusion %u (%.1f %%), not in the level-of-detail cut %u; %u triangles listed\n",
           c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone, 100 * c->cone / n, c->occlusion,
           100 * c->occlusion / n, c->lod, c->triangles);
+      std::printf("cull: %u cluster tests (both phases), %u instances culled whole\n", c->tested, c->instancesCulled);
     }
     if (settings.raster != render::RasterPath::Hardware)
-      if (const auto h = renderer.renderer().handOffTriangles(0)) std::printf("raster hw: %u triangles handed off\n", *h);
+      if (const auto h = renderer.renderer().handOffTriangles(0)) {
+        std::printf("raster hw: %u triangles handed off\n", *h);
+        if (*h > renderer.renderer().handOffCapacity())
+          std::fprintf(stderr, "rtr-view: warning: the hand-off list holds %u triangles: %u were not drawn\n",
+                       renderer.renderer().handOffCapacity(), *h - renderer.renderer().handOffCapacity());
+      }
   }
   if (!o.screenshot.empty()) {
-    render::HeadlessFrame frame =
-        first && o.frames <= 1 ? std::move(*first) : renderer.render(pose, lens, settings, std::max(1, o.frames));
+    render::HeadlessFrame frame = first && rendered >= o.frames
+                                      ? std::move(*first)
+                                      : renderer.render(pose, lens, settings, std::max(1, o.frames - rendered));
     const std::string empty = emptyImageWarning(scene, pose, lens, float(o.width) / float(o.height),
                                                 anyLit(frame.image, settings), settings.lights.lights.size());
     if (!empty.empty()) std::fprintf(stderr, "rtr-view: warning: %s\n", empty.c_str());

@@ -223,6 +223,11 @@ int main(int argc, char** argv) {
                    "their factors until their textures are in)");
   app.add_flag("--no-wait-textures", noWaitTextures, "the first frame shows the materials' factors; textures come later")
       ->excludes(waitOpt);
+  app.add_option("--texture-batch", o.textureBatchMb,
+                 "MiB of staged texels (every level) that textures coming in while frames go on may take per frame; at "
+                 "least one texture")
+      ->check(cli::integer(1, 65536))
+      ->capture_default_str();
   app.add_flag("--timings", o.timings,
                "print the start-up phases in ms, from process start to the first frame (the window's panel shows them too)");
   app.add_flag("--no-pipeline-cache", noPipelineCache,

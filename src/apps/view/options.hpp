@@ -46,7 +46,8 @@ struct ViewOptions {
   // The first frame waits for the textures (deterministic captures); unless given, on for --headless
   // (--screenshot, --bench), off in the window, whose frames show the factors until the textures are in.
   std::optional<bool> waitTextures;
-  bool panel = true;  // the window's settings panel shown at start
+  uint32_t textureBatchMb = 16;  // a deferred load's textures taken in per frame: MiB of staged texels (at least one)
+  bool panel = true;             // the window's settings panel shown at start
   // Test-only seams of the window (hidden options): each panel widget's rectangle on stdout when it
   // changes (--test-ui), and a file whose lines are taken as dropped paths once it appears (--test-drop).
   bool testUi = false;

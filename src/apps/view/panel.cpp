@@ -175,10 +175,10 @@ void drawPanel(ViewState& s, const PanelFacts& facts, const FrameHistory& histor
     track("message");
   }
   if (!facts.shaderError.empty()) ImGui::TextColored(ImVec4(1, 0.35f, 0.3f, 1), "shader error: %s", facts.shaderError.c_str());
-  if (facts.texturesLoading) {  // a bar while a deferred load decodes (the materials show their factors)
+  if (facts.texturesLoading) {  // a bar while a deferred load streams in (materials show factors until theirs)
     char label[64];
-    std::snprintf(label, sizeof label, "textures %zu/%u", facts.texturesDecoded, facts.textures);
-    ImGui::ProgressBar(facts.textures ? float(facts.texturesDecoded) / float(facts.textures) : 0.0f, ImVec2(-1, 0), label);
+    std::snprintf(label, sizeof label, "textures %zu/%u (decoded %zu)", facts.texturesIn, facts.textures, facts.texturesDecoded);
+    ImGui::ProgressBar(facts.textures ? float(facts.texturesIn) / float(facts.textures) : 0.0f, ImVec2(-1, 0), label);
     track("textures");
   }
   // First, where no open section pushes it out of a small window.

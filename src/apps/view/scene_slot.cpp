@@ -28,6 +28,7 @@ void SceneSlot::release() {
 void SceneSlot::build(VkExtent2D extent, render::MipMode mips) {
   gpu_ = std::make_unique<render::GpuScene>(ctx_, *scene_, mips, render::LoadProgress{}, render::GeometryUpload::Auto,
                                             waitTextures_ ? render::TextureLoad::Wait : render::TextureLoad::Deferred, cache_);
+  gpu_->setUploadBudget(textureBatch_);
   frames_ = std::make_unique<ViewFrames>(ctx_, surface_, extent, *gpu_);
   if (env_) frames_->renderer().setEnvironment(env_);
   traced_ = std::make_unique<TraceOverlay>(ctx_, *scene_);
@@ -63,9 +64,14 @@ bool SceneSlot::update(ViewState& app) {
     if (gpu_->texturesReady())
       std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", enumName(app.mips), gpu_->stats().mipGpuMs);
   }
-  // Textures decode on worker threads, then upload and get their mips in a submission of their own, while
-  // frames go on; then they are taken in between frames.
-  if (gpu_->updateTextures()) {
+  // Textures decode on worker threads; batches of those decoded upload and get their mips in submissions of
+  // their own while frames go on, and are taken in between frames as each completes.
+  const bool allIn = gpu_->updateTextures();
+  if (gpu_->texturesIn() > 0 && firstTextureAt_ == 0) {
+    firstTextureAt_ = render::msSinceProcessStart();
+    std::fprintf(stderr, "rtr-view: first textures in at %.0f ms from process start\n", firstTextureAt_);
+  }
+  if (allIn) {
     const auto& st = gpu_->stats();
     if (texturesInAt_ == 0) texturesInAt_ = render::msSinceProcessStart();
     std::fprintf(

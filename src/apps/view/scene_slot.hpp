@@ -28,6 +28,7 @@ class SceneSlot {
   void build(VkExtent2D extent, render::MipMode mips);
   // The texture cache every scene of the slot uses (null: none); it must outlive the slot.
   void setTextureCache(TextureCache* cache) { cache_ = cache; }
+  void setTextureBatch(size_t bytes) { textureBatch_ = bytes; }  // GpuScene::setUploadBudget
   // The environment every scene of the slot is lit by (kept across drops); null: none.
   void setEnvironment(std::shared_ptr<const render::EnvironmentMaps> env) {
     env_ = std::move(env);
@@ -61,7 +62,8 @@ class SceneSlot {
   std::unique_ptr<TraceOverlay> traced_;
   std::future<Scene> loading_;
   std::string loadingPath_;
-  double texturesInAt_ = 0;  // from process start; 0: not yet
+  size_t textureBatch_ = render::GpuScene::kDefaultUploadBudget;
+  double texturesInAt_ = 0, firstTextureAt_ = 0;  // from process start; 0: not yet
 };
 
 // --watch: edited shaders recompiled twice a second; a failure keeps the running pipelines and is shown.

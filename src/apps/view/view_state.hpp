@@ -43,7 +43,7 @@ struct PanelFacts {
   double mipGpuMs = 0;
   std::string traceStatus, shaderError;
   float maxAnisotropy = 1;                                               // the device's; 1: no anisotropic filtering
-  size_t texturesDecoded = 0;                                            // of `textures`
+  size_t texturesDecoded = 0, texturesIn = 0;                            // of `textures`: decoded, on screen
   bool texturesLoading = false;                                          // not all in yet: materials show their factors
   const std::vector<std::pair<std::string, double>>* startup = nullptr;  // phases in ms; empty before the first frame
   double startupTotalMs = 0, texturesInAtMs = 0;                         // from process start; 0: not yet

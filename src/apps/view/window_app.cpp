@@ -103,6 +103,7 @@ int runWindowed(const ViewOptions& opts) {
   SceneSlot slot(ctx, window.surface(), std::move(scene), o.files, waitTextures,
                  [dropped](const std::string& path) { return loadForView(dropped, path); });
   slot.setTextureCache(textureCache.get());
+  slot.setTextureBatch(size_t(o.textureBatchMb) << 20);
   slot.build({o.width, o.height}, app.mips);
   // The environment as loaded, at intensity 1 and not turned: the panel's controls prefilter it again from this.
   ImageF envRadiance;
@@ -169,6 +170,7 @@ int runWindowed(const ViewOptions& opts) {
                        shaders.error(),
                        render::maxAnisotropy(ctx),
                        slot.gpu().texturesDecoded(),
+                       slot.gpu().texturesIn(),
                        !slot.gpu().texturesReady(),
                        clock.phases(),
                        clock.totalMs(),

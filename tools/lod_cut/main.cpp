@@ -1,0 +1,246 @@
+// rtr-lod-cut: the level-of-detail cut that rtr-view's culling pass would choose (docs/virtual-geometry.md),
+// computed on the CPU with the same rule (shaders/shared/cluster_lod.h) and the same projection (the eye,
+// pixels per unit = image height / (2 tan(fovY / 2)), the near plane of the view's fitted depth range), and
+// where it comes from: per level of the hierarchy its clusters, triangles, roots and errors, and per
+// threshold the clusters and triangles the cut takes from each level, how many lie in the view frustum and
+// how large their triangles are on screen. --rebuild builds the hierarchy again (the build's per-group
+// record: how far each level's groups simplified, which groups stuck, which error term decided). No GPU.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cluster_lod.h"
+#include "core/cli.hpp"
+#include "cull.h"
+#include "scene/cluster_lod.hpp"
+#include "scene/clusters.hpp"
+#include "scene/framing.hpp"
+#include "scene/load.hpp"
+
+using namespace rtr;
+
+namespace {
+
+float median(std::vector<float> v) {
+  if (v.empty()) return 0.0f;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Per level of the build: groups, how they simplified, which term of the error decided.
+void printBuild(const std::vector<LodGroupStats>& stats) {
+  std::map<uint32_t, std::vector<const LodGroupStats*>> byLevel;
+  for (const LodGroupStats& s : stats) byLevel[s.level].push_back(&s);
+  std::printf(
+      "\nbuild, per level grouped (the groups' result is the next level):\n"
+      "| level | groups | alone | stuck (tris) | tris in → out | out / in | size term decides | simplifier error "
+      "median | size term median | size term / group radius median |\n|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n");
+  for (const auto& [level, groups] : byLevel) {
+    size_t alone = 0, stuck = 0, stuckTris = 0, in = 0, out = 0, sizeDecides = 0, simplified = 0;
+    std::vector<float> simp, edge, edgeRel;
+    for (const LodGroupStats* g : groups) {
+      if (g->clusters < 2) ++alone, stuckTris += g->trianglesIn;
+      else if (g->trianglesOut == 0) ++stuck, stuckTris += g->trianglesIn;
+      if (g->trianglesOut == 0) continue;
+      ++simplified;
+      in += g->trianglesIn, out += g->trianglesOut;
+      sizeDecides += g->edgeError > g->simplifierError;
+      simp.push_back(g->simplifierError), edge.push_back(g->edgeError);
+      edgeRel.push_back(g->radius > 0 ? g->edgeError / g->radius : 0.0f);
+    }
+    std::printf("| %u | %zu | %zu | %zu (%zu) | %zu → %zu | %.3f | %.1f %% | %.3g | %.3g | %.3f |\n", level, groups.size(), alone,
+                stuck, stuckTris, in, out, in ? double(out) / double(in) : 0.0,
+                simplified ? 100.0 * double(sizeDecides) / double(simplified) : 0.0, median(simp), median(edge), median(edgeRel));
+  }
+}
+
+struct View {
+  glm::vec3 eye;
+  glm::mat4 viewProj;
+  float pixelsPerUnit, zNear;
+  uint32_t width, height;
+};
+
+// The hierarchy per level, all meshes together.
+void printLevels(const Scene& scene) {
+  struct Row {
+    size_t clusters = 0, triangles = 0, roots = 0, rootTriangles = 0;
+    std::vector<float> errors;
+  };
+  std::map<uint32_t, Row> rows;
+  for (const Mesh& m : scene.meshes)
+    for (const LodCluster& c : m.lod.clusters) {
+      Row& r = rows[c.level];
+      ++r.clusters, r.triangles += c.triangleCount, r.errors.push_back(c.error);
+      if (c.parentError >= shader::LOD_ERROR_INFINITE) ++r.roots, r.rootTriangles += c.triangleCount;
+    }
+  std::printf(
+      "\nhierarchy, per level (all meshes):\n| level | clusters | triangles | tris / cluster | roots (their tris) | error min / "
+      "median / max |\n|---:|---:|---:|---:|---:|---|\n");
+  for (auto& [level, r] : rows) {
+    const auto [lo, hi] = std::minmax_element(r.errors.begin(), r.errors.end());
+    std::printf("| %u | %zu | %zu | %.1f | %zu (%zu) | %.3g / %.3g / %.3g |\n", level, r.clusters, r.triangles,
+                double(r.triangles) / double(r.clusters), r.roots, r.rootTriangles, *lo, median(r.errors), *hi);
+  }
+}
+
+// The cut at `threshold` pixels, per level: as rtr-view's culling pass with --cull off lists it (every
+// instance's clusters; a mesh without a hierarchy whole), and of it what lies in the view frustum with
+// its triangles' area on screen.
+void printCut(const Scene& scene, const View& v, float threshold) {
+  struct Row {
+    size_t clusters = 0, triangles = 0, roots = 0, inClusters = 0, inTriangles = 0, large = 0, tiles = 0;
+    double area = 0.0;
+    std::array<size_t, 6> areaBins{};  // < 1/4, < 1, < 4, < 16, < 64, >= 64 px
+  };
+  std::map<uint32_t, Row> rows;
+  std::vector<std::array<size_t, 3>> perMesh(scene.meshes.size());  // triangles in the cut, of level 0, in the frustum
+  std::vector<Instance> instances = scene.instances;
+  if (instances.empty())
+    for (uint32_t m = 0; m < scene.meshes.size(); ++m) instances.push_back({m, glm::mat4(1.0f)});
+  for (const Instance& inst : instances) {
+    const Mesh& m = scene.meshes[inst.mesh];
+    // Spheres and errors in scene space as render/cull.cpp places them (centre by the matrix, radius and
+    // error by the largest stretch).
+    const float stretch = std::sqrt(std::max({glm::dot(glm::vec3(inst.transform[0]), glm::vec3(inst.transform[0])),
+                                              glm::dot(glm::vec3(inst.transform[1]), glm::vec3(inst.transform[1])),
+                                              glm::dot(glm::vec3(inst.transform[2]), glm::vec3(inst.transform[2]))}));
+    auto place = [&](glm::vec4 s) { return glm::vec4(glm::vec3(inst.transform * glm::vec4(glm::vec3(s), 1.0f)), s.w * stretch); };
+    auto scaled = [&](float e) { return e >= shader::LOD_ERROR_INFINITE ? e : e * stretch; };
+    std::vector<LodCluster> whole;
+    if (m.lod.clusters.empty())
+      for (const Cluster& c : m.clusters) {
+        LodCluster l;
+        l.firstTriangle = c.firstTriangle, l.triangleCount = c.triangleCount, l.center = c.center, l.radius = c.radius;
+        l.sphere = l.parentSphere = glm::vec4(c.center, c.radius);
+        l.parentError = shader::LOD_ERROR_INFINITE;
+        whole.push_back(l);
+      }
+    for (const LodCluster& c : m.lod.clusters.empty() ? whole : m.lod.clusters) {
+      if (!shader::lodSelected(place(c.sphere), scaled(c.error), place(c.parentSphere), scaled(c.parentError), v.eye,
+                               v.pixelsPerUnit, v.zNear, threshold))
+        continue;
+      Row& r = rows[c.level];
+      ++r.clusters, r.triangles += c.triangleCount;
+      perMesh[inst.mesh][0] += c.triangleCount, perMesh[inst.mesh][1] += c.level == 0 ? c.triangleCount : 0;
+      r.roots += c.parentError >= shader::LOD_ERROR_INFINITE;
+      if (shader::frustumCulls(place(glm::vec4(c.center, c.radius)), v.viewProj)) continue;
+      ++r.inClusters, r.inTriangles += c.triangleCount, perMesh[inst.mesh][2] += c.triangleCount;
+      const glm::mat4 toClip = v.viewProj * inst.transform;
+      const std::span<const uint32_t> tris = lodTriangles(m, c);
+      for (size_t t = 0; t < tris.size(); t += 3) {
+        glm::vec2 p[3];
+        bool behind = false;
+        for (int k = 0; k < 3; ++k) {
+          const glm::vec4 h = toClip * glm::vec4(m.positions[tris[t + k]], 1.0f);
+          behind |= h.w <= 0.0f;
+          p[k] = glm::vec2(h) / h.w * 0.5f * glm::vec2(v.width, v.height);
+        }
+        if (behind) continue;  // crosses the camera plane: the hardware hand-off's
+        const float area = 0.5f * std::abs((p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y));
+        const glm::vec2 lo = glm::min(p[0], glm::min(p[1], p[2])), hi = glm::max(p[0], glm::max(p[1], p[2]));
+        // About RASTER_SHARED_AREA's rule (the box on screen): the tile pass, one entry per 32 × 32 tile.
+        const glm::vec2 half = 0.5f * glm::vec2(v.width, v.height);
+        const glm::vec2 a = glm::clamp(lo, -half, half), b = glm::clamp(hi, -half, half);
+        if ((b.x - a.x) * (b.y - a.y) > 256.0f)
+          ++r.large, r.tiles += size_t(std::ceil((b.x - a.x) / 32.0f) * std::ceil((b.y - a.y) / 32.0f));
+        r.area += area;
+        ++r.areaBins[area < 0.25f ? 0 : area < 1 ? 1 : area < 4 ? 2 : area < 16 ? 3 : area < 64 ? 4 : 5];
+      }
+    }
+  }
+  std::printf(
+      "\ncut at %g px: | level | clusters | triangles | of them roots (clusters) | in the frustum: clusters | triangles | "
+      "mean area px | area < 1/4, < 1, < 4, < 16, < 64, more (%% of tris) | box > 256 px (32-px tiles) |\n"
+      "|---:|---:|---:|---:|---:|---:|---:|---|---:|\n",
+      threshold);
+  Row all;
+  for (auto& [level, r] : rows) {
+    const size_t n = std::max<size_t>(1, r.inTriangles);
+    std::printf("| %u | %zu | %zu | %zu | %zu | %zu | %.2f | %.0f / %.0f / %.0f / %.0f / %.0f / %.0f | %zu (%zu) |\n", level,
+                r.clusters, r.triangles, r.roots, r.inClusters, r.inTriangles, r.area / double(n), 100.0 * r.areaBins[0] / n,
+                100.0 * r.areaBins[1] / n, 100.0 * r.areaBins[2] / n, 100.0 * r.areaBins[3] / n, 100.0 * r.areaBins[4] / n,
+                100.0 * r.areaBins[5] / n, r.large, r.tiles);
+    all.clusters += r.clusters, all.triangles += r.triangles, all.roots += r.roots, all.inClusters += r.inClusters;
+    all.inTriangles += r.inTriangles, all.area += r.area, all.large += r.large, all.tiles += r.tiles;
+  }
+  std::printf("per mesh (triangles: mesh → cut, of them level 0, in the frustum):");
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    std::printf(" %s %u → %zu, %zu, %zu;", scene.meshes[m].name.c_str(), scene.meshes[m].triangleCount(), perMesh[m][0],
+                perMesh[m][1], perMesh[m][2]);
+  std::printf("\n");
+  const double pixels = double(v.width) * v.height;
+  std::printf("| all | %zu | %zu | %zu | %zu | %zu | %.2f | | %zu (%zu) |\n", all.clusters, all.triangles, all.roots,
+              all.inClusters, all.inTriangles, all.area / double(std::max<size_t>(1, all.inTriangles)), all.large, all.tiles);
+  std::printf(
+      "cut at %g px: %zu triangles listed (%.2f a pixel), %zu in the frustum (%.2f a pixel), %zu clusters listed, %zu tiles of "
+      "%zu large triangles\n",
+      threshold, all.triangles, all.triangles / pixels, all.inTriangles, all.inTriangles / pixels, all.clusters, all.tiles,
+      all.large);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rtr-lod-cut: the level-of-detail cut rtr-view would draw, per level of the hierarchy (CPU)"};
+  std::string file, camera, size = "3840x2160", only;
+  std::vector<float> thresholds{1.0f};
+  float fov = 0.0f;
+  bool rebuild = false;
+  unsigned threads = 0;
+  app.add_option("scene", file, "scene file (.rtrscene with its hierarchy, or any scene: --rebuild)")->required();
+  app.add_option("--camera", camera, "x,y,z,yaw,pitch (default: the scene's stored view, as rtr-view)");
+  app.add_option("--fov", fov, "vertical field of view, degrees (default: as rtr-view)")->check(cli::number(1, 179));
+  app.add_option("--size", size, "WxH of the image");
+  app.add_option("--lod-error", thresholds, "thresholds in pixels, repeatable")->check(cli::number(0, 1e6));
+  app.add_option("--mesh", only, "only the mesh of this name (a scene without instances)");
+  app.add_flag("--rebuild", rebuild, "build the hierarchy again (prints the build per level)");
+  app.add_option("--threads", threads, "for --rebuild (0: all cores)")->check(cli::integer(0, 1024));
+  return cli::run(app, argc, argv, [&] {
+    const cli::Size wh = cli::parseSize("--size", size);
+    Scene scene = loadScene(file);
+    Lens lens;
+    if (fov > 0) lens.fovYDeg = fov;
+    else if (camera.empty() && scene.defaultView && scene.defaultFovYDeg > 0.0f) lens.fovYDeg = scene.defaultFovYDeg;
+    const float aspect = float(wh.width) / float(wh.height);
+    const CameraPose pose = !camera.empty()     ? cli::parsePose("--camera", camera)
+                            : scene.defaultView ? *scene.defaultView
+                                                : framingPose(scene, lens, aspect);
+    lens = fitDepthRange(lens, scene.bounds(), pose);
+    const View v{pose.position,
+                 projectionMatrix(lens, aspect) * viewMatrix(pose),
+                 float(wh.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f)),
+                 lens.zNear,
+                 wh.width,
+                 wh.height};
+    if (!only.empty()) {  // the view stays that of the whole scene
+      if (!scene.instances.empty()) throw UsageError("--mesh: " + file + " places its meshes by instances");
+      std::erase_if(scene.meshes, [&](const Mesh& m) { return m.name != only; });
+      if (scene.meshes.empty()) throw UsageError("--mesh: " + file + " has no mesh named '" + only + "'");
+    }
+    if (rebuild || std::all_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels == 0; })) {
+      buildMissingClusters(scene);
+      std::vector<LodGroupStats> stats;
+      const auto t0 = std::chrono::steady_clock::now();
+      for (Mesh& m : scene.meshes) {
+        if (m.clusters.empty()) continue;
+        const bool cones = m.material >= scene.materials.size() || conesCull(scene.materials[m.material]);
+        m.lod = buildClusterLod(m, cones, threads, &stats);
+      }
+      std::printf("hierarchy built in %.3f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      printBuild(stats);
+    }
+    size_t triangles = 0;
+    for (const Mesh& m : scene.meshes) triangles += m.triangleCount();
+    std::printf("%s: %zu meshes, %zu triangles; eye %s, fovY %g, %ux%u, %.1f px a unit at distance 1, near %g\n", file.c_str(),
+                scene.meshes.size(), triangles, formatPose(pose).c_str(), lens.fovYDeg, wh.width, wh.height, v.pixelsPerUnit,
+                lens.zNear);
+    printLevels(scene);
+    for (float t : thresholds) printCut(scene, v, t);
+    return 0;
+  });
+}
