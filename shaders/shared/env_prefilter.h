@@ -100,19 +100,30 @@ RTR_FN vec2 envLutUv(int brdf, float nv, float roughness, float size) {
   return vec2(t.x, (t.y + float(brdf)) * 0.5f);
 }
 
+// Multiple-scattering energy compensation (docs/environment.md), for BRDF_GGX only: a single-scattering
+// microfacet BRDF loses the light that would leave after more than one bounce, 1 - E of white light
+// (E = A + B, the white metal's albedo at n.v); it comes back mostly along the single-scattering lobe,
+// tinted by F0 once more per bounce, so the specular is scaled by 1 + F0 (1 / E - 1) (a white metal
+// reflects all the light). Beckmann, the brief's model, stays single scattering: 1.
+RTR_FN vec3 envMultiScatter(int brdf, vec3 F0, float E) {
+  if (brdf != BRDF_GGX) return vec3(1.0f);
+  return vec3(1.0f) + F0 * (1.0f / max(E, 1e-3f) - 1.0f);
+}
+
 // The split sum (docs/environment.md): what the environment adds to a surface, from the diffuse
 // irradiance E(n) (spherical harmonics), the specular cube's radiance along the mirror direction at the
 // surface's roughness, and the table's (A, B, C) at (n.v, roughness) for the same BRDF as brdf.h's:
 //   diffuse  = E/pi c (1 - M)(1 - F0d)(1 - C)   (exact for uniform light: brdf.h's diffuse integrated)
-//   specular = prefiltered (F0 A + B)           (F0 = mix(0.04, c, M))
-// For uniform radiance 1 (E = pi, prefiltered = 1) this is the BRDF's directional albedo, <= 1.
+//   specular = prefiltered (F0 A + B) ms         (F0 = mix(0.04, c, M); ms = envMultiScatter(F0, A + B))
+// For uniform radiance 1 (E = pi, prefiltered = 1) this is the BRDF's directional albedo (with the
+// compensation for GGX: 1 for a white metal).
 RTR_FN vec3 envSplitSum(int brdf, vec3 irradiance, vec3 prefiltered, vec3 abc, vec3 baseColor, float metalness) {
   vec3 c = clamp(baseColor, vec3(0.0f), vec3(1.0f));
   float m = clamp(metalness, 0.0f, 1.0f);
   vec3 F0 = mix(vec3(0.04f), c, m);
   vec3 F0d = brdf == BRDF_GGX ? vec3(0.04f) : F0;
   vec3 diffuse = irradiance * (1.0f / BRDF_PI) * c * (1.0f - m) * (vec3(1.0f) - F0d) * (1.0f - abc.z);
-  return diffuse + prefiltered * (F0 * abc.x + vec3(abc.y));
+  return diffuse + prefiltered * (F0 * abc.x + vec3(abc.y)) * envMultiScatter(brdf, F0, abc.x + abc.y);
 }
 
 // Push constants of the prefiltering passes.
@@ -127,7 +138,8 @@ struct EnvPush {
   uint srcLevels;   // specular: mip levels of the source cube
   uint level;       // spherical harmonics and the specular sum: the source level read
   uint srcSize;     // specular sum: that level's face size
-  uint pad0, pad1;
+  float nearAngle;  // specular sum: how far from a texel's direction the lobe is summed at that level (radians)
+  uint pad0;
 };
 #define ENV_GROUP 8
 #define ENV_SUM_SLICES 4  // env_specular_sum.comp: threads per output texel

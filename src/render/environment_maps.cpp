@@ -17,16 +17,23 @@ namespace {
 
 constexpr VkFormat kSourceFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-constexpr uint32_t kShMaxFace = 32;  // the spherical harmonics read the first source level this small
-constexpr uint32_t kSumFace = 16;    // env_specular_sum.comp reads the source level of faces this size
+constexpr uint32_t kShMaxFace = 32;   // the spherical harmonics read the first source level this small
+constexpr uint32_t kSumMinFace = 16;  // env_specular_sum.comp: its coarse level, and the least fine one
+constexpr uint32_t kSumMaxFace = 64;  // the finest level it reads (its cost: the fine texels near each lobe)
+// How far from a texel's direction, in the lobe's half widths, the sum reads the fine level. Measured on
+// a sky whose sun is 10^4 times the sky (roughness 0.25, 64² fine level): 1 leaves the tail's coarse
+// texels 15 % off next to the sun, 2 and more are within 3.3 % as the sum over every fine texel is.
+constexpr float kNearLobes = 4.0f;
 
-// Whether the specular level of `roughness` is summed over the source level of kSumFace faces rather than
-// importance-sampled: where GGX's reflected lobe (half its peak at about 1.29 alpha radians from the
-// centre) is at least two of that level's texels (2 / kSumFace radians at a face's centre) wide. Narrower
-// lobes would need finer levels, whose sums cost the square of their texel count.
-bool summed(float roughness) {
+// The face size of the source level that the specular level of `roughness` is summed over
+// (env_specular_sum.comp) near each texel's direction, or 0 where it is importance-sampled: the smallest
+// level on which GGX's reflected lobe (half its peak at about 1.29 alpha radians from the centre) is at
+// least two texels (2 / face radians at a face's centre) wide, if that is at most kSumMaxFace a side; the
+// source's level 0 where the source is smaller (and at least the coarse level).
+uint32_t sumFace(float roughness, uint32_t sourceSize) {
   const float alpha = std::max(roughness * roughness, shader::BRDF_ALPHA_MIN);
-  return 1.29f * alpha >= 2.0f * 2.0f / float(kSumFace);
+  const uint32_t face = std::max(std::bit_ceil(uint32_t(std::ceil(4.0f / (1.29f * alpha)))), kSumMinFace);
+  return face <= kSumMaxFace && sourceSize >= kSumMinFace ? std::min(face, sourceSize) : 0;
 }
 
 void checkDevice(const vk::Context& ctx) {
@@ -155,11 +162,12 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
     for (uint32_t l = 0; l < s.specularLevels; ++l) {
       pc.size = s.specularSize >> l;
       pc.roughness = float(l) / float(s.specularLevels - 1);
-      pc.srcSize = summed(pc.roughness) ? kSumFace : 0;  // the source is at least 32² a face
+      pc.srcSize = sumFace(pc.roughness, s.sourceSize);
+      pc.nearAngle = kNearLobes * 1.29f * std::max(pc.roughness * pc.roughness, shader::BRDF_ALPHA_MIN);
       const vk::Pipeline& p = pc.srcSize ? specSum : spec;
       p.bind(cb);
       vk::DescriptorWriter w(ctx, p.layout, 0, VK_NULL_HANDLE);
-      if (pc.srcSize) {  // a wide lobe: summed over a small source level
+      if (pc.srcSize) {  // summed over source texels
         pc.level = uint32_t(std::countr_zero(s.sourceSize / pc.srcSize));
         w.image(0, sourceFaces, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
       } else {

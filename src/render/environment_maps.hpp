@@ -23,8 +23,9 @@ struct EnvironmentMapSettings {
   uint32_t sourceSize = 0;      // source cube face; 0: a quarter of the map's width, 32..512, a power of two
   uint32_t specularSize = 128;  // level 0 of the specular cube (roughness 0)
   uint32_t specularLevels = 5;  // roughness (level / (levels - 1)); the last level is at least 8²
-  uint32_t samples = 512;       // half vectors per texel of specular level 1, doubling each level down (level 0: one;
-                                // levels rough enough to be summed over a small source level: none)
+  uint32_t samples = 512;       // half vectors per texel of specular level 1 where it is importance-sampled (a lobe
+                                // narrower than two texels of a 64²-a-face level: more than 5 levels), doubling
+                                // each level down; level 0: one; the other levels are summed over source texels
   uint32_t lutSize = 64;
   uint32_t lutSamples = 256;
 };

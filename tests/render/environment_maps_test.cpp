@@ -185,10 +185,15 @@ TEST_F(EnvironmentMapsTest, SunlitSkyGivesFiniteLevelsThatKeepTheEnergy) {
   }
 }
 
-// The rough levels (roughness >= 0.5) of a sunlit sky against the lobe summed over every texel of the map
-// on the CPU (exact for the map as piecewise constant) at 8 texels of each face: within 15 % (the sum over
-// a 16²-a-face level is at most 10 % off, next to the sun's terminator), where 1024-4096 half vectors per
-// texel left blotches around the sun's reflection 16-51 % off. Level 1 (roughness 0.25) is printed.
+// The levels of roughness >= 0.25 of a sunlit sky (its sun texel ~10^4 times the sky) against the lobe
+// summed over every texel of the map on the CPU (exact for the map as piecewise constant), at 8 texels of
+// each face and every texel within 0.3 radians of the sun, where the lobes are narrowest against its
+// light. Each level is summed near its texel over a source level (64², 16², 16², 16² a face) whose texels
+// are smaller than its lobe, the rest over 16² texels. Measured: largest 3.3, 4.7, 6.2, 10.3 % at
+// roughness 0.25 .. 1 (the rough ones next to the sun's terminator), mean 1.6, 1.8, 0.8, 0.8 %; bounds 6 %
+// at 0.25, 15 % for the others, mean 3 %. Importance-sampled with 512 half vectors a texel, roughness
+// 0.25 was 95 % off near the sun (mean 20 %); summed over 32² texels 29 % (13 %); with the fine level
+// read only within one lobe width of the texel 15 % (2 %).
 TEST_F(EnvironmentMapsTest, RoughLevelsOfASunlitSkyMatchTheLobeSummedOnTheCpu) {
   SkySettings sky;
   sky.width = 512;
@@ -199,36 +204,51 @@ TEST_F(EnvironmentMapsTest, RoughLevelsOfASunlitSkyMatchTheLobeSummedOnTheCpu) {
   const EnvironmentMaps maps(*ctx, env, s);
   const ImageF& map = env.map();
   std::vector<glm::vec4> dirs;  // direction, solid angle of each map texel
+  size_t sun = 0;
   for (uint32_t y = 0; y < map.height; ++y)
     for (uint32_t x = 0; x < map.width; ++x) {
       const double o =
           2 * M_PI / map.width * (std::cos(double(y) / map.height * M_PI) - std::cos(double(y + 1) / map.height * M_PI));
       dirs.emplace_back(shader::envUvToDir({(x + 0.5f) / map.width, (y + 0.5f) / map.height}, 0.0f), float(o));
+      if (map.pixels[dirs.size() - 1].g > map.pixels[sun].g) sun = dirs.size() - 1;
     }
+  const glm::vec3 sunDir(dirs[sun]);
+  ASSERT_GT(map.pixels[sun].g, 1000.0f * map.at(0, map.height / 4).g);  // the case this test is about
   for (uint32_t l = 1; l < s.specularLevels; ++l) {
     const uint32_t size = s.specularSize >> l;
     const auto texels = readLevel(maps.specular(), l);
     const double a2 = std::pow(std::max(std::pow(float(l) / float(s.specularLevels - 1), 2.0f), shader::BRDF_ALPHA_MIN), 2.0);
-    double worst = 0.0;
-    for (uint32_t f = 0; f < 6; ++f)
-      for (uint32_t k = 0; k < 8; ++k) {
-        const uint32_t x = (k * 5 + 1) * size / 40, y = (k * 3 + 2) % 8 * size / 8;
-        const glm::vec3 n = shader::envCubeDir(f, (glm::vec2(x, y) + 0.5f) / float(size) * 2.0f - 1.0f);
-        glm::dvec3 sum(0.0);
-        double w = 0.0;
-        for (size_t i = 0; i < dirs.size(); ++i) {
-          const double nl = glm::dot(n, glm::vec3(dirs[i]));
-          if (nl <= 0.0) continue;
-          const double q = (1.0 + nl) * 0.5 * (a2 - 1.0) + 1.0, wi = a2 / (q * q) * nl * dirs[i].w;  // GGX D n.l
-          sum += glm::dvec3(glm::vec3(map.pixels[i])) * wi;
-          w += wi;
-        }
-        const double cpu = sum.g / w, gpu = texels[(size_t(f) * size + y) * size + x].g;
-        worst = std::max(worst, std::abs(gpu / cpu - 1.0));
+    std::vector<glm::uvec3> points;  // x, y, face
+    for (uint32_t f = 0; f < 6; ++f) {
+      for (uint32_t k = 0; k < 8; ++k) points.emplace_back((k * 5 + 1) * size / 40, (k * 3 + 2) % 8 * size / 8, f);
+      for (uint32_t y = 0; y < size; ++y)
+        for (uint32_t x = 0; x < size; ++x)
+          if (glm::dot(shader::envCubeDir(f, (glm::vec2(x, y) + 0.5f) / float(size) * 2.0f - 1.0f), sunDir) > std::cos(0.3f))
+            points.emplace_back(x, y, f);
+    }
+    double worst = 0.0, total = 0.0;
+    for (const glm::uvec3& p : points) {
+      const glm::vec3 n = shader::envCubeDir(p.z, (glm::vec2(p.x, p.y) + 0.5f) / float(size) * 2.0f - 1.0f);
+      glm::dvec3 sum(0.0);
+      double w = 0.0;
+      for (size_t i = 0; i < dirs.size(); ++i) {
+        const double nl = glm::dot(n, glm::vec3(dirs[i]));
+        if (nl <= 0.0) continue;
+        const double q = (1.0 + nl) * 0.5 * (a2 - 1.0) + 1.0, wi = a2 / (q * q) * nl * dirs[i].w;  // GGX D n.l
+        sum += glm::dvec3(glm::vec3(map.pixels[i])) * wi;
+        w += wi;
       }
-    std::printf("level %u: largest relative difference to the CPU sum %.4f\n", l, worst);
-    if (l >= 2) EXPECT_LT(worst, 0.15) << "level " << l;
+      const double cpu = sum.g / w, gpu = texels[(size_t(p.z) * size + p.y) * size + p.x].g;
+      worst = std::max(worst, std::abs(gpu / cpu - 1.0));
+      total += std::abs(gpu / cpu - 1.0);
+    }
+    const double meanErr = total / double(points.size());
+    std::printf("level %u (%zu texels): relative difference to the CPU sum: largest %.4f, mean %.4f\n", l, points.size(), worst,
+                meanErr);
+    EXPECT_LT(worst, l == 1 ? 0.06 : 0.15) << "level " << l;
+    EXPECT_LT(meanErr, 0.03) << "level " << l;
   }
+  for (const auto& [name, ms] : maps.times()) std::printf("%s %.1f ms\n", name.c_str(), ms);
 }
 
 }  // namespace

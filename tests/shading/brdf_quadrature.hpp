@@ -34,8 +34,10 @@ double overHalfVectors(double alpha, int npsi, int nphi, G g) {
   return sum;
 }
 
-// Directional albedo of BRDF `brdf` at view angle theta_v (n = +z, v in the xz plane).
-inline Estimate directionalAlbedo(int brdf, double thetaV, glm::vec3 base, float rough, float metal, int channel = 0) {
+// Directional albedo of BRDF `brdf` at view angle theta_v (n = +z, v in the xz plane), the specular part
+// times specScale.
+inline Estimate directionalAlbedo(int brdf, double thetaV, glm::vec3 base, float rough, float metal, int channel = 0,
+                                  double specScale = 1) {
   const double pi = 3.14159265358979323846;
   const glm::dvec3 v(std::sin(thetaV), 0, std::cos(thetaV));
   const glm::vec3 n(0, 0, 1);
@@ -45,7 +47,7 @@ inline Estimate directionalAlbedo(int brdf, double thetaV, glm::vec3 base, float
     const glm::dvec3 l = 2 * vh * h - v;
     if (l.z <= 0) return 0.0;
     const BrdfTerms t = brdfTerms(brdf, n, glm::vec3(v), glm::vec3(glm::normalize(l)), base, rough, metal);
-    return double(t.specular[channel]) * l.z * 4 * vh;
+    return double(t.specular[channel]) * specScale * l.z * 4 * vh;
   };
   auto diffuse = [&](int nt, int np) {
     double sum = 0;
@@ -64,6 +66,15 @@ inline Estimate directionalAlbedo(int brdf, double thetaV, glm::vec3 base, float
   const double coarse = overHalfVectors(alpha, 200, 128, spec) + diffuse(64, 128);
   const double fine = overHalfVectors(alpha, 400, 256, spec) + diffuse(128, 256);
   return {fine, std::fabs(fine - coarse) + 1e-4};
+}
+
+// The same with GGX's multiple-scattering compensation (docs/environment.md): the specular part times
+// 1 + F0 (1 / E - 1), E the white metal's albedo at theta_v, F0 = mix(0.04, base, metal); Beckmann as is.
+inline Estimate compensatedAlbedo(int brdf, double thetaV, glm::vec3 base, float rough, float metal, int channel = 0) {
+  if (brdf != BRDF_GGX) return directionalAlbedo(brdf, thetaV, base, rough, metal, channel);
+  const double e = directionalAlbedo(brdf, thetaV, glm::vec3(1.0f), rough, 1.0f).value;
+  const double f0 = 0.04 + (double(base[channel]) - 0.04) * metal;
+  return directionalAlbedo(brdf, thetaV, base, rough, metal, channel, 1 + f0 * (1 / e - 1));
 }
 
 }  // namespace rtr::shader::quadrature

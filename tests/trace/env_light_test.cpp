@@ -106,7 +106,7 @@ TEST(EnvironmentLight, UniformSkyGivesTheDirectionalAlbedo) {
       ImageF img;
       tracer.render(ts, img);
       const Mean got = meanOf(img, 0);
-      const auto ref = shader::quadrature::directionalAlbedo(brdfId(c.brdf), tv, c.base, c.rough, c.metal);
+      const auto ref = shader::quadrature::compensatedAlbedo(brdfId(c.brdf), tv, c.base, c.rough, c.metal);
       EXPECT_NEAR(got.mean, ref.value, 4 * got.se + ref.error + 1e-4)
           << "brdf " << int(c.brdf) << " base " << c.base.x << " rough " << c.rough << " metal " << c.metal << " view " << tv
           << " se " << got.se;
@@ -125,8 +125,11 @@ ImageF sunMap(uint32_t w, uint32_t h) {
   return m;
 }
 
+// GGX's specular carries the multiple-scattering compensation, its E by quadrature (theta_v: v's angle to n).
 double exactUnderMap(const ImageF& map, int brdf, glm::vec3 v, const Material& m, int sub) {
   const glm::vec3 n(0, 1, 0);
+  const double e = shader::quadrature::directionalAlbedo(brdf, std::acos(double(v.y)), glm::vec3(1.0f), m.roughness, 1.0f).value;
+  const double f0 = 0.04 + (double(m.baseColor.x) - 0.04) * m.metalness, ms = brdf == BRDF_GGX ? 1 + f0 * (1 / e - 1) : 1;
   double sum = 0;
   for (uint32_t y = 0; y < map.height / 2; ++y)  // the lower half is below the plane: f = 0
     for (uint32_t x = 0; x < map.width; ++x) {
@@ -136,7 +139,8 @@ double exactUnderMap(const ImageF& map, int brdf, glm::vec3 v, const Material& m
           const float u = (float(x) + (b + 0.5f) / sub) / map.width, vv = (float(y) + (a + 0.5f) / sub) / map.height;
           const glm::vec3 l = shader::envUvToDir({u, vv}, 0.0f);
           const double dOmega = (2 * kPi / map.width / sub) * (kPi / map.height / sub) * std::sin(vv * kPi);
-          brdfPart += double(shader::pbrDirect(brdf, n, v, l, glm::vec3(1.0f), m.baseColor, m.roughness, m.metalness).x) * dOmega;
+          const shader::BrdfTerms t = shader::brdfTerms(brdf, n, v, l, m.baseColor, m.roughness, m.metalness);
+          brdfPart += (double(t.diffuse.x) + double(t.specular.x) * ms) * std::max(double(l.y), 0.0) * dOmega;
         }
       sum += brdfPart * map.at(x, y).x;
     }
@@ -166,11 +170,14 @@ TEST(EnvironmentLight, SunAndSkyGiveTheExactIntegral) {
 }
 
 // The white furnace: a white sphere in a uniform environment of radiance 1. A metal reflects at most 1
-// at every roughness and angle (both BRDFs conserve energy there; what they lose at high roughness is
-// docs/environment.md's table). A dielectric's diffuse is weighted by 1 - F(v.h) per light direction
+// at every roughness and angle; with GGX all of it (the multiple-scattering compensation: single
+// scattering keeps 0.31 at roughness 1 seen head-on), with Beckmann what its single scattering keeps
+// (docs/environment.md's table). A dielectric's diffuse is weighted by 1 - F(v.h) per light direction
 // (the brief's model and glTF's Appendix B alike), which at grazing views adds the diffuse to a nearly
 // total Fresnel reflection: its albedo exceeds 1 beyond ~50° from the normal (1.2 at 75°, the same table),
-// so the bound is asserted only within 45°. Allowance: the estimator's noise at 1024 sample pairs a pixel (below 1 % here).
+// so the bound is asserted only within 45°. Allowance: the estimator's noise at 1024 sample pairs a pixel
+// (below 1 % here; at GGX metal roughness >= 0.5, compensated, 2-3 % a pixel: the spread measured 0.91 ..
+// 1.08, so the bound there is 1.1 and the sphere's mean within 2 % of 1, measured 0.986 .. 1.003).
 TEST(EnvironmentLight, WhiteFurnaceGivesNoPixelAboveOne) {
   for (Brdf brdf : {Brdf::Ggx, Brdf::Beckmann})
     for (float metal : {0.0f, 1.0f})
@@ -184,6 +191,7 @@ TEST(EnvironmentLight, WhiteFurnaceGivesNoPixelAboveOne) {
         ImageF img;
         tracer.render(ts, img);
         float mx = 0.0f, mn = 1e30f;
+        double total = 0;
         int checked = 0;
         for (uint32_t y = 0; y < ts.height; ++y)
           for (uint32_t x = 0; x < ts.width; ++x) {
@@ -195,14 +203,19 @@ TEST(EnvironmentLight, WhiteFurnaceGivesNoPixelAboveOne) {
             const float nv = -glm::dot(tracer.surface(r, h).normal, glm::normalize(r.direction));
             if (metal == 0.0f && nv < std::cos(float(kPi) / 4)) continue;
             ++checked;
+            total += p;
             mx = std::max(mx, p);
             mn = std::min(mn, p);
           }
         EXPECT_GT(checked, 40);
-        EXPECT_LE(mx, 1.02f) << "brdf " << int(brdf) << " metal " << metal << " rough " << rough;
+        const bool compensated = brdf == Brdf::Ggx && metal == 1.0f;
+        EXPECT_LE(mx, compensated && rough >= 0.5f ? 1.1f : 1.02f)
+            << "brdf " << int(brdf) << " metal " << metal << " rough " << rough;
         EXPECT_GT(mn, 0.25f) << "brdf " << int(brdf) << " metal " << metal << " rough " << rough;
-        std::printf("furnace %s metal %.0f rough %.2f: pixels %.4f .. %.4f\n", brdf == Brdf::Ggx ? "ggx" : "beckmann", metal,
-                    rough, mn, mx);
+        if (compensated) EXPECT_NEAR(total / checked, 1.0, 0.02) << "rough " << rough;
+        std::printf("furnace %s metal %.0f rough %.2f: pixels %.4f .. %.4f, mean %.4f, centre %.4f\n",
+                    brdf == Brdf::Ggx ? "ggx" : "beckmann", metal, rough, mn, mx, total / checked,
+                    img.at(ts.width / 2, ts.height / 2).x);
       }
 }
 
