@@ -95,6 +95,8 @@ double implementationError(const vk::Context& ctx, const char* name, const Shade
 
 TEST_F(EnvReferenceTest, GpuMatchesTheExactSplitSum) {
   EXPECT_LE(implementationError(*ctx, "env_sphere_grid_nosun", {"build", "", "", ""}), kImplementationBound);
+  // With the sun: the sampled roughness-0.25 level's blotches were 3.3-9.8 % off here; it is summed since.
+  EXPECT_LE(implementationError(*ctx, "env_sphere_grid", {"build", "", "", ""}), kImplementationBound);
 }
 
 TEST_F(EnvReferenceTest, GpuOffTheExactSplitSumWhenBroken) {
