@@ -225,7 +225,7 @@ class GpuScene {
   std::vector<std::optional<TextureCacheKey>> storeKeys_;  // per texture: a cache miss, stored once its chain is made
   std::vector<std::future<void>> storing_;                 // packing and writing them
   bool materialExtras_ = false;
-  bool ready_ = false;                                     // every texture is on the GPU and the materials point at them
+  bool ready_ = false;  // every texture is on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
