@@ -4,8 +4,7 @@
 // triangle covers, so a shared edge is covered exactly once; each covered pixel gets one 64-bit atomicMin
 // of (depth, id), alpha-masked ones after the mask's test (raster_tri.glsl). Triangles with a bounding box
 // over kSharedArea pixels go to the tile list (one entry per RASTER_TILE² tile, raster_large.comp); those
-// crossing z = -w or the guard band are clipped
-// into pieces (raster_tri.glsl); the hardware hand-off list (raster_hw.vert/frag) takes what the tile list cannot.
+// touching w <= 0 or leaving the guard band go to the hardware hand-off list (raster_hw.vert/frag).
 #extension GL_GOOGLE_include_directive : require
 // With culling (pc.fromList), workgroup k takes the k-th entry of the culling pass's visible list
 // (cull.comp; dispatched indirectly from its counts).
@@ -28,30 +27,20 @@ void main() {
   if (k >= (pc.fromList != 0u ? cullCounts.listed : pc.clusterCount)) return;
   const uint clusterIndex = pc.fromList != 0u ? visibleClusters[k] : k;
   const uint local = gl_LocalInvocationID.x;
-  if (local >= clusters[clusterIndex].triangleCount) return;
+  Tri t;
+  const uint kind = local < clusters[clusterIndex].triangleCount ? setup(clusterIndex, local, t) : kSkip;
   const uint ref = (clusterIndex << RASTER_LOCAL_BITS) | local;
-  // A clipped triangle is several pieces (raster_tri.glsl), each small or large.
-  uint pieces = 1u;
-  for (uint piece = 0u; piece < pieces; ++piece) {
-    Tri t;
-    const uint kind = setup(clusterIndex, local, piece, t, pieces);
-    if (kind == kSmall) {
-      for (int y = t.box.y; y <= t.box.w; ++y)
-        for (int x = t.box.x; x <= t.box.z; ++x) rasterPixel(t, ivec2(x, y));
-    } else if (kind == kLarge) {
-      const ivec2 tiles = (t.box.zw - t.box.xy + RASTER_TILE) / RASTER_TILE;
-      const uint n = uint(tiles.x * tiles.y), first = atomicAdd(largeCount, n);
-      // A full list hands the triangle to the hardware; its reserved entries that fit are marked empty.
-      const bool fits = first + n <= RASTER_LARGE_CAPACITY;
-      for (uint i = 0u; i < n && first + i < RASTER_LARGE_CAPACITY; ++i)
-        largeTiles[first + i] = uvec2(fits ? ref : ~0u, (piece << RASTER_PIECE_SHIFT) | i);
-      if (!fits) {
-        handOff(ref);  // once: the whole triangle
-        return;
-      }
-    } else if (kind == kHardware) {
-      handOff(ref);
-      return;
-    }
+  if (kind == kSmall) {
+    for (int y = t.box.y; y <= t.box.w; ++y)
+      for (int x = t.box.x; x <= t.box.z; ++x) rasterPixel(t, ivec2(x, y));
+  } else if (kind == kLarge) {
+    const ivec2 tiles = (t.box.zw - t.box.xy + RASTER_TILE) / RASTER_TILE;
+    const uint n = uint(tiles.x * tiles.y), first = atomicAdd(largeCount, n);
+    // A full list hands the triangle to the hardware; its reserved entries that fit are marked empty.
+    const bool fits = first + n <= RASTER_LARGE_CAPACITY;
+    for (uint i = 0u; i < n && first + i < RASTER_LARGE_CAPACITY; ++i) largeTiles[first + i] = uvec2(fits ? ref : ~0u, i);
+    if (!fits) handOff(ref);
+  } else if (kind == kHardware) {
+    handOff(ref);
   }
 }

@@ -1,6 +1,6 @@
 #version 460
 // Compute rasteriser, large triangles (raster.comp's tile list): persistent workgroups take RASTER_TILE²
-// tiles of one triangle (or of a clipped triangle's piece) each, a few pixels a thread.
+// tiles of one triangle each, a few pixels a thread.
 #extension GL_GOOGLE_include_directive : require
 #include "raster_tri.glsl"
 
@@ -17,11 +17,10 @@ void main() {
     // One thread sets the triangle up for the group.
     barrier();  // the previous tile's readers are done
     if (gl_LocalInvocationID.x == 0u) {
-      uint pieces;
       Tri s;
-      setup(entry.x >> RASTER_LOCAL_BITS, entry.x & ((1u << RASTER_LOCAL_BITS) - 1u), entry.y >> RASTER_PIECE_SHIFT, s, pieces);
+      setup(entry.x >> RASTER_LOCAL_BITS, entry.x & ((1u << RASTER_LOCAL_BITS) - 1u), s);
       const int tilesX = (s.box.z - s.box.x + RASTER_TILE) / RASTER_TILE;
-      const int tile = int(entry.y & ((1u << RASTER_PIECE_SHIFT) - 1u));
+      const int tile = int(entry.y);
       const ivec2 origin = s.box.xy + RASTER_TILE * ivec2(tile % tilesX, tile / tilesX);
       shared_t = s;
       shared_origin = tileTouches(s, origin) ? origin : ivec2(-1);

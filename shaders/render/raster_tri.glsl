@@ -39,48 +39,7 @@ int64_t edge(ivec2 a, ivec2 b, ivec2 p) {
 // Bounding boxes over this many pixels are rasterised tile by tile (raster_large.comp).
 layout(constant_id = 0) const uint kSharedArea = RASTER_SHARED_AREA;
 
-// Triangles with a vertex behind z = -w (w <= 0 included: a projection maps z >= -w to w > 0) or
-// outside the guard band are clipped against those planes here, so no triangle needs the hardware: the
-// near plane z = -w lies between the camera and the near plane (z = 0), so the per-pixel depth test still
-// clips at z = 0 as for every other triangle. Signed distances (inside >= 0) to plane k.
-float clipDistance(vec4 p, int k, vec2 band) {
-  return k == 0 ? p.z + p.w : k == 1 ? band.x * p.w - p.x : k == 2 ? band.x * p.w + p.x : k == 3 ? band.y * p.w - p.y : band.y * p.w + p.y;
-}
-const int kClipPlanes = 5, kClipMax = 3 + kClipPlanes;  // a convex polygon gains at most a vertex per plane
-
-// Sutherland-Hodgman against the planes in order. A point on an edge is computed from the edge's inside
-// end, so two triangles sharing the edge get the same point, bit for bit, and stay watertight. Returns the
-// vertex count (0: nothing left; -1: more than kClipMax, rounding on a sliver).
-int clipPolygon(inout vec4 poly[kClipMax], inout vec2 polyUv[kClipMax], vec2 band) {
-  int n = 3;
-  for (int k = 0; k < kClipPlanes && n > 0; ++k) {
-    vec4 outP[kClipMax];
-    vec2 outUv[kClipMax];
-    int m = 0;
-    for (int i = 0; i < n; ++i) {
-      const int j = i + 1 < n ? i + 1 : 0;
-      const float di = clipDistance(poly[i], k, band), dj = clipDistance(poly[j], k, band);
-      if (di >= 0.0) {
-        if (m == kClipMax) return -1;
-        outP[m] = poly[i], outUv[m] = polyUv[i], ++m;
-      }
-      if ((di >= 0.0) == (dj >= 0.0)) continue;
-      const int a = di >= 0.0 ? i : j, b = di >= 0.0 ? j : i;
-      precise const float t = (di >= 0.0 ? di : dj) / (di >= 0.0 ? di - dj : dj - di);
-      if (m == kClipMax) return -1;
-      precise const vec4 q = poly[a] + t * (poly[b] - poly[a]);
-      precise const vec2 quv = polyUv[a] + t * (polyUv[b] - polyUv[a]);
-      outP[m] = q, outUv[m] = quv, ++m;
-    }
-    poly = outP, polyUv = outUv, n = m;
-  }
-  return n;
-}
-
-// Sets up piece `piece` of the triangle (one piece unless it is clipped: then `pieces` is the clipped
-// polygon's fan of triangles, all with the triangle's id).
-uint setup(uint clusterIndex, uint local, uint piece, out Tri t, out uint pieces) {
-  pieces = 1u;
+uint setup(uint clusterIndex, uint local, out Tri t) {
   const GpuCluster c = clusters[clusterIndex];
   const GpuInstance inst = instances[c.instance];
   const GpuDraw d = draws[inst.info.x];
@@ -88,47 +47,20 @@ uint setup(uint clusterIndex, uint local, uint piece, out Tri t, out uint pieces
   t.material = NO_TEXTURE;
   const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
   if (!kAlphaMask && masked) return kHardware;
-  const uvec3 tri = triangleVertices(c, d, local);
-  vec4 p[3] = vec4[3](clipPosition(inst, tri.x), clipPosition(inst, tri.y), clipPosition(inst, tri.z));
+  uvec3 tri = triangleVertices(c, d, local);
+  const vec4 p[3] = vec4[3](clipPosition(inst, tri.x), clipPosition(inst, tri.y), clipPosition(inst, tri.z));
   // Outside one plane of the view volume (behind the camera included): nothing to draw.
   for (int k = 0; k < 3; ++k) {
     if (p[0][k] > p[0].w && p[1][k] > p[1].w && p[2][k] > p[2].w) return kSkip;
     if (k < 2 && p[0][k] < -p[0].w && p[1][k] < -p[1].w && p[2][k] < -p[2].w) return kSkip;
   }
   if (p[0].z < 0.0 && p[1].z < 0.0 && p[2].z < 0.0) return kSkip;
-  vec2 uv[3] = vec2[3](vec2(0.0), vec2(0.0), vec2(0.0));
-  if (kAlphaMask && masked) {
-    const GpuMaterial m = materials[d.material];
-    if (m.textures.w != NO_TEXTURE) {
-      t.material = d.material;
-      for (int i = 0; i < 3; ++i) uv[i] = maskTexcoord(m, texcoords[tri[i]]);
-    }
-  }
+  if (min(p[0].w, min(p[1].w, p[2].w)) <= 0.0) return kHardware;
   const vec2 size = vec2(pc.width, pc.height);
-  // The guard band in clip space (x/w, y/w), a pixel inside RASTER_GUARD_BAND so rounding stays within it.
-  const vec2 band = 2.0 * (RASTER_GUARD_BAND - 1.0) / size;
-  bool clip = false;
-  for (int i = 0; i < 3; ++i)
-    for (int k = 0; k < kClipPlanes; ++k) clip = clip || clipDistance(p[i], k, band) < 0.0;
-  if (clip) {
-    vec4 poly[kClipMax];
-    vec2 polyUv[kClipMax];
-    for (int i = 0; i < 3; ++i) poly[i] = p[i], polyUv[i] = uv[i];
-    const int n = clipPolygon(poly, polyUv, band);
-    if (n < 0) return kHardware;
-    if (n < 3) return kSkip;
-    for (int i = 0; i < n; ++i)
-      if (poly[i].w <= 0.0) return kHardware;  // z >= -w with w <= 0: a projection of no camera here
-    pieces = uint(n - 2);
-    if (piece >= pieces) return kSkip;
-    // The fan from vertex 0: its diagonals are shared by neighbouring pieces only.
-    p = vec4[3](poly[0], poly[piece + 1u], poly[piece + 2u]);
-    uv = vec2[3](polyUv[0], polyUv[piece + 1u], polyUv[piece + 2u]);
-  }
   ivec2 v[3];
   for (int i = 0; i < 3; ++i) {
     const vec2 s = (p[i].xy / p[i].w * 0.5 + 0.5) * size;  // the viewport transform
-    if (any(greaterThan(abs(s - 0.5 * size), vec2(RASTER_GUARD_BAND)))) return kHardware;  // not after clipping
+    if (any(greaterThan(abs(s - 0.5 * size), vec2(RASTER_GUARD_BAND)))) return kHardware;
     v[i] = ivec2(floor(s * float(kOne) + 0.5));
     t.z[i] = p[i].z / p[i].w;
     if (kAlphaMask) t.invW[i] = 1.0 / p[i].w;
@@ -143,15 +75,21 @@ uint setup(uint clusterIndex, uint local, uint piece, out Tri t, out uint pieces
     const ivec2 tv = v[1]; v[1] = v[2]; v[2] = tv;
     const float tz = t.z[1]; t.z[1] = t.z[2]; t.z[2] = tz;
     const float tw = t.invW[1]; t.invW[1] = t.invW[2]; t.invW[2] = tw;
-    const vec2 tu = uv[1]; uv[1] = uv[2]; uv[2] = tu;
+    tri = tri.xzy;
   }
   t.v = v;
-  t.uv = uv;
   // Pixels whose centres (x + 0.5) lie in the snapped bounding box, clipped to the image.
   const ivec2 lo = min(v[0], min(v[1], v[2])), hi = max(v[0], max(v[1], v[2]));
   t.box.xy = max((lo - kOne / 2 + kOne - 1) >> RASTER_SUBPIXEL_BITS, ivec2(0));
   t.box.zw = min((hi - kOne / 2) >> RASTER_SUBPIXEL_BITS, ivec2(pc.width, pc.height) - 1);
   if (any(greaterThan(t.box.xy, t.box.zw))) return kSkip;
+  if (kAlphaMask && masked) {
+    const GpuMaterial m = materials[d.material];
+    if (m.textures.w != NO_TEXTURE) {
+      t.material = d.material;
+      for (int i = 0; i < 3; ++i) t.uv[i] = maskTexcoord(m, texcoords[tri[i]]);
+    }
+  }
   const ivec2 extent = t.box.zw - t.box.xy + 1;
   return uint(extent.x) * uint(extent.y) > kSharedArea ? kLarge : kSmall;
 }

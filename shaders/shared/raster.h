@@ -13,13 +13,12 @@ typedef uint32_t uint;
 #define RASTER_GROUP 128         // raster.comp: one workgroup per cluster, a thread per triangle
 #define RASTER_CLEAR_GROUP 256   // raster_clear.comp: a thread per pixel
 #define RASTER_SUBPIXEL_BITS 8   // fixed-point vertex positions: 1/256 pixel
-#define RASTER_GUARD_BAND 16384.0 // px from the image centre; a triangle past it (or past z = -w) is clipped
+#define RASTER_GUARD_BAND 16384.0 // px from the image centre; beyond it (or w <= 0) the hardware draws it
 #define RASTER_SHARED_AREA 256u  // default: bounding boxes over this many pixels are rasterised tile by tile
 #define RASTER_TILE 32           // raster_large.comp: a workgroup per tile of RASTER_TILE² pixels of a triangle
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
 #define RASTER_LARGE_GROUPS 1024u         // raster_large.comp's persistent workgroups
 #define RASTER_LOCAL_BITS 7u     // hardware list entry: cluster << RASTER_LOCAL_BITS | triangle in cluster
-#define RASTER_PIECE_SHIFT 28u   // tile list entry's second word: piece of a clipped triangle << this | tile
 // Hand-off list entries at most (64 MiB): the near-plane and guard-band triangles of a frame, not every
 // triangle of a billion-triangle scene (a storage buffer's range is 4 GiB at most on many devices). Past
 // it, triangles are dropped and counted (ComputeRaster::handOffTriangles, which rtr-view prints).

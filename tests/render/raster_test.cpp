@@ -251,9 +251,8 @@ std::vector<uint32_t> owners(const Mesh& mesh, uint32_t count, uint32_t x, uint3
 }
 
 // No pixel left uncovered from inside the closed cube: straight (vertices on pixel centres), turned, and
-// from near a corner (not nearer than the near plane reaches), where faces cross the plane w = 0 (clipped
-// in compute into pieces: shared edges must be cut at the same point in both triangles) and lie behind
-// the camera.
+// from near a corner (not nearer than the near plane reaches), where faces cross the plane w = 0 (handed to
+// the hardware) and lie behind the camera.
 TEST_F(RasterTest, ClosedMeshFromInsideLeavesNoHole) {
   const Scene scene = insideCube();
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
@@ -363,7 +362,7 @@ TEST_F(RasterTest, AlphaMaskedIdsAgreeWithTheHardware) {
     const Lens lens;
     const std::vector<uint32_t> hw = ids(r, pose, lens, RasterPath::Hardware);
     const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);
-    EXPECT_EQ(r.renderer().handOffTriangles(0), 0u) << "the floor's triangles crossing w = 0 are clipped in compute";
+    EXPECT_LE(r.renderer().handOffTriangles(0), 2u) << "only the floor's two triangles may cross w = 0";
     size_t covered = 0, cut = 0, differ = 0, inside = 0;
     for (int y = 0; y < int(h); ++y)
       for (int x = 0; x < int(w); ++x) {
@@ -385,10 +384,10 @@ TEST_F(RasterTest, AlphaMaskedIdsAgreeWithTheHardware) {
   std::filesystem::remove_all(dir);
 }
 
-// The default temple is rasterised in compute, its alpha-masked foliage and the triangles that cross w = 0
-// or leave the guard band (counted here on the CPU; clipped in compute) included: three views, near plane
-// 0.05, nothing handed to the hardware.
-TEST_F(RasterTest, NothingIsHandedToTheHardware) {
+// The default temple's alpha-masked foliage is rasterised in compute: three views, near plane 0.05, hand
+// at most the triangles that cross w = 0 or leave the guard band (counted here on the CPU by the rule) to
+// the hardware, none of the masked triangles in view that do neither.
+TEST_F(RasterTest, MaskedFoliageStaysInCompute) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
   ASSERT_TRUE(gpu.hasDraws(render::DrawKind::AlphaMasked));
@@ -428,8 +427,7 @@ TEST_F(RasterTest, NothingIsHandedToTheHardware) {
     std::printf("hand-off: %u triangles; %zu cross w = 0 or the guard band; %zu others masked in the view volume\n", *handedOff,
                 crossing, masked);
     EXPECT_GT(masked, 0u) << "no foliage in view to test";
-    EXPECT_GT(crossing, 0u) << "nothing to clip in view";
-    EXPECT_EQ(*handedOff, 0u);
+    EXPECT_LE(*handedOff, crossing);
   }
 }
 

@@ -92,8 +92,8 @@ TEST_F(SamplerTest, FilterChangesTheShadedViewOnBothPathsAndSwitchesBack) {
 
 // --filter reaches every pipeline that samples the scene's textures (they share one writer): the
 // forward image (through either mosaic pass, compute or graphics) and the visibility images change with it
-// on both rasterisers, and so do the compute rasteriser's ids, whose alpha-masked foliage it tests with
-// the same sampler as the others (so its coverage stays the hardware rasteriser's).
+// on both rasterisers, and so do the compute rasteriser's ids, whose alpha-masked foliage its hardware
+// hand-off tests with the same sampler as the others (so its coverage stays the hardware rasteriser's).
 TEST_F(SamplerTest, FilterNearestChangesEveryPath) {
   struct Path {
     render::ShadingPath shading;
