@@ -66,7 +66,8 @@ class Machine:
         return (f"{self.device}" + (f" (nvidia-smi: {gpu})" if gpu else "") +
                 f"; CPU {self.meta.get('cpu', '?')}; {self.meta.get('date', '?')}; commit {self.meta.get('commit', '?')}" +
                 (f"; tracer rows: commit {self.meta['trace-commit']}" if "trace-commit" in self.meta else "") +
-                (f"; environment rows: commit {self.meta['env-commit']}" if "env-commit" in self.meta else ""))
+                (f"; environment rows: commit {self.meta['env-commit']}" if "env-commit" in self.meta else "") +
+                (f"; rows by commit: {self.meta['rows-commit']}" if "rows-commit" in self.meta else ""))
 
 
 # ---------------------------------------------------------------- the sections
