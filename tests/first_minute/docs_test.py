@@ -18,7 +18,7 @@ OPTION = re.compile(r"(?<![\w-])(--[a-z][a-z0-9-]*)")
 OTHERS = {"--preset", "--build", "--target", "--build-only", "--quick", "--keep", "--table", "--target-env",
           "--runs", "--warmup", "--scale", "--scene", "--case", "--only", "--skip", "--out", "--runner",
           "--benchmark", "--explain", "--no-check", "--avx2", "--sse", "--packets-only", "--leaf-rays",
-          "--mip-sizes", "--mips-per-texture", "--textures", "--plain", "--gltf", "--alone-rays", "--alone-sweep",
+          "--mip-sizes", "--mips-per-texture", "--textures", "--plain", "--gltf", "--alone-rays", "--alone-sweep", "--in-flight-sweep", "--profile",
           "--sphere-grid", "--env-cases", "--spp-curve", "--flip", "--flip-map", "--ppd",  # scenegen, rtr-frame-compare
            "--mesh", "--rebuild",  # rtr-lod-cut (docs/virtual-geometry.md)
           "--test-ui", "--test-drop"}  # rtr-view's test-only options, hidden from --help (docs/viewer.md)
