@@ -588,24 +588,20 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
                   fmt(n, paired, "%.2f").c_str(), fmt(n, ours8r, "%.2f").c_str(), fmt(n, ours8, "%.2f").c_str(),
                   fmt(n, theirs, "%.2f").c_str(), t8, fmt(theirs, single, "%.2f×").c_str(), fmt(theirs, paired, "%.2f×").c_str(),
                   r8);
-      if (!sweep.empty()) {  // our packets / Embree's packets with each hand-off threshold, same turns
+      // Our packets / Embree's packets at each setting of a sweep, timed in the same turns.
+      auto sweepLine = [&](std::string& lines, const std::vector<int>& settings, const std::vector<double>& times,
+                           const char* format) {
+        if (times.empty()) return;
         char b[96];
         std::snprintf(b, sizeof b, "\n- %s, %u threads:", s.name, th);
-        sweepLines += b;
-        for (size_t k = 0; k < sweep.size(); ++k) {
-          std::snprintf(b, sizeof b, " from %d live %.2f×", o.aloneSweep[k], theirs8 / sweep[k]);
-          sweepLines += b;
+        lines += b;
+        for (size_t k = 0; k < times.size(); ++k) {
+          std::snprintf(b, sizeof b, format, settings[k], theirs8 / times[k]);
+          lines += b;
         }
-      }
-      if (!flightSweep.empty()) {  // the same with each number of lone walks in flight
-        char b[96];
-        std::snprintf(b, sizeof b, "\n- %s, %u threads:", s.name, th);
-        flightLines += b;
-        for (size_t k = 0; k < flightSweep.size(); ++k) {
-          std::snprintf(b, sizeof b, " %d in flight %.2f×", o.inFlightSweep[k], theirs8 / flightSweep[k]);
-          flightLines += b;
-        }
-      }
+      };
+      sweepLine(sweepLines, o.aloneSweep, sweep, " from %d live %.2f×");
+      sweepLine(flightLines, o.inFlightSweep, flightSweep, " %d in flight %.2f×");
     }
   }
   if (!sweepLines.empty())
