@@ -418,7 +418,7 @@ void Renderer::frame(FrameContext& fc) {
     const EnvironmentMapSettings& es = env_->settings();
     u.environment =
         glm::vec4(float(es.specularLevels - 1), s.backdropBlur < 0.0f ? ENV_BACKDROP_COLOR : std::min(s.backdropBlur, 1.0f),
-                  float(es.lutSize), 0.0f);
+                  float(es.lutSize), env_->rotation());
   }
   u.background = glm::vec4(s.background, 0.0f);
   u.options.x = s.brdf ? uint32_t(*s.brdf) + 1u : 0u;
@@ -441,7 +441,8 @@ void Renderer::frame(FrameContext& fc) {
 
   if (env_) {  // left sampled by their build; a read-back (tests) may have moved them since
     constexpr VkPipelineStageFlags2 kShading = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-    vk::require(cb, {{env_->source().tracked(), vk::Use::Sampled, kShading},
+    vk::require(cb, {{env_->map().tracked(), vk::Use::Sampled, kShading},
+                     {env_->source().tracked(), vk::Use::Sampled, kShading},
                      {env_->specular().tracked(), vk::Use::Sampled, kShading},
                      {env_->brdfLut().tracked(), vk::Use::Sampled, kShading}});
   }
