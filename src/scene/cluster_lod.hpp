@@ -33,7 +33,8 @@ struct LodGroupStats {
 
 // The hierarchy of `mesh` (positions, indices and its clusters, which become level 0: build them first,
 // scene/clusters.hpp). Deterministic, whatever the thread count (0: one per core). Groups whose
-// simplification cannot remove a sixth of their triangles (locked borders everywhere) stop as roots.
+// simplification cannot remove a sixth of their triangles (locked borders everywhere) are grouped again
+// with the next level's clusters; what is left when no group simplifies, or after 64 levels, are roots.
 // `backfaceCone` as buildClusters' (false: the clusters above level 0 get cones that never cull).
 // `stats`, where given, receives one record per group, level by level.
 ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone = true, unsigned threads = 0,

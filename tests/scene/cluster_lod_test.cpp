@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cluster.h"
 #include "cluster_lod.h"
 #include "scene/cluster_lod.hpp"
 #include "scene/clusters.hpp"
@@ -263,6 +264,18 @@ TEST(ClusterLod, ADenseFlatBoxListsAtMostOneTriangleAPixel) {
         << "eye " << eye.x << "," << eye.y << "," << eye.z << ": " << tris.size() / 3 << " triangles for " << pixels
         << " pixels (the mesh's own: " << m.indices.size() / 3 << ")";
   }
+}
+
+// Far away a mesh is a few clusters: the hierarchy has few roots. A sphere of long rows (its triangles
+// in row order, as generated meshes often are) is clustered row by row; grouping only among runs of
+// consecutive clusters kept every group inside its rows, and the rows' borders stayed locked at every level
+// (the 100M temple's statue listed 12 M triangles at 1 px); a stuck group's clusters stayed roots.
+TEST(ClusterLod, FarAwayAMeshOfLongRowsIsAFewClusters) {
+  const Mesh m = bumpySphere(60, 1200);  // 141 600 triangles in 60 rows
+  const ClusterLod lod = buildClusterLod(m);
+  // 54 triangles; 19 718 grouped in runs with stuck groups as roots, 2 474 grouped over the level but
+  // with stuck groups as roots.
+  EXPECT_LE(cut(m, lod, {0, 0, 1000}, 1.0f).size() / 3, 8u * CLUSTER_MAX_TRIANGLES);
 }
 
 // The hierarchy is the same, byte for byte, whatever the thread count: a level is grouped and simplified
