@@ -25,7 +25,7 @@ constexpr float kLodEdgePerError = 32.0f;
 struct LodGroupStats {
   uint32_t level = 0;  // of the clusters grouped; the result is level + 1
   uint32_t clusters = 0, trianglesIn = 0;
-  uint32_t trianglesOut = 0;     // 0: stuck (the group's clusters stay roots)
+  uint32_t trianglesOut = 0;     // 0: stuck (its clusters are grouped again at the next level)
   float simplifierError = 0.0f;  // object space, what the simplifier reports
   float edgeError = 0.0f;        // the size term: longest new edge / kEdgePerError
   float radius = 0.0f;           // of the group's sphere
