@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "core/parallel.hpp"
+#include "scene/grow_array.hpp"
 #include "scene/mtl.hpp"
 #include "scene/obj_piece.hpp"
 #include "scene/text.hpp"
@@ -39,7 +40,7 @@ constexpr size_t kSniffBytes = 8192;            // how much of the start is chec
 struct MeshBuild {
   std::string name;
   uint32_t material = 0;
-  std::vector<Corner> corners;
+  GrowArray<Corner> corners;
   size_t queued = 0;  // corners given a place so far
 };
 
@@ -150,16 +151,22 @@ class ObjParser {
       end.normals += pieces[i].normals.size();
       coloured_ = coloured_ || !pieces[i].colors.empty();
     }
+    // The arrays grow without a pass over them (GrowArray); the pieces' records are copied in on all cores.
+    const size_t uncoloured = colors_.size();  // colours begin in this batch: white for the positions before
     positions_.resize(end.positions);
     texcoords_.resize(end.texcoords);
     normals_.resize(end.normals);
-    if (coloured_) colors_.resize(end.positions, glm::vec4(1.0f));  // white where a `v` had no colour
+    if (coloured_) colors_.resize(end.positions);
+    if (coloured_ && before.size())
+      std::fill(colors_.begin() + uncoloured, colors_.begin() + before[0].positions, glm::vec4(1.0f));
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) {
       objpiece::Piece& p = pieces[i];
       std::copy(p.positions.begin(), p.positions.end(), positions_.begin() + ptrdiff_t(before[i].positions));
       std::copy(p.texcoords.begin(), p.texcoords.end(), texcoords_.begin() + ptrdiff_t(before[i].texcoords));
       std::copy(p.normals.begin(), p.normals.end(), normals_.begin() + ptrdiff_t(before[i].normals));
-      if (coloured_) std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
+      if (coloured_ && p.colors.empty())  // white where a `v` had no colour
+        std::fill_n(colors_.begin() + ptrdiff_t(before[i].positions), p.positions.size(), glm::vec4(1.0f));
+      else if (coloured_) std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
       std::vector<glm::vec3>().swap(p.positions);
       std::vector<glm::vec4>().swap(p.colors);
       std::vector<glm::vec2>().swap(p.texcoords);
@@ -173,10 +180,9 @@ class ObjParser {
     };
     std::vector<Copy> copies;
     for (size_t i = 0; i < pieces.size(); ++i) replay(pieces[i], i, copies);
-    for (const Copy& c : copies) {  // grown geometrically: a mesh spread over many batches is moved rarely
-      std::vector<Corner>& v = builds_[c.mesh].corners;
-      if (v.capacity() < c.at + (c.end - c.first)) v.reserve(std::max(c.at + (c.end - c.first), 2 * v.capacity()));
-      if (v.size() < c.at + (c.end - c.first)) v.resize(c.at + (c.end - c.first));
+    for (const Copy& c : copies) {
+      GrowArray<Corner>& v = builds_[c.mesh].corners;
+      v.resize(std::max(v.size(), c.at + (c.end - c.first)));
     }
     parallelFor(copies.size(), opt_.threads, [&](size_t k) {
       const Copy& c = copies[k];
@@ -184,6 +190,7 @@ class ObjParser {
       std::copy(from.begin() + ptrdiff_t(c.first), from.begin() + ptrdiff_t(c.end),
                 builds_[c.mesh].corners.begin() + ptrdiff_t(c.at));
     });
+    parallelFor(pieces.size(), opt_.threads, [&](size_t i) { pieces[i] = objpiece::Piece(); });  // freed on all cores
   }
 
   template <class Copies>
@@ -312,9 +319,9 @@ class ObjParser {
   ObjStats& stats_;
   size_t line_ = 0;
 
-  std::vector<glm::vec3> positions_, normals_;
-  std::vector<glm::vec4> colors_;  // one per position once a `v` line has a colour; empty before
-  std::vector<glm::vec2> texcoords_;
+  GrowArray<glm::vec3> positions_, normals_;
+  GrowArray<glm::vec4> colors_;  // one per position once a `v` line has a colour; empty before
+  GrowArray<glm::vec2> texcoords_;
   std::vector<MeshBuild> builds_;
   std::unordered_map<uint64_t, uint32_t> meshIds_;
   std::vector<std::string> objectNames_;
@@ -355,7 +362,7 @@ Scene ObjParser::finish() {
   std::vector<WeldCounts> counts(builds_.size());
   auto weld = [&](size_t i, unsigned threads) {
     counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads);
-    std::vector<Corner>().swap(builds_[i].corners);
+    builds_[i].corners.release();
   };
   const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };
   double all = 0, done = 0;  // corners
