@@ -162,8 +162,7 @@ BakeReport bake(const BakeOptions& opt) {
   auto t0 = Clock::now();
   std::string sceneName = opt.output.filename().string();
   sceneName = sceneName.substr(0, sceneName.rfind('.'));
-  TexturePlan plan = planTextures(scene, sceneName, course);
-  scene = Scene{};
+  TexturePlan plan = planTextures(std::move(scene), sceneName, course);
   const bool baked = opt.textures != TextureStore::Files;
   if (baked) {  // into the file: no texture file is written
     if (opt.progress) opt.progress("baking textures", 0.0);

@@ -79,7 +79,8 @@ struct TexturePlan {
   std::vector<std::filesystem::path> sources;                      // per texture of `scene`: the file to copy; empty otherwise
   std::vector<std::shared_ptr<const std::vector<uint8_t>>> bytes;  // per texture: the image to write, or null
 };
-TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks);
+// `in` is taken by value: a bake moves its scene in, so that the geometry is not copied.
+TexturePlan planTextures(Scene in, const std::string& sceneName, bool courseFallbacks);
 
 // Decodes every texture of the plan (its sources or bytes; errors as a bake's, naming the file and where it
 // is named: `namedIn`), filters its full mip chain with the reference filter (core/mip_reference.hpp,

@@ -361,7 +361,8 @@ Scene ObjParser::finish() {
   std::vector<Mesh> meshes(builds_.size());
   std::vector<WeldCounts> counts(builds_.size());
   auto weld = [&](size_t i, unsigned threads) {
-    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads);
+    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads,
+                         [&] { builds_[i].corners.release(); });
     builds_[i].corners.release();
   };
   const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };

@@ -155,7 +155,7 @@ size_t prefix(std::vector<size_t>& v) {
 
 WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors,
-                    unsigned threads) {
+                    unsigned threads, const std::function<void()>& cornersDone) {
   WeldCounts counts;
   const size_t triCount = corners.size() / 3, cornerCount = triCount * 3;
 
@@ -285,6 +285,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       }
     }
   });
+  atPos = Groups();
   const size_t cornerPieces = piecesOf(cornerCount);
   std::vector<size_t> firsts(cornerPieces, 0);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
@@ -302,7 +303,6 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       if (keep[c / 3] && idOf[c] != c) vertexOf[c] = vertexOf[idOf[c]];
   });
   idOf.reset();
-  atPos = Groups();
 
   // 4. Vertices within the tolerance are merged, greedy as one thread would do it: in order, each joins
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
@@ -327,10 +327,11 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     }
   });
   uniq.reset();
+  if (cornersDone) cornersDone();  // from here on only `keep` and the ids are read
   genOf.reset();
   std::vector<glm::vec3>().swap(gen);
   auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
-  const Groups inBucket = groupBy(
+  Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
   auto kept = uninitialised<uint8_t>(uniqCount);
   auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
@@ -363,6 +364,8 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       if (found == kAbsent) kept[u] = 1, found = u;
       target[u] = found;
     }
+  inBucket = Groups();
+  slotOf.reset();
   std::vector<size_t> keptBefore(piecesOf(uniqCount), 0);
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) keptBefore[p] += kept[u];
@@ -393,6 +396,8 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     }
   });
   for (const Bounds& b : bounds) out.bounds.extend(b);
+  verts.reset();
+  vcolor.reset();
   // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
   auto corner = [&](size_t c) { return keptId[target[vertexOf[c]]]; };
   std::vector<size_t> written(pieces.size(), 0);

@@ -114,3 +114,20 @@ TEST(Weld, KeepsCornersWithinTheToleranceAndNoTwoVerticesNear) {
   EXPECT_GT(checked, m.indices.size() / 3 / 2);
   EXPECT_EQ(colours, checked * 3);
 }
+
+// The owner may free the corners once the weld calls cornersDone: nothing read after it changes the mesh.
+TEST(Weld, CornersAreReadNoMoreOnceDone) {
+  const Soup s = makeSoup(120, 3);
+  const Mesh a = weld(s, 3);
+  for (unsigned threads : {1u, 3u}) {
+    std::vector<Corner> corners = s.corners;
+    int calls = 0;
+    Mesh b;
+    weldMesh(corners, s.positions, s.normals, s.texcoords, b, 40.0f, s.colors, threads, [&] {
+      ++calls;
+      std::fill(corners.begin(), corners.end(), Corner{0, 0, 0});  // valid indices, wrong corners
+    });
+    EXPECT_EQ(calls, 1);
+    rtr::test::expectSameMesh(a, b);
+  }
+}
