@@ -62,6 +62,9 @@ struct BakeReport {
   std::vector<LevelError> bcError;                // --textures bc: per level
   double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, lodSeconds = 0, writeSeconds = 0,
          totalSeconds = 0;
+  // The process's CPU time (all threads) of each phase: against its wall time, how many cores it kept busy.
+  double parseCpuSeconds = 0, weldCpuSeconds = 0, textureCpuSeconds = 0, clusterCpuSeconds = 0, lodCpuSeconds = 0,
+         writeCpuSeconds = 0;
   double encodeSeconds = 0, fileWriteSeconds = 0;  // parts of writeSeconds: bytes made in memory, handed to the file
                                                    // (the rest: fsync, textures put in place)
 };

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <optional>
 #include <thread>
@@ -26,6 +27,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double cpuSince(std::clock_t c) { return double(std::clock() - c) / CLOCKS_PER_SEC; }
 
 // The text is read in batches of whole lines and parsed in pieces of about kPieceBytes on all cores.
 // Both are fixed, so the pieces do not depend on the thread count (and a wrong stitch shows with any).
@@ -70,7 +72,9 @@ class ObjParser {
         atEnd = got == 0;
       }
     };
+    auto t = Clock::now();
     fill(buf, have);
+    stats_.textWaitSeconds += since(t);
     while (have) {
       const std::string_view text(buf.data(), have);
       size_t end = have;  // the batch: whole lines (a continued line is one)
@@ -96,10 +100,15 @@ class ObjParser {
       next.resize(buf.size());
       size_t nextHave = have - end;
       std::memcpy(next.data(), buf.data() + end, nextHave);
+      double parsed = 0;
+      t = Clock::now();
       parallelFor(2, opt_.threads, [&](size_t i) {
-        if (i == 0) parseBatch(pieces);
-        else fill(next, nextHave);
+        if (i != 0) return fill(next, nextHave);
+        const auto p = Clock::now();
+        parseBatch(pieces);
+        parsed = since(p);
       });
+      stats_.textWaitSeconds += since(t) - parsed;
       std::swap(buf, next);
       have = nextHave;
       if (opt_.progress) opt_.progress(src.consumed(), src.fileSize());
@@ -419,11 +428,15 @@ Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& rea
   st.fileBytes = source.fileSize();
   ObjParser parser(name, readMtl, options, st, besideMtl);
   auto t0 = Clock::now();
+  std::clock_t c0 = std::clock();
   parser.run(source);
   st.parseSeconds = since(t0);
+  st.parseCpuSeconds = cpuSince(c0);
   t0 = Clock::now();
+  c0 = std::clock();
   Scene scene = parser.finish();
   st.weldSeconds = since(t0);
+  st.weldCpuSeconds = cpuSince(c0);
   return scene;
 }
 
