@@ -13,6 +13,7 @@
 
 #include "cluster.h"
 #include "render/cull.hpp"
+#include "render/staging_ring.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "core/parallel.hpp"
@@ -71,8 +72,8 @@ shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
 }  // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
-                   GeometryUpload upload, TextureLoad textureLoad, TextureCache* cache)
-    : ctx_(ctx), mipMode_(mipMode), progress_(progress), cache_(cache) {
+                   GeometryUpload upload, TextureLoad textureLoad, TextureCache* cache, size_t uploadBudget)
+    : ctx_(ctx), mipMode_(mipMode), progress_(progress), uploadBudget_(uploadBudget), cache_(cache) {
   bounds_ = scene.bounds();
   if (cache_) {  // a chain is the mip mode's on this device and driver (blits and shaders run by it)
     const VkPhysicalDeviceProperties& p = ctx.properties();

@@ -41,10 +41,11 @@ bool blockCompressed(VkFormat f) { return f >= VK_FORMAT_BC1_RGB_UNORM_BLOCK && 
 
 }  // namespace
 
-// Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
-// decoded straight into that texture's own staging buffer. Deferred: on a worker thread while the caller
-// goes on (frames render with the materials' factors until updateTextures()). Returns each scene
-// texture's index in the GPU's array (NO_TEXTURE: not sampled).
+// Textures: only those sampled (scene/textures.hpp), decoded on all cores (each thread keeping what it
+// decoded until its batch is written into the staging ring); baked chains and the cache's hits are kept as
+// they are, to be unpacked straight into the ring. Deferred: on a worker thread while the caller goes on
+// (frames render with the materials' factors until updateTextures()). Returns each scene texture's index
+// in the GPU's array (NO_TEXTURE: not sampled).
 std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad load) {
   const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
   std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
@@ -84,9 +85,9 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
         self->decodedChanged_.notify_all();
       }
     } finished{this};
-    // Baked texels (.rtrscene version 6) and the texture cache's hits: every chain unpacked piece by piece
-    // on all cores straight into its staging buffer, whole (no decode, no mip pass); the others decoded
-    // from their images (and, where the cache missed them, stored once their chains are made).
+    // Baked texels (.rtrscene version 6) and the texture cache's hits: staged as they are, whole chains
+    // (no decode, no mip pass; their pieces are unpacked into the staging ring with their batch); the
+    // others decoded from their images (and, where the cache missed them, stored once their chains are made).
     std::vector<std::shared_ptr<const BakedTexels>> chains(used.size());
     std::vector<TextureCacheKey> keys(used.size());
     std::vector<uint8_t> keyed(used.size(), 0);
@@ -97,30 +98,21 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
         keyed[i] = 1, chains[i] = cache_->find(keys[i], t);
     });
     std::vector<uint32_t> images;
-    std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (GPU texture, piece)
     for (uint32_t i = 0; i < used.size(); ++i) {
-      const BakedTexels* b = chains[i].get();
-      stats_.cacheHits += b && keyed[i];
-      stats_.cacheMisses += !b && keyed[i];
-      if (!b) {
+      stats_.cacheHits += chains[i] && keyed[i];
+      stats_.cacheMisses += !chains[i] && keyed[i];
+      if (!chains[i]) {
         images.push_back(i);
         continue;
       }
       Staged& s = staged_[i];
-      s.extent = {b->width, b->height};
-      s.levels = b->levelOffsets();
-      s.buffer = vk::Buffer(ctx_, s.levels.back(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
+      s.extent = {chains[i]->width, chains[i]->height};
+      s.levels = chains[i]->levelOffsets();
       s.bytes = s.levels.back();
       s.levels.pop_back();
-      for (uint32_t k = 0; k < b->pieces.size(); ++k) pieces.emplace_back(i, k);
+      s.chain = std::move(chains[i]);
+      done(i);
     }
-    std::vector<std::atomic<uint32_t>> left(used.size());
-    for (const auto& [i, k] : pieces) ++left[i];
-    parallelFor(pieces.size(), 0, [&](size_t p) {
-      const auto [i, k] = pieces[p];
-      unpackBakedPiece(*chains[i], k, static_cast<uint8_t*>(staged_[i].buffer.mapped()));
-      if (--left[i] == 0) staged_[i].buffer.flush(), done(i);
-    });
     std::vector<uint32_t> decodeOnly;
     for (uint32_t i : images) decodeOnly.push_back(used[i]);
     std::vector<uint8_t> fellBack;  // the checker stands in: nothing to store
@@ -134,12 +126,9 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
           // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
           HostMipChain chain;
           if (autoSmall(mipMode_, s.extent)) chain = hostMipChain(texels, formats_[i]);
-          const std::vector<uint8_t>& bytes = chain.offsets.empty() ? texels.texels : chain.bytes;
+          s.texels = chain.offsets.empty() ? std::move(texels.texels) : std::move(chain.bytes);
           s.levels = std::move(chain.offsets);
-          s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
-          std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
-          s.buffer.flush();
-          s.bytes = bytes.size();
+          s.bytes = s.texels.size();
           done(i);
         },
         {}, &fellBack);
@@ -170,6 +159,12 @@ bool GpuScene::updateTextures(bool wait) {
   }
 }
 
+size_t GpuScene::batchEnd(const std::vector<uint32_t>& queue, size_t first) const {
+  size_t n = first, bytes = 0;
+  while (n < queue.size() && (n == first || bytes + staged_[queue[n]].bytes <= uploadBudget_)) bytes += staged_[queue[n++]].bytes;
+  return n;
+}
+
 // The textures decoded first, up to the budget (at least one); none while none is decoded and not `wait`.
 std::vector<uint32_t> GpuScene::nextBatch(bool wait) {
   std::unique_lock lock(decodedMutex_);
@@ -180,9 +175,7 @@ std::vector<uint32_t> GpuScene::nextBatch(bool wait) {
     decoding_.get();  // rethrows the decode's error; else every texture was queued
     throw Error("texture streaming: textures missing after the decode");
   }
-  size_t n = 0, bytes = 0;
-  while (n < decodedQueue_.size() && (n == 0 || bytes + staged_[decodedQueue_[n]].bytes <= uploadBudget_))
-    bytes += staged_[decodedQueue_[n++]].bytes;
+  const size_t n = batchEnd(decodedQueue_, 0);
   std::vector<uint32_t> batch(decodedQueue_.begin(), decodedQueue_.begin() + n);
   decodedQueue_.erase(decodedQueue_.begin(), decodedQueue_.begin() + n);
   return batch;
@@ -195,8 +188,7 @@ void GpuScene::startUpload(const std::vector<uint32_t>& batch) {
   upload_ = std::make_unique<PendingUpload>(ctx_);
   upload_->batch = batch;
   upload_->start = Clock::now();
-  upload_->submission.emplace(ctx_, [&](VkCommandBuffer cb) {
-    recordUpload(cb, batch);
+  upload_->submission = &submitBatch(batch, [&](VkCommandBuffer cb) {
     upload_->timer.reset(cb);
     upload_->timer.begin(cb);
     upload_->views = mipGen_->record(cb, gpuMipBatch(batch), mipMode_);  // its barriers wait for the copies
@@ -313,6 +305,46 @@ void GpuScene::storeInCache(std::vector<std::pair<uint32_t, TextureCacheKey>> wh
   }));
 }
 
+const vk::Submission& GpuScene::submitBatch(const std::vector<uint32_t>& batch,
+                                            const std::function<void(VkCommandBuffer)>& after) {
+  const auto t = Clock::now();
+  std::vector<VkDeviceSize> at;
+  size_t bytes = 0;
+  for (uint32_t i : batch) at.push_back(bytes), bytes = (bytes + staged_[i].bytes + 15) & ~size_t(15);
+  if (!ring_) ring_ = std::make_unique<StagingRing>(ctx_, uploadBudget_, 2);
+  if (!fillPool_) fillPool_ = std::make_unique<ThreadPool>(threadCount() - 1);
+  const uint32_t slot = ring_->acquire(bytes);
+  uint8_t* base = ring_->data(slot);
+  // Pieces of kBakedPiece bytes: a chain's own (unpacked), or a decoded texture's texels cut the same way.
+  std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (batch entry, piece)
+  for (uint32_t e = 0; e < batch.size(); ++e) {
+    const Staged& s = staged_[batch[e]];
+    const size_t n = s.chain ? s.chain->pieces.size() : (s.bytes + kBakedPiece - 1) / kBakedPiece;
+    for (uint32_t k = 0; k < n; ++k) pieces.emplace_back(e, k);
+  }
+  parallelFor(*fillPool_, pieces.size(), [&](size_t p) {
+    const auto [e, k] = pieces[p];
+    const Staged& s = staged_[batch[e]];
+    if (s.chain) return unpackBakedPiece(*s.chain, k, base + at[e]);
+    const size_t from = size_t(k) * kBakedPiece;
+    std::memcpy(base + at[e] + from, s.texels.data() + from, std::min(kBakedPiece, s.bytes - from));
+  });
+  for (uint32_t e = 0; e < batch.size(); ++e) {
+    at[e] += ring_->offset(slot);
+    Staged& s = staged_[batch[e]];
+    s.chain.reset(), s.texels = {};  // in the ring now
+  }
+  fillMs_ += msSince(t);
+  ++stats_.uploadBatches;
+  const vk::Submission& submission = ring_->submit(slot, [&](VkCommandBuffer cb) {
+    recordUpload(cb, batch, at);
+    if (after) after(cb);
+  });
+  stats_.stagingAllocations = ring_->allocations();
+  stats_.stagingBytes = ring_->slotBytes() * 2;
+  return submission;
+}
+
 std::vector<const vk::Image*> GpuScene::gpuMipBatch(const std::vector<uint32_t>& which) const {
   std::vector<const vk::Image*> batch;
   for (uint32_t i : which)
@@ -322,7 +354,7 @@ std::vector<const vk::Image*> GpuScene::gpuMipBatch(const std::vector<uint32_t>&
 
 // Staging memory to level 0 of every texture (every level of those with their chain made on the CPU,
 // which are then ready for shaders: the mip generator's layout contract).
-void GpuScene::recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& which) const {
+void GpuScene::recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& which, const std::vector<VkDeviceSize>& at) const {
   std::vector<vk::ImageBarrier> toDst, ready;
   for (uint32_t i : which) {
     const uint32_t levels = hostMips_[i] ? textures_[i].mipLevels() : 1;
@@ -336,17 +368,18 @@ void GpuScene::recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& whi
                        VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, levels});
   }
   vk::barrier(cb, toDst);
-  for (uint32_t i : which) {
+  for (size_t e = 0; e < which.size(); ++e) {
+    const uint32_t i = which[e];
     const Staged& st = staged_[i];
     std::vector<VkBufferImageCopy> regions;
     for (uint32_t l = 0; l < (hostMips_[i] ? st.levels.size() : 1); ++l) {
       VkBufferImageCopy r{};
-      r.bufferOffset = hostMips_[i] ? st.levels[l] : 0;
+      r.bufferOffset = at[e] + (hostMips_[i] ? st.levels[l] : 0);
       r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, 1};
       r.imageExtent = {std::max(1u, st.extent.width >> l), std::max(1u, st.extent.height >> l), 1};
       regions.push_back(r);
     }
-    vkCmdCopyBufferToImage(cb, st.buffer.handle(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+    vkCmdCopyBufferToImage(cb, ring_->buffer(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                            uint32_t(regions.size()), regions.data());
   }
   if (!ready.empty()) vk::barrier(cb, ready);
@@ -355,13 +388,20 @@ void GpuScene::recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& whi
 void GpuScene::finishTextures() {
   const vk::Context& ctx = ctx_;
   vk::PipelineCache& pipelines = ctx.pipelineCache();
-  // Texture upload: one submission of copies into level 0.
+  // Texture upload: batch after batch through the staging ring (the writing of one overlaps the copies of
+  // the one before). Writing the texels (unpacking chains) is CPU work: it counts as decode.
   auto t = Clock::now();
   std::vector<uint32_t> all(textures_.size());
   for (uint32_t i = 0; i < all.size(); ++i) createTexture(all[i] = i);
-  if (!textures_.empty()) vk::submitAndWait(ctx, [&](VkCommandBuffer cb) { recordUpload(cb, all); });
+  const double fillBefore = fillMs_;
+  for (size_t first = 0, end; first < all.size(); first = end) {
+    end = batchEnd(all, first);
+    submitBatch({all.begin() + first, all.begin() + end}, {});
+  }
+  if (ring_) ring_->waitAll();
   staged_.clear();
-  stats_.textureUploadMs = msSince(t);
+  stats_.decodeMs += fillMs_ - fillBefore;
+  stats_.textureUploadMs = msSince(t) - (fillMs_ - fillBefore);
 
   // Mips, in a submission of their own (their pipelines' creation is counted as pipeline creation).
   t = Clock::now();
