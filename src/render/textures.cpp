@@ -149,6 +149,7 @@ bool GpuScene::updateTextures(bool wait) {
     }
     if (texturesIn_ == textures_.size()) {
       decoding_.get();  // its statistics are written
+      ring_.reset(), fillPool_.reset();
       ready_ = true;
       return true;
     }
@@ -398,7 +399,7 @@ void GpuScene::finishTextures() {
     end = batchEnd(all, first);
     submitBatch({all.begin() + first, all.begin() + end}, {});
   }
-  if (ring_) ring_->waitAll();
+  ring_.reset(), fillPool_.reset();  // waits for the copies
   staged_.clear();
   stats_.decodeMs += fillMs_ - fillBefore;
   stats_.textureUploadMs = msSince(t) - (fillMs_ - fillBefore);
