@@ -70,6 +70,7 @@ struct GpuSceneStats {
   double geometryMs = 0;            // vertex and index streams laid out, written and (where needed) copied
   double textureUploadMs = 0;       // staging memory to level 0 of each texture
   double mipsMs = 0, mipGpuMs = 0;  // mip chains: wall time, and the GPU's share of it
+  uint32_t imagesDecoded = 0;       // textures decoded from their images (neither baked nor a cache hit)
   uint32_t cacheHits = 0;           // textures whose chains came from the texture cache (no decode, no mips)
   uint32_t cacheMisses = 0;         // textures looked up and not found: their chains are read back and stored
   double cacheReadbackMs = 0;       // reading those chains back (their packing and writing runs on a worker thread)

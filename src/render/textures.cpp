@@ -113,6 +113,7 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
       s.chain = std::move(chains[i]);
       done(i);
     }
+    stats_.imagesDecoded = uint32_t(images.size());
     std::vector<uint32_t> decodeOnly;
     for (uint32_t i : images) decodeOnly.push_back(used[i]);
     std::vector<uint8_t> fellBack;  // the checker stands in: nothing to store
