@@ -157,8 +157,11 @@ std::shared_ptr<const BakedTexels> TextureCache::find(const TextureCacheKey& key
     return nullptr;
   }
   try {
-    auto bytes = std::make_shared<std::vector<uint8_t>>(readFileBytes(file));
-    ByteReader r(*bytes, file.string());
+    // Mapped, not read: the chain's pieces are unpacked from the page cache straight into staging memory.
+    // Safe beside other processes: entries are replaced by a rename, never rewritten in place.
+    const auto mapped = std::make_shared<const MappedFile>(file, "texture cache entry");
+    const std::span<const uint8_t> bytes = mapped->bytes();
+    ByteReader r(bytes, file.string());
     char magic[8];
     r.raw(magic, 8, "the entry's header");
     if (std::memcmp(magic, kMagic, 8) != 0) r.failAt(0, "not a texture cache entry");
@@ -166,9 +169,9 @@ std::shared_ptr<const BakedTexels> TextureCache::find(const TextureCacheKey& key
     const uint32_t paramsBytes = r.u32("the entry's header");
     const uint64_t content = r.pod<uint64_t>("the entry's header"), contentBytes = r.pod<uint64_t>("the entry's header");
     const uint64_t size = r.pod<uint64_t>("the entry's header"), sum = r.pod<uint64_t>("the entry's header");
-    if (size != bytes->size() - kHeader) r.failAt(32, "truncated or padded");
+    if (size != bytes.size() - kHeader) r.failAt(32, "truncated or padded");
 #ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION  // the fuzzer reaches the parser behind it
-    if (checksum64(std::span<const uint8_t>(*bytes).subspan(kHeader)) != sum) r.failAt(40, "checksum mismatch");
+    if (checksum64(bytes.subspan(kHeader)) != sum) r.failAt(40, "checksum mismatch");
 #else
     (void)sum;
 #endif
@@ -176,7 +179,7 @@ std::shared_ptr<const BakedTexels> TextureCache::find(const TextureCacheKey& key
       r.failAt(16, "made for another image");  // a file-name clash: it is replaced by this image's entry
     r.align(16, "the entry's key");
     Scene one = oneTexture(uint32_t(decodeChannels(t)));
-    readTexs(r, bytes->size(), *bytes, one, bytes, file.string());
+    readTexs(r, bytes.size(), bytes, one, mapped, file.string());
     std::shared_ptr<const BakedTexels> chain = one.textures[0].baked;
     if (bakedBlocks(chain->format)) r.failAt(kHeader, "block-compressed texels");
     fs::last_write_time(file, fs::file_time_type::clock::now(), ec);  // its last use, for the size bound
