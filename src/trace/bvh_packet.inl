@@ -97,7 +97,7 @@ struct PacketWalker {
   F shO[3], shS[3];
   int kx = 0, ky = 0, kz = 0;
   bool sameShear = true, sheared = false;
-  const int nRays, leafRays, aloneRays, inFlight;  // Bvh::kPacketLeafRays, kPacketAloneRays, kPacketAloneInFlight
+  const int nRays, leafRays, aloneRays;  // Bvh::kPacketLeafRays, kPacketAloneRays
 #if RTR_BVH_AVX2
   // The packet's interval: per axis, bounds over its rays of the slab constants, for one conservative
   // test of a node's eight children at once (lanes = children) before each child is tested against the
@@ -123,14 +123,13 @@ struct PacketWalker {
   }
 
   RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, const PacketRays& pr, Hit* h, IntersectMethod m,
-                          int minLeafRays, int maxAloneRays, int aloneInFlight)
+                          int minLeafRays, int maxAloneRays)
       : bvh(view),
         rays(r),
         hits(h),
         nRays(n),
         leafRays(minLeafRays),
         aloneRays(maxAloneRays),
-        inFlight(aloneInFlight),
         method(m) {
     store(tMax, pr.tMax);
     store(cull, pr.tMax);
@@ -549,35 +548,6 @@ struct PacketWalker {
     }
   }
 
-  // The three or four rays of `mask` alone from node or leaf `ref` on, one node or leaf of each in turn
-  // (alonePair's rule with more walks in flight: more memory requests outstanding at once). Any hit:
-  // returns the rays found occluded.
-  RTR_INLINE unsigned aloneGroup(unsigned mask, uint32_t ref) {
-    int id[4], k = 0;
-    const W* w[4];
-    uint64_t stacks[4][kStackSize];
-    Cursor at[4];
-    for (; mask && k < 4; mask &= mask - 1, ++k) {
-      id[k] = ctz(mask);
-      w[k] = &walker(id[k]);
-      at[k] = {0, ref, AnyHit ? tMax[id[k]] : cull[id[k]], false};
-    }
-    RTR_COUNT(c.lone += unsigned(k));
-    unsigned live = (1u << k) - 1, done = 0;
-    [[maybe_unused]] Hit scratch;
-    while (live)
-      for (unsigned m = live; m; m &= m - 1) {
-        const int j = ctz(m);
-        bool more;
-        if constexpr (AnyHit) more = w[j]->step(stacks[j], at[j], scratch);
-        else more = aloneStep(id[j], *w[j], stacks[j], at[j]);
-        if (more) continue;
-        live &= ~(1u << j);
-        if (at[j].found) done |= 1u << id[j];
-      }
-    return done;
-  }
-
   // Walks the packet; any hit: returns the occluded rays; closest hit: the rays to trace again alone.
   RTR_INLINE unsigned run(unsigned active) {
     PacketEntry stack[kStackSize];
@@ -587,16 +557,6 @@ struct PacketWalker {
     for (;;) {
       for (;;) {
         if (__builtin_popcount(active) <= aloneRays) {  // too few rays to share the work
-          if (inFlight >= 4 && __builtin_popcount(active) >= 3) {
-            while (active) {  // four at a time
-              unsigned four = active;
-              for (int k = 0; k < 4 && four; ++k) four &= four - 1;
-              four = active & ~four;
-              done |= aloneGroup(four, ref);
-              active &= ~four;
-            }
-            break;
-          }
           while (active) {
             const int i = ctz(active);
             active &= active - 1;
@@ -653,9 +613,9 @@ struct PacketWalker {
 
 template <bool AnyHit, unsigned Parallel>
 unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, const PacketRays& pr, IntersectMethod method, Hit* hits,
-                    int leafRays, int aloneRays, int inFlight) {
+                    int leafRays, int aloneRays) {
   RTR_COUNT(c.packets += 1);
-  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays, aloneRays, inFlight);
+  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays, aloneRays);
   return p.run((1u << n) - 1);
 }
 

@@ -537,7 +537,7 @@ unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
 // again alone (ties, see bvh_packet.inl). Any hit: returns the occluded rays.
 template <bool AnyHit>
 unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays,
-                        int aloneRays, int inFlight) {
+                        int aloneRays) {
   bool same = method == IntersectMethod::Watertight && n > 1;
   const PacketRays pr = gatherRays(rays, n);
   unsigned p = 0;  // the axes every ray runs parallel to; same: no ray is parallel to another
@@ -547,13 +547,13 @@ unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectM
     else if (zero) same = false;
   }
   switch (same ? p : 8u) {
-    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
+    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
     case 7: return 0;
     default: {
       unsigned m = 0;
@@ -576,12 +576,12 @@ unsigned occludedPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
   return dispatchPair<true>(bvh, rays, method, scratch);
 }
 unsigned closestPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays,
-                       int aloneRays, int inFlight) {
-  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays, aloneRays, inFlight);
+                       int aloneRays) {
+  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays, aloneRays);
 }
 unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch, int leafRays,
-                        int aloneRays, int inFlight) {
-  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays, aloneRays, inFlight);
+                        int aloneRays) {
+  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays, aloneRays);
 }
 
 }  // namespace rtr::trace::RTR_BVH_ISA
