@@ -116,7 +116,11 @@ struct PacketWalker {
   // (on the temple most packets miss after a node or two, and eight set-ups cost more than the walk)
   RTR_INLINE const W& walker(int i) {
     if (!(built >> i & 1)) {
+#if RTR_BVH_AVX2
+      new (walkers[i]) W(bvh, rays[i], method, i, oAxis, rNear, qNear, rFar, qFar, neg);
+#else
       new (walkers[i]) W(bvh, rays[i], method);
+#endif
       built |= 1u << i;
     }
     return *reinterpret_cast<const W*>(walkers[i]);
@@ -124,13 +128,7 @@ struct PacketWalker {
 
   RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, const PacketRays& pr, Hit* h, IntersectMethod m,
                           int minLeafRays, int maxAloneRays)
-      : bvh(view),
-        rays(r),
-        hits(h),
-        nRays(n),
-        leafRays(minLeafRays),
-        aloneRays(maxAloneRays),
-        method(m) {
+      : bvh(view), rays(r), hits(h), nRays(n), leafRays(minLeafRays), aloneRays(maxAloneRays), method(m) {
     store(tMax, pr.tMax);
     store(cull, pr.tMax);
     store(best, set1(kInf));
@@ -376,7 +374,7 @@ struct PacketWalker {
       const F T = U * (w.sz * Az) + V * (w.sz * Bz) + W3 * (w.sz * Cz);
       const F detSign = det & signBit;
       const F Ts = T ^ detSign;
-      m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));
+      m &= bits(gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));  // det ≠ 0 here: Walker::testLeaf
       if (m) {
         const F inv = set1(1.0f) / det;
         alignas(32) float tv[8], iv[8], vv[8], wv[8];
@@ -421,7 +419,7 @@ struct PacketWalker {
     o.T = U * (shS[2] * Az) + V * (shS[2] * Bz) + W3 * (shS[2] * Cz);
     const F detSign = o.det & signBit;
     const F Ts = o.T ^ detSign;
-    o.m &= bits(neq(o.det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (o.det ^ detSign)));
+    o.m &= bits(gt(Ts, zero) & lt(Ts, tLimit * (o.det ^ detSign)));  // det ≠ 0 here: Walker::testLeaf
     o.V = V;
     o.W3 = W3;
     return true;
