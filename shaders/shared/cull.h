@@ -36,6 +36,9 @@ namespace rtr::shader {
 #define CULL_BY_OCCLUSION 3u
 #define CULL_BY_LOD 4u  // not in the cut at this view and threshold (tested first)
 
+// The visible list: uvec2 (GpuInstance, GpuCluster record) per entry; LATE appends after EARLY's entries,
+// so an entry's position names one cluster of one instance for the whole frame (the rasteriser's tile and
+// hand-off lists keep positions).
 // The counts buffer: VkDispatchIndirectCommand {visible clusters, 1, 1}, then the culled counts by reason.
 // Over CullPush::maxGroupsX visible clusters the dispatch is two-dimensional, {maxGroupsX, rows, 1}: a
 // workgroup's list entry is then gl_WorkGroupID.y * maxGroupsX + gl_WorkGroupID.x (below `listed`).
@@ -44,13 +47,13 @@ namespace rtr::shader {
 struct CullCounts {
   uint dispatch[3];
   uint culled[4];         // frustum, cone (back-facing), occlusion, level of detail
-  uint listed;            // entries in the visible list
+  uint listed;            // entries this pass added to the visible list, from listBase on
   uint triangles;         // of the listed clusters
   uint tested;            // clusters the cluster step visited: those of the instances kept
   uint instancesCulled;   // instances culled whole by the frustum (one test each, none of their clusters)
   uint chunks;            // runs of up to CULL_GROUP_SIZE clusters: the cluster step's workgroups
   uint chunkDispatch[3];  // its indirect dispatch
-  uint pad;
+  uint listBase;          // where this pass's entries start: 0, or for LATE the entries EARLY listed
 };
 
 struct CullPush {  // 128 bytes
@@ -127,6 +130,13 @@ RTR_FN ProjectedBox projectBox(vec4 sphere, mat4 viewProj, uint width, uint heig
   const vec2 pHi = clamp((hi * 0.5f + 0.5f) * size, vec2(0.0f, 0.0f), size - 1.0f);
   b.pixels = ivec4(int(floor(pLo.x)), int(floor(pLo.y)), int(floor(pHi.x)), int(floor(pHi.y)));
   return b;
+}
+
+// A record's sphere (xyz centre, w radius) placed by an instance: the centre by the transform, the radius
+// by its largest stretch (GpuCullInstance::placement.x).
+RTR_FN vec4 placeSphere(mat4 transform, float stretch, vec4 s) {
+  const vec4 c = transform * vec4(s.x, s.y, s.z, 1.0f);
+  return vec4(c.x, c.y, c.z, s.w * stretch);
 }
 
 // The depth pyramid: level 0 is half the image and each level half the last, rounding down (Vulkan's mip

@@ -51,9 +51,6 @@ uint32_t clusterFlags(const Mesh& m, const Material& mat) {
   return CLUSTER_DOUBLE_SIDED | (mat.texture(TextureSlot::AlphaMask) != kNoTexture ? CLUSTER_ALPHA_MASKED : 0u);
 }
 
-namespace {
-
-// The linear part's largest stretch, and whether it is a similarity.
 std::pair<float, bool> largestStretch(const glm::mat4& transform) {
   // A column's length for a similarity, the Frobenius norm (>= the spectral norm) otherwise.
   const glm::mat3 l(transform);
@@ -64,6 +61,8 @@ std::pair<float, bool> largestStretch(const glm::mat4& transform) {
                           std::abs(glm::dot(l[1], l[2])) <= eps;
   return {similarity ? s : std::sqrt(glm::dot(len, len)), similarity};
 }
+
+namespace {
 
 // Records [first, end) of `out` placed by `transform`.
 void place(const glm::mat4& transform, size_t first, std::vector<shader::GpuCluster>& out) {
@@ -210,8 +209,11 @@ void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk:
   }
 }
 
-ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx_(ctx), maxClusters_(maxClusters) {
-  visible_ = vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint32_t maxChunks)
+    : ctx_(ctx),
+      maxClusters_(maxClusters),
+      maxChunks_(maxChunks ? maxChunks : (maxClusters + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE) {
+  visible_ = vk::Buffer(ctx, std::max<VkDeviceSize>(8, VkDeviceSize(maxClusters) * 8),
                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Device,
                         "visible clusters");
   counts_ = vk::Buffer(ctx, sizeof(shader::CullCounts),
@@ -219,10 +221,9 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
                            VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                        vk::MemoryUse::Device, "cull counts");
   history_ =
-      vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+      vk::Buffer(ctx, 4 * (VkDeviceSize(maxClusters) / 32 + 1),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, "cluster history");
-  // Every chunk holds at least one cluster.
-  chunks_ = vk::Buffer(ctx, std::max<VkDeviceSize>(8, VkDeviceSize(maxClusters) * 8), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+  chunks_ = vk::Buffer(ctx, std::max<VkDeviceSize>(16, VkDeviceSize(maxChunks_) * 16), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                        vk::MemoryUse::Device, "cluster chunks");
   whole_ = vk::Buffer(ctx, sizeof(shader::GpuCullInstance), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                       vk::MemoryUse::Device, "all clusters as one instance");
@@ -246,17 +247,25 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
 
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
                            const DepthPyramid* pyramid, CullTests tests, CullPhase phase, VkBuffer lods, VkBuffer instances,
-                           uint32_t instanceCount, VkBuffer levels) {
-  if (count > maxClusters_)
+                           uint32_t instanceCount, VkBuffer levels, VkBuffer placements) {
+  if (count > maxClusters_ || (!instances && (count + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE > maxChunks_))
     throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
   vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);
+  // Late appends to Early's list: its entries start where Early's end (the early ones stay valid).
+  size_t reset = sizeof(shader::CullCounts);
+  if (phase == CullPhase::Late) {
+    const VkBufferCopy base{offsetof(shader::CullCounts, listed), offsetof(shader::CullCounts, listBase), 4};
+    vkCmdCopyBuffer(cb, counts_.handle(), counts_.handle(), 1, &base);
+    vk::bufferBarrier(cb, vk::kTransferWrite | vk::kCopyRead, vk::kTransferWrite);
+    reset = offsetof(shader::CullCounts, listBase);
+  }
   const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, 0, 0, 0, {0, 1, 1}, 0};  // indirect dispatches' y, z: 1
-  vkCmdUpdateBuffer(cb, counts_.handle(), 0, sizeof(zero), &zero);
+  vkCmdUpdateBuffer(cb, counts_.handle(), 0, reset, &zero);
   if (!instances) {  // one level that is always in the window (error 0, parents' infinite)
     const shader::GpuCullInstance all{glm::vec4(0.0f, 0.0f, 0.0f, 1e30f), glm::vec4(0.0f, 0.0f, 0.0f, 1e30f),
-                                      glm::uvec4(0, 1, 0, 0)};
+                                      glm::uvec4(0, 1, CULL_RECORD_INSTANCE, 0), glm::vec4(1.0f, 1.0f, 1.0f, 0.0f)};
     const shader::GpuCullLevel level{0, count, 0.0f, shader::LOD_ERROR_INFINITE};
     vkCmdUpdateBuffer(cb, whole_.handle(), 0, sizeof(all), &all);
     vkCmdUpdateBuffer(cb, wholeLevel_.handle(), 0, sizeof(level), &level);
@@ -299,7 +308,9 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
       .image(3, pyramid ? pyramid->view() : noPyramid_.view(), VK_IMAGE_LAYOUT_GENERAL)
       .buffer(4, history_.handle())
       .buffer(5, lods ? lods : clusters)  // not read without CULL_LOD
+      .buffer(6, instances)
       .buffer(7, chunks_.handle())
+      .buffer(9, placements ? placements : clusters)  // not read for CULL_RECORD_INSTANCE
       .push(cb, pipeline_);
   pipeline_.push(cb, push);
   vkCmdDispatchIndirect(cb, counts_.handle(), offsetof(shader::CullCounts, chunkDispatch));

@@ -8,6 +8,7 @@
 // Use, per frame (two-phase, CullPhase below): culler.record(Early); dispatch indirect on counts() over
 // visible(); pyramid.build(depth of that); culler.record(Late, &pyramid); dispatch again. docs/culling.md.
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -31,6 +32,9 @@ namespace rtr::render {
 std::vector<Instance> gpuInstances(const Scene& scene);
 // Whether a transform flips the winding (negative determinant).
 bool mirrored(const glm::mat4& transform);
+// The linear part's largest stretch (a column's length for a similarity, else the Frobenius norm, an
+// upper bound), and whether it is a similarity (rotation, uniform scale, mirror).
+std::pair<float, bool> largestStretch(const glm::mat4& transform);
 
 // The CLUSTER_* flags of a mesh's clusters: the GPU's alpha-tested, two-sided draws are double-sided,
 // and alpha-masked where they have a mask texture (render/gpu_scene.cpp's draw kinds).
@@ -103,25 +107,32 @@ enum class CullPhase : uint32_t { Single = CULL_SINGLE, Early = CULL_EARLY, Late
 
 class ClusterCuller {
  public:
-  ClusterCuller(const vk::Context& ctx, uint32_t maxClusters);
+  // maxClusters: the (instance, cluster) pairs it may visit (list entries, history bits); maxChunks: the
+  // runs of up to CULL_GROUP_SIZE clusters the instance step may emit (0: those of one instance of
+  // maxClusters, the record() without instances).
+  ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint32_t maxChunks = 0);
   // Records the pass over `count` GpuClusters in `clusters` (a storage buffer; the same clusters every
   // frame for Early/Late). With a pyramid (not used by Early), clusters hidden behind its depths are culled
   // too: a cluster whose every point lies behind that depth image there cannot be seen above it. Ends with
   // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
   // `lods`: the clusters' GpuClusterLod records (cluster.h), for the level-of-detail cut, tested first.
   // `instances`: GpuCullInstances (cluster.h), tested first (frustum, and the level window with `levels`,
-  // their GpuCullLevels): a culled instance's clusters, and those of levels outside its window, are not
-  // visited. None: one instance of the first `count` clusters that is never culled.
+  // their meshes' GpuCullLevels): a culled instance's clusters, and those of levels outside its window, are
+  // not visited; the records are placed by `placements` (GpuInstance, frame.h) as the instance says. None:
+  // one instance of the first `count` clusters, records placed already (gpuClusters), never culled.
   void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera, const DepthPyramid* pyramid,
               CullTests tests = {}, CullPhase phase = CullPhase::Single, VkBuffer lods = VK_NULL_HANDLE,
-              VkBuffer instances = VK_NULL_HANDLE, uint32_t instanceCount = 0, VkBuffer levels = VK_NULL_HANDLE);
-  VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
-  VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
+              VkBuffer instances = VK_NULL_HANDLE, uint32_t instanceCount = 0, VkBuffer levels = VK_NULL_HANDLE,
+              VkBuffer placements = VK_NULL_HANDLE);
+  // uvec2 (GpuInstance, GpuCluster record) per visible cluster, any order; Late's after Early's
+  // (CullCounts::listBase).
+  VkBuffer visible() const { return visible_.handle(); }
+  VkBuffer counts() const { return counts_.handle(); }  // shader::CullCounts; offset 0 the dispatch args
   uint32_t maxClusters() const { return maxClusters_; }
 
  private:
   const vk::Context& ctx_;
-  uint32_t maxClusters_;
+  uint32_t maxClusters_, maxChunks_;
   vk::Buffer visible_, counts_, history_, chunks_;
   vk::Buffer whole_, wholeLevel_;  // the one GpuCullInstance and level of a record() without instances
   vk::Image noPyramid_;            // 1×1 stand-in so the pass always has a valid binding
