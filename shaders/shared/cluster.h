@@ -47,26 +47,34 @@ struct GpuClusterLod {
 struct GpuCullInstance {
   vec4 sphere;     // scene space: holds the culling sphere of every one of its clusters
   vec4 lodSphere;  // scene space: holds every level-of-detail sphere of its clusters (own and parent's)
-  uvec4 levels;    // x: its mesh's first GpuCullLevel, y: how many (level 0 first), z: its GpuInstance
-                   // (CULL_RECORD_INSTANCE: records placed already, each names its own), w: its history
-                   // slots' offset (a record's slot is record + w, modulo 2^32)
+  uvec4 levels;    // x: its mesh's first GpuCullNode, the root of level 0's tree (the other levels' roots
+                   // follow), y: how many levels, z: its GpuInstance (CULL_RECORD_INSTANCE: records placed
+                   // already, each names its own), w: its history slots' offset (a record's slot is
+                   // record + w, modulo 2^32)
   vec4 placement;  // x: the transform's largest stretch (radii, errors), y: 1 where it is a similarity
                    // (the cone turns with it; else dropped), z: 1 for the identity (records used as stored)
 };
 #define CULL_RECORD_INSTANCE 0xFFFFFFFFu
 
-// One level of a mesh's clusters (storage buffer, std430, 16 bytes), errors in the mesh's space: the
-// level window (docs/virtual-geometry.md) skips a level none of whose clusters can be in the cut.
-struct GpuCullLevel {
-  uint firstCluster;     // its records, contiguous; the levels above 0 follow one another
-  uint clusterCount;
-  float minError;        // the least error of its clusters
+// A node of the tree over one level of a mesh's clusters (storage buffer, std430, 48 bytes), in the mesh's
+// space: a leaf is a run of up to CULL_GROUP_SIZE consecutive records, an inner node up to
+// CULL_NODE_CHILDREN consecutive nodes. The culling pass descends a node only where one of the clusters
+// below can be listed (docs/culling.md, "The hierarchy").
+struct GpuCullNode {
+  vec4 sphere;           // holds the culling spheres of the clusters below
+  vec4 lodSphere;        // holds their level-of-detail spheres (own, and parents' where they have one)
+  float minError;        // the least error of the clusters below
   float maxParentError;  // the largest error of their parents (LOD_ERROR_INFINITE where one is a root)
+  uint first;            // a leaf: its first record; else its first child node
+  uint count;            // records or children, | CULL_NODE_LEAF for a leaf
 };
+#define CULL_NODE_LEAF 0x80000000u
+#define CULL_NODE_CHILDREN 8u
+#define CULL_MAX_DEPTH 8u  // node levels of one tree: 64 * 8^7 clusters a level at most
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuCluster) == 48 && sizeof(GpuClusterLod) == 48 && sizeof(GpuCullInstance) == 64 &&
-              sizeof(GpuCullLevel) == 16);
+              sizeof(GpuCullNode) == 48);
 }  // namespace rtr::shader
 #endif
 #endif

@@ -68,9 +68,10 @@ struct GeometryPlan {
   std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
   std::vector<uint32_t> idPages;            // visIdPages(): the instance holding each page's first id
   std::vector<shader::GpuCullInstance> cullInstances;
-  std::vector<shader::GpuCullLevel> cullLevels;
-  std::vector<glm::uvec2> baseEntries;  // (instance, record) of every instance's level 0
-  uint64_t pairs = 0, chunks = 0;       // (instance, cluster) pairs; the culling pass's chunks at most
+  std::vector<shader::GpuCullNode> cullNodes;  // each mesh's level trees, their roots first
+  std::vector<uint64_t> queues;                // per tree depth: (instance, node) pairs at it
+  std::vector<glm::uvec2> baseEntries;         // (instance, record) of every instance's level 0
+  uint64_t pairs = 0, chunks = 0;              // (instance, cluster) pairs; the culling pass's chunks at most
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
 };
@@ -297,8 +298,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   // Each mesh's cluster records once, in its own space (docs/culling.md): level 0 (the mesh's clusters),
   // then the levels above; its spheres and its levels.
   struct MeshRecords {
-    uint32_t first = 0, count = 0, level0 = 0, firstLevel = 0, levels = 0;
+    uint32_t first = 0, count = 0, level0 = 0, firstLevel = 0, levels = 0, leaves = 0;
     glm::vec4 sphere{0.0f}, lodSphere{0.0f};
+    std::vector<uint32_t> depths;  // its trees' nodes at each depth
   };
   std::vector<MeshRecords> meshRecords(scene.meshes.size());
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
@@ -323,25 +325,19 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
         if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) add(p.lods[c].parentSphere);
       }
     });
-    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level).
-    r.firstLevel = uint32_t(p.cullLevels.size());
-    auto level = [&](uint32_t first, uint32_t count) {
-      shader::GpuCullLevel v{first, count, shader::LOD_ERROR_INFINITE, 0.0f};
-      for (size_t c = first; c < first + count; ++c) {
-        v.minError = std::min(v.minError, p.lods.empty() ? 0.0f : p.lods[c].error.x);
-        v.maxParentError = std::max(v.maxParentError, p.lods.empty() ? shader::LOD_ERROR_INFINITE : p.lods[c].error.y);
-      }
-      p.cullLevels.push_back(v);
-      ++r.levels;
-    };
-    level(r.first, r.level0);
-    uint32_t c = r.first + r.level0, run = 0, at = 0;
-    for (size_t k = 0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
+    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
+    // tree over each, their roots side by side.
+    std::vector<glm::uvec2> runs{{r.first, r.level0}};
+    uint32_t at = 0;
+    for (size_t k = 0, c = r.first + r.level0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
       if (m.lod.clusters[k].level == 0) continue;
-      if (run > 0 && m.lod.clusters[k].level != at) level(c - run, run), run = 0;
-      at = m.lod.clusters[k].level, ++run, ++c;
+      if (runs.size() == 1 || m.lod.clusters[k].level != at) runs.push_back({uint32_t(c), 0});
+      at = m.lod.clusters[k].level, ++runs.back().y, ++c;
     }
-    if (run > 0) level(c - run, run);
+    r.firstLevel = uint32_t(p.cullNodes.size()), r.levels = uint32_t(runs.size());
+    p.cullNodes.resize(p.cullNodes.size() + runs.size());
+    for (size_t l = 0; l < runs.size(); ++l)
+      r.leaves += appendClusterTree(p.clusters, p.lods, runs[l].x, runs[l].y, r.firstLevel + uint32_t(l), p.cullNodes, r.depths);
   }
   Bounds box;  // of the draw being extended
   uint64_t slots = 0, chunks = 0;
@@ -372,7 +368,9 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
                                glm::vec4(identity ? 1.0f : stretch, similarity ? 1.0f : 0.0f, identity ? 1.0f : 0.0f, 0.0f)});
     for (uint32_t k = 0; k < r.level0; ++k) p.baseEntries.push_back(glm::uvec2(i, r.first + k));
     slots += r.count;
-    chunks += (r.level0 + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE + (r.count - r.level0 + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE;
+    chunks += r.leaves;
+    if (p.queues.size() < r.depths.size()) p.queues.resize(r.depths.size(), 0);
+    for (size_t d = 0; d < r.depths.size(); ++d) p.queues[d] += r.depths[d];
     std::vector<DrawItem>& list = draws_[size_t(md.kind)];
     if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
       list.push_back(md.item);
@@ -474,7 +472,7 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     kLod,
     kIds,
     kCullInst,
-    kCullLevel,
+    kCullNode,
     kBaseEntries,
     kTargets
   };
@@ -494,20 +492,22 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&clusterLods_, bytes(plan.lods), plan.lods.data()},
                                         {&visIdPages_, bytes(plan.idPages), plan.idPages.data()},
                                         {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()},
-                                        {&cullLevels_, bytes(plan.cullLevels), plan.cullLevels.data()},
+                                        {&cullNodes_, bytes(plan.cullNodes), plan.cullNodes.data()},
                                         {&baseEntries_, bytes(plan.baseEntries), plan.baseEntries.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
   const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
                                                        kStorage, kStorage, kStorage, kStorage, kStorage, kStorage,
                                                        kStorage, kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",   "indices32",      "materials",
-                                 "draws",        "instances", "clusters",       "texcoords1",  "tangents",       "colours",
-                                 "cluster lods", "id pages",  "cull instances", "cull levels", "cluster entries"};
+  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32",      "materials",
+                                 "draws",        "instances", "clusters",       "texcoords1", "tangents",       "colours",
+                                 "cluster lods", "id pages",  "cull instances", "cull nodes", "cluster entries"};
   // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
   clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
   baseClusterCount_ = uint32_t(plan.baseEntries.size());
   chunkCapacity_ = uint32_t(std::min<uint64_t>(plan.chunks, UINT32_MAX));
+  cullQueueCapacity_.clear();
+  for (uint64_t n : plan.queues) cullQueueCapacity_.push_back(uint32_t(std::min<uint64_t>(n, UINT32_MAX)));
   cullInstanceCount_ = uint32_t(plan.cullInstances.size());
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {

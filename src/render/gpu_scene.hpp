@@ -164,7 +164,10 @@ class GpuScene {
   // GpuCullInstance (cluster.h) per instance with clusters: its spheres, its mesh's levels, its placement.
   VkBuffer cullInstances() const { return cullInstances_.handle(); }
   uint32_t cullInstanceCount() const { return cullInstanceCount_; }
-  VkBuffer cullLevels() const { return cullLevels_.handle(); }  // GpuCullLevel: each mesh's, level 0 first
+  // GpuCullNode (cluster.h): each mesh's trees over its levels, the roots first (level 0's, then above).
+  VkBuffer cullNodes() const { return cullNodes_.handle(); }
+  // Per tree depth, the (instance, node) pairs at it: the culling pass's queues (ClusterCuller).
+  const std::vector<uint32_t>& cullQueueCapacity() const { return cullQueueCapacity_; }
   // GpuClusterLod per GpuCluster where some mesh has a hierarchy (docs/virtual-geometry.md); else null.
   VkBuffer clusterLods() const { return clusterLods_.handle(); }
   // Visibility ids (frame.h): instance i names the ids [firstId(i), firstId(i) + its draw's primitives),
@@ -233,8 +236,9 @@ class GpuScene {
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
-  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_, cullInstances_, cullLevels_, baseEntries_;
+  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_, cullInstances_, cullNodes_, baseEntries_;
   uint32_t clusterCount_ = 0, baseClusterCount_ = 0, cullInstanceCount_ = 0, chunkCapacity_ = 0;
+  std::vector<uint32_t> cullQueueCapacity_;
   std::vector<uint64_t> firstIds_;  // per instance
   uint64_t visIdCount_ = 0;
   uint32_t idPageShift_ = 0;
