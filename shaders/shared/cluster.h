@@ -70,6 +70,7 @@ struct GpuCullNode {
 };
 #define CULL_NODE_LEAF 0x80000000u
 #define CULL_NODE_CHILDREN 8u
+#define CULL_LEAF_SIZE 16u  // records of a leaf
 #define CULL_MAX_DEPTH 8u  // node levels of one tree: 64 * 8^7 clusters a level at most
 
 #ifdef __cplusplus

@@ -159,8 +159,8 @@ uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, cons
   // nodes (first: an index in the layer below until stored), up to one.
   std::vector<std::vector<shader::GpuCullNode>> layers(1);
   std::vector<glm::vec4> spheres, lodSpheres;
-  for (uint32_t at = first; at < first + count || (count == 0 && layers[0].empty()); at += CULL_GROUP_SIZE) {
-    const uint32_t n = std::min<uint32_t>(CULL_GROUP_SIZE, first + count - at);
+  for (uint32_t at = first; at < first + count || (count == 0 && layers[0].empty()); at += CULL_LEAF_SIZE) {
+    const uint32_t n = std::min<uint32_t>(CULL_LEAF_SIZE, first + count - at);
     shader::GpuCullNode leaf{{}, {}, lods.empty() ? 0.0f : shader::LOD_ERROR_INFINITE, 0.0f, at, n | CULL_NODE_LEAF};
     spheres.clear(), lodSpheres.clear();
     for (uint32_t c = at; c < at + n; ++c) {
