@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <new>
 #include <set>
@@ -28,6 +29,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double cpuSince(std::clock_t c) { return double(std::clock() - c) / CLOCKS_PER_SEC; }
 
 bool endsWith(const std::string& s, std::string_view e) {
   return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
@@ -131,8 +133,10 @@ BakeReport bake(const BakeOptions& opt) {
     lo.note = opt.note;
     lo.creaseDeg = opt.creaseDeg;
     const auto t = Clock::now();
+    const std::clock_t c = std::clock();
     scene = stage("reading " + opt.input.string(), [&] { return loadScene(opt.input, lo); });
     rep.parseSeconds = since(t);
+    rep.parseCpuSeconds = cpuSince(c);
     rep.gltf = true;
   } else {
     ObjOptions oo;
@@ -147,6 +151,8 @@ BakeReport bake(const BakeOptions& opt) {
     scene = stage("reading " + opt.input.string(), [&] { return loadObj(opt.input, oo, &rep.obj); });
     rep.parseSeconds = rep.obj.parseSeconds;
     rep.weldSeconds = rep.obj.weldSeconds;
+    rep.parseCpuSeconds = rep.obj.parseCpuSeconds;
+    rep.weldCpuSeconds = rep.obj.weldCpuSeconds;
   }
   turnScene(scene, opt.up);
   for (const Mesh& m : scene.meshes) rep.triangles += m.triangleCount();
@@ -160,10 +166,10 @@ BakeReport bake(const BakeOptions& opt) {
   // as they were.
   const std::string input = opt.input.string();
   auto t0 = Clock::now();
+  std::clock_t c0 = std::clock();
   std::string sceneName = opt.output.filename().string();
   sceneName = sceneName.substr(0, sceneName.rfind('.'));
-  TexturePlan plan = planTextures(scene, sceneName, course);
-  scene = Scene{};
+  TexturePlan plan = planTextures(std::move(scene), sceneName, course);
   const bool baked = opt.textures != TextureStore::Files;
   if (baked) {  // into the file: no texture file is written
     if (opt.progress) opt.progress("baking textures", 0.0);
@@ -221,23 +227,28 @@ BakeReport bake(const BakeOptions& opt) {
     if (opt.progress) opt.progress("copying textures", double(i + 1) / double(plan.scene.textures.size()));
   }
   rep.textureSeconds = since(t0);
+  rep.textureCpuSeconds = cpuSince(c0);
 
   // 3. Clusters (.rtrscene stores them; the course format has no place for them, its loader builds them).
   if (!course) {
     t0 = Clock::now();
+    c0 = std::clock();
     if (opt.progress) opt.progress("clustering", 0.0);
     try {
       stage("clustering " + input, [&] { buildMissingClusters(plan.scene); });
     } catch (const Error& e) { throw fileError(input, "", e.what()); }
     rep.clusterSeconds = since(t0);
+    rep.clusterCpuSeconds = cpuSince(c0);
     // The level-of-detail hierarchy over those clusters (docs/virtual-geometry.md), on all cores.
     if (opt.lod) {
       t0 = Clock::now();
+      c0 = std::clock();
       if (opt.progress) opt.progress("cluster hierarchy", 0.0);
       try {
         stage("cluster hierarchy of " + input, [&] { buildMissingClusterLods(plan.scene, threads); });
       } catch (const Error& e) { throw fileError(input, "", e.what()); }
       rep.lodSeconds = since(t0);
+      rep.lodCpuSeconds = cpuSince(c0);
     }
   }
 
@@ -245,6 +256,7 @@ BakeReport bake(const BakeOptions& opt) {
   // --force each goes in by link, so that an output another run made meanwhile is kept (and this run's
   // textures already placed are removed again).
   t0 = Clock::now();
+  c0 = std::clock();
   if (opt.progress) opt.progress("writing", 0.0);
   const std::string bytes = stage("encoding " + opt.output.string(),
                                   [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
@@ -261,6 +273,7 @@ BakeReport bake(const BakeOptions& opt) {
   sceneFile.commit(replace);
   created.keep = true;
   rep.writeSeconds = since(t0);
+  rep.writeCpuSeconds = cpuSince(c0);
   rep.outputBytes = bytes.size();
   rep.meshes = plan.scene.meshes.size();
   rep.materials = plan.scene.materials.size();

@@ -62,6 +62,9 @@ struct BakeReport {
   std::vector<LevelError> bcError;                // --textures bc: per level
   double parseSeconds = 0, weldSeconds = 0, textureSeconds = 0, clusterSeconds = 0, lodSeconds = 0, writeSeconds = 0,
          totalSeconds = 0;
+  // The process's CPU time (all threads) of each phase: against its wall time, how many cores it kept busy.
+  double parseCpuSeconds = 0, weldCpuSeconds = 0, textureCpuSeconds = 0, clusterCpuSeconds = 0, lodCpuSeconds = 0,
+         writeCpuSeconds = 0;
   double encodeSeconds = 0, fileWriteSeconds = 0;  // parts of writeSeconds: bytes made in memory, handed to the file
                                                    // (the rest: fsync, textures put in place)
 };
@@ -79,7 +82,8 @@ struct TexturePlan {
   std::vector<std::filesystem::path> sources;                      // per texture of `scene`: the file to copy; empty otherwise
   std::vector<std::shared_ptr<const std::vector<uint8_t>>> bytes;  // per texture: the image to write, or null
 };
-TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks);
+// `in` is taken by value: a bake moves its scene in, so that the geometry is not copied.
+TexturePlan planTextures(Scene in, const std::string& sceneName, bool courseFallbacks);
 
 // Decodes every texture of the plan (its sources or bytes; errors as a bake's, naming the file and where it
 // is named: `namedIn`), filters its full mip chain with the reference filter (core/mip_reference.hpp,

@@ -38,11 +38,11 @@ std::string key(const std::string& rel, const Texture& t) {
 
 }  // namespace
 
-TexturePlan planTextures(const Scene& in, const std::string& sceneName, bool courseFallbacks) {
+TexturePlan planTextures(Scene in, const std::string& sceneName, bool courseFallbacks) {
   TexturePlan plan;
   plan.scene.baseDir = in.baseDir;
-  plan.scene.meshes = in.meshes;
-  plan.scene.instances = in.instances;
+  plan.scene.meshes = std::move(in.meshes);
+  plan.scene.instances = std::move(in.instances);
   plan.scene.defaultView = in.defaultView;
   plan.scene.defaultFovYDeg = in.defaultFovYDeg;
   plan.scene.lights = in.lights;

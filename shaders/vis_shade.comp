@@ -6,12 +6,15 @@
 // (docs/shading.md, "Visibility path").
 // MATERIAL_EXTRAS (variants.h): only a scene with glTF's material extras gets the code for them; the
 // others (OBJ, the course's format) sample set 0's texcoords untransformed, as the identity would.
+// DISPLAY (variants.h): where nothing else reads the linear image (mosaic off, no transparent pass), the
+// pass writes the target's bytes itself, as the post pass's copy would (Renderer::frame).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_nonuniform_qualifier : require
 #extension GL_EXT_samplerless_texture_functions : require
 #include "frame.h"
 #include "brdf.h"
 #include "variants.h"
+#include "render/color8.glsl"
 
 layout(local_size_x = VIS_GROUP_X, local_size_y = VIS_GROUP_Y) in;
 
@@ -27,6 +30,7 @@ layout(set = 0, binding = 6, std430) readonly buffer Indices16 { uint indices16[
 layout(set = 0, binding = 7) uniform utexture2D visibilityImage;
 layout(set = 0, binding = 14, std430) readonly buffer Visibility { uvec2 visibilityBuffer[]; };  // x: the low half
 layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D sceneColor;
+layout(set = 0, binding = 16) writeonly uniform image2D displayImage;  // DISPLAY: the target (UNORM; BGRA too)
 // HAS_TEXCOORDS only:
 layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
 layout(set = 1, binding = 0) uniform sampler2D textures[];
@@ -40,6 +44,26 @@ layout(push_constant) uniform Push { VisShadePush pc; };
 #include "env_light.glsl"
 
 const float kMaxRadiance = 60000.0;  // as pbr.frag: stay below the half-float maximum
+
+ivec2 outputSize() { return DISPLAY ? imageSize(displayImage) : imageSize(sceneColor); }
+
+// x rounded to the nearest half float (ties to even), as a float. In integers: a compiler may fold
+// packHalf2x16 into the image store's conversion, whose rounding the device picks (lavapipe truncates).
+float toHalf(float x) {
+  if (abs(x) < 6.103515625e-05) return roundEven(x * 16777216.0) / 16777216.0;  // half subnormals: steps of 2^-24
+  const uint b = floatBitsToUint(x);
+  return uintBitsToFloat((b + 0xFFFu + ((b >> 13) & 1u)) & ~0x1FFFu);  // 10 of the 23 mantissa bits kept
+}
+
+// The pixel's radiance as the half floats the linear image holds, rounded here, so the store converts
+// exactly; DISPLAY: those values sRGB-encoded to 8 bits as the post pass's copy (mosaic.comp, block 1x1)
+// encodes them, so the bytes are the same.
+void store(ivec2 p, vec3 c) {
+  c = min(c, vec3(kMaxRadiance));
+  const vec3 h = vec3(toHalf(c.r), toHalf(c.g), toHalf(c.b));
+  if (DISPLAY) imageStore(displayImage, p, encode8(vec4(h, 1.0), true));
+  else imageStore(sceneColor, p, vec4(h, 1.0));
+}
 
 vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
 vec3 normal(uint i) { return vec3(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]); }
@@ -84,13 +108,13 @@ uint instanceOf(uint id) {
 
 void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-  if (any(greaterThanEqual(p, imageSize(sceneColor)))) return;
+  if (any(greaterThanEqual(p, outputSize()))) return;
   uint packed;
-  if (VIS_BUFFER) packed = visibilityBuffer[p.y * imageSize(sceneColor).x + p.x].x;
+  if (VIS_BUFFER) packed = visibilityBuffer[p.y * outputSize().x + p.x].x;
   else packed = texelFetch(visibilityImage, p, 0).x;
   const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
   if (packed == VIS_EMPTY) {  // the backdrop: the forward pass's clear colour, or the environment
-    imageStore(sceneColor, p, vec4(HAS_ENV ? min(envBackdrop(dir), vec3(kMaxRadiance)) : frame.background.rgb, 1.0));
+    store(p, HAS_ENV ? envBackdrop(dir) : frame.background.rgb);
     return;
   }
   const GpuInstance inst = instances[instanceOf(packed)];
@@ -153,7 +177,7 @@ void main() {
     }
   }
   if (MATERIAL_EXTRAS && (m.textures2.w & MATERIAL_UNLIT) != 0u) {
-    imageStore(sceneColor, p, vec4(min(baseColor, vec3(kMaxRadiance)), 1.0));
+    store(p, baseColor);
     return;
   }
 
@@ -167,5 +191,5 @@ void main() {
     c += pbrDirect(brdf, nrm, v, ls.l, ls.radiance, baseColor, roughness, metalness);
   }
   if (HAS_ENV) c += envLight(brdf, nrm, v, baseColor, roughness, metalness, occlusion);
-  imageStore(sceneColor, p, vec4(min(c, vec3(kMaxRadiance)), 1.0));
+  store(p, c);
 }

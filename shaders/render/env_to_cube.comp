@@ -13,22 +13,6 @@ layout(set = 0, binding = 0) uniform texture2D equirect;
 layout(set = 0, binding = 1, rgba32f) writeonly uniform image2DArray cube;
 layout(push_constant) uniform Push { EnvPush pc; };
 
-// Bilinear by hand (a 32-bit float image need not be filterable): wraps around in u, clamps in v.
-vec3 fetch(vec2 uv) {
-  const ivec2 size = ivec2(pc.srcWidth, pc.srcHeight);
-  const vec2 p = uv * vec2(size) - 0.5;
-  const ivec2 i = ivec2(floor(p));
-  const vec2 f = p - vec2(i);
-  vec3 c[4];
-  for (int k = 0; k < 4; ++k) {
-    ivec2 q = i + ivec2(k & 1, k >> 1);
-    q.x = (q.x % size.x + size.x) % size.x;
-    q.y = clamp(q.y, 0, size.y - 1);
-    c[k] = texelFetch(equirect, q, 0).rgb;
-  }
-  return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
-}
-
 void main() {
   const uvec3 id = gl_GlobalInvocationID;
   if (id.x >= pc.size || id.y >= pc.size) return;
@@ -36,7 +20,7 @@ void main() {
   for (int j = 0; j < 4; ++j)
     for (int i = 0; i < 4; ++i) {
       const vec2 st = (vec2(id.xy) + (vec2(i, j) + 0.5) / 4.0) / float(pc.size) * 2.0 - 1.0;
-      sum += fetch(envDirToUv(envCubeDir(id.z, st), pc.rotation));
+      sum += envMapBilinear(equirect, envDirToUv(envCubeDir(id.z, st), pc.rotation));
     }
   imageStore(cube, ivec3(id), vec4(sum / 16.0, 1.0));
 }

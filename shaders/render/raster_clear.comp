@@ -9,6 +9,7 @@ layout(local_size_x = RASTER_CLEAR_GROUP) in;
 
 void main() {
   const uint i = gl_GlobalInvocationID.x;
-  if (i == 0u) vertexCount = 0u, instanceCount = 1u, firstVertex = 0u, firstInstance = 0u, largeCount = 0u, largeFirst = 0u;
+  if (i == 0u) vertexCount = 0u, instanceCount = 1u, firstVertex = 0u, firstInstance = 0u, largeCount = 0u, largeFirst = 0u,
+                 largeTriCount = 0u;
   if (i < pc.width * pc.height) vis[i] = ~uint64_t(0);
 }

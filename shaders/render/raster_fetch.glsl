@@ -27,9 +27,11 @@ layout(set = 0, binding = 7, std430) RASTER_LIST_ACCESS buffer HardwareList {
 // Large triangles' tiles (raster.comp -> raster_large.comp): (triangle as in hwTriangles, tile index).
 // raster_large.comp takes entries [largeFirst, largeCount): with culling, the second phase's only.
 layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
-  uint largeCount, largeFirst, largePad1, largePad2;
-  uvec2 largeTiles[];
+  uint largeCount, largeFirst, largeTriCount, largePad;
+  uvec2 largeTiles[];  // (the triangle's record in largeTris, tile index)
 };
+// The large triangles' setup, largeTriCount records (raster.h).
+layout(set = 0, binding = 14, std430) RASTER_LIST_ACCESS buffer LargeTris { RasterLargeTri largeTris[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Instances { GpuInstance instances[]; };
 // The clusters drawn, (GpuInstance, GpuCluster record) each: the culling pass's visible list or, without
 // it, every instance's full-detail clusters (GpuScene::baseEntries). Workgroups, tiles and hand-off entries

@@ -94,6 +94,36 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
   return uint(extent.x) * uint(extent.y) > kSharedArea ? kLarge : kSmall;
 }
 
+// A large triangle's setup, kept for its tiles (raster.h's RasterLargeTri), and read back.
+void storeLarge(uint k, Tri t) {
+  largeTris[k].box = t.box;
+  largeTris[k].v01 = ivec4(t.v[0], t.v[1]);
+  largeTris[k].v2 = ivec4(t.v[2], int(t.id), int(t.material));
+  largeTris[k].z = vec4(t.z, 0.0);
+  if (kAlphaMask) {
+    largeTris[k].invW = vec4(t.invW, 0.0);
+    largeTris[k].uv01 = vec4(t.uv[0], t.uv[1]);
+    largeTris[k].uv2 = vec4(t.uv[2], 0.0, 0.0);
+  }
+}
+
+Tri loadLarge(uint k) {
+  Tri t;
+  t.box = largeTris[k].box;
+  const ivec4 v01 = largeTris[k].v01, v2 = largeTris[k].v2;
+  t.v = ivec2[3](v01.xy, v01.zw, v2.xy);
+  t.id = uint(v2.z);
+  t.material = uint(v2.w);
+  t.z = largeTris[k].z.xyz;
+  t.area2 = int64_t(t.v[1].x - t.v[0].x) * int64_t(t.v[2].y - t.v[0].y) - int64_t(t.v[1].y - t.v[0].y) * int64_t(t.v[2].x - t.v[0].x);
+  if (kAlphaMask && t.material != NO_TEXTURE) {
+    t.invW = largeTris[k].invW.xyz;
+    const vec4 uv01 = largeTris[k].uv01;
+    t.uv = vec2[3](uv01.xy, uv01.zw, largeTris[k].uv2.xy);
+  }
+  return t;
+}
+
 // Perspective-correct mask texcoords where the (unnormalised) screen-space weights are `e`.
 vec2 maskUv(Tri t, vec3 e) {
   const vec3 q = e * t.invW;

@@ -133,13 +133,10 @@ struct EnvPush {
   float roughness;  // specular: of the level written
   float srcTexelSolidAngle;  // specular: of a level-0 texel of the source cube (filtered sampling)
   float rotation;   // to the cube: the environment's rotation about +y, radians
-  uint srcWidth;    // to the cube: the equirectangular map's size
-  uint srcHeight;
   uint srcLevels;   // specular: mip levels of the source cube
   uint level;       // spherical harmonics and the specular sum: the source level read
   uint srcSize;     // specular sum: that level's face size
   float nearAngle;  // specular sum: how far from a texel's direction the lobe is summed at that level (radians)
-  uint pad0;
 };
 #define ENV_GROUP 8
 #define ENV_SUM_SLICES 4  // env_specular_sum.comp: threads per output texel

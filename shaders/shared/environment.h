@@ -33,6 +33,27 @@ RTR_FN vec3 envUvToDir(vec2 uv, float rotation) {
   return vec3(s * sin(phi), cos(theta), -s * cos(phi));
 }
 
+#ifndef __cplusplus
+// The map's radiance at (u, v) (envDirToUv), bilinear as the CPU's Environment::lookup: by hand, so the
+// weights keep full float precision (a sampler's are fixed point, 8 bits on many GPUs, and a sun 10^4
+// times the sky would be off by tens of units at the pixels its reflection lands on), around the sphere
+// in u, clamped in v. GLSL only (needs GL_EXT_samplerless_texture_functions).
+vec3 envMapBilinear(texture2D map, vec2 uv) {
+  const ivec2 size = textureSize(map, 0);
+  const vec2 p = uv * vec2(size) - 0.5;
+  const ivec2 i = ivec2(floor(p));
+  const vec2 f = p - vec2(i);
+  vec3 c[4];
+  for (int k = 0; k < 4; ++k) {
+    ivec2 q = i + ivec2(k & 1, k >> 1);
+    q.x = (q.x + size.x) % size.x;  // u in [0, 1]: q.x >= -1, and GLSL's % of a negative is undefined
+    q.y = clamp(q.y, 0, size.y - 1);
+    c[k] = texelFetch(map, q, 0).rgb;
+  }
+  return mix(mix(c[0], c[1], f.x), mix(c[2], c[3], f.x), f.y);
+}
+#endif
+
 // Real spherical harmonics Y_lm for l = 0..2 at unit direction d, in the order
 // (0,0), (1,-1), (1,0), (1,1), (2,-2), (2,-1), (2,0), (2,1), (2,2).
 RTR_FN float envSh(int i, vec3 d) {

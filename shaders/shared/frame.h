@@ -46,10 +46,11 @@ struct FrameUniforms {
   uvec4 lightCount;   // x: lights in use (<= MAX_LIGHTS); debug views use the first.
                       // y: 1 where the sampler takes the nearest mip level (the mip view shows whole levels)
   GpuLight lights[MAX_LIGHTS];
-  // Light from an environment (docs/environment.md; its maps are in world space, rotation applied) and the
+  // Light from an environment (docs/environment.md; its cubes are in world space, rotation applied) and the
   // backdrop. x: the specular cube's last level (roughness 1); y: how the backdrop shows the environment
   // (ENV_BACKDROP_COLOR: not at all, the colour instead; 0: sharp, the source cube; > 0: the specular cube
-  // at that roughness); z: the split-sum table's width; w: unused.
+  // at that roughness); z: the split-sum table's width; w: the rotation about +y (radians) of the
+  // equirectangular map, which is kept as it came.
   vec4 environment;
   vec4 background;    // rgb: linear colour of pixels nothing covers where the environment does not show
   uvec4 options;      // x: the BRDF of every material, 1 + BRDF_*; 0: each material's own (MATERIAL_GGX)

@@ -4,10 +4,13 @@
 #ifndef RTR_SHADERS_SHARED_RASTER_H
 #define RTR_SHADERS_SHARED_RASTER_H
 
+#include "shared.h"
 #ifdef __cplusplus
 #include <cstdint>
 namespace rtr::shader {
 typedef uint32_t uint;
+using glm::ivec4;
+using glm::vec4;
 #endif
 
 #define RASTER_GROUP 128         // raster.comp: one workgroup per cluster, a thread per triangle
@@ -17,12 +20,25 @@ typedef uint32_t uint;
 #define RASTER_SHARED_AREA 256u  // default: bounding boxes over this many pixels are rasterised tile by tile
 #define RASTER_TILE 32           // raster_large.comp: a workgroup per tile of RASTER_TILE² pixels of a triangle
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
+#define RASTER_LARGE_TRIANGLES (1u << 17) // large triangles' records a frame; one that does not fit goes to the hardware
 #define RASTER_LARGE_GROUPS 1024u         // raster_large.comp's persistent workgroups
 #define RASTER_LOCAL_BITS 7u     // hand-off and tile entries: position in the cluster list << RASTER_LOCAL_BITS | triangle
 // Hand-off list entries at most (64 MiB): the near-plane and guard-band triangles of a frame, not every
 // triangle of a billion-triangle scene (a storage buffer's range is 4 GiB at most on many devices). Past
 // it, triangles are dropped and counted (ComputeRaster::handOffTriangles, which rtr-view prints).
 #define RASTER_HANDOFF_CAPACITY (1u << 24)
+
+// A large triangle as raster.comp set it up (raster_tri.glsl's Tri, less what follows from it), written
+// once for raster_large.comp's tiles: a tile reads it instead of fetching and transforming the triangle.
+struct RasterLargeTri {
+  ivec4 box;   // pixels whose centres lie in the snapped bounding box (min x, min y, max x, max y)
+  ivec4 v01;   // fixed-point vertices 0 and 1, ordered so that the edge functions are positive inside
+  ivec4 v2;    // vertex 2 (x, y); z: the id; w: the alpha test's material (NO_TEXTURE: none)
+  vec4 z;      // depth (z/w) at the vertices
+  vec4 invW;   // the alpha test only: 1/w at the vertices,
+  vec4 uv01;   // the mask's texcoords at vertices 0 and 1,
+  vec4 uv2;    // and at vertex 2
+};
 
 struct RasterPush {
   uint width;

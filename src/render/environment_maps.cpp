@@ -58,7 +58,7 @@ vk::Sampler makeEnvSampler(const vk::Context& ctx) {
 }  // namespace
 
 EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env, const EnvironmentMapSettings& settings)
-    : settings_(settings) {
+    : settings_(settings), rotation_(env.rotation()) {
   if (env.empty()) throw Error("EnvironmentMaps: no environment");
   checkDevice(ctx);
   const ImageF& map = env.map();
@@ -72,13 +72,13 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
 
   // Copy source: the maps can be read back (tests, the report's error figures).
   constexpr VkImageUsageFlags kRw = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  vk::Image equirect(ctx, {{map.width, map.height},
-                           kSourceFormat,
-                           1,
-                           VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                           0,
-                           0,
-                           "environment map"});
+  map_ = vk::Image(ctx, {{map.width, map.height},
+                         kSourceFormat,
+                         1,
+                         VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                         0,
+                         0,
+                         "environment map"});
   source_ =
       vk::Image(ctx, {{s.sourceSize, s.sourceSize}, kSourceFormat, sourceLevels, kRw, 0, 0, "environment source cube", true});
   specular_ = vk::Image(ctx, {{s.specularSize, s.specularSize},
@@ -119,22 +119,20 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
   vk::GpuTimer timer(ctx, 8);
   vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
     timer.reset(cb);
-    vk::require(cb, equirect.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT, true);
+    vk::require(cb, map_.tracked(), vk::Use::CopyDst, VK_PIPELINE_STAGE_2_COPY_BIT, true);
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {map.width, map.height, 1};
-    vkCmdCopyBufferToImage(cb, stage.handle(), equirect.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    vk::require(cb, {{equirect.tracked(), vk::Use::Sampled, kCompute}, {source_.tracked(), vk::Use::Storage, kCompute, true}});
+    vkCmdCopyBufferToImage(cb, stage.handle(), map_.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    vk::require(cb, {{map_.tracked(), vk::Use::Sampled, kCompute}, {source_.tracked(), vk::Use::Storage, kCompute, true}});
     timer.begin(cb);
 
     shader::EnvPush pc{};
     pc.size = s.sourceSize;
     pc.rotation = env.rotation();
-    pc.srcWidth = map.width;
-    pc.srcHeight = map.height;
     toCube.bind(cb);
     vk::DescriptorWriter(ctx, toCube.layout, 0, VK_NULL_HANDLE)
-        .image(0, equirect.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
+        .image(0, map_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
         .image(1, sourceLevelViews[0], VK_IMAGE_LAYOUT_GENERAL)
         .push(cb, toCube);
     toCube.push(cb, pc);
@@ -204,7 +202,8 @@ EnvironmentMaps::EnvironmentMaps(const vk::Context& ctx, const Environment& env,
 
     // Ready for shading in compute or fragment shaders.
     constexpr VkPipelineStageFlags2 kShading = kCompute | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-    vk::require(cb, {{source_.tracked(), vk::Use::Sampled, kShading},
+    vk::require(cb, {{map_.tracked(), vk::Use::Sampled, kShading},
+                     {source_.tracked(), vk::Use::Sampled, kShading},
                      {specular_.tracked(), vk::Use::Sampled, kShading},
                      {lut_.tracked(), vk::Use::Sampled, kShading}});
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead | vk::kFragmentRead);  // the sh buffer
@@ -224,6 +223,7 @@ void writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout,
   if (has(21)) w.image(21, env->brdfLut().view(), kRead, env->sampler());
   if (has(22)) w.buffer(22, env->sh());
   if (has(23)) w.image(23, env->source().view(), kRead, env->sampler());
+  if (has(24)) w.image(24, env->map().view(), kRead);
 }
 
 }  // namespace rtr::render

@@ -35,6 +35,7 @@ class EnvironmentMaps {
   // Throws rtr::Error for an empty environment or a device that cannot filter 32-bit float images.
   EnvironmentMaps(const vk::Context& ctx, const Environment& env, const EnvironmentMapSettings& settings = {});
 
+  const vk::Image& map() const { return map_; }            // RGBA32F, the equirectangular map (the mirror reads it)
   const vk::Image& source() const { return source_; }      // RGBA32F cube with mips
   const vk::Image& specular() const { return specular_; }  // RGBA16F cube, roughness per mip
   // RGBA16F (A, B, C, 0), lutSize wide and 2 lutSize high: Beckmann's rows, then GGX's (envLutUv).
@@ -42,18 +43,20 @@ class EnvironmentMaps {
   VkBuffer sh() const { return sh_.handle(); }    // 9 vec4: rgb coefficients
   VkSampler sampler() const { return sampler_; }  // linear, mips, clamped
   const EnvironmentMapSettings& settings() const { return settings_; }
+  float rotation() const { return rotation_; }  // the map's about +y, radians (the cubes have it applied)
   // GPU milliseconds of each pass of the build, in order: cube, source mips, specular, sh, lut.
   const std::vector<std::pair<std::string, double>>& times() const { return times_; }
 
  private:
   EnvironmentMapSettings settings_;
-  vk::Image source_, specular_, lut_;
+  float rotation_ = 0.0f;
+  vk::Image map_, source_, specular_, lut_;
   vk::Buffer sh_;
   vk::Sampler sampler_;
   std::vector<std::pair<std::string, double>> times_;
 };
 
-// Writes `env`'s maps to set 0, bindings 20-23 (shaders/env_light.glsl), each where `layout` has it
+// Writes `env`'s maps to set 0, bindings 20-24 (shaders/env_light.glsl), each where `layout` has it
 // (specialization drops what a variant does not read); nothing without an environment.
 void writeEnvironment(vk::DescriptorWriter& w, const vk::PipelineLayout& layout, const EnvironmentMaps* env);
 

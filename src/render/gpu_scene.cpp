@@ -6,20 +6,17 @@
 #include <chrono>
 #include <cstring>
 #include <functional>
-#include <future>
 #include <optional>
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <mutex>
-#include <thread>
 
 #include "cluster.h"
 #include "render/cull.hpp"
+#include "render/staging_ring.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "core/parallel.hpp"
-#include "scene/baked_texels.hpp"
-#include "scene/textures.hpp"
 #include "vk/check.hpp"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
@@ -30,17 +27,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-
-VkFormat textureFormat(const Texture& t) {
-  const bool srgb = decodeSrgb(t);
-  if (t.baked && t.baked->format == BakedFormat::Bc1) return srgb ? VK_FORMAT_BC1_RGB_SRGB_BLOCK : VK_FORMAT_BC1_RGB_UNORM_BLOCK;
-  if (t.baked && t.baked->format == BakedFormat::Bc3) return srgb ? VK_FORMAT_BC3_SRGB_BLOCK : VK_FORMAT_BC3_UNORM_BLOCK;
-  if (t.baked && t.baked->format == BakedFormat::Bc4) return VK_FORMAT_BC4_UNORM_BLOCK;
-  if (decodeChannels(t) == 1) return VK_FORMAT_R8_UNORM;
-  return srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
-}
-
-bool blockCompressed(VkFormat f) { return f >= VK_FORMAT_BC1_RGB_UNORM_BLOCK && f <= VK_FORMAT_BC7_SRGB_BLOCK; }
 
 }  // namespace
 
@@ -88,8 +74,8 @@ shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
 }  // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
-                   GeometryUpload upload, TextureLoad textureLoad, TextureCache* cache)
-    : ctx_(ctx), mipMode_(mipMode), progress_(progress), cache_(cache) {
+                   GeometryUpload upload, TextureLoad textureLoad, TextureCache* cache, size_t uploadBudget)
+    : ctx_(ctx), mipMode_(mipMode), progress_(progress), uploadBudget_(uploadBudget), cache_(cache) {
   bounds_ = scene.bounds();
   if (cache_) {  // a chain is the mip mode's on this device and driver (blits and shaders run by it)
     const VkPhysicalDeviceProperties& p = ctx.properties();
@@ -127,115 +113,6 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     storeInCache(std::move(misses), true);
     in_.assign(textures_.size(), 1), texturesIn_ = textures_.size(), ready_ = true;
   }
-}
-
-// Textures: only those sampled (scene/textures.hpp), decoded on all cores, each thread copying what it
-// decoded straight into that texture's own staging buffer. Deferred: on a worker thread while the caller
-// goes on (frames render with the materials' factors until updateTextures()). Returns each scene
-// texture's index in the GPU's array (NO_TEXTURE: not sampled).
-std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad load) {
-  const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
-  std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
-  for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
-  for (uint32_t i : used) formats_.push_back(textureFormat(scene.textures[i])), samplers_.push_back(scene.textures[i].sampler);
-  staged_.resize(used.size());
-  textures_.resize(used.size());
-  hostMips_.assign(used.size(), false);
-  in_.assign(used.size(), 0);
-  storeKeys_.resize(used.size());
-  stats_.textures = uint32_t(used.size());
-  VkPhysicalDeviceFeatures features{};
-  vkGetPhysicalDeviceFeatures(ctx_.physicalDevice(), &features);
-  for (VkFormat f : formats_)
-    if (blockCompressed(f) && !features.textureCompressionBC)
-      throw Error("this device samples no BC textures (textureCompressionBC); bake the scene with --textures lossless");
-  auto decode = [this, &scene, used] {
-    const auto t = Clock::now();
-    std::mutex progressMutex;
-    auto done = [&](uint32_t i) {  // texture i is staged: a deferred load may take it in
-      {
-        const std::lock_guard lock(decodedMutex_);
-        decodedQueue_.push_back(i);
-      }
-      decodedChanged_.notify_all();
-      const std::lock_guard lock(progressMutex);
-      const size_t n = ++decoded_;
-      if (progress_) progress_("decoding textures", n, staged_.size());
-    };
-    struct Finished {  // also when the decode throws: a waiting updateTextures() then rethrows
-      GpuScene* self;
-      ~Finished() {
-        {
-          const std::lock_guard lock(self->decodedMutex_);
-          self->decodeFinished_ = true;
-        }
-        self->decodedChanged_.notify_all();
-      }
-    } finished{this};
-    // Baked texels (.rtrscene version 6) and the texture cache's hits: every chain unpacked piece by piece
-    // on all cores straight into its staging buffer, whole (no decode, no mip pass); the others decoded
-    // from their images (and, where the cache missed them, stored once their chains are made).
-    std::vector<std::shared_ptr<const BakedTexels>> chains(used.size());
-    std::vector<TextureCacheKey> keys(used.size());
-    std::vector<uint8_t> keyed(used.size(), 0);
-    parallelFor(used.size(), 0, [&](size_t i) {
-      const Texture& t = scene.textures[used[i]];
-      chains[i] = t.baked;
-      if (!chains[i] && cache_ && cache_->key(scene, t, cacheVariant_, keys[i]))
-        keyed[i] = 1, chains[i] = cache_->find(keys[i], t);
-    });
-    std::vector<uint32_t> images;
-    std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (GPU texture, piece)
-    for (uint32_t i = 0; i < used.size(); ++i) {
-      const BakedTexels* b = chains[i].get();
-      stats_.cacheHits += b && keyed[i];
-      stats_.cacheMisses += !b && keyed[i];
-      if (!b) {
-        images.push_back(i);
-        continue;
-      }
-      Staged& s = staged_[i];
-      s.extent = {b->width, b->height};
-      s.levels = b->levelOffsets();
-      s.buffer = vk::Buffer(ctx_, s.levels.back(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
-      s.bytes = s.levels.back();
-      s.levels.pop_back();
-      for (uint32_t k = 0; k < b->pieces.size(); ++k) pieces.emplace_back(i, k);
-    }
-    std::vector<std::atomic<uint32_t>> left(used.size());
-    for (const auto& [i, k] : pieces) ++left[i];
-    parallelFor(pieces.size(), 0, [&](size_t p) {
-      const auto [i, k] = pieces[p];
-      unpackBakedPiece(*chains[i], k, static_cast<uint8_t*>(staged_[i].buffer.mapped()));
-      if (--left[i] == 0) staged_[i].buffer.flush(), done(i);
-    });
-    std::vector<uint32_t> decodeOnly;
-    for (uint32_t i : images) decodeOnly.push_back(used[i]);
-    std::vector<uint8_t> fellBack;  // the checker stands in: nothing to store
-    decodeTextures(
-        scene, decodeOnly,
-        [&](size_t j, TexelData&& texels) {
-          const uint32_t i = images[j];
-          if (keyed[i] && !fellBack[j]) storeKeys_[i] = std::move(keys[i]);
-          Staged& s = staged_[i];
-          s.extent = {texels.width, texels.height};
-          // A small texture under --mips auto: its whole chain, made here (no mip pass on the GPU for it).
-          HostMipChain chain;
-          if (autoSmall(mipMode_, s.extent)) chain = hostMipChain(texels, formats_[i]);
-          const std::vector<uint8_t>& bytes = chain.offsets.empty() ? texels.texels : chain.bytes;
-          s.levels = std::move(chain.offsets);
-          s.buffer = vk::Buffer(ctx_, std::max<size_t>(bytes.size(), 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload);
-          std::memcpy(s.buffer.mapped(), bytes.data(), bytes.size());
-          s.buffer.flush();
-          s.bytes = bytes.size();
-          done(i);
-        },
-        {}, &fellBack);
-    stats_.decodeMs = msSince(t);
-  };
-  if (load == TextureLoad::Deferred && !used.empty()) decoding_ = std::async(std::launch::async, decode);
-  else decode();
-  return gpuIndex;
 }
 
 // Geometry: one stream per attribute for all meshes, each mesh once however many instances draw it;
@@ -602,237 +479,6 @@ GpuScene::~GpuScene() {
   for (auto& f : storing_) f.wait();        // they read this object's read-back buffers
 }  // a pending upload and material updates wait for their submissions, before the images and buffers go
 
-bool GpuScene::updateTextures(bool wait) {
-  if (ready_) return false;
-  std::erase_if(materialUpdates_, [](const MaterialUpdate& u) { return u.submission->done(); });
-  for (;;) {
-    if (upload_) {
-      if (!wait && !upload_->submission->done()) return false;
-      takeIn();
-    }
-    if (texturesIn_ == textures_.size()) {
-      decoding_.get();  // its statistics are written
-      ready_ = true;
-      return true;
-    }
-    const std::vector<uint32_t> batch = nextBatch(wait);
-    if (batch.empty()) return false;
-    startUpload(batch);
-    if (!wait) return false;
-  }
-}
-
-// The textures decoded first, up to the budget (at least one); none while none is decoded and not `wait`.
-std::vector<uint32_t> GpuScene::nextBatch(bool wait) {
-  std::unique_lock lock(decodedMutex_);
-  if (wait) decodedChanged_.wait(lock, [&] { return !decodedQueue_.empty() || decodeFinished_; });
-  if (decodedQueue_.empty()) {
-    if (!decodeFinished_) return {};
-    lock.unlock();
-    decoding_.get();  // rethrows the decode's error; else every texture was queued
-    throw Error("texture streaming: textures missing after the decode");
-  }
-  size_t n = 0, bytes = 0;
-  while (n < decodedQueue_.size() && (n == 0 || bytes + staged_[decodedQueue_[n]].bytes <= uploadBudget_))
-    bytes += staged_[decodedQueue_[n++]].bytes;
-  std::vector<uint32_t> batch(decodedQueue_.begin(), decodedQueue_.begin() + n);
-  decodedQueue_.erase(decodedQueue_.begin(), decodedQueue_.begin() + n);
-  return batch;
-}
-
-// A deferred load's batch: upload and mips in one submission, polled by updateTextures() while frames go on.
-void GpuScene::startUpload(const std::vector<uint32_t>& batch) {
-  for (uint32_t i : batch) createTexture(i);
-  if (!mipGen_) mipGen_ = std::make_unique<MipGenerator>(ctx_);
-  upload_ = std::make_unique<PendingUpload>(ctx_);
-  upload_->batch = batch;
-  upload_->start = Clock::now();
-  upload_->submission.emplace(ctx_, [&](VkCommandBuffer cb) {
-    recordUpload(cb, batch);
-    upload_->timer.reset(cb);
-    upload_->timer.begin(cb);
-    upload_->views = mipGen_->record(cb, gpuMipBatch(batch), mipMode_);  // its barriers wait for the copies
-    upload_->timer.mark(cb, "mips");
-  });
-}
-
-// The batch's submission has completed: its chains stored where the cache missed them (read back before any
-// frame samples them), then the materials' slots pointed at its textures by a copy that the queue orders
-// after the frames submitted so far (they read the old slots) and before the next.
-void GpuScene::takeIn() {
-  upload_->submission->wait();
-  stats_.textureUploadMs += msSince(upload_->start);
-  stats_.mipGpuMs += upload_->timer.results().at(0).second;
-  const std::vector<uint32_t> batch = std::move(upload_->batch);
-  upload_.reset();
-  std::vector<std::pair<uint32_t, TextureCacheKey>> misses;
-  for (uint32_t i : batch) {
-    staged_[i] = {};
-    if (storeKeys_[i]) misses.emplace_back(i, std::move(*storeKeys_[i])), storeKeys_[i].reset();
-    in_[i] = 1;
-  }
-  texturesIn_ += batch.size();
-  storeInCache(std::move(misses), texturesIn_ == textures_.size());
-  for (size_t m = 0; m < shownMaterials_.size(); ++m) {
-    auto show = [&](uint32_t& shown, uint32_t full) {
-      if (full != NO_TEXTURE && in_[full]) shown = full;
-    };
-    for (int k = 0; k < 4; ++k) show(shownMaterials_[m].textures[k], texturedMaterials_[m].textures[k]);
-    for (int k = 0; k < 3; ++k) show(shownMaterials_[m].textures2[k], texturedMaterials_[m].textures2[k]);
-  }
-  const size_t bytes = shownMaterials_.size() * sizeof(shader::GpuMaterial);
-  MaterialUpdate& u = materialUpdates_.emplace_back();
-  u.staging = vk::Buffer(ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "materials staging");
-  std::memcpy(u.staging.mapped(), shownMaterials_.data(), bytes);
-  u.staging.flush();
-  constexpr vk::BufferUse kReaders = vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead;
-  u.submission.emplace(ctx_, [&](VkCommandBuffer cb) {
-    vk::bufferBarrier(cb, kReaders, vk::kCopyWrite);  // the frames before read the old slots first
-    const VkBufferCopy region{0, 0, bytes};
-    vkCmdCopyBuffer(cb, u.staging.handle(), materials_.handle(), 1, &region);
-    vk::bufferBarrier(cb, vk::kCopyWrite, kReaders);
-  });
-  ++arrivals_;
-}
-
-void GpuScene::createTexture(uint32_t i) {
-  vk::ImageDesc desc = textureDesc(staged_[i].extent, formats_[i]);
-  if (blockCompressed(formats_[i]))  // baked with its chain: copied into, sampled, nothing else
-    desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, desc.flags = 0, desc.viewUsage = 0;
-  textures_[i] = vk::Image(ctx_, desc);
-  hostMips_[i] = !staged_[i].levels.empty();
-}
-
-// Every level of each texture the cache missed, copied into a buffer laid out as a baked chain; packed and
-// written on a worker thread (the destructor waits for it), then the cache trimmed to its bound.
-void GpuScene::storeInCache(std::vector<std::pair<uint32_t, TextureCacheKey>> which, bool last) {
-  if (!cache_ || which.empty()) return;
-  const auto t = Clock::now();
-  struct Back {
-    BakedTexels layout;
-    vk::Buffer buffer;
-    TextureCacheKey key;
-  };
-  auto backs = std::make_shared<std::vector<Back>>();
-  std::vector<vk::ImageBarrier> toSrc, back;
-  for (auto& [i, key] : which) {
-    Back b;
-    b.layout.format = formats_[i] == VK_FORMAT_R8_UNORM ? BakedFormat::R8 : BakedFormat::Rgba8;
-    b.layout.width = textures_[i].extent().width;
-    b.layout.height = textures_[i].extent().height;
-    b.buffer = vk::Buffer(ctx_, b.layout.bytes(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "cache read-back");
-    b.key = std::move(key);
-    backs->push_back(std::move(b));
-    const uint32_t levels = textures_[i].mipLevels();
-    toSrc.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                     VK_ACCESS_2_TRANSFER_READ_BIT, 0, levels});
-    back.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                    VK_PIPELINE_STAGE_2_COPY_BIT,
-                    VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
-                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, levels});
-  }
-  vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
-    vk::barrier(cb, toSrc);
-    for (size_t k = 0; k < backs->size(); ++k) {
-      const Back& b = (*backs)[k];
-      const std::vector<uint64_t> at = b.layout.levelOffsets();
-      std::vector<VkBufferImageCopy> regions;
-      for (uint32_t l = 0; l < b.layout.levels(); ++l) {
-        VkBufferImageCopy r{};
-        r.bufferOffset = at[l];
-        r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, 1};
-        r.imageExtent = {std::max(1u, b.layout.width >> l), std::max(1u, b.layout.height >> l), 1};
-        regions.push_back(r);
-      }
-      vkCmdCopyImageToBuffer(cb, textures_[which[k].first].handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b.buffer.handle(),
-                             uint32_t(regions.size()), regions.data());
-    }
-    vk::barrier(cb, back);
-    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
-  });
-  stats_.cacheReadbackMs += msSince(t);
-  storing_.push_back(std::async(std::launch::async, [cache = cache_, backs, last] {
-    parallelFor(backs->size(), 0, [&](size_t k) {
-      Back& b = (*backs)[k];
-      b.buffer.invalidate();
-      const auto* p = static_cast<const uint8_t*>(b.buffer.mapped());
-      cache->store(b.key, packBakedTexels(b.layout.format, b.layout.width, b.layout.height,
-                                          std::vector<uint8_t>(p, p + b.layout.bytes()), 1));
-      b.buffer = {};
-    });
-    if (last) cache->trim();
-  }));
-}
-
-std::vector<const vk::Image*> GpuScene::gpuMipBatch(const std::vector<uint32_t>& which) const {
-  std::vector<const vk::Image*> batch;
-  for (uint32_t i : which)
-    if (!hostMips_[i]) batch.push_back(&textures_[i]);
-  return batch;
-}
-
-// Staging memory to level 0 of every texture (every level of those with their chain made on the CPU,
-// which are then ready for shaders: the mip generator's layout contract).
-void GpuScene::recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& which) const {
-  std::vector<vk::ImageBarrier> toDst, ready;
-  for (uint32_t i : which) {
-    const uint32_t levels = hostMips_[i] ? textures_[i].mipLevels() : 1;
-    toDst.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                     VK_PIPELINE_STAGE_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT, 0,
-                     levels});
-    if (hostMips_[i])
-      ready.push_back({textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                       VK_PIPELINE_STAGE_2_COPY_BIT,
-                       VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, 0, levels});
-  }
-  vk::barrier(cb, toDst);
-  for (uint32_t i : which) {
-    const Staged& st = staged_[i];
-    std::vector<VkBufferImageCopy> regions;
-    for (uint32_t l = 0; l < (hostMips_[i] ? st.levels.size() : 1); ++l) {
-      VkBufferImageCopy r{};
-      r.bufferOffset = hostMips_[i] ? st.levels[l] : 0;
-      r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, 1};
-      r.imageExtent = {std::max(1u, st.extent.width >> l), std::max(1u, st.extent.height >> l), 1};
-      regions.push_back(r);
-    }
-    vkCmdCopyBufferToImage(cb, st.buffer.handle(), textures_[i].handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                           uint32_t(regions.size()), regions.data());
-  }
-  if (!ready.empty()) vk::barrier(cb, ready);
-}
-
-void GpuScene::finishTextures() {
-  const vk::Context& ctx = ctx_;
-  vk::PipelineCache& pipelines = ctx.pipelineCache();
-  // Texture upload: one submission of copies into level 0.
-  auto t = Clock::now();
-  std::vector<uint32_t> all(textures_.size());
-  for (uint32_t i = 0; i < all.size(); ++i) createTexture(all[i] = i);
-  if (!textures_.empty()) vk::submitAndWait(ctx, [&](VkCommandBuffer cb) { recordUpload(cb, all); });
-  staged_.clear();
-  stats_.textureUploadMs = msSince(t);
-
-  // Mips, in a submission of their own (their pipelines' creation is counted as pipeline creation).
-  t = Clock::now();
-  const double pipelineMs = pipelines.stats().ms;
-  if (const std::vector<const vk::Image*> batch = gpuMipBatch(all); !batch.empty()) {
-    MipGenerator mipGen(ctx);
-    MipViews views;  // alive until the submission has completed
-    vk::GpuTimer timer(ctx, 1);
-    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-      timer.reset(cb);
-      timer.begin(cb);
-      views = mipGen.record(cb, batch, mipMode_);  // all textures, one barrier per step
-      timer.mark(cb, "mips");
-    });
-    stats_.mipGpuMs = timer.results().at(0).second;
-  }
-  stats_.mipsMs = msSince(t) - (pipelines.stats().ms - pipelineMs);
-}
-
 float maxAnisotropy(const vk::Context& ctx) {
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
@@ -861,12 +507,6 @@ vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings,
   VkSampler raw;
   VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &raw));
   return vk::Sampler(ctx.device(), raw);
-}
-
-std::vector<VkImageView> GpuScene::textureViews() const {
-  std::vector<VkImageView> out;
-  for (size_t i = 0; i < textures_.size(); ++i) out.push_back(in_[i] ? textures_[i].view() : VK_NULL_HANDLE);
-  return out;
 }
 
 }  // namespace rtr::render

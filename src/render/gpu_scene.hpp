@@ -1,8 +1,9 @@
 #pragma once
 // A scene on the GPU: vertex streams, index buffers (16-bit where a mesh allows; both also readable as
 // storage buffers by the visibility path's shading pass), the material and draw buffers, and the textures
-// that some drawn material uses (decoded on all cores into staging buffers, mips generated on the GPU, or
-// under MipMode::Auto on the CPU for small ones).
+// that some drawn material uses (decoded on all cores, uploaded batch by batch through one staging ring,
+// mips generated on the GPU, or under MipMode::Auto on the CPU for small ones; baked and cached chains
+// unpacked straight into the ring: render/textures.cpp).
 // Geometry is written on all cores straight into device-local memory where the host can write it (every
 // CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
 #include <array>
@@ -25,6 +26,9 @@
 #include "vk/commands.hpp"
 #include "vk/resources.hpp"
 
+namespace rtr {
+class ThreadPool;
+}
 namespace rtr::vk {
 class Context;
 }
@@ -66,9 +70,13 @@ struct GpuSceneStats {
   double geometryMs = 0;            // vertex and index streams laid out, written and (where needed) copied
   double textureUploadMs = 0;       // staging memory to level 0 of each texture
   double mipsMs = 0, mipGpuMs = 0;  // mip chains: wall time, and the GPU's share of it
+  uint32_t imagesDecoded = 0;       // textures decoded from their images (neither baked nor a cache hit)
   uint32_t cacheHits = 0;           // textures whose chains came from the texture cache (no decode, no mips)
   uint32_t cacheMisses = 0;         // textures looked up and not found: their chains are read back and stored
   double cacheReadbackMs = 0;       // reading those chains back (their packing and writing runs on a worker thread)
+  uint32_t uploadBatches = 0;       // submissions of texel copies (one per batch through the staging ring)
+  uint32_t stagingAllocations = 0;  // staging buffers made for textures (the ring's: 1 unless a texture outgrew it)
+  size_t stagingBytes = 0;          // their size
   size_t geometryBytes = 0;
 };
 
@@ -104,14 +112,18 @@ enum class GeometryUpload { Auto, Staging };
 // texture is in, a material's slot shows its factor alone.
 enum class TextureLoad { Wait, Deferred };
 
+class StagingRing;
+
 class GpuScene {
  public:
   // `scene` and `progress` must outlive a Deferred texture load (or the object).
   // `cache` (it too must outlive the object): textures read from files or glTF images are looked up there
   // first (a hit: the chain as this device made it, uploaded whole), and the chains of those not found are
   // stored once the GPU has made them (read back, then packed and written on a worker thread).
+  // `uploadBudget`: bytes of texels per upload batch (setUploadBudget), which sizes the staging ring.
   GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {},
-           GeometryUpload upload = GeometryUpload::Auto, TextureLoad textures = TextureLoad::Wait, TextureCache* cache = nullptr);
+           GeometryUpload upload = GeometryUpload::Auto, TextureLoad textures = TextureLoad::Wait, TextureCache* cache = nullptr,
+           size_t uploadBudget = kDefaultUploadBudget);
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
@@ -129,7 +141,8 @@ class GpuScene {
   size_t texturesIn() const { return texturesIn_; }    // on the GPU, their materials pointing at them
   bool textureIn(uint32_t gpuIndex) const { return in_.at(gpuIndex) != 0; }
   uint64_t textureArrivals() const { return arrivals_; }  // changes whenever textures came in
-  // The per-batch budget of a deferred load (bytes of staged texels, every level included).
+  // The per-batch budget (bytes of staged texels, every level included; a waited load's batches too). The
+  // staging ring holds two batches; a change after the first batch changes the batches, not the ring.
   static constexpr size_t kDefaultUploadBudget = size_t(16) << 20;
   void setUploadBudget(size_t bytes) { uploadBudget_ = bytes; }
 
@@ -198,22 +211,27 @@ class GpuScene {
   void startUpload(const std::vector<uint32_t>& batch);  // the same in one submission, not waited for
   void takeIn();                                         // its submission completed: the materials point at them
   void createTexture(uint32_t i);
-  void recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& which) const;
+  size_t batchEnd(const std::vector<uint32_t>& queue, size_t first) const;  // a batch from `first`, by the budget
+  // Writes the batch's texels into a slot of the staging ring on all cores and submits their copies, then
+  // what `after` records; returns that submission (the ring's, until the slot is taken again).
+  const vk::Submission& submitBatch(const std::vector<uint32_t>& batch, const std::function<void(VkCommandBuffer)>& after);
+  void recordUpload(VkCommandBuffer cb, const std::vector<uint32_t>& which, const std::vector<VkDeviceSize>& at) const;
   // The chains of the textures the cache missed: read back, then stored (the cache trimmed after the last).
   void storeInCache(std::vector<std::pair<uint32_t, TextureCacheKey>> which, bool last);
 
   const vk::Context& ctx_;
   MipMode mipMode_;
   LoadProgress progress_;
-  struct Staged {
-    vk::Buffer buffer;
+  struct Staged {                              // a texture's texels until its batch is written into the staging ring
+    std::shared_ptr<const BakedTexels> chain;  // baked or a cache hit: its pieces unpacked into the ring
+    std::vector<uint8_t> texels;               // else decoded: level 0, or the chain made on the CPU
     size_t bytes = 0;
     VkExtent2D extent;
-    std::vector<VkDeviceSize> levels;  // a chain made on the CPU: each level's offset; else empty
+    std::vector<VkDeviceSize> levels;  // a whole chain (baked, cached, made on the CPU): each level's offset; else empty
   };
-  std::vector<bool> hostMips_;  // per texture: its chain was made on the CPU (uploaded whole)
+  std::vector<bool> hostMips_;  // per texture: its whole chain came with it (uploaded whole, no mip pass)
   std::vector<const vk::Image*> gpuMipBatch(const std::vector<uint32_t>& which) const;  // chains the GPU makes
-  std::vector<Staged> staged_;                                                          // decoded texels, until uploaded
+  std::vector<Staged> staged_;                                                          // texels, until uploaded
   std::vector<VkFormat> formats_;                                                       // of each texture
   std::vector<shader::GpuMaterial> texturedMaterials_;  // a deferred load's materials, as they will be
   std::vector<shader::GpuMaterial> shownMaterials_;     // and as the material buffer holds them meanwhile
@@ -227,6 +245,7 @@ class GpuScene {
   size_t texturesIn_ = 0;
   uint64_t arrivals_ = 0;
   size_t uploadBudget_ = kDefaultUploadBudget;
+  double fillMs_ = 0;  // writing batches into the staging ring (a waited load counts it as decode)
   TextureCache* cache_ = nullptr;
   std::string cacheVariant_;                               // what makes this device's chains (the cache key)
   std::vector<std::optional<TextureCacheKey>> storeKeys_;  // per texture: a cache miss, stored once its chain is made
@@ -250,10 +269,12 @@ class GpuScene {
     std::vector<uint32_t> batch;
     MipViews views;
     vk::GpuTimer timer;
-    std::optional<vk::Submission> submission;
+    const vk::Submission* submission = nullptr;  // the ring's
     std::chrono::steady_clock::time_point start;
   };
-  std::unique_ptr<PendingUpload> upload_;  // after textures_: destroyed (waited for) first
+  std::unique_ptr<PendingUpload> upload_;  // after textures_: destroyed after the ring, before the images
+  std::unique_ptr<ThreadPool> fillPool_;   // writes the batches into the ring
+  std::unique_ptr<StagingRing> ring_;      // after upload_: waits for its submissions first
   struct MaterialUpdate {                  // the material buffer rewritten by a copy, alive until done
     vk::Buffer staging;
     std::optional<vk::Submission> submission;

@@ -16,8 +16,8 @@ HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene
 }
 
 void HeadlessRenderer::frame(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
-                             const std::function<void(VkCommandBuffer)>& after) {
-  FrameContext fc{ring_.begin(), pose, lens, settings, target()};
+                             const std::function<void(VkCommandBuffer)>& after, bool readSceneColor) {
+  FrameContext fc{ring_.begin(), pose, lens, settings, target(), readSceneColor};
   renderer_.frame(fc);
   if (after) after(fc.frame.cb);
   ring_.submit(fc.frame);
@@ -31,16 +31,19 @@ HeadlessFrame HeadlessRenderer::render(const CameraPose& pose, const Lens& lens,
     colorReadback_ = vk::Buffer(ctx_, pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "colour readback");
   for (int f = 0; f < frames; ++f) {
     const bool last = f + 1 == frames;
-    frame(pose, lens, settings, [&](VkCommandBuffer cb) {
-      if (!last) return;
-      vk::require(cb, target_.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
-      vk::copyImageToHost(cb, target_.handle(), extent_, readback_.handle());
-      if (readSceneColor) {
-        const vk::Image& color = renderer_.sceneColor();
-        vk::require(cb, color.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
-        vk::copyImageToHost(cb, color.handle(), extent_, colorReadback_.handle());
-      }
-    });
+    frame(
+        pose, lens, settings,
+        [&](VkCommandBuffer cb) {
+          if (!last) return;
+          vk::require(cb, target_.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
+          vk::copyImageToHost(cb, target_.handle(), extent_, readback_.handle());
+          if (readSceneColor) {
+            const vk::Image& color = renderer_.sceneColor();
+            vk::require(cb, color.tracked(), vk::Use::CopySrc, VK_PIPELINE_STAGE_2_COPY_BIT);
+            vk::copyImageToHost(cb, color.handle(), extent_, colorReadback_.handle());
+          }
+        },
+        readSceneColor && last);
   }
   HeadlessFrame out;
   out.gpuTimes = renderer_.gpuTimes(0);

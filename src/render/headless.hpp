@@ -34,7 +34,7 @@ class HeadlessRenderer {
   RenderTarget target() const { return {target_.tracked(), target_.view(), target_.format(), extent_}; }
   // One frame through Renderer::frame, as the window app's; `after` records more into it. Waits for it.
   void frame(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
-             const std::function<void(VkCommandBuffer)>& after = {});
+             const std::function<void(VkCommandBuffer)>& after = {}, bool readSceneColor = false);
 
   const vk::Context& ctx_;
   VkExtent2D extent_;

@@ -49,6 +49,8 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
       vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                  vk::MemoryUse::Device, "raster tiles");
+  largeTris_ = vk::Buffer(ctx, sizeof(shader::RasterLargeTri) * VkDeviceSize(RASTER_LARGE_TRIANGLES),
+                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device, "raster large triangles");
   cullReadback_ = vk::Buffer(ctx, 2 * sizeof(shader::CullCounts) * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryUse::Readback, "cull counts read-back");
   handOffReadback_ =
@@ -127,7 +129,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
                                   largeList_.handle(),
                                   list,
                                   counts,
-                                  scene_.instances()};
+                                  scene_.instances(),
+                                  largeTris_.handle()};
       if (b.binding == 0) w.buffer(0, uniforms.buffer, uniforms.offset, sizeof(shader::FrameUniforms));
       else w.buffer(b.binding, buffers[b.binding]);
     }

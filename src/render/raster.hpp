@@ -59,7 +59,7 @@ class ComputeRaster {
   vk::Pipeline clear_, raster_, large_, hardware_;
   vk::DescriptorSets textures_[3];  // set 1 of textured()'s pipelines where they have one
   std::array<const vk::Pipeline*, 3> textured() const { return {&raster_, &large_, &hardware_}; }
-  vk::Buffer vis_, hwList_, largeList_;
+  vk::Buffer vis_, hwList_, largeList_, largeTris_;
   uint32_t handOffCapacity_ = 1;
   VkExtent2D extent_{0, 0};
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size

@@ -138,7 +138,7 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
   return out;
 }
 
-Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
+Renderer::VisShade Renderer::makeShade(bool fromBuffer, bool display) const {
   const bool textured = scene_.texcoords() != VK_NULL_HANDLE;
   vk::LayoutOptions options{.pushDescriptorSets = {0}};
   options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
@@ -147,7 +147,8 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer) const {
                                              {{VARIANT_TEXCOORDS, textured},
                                               {VARIANT_VIS_BUFFER, fromBuffer},
                                               {VARIANT_ENV, env_ != nullptr},
-                                              {VARIANT_MATERIAL_EXTRAS, scene_.materialExtras()}}));
+                                              {VARIANT_MATERIAL_EXTRAS, scene_.materialExtras()},
+                                              {VARIANT_DISPLAY, display}}));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
@@ -189,12 +190,12 @@ void Renderer::ensurePipelines(PipelineSet set) {
 void Renderer::rebuildPipelines() {
   // Build all that exist first, swap after: a failure leaves the running pipelines untouched.
   std::array<std::optional<KindPipelines>, kPipelineSetCount> fresh;
-  std::array<VisShade, 3> shade;
+  std::array<VisShade, 6> shade;
   std::optional<ComputeRaster> raster;
   for (int set = 0; set < kPipelineSetCount; ++set)
     if (pipelines_[set]) fresh[set] = makePipelines(PipelineSet(set));
-  for (RasterPath r : {RasterPath::Hardware, RasterPath::Compute})
-    if (shade_[size_t(r)].pipeline) shade[size_t(r)] = makeShade(r == RasterPath::Compute);
+  for (size_t i = 0; i < shade.size(); ++i)
+    if (shade_[i].pipeline) shade[i] = makeShade(RasterPath(i / 2) == RasterPath::Compute, i % 2 != 0);
   if (raster_) raster.emplace(ctx_, scene_, framesInFlight_);
   std::optional<vk::Pipeline> backdrop;
   if (backdrop_)
@@ -266,10 +267,7 @@ void Renderer::writeTextureSets(const std::vector<uint8_t>* only) {
 void Renderer::createTargets(VkExtent2D extent, bool visibility) {
   vkDeviceWaitIdle(ctx_.device());
   if (extent.width != extent_.width || extent.height != extent_.height) {
-    color_ = vk::Image(ctx_, {extent, kColorFormat, 1,
-                              VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                  VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                              0, 0, "scene colour"});
+    color_ = {};  // made by the first frame that needs it
     depth_ = vk::Image(ctx_, {extent, kDepthFormat, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, 0, 0, "scene depth"});
     vis_ = {};
     extent_ = extent;
@@ -319,8 +317,8 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
   }
 }
 
-void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
-  const VisShade& shade = shade_[size_t(raster)];
+void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster, VkImageView display) {
+  const VisShade& shade = shade_[2 * size_t(raster) + (display != VK_NULL_HANDLE)];
   const vk::Pipeline& c = *shade.pipeline;
   c.bind(cb);
   // A scene may lack one index width: any storage buffer fills that binding (no draw reads it).
@@ -335,8 +333,9 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster) {
       .buffer(5, i32)
       .buffer(6, i16)
       .buffer(10, scene_.instances())
-      .buffer(15, scene_.visIdPages())
-      .image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
+      .buffer(15, scene_.visIdPages());
+  if (display) w.image(16, display, VK_IMAGE_LAYOUT_GENERAL);
+  else w.image(8, color_.view(), VK_IMAGE_LAYOUT_GENERAL);
   // glTF's streams, in the MATERIAL_EXTRAS variant only: any buffer where the scene has none (nothing reads it).
   if (c.layout.hasBinding(0, 13)) w.buffer(13, scene_.colors() ? scene_.colors() : scene_.positions());
   writeEnvironment(w, c.layout, env_.get());
@@ -393,7 +392,16 @@ void Renderer::frame(FrameContext& fc) {
     for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set);
   }
   if (!compute) ensurePipelines(set);
-  if (visibility && !shade_[size_t(raster)].pipeline) shade_[size_t(raster)] = makeShade(compute);
+  // The shading pass writes the target's bytes itself where nothing else reads the linear image: the
+  // post pass would only copy and encode it (mosaic off), no transparent pass blends into it, no caller reads it.
+  const bool display = visibility && s.mosaic == MosaicMode::Off && !transparency_ && !fc.readSceneColor;
+  if (!display && !color_.handle())
+    color_ = vk::Image(ctx_, {extent_, kColorFormat, 1,
+                              VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                  VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                              0, 0, "scene colour"});
+  VisShade& shade = shade_[2 * size_t(raster) + display];
+  if (visibility && !shade.pipeline) shade = makeShade(compute, display);
   lastRaster_ = raster;
   const float aspect = float(target.extent.width) / float(target.extent.height);
   // The forward shaded view shows the environment behind the scene in a pass of its own.
@@ -418,7 +426,7 @@ void Renderer::frame(FrameContext& fc) {
     const EnvironmentMapSettings& es = env_->settings();
     u.environment =
         glm::vec4(float(es.specularLevels - 1), s.backdropBlur < 0.0f ? ENV_BACKDROP_COLOR : std::min(s.backdropBlur, 1.0f),
-                  float(es.lutSize), 0.0f);
+                  float(es.lutSize), env_->rotation());
   }
   u.background = glm::vec4(s.background, 0.0f);
   u.options.x = s.brdf ? uint32_t(*s.brdf) + 1u : 0u;
@@ -441,7 +449,8 @@ void Renderer::frame(FrameContext& fc) {
 
   if (env_) {  // left sampled by their build; a read-back (tests) may have moved them since
     constexpr VkPipelineStageFlags2 kShading = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-    vk::require(cb, {{env_->source().tracked(), vk::Use::Sampled, kShading},
+    vk::require(cb, {{env_->map().tracked(), vk::Use::Sampled, kShading},
+                     {env_->source().tracked(), vk::Use::Sampled, kShading},
                      {env_->specular().tracked(), vk::Use::Sampled, kShading},
                      {env_->brdfLut().tracked(), vk::Use::Sampled, kShading}});
   }
@@ -462,12 +471,14 @@ void Renderer::frame(FrameContext& fc) {
     }
   }
   if (visibility) {
-    const vk::Requirement out{color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, true};
+    const vk::Requirement out{display ? target.image : color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                              true};
     if (compute) vk::require(cb, {out});
     else vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT}, out});
-    shadeVisibility(cb, raster);
+    shadeVisibility(cb, raster, display ? target.view : VK_NULL_HANDLE);
     timer.mark(cb, "shade");
   }
+  if (display) return;
   if (transparency_ && s.mode == VIEW_SHADED) {  // debug views show the opaque surfaces only
     transparency_->record(cb, uniforms_, color_, depth_, extent_, pose.position, compute ? raster_->ids() : VK_NULL_HANDLE);
     timer.mark(cb, "transparent");

@@ -1,7 +1,8 @@
 #pragma once
 // One frame of the renderer, start to end: the scene pass (shaded or a debug view) into an intermediate
 // linear-light image, then the post pass (mosaic or copy) into the target (a swapchain image or an
-// offscreen image). Knows no window.
+// offscreen image); where nothing else needs the intermediate image (visibility path, mosaic off, no
+// transparent surfaces) the shading pass writes the target itself. Knows no window.
 #include <array>
 #include <memory>
 #include <optional>
@@ -64,8 +65,8 @@ struct RenderSettings {
   std::optional<int> brdf;  // BRDF_BECKMANN or BRDF_GGX (brdf.h) for every material; none: each material's
 };
 
-// The frame leaves the target written by the post pass (its state tracked); the caller requires what
-// comes next (a copy, presentation).
+// The frame leaves the target written by the post pass or the shading pass (its state tracked); the caller
+// requires what comes next (a copy, presentation).
 struct RenderTarget {
   vk::TrackedImage image;
   VkImageView view = VK_NULL_HANDLE;
@@ -81,6 +82,7 @@ struct FrameContext {
   Lens lens;
   RenderSettings settings;
   RenderTarget target;
+  bool readSceneColor = false;  // the caller reads sceneColor() after the frame: it is written even where not needed
 };
 
 // The draws nearest `eye` first (by their meshes' box centres; ties keep their order): drawn so, the depth
@@ -106,7 +108,8 @@ class Renderer {
   void frame(FrameContext& fc);
   // Per-pass GPU times of the last completed use of `frame`, in ms.
   std::vector<std::pair<std::string, double>> gpuTimes(uint32_t frame) const { return timers_[frame].results(); }
-  // The linear-light intermediate image of the last frame (its state tracked: require() before use).
+  // The linear-light intermediate image of the last frame that wrote it (FrameContext::readSceneColor; its
+  // state tracked: require() before use).
   const vk::Image& sceneColor() const { return color_; }
   // Rebuilds the scene pipelines from the shader folder (hot reload); on error keeps the old ones.
   void rebuildPipelines();
@@ -146,13 +149,14 @@ class Renderer {
   ScenePipelines makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull,
                               std::vector<vk::SpecializationConstant> variant) const;
   KindPipelines makePipelines(PipelineSet set) const;
-  VisShade makeShade(bool fromBuffer) const;
+  VisShade makeShade(bool fromBuffer, bool display) const;
   void backdropPass(VkCommandBuffer cb);
   void ensurePipelines(PipelineSet set);
   void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye, const glm::vec3& background,
                   bool backdrop);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
-  void shadeVisibility(VkCommandBuffer cb, RasterPath raster);
+  // display: the target's view, written sRGB-encoded (no post pass); null: the linear image.
+  void shadeVisibility(VkCommandBuffer cb, RasterPath raster, VkImageView display);
   // The scene's texture array, as every pipeline that samples it binds it (set 1, binding 0): each
   // texture with a sampler made from its own SamplerDesc and the settings (one per distinct pair).
   void makeTextureInfos();
@@ -169,7 +173,8 @@ class Renderer {
   uint64_t arrivalsSeen_;            // the scene's textureArrivals() when the texture sets were last written
   vk::UploadArena::Slice uniforms_;  // this frame's FrameUniforms, in its upload arena
   std::array<std::optional<KindPipelines>, kPipelineSetCount> pipelines_;
-  std::array<VisShade, 3> shade_;        // by RasterPath: Hardware reads the id image, Compute the 64-bit buffer
+  // By 2 * RasterPath + display: Hardware reads the id image, Compute the 64-bit buffer; display writes the target.
+  std::array<VisShade, 6> shade_;
   std::optional<ComputeRaster> raster_;  // built on first use
   std::shared_ptr<const EnvironmentMaps> env_;
   std::optional<vk::Pipeline> backdrop_;          // the forward path's environment backdrop, on first use
@@ -180,7 +185,7 @@ class Renderer {
   std::string visibilityRefusal_;
   MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;
-  vk::Image color_, depth_, vis_;  // vis_ only once the visibility path ran
+  vk::Image color_, depth_, vis_;  // color_ only once a frame needed it, vis_ once the hardware visibility path ran
   VkExtent2D extent_{0, 0};
 };
 

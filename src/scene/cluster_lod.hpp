@@ -25,7 +25,7 @@ constexpr float kLodEdgePerError = 32.0f;
 struct LodGroupStats {
   uint32_t level = 0;  // of the clusters grouped; the result is level + 1
   uint32_t clusters = 0, trianglesIn = 0;
-  uint32_t trianglesOut = 0;     // 0: stuck (the group's clusters stay roots)
+  uint32_t trianglesOut = 0;     // 0: stuck (its clusters are grouped again at the next level)
   float simplifierError = 0.0f;  // object space, what the simplifier reports
   float edgeError = 0.0f;        // the size term: longest new edge / kEdgePerError
   float radius = 0.0f;           // of the group's sphere
@@ -33,7 +33,8 @@ struct LodGroupStats {
 
 // The hierarchy of `mesh` (positions, indices and its clusters, which become level 0: build them first,
 // scene/clusters.hpp). Deterministic, whatever the thread count (0: one per core). Groups whose
-// simplification cannot remove a sixth of their triangles (locked borders everywhere) stop as roots.
+// simplification cannot remove a sixth of their triangles (locked borders everywhere) are grouped again
+// with the next level's clusters; what is left when no group simplifies, or after 64 levels, are roots.
 // `backfaceCone` as buildClusters' (false: the clusters above level 0 get cones that never cull).
 // `stats`, where given, receives one record per group, level by level.
 ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone = true, unsigned threads = 0,

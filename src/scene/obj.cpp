@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <optional>
 #include <thread>
@@ -15,6 +16,7 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "core/parallel.hpp"
+#include "scene/grow_array.hpp"
 #include "scene/mtl.hpp"
 #include "scene/obj_piece.hpp"
 #include "scene/text.hpp"
@@ -25,6 +27,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double cpuSince(std::clock_t c) { return double(std::clock() - c) / CLOCKS_PER_SEC; }
 
 // The text is read in batches of whole lines and parsed in pieces of about kPieceBytes on all cores.
 // Both are fixed, so the pieces do not depend on the thread count (and a wrong stitch shows with any).
@@ -39,7 +42,7 @@ constexpr size_t kSniffBytes = 8192;            // how much of the start is chec
 struct MeshBuild {
   std::string name;
   uint32_t material = 0;
-  std::vector<Corner> corners;
+  GrowArray<Corner> corners;
   size_t queued = 0;  // corners given a place so far
 };
 
@@ -69,7 +72,9 @@ class ObjParser {
         atEnd = got == 0;
       }
     };
+    auto t = Clock::now();
     fill(buf, have);
+    stats_.textWaitSeconds += since(t);
     while (have) {
       const std::string_view text(buf.data(), have);
       size_t end = have;  // the batch: whole lines (a continued line is one)
@@ -95,10 +100,15 @@ class ObjParser {
       next.resize(buf.size());
       size_t nextHave = have - end;
       std::memcpy(next.data(), buf.data() + end, nextHave);
+      double parsed = 0;
+      t = Clock::now();
       parallelFor(2, opt_.threads, [&](size_t i) {
-        if (i == 0) parseBatch(pieces);
-        else fill(next, nextHave);
+        if (i != 0) return fill(next, nextHave);
+        const auto p = Clock::now();
+        parseBatch(pieces);
+        parsed = since(p);
       });
+      stats_.textWaitSeconds += since(t) - parsed;
       std::swap(buf, next);
       have = nextHave;
       if (opt_.progress) opt_.progress(src.consumed(), src.fileSize());
@@ -150,16 +160,22 @@ class ObjParser {
       end.normals += pieces[i].normals.size();
       coloured_ = coloured_ || !pieces[i].colors.empty();
     }
+    // The arrays grow without a pass over them (GrowArray); the pieces' records are copied in on all cores.
+    const size_t uncoloured = colors_.size();  // colours begin in this batch: white for the positions before
     positions_.resize(end.positions);
     texcoords_.resize(end.texcoords);
     normals_.resize(end.normals);
-    if (coloured_) colors_.resize(end.positions, glm::vec4(1.0f));  // white where a `v` had no colour
+    if (coloured_) colors_.resize(end.positions);
+    if (coloured_ && before.size())
+      std::fill(colors_.begin() + uncoloured, colors_.begin() + before[0].positions, glm::vec4(1.0f));
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) {
       objpiece::Piece& p = pieces[i];
       std::copy(p.positions.begin(), p.positions.end(), positions_.begin() + ptrdiff_t(before[i].positions));
       std::copy(p.texcoords.begin(), p.texcoords.end(), texcoords_.begin() + ptrdiff_t(before[i].texcoords));
       std::copy(p.normals.begin(), p.normals.end(), normals_.begin() + ptrdiff_t(before[i].normals));
-      if (coloured_) std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
+      if (coloured_ && p.colors.empty())  // white where a `v` had no colour
+        std::fill_n(colors_.begin() + ptrdiff_t(before[i].positions), p.positions.size(), glm::vec4(1.0f));
+      else if (coloured_) std::copy(p.colors.begin(), p.colors.end(), colors_.begin() + ptrdiff_t(before[i].positions));
       std::vector<glm::vec3>().swap(p.positions);
       std::vector<glm::vec4>().swap(p.colors);
       std::vector<glm::vec2>().swap(p.texcoords);
@@ -173,10 +189,9 @@ class ObjParser {
     };
     std::vector<Copy> copies;
     for (size_t i = 0; i < pieces.size(); ++i) replay(pieces[i], i, copies);
-    for (const Copy& c : copies) {  // grown geometrically: a mesh spread over many batches is moved rarely
-      std::vector<Corner>& v = builds_[c.mesh].corners;
-      if (v.capacity() < c.at + (c.end - c.first)) v.reserve(std::max(c.at + (c.end - c.first), 2 * v.capacity()));
-      if (v.size() < c.at + (c.end - c.first)) v.resize(c.at + (c.end - c.first));
+    for (const Copy& c : copies) {
+      GrowArray<Corner>& v = builds_[c.mesh].corners;
+      v.resize(std::max(v.size(), c.at + (c.end - c.first)));
     }
     parallelFor(copies.size(), opt_.threads, [&](size_t k) {
       const Copy& c = copies[k];
@@ -184,6 +199,7 @@ class ObjParser {
       std::copy(from.begin() + ptrdiff_t(c.first), from.begin() + ptrdiff_t(c.end),
                 builds_[c.mesh].corners.begin() + ptrdiff_t(c.at));
     });
+    parallelFor(pieces.size(), opt_.threads, [&](size_t i) { pieces[i] = objpiece::Piece(); });  // freed on all cores
   }
 
   template <class Copies>
@@ -312,9 +328,9 @@ class ObjParser {
   ObjStats& stats_;
   size_t line_ = 0;
 
-  std::vector<glm::vec3> positions_, normals_;
-  std::vector<glm::vec4> colors_;  // one per position once a `v` line has a colour; empty before
-  std::vector<glm::vec2> texcoords_;
+  GrowArray<glm::vec3> positions_, normals_;
+  GrowArray<glm::vec4> colors_;  // one per position once a `v` line has a colour; empty before
+  GrowArray<glm::vec2> texcoords_;
   std::vector<MeshBuild> builds_;
   std::unordered_map<uint64_t, uint32_t> meshIds_;
   std::vector<std::string> objectNames_;
@@ -354,8 +370,9 @@ Scene ObjParser::finish() {
   std::vector<Mesh> meshes(builds_.size());
   std::vector<WeldCounts> counts(builds_.size());
   auto weld = [&](size_t i, unsigned threads) {
-    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads);
-    std::vector<Corner>().swap(builds_[i].corners);
+    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads,
+                         [&] { builds_[i].corners.release(); });
+    builds_[i].corners.release();
   };
   const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };
   double all = 0, done = 0;  // corners
@@ -411,11 +428,15 @@ Scene parseObj(ByteSource& source, const std::string& name, const MtlReader& rea
   st.fileBytes = source.fileSize();
   ObjParser parser(name, readMtl, options, st, besideMtl);
   auto t0 = Clock::now();
+  std::clock_t c0 = std::clock();
   parser.run(source);
   st.parseSeconds = since(t0);
+  st.parseCpuSeconds = cpuSince(c0);
   t0 = Clock::now();
+  c0 = std::clock();
   Scene scene = parser.finish();
   st.weldSeconds = since(t0);
+  st.weldCpuSeconds = cpuSince(c0);
   return scene;
 }
 

@@ -36,6 +36,9 @@ struct ObjStats {
   size_t verticesAfterWeld = 0;
   size_t warnings = 0;  // all of them, also those not passed on to the sink
   double parseSeconds = 0, weldSeconds = 0;
+  double parseCpuSeconds = 0, weldCpuSeconds = 0;  // the process's CPU time (all threads): against the wall time,
+                                                   // how many cores the phase kept busy
+  double textWaitSeconds = 0;  // of parseSeconds: waiting for text (read, decompressed) that the parse did not hide
 };
 
 // Reads `file` (.obj, .obj.zst, .obj-zstd) and its MTL: options.mtl when given (an error when absent),

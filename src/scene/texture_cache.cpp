@@ -1,6 +1,9 @@
 #include "scene/texture_cache.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -22,6 +25,13 @@ constexpr char kMagic[8] = {'R', 'T', 'R', 'T', 'E', 'X', 'C', '1'};
 constexpr uint32_t kVersion = 1;
 constexpr size_t kHeader = 48;  // magic, version, params length, content, content bytes, body bytes, checksum
 constexpr char kExtension[] = ".rtrtex";
+// A file's content key remembered under its path, size, modification time and inode: RTRKEY1\0, checksum64
+// of the rest, then the file's identity (that string), its content checksum64 and length.
+constexpr char kKeyMagic[8] = {'R', 'T', 'R', 'K', 'E', 'Y', '1', '\0'};
+constexpr char kKeyExtension[] = ".rtrkey";
+// A file modified less than this long ago is hashed every time: a later write within the file system's time
+// granularity could keep its size and modification time.
+constexpr int64_t kSettledNs = 2'000'000'000;
 // Bumped when the decoders' texels for the same bytes change (the image library, the channel pick).
 constexpr char kDecoder[] = "decode 1";
 
@@ -73,22 +83,69 @@ std::unique_ptr<TextureCache> TextureCache::fromEnvironment() {
   return std::make_unique<TextureCache>(dir, mib << 20);
 }
 
-bool TextureCache::key(const Scene& scene, const Texture& t, const std::string& variant, TextureCacheKey& out) const {
-  std::vector<uint8_t> file;
-  std::span<const uint8_t> bytes;
+bool TextureCache::key(const Scene& scene, const Texture& t, const std::string& variant, TextureCacheKey& out) {
   if (t.bytes) {
-    bytes = *t.bytes;
-  } else {
-    try {
-      file = readFileBytes(t.path.is_absolute() ? t.path : scene.baseDir / t.path);
-    } catch (const Error&) { return false; }
-    bytes = file;
+    out.content = checksum64(*t.bytes);
+    out.contentBytes = t.bytes->size();
+    ++counts_.hashed;
+  } else if (!fileKey(t.path.is_absolute() ? t.path : scene.baseDir / t.path, out)) {
+    return false;
   }
-  out.content = checksum64(bytes);
-  out.contentBytes = bytes.size();
   out.params = std::string(kDecoder) + "; channels " + std::to_string(decodeChannels(t)) + "; pick " +
                std::to_string(decodeChannels(t) == 1 ? t.sourceChannel : 0) + "; srgb " + std::to_string(decodeSrgb(t)) + "; " +
                variant;
+  return true;
+}
+
+// The content key of an image file: remembered from an earlier open while the file's path, size,
+// modification time and inode are unchanged (no read, no hash), else read and hashed (and remembered once
+// the file has not changed for kSettledNs).
+bool TextureCache::fileKey(const fs::path& file, TextureCacheKey& out) {
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) return false;
+  std::error_code ec;
+  std::string id = fs::absolute(file, ec).string();
+  for (const int64_t v :
+       {int64_t(st.st_size), int64_t(st.st_mtim.tv_sec), int64_t(st.st_mtim.tv_nsec), int64_t(st.st_ino), int64_t(st.st_dev)})
+    id += '\0' + std::to_string(v);
+  const fs::path alias = dir_ / (hex(checksumOf(id)) + kKeyExtension);
+  const size_t body = id.size() + 16;
+  try {
+    const std::vector<uint8_t> a = readFileBytes(alias);
+    uint64_t sum = 0;
+    if (a.size() == 16 + body && std::memcmp(a.data(), kKeyMagic, 8) == 0 &&
+        (std::memcpy(&sum, a.data() + 8, 8), sum == checksum64(std::span(a).subspan(16))) &&
+        std::memcmp(a.data() + 16, id.data(), id.size()) == 0) {
+      std::memcpy(&out.content, a.data() + 16 + id.size(), 8);
+      std::memcpy(&out.contentBytes, a.data() + 24 + id.size(), 8);
+      if (out.contentBytes == uint64_t(st.st_size)) {
+        ++counts_.remembered;
+        return true;
+      }
+    }
+  } catch (const Error&) {}  // none yet (or unreadable): hashed below
+  std::vector<uint8_t> bytes;
+  try {
+    bytes = readFileBytes(file);
+  } catch (const Error&) { return false; }
+  out.content = checksum64(bytes);
+  out.contentBytes = bytes.size();
+  ++counts_.hashed;
+  timespec now{};
+  ::clock_gettime(CLOCK_REALTIME, &now);
+  if ((int64_t(now.tv_sec) - st.st_mtim.tv_sec) * 1'000'000'000 + (now.tv_nsec - st.st_mtim.tv_nsec) < kSettledNs ||
+      bytes.size() != uint64_t(st.st_size))
+    return true;
+  std::string a(16, '\0');
+  std::memcpy(a.data(), kKeyMagic, 8);
+  a += id;
+  a.append(reinterpret_cast<const char*>(&out.content), 8).append(reinterpret_cast<const char*>(&out.contentBytes), 8);
+  const uint64_t sum = checksum64({reinterpret_cast<const uint8_t*>(a.data()) + 16, body});
+  std::memcpy(a.data() + 8, &sum, 8);
+  try {
+    fs::create_directories(dir_);
+    writeFileAtomic(alias, a);
+  } catch (const std::exception& e) { note(alias.string() + ": not written: " + e.what()); }
   return true;
 }
 
@@ -100,8 +157,11 @@ std::shared_ptr<const BakedTexels> TextureCache::find(const TextureCacheKey& key
     return nullptr;
   }
   try {
-    auto bytes = std::make_shared<std::vector<uint8_t>>(readFileBytes(file));
-    ByteReader r(*bytes, file.string());
+    // Mapped, not read: the chain's pieces are unpacked from the page cache straight into staging memory.
+    // Safe beside other processes: entries are replaced by a rename, never rewritten in place.
+    const auto mapped = std::make_shared<const MappedFile>(file, "texture cache entry");
+    const std::span<const uint8_t> bytes = mapped->bytes();
+    ByteReader r(bytes, file.string());
     char magic[8];
     r.raw(magic, 8, "the entry's header");
     if (std::memcmp(magic, kMagic, 8) != 0) r.failAt(0, "not a texture cache entry");
@@ -109,9 +169,9 @@ std::shared_ptr<const BakedTexels> TextureCache::find(const TextureCacheKey& key
     const uint32_t paramsBytes = r.u32("the entry's header");
     const uint64_t content = r.pod<uint64_t>("the entry's header"), contentBytes = r.pod<uint64_t>("the entry's header");
     const uint64_t size = r.pod<uint64_t>("the entry's header"), sum = r.pod<uint64_t>("the entry's header");
-    if (size != bytes->size() - kHeader) r.failAt(32, "truncated or padded");
+    if (size != bytes.size() - kHeader) r.failAt(32, "truncated or padded");
 #ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION  // the fuzzer reaches the parser behind it
-    if (checksum64(std::span<const uint8_t>(*bytes).subspan(kHeader)) != sum) r.failAt(40, "checksum mismatch");
+    if (checksum64(bytes.subspan(kHeader)) != sum) r.failAt(40, "checksum mismatch");
 #else
     (void)sum;
 #endif
@@ -119,7 +179,7 @@ std::shared_ptr<const BakedTexels> TextureCache::find(const TextureCacheKey& key
       r.failAt(16, "made for another image");  // a file-name clash: it is replaced by this image's entry
     r.align(16, "the entry's key");
     Scene one = oneTexture(uint32_t(decodeChannels(t)));
-    readTexs(r, bytes->size(), *bytes, one, bytes, file.string());
+    readTexs(r, bytes.size(), bytes, one, mapped, file.string());
     std::shared_ptr<const BakedTexels> chain = one.textures[0].baked;
     if (bakedBlocks(chain->format)) r.failAt(kHeader, "block-compressed texels");
     fs::last_write_time(file, fs::file_time_type::clock::now(), ec);  // its last use, for the size bound
@@ -174,7 +234,7 @@ void TextureCache::trim() {
       removeStaleTemporaries(dir_ / name.substr(1, tmp - 1));  // what a killed writer left
       continue;
     }
-    if (p.extension() != kExtension) continue;
+    if (p.extension() != kExtension && p.extension() != kKeyExtension) continue;
     std::error_code e1, e2;
     const uint64_t bytes = it->file_size(e1);
     const fs::file_time_type used = it->last_write_time(e2);

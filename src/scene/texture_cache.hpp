@@ -34,6 +34,8 @@ struct TextureCacheKey {
 
 struct TextureCacheCounts {
   std::atomic<uint32_t> hits{0}, misses{0}, stored{0}, damaged{0}, evicted{0};
+  std::atomic<uint32_t> hashed{0};      // keys made by reading and hashing the image's bytes
+  std::atomic<uint32_t> remembered{0};  // keys of files unchanged since an earlier open: neither read nor hashed
 };
 
 class TextureCache {
@@ -49,8 +51,11 @@ class TextureCache {
   uint64_t maxBytes() const { return maxBytes_; }
 
   // The key of texture `t` of `scene` (its file, or its bytes held in memory), for chains made as `variant`
-  // says. False when the image cannot be read (the decoder then says why).
-  bool key(const Scene& scene, const Texture& t, const std::string& variant, TextureCacheKey& out) const;
+  // says. False when the image cannot be read (the decoder then says why). A file's content checksum is
+  // remembered in the folder (a small *.rtrkey record) under its path, size, modification time and inode,
+  // so that the next open of an unchanged file neither reads nor hashes it; a file modified in the last two
+  // seconds is hashed every time. Thread-safe.
+  bool key(const Scene& scene, const Texture& t, const std::string& variant, TextureCacheKey& out);
 
   // The entry's chain (lossless, the channels of `t`'s slot), its use recorded; null when there is none or
   // it is damaged (then removed, one note on stderr). Counts a hit or a miss. Thread-safe.
@@ -64,6 +69,7 @@ class TextureCache {
   const TextureCacheCounts& counts() const { return counts_; }
 
  private:
+  bool fileKey(const std::filesystem::path& file, TextureCacheKey& out);
   std::filesystem::path dir_;
   uint64_t maxBytes_;
   TextureCacheCounts counts_;

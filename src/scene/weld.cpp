@@ -38,16 +38,15 @@ inline uint64_t cellHash(int64_t x, int64_t y, int64_t z) {
   return mix(uint64_t(x) * 0x9E3779B97F4A7C15ull ^ mix(uint64_t(y) + 0x632BE59BD9B4E019ull) ^ (uint64_t(z) << 1));
 }
 
-struct Vertex {
+struct Vertex {  // its colour, when the file has colours, is held apart: most files have none
   glm::vec3 p, n;
   glm::vec2 t;
-  glm::vec4 c;  // vertex colour; 0 when the file has none
 };
 
 inline bool near(const Vertex& a, const Vertex& b) {
   auto c = [](float x, float y) { return std::fabs(x - y) <= kWeldTolerance; };
   return c(a.p.x, b.p.x) && c(a.p.y, b.p.y) && c(a.p.z, b.p.z) && c(a.n.x, b.n.x) && c(a.n.y, b.n.y) && c(a.n.z, b.n.z) &&
-         c(a.t.x, b.t.x) && c(a.t.y, b.t.y) && a.c == b.c;
+         c(a.t.x, b.t.x) && c(a.t.y, b.t.y);
 }
 
 // The cells a vertex looks in for its neighbours: its own, and the next one along an axis where it lies
@@ -87,7 +86,8 @@ std::unique_ptr<T[]> uninitialised(size_t n) {
 
 // Items grouped by key, each group's items in increasing order: group g holds items[start[g], start[g + 1]).
 struct Groups {
-  std::vector<uint32_t> start{0}, items;
+  std::vector<uint32_t> start{0};
+  std::unique_ptr<uint32_t[]> items;
   size_t count() const { return start.size() - 1; }
 };
 
@@ -101,7 +101,7 @@ Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool den
     for (size_t i = 0; i < n; ++i)
       if (const uint32_t k = key(i); k != kAbsent) pairs.push_back(uint64_t(k) << 32 | i);
     std::sort(pairs.begin(), pairs.end());
-    g.items.resize(pairs.size());
+    g.items = uninitialised<uint32_t>(pairs.size());
     for (size_t j = 0; j < pairs.size(); ++j) {
       if (j > 0 && pairs[j] >> 32 != pairs[j - 1] >> 32) g.start.push_back(uint32_t(j));
       g.items[j] = uint32_t(pairs[j]);
@@ -124,14 +124,14 @@ Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool den
     for (size_t p = 0; p < pieces; ++p) sum += std::exchange(at[p * shards + s], sum);
   }
   shardStart[shards] = sum;
-  std::vector<uint32_t> byShard(sum);
+  auto byShard = uninitialised<uint32_t>(sum);
   forPieces(n, threads, [&](size_t p, size_t b, size_t e) {
     uint32_t* c = &at[p * shards];
     for (size_t i = b; i < e; ++i)
       if (const uint32_t k = key(i); k != kAbsent) byShard[c[k / kPiece]++] = uint32_t(i);
   });
   g.start.resize(keys + 1);
-  g.items.resize(sum);
+  g.items = uninitialised<uint32_t>(sum);
   parallelFor(shards, threads, [&](size_t s) {
     const size_t k0 = s * kPiece, k1 = std::min(keys, k0 + kPiece);
     std::vector<uint32_t> c(k1 - k0, 0);
@@ -155,12 +155,14 @@ size_t prefix(std::vector<size_t>& v) {
 
 WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors,
-                    unsigned threads) {
+                    unsigned threads, const std::function<void()>& cornersDone) {
   WeldCounts counts;
   const size_t triCount = corners.size() / 3, cornerCount = triCount * 3;
 
   // 1. Drop triangles with a repeated corner position or zero area.
-  std::vector<uint8_t> keep(triCount, 0);
+  // Large arrays are left unset where every element is written before it is read: the threads that
+  // write them touch their pages first, instead of one thread clearing them.
+  auto keep = uninitialised<uint8_t>(triCount);
   struct Piece {
     size_t kept = 0;
     bool needNormals = false, hasTex = false;
@@ -173,8 +175,8 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       const Corner* c = &corners[t * 3];
       const glm::vec3 a = positions[c[0].p], bb = positions[c[1].p], d = positions[c[2].p];
       const glm::vec3 x = glm::cross(bb - a, d - a);
-      if (c[0].p == c[1].p || c[1].p == c[2].p || c[0].p == c[2].p || !(glm::dot(x, x) > 0.0f)) continue;
-      keep[t] = 1;
+      keep[t] = !(c[0].p == c[1].p || c[1].p == c[2].p || c[0].p == c[2].p || !(glm::dot(x, x) > 0.0f));
+      if (!keep[t]) continue;
       ++s.kept;
       for (int k = 0; k < 3; ++k) {
         s.needNormals |= c[k].n == kAbsent;
@@ -203,7 +205,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   if (counts.triangles == 0) return counts;
 
   // The kept corners at each position, in order.
-  const Groups atPos = groupBy(
+  Groups atPos = groupBy(
       cornerCount, size_t(pmax - pmin) + 1, threads, [&](size_t c) { return keep[c / 3] ? corners[c].p - pmin : kAbsent; },
       false);
 
@@ -214,7 +216,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   std::vector<glm::vec3> gen;
   std::unique_ptr<uint32_t[]> genOf;
   if (needNormals) {
-    std::vector<glm::vec3> cross(triCount);
+    auto cross = uninitialised<glm::vec3>(triCount);  // set for kept triangles, the only ones read
     forPieces(triCount, threads, [&](size_t, size_t b, size_t e) {
       for (size_t t = b; t < e; ++t) {
         const Corner* c = &corners[t * 3];
@@ -230,16 +232,19 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     genOf = uninitialised<uint32_t>(cornerCount);
     std::vector<std::vector<glm::vec3>> made(piecesOf(atPos.count()));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
+      std::vector<glm::vec3> units;  // of the faces at this position
       for (size_t g = b; g < e; ++g) {
-        const uint32_t *first = atPos.items.data() + atPos.start[g], *last = atPos.items.data() + atPos.start[g + 1];
+        const uint32_t *first = atPos.items.get() + atPos.start[g], *last = atPos.items.get() + atPos.start[g + 1];
         const size_t here = made[p].size();  // the normals made at this position so far
+        units.clear();
+        for (const uint32_t* c = first; c != last; ++c) units.push_back(unit(cross[*c / 3]));
         for (const uint32_t* c = first; c != last; ++c) {
           if (corners[*c].n != kAbsent) continue;
           const size_t t = *c / 3;
-          const glm::vec3 own = unit(cross[t]);
+          const glm::vec3 own = units[size_t(c - first)];
           glm::vec3 sum(0.0f);
           for (const uint32_t* o = first; o != last; ++o)
-            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, unit(cross[*o / 3])) >= cosCrease)) sum += cross[*o / 3];
+            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, units[size_t(o - first)]) >= cosCrease)) sum += cross[*o / 3];
           const glm::vec3 n = unit(sum);
           size_t k = here;
           while (k < made[p].size() && made[p][k] != n) ++k;
@@ -280,6 +285,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       }
     }
   });
+  atPos = Groups();
   const size_t cornerPieces = piecesOf(cornerCount);
   std::vector<size_t> firsts(cornerPieces, 0);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
@@ -302,8 +308,9 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
   // else is kept. A vertex with no earlier vertex near it at all is kept for sure, which all cores decide
   // at once; the rest (rare: near but not equal) are decided in order afterwards.
-  std::vector<Vertex> verts(uniqCount);
-  std::vector<uint32_t> slotOf(uniqCount);
+  auto verts = uninitialised<Vertex>(uniqCount);
+  auto vcolor = uninitialised<glm::vec4>(colors.empty() ? 0 : uniqCount);
+  auto slotOf = uninitialised<uint32_t>(uniqCount);
   size_t cap = 16;  // the hash slots one thread would use: their collisions decide which vertex is found first
   while (cap < uniqCount * 2) cap <<= 1;
   const size_t mask = cap - 1, buckets = std::max<size_t>(16, cap / 4);
@@ -314,15 +321,19 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       v.p = positions[c.p];
       v.n = c.n < normals.size() ? normals[c.n] : gen[c.n - normals.size()];
       v.t = c.t != kAbsent ? texcoords[c.t] : glm::vec2(0.0f);
-      v.c = colors.empty() ? glm::vec4(0.0f) : colors[c.p];
+      if (!colors.empty()) vcolor[u] = colors[c.p];
       const Around a(v.p);
       slotOf[u] = uint32_t(cellHash(a.cell[0], a.cell[1], a.cell[2]) & mask);
     }
   });
   uniq.reset();
-  const Groups inBucket = groupBy(
+  if (cornersDone) cornersDone();  // from here on only `keep` and the ids are read
+  genOf.reset();
+  std::vector<glm::vec3>().swap(gen);
+  auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
+  Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
-  std::vector<uint8_t> kept(uniqCount);
+  auto kept = uninitialised<uint8_t>(uniqCount);
   auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
   std::vector<std::vector<uint32_t>> open(piecesOf(uniqCount));
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
@@ -330,11 +341,12 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       const bool near_ = Around(verts[u].p).any([&](uint64_t h) {
         const size_t k = h & (buckets - 1);
         for (uint32_t i = inBucket.start[k]; i < inBucket.start[k + 1] && inBucket.items[i] < u; ++i)
-          if (near(verts[inBucket.items[i]], verts[u])) return true;
+          if (isNear(inBucket.items[i], uint32_t(u))) return true;
         return false;
       });
+      kept[u] = !near_;
       if (near_) open[p].push_back(uint32_t(u));
-      else kept[u] = 1, target[u] = uint32_t(u);
+      else target[u] = uint32_t(u);
     }
   });
   for (const std::vector<uint32_t>& list : open)
@@ -345,13 +357,15 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
         const size_t k = slot & (buckets - 1);
         for (uint32_t i = inBucket.start[k + 1]; i-- > inBucket.start[k];) {
           const uint32_t w = inBucket.items[i];
-          if (w < u && kept[w] && slotOf[w] == slot && near(verts[w], verts[u])) return found = w, true;
+          if (w < u && kept[w] && slotOf[w] == slot && isNear(w, u)) return found = w, true;
         }
         return false;
       });
       if (found == kAbsent) kept[u] = 1, found = u;
       target[u] = found;
     }
+  inBucket = Groups();
+  slotOf.reset();
   std::vector<size_t> keptBefore(piecesOf(uniqCount), 0);
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) keptBefore[p] += kept[u];
@@ -377,11 +391,13 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       out.positions[r] = verts[u].p;
       out.normals[r] = verts[u].n;
       if (hasTex) out.texcoords[r] = verts[u].t;
-      if (!colors.empty()) out.colors[r] = verts[u].c;
+      if (!colors.empty()) out.colors[r] = vcolor[u];
       bounds[p].extend(verts[u].p);
     }
   });
   for (const Bounds& b : bounds) out.bounds.extend(b);
+  verts.reset();
+  vcolor.reset();
   // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
   auto corner = [&](size_t c) { return keptId[target[vertexOf[c]]]; };
   std::vector<size_t> written(pieces.size(), 0);

@@ -3,6 +3,7 @@
 // dropped, area-weighted normals generated where a corner has none (split at a crease angle), vertices
 // welded within 1e-5.
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include "scene/scene.hpp"
@@ -29,9 +30,10 @@ constexpr float kDefaultCreaseDeg = 40.0f;
 // `corners` holds 3 per triangle. Fills out.positions/normals/texcoords/colors/indices/bounds (not name or
 // material). A generated normal averages the faces at its position within `creaseDeg` of its own face (0:
 // flat, 180: smooth). `colors`: one per position, or empty. Runs on `threads` (0: all cores) in fixed
-// pieces: the mesh is the same for any thread count.
+// pieces: the mesh is the same for any thread count. `cornersDone`, when given, is called once `corners`
+// is read no more, before the mesh is made: its owner may free it there (memory at a large bake's peak).
 WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg = kDefaultCreaseDeg,
-                    std::span<const glm::vec4> colors = {}, unsigned threads = 1);
+                    std::span<const glm::vec4> colors = {}, unsigned threads = 1, const std::function<void()>& cornersDone = {});
 
 }  // namespace rtr

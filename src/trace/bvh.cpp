@@ -678,14 +678,14 @@ void HugeArray<T>::Free::operator()(T* p) const {
 template class HugeArray<Node>;
 template class HugeArray<TriPack>;
 
-#define RTR_DECLARE_TRAVERSAL(ns)                                                                   \
-  namespace ns {                                                                                    \
-  bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);                                \
-  bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&);                               \
-  unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*);                        \
-  unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*);                       \
-  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int, int);  \
-  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int, int); \
+#define RTR_DECLARE_TRAVERSAL(ns)                                                              \
+  namespace ns {                                                                               \
+  bool closest(const Bvh::View&, const Ray&, IntersectMethod, Hit&);                           \
+  bool occluded(const Bvh::View&, const Ray&, IntersectMethod, Hit&);                          \
+  unsigned closestPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*);                   \
+  unsigned occludedPair(const Bvh::View&, const Ray*, IntersectMethod, Hit*);                  \
+  unsigned closestPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int);  \
+  unsigned occludedPacket(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int); \
   }
 RTR_DECLARE_TRAVERSAL(sse)
 RTR_DECLARE_TRAVERSAL(avx2)
@@ -700,8 +700,8 @@ struct Traversal {
   bool (*occluded)(const Bvh::View&, const Ray&, IntersectMethod, Hit&);
   unsigned (*closestPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
   unsigned (*occludedPair)(const Bvh::View&, const Ray*, IntersectMethod, Hit*);
-  unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int, int);
-  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int, int);
+  unsigned (*closestPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int);
+  unsigned (*occludedPacket)(const Bvh::View&, const Ray*, int, IntersectMethod, Hit*, int, int);
 };
 #define RTR_TRAVERSAL(ns) \
   { ns::closest, ns::occluded, ns::closestPair, ns::occludedPair, ns::closestPacket, ns::occludedPacket }
@@ -710,9 +710,7 @@ constexpr Traversal kCounted = RTR_TRAVERSAL(counted);
 std::atomic<bool> counting{false};
 std::atomic<int> packetLeafRays{Bvh::kPacketLeafRays};
 std::atomic<int> packetAloneRays[3] = {Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]};
-std::atomic<int> packetAloneInFlight{Bvh::kPacketAloneInFlight};
 int aloneRays(int kind) { return packetAloneRays[kind].load(std::memory_order_relaxed); }
-int aloneInFlight() { return packetAloneInFlight.load(std::memory_order_relaxed); }
 thread_local BvhCounters threadCounters;
 #undef RTR_TRAVERSAL
 }  // namespace
@@ -751,7 +749,6 @@ void Bvh::setPacketAloneRays(int coherent, int scattered, int shadow) {
   packetAloneRays[1] = scattered;
   packetAloneRays[2] = shadow;
 }
-void Bvh::setPacketAloneInFlight(int n) { packetAloneInFlight = n; }
 BvhCounters& Bvh::counters() { return threadCounters; }
 
 namespace {
@@ -804,7 +801,7 @@ void Bvh::closest8(const Ray* rays, int n, Hit* hits, IntersectMethod method, Pa
   const View v{nodes_.data(), packs_.data(), root_};
   // Rays with a near-tie between two candidates are traced again alone (bvh_packet.inl).
   for (unsigned retry = tr.closestPacket(v, rays, std::min(n, 8), method, hits, packetLeafRays.load(std::memory_order_relaxed),
-                                         aloneRays(int(kind)), aloneInFlight());
+                                         aloneRays(int(kind)));
        retry; retry &= retry - 1) {
     const int i = __builtin_ctz(retry);
     if (&tr == &kCounted) ++threadCounters.retries;
@@ -818,7 +815,7 @@ unsigned Bvh::occluded8(const Ray* rays, int n, IntersectMethod method) const {
   if (n == 1) return unsigned(occluded(rays[0], method));
   Hit scratch[8];
   return traversal().occludedPacket({nodes_.data(), packs_.data(), root_}, rays, std::min(n, 8), method, scratch,
-                                    packetLeafRays.load(std::memory_order_relaxed), aloneRays(2), aloneInFlight());
+                                    packetLeafRays.load(std::memory_order_relaxed), aloneRays(2));
 }
 
 }  // namespace rtr::trace

@@ -118,11 +118,6 @@ class Bvh {
   // round 12). For tests and benchmarks: setPacketAloneRays.
   static constexpr int kPacketAloneRays[3] = {1, 4, 4};
   static void setPacketAloneRays(int coherent, int scattered, int shadow);
-  // How many of those lone walks run interleaved, one node or leaf of each in turn: 2 (pairs; an odd
-  // ray alone) or 4 (three or four rays at once: more memory requests in flight). For tests and
-  // benchmarks (docs/bench/trace.md, round 13): setPacketAloneInFlight.
-  static constexpr int kPacketAloneInFlight = 2;
-  static void setPacketAloneInFlight(int n);
   // Counting (tests and benchmarks): while on, every query of this process runs the counting traversal
   // (the AVX2 code, slower; no counting on a CPU without AVX2) and adds to its thread's counters.
   static void setCounting(bool on);

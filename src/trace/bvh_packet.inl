@@ -97,7 +97,7 @@ struct PacketWalker {
   F shO[3], shS[3];
   int kx = 0, ky = 0, kz = 0;
   bool sameShear = true, sheared = false;
-  const int nRays, leafRays, aloneRays, inFlight;  // Bvh::kPacketLeafRays, kPacketAloneRays, kPacketAloneInFlight
+  const int nRays, leafRays, aloneRays;  // Bvh::kPacketLeafRays, kPacketAloneRays
 #if RTR_BVH_AVX2
   // The packet's interval: per axis, bounds over its rays of the slab constants, for one conservative
   // test of a node's eight children at once (lanes = children) before each child is tested against the
@@ -116,22 +116,19 @@ struct PacketWalker {
   // (on the temple most packets miss after a node or two, and eight set-ups cost more than the walk)
   RTR_INLINE const W& walker(int i) {
     if (!(built >> i & 1)) {
+#if RTR_BVH_AVX2
+      new (walkers[i]) W(bvh, rays[i], method, i, oAxis, rNear, qNear, rFar, qFar, neg);
+#else
       new (walkers[i]) W(bvh, rays[i], method);
+#endif
       built |= 1u << i;
     }
     return *reinterpret_cast<const W*>(walkers[i]);
   }
 
   RTR_INLINE PacketWalker(const Bvh::View& view, const Ray* r, int n, const PacketRays& pr, Hit* h, IntersectMethod m,
-                          int minLeafRays, int maxAloneRays, int aloneInFlight)
-      : bvh(view),
-        rays(r),
-        hits(h),
-        nRays(n),
-        leafRays(minLeafRays),
-        aloneRays(maxAloneRays),
-        inFlight(aloneInFlight),
-        method(m) {
+                          int minLeafRays, int maxAloneRays)
+      : bvh(view), rays(r), hits(h), nRays(n), leafRays(minLeafRays), aloneRays(maxAloneRays), method(m) {
     store(tMax, pr.tMax);
     store(cull, pr.tMax);
     store(best, set1(kInf));
@@ -377,7 +374,7 @@ struct PacketWalker {
       const F T = U * (w.sz * Az) + V * (w.sz * Bz) + W3 * (w.sz * Cz);
       const F detSign = det & signBit;
       const F Ts = T ^ detSign;
-      m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));
+      m &= bits(gt(Ts, zero) & lt(Ts, tLimit * (det ^ detSign)));  // det ≠ 0 here: Walker::testLeaf
       if (m) {
         const F inv = set1(1.0f) / det;
         alignas(32) float tv[8], iv[8], vv[8], wv[8];
@@ -422,7 +419,7 @@ struct PacketWalker {
     o.T = U * (shS[2] * Az) + V * (shS[2] * Bz) + W3 * (shS[2] * Cz);
     const F detSign = o.det & signBit;
     const F Ts = o.T ^ detSign;
-    o.m &= bits(neq(o.det, zero) & gt(Ts, zero) & lt(Ts, tLimit * (o.det ^ detSign)));
+    o.m &= bits(gt(Ts, zero) & lt(Ts, tLimit * (o.det ^ detSign)));  // det ≠ 0 here: Walker::testLeaf
     o.V = V;
     o.W3 = W3;
     return true;
@@ -549,35 +546,6 @@ struct PacketWalker {
     }
   }
 
-  // The three or four rays of `mask` alone from node or leaf `ref` on, one node or leaf of each in turn
-  // (alonePair's rule with more walks in flight: more memory requests outstanding at once). Any hit:
-  // returns the rays found occluded.
-  RTR_INLINE unsigned aloneGroup(unsigned mask, uint32_t ref) {
-    int id[4], k = 0;
-    const W* w[4];
-    uint64_t stacks[4][kStackSize];
-    Cursor at[4];
-    for (; mask && k < 4; mask &= mask - 1, ++k) {
-      id[k] = ctz(mask);
-      w[k] = &walker(id[k]);
-      at[k] = {0, ref, AnyHit ? tMax[id[k]] : cull[id[k]], false};
-    }
-    RTR_COUNT(c.lone += unsigned(k));
-    unsigned live = (1u << k) - 1, done = 0;
-    [[maybe_unused]] Hit scratch;
-    while (live)
-      for (unsigned m = live; m; m &= m - 1) {
-        const int j = ctz(m);
-        bool more;
-        if constexpr (AnyHit) more = w[j]->step(stacks[j], at[j], scratch);
-        else more = aloneStep(id[j], *w[j], stacks[j], at[j]);
-        if (more) continue;
-        live &= ~(1u << j);
-        if (at[j].found) done |= 1u << id[j];
-      }
-    return done;
-  }
-
   // Walks the packet; any hit: returns the occluded rays; closest hit: the rays to trace again alone.
   RTR_INLINE unsigned run(unsigned active) {
     PacketEntry stack[kStackSize];
@@ -587,16 +555,6 @@ struct PacketWalker {
     for (;;) {
       for (;;) {
         if (__builtin_popcount(active) <= aloneRays) {  // too few rays to share the work
-          if (inFlight >= 4 && __builtin_popcount(active) >= 3) {
-            while (active) {  // four at a time
-              unsigned four = active;
-              for (int k = 0; k < 4 && four; ++k) four &= four - 1;
-              four = active & ~four;
-              done |= aloneGroup(four, ref);
-              active &= ~four;
-            }
-            break;
-          }
           while (active) {
             const int i = ctz(active);
             active &= active - 1;
@@ -653,9 +611,9 @@ struct PacketWalker {
 
 template <bool AnyHit, unsigned Parallel>
 unsigned walkPacket(const Bvh::View& bvh, const Ray* rays, int n, const PacketRays& pr, IntersectMethod method, Hit* hits,
-                    int leafRays, int aloneRays, int inFlight) {
+                    int leafRays, int aloneRays) {
   RTR_COUNT(c.packets += 1);
-  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays, aloneRays, inFlight);
+  PacketWalker<AnyHit, Parallel> p(bvh, rays, n, pr, hits, method, leafRays, aloneRays);
   return p.run((1u << n) - 1);
 }
 

@@ -234,11 +234,41 @@ struct Walker {
       farOff[a] = ((1 - nearSide) * 3 + a) * 8;
     }
 #endif
-    // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
-    // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
-    // must shear identically), inline here and sharing the reciprocal with the slab test.
+    initShear(o, d, rcp);
+  }
+
+#if RTR_BVH_AVX2
+  // The same walk for lane i of a packet (PacketWalker), whose constructor made these slab constants
+  // with the operations above, eight rays at a time: a lone ray's set-up without its slab arithmetic
+  // (a shadow packet on the sphere hands ten rays a packet to lone walks).
+  RTR_INLINE Walker(const Bvh::View& view, const Ray& r, IntersectMethod m, int i, const F* o3, const F* rn, const F* qn,
+                    const F* rf, const F* qf, const F* negative)
+      : bvh(view), ray(r), method(m) {
+    const __m256i idx = _mm256_set1_epi32(i);
+    auto laneOf = [&](F v) { return F{_mm256_permutevar8x32_ps(v.v, idx)}; };
+    for (int a = 0; a < 3; ++a) {
+      oAxis[a] = laneOf(o3[a]);
+      rNear[a] = laneOf(rn[a]);
+      qNear[a] = laneOf(qn[a]);
+      rFar[a] = laneOf(rf[a]);
+      qFar[a] = laneOf(qf[a]);
+      const int nearSide = bits(negative[a]) >> i & 1;
+      nearOff[a] = (nearSide * 3 + a) * 8;
+      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+    }
+    const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+    const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+    initShear(o, d, nullptr);
+  }
+#endif
+
+  // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
+  // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
+  // must shear identically), inline here and sharing the reciprocal with the slab test (rcp; null: one
+  // division here, the same).
+  RTR_INLINE void initShear(const float* o, const float* d, const float* rcp) {
     shearAxes(d, 1, kx, ky, kz);
-    const float szs = rcp[kz];
+    const float szs = rcp ? rcp[kz] : 1.0f / d[kz];
     ox = set1(o[kx]);
     oy = set1(o[ky]);
     oz = set1(o[kz]);
@@ -376,7 +406,8 @@ struct Walker {
       const F cx = (load(pk.v[2][kx]) - ox) - sx * Cz, cy = (load(pk.v[2][ky]) - oy) - sy * Cz;
       const F U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
       // Inside: U, V, W of one sign. Lanes with a zero go to the edge path; a NaN lane that passes
-      // here fails the t test below (as in the scalar routine, where it fails here).
+      // here fails the t test below (as in the scalar routine, where it fails here). So det, a sum of
+      // nonzero terms of one sign, is never zero on these lanes: no test for it.
       // Exactly on an edge in float: the scalar routine decides in double.
       unsigned edge = bits(eq(U, zero) | eq(V, zero) | eq(W, zero));
       unsigned m = ~bits((U ^ V) | (V ^ W)) & 0xFFu & ~edge;
@@ -385,7 +416,7 @@ struct Walker {
       const F T = U * (sz * Az) + V * (sz * Bz) + W * (sz * Cz);
       const F detSign = det & signBit;
       const F Ts = T ^ detSign;
-      m &= bits(neq(det, zero) & gt(Ts, zero) & lt(Ts, tHitV * (det ^ detSign)));
+      m &= bits(gt(Ts, zero) & lt(Ts, tHitV * (det ^ detSign)));
       if constexpr (AnyHit) {
         const unsigned casters = ~topBits(pk.prim);
         if (m & casters) return true;
@@ -537,7 +568,7 @@ unsigned dispatchPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
 // again alone (ties, see bvh_packet.inl). Any hit: returns the occluded rays.
 template <bool AnyHit>
 unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays,
-                        int aloneRays, int inFlight) {
+                        int aloneRays) {
   bool same = method == IntersectMethod::Watertight && n > 1;
   const PacketRays pr = gatherRays(rays, n);
   unsigned p = 0;  // the axes every ray runs parallel to; same: no ray is parallel to another
@@ -547,13 +578,13 @@ unsigned dispatchPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectM
     else if (zero) same = false;
   }
   switch (same ? p : 8u) {
-    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
-    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, pr, method, hits, leafRays, aloneRays, inFlight);
+    case 0: return walkPacket<AnyHit, 0>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 1: return walkPacket<AnyHit, 1>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 2: return walkPacket<AnyHit, 2>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 3: return walkPacket<AnyHit, 3>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 4: return walkPacket<AnyHit, 4>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 5: return walkPacket<AnyHit, 5>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
+    case 6: return walkPacket<AnyHit, 6>(bvh, rays, n, pr, method, hits, leafRays, aloneRays);
     case 7: return 0;
     default: {
       unsigned m = 0;
@@ -576,12 +607,12 @@ unsigned occludedPair(const Bvh::View& bvh, const Ray* rays, IntersectMethod met
   return dispatchPair<true>(bvh, rays, method, scratch);
 }
 unsigned closestPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* hits, int leafRays,
-                       int aloneRays, int inFlight) {
-  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays, aloneRays, inFlight);
+                       int aloneRays) {
+  return dispatchPacket<false>(bvh, rays, n, method, hits, leafRays, aloneRays);
 }
 unsigned occludedPacket(const Bvh::View& bvh, const Ray* rays, int n, IntersectMethod method, Hit* scratch, int leafRays,
-                        int aloneRays, int inFlight) {
-  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays, aloneRays, inFlight);
+                        int aloneRays) {
+  return dispatchPacket<true>(bvh, rays, n, method, scratch, leafRays, aloneRays);
 }
 
 }  // namespace rtr::trace::RTR_BVH_ISA

@@ -15,7 +15,7 @@
 
 namespace rtr::reftest {
 
-ImageF splitSumCase(const ReferenceScene& rs, const PoseEntry& pe, const PairOptions& o) {
+ImageF splitSumCase(const ReferenceScene& rs, const PoseEntry& pe, const PairOptions& o, float maxRoughness) {
   if (!rs.environment || !rs.lights.lights.empty())
     throw Error("the exact split sum: only for cases lit by the environment alone (env_*)");
   const trace::TraceSettings ts = traceSettings(rs, pe, View::Shaded, o);
@@ -47,6 +47,7 @@ ImageF splitSumCase(const ReferenceScene& rs, const PoseEntry& pe, const PairOpt
       if (!hit.hit()) continue;
       const trace::SurfacePoint sp = tracer.surface(ray, hit);
       const Material& m = *sp.material;
+      if (m.roughness > maxRoughness) continue;
       if (m.texture(TextureSlot::BaseColor) != kNoTexture) throw Error("the exact split sum: untextured cases only");
       const int brdf = (m.flags & kMaterialGltf) ? BRDF_GGX : BRDF_BECKMANN;
       const glm::vec3 n = sp.normal, v = -glm::normalize(ray.direction);

@@ -92,7 +92,8 @@ trace::TraceSettings traceSettings(const ReferenceScene& rs, const PoseEntry& po
 // Environment cases without textures: the split sum evaluated exactly on the CPU (env_split.cpp): every
 // texel of the map summed for the prefiltered radiance, the table's integrals by 4096 samples, the SH of
 // the whole map. Against the tracer: the approximation's own error; against the GPU: the implementation's.
-ImageF splitSumCase(const ReferenceScene& rs, const PoseEntry& pose, const PairOptions& options);
+// Pixels of materials rougher than `maxRoughness` are left uncovered (the mirrors alone are cheap).
+ImageF splitSumCase(const ReferenceScene& rs, const PoseEntry& pose, const PairOptions& options, float maxRoughness = 1.0f);
 
 // A shader source edit for the tests that break the GPU side on purpose: in `file` (relative to shaders/),
 // the exact text `from` becomes `to`; an empty `from` is no edit (the control).

@@ -136,6 +136,28 @@ TEST_F(FrameTest, VisibilityPathMatchesForward) {
     }
 }
 
+// With the mosaic off the post pass would only copy the linear image into the target, sRGB-encoded, so
+// the shading pass writes those bytes itself and the pass is not recorded; a caller reading the linear
+// image gets it and the post pass as before. The bytes are the same: the shading pass encodes the half
+// float the image would hold.
+TEST_F(FrameTest, ShadingWritesTheBytesThePostPassWould) {
+  for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute}) {
+    SCOPED_TRACE(rtr::enumName(raster));
+    const auto direct = render(VIEW_SHADED, false, render::ShadingPath::Visibility, 0.0f, raster);
+    const auto copied = render(VIEW_SHADED, true, render::ShadingPath::Visibility, 0.0f, raster);
+    EXPECT_TRUE(ranPass(direct, "shade") && !ranPass(direct, "post"));
+    EXPECT_TRUE(ranPass(copied, "shade") && ranPass(copied, "post"));
+    ASSERT_EQ(direct.image.pixels.size(), copied.image.pixels.size());
+    size_t differ = 0, lit = 0;
+    for (size_t i = 0; i < direct.image.pixels.size(); i += 4) {
+      differ += !std::equal(&direct.image.pixels[i], &direct.image.pixels[i + 4], &copied.image.pixels[i]);
+      lit += direct.image.pixels[i] + direct.image.pixels[i + 1] + direct.image.pixels[i + 2] > 0;
+    }
+    EXPECT_EQ(differ, 0u) << "of " << direct.image.pixels.size() / 4 << " pixels";
+    EXPECT_GT(lit, size_t(kW) * kH / 2) << "comparing mostly black images proves nothing";
+  }
+}
+
 // Along the image's centre column, the bottom 35% is floor: linear depth grows toward the horizon.
 TEST_F(FrameTest, LinearDepthGrowsAlongTheFloor) {
   auto f = render(VIEW_LINEAR_DEPTH);
@@ -190,6 +212,7 @@ TEST_F(FrameTest, EveryViewModeRendersWithoutValidationMessages) {
 //   [visibility] the ids go to the shading compute pass, which discards the colour image and writes it;
 //   the colour image is sampled by the post pass (compute, or fragment for the graphics mosaic), which
 //   discards the target after last frame's read-back copy; the target goes to the read-back copy.
+//   [visibility, mosaic off] the shading pass discards and writes the target itself: no colour image.
 //   The compute rasteriser's buffers are synchronised by memory barriers, which the log does not list: its
 //   frame starts at the shading pass, with cluster culling (its pyramid stays in GENERAL) or without.
 std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::MosaicMode mosaic, bool computeIds) {
@@ -207,9 +230,11 @@ std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::M
       out.push_back(
           "visibility: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> "
           "COMPUTE_SHADER/SHADER_SAMPLED_READ");
-    out.push_back("scene colour: UNDEFINED -> GENERAL, " + postRead + "/NONE -> COMPUTE_SHADER/SHADER_STORAGE_WRITE");
-    out.push_back("scene colour: GENERAL -> SHADER_READ_ONLY, COMPUTE_SHADER/SHADER_STORAGE_WRITE -> " + postRead +
-                  "/SHADER_SAMPLED_READ");
+    if (mosaic != render::MosaicMode::Off) {
+      out.push_back("scene colour: UNDEFINED -> GENERAL, " + postRead + "/NONE -> COMPUTE_SHADER/SHADER_STORAGE_WRITE");
+      out.push_back("scene colour: GENERAL -> SHADER_READ_ONLY, COMPUTE_SHADER/SHADER_STORAGE_WRITE -> " + postRead +
+                    "/SHADER_SAMPLED_READ");
+    }
   } else {
     out.push_back("scene colour: COLOR_ATTACHMENT -> SHADER_READ_ONLY, COLOR_ATTACHMENT_OUTPUT/COLOR_ATTACHMENT_WRITE -> " +
                   postRead + "/SHADER_SAMPLED_READ");
@@ -224,7 +249,7 @@ std::vector<std::string> steadyFrameBarriers(render::ShadingPath path, render::M
 TEST_F(FrameTest, OneFrameRecordsExactlyTheBarriersItNeeds) {
   for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility})
     for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
-      for (auto mosaic : {render::MosaicMode::Compute, render::MosaicMode::Graphics})
+      for (auto mosaic : {render::MosaicMode::Off, render::MosaicMode::Compute, render::MosaicMode::Graphics})
         for (bool cull : {true, false}) {
           SCOPED_TRACE(std::string(rtr::enumName(path)) + ", mosaic " + rtr::enumName(mosaic) + ", " + rtr::enumName(raster) +
                        " raster, cull " + (cull ? "on" : "off"));

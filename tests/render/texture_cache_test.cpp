@@ -65,12 +65,14 @@ TEST_F(VulkanTest, ACachedOpenDrawsExactlyWhatAnUncachedOpenDraws) {
       const render::GpuScene first(*ctx, scene, mode, {}, render::GeometryUpload::Auto, render::TextureLoad::Wait, &cache);
       EXPECT_EQ(first.stats().cacheHits, 0u);
       EXPECT_EQ(first.stats().cacheMisses, textures);
+      EXPECT_EQ(first.stats().imagesDecoded, textures);
       same(first, "the open that filled the cache");
     }  // its entries are written by now
     EXPECT_EQ(entries(cache.dir()), stored += textures);
     const render::GpuScene second(*ctx, scene, mode, {}, render::GeometryUpload::Auto, render::TextureLoad::Wait, &cache);
     EXPECT_EQ(second.stats().cacheHits, textures);
     EXPECT_EQ(second.stats().cacheMisses, 0u);
+    EXPECT_EQ(second.stats().imagesDecoded, 0u) << "a cache hit decoded its image";
     EXPECT_EQ(second.stats().mipGpuMs, 0.0) << "a mip pass ran for cached chains";
     same(second, "the open from the cache");
     render::GpuScene deferred(*ctx, scene, mode, {}, render::GeometryUpload::Auto, render::TextureLoad::Deferred, &cache);

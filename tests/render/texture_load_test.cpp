@@ -185,5 +185,35 @@ TEST_F(VulkanTest, AutoMipsMakeSmallTexturesChainsOnTheCpu) {
   }
 }
 
+// A waited load in batches: every batch goes through the one staging ring (no staging buffer per texture,
+// the ring two batches long however many textures pass), and the frames are those of a load in one batch.
+TEST_F(VulkanTest, TexturesGoThroughOneStagingRingBatchByBatch) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  const CameraPose pose = *scene.defaultView;
+  const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
+  constexpr size_t kBudget = 64 << 10;  // the temple's largest level 0 (160 x 100 RGBA8) fits
+  const render::GpuScene whole(*ctx, scene, render::MipMode::Compute, {}, render::GeometryUpload::Auto, render::TextureLoad::Wait,
+                               nullptr, size_t(1) << 30);
+  const render::GpuScene batched(*ctx, scene, render::MipMode::Compute, {}, render::GeometryUpload::Auto,
+                                 render::TextureLoad::Wait, nullptr, kBudget);
+  render::GpuScene streamed(*ctx, scene, render::MipMode::Compute, {}, render::GeometryUpload::Auto,
+                            render::TextureLoad::Deferred, nullptr, kBudget);
+  streamed.updateTextures(true);
+  EXPECT_EQ(whole.stats().uploadBatches, 1u);
+  for (const render::GpuScene* s : {&batched, static_cast<const render::GpuScene*>(&streamed)}) {
+    EXPECT_GT(s->stats().uploadBatches, 2u);
+    EXPECT_LT(s->stats().uploadBatches, s->textureCount()) << "batches of one texture: the budget is not used";
+    EXPECT_EQ(s->stats().stagingAllocations, 1u) << "staging memory allocated per batch or per texture";
+    EXPECT_EQ(s->stats().stagingBytes, 2 * kBudget);
+  }
+  render::HeadlessRenderer a(*ctx, whole, {kW, kH}), b(*ctx, batched, {kW, kH}), c(*ctx, streamed, {kW, kH});
+  for (int mode : {VIEW_ALBEDO, VIEW_SHADED, VIEW_MIP_LEVEL})
+    for (render::ShadingPath path : {render::ShadingPath::Forward, render::ShadingPath::Visibility}) {
+      const ImageRGBA8 want = a.render(pose, lens, settings(mode, path)).image;
+      EXPECT_EQ(b.render(pose, lens, settings(mode, path)).image.pixels, want.pixels) << "mode " << mode;
+      EXPECT_EQ(c.render(pose, lens, settings(mode, path)).image.pixels, want.pixels) << "mode " << mode;
+    }
+}
+
 }  // namespace
 }  // namespace rtr

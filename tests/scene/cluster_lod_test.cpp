@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cluster.h"
 #include "cluster_lod.h"
 #include "scene/cluster_lod.hpp"
 #include "scene/clusters.hpp"
@@ -265,11 +266,23 @@ TEST(ClusterLod, ADenseFlatBoxListsAtMostOneTriangleAPixel) {
   }
 }
 
-// The hierarchy is the same, byte for byte, whatever the thread count: a level is grouped and simplified
-// in fixed pieces. The mesh has several pieces of clusters (kGroupPiece, 256) at level 0.
+// Far away a mesh is a few clusters: the hierarchy has few roots. A sphere of long rows (its triangles
+// in row order, as generated meshes often are) is clustered row by row; grouping only among runs of
+// consecutive clusters kept every group inside its rows, and the rows' borders stayed locked at every level
+// (the 100M temple's statue listed 12 M triangles at 1 px); a stuck group's clusters stayed roots.
+TEST(ClusterLod, FarAwayAMeshOfLongRowsIsAFewClusters) {
+  const Mesh m = bumpySphere(60, 1200);  // 141 600 triangles in 60 rows
+  const ClusterLod lod = buildClusterLod(m);
+  // 54 triangles; 19 718 grouped in runs with stuck groups as roots, 2 474 grouped over the level but
+  // with stuck groups as roots.
+  EXPECT_LE(cut(m, lod, {0, 0, 1000}, 1.0f).size() / 3, 8u * CLUSTER_MAX_TRIANGLES);
+}
+
+// The hierarchy is the same, byte for byte, whatever the thread count: a level's edges are listed and its
+// groups simplified in fixed pieces. The mesh has more than one piece of the edge listing (1024 clusters).
 TEST(ClusterLod, SameHierarchyOnOneThreadAndOnMany) {
   const Mesh m = bumpySphere(160, 320);  // 101 760 triangles
-  ASSERT_GT(m.clusters.size(), 3 * 256u);
+  ASSERT_GT(m.clusters.size(), 1024u);
   const ClusterLod one = buildClusterLod(m, true, 1), many = buildClusterLod(m, true, 7);
   ASSERT_GE(one.levels, 5u);
   EXPECT_EQ(one.levels, many.levels);

@@ -9,6 +9,7 @@
 #include <zstd.h>
 
 #include "core/error.hpp"
+#include "scene/grow_array.hpp"
 #include "scene/obj.hpp"
 #include "scene_compare.hpp"
 #include "test_paths.hpp"
@@ -306,4 +307,42 @@ TEST(ObjPieces, FilesStitchAsOnePiece) {
       expectSame(one, parseFile(f, 3, piece));
     }
   }
+}
+
+// Vertex colours that begin in a later batch: the positions of the batches before them are white, as in
+// one batch.
+TEST(ObjPieces, ColoursBeginningInALaterBatch) {
+  std::string obj;
+  for (int i = 0; i < 30000; ++i) obj += "v " + std::to_string(i % 97) + " " + std::to_string(i / 97) + " 0\n";
+  obj += "v 0 0 1 1 0 0\nv 1 0 1 0 1 0\nv 0 1 1 0 0 1\nf 1 2 98\nf -3 -2 -1\n";
+  const Outcome one = parseText(obj, {}, 1, size_t(1) << 30);
+  ASSERT_EQ(one.error, "");
+  ASSERT_EQ(one.scene.meshes.size(), 1u);
+  const Mesh& m = one.scene.meshes[0];
+  ASSERT_EQ(m.colors.size(), 6u);
+  for (size_t v = 0; v < 6; ++v) EXPECT_EQ(m.colors[v] == glm::vec4(1.0f), m.positions[v].z == 0.0f) << v;
+  const Outcome batches = parseText(obj, {}, 3, 4096, true);
+  ASSERT_GT(obj.size(), 3 * size_t(65536)) << "several batches";
+  expectSame(one, batches);
+}
+
+// The arrays the OBJ reader grows batch by batch keep what they hold when they grow, small or large (a large
+// block is moved by the kernel, not copied).
+TEST(ObjPieces, GrowArrayKeepsWhatItHolds) {
+  GrowArray<uint32_t> a;
+  size_t n = 0;
+  for (size_t step : {size_t(1), size_t(7), size_t(1000), size_t(300000), size_t(5000000), size_t(20000000)}) {
+    a.resize(n + step);
+    for (size_t i = n; i < n + step; ++i) a[i] = uint32_t(i * 2654435761u);
+    n += step;
+    bool same = true;
+    for (size_t i = 0; i < n; ++i) same = same && a[i] == uint32_t(i * 2654435761u);
+    EXPECT_TRUE(same) << n;
+  }
+  GrowArray<uint32_t> b = std::move(a);
+  EXPECT_EQ(b.size(), n);
+  EXPECT_TRUE(a.empty());
+  EXPECT_EQ(b[n - 1], uint32_t((n - 1) * 2654435761u));
+  b.release();
+  EXPECT_TRUE(b.empty());
 }

@@ -91,7 +91,7 @@ TEST_F(TextureCacheTest, AnEntryLaidOutAsDocumentedIsRead) {
 }
 
 TEST_F(TextureCacheTest, TheKeyFollowsTheImageBytesAndTheSlot) {
-  const TextureCache cache(dir, uint64_t(1) << 30);
+  TextureCache cache(dir, uint64_t(1) << 30);
   auto keyName = [&](const Texture& t, const std::string& variant) {
     TextureCacheKey k;
     EXPECT_TRUE(cache.key(Scene{}, t, variant, k));
@@ -151,6 +151,63 @@ TEST_F(TextureCacheTest, ADamagedEntryIsIgnoredRemovedAndWrittenAgain) {
     ASSERT_NE(again, nullptr);
     EXPECT_EQ(unpacked(*again), unpacked(*chain));
   }
+}
+
+// A file opened again unchanged is keyed without reading it (its key remembered under its path, size,
+// modification time and inode); any of those changed, or a file modified in the last seconds, is read and
+// hashed again.
+TEST_F(TextureCacheTest, AFileSeenBeforeIsKeyedWithoutReadingIt) {
+  TextureCache cache(dir, uint64_t(1) << 30);
+  fs::create_directories(dir / "images");
+  const fs::path png = dir / "images" / "t.png";
+  Texture file = rgba();
+  file.path = png;
+  const auto write = [&](const std::string& bytes, std::chrono::seconds age) {
+    std::ofstream(png, std::ios::binary | std::ios::trunc).write(bytes.data(), std::streamsize(bytes.size()));
+    fs::last_write_time(png, fs::file_time_type::clock::now() - age);
+  };
+  const auto keyName = [&] {
+    TextureCacheKey k;
+    EXPECT_TRUE(cache.key(Scene{}, file, "v", k));
+    return k.fileName();
+  };
+  Texture inMemory = rgba();
+  inMemory.bytes = std::make_shared<const std::vector<uint8_t>>(std::vector<uint8_t>{1, 2, 3, 4});
+  write("\x01\x02\x03\x04", std::chrono::hours(1));
+  const std::string first = keyName();
+  EXPECT_EQ(cache.counts().hashed, 1u);
+  EXPECT_EQ(keyName(), first);
+  EXPECT_EQ(cache.counts().hashed, 1u) << "an unchanged file was read and hashed again";
+  EXPECT_EQ(cache.counts().remembered, 1u);
+  {
+    TextureCacheKey k;
+    cache.key(Scene{}, inMemory, "v", k);
+    EXPECT_EQ(k.fileName(), first) << "a remembered key differs from the content's";
+    EXPECT_EQ(cache.counts().hashed, 2u);
+  }
+  write("\x01\x02\x03\x05", std::chrono::minutes(30));  // same size, another time
+  EXPECT_NE(keyName(), first);
+  EXPECT_EQ(cache.counts().hashed, 3u);
+  write("\x01\x02\x03\x04\x05", std::chrono::minutes(30));  // same time, another size
+  const std::string longer = keyName();
+  EXPECT_EQ(cache.counts().hashed, 4u);
+  EXPECT_EQ(keyName(), longer);
+  EXPECT_EQ(cache.counts().hashed, 4u);
+  write("\x01\x02\x03\x06", std::chrono::seconds(0));  // just written: hashed every time
+  const std::string fresh = keyName();
+  EXPECT_EQ(keyName(), fresh);
+  EXPECT_EQ(cache.counts().hashed, 6u) << "a file written a moment ago was trusted by its time";
+  // A damaged record is not believed.
+  write("\x01\x02\x03\x07", std::chrono::hours(2));
+  const std::string settled = keyName();
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".rtrkey") {
+      std::fstream f(e.path(), std::ios::binary | std::ios::in | std::ios::out);
+      f.seekp(-9, std::ios::end);  // in the content checksum
+      f.put('\x7f');
+    }
+  EXPECT_EQ(keyName(), settled);
+  EXPECT_EQ(cache.counts().hashed, 8u) << "a damaged key record was believed";
 }
 
 TEST_F(TextureCacheTest, TheSizeBoundRemovesTheLeastRecentlyUsed) {

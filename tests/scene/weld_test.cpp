@@ -98,8 +98,8 @@ TEST(Weld, KeepsCornersWithinTheToleranceAndNoTwoVerticesNear) {
         for (size_t w : column[d])
           if (w > v) pairs += near(m, v, w);
   EXPECT_EQ(pairs, 0u);
-  // Every kept triangle's corners are its soup corners' positions within the tolerance.
-  size_t t = 0, checked = 0;
+  // Every kept triangle's corners are its soup corners' positions within the tolerance, and their colours.
+  size_t t = 0, checked = 0, colours = 0;
   for (size_t k = 0; k + 2 < s.corners.size() && t * 3 < m.indices.size(); k += 3) {
     const glm::vec3 p = s.positions[s.corners[k].p];
     const glm::vec3 q = m.positions[m.indices[t * 3]];
@@ -107,8 +107,27 @@ TEST(Weld, KeepsCornersWithinTheToleranceAndNoTwoVerticesNear) {
     for (int i = 0; i < 3; ++i) {
       const glm::vec3 a = s.positions[s.corners[k + i].p], b = m.positions[m.indices[t * 3 + i]];
       EXPECT_LE(glm::length(a - b), 2e-5f);
+      colours += s.colors[s.corners[k + i].p] == m.colors[m.indices[t * 3 + i]];  // colours are welded only when equal
     }
     ++t, ++checked;
   }
   EXPECT_GT(checked, m.indices.size() / 3 / 2);
+  EXPECT_EQ(colours, checked * 3);
+}
+
+// The owner may free the corners once the weld calls cornersDone: nothing read after it changes the mesh.
+TEST(Weld, CornersAreReadNoMoreOnceDone) {
+  const Soup s = makeSoup(120, 3);
+  const Mesh a = weld(s, 3);
+  for (unsigned threads : {1u, 3u}) {
+    std::vector<Corner> corners = s.corners;
+    int calls = 0;
+    Mesh b;
+    weldMesh(corners, s.positions, s.normals, s.texcoords, b, 40.0f, s.colors, threads, [&] {
+      ++calls;
+      std::fill(corners.begin(), corners.end(), Corner{0, 0, 0});  // valid indices, wrong corners
+    });
+    EXPECT_EQ(calls, 1);
+    rtr::test::expectSameMesh(a, b);
+  }
 }

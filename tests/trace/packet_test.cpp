@@ -25,8 +25,8 @@ std::vector<Triangle> trianglesOf(const Mesh& m, glm::vec3 offset = glm::vec3(0.
 
 // Every group of `width` consecutive rays as one packet against each ray alone, on every ISA, with leaves
 // tested all rays at once wherever two or more rays reach them, and always ray by ray, closest hit as
-// coherent and as scattered rays, with hand-offs to single rays from 0 (never) to 8 (at once) live rays,
-// those walking in pairs or in fours (every other pass); returns the number of hits (of the last pass) so callers can check the case is not vacuous.
+// coherent and as scattered rays, with hand-offs to single rays from 0 (never) to 8 (at once) live rays;
+// returns the number of hits (of the last pass) so callers can check the case is not vacuous.
 size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, int width = 8, const char* what = "") {
   size_t hits = 0;
   for (int pass = 0; pass < 6; ++pass) {
@@ -36,8 +36,6 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
     Bvh::setIsa(isa);
     Bvh::setPacketLeafRays(leafRays);
     Bvh::setPacketAloneRays(kAlone[pass][0], kAlone[pass][1], kAlone[pass][2]);
-    const int inFlight = pass % 2 == 0 ? 4 : 2;
-    Bvh::setPacketAloneInFlight(inFlight);
     hits = 0;
     for (size_t i = 0; i < rays.size(); i += width) {
       const int n = int(std::min<size_t>(width, rays.size() - i));
@@ -52,11 +50,11 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
         if (!same || (occ >> k & 1) != occ1) {
           ADD_FAILURE() << what << " " << Bvh::isaName(isa)
                         << (leafRays == 2 ? ", leaves all rays at once" : ", leaves ray by ray") << ", alone from "
-                        << kAlone[pass][0] << "/" << kAlone[pass][1] << "/" << kAlone[pass][2] << ", " << inFlight
-                        << " in flight, ray " << i + k << " of a packet of " << n << ": triangle " << h[k].prim << " t " << h[k].t
-                        << " b " << h[k].b1 << " " << h[k].b2 << " (scattered: triangle " << hs[k].prim << " t " << hs[k].t
-                        << ") occluded " << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b " << one.b1 << " "
-                        << one.b2 << " occluded " << occ1;
+                        << kAlone[pass][0] << "/" << kAlone[pass][1] << "/" << kAlone[pass][2] << ", ray " << i + k
+                        << " of a packet of " << n << ": triangle " << h[k].prim << " t " << h[k].t << " b " << h[k].b1 << " "
+                        << h[k].b2 << " (scattered: triangle " << hs[k].prim << " t " << hs[k].t << ") occluded "
+                        << (occ >> k & 1) << "; alone: " << one.prim << " t " << one.t << " b " << one.b1 << " " << one.b2
+                        << " occluded " << occ1;
           break;
         }
         hits += one.hit();
@@ -68,7 +66,6 @@ size_t expectPacketsMatchSingles(const Bvh& bvh, const std::vector<Ray>& rays, i
   Bvh::setIsa(BvhIsa::Avx512);
   Bvh::setPacketLeafRays(Bvh::kPacketLeafRays);
   Bvh::setPacketAloneRays(Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]);
-  Bvh::setPacketAloneInFlight(Bvh::kPacketAloneInFlight);
   return hits;
 }
 

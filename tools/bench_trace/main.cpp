@@ -302,8 +302,6 @@ struct Options {
   int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
   int aloneRays[3] = {Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]};
   std::vector<int> aloneSweep;  // --alone-sweep: our packets timed with each of these, same turns
-  int inFlight = Bvh::kPacketAloneInFlight;
-  std::vector<int> inFlightSweep;  // --in-flight-sweep: the same for the lone walks in flight
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
   bool buildOnly = false;    // time only the builds, ours and Embree's alternately
@@ -512,7 +510,7 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<unsigned> counts{1};
   if (threads > 1) counts.push_back(threads);
-  std::string sweepLines, flightLines;  // --alone-sweep, --in-flight-sweep, printed after the table
+  std::string sweepLines;  // --alone-sweep, printed after the table
   for (unsigned th : counts) {
     for (const RaySet& s : all.sets()) {
       const auto& rays = *s.rays;
@@ -520,7 +518,7 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
       // Alternate the four, best of each: a machine that slows down for a while slows all. Each turn
       // runs twice, so that the best run finds its own BVH in the caches, not the other's.
       double single = 1e30, paired = 1e30, ours8 = 1e30, ours8r = 1e30, theirs = 1e30, theirs8 = 1e30;
-      std::vector<double> sweep(o.aloneSweep.size(), 1e30), flightSweep(o.inFlightSweep.size(), 1e30);
+      std::vector<double> sweep(o.aloneSweep.size(), 1e30);
       for (int r = 0; r < reps; ++r) {
         if (!o.packetsOnly)
           single = std::min(single, timed(rays.size(), th, 2, [&](size_t i) {
@@ -554,11 +552,6 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
           sweep[k] = std::min(sweep[k], timed((rays.size() + 7) / 8, th, 2, packets8));
           Bvh::setPacketAloneRays(o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
         }
-        for (size_t k = 0; k < o.inFlightSweep.size(); ++k) {
-          Bvh::setPacketAloneInFlight(o.inFlightSweep[k]);
-          flightSweep[k] = std::min(flightSweep[k], timed((rays.size() + 7) / 8, th, 2, packets8));
-          Bvh::setPacketAloneInFlight(o.inFlight);
-        }
         Bvh::setPacketLeafRays(9);  // every leaf ray by ray (lanes = triangles), as before round 8
         if (!o.packetsOnly) ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
         Bvh::setPacketLeafRays(leafRays);
@@ -588,27 +581,21 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
                   fmt(n, paired, "%.2f").c_str(), fmt(n, ours8r, "%.2f").c_str(), fmt(n, ours8, "%.2f").c_str(),
                   fmt(n, theirs, "%.2f").c_str(), t8, fmt(theirs, single, "%.2f×").c_str(), fmt(theirs, paired, "%.2f×").c_str(),
                   r8);
-      // Our packets / Embree's packets at each setting of a sweep, timed in the same turns.
-      auto sweepLine = [&](std::string& lines, const std::vector<int>& settings, const std::vector<double>& times,
-                           const char* format) {
-        if (times.empty()) return;
+      // Our packets / Embree's packets at each threshold of the sweep, timed in the same turns.
+      if (!sweep.empty()) {
         char b[96];
         std::snprintf(b, sizeof b, "\n- %s, %u threads:", s.name, th);
-        lines += b;
-        for (size_t k = 0; k < times.size(); ++k) {
-          std::snprintf(b, sizeof b, format, settings[k], theirs8 / times[k]);
-          lines += b;
+        sweepLines += b;
+        for (size_t k = 0; k < sweep.size(); ++k) {
+          std::snprintf(b, sizeof b, " from %d live %.2f×", o.aloneSweep[k], theirs8 / sweep[k]);
+          sweepLines += b;
         }
-      };
-      sweepLine(sweepLines, o.aloneSweep, sweep, " from %d live %.2f×");
-      sweepLine(flightLines, o.inFlightSweep, flightSweep, " %d in flight %.2f×");
+      }
     }
   }
   if (!sweepLines.empty())
     std::printf("\nOur packets / Embree's packets, single rays from this many live rays (--alone-sweep):%s\n",
                 sweepLines.c_str());
-  if (!flightLines.empty())
-    std::printf("\nOur packets / Embree's packets, this many lone walks in flight (--in-flight-sweep):%s\n", flightLines.c_str());
 }
 
 // --profile: where a packet's time goes, ours and Embree's, each kind of rays, 1 and N threads. Per
@@ -796,11 +783,7 @@ int main(int argc, char** argv) {
     } else if (a == "--alone-sweep" && i + 1 < argc) {
       for (const char* p = argv[++i]; *p; ++p)
         if (p == argv[i] || p[-1] == ',') o.aloneSweep.push_back(std::atoi(p));
-    } else if (a == "--in-flight-sweep" && i + 1 < argc) {
-      for (const char* p = argv[++i]; *p; ++p)
-        if (p == argv[i] || p[-1] == ',') o.inFlightSweep.push_back(std::atoi(p));
-    } else if (a == "--in-flight" && i + 1 < argc) o.inFlight = std::atoi(argv[++i]);
-    else if (a == "--quick") quick = true;
+    } else if (a == "--quick") quick = true;
     else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--packets-only") quick = o.packetsOnly = true;
     else if (a == "--no-sphere") noSphere = true;
@@ -813,7 +796,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(
           stderr,
-          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--in-flight 2|4] [--in-flight-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile]\n"
+          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile]\n"
           "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
           "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
           "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
@@ -823,8 +806,6 @@ int main(int argc, char** argv) {
           "  --alone-rays C,S,A: our packets walk on as single rays from this many live rays or fewer: closest hit\n"
           "    coherent (primary, orthographic), closest hit scattered (mirror), any hit (shadow)\n"
           "  --alone-sweep N,...: our packets also timed with each set's threshold at each N (same turns)\n"
-          "  --in-flight 2|4: a packet's lone rays walk interleaved in pairs (2, default) or fours\n"
-          "  --in-flight-sweep N,...: our packets also timed with each of these (2, 4) in flight (same turns)\n"
           "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
           "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
           "  --no-sphere: only the --scene files\n"
@@ -836,15 +817,12 @@ int main(int argc, char** argv) {
   bool badAlone = false;
   for (int n : o.aloneRays) badAlone |= n < 0 || n > 8;
   for (int n : o.aloneSweep) badAlone |= n < 0 || n > 8;
-  for (int n : o.inFlightSweep) badAlone |= n != 2 && n != 4;
-  badAlone |= o.inFlight != 2 && o.inFlight != 4;
   if (threads == 0 || res <= 0 || rings < 2 || reps < 1 || badAlone) {
     std::fprintf(stderr, "bench-trace: bad argument\n");
     return 2;
   }
   Bvh::setPacketLeafRays(leafRays);
   Bvh::setPacketAloneRays(o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
-  Bvh::setPacketAloneInFlight(o.inFlight);
   if (!quick) benchRoutines();
   const Mesh sphere = uvSphere({0, 0, 0}, 1.0f, rings, rings + 1);
   std::vector<Triangle> tris;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -69,22 +70,31 @@ struct View {
 void printLevels(const Scene& scene) {
   struct Row {
     size_t clusters = 0, triangles = 0, roots = 0, rootTriangles = 0;
-    std::vector<float> errors;
+    std::vector<float> errors, radii, groupRadii, fill;
   };
   std::map<uint32_t, Row> rows;
   for (const Mesh& m : scene.meshes)
     for (const LodCluster& c : m.lod.clusters) {
       Row& r = rows[c.level];
       ++r.clusters, r.triangles += c.triangleCount, r.errors.push_back(c.error);
+      r.radii.push_back(c.radius), r.groupRadii.push_back(c.sphere.w);
+      // How much of its sphere's disc its triangles cover: ~1 for a round flat patch, small for a strip.
+      double area = 0.0;
+      const std::span<const uint32_t> t = lodTriangles(m, c);
+      for (size_t k = 0; k < t.size(); k += 3)
+        area +=
+            0.5 * glm::length(glm::cross(m.positions[t[k + 1]] - m.positions[t[k]], m.positions[t[k + 2]] - m.positions[t[k]]));
+      r.fill.push_back(c.radius > 0 ? float(area / (3.14159265 * c.radius * c.radius)) : 0.0f);
       if (c.parentError >= shader::LOD_ERROR_INFINITE) ++r.roots, r.rootTriangles += c.triangleCount;
     }
   std::printf(
       "\nhierarchy, per level (all meshes):\n| level | clusters | triangles | tris / cluster | roots (their tris) | error min / "
-      "median / max |\n|---:|---:|---:|---:|---:|---|\n");
+      "median / max | radius median: cluster, group | area / disc median |\n|---:|---:|---:|---:|---:|---|---|---:|\n");
   for (auto& [level, r] : rows) {
     const auto [lo, hi] = std::minmax_element(r.errors.begin(), r.errors.end());
-    std::printf("| %u | %zu | %zu | %.1f | %zu (%zu) | %.3g / %.3g / %.3g |\n", level, r.clusters, r.triangles,
-                double(r.triangles) / double(r.clusters), r.roots, r.rootTriangles, *lo, median(r.errors), *hi);
+    std::printf("| %u | %zu | %zu | %.1f | %zu (%zu) | %.3g / %.3g / %.3g | %.3g, %.3g | %.2f |\n", level, r.clusters,
+                r.triangles, double(r.triangles) / double(r.clusters), r.roots, r.rootTriangles, *lo, median(r.errors), *hi,
+                median(r.radii), median(r.groupRadii), median(r.fill));
   }
 }
 
@@ -98,7 +108,7 @@ void printCut(const Scene& scene, const View& v, float threshold) {
     std::array<size_t, 6> areaBins{};  // < 1/4, < 1, < 4, < 16, < 64, >= 64 px
   };
   std::map<uint32_t, Row> rows;
-  std::vector<std::array<size_t, 3>> perMesh(scene.meshes.size());  // triangles in the cut, of level 0, in the frustum
+  std::vector<std::array<size_t, 4>> perMesh(scene.meshes.size());  // triangles in the cut, of level 0, in the frustum, roots
   std::vector<Instance> instances = scene.instances;
   if (instances.empty())
     for (uint32_t m = 0; m < scene.meshes.size(); ++m) instances.push_back({m, glm::mat4(1.0f)});
@@ -128,6 +138,7 @@ void printCut(const Scene& scene, const View& v, float threshold) {
       ++r.clusters, r.triangles += c.triangleCount;
       perMesh[inst.mesh][0] += c.triangleCount, perMesh[inst.mesh][1] += c.level == 0 ? c.triangleCount : 0;
       r.roots += c.parentError >= shader::LOD_ERROR_INFINITE;
+      perMesh[inst.mesh][3] += c.parentError >= shader::LOD_ERROR_INFINITE ? c.triangleCount : 0;
       if (shader::frustumCulls(place(glm::vec4(c.center, c.radius)), v.viewProj)) continue;
       ++r.inClusters, r.inTriangles += c.triangleCount, perMesh[inst.mesh][2] += c.triangleCount;
       const glm::mat4 toClip = v.viewProj * inst.transform;
@@ -168,10 +179,10 @@ void printCut(const Scene& scene, const View& v, float threshold) {
     all.clusters += r.clusters, all.triangles += r.triangles, all.roots += r.roots, all.inClusters += r.inClusters;
     all.inTriangles += r.inTriangles, all.area += r.area, all.large += r.large, all.tiles += r.tiles;
   }
-  std::printf("per mesh (triangles: mesh → cut, of them level 0, in the frustum):");
+  std::printf("per mesh (triangles: mesh → cut, of them level 0, in the frustum, of roots):");
   for (size_t m = 0; m < scene.meshes.size(); ++m)
-    std::printf(" %s %u → %zu, %zu, %zu;", scene.meshes[m].name.c_str(), scene.meshes[m].triangleCount(), perMesh[m][0],
-                perMesh[m][1], perMesh[m][2]);
+    std::printf(" %s %u → %zu, %zu, %zu, %zu;", scene.meshes[m].name.c_str(), scene.meshes[m].triangleCount(), perMesh[m][0],
+                perMesh[m][1], perMesh[m][2], perMesh[m][3]);
   std::printf("\n");
   const double pixels = double(v.width) * v.height;
   std::printf("| all | %zu | %zu | %zu | %zu | %zu | %.2f | | %zu (%zu) |\n", all.clusters, all.triangles, all.roots,

@@ -140,8 +140,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   const bool wait = o.waitTextures.value_or(true);
   const std::unique_ptr<TextureCache> textureCache = cli::textureCache(!o.textureCache);
   render::GpuScene gpuScene(ctx, scene, choice.mips, progress, render::GeometryUpload::Auto,
-                            wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred, textureCache.get());
-  gpuScene.setUploadBudget(size_t(o.textureBatchMb) << 20);
+                            wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred, textureCache.get(),
+                            size_t(o.textureBatchMb) << 20);
   const auto& st = gpuScene.stats();  // the texture phases: once they are in
   if (wait) timeline.add("texture decode", st.decodeMs);
   timeline.add("geometry upload", st.geometryMs);

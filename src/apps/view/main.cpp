@@ -224,8 +224,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-wait-textures", noWaitTextures, "the first frame shows the materials' factors; textures come later")
       ->excludes(waitOpt);
   app.add_option("--texture-batch", o.textureBatchMb,
-                 "MiB of staged texels (every level) that textures coming in while frames go on may take per frame; at "
-                 "least one texture")
+                 "MiB of staged texels (every level) per upload batch, at least one texture: what textures coming in "
+                 "while frames go on may take per frame; the staging ring holds two batches")
       ->check(cli::integer(1, 65536))
       ->capture_default_str();
   app.add_flag("--timings", o.timings,

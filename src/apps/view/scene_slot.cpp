@@ -27,8 +27,8 @@ void SceneSlot::release() {
 
 void SceneSlot::build(VkExtent2D extent, render::MipMode mips) {
   gpu_ = std::make_unique<render::GpuScene>(ctx_, *scene_, mips, render::LoadProgress{}, render::GeometryUpload::Auto,
-                                            waitTextures_ ? render::TextureLoad::Wait : render::TextureLoad::Deferred, cache_);
-  gpu_->setUploadBudget(textureBatch_);
+                                            waitTextures_ ? render::TextureLoad::Wait : render::TextureLoad::Deferred, cache_,
+                                            textureBatch_);
   frames_ = std::make_unique<ViewFrames>(ctx_, surface_, extent, *gpu_);
   if (env_) frames_->renderer().setEnvironment(env_);
   traced_ = std::make_unique<TraceOverlay>(ctx_, *scene_);

@@ -25,8 +25,9 @@ bool ViewFrames::frame(VkExtent2D windowExtent, const ViewFrameInput& in, ImageR
   if (readBack)
     shot_ = vk::Buffer(ctx_, VkDeviceSize(e.width) * e.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback);
   const bool showTrace = in.trace && in.trace->visible() && (swapchain_.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT);
-  // The post pass is the first to touch the swapchain image, in compute or as a colour attachment, after
-  // the acquire semaphore waited at those stages: its barrier chains to that wait.
+  // The post pass (the shading pass where it writes the target) is the first to touch the swapchain image,
+  // in compute or as a colour attachment, after the acquire semaphore waited at those stages: its barrier
+  // chains to that wait.
   constexpr VkPipelineStageFlags2 kAcquireWait =
       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
   vk::ImageState acquiredState{VK_IMAGE_LAYOUT_UNDEFINED, kAcquireWait, VK_ACCESS_2_NONE, 0};

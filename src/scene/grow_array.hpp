@@ -1,0 +1,83 @@
+#pragma once
+// An array of plain elements that grows without a serial pass over what it holds, for the OBJ reader's
+// arrays of hundreds of millions of elements: elements added are left unset for the caller to write (on
+// all cores, so the pages are first touched there), and past 1 MiB it lives in its own mapping, which
+// grows by moving its pages (mremap) instead of copying them. Small arrays stay on the heap.
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+#include <span>
+#include <type_traits>
+#include <utility>
+
+namespace rtr {
+
+template <class T>
+class GrowArray {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+  static constexpr size_t kMapBytes = size_t(1) << 20;
+
+ public:
+  GrowArray() = default;
+  GrowArray(GrowArray&& o) noexcept
+      : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)), cap_(std::exchange(o.cap_, 0)) {}
+  GrowArray& operator=(GrowArray&& o) noexcept {
+    std::swap(data_, o.data_);
+    std::swap(size_, o.size_);
+    std::swap(cap_, o.cap_);
+    return *this;
+  }
+  ~GrowArray() {
+    if (mapped(cap_)) ::munmap(data_, cap_ * sizeof(T));
+    else std::free(data_);
+  }
+
+  // n elements; those added are unset. The capacity grows by half at least, so appends cost O(1) calls.
+  void resize(size_t n) {
+    if (n > cap_) grow(std::max(n, cap_ + cap_ / 2));
+    size_ = n;
+  }
+  void release() { *this = GrowArray(); }  // the memory goes back now
+
+  size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  T* data() { return data_; }
+  const T* data() const { return data_; }
+  T* begin() { return data_; }
+  T* end() { return data_ + size_; }
+  T& operator[](size_t i) { return data_[i]; }
+  const T& operator[](size_t i) const { return data_[i]; }
+  operator std::span<const T>() const { return {data_, size_}; }
+
+ private:
+  static bool mapped(size_t cap) { return cap * sizeof(T) >= kMapBytes; }
+
+  void grow(size_t cap) {
+    if (cap > std::numeric_limits<size_t>::max() / sizeof(T)) throw std::bad_alloc();
+    const size_t bytes = cap * sizeof(T);
+    void* p = nullptr;
+    if (!mapped(cap)) {
+      p = std::realloc(data_, bytes);
+      if (!p) throw std::bad_alloc();
+    } else if (mapped(cap_)) {
+      p = ::mremap(data_, cap_ * sizeof(T), bytes, MREMAP_MAYMOVE);
+      if (p == MAP_FAILED) throw std::bad_alloc();
+    } else {  // from the heap into a mapping: the one copy, of less than kMapBytes
+      p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (p == MAP_FAILED) throw std::bad_alloc();
+      if (size_) std::memcpy(p, data_, size_ * sizeof(T));
+      std::free(data_);
+    }
+    data_ = static_cast<T*>(p);
+    cap_ = cap;
+  }
+
+  T* data_ = nullptr;
+  size_t size_ = 0, cap_ = 0;
+};
+
+}  // namespace rtr
