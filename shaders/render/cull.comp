@@ -1,22 +1,27 @@
 #version 460
 // Cluster culling, second step: one workgroup per chunk of clusters that cull_instances.comp kept, a
-// thread per cluster; the level-of-detail cut, frustum, back-face cone, then
-// occlusion against the depth pyramid (shaders/shared/cull.h has the tests and the phases). Visible clusters are appended to a compact list whose
-// length is the size of an indirect dispatch (one workgroup per visible cluster; cull.h); culled ones are counted by
-// reason. The caller zeroes the counts (x = 0, y = z = 1) before the pass.
+// thread per cluster; the records (the mesh's) placed by the chunk's instance, then the level-of-detail
+// cut, frustum, back-face cone and occlusion against the depth pyramid (shaders/shared/cull.h has the
+// tests and the phases). Visible clusters are appended as (instance, record) to a compact list whose
+// length is the size of an indirect dispatch (one workgroup per visible cluster; cull.h); culled ones are
+// counted by reason. The caller zeroes the counts (x = 0, y = z = 1) before the pass.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
 #include "cull.h"
+#include "frame.h"
 
 layout(local_size_x = CULL_GROUP_SIZE) in;
 
 layout(set = 0, binding = 0, std430) readonly buffer Clusters { GpuCluster clusters[]; };
 layout(set = 0, binding = 1, std430) buffer Counts { CullCounts counts; };
-layout(set = 0, binding = 2, std430) writeonly buffer Visible { uint visible[]; };
+layout(set = 0, binding = 2, std430) writeonly buffer Visible { uvec2 visible[]; };
 layout(set = 0, binding = 3) uniform texture2D pyramid;  // R32F, farthest depth per texel (hiz.comp)
-layout(set = 0, binding = 4, std430) buffer History { uint history[]; };  // 1: visible in the last LATE pass
+// A bit per history slot (GpuCullInstance::levels.w): visible in the last LATE pass.
+layout(set = 0, binding = 4, std430) buffer History { uint history[]; };
 layout(set = 0, binding = 5, std430) readonly buffer Lods { GpuClusterLod lods[]; };  // read with CULL_LOD
-layout(set = 0, binding = 7, std430) readonly buffer Chunks { uvec2 chunks[]; };      // first cluster, count
+layout(set = 0, binding = 6, std430) readonly buffer CullInstances { GpuCullInstance cullInstances[]; };
+layout(set = 0, binding = 7, std430) readonly buffer Chunks { uvec4 chunks[]; };  // instance, first record, count
+layout(set = 0, binding = 9, std430) readonly buffer Instances { GpuInstance instances[]; };
 
 layout(push_constant) uniform Push { CullPush pc; };
 
@@ -35,25 +40,47 @@ bool occluded(vec4 sphere) {
 void main() {
   const uint k = gl_WorkGroupID.y * max(pc.maxGroupsX, 1u) + gl_WorkGroupID.x;
   if (k >= counts.chunks) return;
-  const uvec2 chunk = chunks[k];
-  if (gl_LocalInvocationID.x >= chunk.y) return;
-  const uint i = chunk.x + gl_LocalInvocationID.x;
-  const bool wasVisible = pc.phase != CULL_SINGLE && history[i] != 0u;
+  const uvec4 chunk = chunks[k];
+  if (gl_LocalInvocationID.x >= chunk.z) return;
+  const uint i = chunk.y + gl_LocalInvocationID.x;
+  const GpuCullInstance ci = cullInstances[chunk.x];
+  const uint slot = i + ci.levels.w;
+  const bool wasVisible = pc.phase != CULL_SINGLE && (history[slot >> 5u] & (1u << (slot & 31u))) != 0u;
   if (pc.phase == CULL_EARLY && !wasVisible) return;
-  const GpuCluster c = clusters[i];
+  GpuCluster c = clusters[i];
+  GpuClusterLod lod;
+  if ((pc.flags & CULL_LOD) != 0u) lod = lods[i];
+  uint instance = c.instance;
+  if (ci.levels.z != CULL_RECORD_INSTANCE) {
+    instance = ci.levels.z;
+    if (ci.placement.z == 0.0f) {  // not the identity: place the records (the identity keeps them exact)
+      const mat4 m = instances[instance].transform;
+      const float s = ci.placement.x;
+      c.sphere = placeSphere(m, s, c.sphere);
+      // A similarity turns the cone (a mirror with it: the winding flips too); other transforms bend it.
+      if (ci.placement.y == 0.0f) c.cone = vec4(0.0f, 0.0f, 1.0f, 2.0f);
+      else if (c.cone.w < 1.0f) c.cone.xyz = normalize(mat3(m) * c.cone.xyz);
+      if ((pc.flags & CULL_LOD) != 0u) {
+        lod.sphere = placeSphere(m, s, lod.sphere);
+        lod.parentSphere = placeSphere(m, s, lod.parentSphere);
+        lod.error.x *= s;
+        if (lod.error.y < LOD_ERROR_INFINITE) lod.error.y *= s;
+      }
+    }
+  }
   uint reason = CULL_VISIBLE;
-  if ((pc.flags & CULL_LOD) != 0u && !lodSelected(lods[i].sphere, lods[i].error.x, lods[i].parentSphere,
-                                                  lods[i].error.y, pc.eye.xyz, pc.pixelsPerUnit, pc.zNear,
-                                                  pc.lodThreshold))
+  if ((pc.flags & CULL_LOD) != 0u &&
+      !lodSelected(lod.sphere, lod.error.x, lod.parentSphere, lod.error.y, pc.eye.xyz, pc.pixelsPerUnit, pc.zNear, pc.lodThreshold))
     reason = CULL_BY_LOD;
   else if ((pc.flags & CULL_FRUSTUM) != 0u && frustumCulls(c.sphere, pc.viewProj)) reason = CULL_BY_FRUSTUM;
   else if ((pc.flags & CULL_CONE) != 0u && coneCulls(c.sphere, c.cone, pc.eye.xyz)) reason = CULL_BY_CONE;
   else if ((pc.flags & CULL_OCCLUSION) != 0u && pc.phase != CULL_EARLY && occluded(c.sphere)) reason = CULL_BY_OCCLUSION;
-  if (pc.phase == CULL_LATE) history[i] = reason == CULL_VISIBLE ? 1u : 0u;
+  if (pc.phase == CULL_LATE && (reason == CULL_VISIBLE) != wasVisible)
+    atomicXor(history[slot >> 5u], 1u << (slot & 31u));
   if (reason != CULL_VISIBLE) atomicAdd(counts.culled[reason - 1u], 1u);
   else if (!(pc.phase == CULL_LATE && wasVisible)) {
     const uint n = atomicAdd(counts.listed, 1u), maxX = max(pc.maxGroupsX, 1u);
-    visible[n] = i;
+    visible[counts.listBase + n] = uvec2(instance, i);
     atomicAdd(counts.triangles, c.triangleCount);
     if (n < maxX) atomicMax(counts.dispatch[0], n + 1u);
     if (n % maxX == 0u) atomicMax(counts.dispatch[1], n / maxX + 1u);

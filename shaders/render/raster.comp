@@ -7,14 +7,13 @@
 // tile, raster_large.comp); those
 // touching w <= 0 or leaving the guard band go to the hardware hand-off list (raster_hw.vert/frag).
 #extension GL_GOOGLE_include_directive : require
-// With culling (pc.fromList), workgroup k takes the k-th entry of the culling pass's visible list
-// (cull.comp; dispatched indirectly from its counts).
+// With culling (pc.fromList), workgroup k takes the k-th entry this phase added to the culling pass's
+// visible list (cull.comp; dispatched indirectly from its counts); without, the k-th of clusterList.
 #include "raster_tri.glsl"
 #include "cull.h"
 
 layout(local_size_x = RASTER_GROUP) in;
 
-layout(set = 0, binding = 11, std430) readonly buffer VisibleClusters { uint visibleClusters[]; };
 layout(set = 0, binding = 12, std430) readonly buffer Counts { CullCounts cullCounts; };
 
 // Past the list's capacity a triangle is counted, not stored (the draw skips those entries).
@@ -26,10 +25,10 @@ void handOff(uint ref) {
 void main() {
   const uint k = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   if (k >= (pc.fromList != 0u ? cullCounts.listed : pc.clusterCount)) return;
-  const uint clusterIndex = pc.fromList != 0u ? visibleClusters[k] : k;
+  const uint clusterIndex = (pc.fromList != 0u ? cullCounts.listBase : 0u) + k;  // in clusterList
   const uint local = gl_LocalInvocationID.x;
   Tri t;
-  const uint kind = local < clusters[clusterIndex].triangleCount ? setup(clusterIndex, local, t) : kSkip;
+  const uint kind = local < clusters[clusterList[clusterIndex].y].triangleCount ? setup(clusterIndex, local, t) : kSkip;
   const uint ref = (clusterIndex << RASTER_LOCAL_BITS) | local;
   if (kind == kSmall) {
     for (int y = t.box.y; y <= t.box.w; ++y)

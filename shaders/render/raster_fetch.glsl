@@ -33,7 +33,20 @@ layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
 // The large triangles' setup, largeTriCount records (raster.h).
 layout(set = 0, binding = 14, std430) RASTER_LIST_ACCESS buffer LargeTris { RasterLargeTri largeTris[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Instances { GpuInstance instances[]; };
+// The clusters drawn, (GpuInstance, GpuCluster record) each: the culling pass's visible list or, without
+// it, every instance's full-detail clusters (GpuScene::baseEntries). Workgroups, tiles and hand-off entries
+// name a cluster by its position here.
+layout(set = 0, binding = 11, std430) readonly buffer ClusterList { uvec2 clusterList[]; };
 layout(push_constant) uniform Push { RasterPush pc; };
+
+// The cluster at `entry` of clusterList, its instance and mirrored flag filled in (records are the mesh's).
+GpuCluster listedCluster(uint entry) {
+  const uvec2 e = clusterList[entry];
+  GpuCluster c = clusters[e.y];
+  c.instance = e.x;
+  if ((instances[e.x].info.y & INSTANCE_MIRRORED) != 0u) c.flags |= CLUSTER_MIRRORED;
+  return c;
+}
 
 vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }
 

@@ -21,7 +21,7 @@ void main() {
     return;
   }
   const uint entry = hwTriangles[gl_VertexIndex / 3];
-  const GpuCluster c = clusters[entry >> RASTER_LOCAL_BITS];
+  const GpuCluster c = listedCluster(entry >> RASTER_LOCAL_BITS);
   const GpuInstance inst = instances[c.instance];
   const GpuDraw d = draws[inst.info.x];
   const uint local = entry & ((1u << RASTER_LOCAL_BITS) - 1u);

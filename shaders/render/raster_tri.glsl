@@ -40,7 +40,7 @@ int64_t edge(ivec2 a, ivec2 b, ivec2 p) {
 layout(constant_id = 0) const uint kSharedArea = RASTER_SHARED_AREA;
 
 uint setup(uint clusterIndex, uint local, out Tri t) {
-  const GpuCluster c = clusters[clusterIndex];
+  const GpuCluster c = listedCluster(clusterIndex);
   const GpuInstance inst = instances[c.instance];
   const GpuDraw d = draws[inst.info.x];
   t.id = inst.info.z + c.firstTriangle + local;

@@ -20,6 +20,7 @@ namespace rtr::shader {
 #define CULL_CONE 2u       // perspective cameras only: the test assumes rays from the eye
 #define CULL_OCCLUSION 4u  // against the depth pyramid bound to the pass
 #define CULL_LOD 8u        // the level-of-detail cut (cluster_lod.h's lodSelected) over the GpuClusterLods
+#define CULL_NODES 16u     // prune the tree's nodes (else every node is descended: the flat test, for tests)
 
 // CullPush::phase. Two-phase occlusion culling (docs/culling.md): EARLY passes the clusters visible last
 // frame (per the history buffer) through frustum and cone only; once they are drawn and the pyramid built
@@ -36,21 +37,37 @@ namespace rtr::shader {
 #define CULL_BY_OCCLUSION 3u
 #define CULL_BY_LOD 4u  // not in the cut at this view and threshold (tested first)
 
+// The visible list: uvec2 (GpuInstance, GpuCluster record) per entry; LATE appends after EARLY's entries,
+// so an entry's position names one cluster of one instance for the whole frame (the rasteriser's tile and
+// hand-off lists keep positions).
 // The counts buffer: VkDispatchIndirectCommand {visible clusters, 1, 1}, then the culled counts by reason.
 // Over CullPush::maxGroupsX visible clusters the dispatch is two-dimensional, {maxGroupsX, rows, 1}: a
 // workgroup's list entry is then gl_WorkGroupID.y * maxGroupsX + gl_WorkGroupID.x (below `listed`).
-// The pass runs in two steps: instances (cull_instances.comp), then the chunks of clusters of the
-// instances kept (cull.comp), dispatched from chunkDispatch the same way.
+// The pass runs in steps: instances, then the tree over each level of their meshes' clusters depth by
+// depth (cull_instances.comp), then the chunks of clusters of the leaves reached (cull.comp), dispatched
+// from chunkDispatch the same way.
 struct CullCounts {
   uint dispatch[3];
   uint culled[4];         // frustum, cone (back-facing), occlusion, level of detail
-  uint listed;            // entries in the visible list
+  uint listed;            // entries this pass added to the visible list, from listBase on
   uint triangles;         // of the listed clusters
   uint tested;            // clusters the cluster step visited: those of the instances kept
   uint instancesCulled;   // instances culled whole by the frustum (one test each, none of their clusters)
   uint chunks;            // runs of up to CULL_GROUP_SIZE clusters: the cluster step's workgroups
   uint chunkDispatch[3];  // its indirect dispatch
-  uint pad;
+  uint listBase;          // where this pass's entries start: 0, or for LATE the entries EARLY listed
+  uint nodes;             // tree nodes tested
+  uint pad0, pad1, pad2;
+};
+
+// The tree's work queues, one per depth (CULL_MAX_DEPTH of them, 32 bytes each): (instance, node) items
+// at queue `base`, `count` of them; dispatch, the indirect dispatch of the step that tests them (threads
+// of CULL_GROUP_SIZE, two-dimensional past maxGroupsX workgroups).
+struct CullQueue {
+  uint dispatch[3];
+  uint count;
+  uint base;
+  uint pad0, pad1, pad2;
 };
 
 struct CullPush {  // 128 bytes
@@ -66,8 +83,10 @@ struct CullPush {  // 128 bytes
   float lodThreshold;   // CULL_LOD: pixels of projected error
   float pixelsPerUnit;  // image height / (2 tan(fovY / 2))
   float zNear;
-  uint pad1, pad2;
+  uint clusters;  // without instances (CULL_RECORD_INSTANCE): the records to test
+  uint depth;     // cull_instances.comp: CULL_INSTANCE_STEP, or the tree depth whose queue it tests
 };
+#define CULL_INSTANCE_STEP 0xFFFFFFFFu
 
 RTR_FN vec4 matrixRow(mat4 m, int i) { return vec4(m[0][i], m[1][i], m[2][i], m[3][i]); }
 
@@ -129,6 +148,13 @@ RTR_FN ProjectedBox projectBox(vec4 sphere, mat4 viewProj, uint width, uint heig
   return b;
 }
 
+// A record's sphere (xyz centre, w radius) placed by an instance: the centre by the transform, the radius
+// by its largest stretch (GpuCullInstance::placement.x).
+RTR_FN vec4 placeSphere(mat4 transform, float stretch, vec4 s) {
+  const vec4 c = transform * vec4(s.x, s.y, s.z, 1.0f);
+  return vec4(c.x, c.y, c.z, s.w * stretch);
+}
+
 // The depth pyramid: level 0 is half the image and each level half the last, rounding down (Vulkan's mip
 // sizes); texel t of a level holds the farthest of the texels 2t and 2t + 1 below it and, for the last
 // texel of an odd-sized level below, 2t + 2 too. So texel min(p >> (L + 1), size_L - 1) of level L covers
@@ -149,7 +175,7 @@ RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {
 }
 
 #ifdef __cplusplus
-static_assert(sizeof(CullPush) == 128 && sizeof(CullCounts) == 64);
+static_assert(sizeof(CullPush) == 128 && sizeof(CullCounts) == 80 && sizeof(CullQueue) == 32);
 }  // namespace rtr::shader
 #endif
 #endif

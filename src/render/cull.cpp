@@ -1,6 +1,7 @@
 #include "render/cull.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <functional>
@@ -51,9 +52,6 @@ uint32_t clusterFlags(const Mesh& m, const Material& mat) {
   return CLUSTER_DOUBLE_SIDED | (mat.texture(TextureSlot::AlphaMask) != kNoTexture ? CLUSTER_ALPHA_MASKED : 0u);
 }
 
-namespace {
-
-// The linear part's largest stretch, and whether it is a similarity.
 std::pair<float, bool> largestStretch(const glm::mat4& transform) {
   // A column's length for a similarity, the Frobenius norm (>= the spectral norm) otherwise.
   const glm::mat3 l(transform);
@@ -64,6 +62,8 @@ std::pair<float, bool> largestStretch(const glm::mat4& transform) {
                           std::abs(glm::dot(l[1], l[2])) <= eps;
   return {similarity ? s : std::sqrt(glm::dot(len, len)), similarity};
 }
+
+namespace {
 
 // Records [first, end) of `out` placed by `transform`.
 void place(const glm::mat4& transform, size_t first, std::vector<shader::GpuCluster>& out) {
@@ -144,6 +144,73 @@ std::vector<shader::GpuCluster> gpuClusters(const Scene& scene) {
   return out;
 }
 
+glm::vec4 enclosingSphere(const std::vector<glm::vec4>& spheres) {
+  Bounds b;
+  for (const glm::vec4& s : spheres) b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w);
+  float r = 0.0f;
+  for (const glm::vec4& s : spheres) r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w);
+  return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
+}
+
+uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, const std::vector<shader::GpuClusterLod>& lods,
+                           uint32_t first, uint32_t count, uint32_t root, std::vector<shader::GpuCullNode>& nodes,
+                           std::vector<uint32_t>& depthCounts) {
+  // Bottom up: leaves of CULL_GROUP_SIZE consecutive records, then nodes of CULL_NODE_CHILDREN consecutive
+  // nodes (first: an index in the layer below until stored), up to one.
+  std::vector<std::vector<shader::GpuCullNode>> layers(1);
+  std::vector<glm::vec4> spheres, lodSpheres;
+  for (uint32_t at = first; at < first + count || (count == 0 && layers[0].empty()); at += CULL_LEAF_SIZE) {
+    const uint32_t n = std::min<uint32_t>(CULL_LEAF_SIZE, first + count - at);
+    shader::GpuCullNode leaf{{}, {}, lods.empty() ? 0.0f : shader::LOD_ERROR_INFINITE, 0.0f, at, n | CULL_NODE_LEAF};
+    spheres.clear(), lodSpheres.clear();
+    for (uint32_t c = at; c < at + n; ++c) {
+      spheres.push_back(clusters[c].sphere);
+      if (lods.empty()) continue;
+      const shader::GpuClusterLod& l = lods[c];
+      lodSpheres.push_back(l.sphere);
+      if (l.error.y < shader::LOD_ERROR_INFINITE) lodSpheres.push_back(l.parentSphere);
+      leaf.minError = std::min(leaf.minError, l.error.x);
+      leaf.maxParentError = std::max(leaf.maxParentError, l.error.y);
+    }
+    if (lods.empty()) leaf.maxParentError = shader::LOD_ERROR_INFINITE;
+    leaf.sphere = enclosingSphere(spheres);
+    leaf.lodSphere = lods.empty() ? leaf.sphere : enclosingSphere(lodSpheres);
+    layers[0].push_back(leaf);
+    if (count == 0) break;
+  }
+  while (layers.back().size() > 1) {
+    const std::vector<shader::GpuCullNode>& below = layers.back();
+    std::vector<shader::GpuCullNode> up;
+    for (uint32_t at = 0; at < below.size(); at += CULL_NODE_CHILDREN) {
+      const uint32_t n = std::min<uint32_t>(CULL_NODE_CHILDREN, uint32_t(below.size()) - at);
+      shader::GpuCullNode node{{}, {}, shader::LOD_ERROR_INFINITE, 0.0f, at, n};
+      spheres.clear(), lodSpheres.clear();
+      for (uint32_t c = at; c < at + n; ++c) {
+        spheres.push_back(below[c].sphere), lodSpheres.push_back(below[c].lodSphere);
+        node.minError = std::min(node.minError, below[c].minError);
+        node.maxParentError = std::max(node.maxParentError, below[c].maxParentError);
+      }
+      node.sphere = enclosingSphere(spheres), node.lodSphere = enclosingSphere(lodSpheres);
+      up.push_back(node);
+    }
+    layers.push_back(std::move(up));
+  }
+  // Stored top down: the root in its slot, each layer below in one run, parents pointed at their children.
+  const size_t top = layers.size() - 1;
+  if (depthCounts.size() < layers.size()) depthCounts.resize(layers.size(), 0);
+  nodes[root] = layers[top][0];
+  ++depthCounts[0];
+  size_t parents = root;  // where the layer above was stored
+  for (size_t k = top; k-- > 0;) {
+    const uint32_t base = uint32_t(nodes.size());
+    for (size_t j = 0; j < layers[k + 1].size(); ++j) nodes[parents + j].first += base;
+    nodes.insert(nodes.end(), layers[k].begin(), layers[k].end());
+    depthCounts[top - k] += uint32_t(layers[k].size());
+    parents = base;
+  }
+  return uint32_t(layers[0].size());
+}
+
 DepthPyramid::DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent) : ctx_(ctx), depthExtent_(depthExtent) {
   vk::ImageDesc d;
   d.extent = pyramidExtent(depthExtent);
@@ -210,8 +277,25 @@ void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk:
   }
 }
 
-ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx_(ctx), maxClusters_(maxClusters) {
-  visible_ = vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint32_t maxChunks,
+                             const std::vector<uint32_t>& queueCapacity)
+    : ctx_(ctx),
+      maxClusters_(maxClusters),
+      maxChunks_(maxChunks ? maxChunks : (maxClusters + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE) {
+  if (queueCapacity.size() > CULL_MAX_DEPTH)
+    throw Error("cluster culling: trees " + std::to_string(queueCapacity.size()) + " deep, at most " +
+                std::to_string(CULL_MAX_DEPTH));
+  uint64_t items = 0;
+  for (size_t d = 0; d < queueCapacity.size(); ++d) queueBases_[d] = uint32_t(items), items += queueCapacity[d];
+  if (items > UINT32_MAX / 8) throw Error("cluster culling: " + std::to_string(items) + " tree nodes over the instances");
+  depths_ = uint32_t(queueCapacity.size());
+  items_ = vk::Buffer(ctx, std::max<VkDeviceSize>(8, items * 8), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device,
+                      "cull tree queues");
+  queues_ =
+      vk::Buffer(ctx, sizeof(shader::CullQueue) * CULL_MAX_DEPTH,
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                 vk::MemoryUse::Device, "cull tree queue counts");
+  visible_ = vk::Buffer(ctx, std::max<VkDeviceSize>(8, VkDeviceSize(maxClusters) * 8),
                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Device,
                         "visible clusters");
   counts_ = vk::Buffer(ctx, sizeof(shader::CullCounts),
@@ -219,16 +303,12 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
                            VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                        vk::MemoryUse::Device, "cull counts");
   history_ =
-      vk::Buffer(ctx, std::max<VkDeviceSize>(4, VkDeviceSize(maxClusters) * 4),
+      vk::Buffer(ctx, 4 * (VkDeviceSize(maxClusters) / 32 + 1),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Device, "cluster history");
-  // Every chunk holds at least one cluster.
-  chunks_ = vk::Buffer(ctx, std::max<VkDeviceSize>(8, VkDeviceSize(maxClusters) * 8), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+  chunks_ = vk::Buffer(ctx, std::max<VkDeviceSize>(16, VkDeviceSize(maxChunks_) * 16), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                        vk::MemoryUse::Device, "cluster chunks");
   whole_ = vk::Buffer(ctx, sizeof(shader::GpuCullInstance), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                       vk::MemoryUse::Device, "all clusters as one instance");
-  wholeLevel_ =
-      vk::Buffer(ctx, sizeof(shader::GpuCullLevel), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                 vk::MemoryUse::Device, "all clusters as one level");
   vk::ImageDesc d;
   d.format = kPyramidFormat;
   d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
@@ -246,21 +326,32 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters) : ctx
 
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
                            const DepthPyramid* pyramid, CullTests tests, CullPhase phase, VkBuffer lods, VkBuffer instances,
-                           uint32_t instanceCount, VkBuffer levels) {
-  if (count > maxClusters_)
+                           uint32_t instanceCount, VkBuffer nodes, VkBuffer placements) {
+  if (count > maxClusters_ || (!instances && (count + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE > maxChunks_))
     throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
   vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);
-  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, 0, 0, 0, {0, 1, 1}, 0};  // indirect dispatches' y, z: 1
-  vkCmdUpdateBuffer(cb, counts_.handle(), 0, sizeof(zero), &zero);
-  if (!instances) {  // one level that is always in the window (error 0, parents' infinite)
+  // Late appends to Early's list: its entries start where Early's end (the early ones stay valid).
+  size_t reset = sizeof(shader::CullCounts);
+  if (phase == CullPhase::Late) {
+    const VkBufferCopy base{offsetof(shader::CullCounts, listed), offsetof(shader::CullCounts, listBase), 4};
+    vkCmdCopyBuffer(cb, counts_.handle(), counts_.handle(), 1, &base);
+    vk::bufferBarrier(cb, vk::kTransferWrite | vk::kCopyRead, vk::kTransferWrite);
+    reset = offsetof(shader::CullCounts, listBase);
+  }
+  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, 0, 0, 0, {0, 1, 1}, 0, 0, 0, 0, 0};  // dispatches' y, z: 1
+  vkCmdUpdateBuffer(cb, counts_.handle(), 0, reset, &zero);
+  std::array<shader::CullQueue, CULL_MAX_DEPTH> queues{};
+  for (uint32_t d = 0; d < CULL_MAX_DEPTH; ++d) queues[d] = {{0, 1, 1}, 0, queueBases_[d], 0, 0, 0};
+  vkCmdUpdateBuffer(cb, queues_.handle(), 0, sizeof(queues), queues.data());
+  if (!instances) {  // one instance of records placed already, never culled
     const shader::GpuCullInstance all{glm::vec4(0.0f, 0.0f, 0.0f, 1e30f), glm::vec4(0.0f, 0.0f, 0.0f, 1e30f),
-                                      glm::uvec4(0, 1, 0, 0)};
-    const shader::GpuCullLevel level{0, count, 0.0f, shader::LOD_ERROR_INFINITE};
+                                      glm::uvec4(0, 1, CULL_RECORD_INSTANCE, 0), glm::vec4(1.0f, 1.0f, 1.0f, 0.0f)};
     vkCmdUpdateBuffer(cb, whole_.handle(), 0, sizeof(all), &all);
-    vkCmdUpdateBuffer(cb, wholeLevel_.handle(), 0, sizeof(level), &level);
-    instances = whole_.handle(), levels = wholeLevel_.handle(), instanceCount = 1;
+    instances = whole_.handle(), instanceCount = 1, nodes = VK_NULL_HANDLE;
+  } else if (!nodes) {
+    throw Error("cluster culling: instances without their trees");
   }
   vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
 
@@ -270,7 +361,9 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
   push.count = instanceCount;
   push.flags = (tests.frustum ? CULL_FRUSTUM : 0u) | (tests.cone && !camera.orthographic ? CULL_CONE : 0u) |
                (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u) |
-               (tests.lod && lods && camera.lodThreshold > 0.0f && !camera.orthographic ? CULL_LOD : 0u);
+               (tests.lod && lods && camera.lodThreshold > 0.0f && !camera.orthographic ? CULL_LOD : 0u) |
+               (tests.nodes ? CULL_NODES : 0u);
+  push.clusters = count;
   push.lodThreshold = camera.lodThreshold;
   push.pixelsPerUnit = camera.pixelsPerUnit;
   push.zNear = camera.zNear;
@@ -281,15 +374,26 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
     push.height = pyramid->depthExtent().height;
     push.pyramidLevels = pyramid->levels();
   }
+  // The instances, then the trees depth by depth (each step's queue filled by the one before).
   instancePipeline_.bind(cb);
   vk::DescriptorWriter(ctx_, instancePipeline_.layout, 0, VK_NULL_HANDLE)
       .buffer(1, counts_.handle())
       .buffer(6, instances)
       .buffer(7, chunks_.handle())
-      .buffer(8, levels)
+      .buffer(8, nodes ? nodes : instances)  // not read without a tree
+      .buffer(9, placements ? placements : instances)
+      .buffer(10, queues_.handle())
+      .buffer(11, items_.handle())
       .push(cb, instancePipeline_);
+  push.depth = CULL_INSTANCE_STEP;
   instancePipeline_.push(cb, push);
   instancePipeline_.dispatch(cb, instanceCount);
+  for (uint32_t d = 0; nodes && d < depths_; ++d) {
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
+    push.depth = d;
+    instancePipeline_.push(cb, push);
+    vkCmdDispatchIndirect(cb, queues_.handle(), d * sizeof(shader::CullQueue));
+  }
   vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
   pipeline_.bind(cb);
   vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
@@ -299,7 +403,9 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
       .image(3, pyramid ? pyramid->view() : noPyramid_.view(), VK_IMAGE_LAYOUT_GENERAL)
       .buffer(4, history_.handle())
       .buffer(5, lods ? lods : clusters)  // not read without CULL_LOD
+      .buffer(6, instances)
       .buffer(7, chunks_.handle())
+      .buffer(9, placements ? placements : clusters)  // not read for CULL_RECORD_INSTANCE
       .push(cb, pipeline_);
   pipeline_.push(cb, push);
   vkCmdDispatchIndirect(cb, counts_.handle(), offsetof(shader::CullCounts, chunkDispatch));

@@ -7,7 +7,9 @@
 //
 // Use, per frame (two-phase, CullPhase below): culler.record(Early); dispatch indirect on counts() over
 // visible(); pyramid.build(depth of that); culler.record(Late, &pyramid); dispatch again. docs/culling.md.
+#include <array>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -31,6 +33,9 @@ namespace rtr::render {
 std::vector<Instance> gpuInstances(const Scene& scene);
 // Whether a transform flips the winding (negative determinant).
 bool mirrored(const glm::mat4& transform);
+// The linear part's largest stretch (a column's length for a similarity, else the Frobenius norm, an
+// upper bound), and whether it is a similarity (rotation, uniform scale, mirror).
+std::pair<float, bool> largestStretch(const glm::mat4& transform);
 
 // The CLUSTER_* flags of a mesh's clusters: the GPU's alpha-tested, two-sided draws are double-sided,
 // and alpha-masked where they have a mask texture (render/gpu_scene.cpp's draw kinds).
@@ -49,6 +54,15 @@ void appendClusters(const Mesh& mesh, const glm::mat4& transform, uint32_t insta
 // placed by `transform` as appendClusters places them, errors scaled by its largest stretch.
 void appendClusterLods(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above, size_t first,
                        std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods);
+// The sphere around the box of `spheres` that holds each (rounded outwards).
+glm::vec4 enclosingSphere(const std::vector<glm::vec4>& spheres);
+// The culling tree over records [first, first + count), one level of a mesh (culling spheres in `clusters`,
+// level-of-detail records in `lods`, or none): leaves of up to CULL_GROUP_SIZE consecutive records, nodes
+// of up to CULL_NODE_CHILDREN (cluster.h). Its root goes to nodes[root] (the caller's slot), the rest is
+// appended; adds its nodes at each depth (the root's 0) to `depthCounts`; returns its leaves.
+uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, const std::vector<shader::GpuClusterLod>& lods,
+                           uint32_t first, uint32_t count, uint32_t root, std::vector<shader::GpuCullNode>& nodes,
+                           std::vector<uint32_t>& depthCounts);
 // Every GpuCluster of a scene, numbered as GpuScene numbers its instances.
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
 
@@ -93,6 +107,7 @@ struct CullCamera {
 struct CullTests {
   bool frustum = true, cone = true, occlusion = true;  // occlusion only when a pyramid is given
   bool lod = true;                                     // only with a GpuClusterLod buffer and a camera's threshold above 0
+  bool nodes = true;  // prune the trees (off: every node descended, every cluster of the levels tested)
 };
 
 // Single: every cluster tested once (occlusion conservative only for the view the pyramid was built from).
@@ -103,28 +118,40 @@ enum class CullPhase : uint32_t { Single = CULL_SINGLE, Early = CULL_EARLY, Late
 
 class ClusterCuller {
  public:
-  ClusterCuller(const vk::Context& ctx, uint32_t maxClusters);
+  // maxClusters: the (instance, cluster) pairs it may visit (list entries, history bits); maxChunks: the
+  // runs of up to CULL_GROUP_SIZE clusters it may emit (0: those of one instance of maxClusters, the
+  // record() without instances); queueCapacity: per tree depth, the (instance, node) pairs at it
+  // (GpuScene::cullQueueCapacity).
+  ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint32_t maxChunks = 0,
+                const std::vector<uint32_t>& queueCapacity = {});
   // Records the pass over `count` GpuClusters in `clusters` (a storage buffer; the same clusters every
   // frame for Early/Late). With a pyramid (not used by Early), clusters hidden behind its depths are culled
   // too: a cluster whose every point lies behind that depth image there cannot be seen above it. Ends with
   // a barrier that makes visible() and counts() readable by compute shaders and indirect commands.
   // `lods`: the clusters' GpuClusterLod records (cluster.h), for the level-of-detail cut, tested first.
-  // `instances`: GpuCullInstances (cluster.h), tested first (frustum, and the level window with `levels`,
-  // their GpuCullLevels): a culled instance's clusters, and those of levels outside its window, are not
-  // visited. None: one instance of the first `count` clusters that is never culled.
+  // `instances`: GpuCullInstances (cluster.h), tested first (frustum), then the trees over their meshes'
+  // levels (`nodes`: GpuCullNodes) down to the clusters that can be listed (docs/culling.md); the records
+  // are placed by `placements` (GpuInstance, frame.h) as the instance says. None: one instance of the
+  // first `count` clusters, records placed already (gpuClusters), never culled, no tree.
   void record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera, const DepthPyramid* pyramid,
               CullTests tests = {}, CullPhase phase = CullPhase::Single, VkBuffer lods = VK_NULL_HANDLE,
-              VkBuffer instances = VK_NULL_HANDLE, uint32_t instanceCount = 0, VkBuffer levels = VK_NULL_HANDLE);
-  VkBuffer visible() const { return visible_.handle(); }  // uint per visible cluster: its index, any order
-  VkBuffer counts() const { return counts_.handle(); }    // shader::CullCounts; offset 0 the dispatch args
+              VkBuffer instances = VK_NULL_HANDLE, uint32_t instanceCount = 0, VkBuffer nodes = VK_NULL_HANDLE,
+              VkBuffer placements = VK_NULL_HANDLE);
+  // uvec2 (GpuInstance, GpuCluster record) per visible cluster, any order; Late's after Early's
+  // (CullCounts::listBase).
+  VkBuffer visible() const { return visible_.handle(); }
+  VkBuffer counts() const { return counts_.handle(); }  // shader::CullCounts; offset 0 the dispatch args
   uint32_t maxClusters() const { return maxClusters_; }
 
  private:
   const vk::Context& ctx_;
-  uint32_t maxClusters_;
+  uint32_t maxClusters_, maxChunks_;
   vk::Buffer visible_, counts_, history_, chunks_;
-  vk::Buffer whole_, wholeLevel_;  // the one GpuCullInstance and level of a record() without instances
-  vk::Image noPyramid_;            // 1×1 stand-in so the pass always has a valid binding
+  vk::Buffer whole_;           // the one GpuCullInstance of a record() without instances
+  vk::Buffer items_, queues_;  // the trees' (instance, node) queues and their counts (CullQueue)
+  std::array<uint32_t, CULL_MAX_DEPTH> queueBases_{};
+  uint32_t depths_ = 0;
+  vk::Image noPyramid_;  // 1×1 stand-in so the pass always has a valid binding
   vk::Pipeline instancePipeline_, pipeline_;
 };
 

@@ -54,8 +54,10 @@ struct GeometryPlan {
   std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
   std::vector<uint32_t> idPages;            // visIdPages(): the instance holding each page's first id
   std::vector<shader::GpuCullInstance> cullInstances;
-  std::vector<shader::GpuCullLevel> cullLevels;
-  size_t baseClusters = 0;
+  std::vector<shader::GpuCullNode> cullNodes;  // each mesh's level trees, their roots first
+  std::vector<uint64_t> queues;                // per tree depth: (instance, node) pairs at it
+  std::vector<glm::uvec2> baseEntries;         // (instance, record) of every instance's level 0
+  uint64_t pairs = 0, chunks = 0;              // (instance, cluster) pairs; the culling pass's chunks at most
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
 };
@@ -162,9 +164,60 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   }
   const std::vector<Instance> instances = gpuInstances(scene);
   const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
-  std::vector<uint32_t> cullIndex(instances.size(), UINT32_MAX);  // its GpuCullInstance
-  std::vector<std::array<glm::uvec2, 2>> runs(instances.size());  // per GpuCullInstance: full detail, levels above
-  Bounds box;                                                     // of the draw being extended
+  // Spheres around the box of the spheres `each` gives, holding each.
+  auto enclose = [](auto&& each) {
+    Bounds b;
+    each([&](glm::vec4 s) { b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w); });
+    float r = 0.0f;
+    each([&](glm::vec4 s) { r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w); });
+    return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
+  };
+  // Each mesh's cluster records once, in its own space (docs/culling.md): level 0 (the mesh's clusters),
+  // then the levels above; its spheres and its levels.
+  struct MeshRecords {
+    uint32_t first = 0, count = 0, level0 = 0, firstLevel = 0, levels = 0, leaves = 0;
+    glm::vec4 sphere{0.0f}, lodSphere{0.0f};
+    std::vector<uint32_t> depths;  // its trees' nodes at each depth
+  };
+  std::vector<MeshRecords> meshRecords(scene.meshes.size());
+  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const Mesh& m = scene.meshes[mi];
+    if (!meshDraw[mi] || scene.materials.at(m.material).blended()) continue;  // the transparency pass draws it
+    MeshRecords& r = meshRecords[mi];
+    r.first = uint32_t(p.clusters.size());
+    appendClusters(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, p.clusters);
+    r.level0 = uint32_t(p.clusters.size()) - r.first;
+    if (lods) {
+      appendClusterLods(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, false, r.first, p.clusters, p.lods);
+      appendClusterLods(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, true, 0, p.clusters, p.lods);
+    }
+    r.count = uint32_t(p.clusters.size()) - r.first;
+    const size_t end = r.first + r.count;
+    r.sphere = enclose([&](auto&& add) {
+      for (size_t c = r.first; c < end; ++c) add(p.clusters[c].sphere);
+    });
+    r.lodSphere = p.lods.empty() ? r.sphere : enclose([&](auto&& add) {
+      for (size_t c = r.first; c < end; ++c) {
+        add(p.lods[c].sphere);
+        if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) add(p.lods[c].parentSphere);
+      }
+    });
+    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
+    // tree over each, their roots side by side.
+    std::vector<glm::uvec2> runs{{r.first, r.level0}};
+    uint32_t at = 0;
+    for (size_t k = 0, c = r.first + r.level0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
+      if (m.lod.clusters[k].level == 0) continue;
+      if (runs.size() == 1 || m.lod.clusters[k].level != at) runs.push_back({uint32_t(c), 0});
+      at = m.lod.clusters[k].level, ++runs.back().y, ++c;
+    }
+    r.firstLevel = uint32_t(p.cullNodes.size()), r.levels = uint32_t(runs.size());
+    p.cullNodes.resize(p.cullNodes.size() + runs.size());
+    for (size_t l = 0; l < runs.size(); ++l)
+      r.leaves += appendClusterTree(p.clusters, p.lods, runs[l].x, runs[l].y, r.firstLevel + uint32_t(l), p.cullNodes, r.depths);
+  }
+  Bounds box;  // of the draw being extended
+  uint64_t slots = 0, chunks = 0;
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
     const Mesh& m = scene.meshes[in.mesh];
@@ -172,19 +225,29 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     const bool flip = mirrored(in.transform);
     p.instances.push_back(gpuInstance(in.transform, md.item.id));
     // The identity keeps the box exact (the nearest-first order of existing scenes unchanged).
-    const Bounds b = in.transform == glm::mat4(1.0f) ? m.bounds : transformed(m.bounds, in.transform);
+    const bool identity = in.transform == glm::mat4(1.0f);
+    const Bounds b = identity ? m.bounds : transformed(m.bounds, in.transform);
     if (const Material& mat = scene.materials.at(m.material); mat.blended()) {
       BlendDraw bd{md.item, !m.texcoords.empty(), (mat.flags & kMaterialDoubleSided) != 0};
       bd.item.firstInstance = i, bd.item.mirrored = flip, bd.item.center = b.empty() ? glm::vec3(0.0f) : b.center();
       blendDraws_.push_back(bd);
       continue;
     }
-    const size_t first = p.clusters.size();
-    appendClusters(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), p.clusters);
-    cullIndex[i] = uint32_t(p.cullInstances.size());
-    p.cullInstances.push_back({glm::vec4(0.0f), glm::vec4(0.0f), glm::uvec4(0)});
-    runs[cullIndex[i]] = {glm::uvec2(first, p.clusters.size() - first), glm::uvec2(0)};
-    if (lods) appendClusterLods(m, in.transform, i, md.flags | (flip ? CLUSTER_MIRRORED : 0u), false, first, p.clusters, p.lods);
+    // Its culling record: the mesh's spheres placed (a sphere holding the placed ones), how to place the
+    // records, and its history slots.
+    const MeshRecords& r = meshRecords[in.mesh];
+    const auto [stretch, similarity] = largestStretch(in.transform);
+    auto place = [&](glm::vec4 s) {
+      return identity ? s : glm::vec4(glm::vec3(in.transform * glm::vec4(glm::vec3(s), 1.0f)), s.w * stretch * (1.0f + 1e-5f));
+    };
+    p.cullInstances.push_back({place(r.sphere), place(r.lodSphere),
+                               glm::uvec4(r.firstLevel, r.levels, i, uint32_t(slots - r.first)),
+                               glm::vec4(identity ? 1.0f : stretch, similarity ? 1.0f : 0.0f, identity ? 1.0f : 0.0f, 0.0f)});
+    for (uint32_t k = 0; k < r.level0; ++k) p.baseEntries.push_back(glm::uvec2(i, r.first + k));
+    slots += r.count;
+    chunks += r.leaves;
+    if (p.queues.size() < r.depths.size()) p.queues.resize(r.depths.size(), 0);
+    for (size_t d = 0; d < r.depths.size(); ++d) p.queues[d] += r.depths[d];
     std::vector<DrawItem>& list = draws_[size_t(md.kind)];
     if (list.empty() || list.back().id != md.item.id || list.back().mirrored != flip) {
       list.push_back(md.item);
@@ -195,7 +258,7 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     box.extend(b);
     if (!box.empty()) list.back().center = box.center();
   }
-  p.baseClusters = p.clusters.size();
+  p.pairs = slots, p.chunks = chunks;
   // Visibility ids (frame.h): each drawn instance its own range, as long as its draw's primitives, in order.
   uint64_t ids = 0;
   firstIds_.clear();
@@ -215,56 +278,6 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
       p.idPages.push_back(uint32_t(i));
     }
   if (p.idPages.empty()) p.idPages.push_back(0);
-  for (uint32_t i = 0; lods && i < instances.size(); ++i) {  // the hierarchies' clusters after all full-detail ones
-    const Mesh& m = scene.meshes[instances[i].mesh];
-    if (scene.materials.at(m.material).blended()) continue;  // drawn by the transparency pass, no clusters
-    const uint32_t flags = meshDraw[instances[i].mesh]->flags | (mirrored(instances[i].transform) ? CLUSTER_MIRRORED : 0u);
-    const size_t first = p.clusters.size();
-    appendClusterLods(m, instances[i].transform, i, flags, true, 0, p.clusters, p.lods);
-    if (cullIndex[i] != UINT32_MAX) runs[cullIndex[i]][1] = glm::uvec2(first, p.clusters.size() - first);
-  }
-  // Each instance's spheres (around the box of the spheres they hold, holding each) and levels.
-  auto enclose = [&](const std::array<glm::uvec2, 2>& rs, auto&& spheres) {
-    Bounds b;
-    for (const glm::uvec2 run : rs)
-      for (size_t c = run.x; c < run.x + run.y; ++c)
-        spheres(c, [&](glm::vec4 s) { b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w); });
-    float r = 0.0f;
-    for (const glm::uvec2 run : rs)
-      for (size_t c = run.x; c < run.x + run.y; ++c)
-        spheres(c, [&](glm::vec4 s) { r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w); });
-    return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
-  };
-  for (uint32_t i = 0; i < instances.size(); ++i) {
-    if (cullIndex[i] == UINT32_MAX) continue;
-    shader::GpuCullInstance& ci = p.cullInstances[cullIndex[i]];
-    const std::array<glm::uvec2, 2>& rs = runs[cullIndex[i]];
-    ci.sphere = enclose(rs, [&](size_t c, auto&& add) { add(p.clusters[c].sphere); });
-    ci.lodSphere = p.lods.empty() ? ci.sphere : enclose(rs, [&](size_t c, auto&& add) {
-      add(p.lods[c].sphere);
-      if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) add(p.lods[c].parentSphere);
-    });
-    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level).
-    ci.levels = glm::uvec4(p.cullLevels.size(), 0, 0, 0);
-    auto level = [&](uint32_t first, uint32_t count) {
-      shader::GpuCullLevel v{first, count, shader::LOD_ERROR_INFINITE, 0.0f};
-      for (size_t c = first; c < first + count; ++c) {
-        v.minError = std::min(v.minError, p.lods.empty() ? 0.0f : p.lods[c].error.x);
-        v.maxParentError = std::max(v.maxParentError, p.lods.empty() ? shader::LOD_ERROR_INFINITE : p.lods[c].error.y);
-      }
-      p.cullLevels.push_back(v);
-      ++ci.levels.y;
-    };
-    level(rs[0].x, rs[0].y);
-    const Mesh& m = scene.meshes[instances[i].mesh];
-    uint32_t c = rs[1].x, run = 0, at = 0;
-    for (size_t k = 0; k < m.lod.clusters.size() && rs[1].y > 0; ++k) {
-      if (m.lod.clusters[k].level == 0) continue;
-      if (run > 0 && m.lod.clusters[k].level != at) level(c - run, run), run = 0;
-      at = m.lod.clusters[k].level, ++run, ++c;
-    }
-    if (run > 0) level(c - run, run);
-  }
   stats_.instances = uint32_t(instances.size());
   stats_.vertices = uint32_t(p.vertices);
   p.count16 += p.count16 % 2;  // keep the buffer size a multiple of 4
@@ -336,7 +349,8 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     kLod,
     kIds,
     kCullInst,
-    kCullLevel,
+    kCullNode,
+    kBaseEntries,
     kTargets
   };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
@@ -355,17 +369,22 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
                                         {&clusterLods_, bytes(plan.lods), plan.lods.data()},
                                         {&visIdPages_, bytes(plan.idPages), plan.idPages.data()},
                                         {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()},
-                                        {&cullLevels_, bytes(plan.cullLevels), plan.cullLevels.data()}}};
+                                        {&cullNodes_, bytes(plan.cullNodes), plan.cullNodes.data()},
+                                        {&baseEntries_, bytes(plan.baseEntries), plan.baseEntries.data()}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
   const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
                                                        kStorage, kStorage, kStorage, kStorage, kStorage, kStorage,
-                                                       kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32", "materials",
-                                 "draws",        "instances", "clusters",       "texcoords1", "tangents",  "colours",
-                                 "cluster lods", "id pages",  "cull instances", "cull levels"};
-  clusterCount_ = uint32_t(plan.clusters.size());
-  baseClusterCount_ = uint32_t(plan.baseClusters);
+                                                       kStorage, kStorage, kStorage, kStorage, kStorage};
+  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32",      "materials",
+                                 "draws",        "instances", "clusters",       "texcoords1", "tangents",       "colours",
+                                 "cluster lods", "id pages",  "cull instances", "cull nodes", "cluster entries"};
+  // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
+  clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
+  baseClusterCount_ = uint32_t(plan.baseEntries.size());
+  chunkCapacity_ = uint32_t(std::min<uint64_t>(plan.chunks, UINT32_MAX));
+  cullQueueCapacity_.clear();
+  for (uint64_t n : plan.queues) cullQueueCapacity_.push_back(uint32_t(std::min<uint64_t>(n, UINT32_MAX)));
   cullInstanceCount_ = uint32_t(plan.cullInstances.size());
   size_t stagingSize = 0;
   for (size_t i = 0; i < kTargets; ++i) {

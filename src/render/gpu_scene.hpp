@@ -165,15 +165,22 @@ class GpuScene {
   VkBuffer drawInfo() const { return drawInfo_.handle(); }    // GpuDraw per draw, for shading in compute
   VkBuffer instances() const { return instances_.handle(); }  // GpuInstance (frame.h), gpuInstances() order
   uint32_t instanceCount() const { return stats_.instances; }
-  // GpuCluster (cluster.h): every instance's full-detail clusters (the first baseClusterCount(), instance by
-  // instance), then those of the meshes' hierarchies above level 0, instance by instance.
+  // GpuCluster (cluster.h) per cluster of each mesh, in the mesh's space (docs/culling.md): its full-detail
+  // clusters, then those of its hierarchy above level 0; the culling pass places them per instance.
   VkBuffer clusters() const { return clusters_.handle(); }
-  uint32_t clusterCount() const { return clusterCount_; }
-  uint32_t baseClusterCount() const { return baseClusterCount_; }
-  // GpuCullInstance (cluster.h) per instance with clusters: its sphere and its runs of clusters.
+  uint32_t clusterCount() const { return clusterCount_; }          // (instance, cluster) pairs, every level
+  uint32_t baseClusterCount() const { return baseClusterCount_; }  // (instance, cluster) pairs of level 0
+  // uvec2 (GpuInstance, GpuCluster) per pair of level 0, instance by instance: what the compute rasteriser
+  // draws without the culling pass (raster_fetch.glsl's clusterList).
+  VkBuffer baseEntries() const { return baseEntries_.handle(); }
+  uint32_t chunkCapacity() const { return chunkCapacity_; }  // the culling pass's chunks at most (ClusterCuller)
+  // GpuCullInstance (cluster.h) per instance with clusters: its spheres, its mesh's levels, its placement.
   VkBuffer cullInstances() const { return cullInstances_.handle(); }
   uint32_t cullInstanceCount() const { return cullInstanceCount_; }
-  VkBuffer cullLevels() const { return cullLevels_.handle(); }  // GpuCullLevel: each instance's, level 0 first
+  // GpuCullNode (cluster.h): each mesh's trees over its levels, the roots first (level 0's, then above).
+  VkBuffer cullNodes() const { return cullNodes_.handle(); }
+  // Per tree depth, the (instance, node) pairs at it: the culling pass's queues (ClusterCuller).
+  const std::vector<uint32_t>& cullQueueCapacity() const { return cullQueueCapacity_; }
   // GpuClusterLod per GpuCluster where some mesh has a hierarchy (docs/virtual-geometry.md); else null.
   VkBuffer clusterLods() const { return clusterLods_.handle(); }
   // Visibility ids (frame.h): instance i names the ids [firstId(i), firstId(i) + its draw's primitives),
@@ -248,8 +255,9 @@ class GpuScene {
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;
   vk::Buffer positions_, normals_, texcoords_, indices16_, indices32_, materials_, drawInfo_, instances_, clusters_;
-  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_, cullInstances_, cullLevels_;
-  uint32_t clusterCount_ = 0, baseClusterCount_ = 0, cullInstanceCount_ = 0;
+  vk::Buffer texcoords1_, tangents_, colors_, clusterLods_, visIdPages_, cullInstances_, cullNodes_, baseEntries_;
+  uint32_t clusterCount_ = 0, baseClusterCount_ = 0, cullInstanceCount_ = 0, chunkCapacity_ = 0;
+  std::vector<uint32_t> cullQueueCapacity_;
   std::vector<uint64_t> firstIds_;  // per instance
   uint64_t visIdCount_ = 0;
   uint32_t idPageShift_ = 0;

@@ -81,6 +81,7 @@ std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame)
               c[1].culled[1],        c[1].culled[2], c[1].culled[3], earlyTriangles + c[1].triangles};
   s.tested = (twoPhase_.at(frame) ? c[0].tested : 0) + c[1].tested;
   s.instancesCulled = c[1].instancesCulled;
+  s.nodes = (twoPhase_.at(frame) ? c[0].nodes : 0) + c[1].nodes;
   return s;
 }
 
@@ -103,7 +104,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   const bool lod = scene_.clusterLods() && camera.lodThreshold > 0.0f && !camera.orthographic;
   const uint32_t clusterCount = lod ? scene_.clusterCount() : scene_.baseClusterCount();
   const bool twoPhase = cull && clusterCount > 0, culling = (cull || lod) && clusterCount > 0;
-  if (culling && !culler_) culler_.emplace(ctx_, scene_.clusterCount());
+  if (culling && !culler_) culler_.emplace(ctx_, scene_.clusterCount(), scene_.chunkCapacity(), scene_.cullQueueCapacity());
   if (twoPhase && !pyramid_) pyramid_.emplace(ctx_, extent_);
   culled_.at(frame) = culling;
   twoPhase_.at(frame) = twoPhase;
@@ -113,8 +114,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
     for (const vk::ReflectedBinding& b : p.layout.interface().bindings) {
       if (b.set != 0) continue;
-      const VkBuffer list = culler_ ? culler_->visible() : scene_.clusters();  // not read without culling
-      const VkBuffer counts = culler_ ? culler_->counts() : scene_.clusters();
+      const VkBuffer list = culling ? culler_->visible() : scene_.baseEntries();
+      const VkBuffer counts = culler_ ? culler_->counts() : scene_.clusters();  // not read without culling
       const VkBuffer buffers[] = {uniforms.buffer,
                                   scene_.clusters(),
                                   scene_.drawInfo(),
@@ -168,14 +169,14 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   };
   if (culling && !twoPhase) {  // the level-of-detail cut alone
     culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {false, false, false, true}, CullPhase::Single, lods,
-                    scene_.cullInstances(), scene_.cullInstanceCount(), scene_.cullLevels());
+                    scene_.cullInstances(), scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
     vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     timer.mark(cb, "cull");
   }
   if (twoPhase) {
     culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {}, CullPhase::Early, lods, scene_.cullInstances(),
-                    scene_.cullInstanceCount(), scene_.cullLevels());
+                    scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[0]);
     timer.mark(cb, "cull early");
     rasterise("raster early", "raster large early");
@@ -187,7 +188,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     timer.mark(cb, "pyramid");
     // Its first barrier orders the copies above before its reset, its second makes them visible to compute.
     culler_->record(cb, scene_.clusters(), clusterCount, camera, &*pyramid_, {}, CullPhase::Late, lods, scene_.cullInstances(),
-                    scene_.cullInstanceCount(), scene_.cullLevels());
+                    scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
     vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     timer.mark(cb, "cull");

@@ -45,6 +45,7 @@ class ComputeRaster {
     uint32_t triangles = 0;                                  // of the listed clusters, both phases
     uint32_t tested = 0;                                     // clusters visited, both phases (those of the instances not culled)
     uint32_t instancesCulled = 0;                            // by the late phase's frustum test, whole
+    uint32_t nodes = 0;                                      // tree nodes tested, both phases
   };
   std::optional<CullStats> cullStats(uint32_t frame) const;
   // Triangles handed to the hardware by the last completed use of `frame` (both phases); those past

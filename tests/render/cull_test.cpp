@@ -90,22 +90,25 @@ class CullTest : public test::VulkanTest {
   GpuResult cull(ClusterCuller& culler, const vk::Buffer& clusters, uint32_t count, const CullCamera& cam,
                  const DepthPyramid* pyramid, const std::function<void(VkCommandBuffer)>& before = {},
                  render::CullPhase phase = render::CullPhase::Single) {
-    vk::Buffer back(*ctx, 32 + size_t(count) * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "cull back");
+    constexpr size_t kCounts = sizeof(shader::CullCounts);
+    vk::Buffer back(*ctx, kCounts + size_t(count) * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "cull back");
     vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
       if (before) before(cb);
       culler.record(cb, clusters.handle(), count, cam, pyramid, {}, phase);
-      VkBufferCopy a{0, 0, 32}, b{0, 32, size_t(count) * 4};
+      VkBufferCopy a{0, 0, kCounts}, b{0, kCounts, size_t(count) * 8};
       vkCmdCopyBuffer(cb, culler.counts(), back.handle(), 1, &a);
       vkCmdCopyBuffer(cb, culler.visible(), back.handle(), 1, &b);
       vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     });
     back.invalidate();
     GpuResult r;
-    std::memcpy(&r.counts, back.mapped(), 32);
-    const uint32_t* ids = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(back.mapped()) + 32);
-    EXPECT_LE(r.counts.listed, count);
-    for (uint32_t i = 0; i < std::min(r.counts.listed, count); ++i)
-      EXPECT_TRUE(r.visible.insert(ids[i]).second) << "listed twice";
+    std::memcpy(&r.counts, back.mapped(), kCounts);
+    // Entries (instance, record) from listBase on: Late's follow Early's.
+    const uint32_t* entries = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(back.mapped()) + kCounts);
+    EXPECT_LE(r.counts.listBase + r.counts.listed, count);
+    EXPECT_EQ(r.counts.listBase, phase == render::CullPhase::Late ? lastListed : 0u) << "Late appends to Early's list";
+    for (uint32_t i = r.counts.listBase; i < std::min(r.counts.listBase + r.counts.listed, count); ++i)
+      EXPECT_TRUE(r.visible.insert(entries[2 * i + 1]).second) << "listed twice";
     // One workgroup per entry: {listed, 1, 1}, or two-dimensional past the device's (or 65 535) groups in x.
     const uint32_t maxX = std::min(ctx->properties().limits.maxComputeWorkGroupCount[0], 65535u);
     if (r.counts.listed <= maxX) {
@@ -119,8 +122,10 @@ class CullTest : public test::VulkanTest {
     if (phase == render::CullPhase::Single) {
       EXPECT_EQ(r.counts.listed + r.counts.culled[0] + r.counts.culled[1] + r.counts.culled[2], count);
     }
+    lastListed = r.counts.listed;
     return r;
   }
+  uint32_t lastListed = 0;  // the last cull()'s list length
 
   HostPyramid readPyramid(const DepthPyramid& p) {
     HostPyramid h;

@@ -2,6 +2,8 @@
 // a hierarchy; a closed mesh seen from inside at 4 pixels of error shows no background through a crack;
 // culling with a cut equals no culling with it; the image error against full detail stays small.
 #include <cmath>
+#include <cstring>
+#include <set>
 #include <cstdio>
 
 #include <gtest/gtest.h>
@@ -11,7 +13,9 @@
 #include "cluster_lod.h"
 #include "core/bounds.hpp"
 #include "core/camera.hpp"
+#include "render/cull.hpp"
 #include "render/headless.hpp"
+#include "vk/commands.hpp"
 #include "scene/cluster_lod.hpp"
 #include "scene/clusters.hpp"
 #include "scene/load.hpp"
@@ -141,6 +145,72 @@ TEST_F(LodTest, LevelWindowVisitsFewerClustersAndKeepsTheCut) {
     EXPECT_LT(c->tested, gpu.clusterCount() / 2) << "the window skips little";
     EXPECT_NEAR(double(c->triangles), double(want), double(want) / 1000);
   }
+}
+
+// The trees over each level (cull_instances.comp) prune only what the clusters' own tests would drop:
+// 36 temples, some turned, scaled and mirrored, seen from beside the grid and from inside one at 1 and
+// 4 px, frustum and cone on; the culling pass lists the same (instance, cluster) pairs with the trees
+// pruning as with every node descended (each cluster of every level tested), with far fewer tests.
+TEST_F(LodTest, TreesListTheClustersTheFlatTestLists) {
+  Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  const Bounds one = scene.bounds();
+  const glm::vec3 step = (one.max - one.min) * 1.5f;
+  scene.instances.clear();
+  for (int i = 0; i < 36; ++i) {
+    glm::mat4 t = glm::translate(glm::mat4(1.0f), glm::vec3(step.x * float(i % 6), 0.0f, -step.z * float(i / 6)));
+    if (i % 3 == 1) t = glm::rotate(t, glm::radians(40.0f * float(i)), glm::vec3(0, 1, 0));
+    if (i % 5 == 2) t = glm::scale(t, glm::vec3(0.6f));
+    if (i % 7 == 3) t = glm::scale(t, glm::vec3(-1.0f, 1.0f, 1.0f));
+    if (i % 11 == 4) t = glm::scale(t, glm::vec3(1.0f, 1.5f, 1.0f));  // non-uniform: no cone
+    for (uint32_t m = 0; m < scene.meshes.size(); ++m) scene.instances.push_back({m, t});
+  }
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  ASSERT_GT(gpu.cullQueueCapacity().size(), 1u) << "the temple's trees have inner nodes";
+  render::ClusterCuller culler(*ctx, gpu.clusterCount(), gpu.chunkCapacity(), gpu.cullQueueCapacity());
+  const VkExtent2D e{320, 200};
+  const Bounds b = scene.bounds();
+  uint64_t sumFlat = 0, sumTree = 0;
+  for (const CameraPose& pose : {orbitFrame(b, Lens{}, 1.6f, 200.0f, -10.0f), CameraPose{one.center(), 200.0f, -5.0f}})
+    for (float threshold : {1.0f, 4.0f}) {
+      const Lens lens = fitDepthRange(Lens{}, b, pose);
+      const float ppu = float(e.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
+      const render::CullCamera cam{projectionMatrix(lens, float(e.width) / float(e.height)) * viewMatrix(pose),
+                                   pose.position,
+                                   false,
+                                   threshold,
+                                   ppu,
+                                   lens.zNear};
+      auto run = [&](bool nodes) {
+        render::CullTests tests;
+        tests.nodes = nodes;
+        const size_t n = gpu.clusterCount();
+        vk::Buffer back(*ctx, sizeof(shader::CullCounts) + n * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback,
+                        "cull back");
+        vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
+          culler.record(cb, gpu.clusters(), gpu.clusterCount(), cam, nullptr, tests, render::CullPhase::Single, gpu.clusterLods(),
+                        gpu.cullInstances(), gpu.cullInstanceCount(), gpu.cullNodes(), gpu.instances());
+          const VkBufferCopy a{0, 0, sizeof(shader::CullCounts)}, v{0, sizeof(shader::CullCounts), n * 8};
+          vkCmdCopyBuffer(cb, culler.counts(), back.handle(), 1, &a);
+          vkCmdCopyBuffer(cb, culler.visible(), back.handle(), 1, &v);
+          vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+        });
+        back.invalidate();
+        std::pair<shader::CullCounts, std::set<std::pair<uint32_t, uint32_t>>> r;
+        std::memcpy(&r.first, back.mapped(), sizeof(shader::CullCounts));
+        const uint32_t* list = reinterpret_cast<const uint32_t*>(static_cast<const uint8_t*>(back.mapped()) + sizeof r.first);
+        for (uint32_t i = 0; i < r.first.listed; ++i) EXPECT_TRUE(r.second.insert({list[2 * i], list[2 * i + 1]}).second);
+        return r;
+      };
+      const auto flat = run(false), tree = run(true);
+      std::printf("%.0f px: %u pairs listed, %u triangles; cluster tests %u flat, %u with the trees (+ %u node tests)\n",
+                  threshold, tree.first.listed, tree.first.triangles, flat.first.tested, tree.first.tested, tree.first.nodes);
+      EXPECT_GT(tree.first.listed, 0u);
+      EXPECT_TRUE(flat.second == tree.second) << "flat " << flat.second.size() << " pairs, trees " << tree.second.size();
+      EXPECT_EQ(flat.first.triangles, tree.first.triangles);
+      if (flat.first.instancesCulled == 0) { EXPECT_EQ(flat.first.tested, gpu.clusterCount()) << "flat: every cluster tested"; }
+      sumFlat += flat.first.tested, sumTree += tree.first.tested;
+    }
+  EXPECT_LT(sumTree * 2, sumFlat) << "the trees test under half of the clusters";
 }
 
 // The rendered error of a cut against full detail: the mean over pixels of the largest channel difference

@@ -221,7 +221,8 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
           "occlusion %u (%.1f %%), not in the level-of-detail cut %u; %u triangles listed\n",
           c->clusters, c->early, c->late, c->frustum, 100 * c->frustum / n, c->cone, 100 * c->cone / n, c->occlusion,
           100 * c->occlusion / n, c->lod, c->triangles);
-      std::printf("cull: %u cluster tests (both phases), %u instances culled whole\n", c->tested, c->instancesCulled);
+      std::printf("cull: %u cluster tests and %u tree node tests (both phases), %u instances culled whole\n", c->tested, c->nodes,
+                  c->instancesCulled);
     }
     if (settings.raster != render::RasterPath::Hardware)
       if (const auto h = renderer.renderer().handOffTriangles(0)) {
