@@ -4,6 +4,7 @@
 // a mesh, a chunk of count / kPieces elements — never count / threads), so what fn computes, and which
 // exception the caller sees, do not depend on the thread count. ThreadPool keeps threads for a job that
 // spreads work many times (the BVH build); parallelFor on a pool runs the same loop on its threads.
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
@@ -111,6 +112,23 @@ void parallelFor(ThreadPool& pool, size_t count, Fn&& fn) {
   loop.run(fn);
   pool.wait(g);
   loop.rethrow();
+}
+
+// std::sort's result on all cores: fixed pieces sorted at once, then merged pairwise, round by round. The
+// order must be total (ties broken by something that tells elements apart, or equal elements identical),
+// so the result is std::sort's whatever the thread count.
+template <class T, class Less = std::less<>>
+void parallelSort(std::vector<T>& v, unsigned threads = 0, Less less = {}) {
+  constexpr size_t kPiece = size_t(1) << 16;
+  const size_t n = v.size();
+  if (n <= kPiece) return std::sort(v.begin(), v.end(), less);
+  parallelFor((n + kPiece - 1) / kPiece, threads,
+              [&](size_t p) { std::sort(v.begin() + p * kPiece, v.begin() + std::min(n, (p + 1) * kPiece), less); });
+  for (size_t run = kPiece; run < n; run *= 2)
+    parallelFor((n + 2 * run - 1) / (2 * run), threads, [&](size_t m) {
+      const size_t b = m * 2 * run;
+      std::inplace_merge(v.begin() + b, v.begin() + std::min(n, b + run), v.begin() + std::min(n, b + 2 * run), less);
+    });
 }
 
 }  // namespace rtr

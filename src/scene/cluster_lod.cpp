@@ -69,7 +69,7 @@ std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
 
 // Each vertex's first vertex at the same position: clusters on the two sides of a seam (vertices split
 // by normal or uv) are neighbours, so a group may hold both sides and the simplifier sees the seam.
-std::vector<uint32_t> positionIds(const Mesh& mesh) {
+std::vector<uint32_t> positionIds(const Mesh& mesh, unsigned threads) {
   using Key = std::array<uint32_t, 3>;
   auto key = [&](uint32_t v) {
     Key k;
@@ -78,7 +78,7 @@ std::vector<uint32_t> positionIds(const Mesh& mesh) {
   };
   std::vector<uint32_t> order(mesh.positions.size()), id(mesh.positions.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+  parallelSort(order, threads, [&](uint32_t a, uint32_t b) {
     const Key ka = key(a), kb = key(b);
     return ka != kb ? ka < kb : a < b;
   });
@@ -123,7 +123,7 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
   });
   std::vector<Entry> all;
   for (auto& piece : perPiece) all.insert(all.end(), piece.begin(), piece.end()), piece = {};
-  std::sort(all.begin(), all.end());
+  parallelSort(all, threads);
   std::vector<uint64_t> pairs;  // (a << 32 | b), a < b: one per edge the two share
   for (size_t i = 0, j; i < all.size(); i = j) {
     for (j = i + 1; j < all.size() && all[j].edge == all[i].edge;) ++j;
@@ -131,7 +131,7 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
       for (size_t b = a + 1; b < j; ++b) pairs.push_back(uint64_t(all[a].cluster) << 32 | all[b].cluster);
   }
   all = {};
-  std::sort(pairs.begin(), pairs.end());
+  parallelSort(pairs, threads);
   // Neighbours per cluster, with the edges they share (in neighbour order).
   std::vector<uint32_t> first(n + 1, 0);
   std::vector<std::pair<uint32_t, uint32_t>> links;
@@ -286,7 +286,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     return uint32_t(lod.clusters.size() - 1);
   };
 
-  const std::vector<uint32_t> pos = positionIds(mesh);
+  const std::vector<uint32_t> pos = positionIds(mesh, threads);
   lod.levels = 1;
   for (uint32_t level = 1; current.size() > 1 && level < 64; ++level) {
     const std::vector<std::vector<uint32_t>> groups = groupLevel(current, pos, threads);
