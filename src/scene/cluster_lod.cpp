@@ -160,7 +160,8 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
     while (g.size() < kGroupSize) {
       shared.clear();
       for (uint32_t m : g)
-        for (auto [nb, edges] : neighbours(m)) {
+        for (const auto& link : neighbours(m)) {
+          const uint32_t nb = link.first, edges = link.second;  // not a structured binding: clang 14 cannot capture one
           if (group[nb] >= 0) continue;
           auto it = std::find_if(shared.begin(), shared.end(), [&](auto& s) { return s.first == nb; });
           if (it == shared.end()) shared.push_back({nb, edges});
