@@ -164,14 +164,6 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   }
   const std::vector<Instance> instances = gpuInstances(scene);
   const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
-  // Spheres around the box of the spheres `each` gives, holding each.
-  auto enclose = [](auto&& each) {
-    Bounds b;
-    each([&](glm::vec4 s) { b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w); });
-    float r = 0.0f;
-    each([&](glm::vec4 s) { r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w); });
-    return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
-  };
   // Each mesh's cluster records once, in its own space (docs/culling.md): level 0 (the mesh's clusters),
   // then the levels above; its spheres and its levels.
   struct MeshRecords {
@@ -193,15 +185,19 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     }
     r.count = uint32_t(p.clusters.size()) - r.first;
     const size_t end = r.first + r.count;
-    r.sphere = enclose([&](auto&& add) {
-      for (size_t c = r.first; c < end; ++c) add(p.clusters[c].sphere);
-    });
-    r.lodSphere = p.lods.empty() ? r.sphere : enclose([&](auto&& add) {
+    std::vector<glm::vec4> spheres;
+    for (size_t c = r.first; c < end; ++c) spheres.push_back(p.clusters[c].sphere);
+    r.sphere = enclosingSphere(spheres);
+    if (p.lods.empty()) {
+      r.lodSphere = r.sphere;
+    } else {
+      spheres.clear();
       for (size_t c = r.first; c < end; ++c) {
-        add(p.lods[c].sphere);
-        if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) add(p.lods[c].parentSphere);
+        spheres.push_back(p.lods[c].sphere);
+        if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(p.lods[c].parentSphere);
       }
-    });
+      r.lodSphere = enclosingSphere(spheres);
+    }
     // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
     // tree over each, their roots side by side.
     std::vector<glm::uvec2> runs{{r.first, r.level0}};
