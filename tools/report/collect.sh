@@ -7,7 +7,7 @@
 #     --runner CMD  how to start a binary: "CMD NAME ARGS" (e.g. .device/run.sh on the GPU machine);
 #                   default: build/release/bin/NAME
 #     --quick       fewer frames and runs (lavapipe at 4K takes about a second a frame)
-#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,env,trace,bake,startup,load,textures
+#     --skip LIST   comma-separated row groups to leave out: gpu,frame,big,compare,env,trace,bake,startup,load,textures,scale
 # The rows and their exact arguments are fixed here, so a rerun measures the same thing (fixed seeds and
 # poses: tests/reference/poses.txt, the generated scenes).
 set -uo pipefail
@@ -26,8 +26,10 @@ done
 root=$(cd "$(dirname "$0")/../.." && pwd)
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-bin() {  # bin NAME ARGS...
-  if [[ -n $runner ]]; then "$runner" "$@"; else "$root/build/release/bin/$1" "${@:2}"; fi
+bin() {  # bin NAME ARGS...; with timed=1, under /usr/bin/time -v (wall, CPU, peak memory)
+  local t=()
+  [[ ${timed:-0} == 1 ]] && t=(/usr/bin/time -v)
+  if [[ -n $runner ]]; then "${t[@]}" "$runner" "$@"; else "${t[@]}" "$root/build/release/bin/$1" "${@:2}"; fi
 }
 skipped() { [[ ",$skip," == *",$1,"* ]]; }
 # tool NAME ARGS...: a program from outside this build (gltfpack): the bundle's copy, else this machine's.
@@ -165,6 +167,47 @@ if ! skipped load; then  # time to the scene in memory: the 1M-triangle temple a
     fi
     row load bench-load --runs $((quick ? 3 : 10)) "$ld/temple.rtrscene" "$ld/temple.obj" "${glbs[@]}"
     [[ -z $note ]] || echo "$note" >>"$out/load.txt"
+  fi
+fi
+if ! skipped scale; then  # issues 29 and 30 at scale: the temple at 100M triangles (quick: 10M) baked without
+  # and with the hierarchy (phases, CPU, peak memory), its start-up and frames by view and level of detail,
+  # and 100 instances of the 10M temple (quick: of the 1M) against their base mesh alone
+  sd=$work/scale big=$((quick ? 1000 : 10000)) base=$((quick ? 100 : 1000))
+  size=$([[ $quick == 1 ]] && echo 1920x1080 || echo 3840x2160)
+  views=("stored" "inside --camera 0,1.5,0,30,-5" "outside --camera 0,3,8,0,-15")
+  frame() {  # frame ID SCENE [ARGS...]: one --bench row at each level of detail, full detail and 1 px
+    local id=$1 scene=$2; shift 2
+    for e in 0 1; do
+      row "$id-$e" rtr-view "$scene" --headless --size "$size" --bench $((quick ? 3 : 50)) --timings --shading-path visibility --raster compute --cull on --lod-error $e "$@"
+    done
+  }
+  if bin scenegen --out "$sd/big" --scale $big >/dev/null 2>&1; then
+    timed=1 row "scale-bake-$big-nolod" rtr-bake "$sd/big/temple.obj.zst" "$sd/big/nolod.rtrscene" --no-lod --view 0,2.2,-2.5,0,-3
+    ls -l "$sd/big/nolod.rtrscene" >>"$out/scale-bake-$big-nolod.txt"
+    rm -f "$sd/big/nolod.rtrscene"
+    timed=1 row "scale-bake-$big-lod" rtr-bake "$sd/big/temple.obj.zst" "$sd/big/temple.rtrscene" --view 0,2.2,-2.5,0,-3
+    ls -l "$sd/big/temple.rtrscene" >>"$out/scale-bake-$big-lod.txt"
+    rm -f "$sd/big/temple.obj.zst"
+    if ((!quick)); then  # the startup group's rows, one scale up (quick runs have 10M there already)
+      rm -rf "$sd/cache"
+      for run in cold warm; do
+        RTR_PIPELINE_CACHE=$sd/cache row "startup-$big-$run" rtr-view "$sd/big/temple.rtrscene" --headless \
+          --size 3840x2160 --timings --screenshot "$work/startup.png" --force
+      done
+    fi
+    for v in "${views[@]}"; do
+      read -r name cam <<<"$v"
+      frame "scale-frame-$big-$name" "$sd/big/temple.rtrscene" $cam
+    done
+    rm -rf "$sd/big"
+  fi
+  if bin scenegen --out "$sd/grid" --scale $base --instances 100 >"$out/scale-grid-gen.txt" 2>&1 &&
+     bin rtr-bake "$sd/grid/temple.obj.zst" "$sd/grid/temple.rtrscene" --view 0,2.2,-2.5,0,-3 >/dev/null 2>&1; then
+    frame "scale-frame-$base-stored" "$sd/grid/temple.rtrscene"
+    for v in "stored" "inside --camera 0,1.5,0,30,-5" "outside --camera 16.34,17.74,16.06,30,-25"; do
+      read -r name cam <<<"$v"
+      frame "scale-frame-grid$base-$name" "$sd/grid/temple-grid.rtrscene" $cam
+    done
   fi
 fi
 echo "collect: done -> $out" >&2
