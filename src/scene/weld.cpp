@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "core/error.hpp"
 #include "core/parallel.hpp"
 
 namespace rtr {
@@ -71,6 +72,8 @@ struct Around {
     return false;
   }
 };
+
+constexpr uint32_t kDone = 0x80000000u;  // a corner's vertex id is set (weldMesh, step 3)
 
 // Every step runs over fixed pieces of kPiece elements, so the result does not depend on the thread count.
 constexpr size_t kPiece = size_t(1) << 16;
@@ -153,7 +156,7 @@ size_t prefix(std::vector<size_t>& v) {
 
 }  // namespace
 
-WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors,
                     unsigned threads, const std::function<void()>& cornersDone) {
   WeldCounts counts;
@@ -213,43 +216,43 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   // lie within `creaseDeg` of its own face's (180: every face, one smooth normal per position; 0: its own
   // face only, flat). The unnormalised cross product is twice the area times the normal. Such a corner
   // gets the id normals.size() + genOf[c] of a generated normal; equal sums at a position share an id.
+  // Those ids are written into the corners' n (a per-corner array would be the weld's peak of memory); the
+  // faces' cross products are made again per position rather than held per triangle, for the same reason.
   std::vector<glm::vec3> gen;
-  std::unique_ptr<uint32_t[]> genOf;
   if (needNormals) {
-    auto cross = uninitialised<glm::vec3>(triCount);  // set for kept triangles, the only ones read
-    forPieces(triCount, threads, [&](size_t, size_t b, size_t e) {
-      for (size_t t = b; t < e; ++t) {
-        const Corner* c = &corners[t * 3];
-        const glm::vec3 a = positions[c[0].p];
-        if (keep[t]) cross[t] = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
-      }
-    });
+    auto cross = [&](size_t t) {  // as step 1 computes it
+      const Corner* c = &corners[t * 3];
+      const glm::vec3 a = positions[c[0].p];
+      return glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
+    };
     const float cosCrease = creaseDeg >= 180.0f ? -2.0f : std::cos(glm::radians(std::max(creaseDeg, 0.0f))) - 1e-6f;
     auto unit = [](glm::vec3 n) {
       const float l = glm::length(n);
       return l > 0.0f && std::isfinite(l) ? n / l : glm::vec3(0, 0, 1);
     };
-    genOf = uninitialised<uint32_t>(cornerCount);
+    const uint32_t fileNormals = uint32_t(normals.size());
     std::vector<std::vector<glm::vec3>> made(piecesOf(atPos.count()));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
-      std::vector<glm::vec3> units;  // of the faces at this position
+      std::vector<glm::vec3> crosses, units;  // of the faces at this position
       for (size_t g = b; g < e; ++g) {
         const uint32_t *first = atPos.items.get() + atPos.start[g], *last = atPos.items.get() + atPos.start[g + 1];
         const size_t here = made[p].size();  // the normals made at this position so far
+        crosses.clear();
         units.clear();
-        for (const uint32_t* c = first; c != last; ++c) units.push_back(unit(cross[*c / 3]));
+        for (const uint32_t* c = first; c != last; ++c) crosses.push_back(cross(*c / 3)), units.push_back(unit(crosses.back()));
         for (const uint32_t* c = first; c != last; ++c) {
           if (corners[*c].n != kAbsent) continue;
           const size_t t = *c / 3;
           const glm::vec3 own = units[size_t(c - first)];
           glm::vec3 sum(0.0f);
           for (const uint32_t* o = first; o != last; ++o)
-            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, units[size_t(o - first)]) >= cosCrease)) sum += cross[*o / 3];
+            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, units[size_t(o - first)]) >= cosCrease))
+              sum += crosses[size_t(o - first)];
           const glm::vec3 n = unit(sum);
           size_t k = here;
           while (k < made[p].size() && made[p][k] != n) ++k;
           if (k == made[p].size()) made[p].push_back(n);
-          genOf[*c] = uint32_t(k);
+          corners[*c].n = fileNormals + uint32_t(k);  // the piece's base is added below
         }
       }
     });
@@ -259,17 +262,14 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
       std::copy(made[p].begin(), made[p].end(), gen.begin() + ptrdiff_t(base[p]));
       for (uint32_t i = atPos.start[b]; i < atPos.start[e]; ++i)
-        if (corners[atPos.items[i]].n == kAbsent) genOf[atPos.items[i]] += uint32_t(base[p]);
+        if (corners[atPos.items[i]].n >= fileNormals) corners[atPos.items[i]].n += uint32_t(base[p]);
     });
   }
-  auto cornerAt = [&](size_t c) {
-    Corner x = corners[c];
-    if (x.n == kAbsent) x.n = uint32_t(normals.size()) + genOf[c];
-    return x;
-  };
+  auto cornerAt = [&](size_t c) { return corners[c]; };
 
   // 3. Identical corners become one vertex (numbered as they first appear): each kept corner gets its
   // vertex id in idOf, found through its position's group.
+  if (cornerCount >= kDone) throw Error("a mesh of more than 715 million triangles cannot be welded");
   auto idOf = uninitialised<uint32_t>(cornerCount);  // the first equal corner, then the vertex id
   forPieces(atPos.count(), threads, [&](size_t, size_t b, size_t e) {
     std::vector<uint32_t> distinct;
@@ -293,16 +293,10 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   });
   const size_t uniqCount = prefix(firsts);
   auto uniq = uninitialised<uint32_t>(uniqCount);  // each vertex's first corner
-  auto vertexOf = uninitialised<uint32_t>(cornerCount);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t c = b, id = firsts[p]; c < e; ++c)
-      if (keep[c / 3] && idOf[c] == c) uniq[id] = uint32_t(c), vertexOf[c] = uint32_t(id++);
+      if (keep[c / 3] && idOf[c] == c) uniq[id++] = uint32_t(c);
   });
-  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the ids of first corners only
-    for (size_t c = b; c < e; ++c)
-      if (keep[c / 3] && idOf[c] != c) vertexOf[c] = vertexOf[idOf[c]];
-  });
-  idOf.reset();
 
   // 4. Vertices within the tolerance are merged, greedy as one thread would do it: in order, each joins
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
@@ -328,8 +322,18 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   });
   uniq.reset();
   if (cornersDone) cornersDone();  // from here on only `keep` and the ids are read
-  genOf.reset();
   std::vector<glm::vec3>().swap(gen);
+  // Each corner's vertex id, in idOf's place (its memory is the weld's peak): a vertex's first corner gets
+  // the id (top bit set: done), then every other corner the id of the first equal one, which lies before it.
+  forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
+    for (size_t c = b, id = firsts[p]; c < e; ++c)
+      if (keep[c / 3] && idOf[c] == c) idOf[c] = uint32_t(id++) | kDone;
+  });
+  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the entries of first corners only
+    for (size_t c = b; c < e; ++c)
+      if (keep[c / 3] && !(idOf[c] & kDone)) idOf[c] = idOf[idOf[c]];
+  });
+  std::unique_ptr<uint32_t[]> vertexOf = std::move(idOf);  // with kDone set
   auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
   Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
@@ -399,7 +403,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   verts.reset();
   vcolor.reset();
   // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
-  auto corner = [&](size_t c) { return keptId[target[vertexOf[c]]]; };
+  auto corner = [&](size_t c) { return keptId[target[vertexOf[c] & ~kDone]]; };
   std::vector<size_t> written(pieces.size(), 0);
   forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t t = b; t < e; ++t) {
