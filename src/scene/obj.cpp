@@ -371,8 +371,8 @@ Scene ObjParser::finish() {
   std::vector<WeldCounts> counts(builds_.size());
   auto weld = [&](size_t i, unsigned threads) {
     counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads,
-                         [&] { builds_[i].corners.release(); });
-    builds_[i].corners.release();
+                         [&] { builds_[i].corners.release(threads); });
+    builds_[i].corners.release(threads);
   };
   const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };
   double all = 0, done = 0;  // corners

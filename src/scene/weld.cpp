@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "scene/grow_array.hpp"
 
 namespace rtr {
 namespace {
@@ -144,7 +145,13 @@ Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool den
     for (uint32_t j = shardStart[s]; j < shardStart[s + 1]; ++j) g.items[c[key(byShard[j]) - k0]++] = byShard[j];
   });
   g.start[keys] = sum;
+  freeOnAllCores(byShard, sum, threads);
   return g;
+}
+
+void freeGroups(Groups& g, unsigned threads) {
+  freeOnAllCores(g.items, g.start.back(), threads);
+  g = Groups();
 }
 
 // Exclusive prefix sum of per-piece counts; returns the total.
@@ -218,7 +225,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   // gets the id normals.size() + genOf[c] of a generated normal; equal sums at a position share an id.
   // Those ids are written into the corners' n (a per-corner array would be the weld's peak of memory); the
   // faces' cross products are made again per position rather than held per triangle, for the same reason.
-  std::vector<glm::vec3> gen;
+  std::unique_ptr<glm::vec3[]> gen;
   if (needNormals) {
     auto cross = [&](size_t t) {  // as step 1 computes it
       const Corner* c = &corners[t * 3];
@@ -258,9 +265,9 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     });
     std::vector<size_t> base(made.size());
     for (size_t p = 0; p < made.size(); ++p) base[p] = made[p].size();
-    gen.resize(prefix(base));
+    gen = uninitialised<glm::vec3>(prefix(base));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
-      std::copy(made[p].begin(), made[p].end(), gen.begin() + ptrdiff_t(base[p]));
+      std::copy(made[p].begin(), made[p].end(), gen.get() + base[p]);
       for (uint32_t i = atPos.start[b]; i < atPos.start[e]; ++i)
         if (corners[atPos.items[i]].n >= fileNormals) corners[atPos.items[i]].n += uint32_t(base[p]);
     });
@@ -285,7 +292,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       }
     }
   });
-  atPos = Groups();
+  freeGroups(atPos, threads);
   const size_t cornerPieces = piecesOf(cornerCount);
   std::vector<size_t> firsts(cornerPieces, 0);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
@@ -320,9 +327,9 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       slotOf[u] = uint32_t(cellHash(a.cell[0], a.cell[1], a.cell[2]) & mask);
     }
   });
-  uniq.reset();
+  freeOnAllCores(uniq, uniqCount, threads);
   if (cornersDone) cornersDone();  // from here on only `keep` and the ids are read
-  std::vector<glm::vec3>().swap(gen);
+  gen.reset();
   // Each corner's vertex id, in idOf's place (its memory is the weld's peak): a vertex's first corner gets
   // the id (top bit set: done), then every other corner the id of the first equal one, which lies before it.
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
@@ -368,8 +375,8 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       if (found == kAbsent) kept[u] = 1, found = u;
       target[u] = found;
     }
-  inBucket = Groups();
-  slotOf.reset();
+  freeGroups(inBucket, threads);
+  freeOnAllCores(slotOf, uniqCount, threads);
   std::vector<size_t> keptBefore(piecesOf(uniqCount), 0);
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) keptBefore[p] += kept[u];
@@ -383,10 +390,10 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
 
   // 5. Emit.
   const size_t n = counts.vertices;
-  out.positions.resize(n);
-  out.normals.resize(n);
-  out.texcoords.resize(hasTex ? n : 0);
-  out.colors.resize(colors.empty() ? 0 : n);
+  resizeOnAllCores(out.positions, n, threads);
+  resizeOnAllCores(out.normals, n, threads);
+  resizeOnAllCores(out.texcoords, hasTex ? n : 0, threads);
+  resizeOnAllCores(out.colors, colors.empty() ? 0 : n, threads);
   std::vector<Bounds> bounds(piecesOf(uniqCount));
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) {
@@ -400,8 +407,8 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     }
   });
   for (const Bounds& b : bounds) out.bounds.extend(b);
-  verts.reset();
-  vcolor.reset();
+  freeOnAllCores(verts, uniqCount, threads);
+  freeOnAllCores(vcolor, colors.empty() ? 0 : uniqCount, threads);
   // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
   auto corner = [&](size_t c) { return keptId[target[vertexOf[c] & ~kDone]]; };
   std::vector<size_t> written(pieces.size(), 0);
@@ -415,7 +422,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   const size_t triangles = prefix(written);
   counts.degenerate += counts.triangles - triangles;
   counts.triangles = triangles;
-  out.indices.resize(triangles * 3);
+  resizeOnAllCores(out.indices, triangles * 3, threads);
   forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t t = b, at = written[p] * 3; t < e; ++t) {
       if (!keep[t]) continue;
@@ -423,6 +430,9 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       if (x != y && y != z && x != z) out.indices[at] = x, out.indices[at + 1] = y, out.indices[at + 2] = z, at += 3;
     }
   });
+  freeOnAllCores(vertexOf, cornerCount, threads);
+  freeOnAllCores(target, uniqCount, threads);
+  freeOnAllCores(keptId, uniqCount, threads);
   return counts;
 }
 
