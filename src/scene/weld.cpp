@@ -272,7 +272,6 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
         if (corners[atPos.items[i]].n >= fileNormals) corners[atPos.items[i]].n += uint32_t(base[p]);
     });
   }
-  auto cornerAt = [&](size_t c) { return corners[c]; };
 
   // 3. Identical corners become one vertex (numbered as they first appear): each kept corner gets its
   // vertex id in idOf, found through its position's group.
@@ -284,9 +283,9 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       distinct.clear();
       for (uint32_t i = atPos.start[g]; i < atPos.start[g + 1]; ++i) {
         const uint32_t c = atPos.items[i];
-        const Corner x = cornerAt(c);
+        const Corner x = corners[c];
         size_t k = 0;
-        while (k < distinct.size() && !(cornerAt(distinct[k]) == x)) ++k;
+        while (k < distinct.size() && !(corners[distinct[k]] == x)) ++k;
         if (k == distinct.size()) distinct.push_back(c);
         idOf[c] = distinct[k];
       }
@@ -299,11 +298,20 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     for (size_t c = b; c < e; ++c) firsts[p] += keep[c / 3] && idOf[c] == c;
   });
   const size_t uniqCount = prefix(firsts);
-  auto uniq = uninitialised<uint32_t>(uniqCount);  // each vertex's first corner
+  // Each vertex's first corner is copied out, so that the corners can go before the vertices are made (the
+  // weld's peak of memory), and gets its vertex id in idOf's place (top bit set: done); every other corner
+  // then gets the id of the first equal one, which lies before it.
+  auto uniq = uninitialised<Corner>(uniqCount);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t c = b, id = firsts[p]; c < e; ++c)
-      if (keep[c / 3] && idOf[c] == c) uniq[id++] = uint32_t(c);
+      if (keep[c / 3] && idOf[c] == c) uniq[id] = corners[c], idOf[c] = uint32_t(id++) | kDone;
   });
+  if (cornersDone) cornersDone();                                    // from here on only `keep` and the ids are read
+  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the entries of first corners only
+    for (size_t c = b; c < e; ++c)
+      if (keep[c / 3] && !(idOf[c] & kDone)) idOf[c] = idOf[idOf[c]];
+  });
+  std::unique_ptr<uint32_t[]> vertexOf = std::move(idOf);  // with kDone set
 
   // 4. Vertices within the tolerance are merged, greedy as one thread would do it: in order, each joins
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
@@ -317,7 +325,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   const size_t mask = cap - 1, buckets = std::max<size_t>(16, cap / 4);
   forPieces(uniqCount, threads, [&](size_t, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) {
-      const Corner c = cornerAt(uniq[u]);
+      const Corner c = uniq[u];
       Vertex& v = verts[u];
       v.p = positions[c.p];
       v.n = c.n < normals.size() ? normals[c.n] : gen[c.n - normals.size()];
@@ -328,19 +336,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     }
   });
   freeOnAllCores(uniq, uniqCount, threads);
-  if (cornersDone) cornersDone();  // from here on only `keep` and the ids are read
   gen.reset();
-  // Each corner's vertex id, in idOf's place (its memory is the weld's peak): a vertex's first corner gets
-  // the id (top bit set: done), then every other corner the id of the first equal one, which lies before it.
-  forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
-    for (size_t c = b, id = firsts[p]; c < e; ++c)
-      if (keep[c / 3] && idOf[c] == c) idOf[c] = uint32_t(id++) | kDone;
-  });
-  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the entries of first corners only
-    for (size_t c = b; c < e; ++c)
-      if (keep[c / 3] && !(idOf[c] & kDone)) idOf[c] = idOf[idOf[c]];
-  });
-  std::unique_ptr<uint32_t[]> vertexOf = std::move(idOf);  // with kDone set
   auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
   Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
