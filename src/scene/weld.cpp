@@ -134,7 +134,7 @@ Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool den
     for (size_t i = b; i < e; ++i)
       if (const uint32_t k = key(i); k != kAbsent) byShard[c[k / kPiece]++] = uint32_t(i);
   });
-  g.start.resize(keys + 1);
+  resizeOnAllCores(g.start, keys + 1, threads);  // every entry is written below; its pages are first touched on all cores
   g.items = uninitialised<uint32_t>(sum);
   parallelFor(shards, threads, [&](size_t s) {
     const size_t k0 = s * kPiece, k1 = std::min(keys, k0 + kPiece);
