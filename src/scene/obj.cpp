@@ -390,7 +390,11 @@ Scene ObjParser::finish() {
   for (size_t i = 0; i < builds_.size(); ++i)
     if (large(i)) {
       const double corners = double(builds_[i].corners.size());
-      weld(i, opt_.threads);
+      try {
+        weld(i, opt_.threads);
+      } catch (const Error& e) {  // a mesh beyond the weld's limit
+        throw fileError(name_, "object '" + builds_[i].name + "'", e.what());
+      }
       progress(corners);
     }
 
