@@ -258,11 +258,15 @@ BakeReport bake(const BakeOptions& opt) {
   t0 = Clock::now();
   c0 = std::clock();
   if (opt.progress) opt.progress("writing", 0.0);
-  const std::string bytes = stage("encoding " + opt.output.string(),
-                                  [&] { return course ? encodeCourseMesh(plan.scene) : encodeRtrScene(plan.scene); });
-  rep.encodeSeconds = since(t0);
   AtomicFile sceneFile(opt.output);
-  sceneFile.write(bytes.data(), bytes.size());
+  if (course) {
+    const std::string bytes = stage("encoding " + opt.output.string(), [&] { return encodeCourseMesh(plan.scene); });
+    rep.encodeSeconds = since(t0);
+    sceneFile.write(bytes.data(), bytes.size());
+    rep.outputBytes = bytes.size();
+  } else {  // made, summed and written in windows on all cores: the file is never whole in memory
+    rep.outputBytes = stage("writing " + opt.output.string(), [&] { return writeRtrScene(plan.scene, sceneFile, threads); });
+  }
   rep.fileWriteSeconds = since(t0) - rep.encodeSeconds;
   sceneFile.sync();
   for (size_t k = 0; k < textures.size(); ++k) {
@@ -274,7 +278,6 @@ BakeReport bake(const BakeOptions& opt) {
   created.keep = true;
   rep.writeSeconds = since(t0);
   rep.writeCpuSeconds = cpuSince(c0);
-  rep.outputBytes = bytes.size();
   rep.meshes = plan.scene.meshes.size();
   rep.materials = plan.scene.materials.size();
   rep.textures = plan.scene.textures.size() - rep.fallbackTextures;

@@ -107,9 +107,9 @@ int main(int argc, char** argv) {
     std::printf("  vertices %zu before welding, %zu after\n", o.verticesBeforeWeld, o.verticesAfterWeld);
     std::printf("  warnings %zu, output %.2f MB\n", o.warnings, double(r.outputBytes) / 1e6);
     std::printf(
-        "  time: parse %.3f s (%.0f MB/s of OBJ text, %u threads, %.3f s of it waiting for the text), weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s (encode %.3f, write %.3f, sync %.3f), total %.3f s\n",
+        "  time: parse %.3f s (%.0f MB/s of OBJ text, %u threads, %.3f s of it waiting for the text), weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s (made and written %.3f, sync %.3f), total %.3f s\n",
         r.parseSeconds, r.parseSeconds > 0 ? mb / r.parseSeconds : 0.0, rtr::threadCount(opt.threads), o.textWaitSeconds,
-        r.weldSeconds, r.textureSeconds, r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.encodeSeconds, r.fileWriteSeconds,
+        r.weldSeconds, r.textureSeconds, r.clusterSeconds, r.lodSeconds, r.writeSeconds, r.encodeSeconds + r.fileWriteSeconds,
         r.writeSeconds - r.encodeSeconds - r.fileWriteSeconds, r.totalSeconds);
     std::printf(
         "  cpu (all threads): parse %.3f s, weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s\n",

@@ -5,7 +5,9 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,9 +20,24 @@ namespace rtr {
 
 static_assert(std::endian::native == std::endian::little, "the baked formats are little-endian");
 
+// Appends little-endian records. In memory by default (data() holds the bytes); or streaming to a file:
+// the bytes go out in windows as they are made, each window's kChecksumPiece pieces of the payload
+// (the bytes from `sumFrom` on) summed on all cores and written by a thread of its own while the next
+// window fills, so the whole file never sits in memory. Places written before their value is known are
+// reserved with hole() and filled with patch(); finishing gives the payload's pieceChecksum64.
 class ByteWriter {
  public:
-  void bytes(const void* p, size_t n) { out_.append(static_cast<const char*>(p), n); }
+  ByteWriter();
+  // Streams into `fd` (an empty file, written from offset 0; `file` names it in errors).
+  ByteWriter(int fd, std::string file, size_t sumFrom, unsigned threads = 0, size_t window = size_t(64) << 20);
+  ~ByteWriter();
+  ByteWriter(const ByteWriter&) = delete;
+  ByteWriter& operator=(const ByteWriter&) = delete;
+
+  void bytes(const void* p, size_t n) {
+    if (!stream_) out_.append(static_cast<const char*>(p), n);
+    else streamBytes(static_cast<const char*>(p), n);
+  }
   template <class T>
   void pod(const T& v) {
     bytes(&v, sizeof v);
@@ -32,13 +49,27 @@ class ByteWriter {
   void array(const std::vector<T>& v) {
     bytes(v.data(), v.size() * sizeof(T));
   }
-  void pad(size_t align) { out_.append((align - out_.size() % align) % align, '\0'); }
-  size_t size() const { return out_.size(); }
-  void reserve(size_t n) { out_.reserve(n); }  // a large file grown by doubling copies itself again and again
-  std::string& data() { return out_; }
+  void zeros(size_t n);
+  void pad(size_t align) { zeros((align - size() % align) % align); }
+  size_t size() const;
+  void reserve(size_t n) { out_.reserve(n); }  // in memory: a large file grown by doubling copies itself again and again
+  std::string& data() {                        // in memory: all bytes written
+    if (stream_) throw std::logic_error("ByteWriter::data() of a streaming writer");
+    return out_;
+  }
+  // n zero bytes to be patched later (streaming: the pieces holding them are summed once patched); returns
+  // where they start.
+  size_t hole(size_t n);
+  void patch(size_t at, const void* p, size_t n);  // bytes already written: in a hole, or before sumFrom
+  // Streaming: writes what is left and every patch, waits for the file; returns the payload's
+  // pieceChecksum64. In memory: pieceChecksum64 of data() from sumFrom (not to be called twice).
+  uint64_t finishPayload(size_t sumFrom, unsigned threads = 0);
 
  private:
+  struct Stream;
+  void streamBytes(const char* p, size_t n);
   std::string out_;
+  std::unique_ptr<Stream> stream_;
 };
 
 class ByteReader {

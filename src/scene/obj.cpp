@@ -371,8 +371,8 @@ Scene ObjParser::finish() {
   std::vector<WeldCounts> counts(builds_.size());
   auto weld = [&](size_t i, unsigned threads) {
     counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads,
-                         [&] { builds_[i].corners.release(); });
-    builds_[i].corners.release();
+                         [&] { builds_[i].corners.release(threads); });
+    builds_[i].corners.release(threads);
   };
   const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };
   double all = 0, done = 0;  // corners
@@ -390,7 +390,11 @@ Scene ObjParser::finish() {
   for (size_t i = 0; i < builds_.size(); ++i)
     if (large(i)) {
       const double corners = double(builds_[i].corners.size());
-      weld(i, opt_.threads);
+      try {
+        weld(i, opt_.threads);
+      } catch (const Error& e) {  // a mesh beyond the weld's limit
+        throw fileError(name_, "object '" + builds_[i].name + "'", e.what());
+      }
       progress(corners);
     }
 

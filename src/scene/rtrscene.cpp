@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -411,9 +412,8 @@ size_t sizeBound(const Scene& scene) {
   return n;
 }
 
-}  // namespace
-
-std::string encodeRtrScene(const Scene& scene, uint32_t version) {
+// The whole file into `w` (in memory, or streaming to a file), its header's size and checksum patched last.
+void encode(ByteWriter& w, const Scene& scene, uint32_t version, unsigned threads) {
   if (version < 1 || version > kRtrSceneVersion || (version < 2 && !scene.lights.empty()))
     throw Error("cannot encode .rtrscene version " + std::to_string(version) + (scene.lights.empty() ? "" : " with lights"));
   if (const std::string what = newerThan4(scene); version < 5 && !what.empty())
@@ -425,8 +425,6 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   for (const Instance& i : scene.instances)
     if (i.mesh >= scene.meshes.size())
       throw Error("cannot encode an instance of mesh " + std::to_string(i.mesh) + ": no such mesh");
-  ByteWriter w;
-  w.reserve(sizeBound(scene));
   w.bytes(kMagic, 8);
   w.u32(version);
   w.u32(scene.defaultView ? kHasView : 0);
@@ -459,7 +457,7 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   if (version >= 5) w.pad(kAlign);
   for (const Instance& i : scene.instances) {  // version 5: 80 bytes each (none before: refused above)
     w.u32(i.mesh);
-    w.data().append(12, '\0');
+    w.zeros(12);
     w.pod(i.transform);  // column-major, as glm holds it
   }
   for (const Texture& t : scene.textures) {
@@ -536,13 +534,21 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
       w.array(m.colors);
       w.pad(kAlign);
     }
-    if (small) w.array(std::vector<uint16_t>(m.indices.begin(), m.indices.end()));
-    else w.array(m.indices);
+    if (small) {
+      uint16_t part[4096];
+      for (size_t f = 0; f < m.indices.size(); f += std::size(part)) {
+        const size_t n = std::min(std::size(part), m.indices.size() - f);
+        std::copy_n(m.indices.begin() + ptrdiff_t(f), n, part);
+        w.bytes(part, n * 2);
+      }
+    } else {
+      w.array(m.indices);
+    }
     w.pad(kAlign);
     // Version 3: the clusters (zero: none stored, built at load).
     if (version < 3) continue;
     w.u32(uint32_t(m.clusters.size()));
-    w.data().append(12, '\0');
+    w.zeros(12);
     for (const Cluster& c : m.clusters) {  // 40 bytes each
       writeVec(w, c.center);
       w.f32(c.radius);
@@ -555,24 +561,41 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   }
   // Version 6: chunks, each a 16-byte header {tag, 0, u64 body size}, the body, pad16.
   const auto chunk = [&w](const char* tag, const auto& writeBody) {
-    const size_t at = w.size();
     w.bytes(tag, 4);
     w.u32(0);
-    w.pod(uint64_t(0));
+    const size_t sizeAt = w.hole(8);
     writeBody();
-    const uint64_t body = w.size() - at - 16;
-    std::memcpy(w.data().data() + at + 8, &body, 8);
+    const uint64_t body = w.size() - sizeAt - 8;
+    w.patch(sizeAt, &body, 8);
     w.pad(kAlign);
   };
   if (hasBakedTextures(scene)) chunk("TEXS", [&] { writeTexs(w, scene); });
   if (version >= 6 && hasClusterLods(scene)) chunk("CLOD", [&] { writeClusterLods(w, scene); });
-  std::string& out = w.data();
-  const uint64_t payload = out.size() - kHeaderSize;
-  const std::span<const uint8_t> payloadBytes{reinterpret_cast<const uint8_t*>(out.data()) + kHeaderSize, payload};
-  const uint64_t sum = version >= 4 ? pieceChecksum64(payloadBytes) : checksum64(payloadBytes);
-  std::memcpy(out.data() + 32, &payload, 8);
-  std::memcpy(out.data() + 40, &sum, 8);
-  return std::move(out);
+  const uint64_t payload = w.size() - kHeaderSize;
+  uint64_t sum;
+  if (version >= 4) {
+    sum = w.finishPayload(kHeaderSize, threads);
+  } else {  // one chain: in memory only (older versions are written for the reader's tests)
+    const auto* b = reinterpret_cast<const uint8_t*>(w.data().data());
+    sum = checksum64({b + kHeaderSize, payload});
+  }
+  w.patch(32, &payload, 8);
+  w.patch(40, &sum, 8);
+}
+
+}  // namespace
+
+std::string encodeRtrScene(const Scene& scene, uint32_t version) {
+  ByteWriter w;
+  w.reserve(sizeBound(scene));
+  encode(w, scene, version, 0);
+  return std::move(w.data());
+}
+
+uint64_t writeRtrScene(const Scene& scene, AtomicFile& file, unsigned threads, size_t window) {
+  ByteWriter w(file.fd(), file.target().string(), kHeaderSize, threads, window);
+  encode(w, scene, kRtrSceneVersion, threads);
+  return w.size();
 }
 
 Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, unsigned threads,

@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 
+#include "core/atomic_file.hpp"
 #include "scene/scene.hpp"
 
 namespace rtr {
@@ -21,6 +22,11 @@ constexpr uint32_t kRtrSceneVersion = 6;
 // ones. Textures held in memory (Texture::bytes) are refused: the file names image files, or holds baked
 // texels (Texture::baked: all of a scene's textures or none; version 6).
 std::string encodeRtrScene(const Scene& scene, uint32_t version = kRtrSceneVersion);
+// The same bytes (the current version) streamed into `file` as they are made, in windows of `window`
+// bytes (a multiple of 1 MiB) summed on `threads` threads and written while the next fills: the file is
+// never whole in memory. Returns its size; the caller syncs and commits `file`. Throws rtr::Error naming
+// the file on a write error (the temporary is then the caller's to drop).
+uint64_t writeRtrScene(const Scene& scene, AtomicFile& file, unsigned threads = 0, size_t window = size_t(64) << 20);
 // Validates everything (sizes, counts, strings, indices, texture ids, finite values, clusters, checksum).
 // The checksum (version 4), the arrays and their checks run on `threads` threads (0: one per core, or
 // one for a file under 4 MiB); the scene and any fault reported do not depend on the count. Baked texels

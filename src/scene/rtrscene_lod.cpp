@@ -39,7 +39,7 @@ void writeClusterLods(ByteWriter& w, const Scene& scene) {
   uint32_t meshes = 0;
   for (const Mesh& m : scene.meshes) meshes += m.lod.levels > 0;
   w.u32(meshes);
-  w.data().append(12, '\0');
+  w.zeros(12);
   for (uint32_t i = 0; i < scene.meshes.size(); ++i) {
     const ClusterLod& lod = scene.meshes[i].lod;
     if (lod.levels == 0) continue;
@@ -52,7 +52,7 @@ void writeClusterLods(ByteWriter& w, const Scene& scene) {
       vec4(w, c.sphere);
       vec4(w, c.parentSphere);
       w.f32(c.parentError);
-      w.data().append(12, '\0');
+      w.zeros(12);
     }
     w.array(lod.indices);
     w.pad(16);

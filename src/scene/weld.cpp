@@ -9,7 +9,9 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "core/error.hpp"
 #include "core/parallel.hpp"
+#include "scene/grow_array.hpp"
 
 namespace rtr {
 namespace {
@@ -72,6 +74,8 @@ struct Around {
   }
 };
 
+constexpr uint32_t kDone = 0x80000000u;  // a corner's vertex id is set (weldMesh, step 3)
+
 // Every step runs over fixed pieces of kPiece elements, so the result does not depend on the thread count.
 constexpr size_t kPiece = size_t(1) << 16;
 size_t piecesOf(size_t n) { return (n + kPiece - 1) / kPiece; }
@@ -130,7 +134,7 @@ Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool den
     for (size_t i = b; i < e; ++i)
       if (const uint32_t k = key(i); k != kAbsent) byShard[c[k / kPiece]++] = uint32_t(i);
   });
-  g.start.resize(keys + 1);
+  resizeOnAllCores(g.start, keys + 1, threads);  // every entry is written below; its pages are first touched on all cores
   g.items = uninitialised<uint32_t>(sum);
   parallelFor(shards, threads, [&](size_t s) {
     const size_t k0 = s * kPiece, k1 = std::min(keys, k0 + kPiece);
@@ -141,7 +145,13 @@ Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool den
     for (uint32_t j = shardStart[s]; j < shardStart[s + 1]; ++j) g.items[c[key(byShard[j]) - k0]++] = byShard[j];
   });
   g.start[keys] = sum;
+  freeOnAllCores(byShard, sum, threads);
   return g;
+}
+
+void freeGroups(Groups& g, unsigned threads) {
+  freeOnAllCores(g.items, g.start.back(), threads);
+  g = Groups();
 }
 
 // Exclusive prefix sum of per-piece counts; returns the total.
@@ -153,7 +163,7 @@ size_t prefix(std::vector<size_t>& v) {
 
 }  // namespace
 
-WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors,
                     unsigned threads, const std::function<void()>& cornersDone) {
   WeldCounts counts;
@@ -213,63 +223,59 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   // lie within `creaseDeg` of its own face's (180: every face, one smooth normal per position; 0: its own
   // face only, flat). The unnormalised cross product is twice the area times the normal. Such a corner
   // gets the id normals.size() + genOf[c] of a generated normal; equal sums at a position share an id.
-  std::vector<glm::vec3> gen;
-  std::unique_ptr<uint32_t[]> genOf;
+  // Those ids are written into the corners' n (a per-corner array would be the weld's peak of memory); the
+  // faces' cross products are made again per position rather than held per triangle, for the same reason.
+  std::unique_ptr<glm::vec3[]> gen;
   if (needNormals) {
-    auto cross = uninitialised<glm::vec3>(triCount);  // set for kept triangles, the only ones read
-    forPieces(triCount, threads, [&](size_t, size_t b, size_t e) {
-      for (size_t t = b; t < e; ++t) {
-        const Corner* c = &corners[t * 3];
-        const glm::vec3 a = positions[c[0].p];
-        if (keep[t]) cross[t] = glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
-      }
-    });
+    auto cross = [&](size_t t) {  // as step 1 computes it
+      const Corner* c = &corners[t * 3];
+      const glm::vec3 a = positions[c[0].p];
+      return glm::cross(positions[c[1].p] - a, positions[c[2].p] - a);
+    };
     const float cosCrease = creaseDeg >= 180.0f ? -2.0f : std::cos(glm::radians(std::max(creaseDeg, 0.0f))) - 1e-6f;
     auto unit = [](glm::vec3 n) {
       const float l = glm::length(n);
       return l > 0.0f && std::isfinite(l) ? n / l : glm::vec3(0, 0, 1);
     };
-    genOf = uninitialised<uint32_t>(cornerCount);
+    const uint32_t fileNormals = uint32_t(normals.size());
     std::vector<std::vector<glm::vec3>> made(piecesOf(atPos.count()));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
-      std::vector<glm::vec3> units;  // of the faces at this position
+      std::vector<glm::vec3> crosses, units;  // of the faces at this position
       for (size_t g = b; g < e; ++g) {
         const uint32_t *first = atPos.items.get() + atPos.start[g], *last = atPos.items.get() + atPos.start[g + 1];
         const size_t here = made[p].size();  // the normals made at this position so far
+        crosses.clear();
         units.clear();
-        for (const uint32_t* c = first; c != last; ++c) units.push_back(unit(cross[*c / 3]));
+        for (const uint32_t* c = first; c != last; ++c) crosses.push_back(cross(*c / 3)), units.push_back(unit(crosses.back()));
         for (const uint32_t* c = first; c != last; ++c) {
           if (corners[*c].n != kAbsent) continue;
           const size_t t = *c / 3;
           const glm::vec3 own = units[size_t(c - first)];
           glm::vec3 sum(0.0f);
           for (const uint32_t* o = first; o != last; ++o)
-            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, units[size_t(o - first)]) >= cosCrease)) sum += cross[*o / 3];
+            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, units[size_t(o - first)]) >= cosCrease))
+              sum += crosses[size_t(o - first)];
           const glm::vec3 n = unit(sum);
           size_t k = here;
           while (k < made[p].size() && made[p][k] != n) ++k;
           if (k == made[p].size()) made[p].push_back(n);
-          genOf[*c] = uint32_t(k);
+          corners[*c].n = fileNormals + uint32_t(k);  // the piece's base is added below
         }
       }
     });
     std::vector<size_t> base(made.size());
     for (size_t p = 0; p < made.size(); ++p) base[p] = made[p].size();
-    gen.resize(prefix(base));
+    gen = uninitialised<glm::vec3>(prefix(base));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
-      std::copy(made[p].begin(), made[p].end(), gen.begin() + ptrdiff_t(base[p]));
+      std::copy(made[p].begin(), made[p].end(), gen.get() + base[p]);
       for (uint32_t i = atPos.start[b]; i < atPos.start[e]; ++i)
-        if (corners[atPos.items[i]].n == kAbsent) genOf[atPos.items[i]] += uint32_t(base[p]);
+        if (corners[atPos.items[i]].n >= fileNormals) corners[atPos.items[i]].n += uint32_t(base[p]);
     });
   }
-  auto cornerAt = [&](size_t c) {
-    Corner x = corners[c];
-    if (x.n == kAbsent) x.n = uint32_t(normals.size()) + genOf[c];
-    return x;
-  };
 
   // 3. Identical corners become one vertex (numbered as they first appear): each kept corner gets its
   // vertex id in idOf, found through its position's group.
+  if (cornerCount >= kDone) throw Error("a mesh of more than 715 million triangles cannot be welded");
   auto idOf = uninitialised<uint32_t>(cornerCount);  // the first equal corner, then the vertex id
   forPieces(atPos.count(), threads, [&](size_t, size_t b, size_t e) {
     std::vector<uint32_t> distinct;
@@ -277,32 +283,35 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       distinct.clear();
       for (uint32_t i = atPos.start[g]; i < atPos.start[g + 1]; ++i) {
         const uint32_t c = atPos.items[i];
-        const Corner x = cornerAt(c);
+        const Corner x = corners[c];
         size_t k = 0;
-        while (k < distinct.size() && !(cornerAt(distinct[k]) == x)) ++k;
+        while (k < distinct.size() && !(corners[distinct[k]] == x)) ++k;
         if (k == distinct.size()) distinct.push_back(c);
         idOf[c] = distinct[k];
       }
     }
   });
-  atPos = Groups();
+  freeGroups(atPos, threads);
   const size_t cornerPieces = piecesOf(cornerCount);
   std::vector<size_t> firsts(cornerPieces, 0);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t c = b; c < e; ++c) firsts[p] += keep[c / 3] && idOf[c] == c;
   });
   const size_t uniqCount = prefix(firsts);
-  auto uniq = uninitialised<uint32_t>(uniqCount);  // each vertex's first corner
-  auto vertexOf = uninitialised<uint32_t>(cornerCount);
+  // Each vertex's first corner is copied out, so that the corners can go before the vertices are made (the
+  // weld's peak of memory), and gets its vertex id in idOf's place (top bit set: done); every other corner
+  // then gets the id of the first equal one, which lies before it.
+  auto uniq = uninitialised<Corner>(uniqCount);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t c = b, id = firsts[p]; c < e; ++c)
-      if (keep[c / 3] && idOf[c] == c) uniq[id] = uint32_t(c), vertexOf[c] = uint32_t(id++);
+      if (keep[c / 3] && idOf[c] == c) uniq[id] = corners[c], idOf[c] = uint32_t(id++) | kDone;
   });
-  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the ids of first corners only
+  if (cornersDone) cornersDone();                                    // from here on only `keep` and the ids are read
+  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the entries of first corners only
     for (size_t c = b; c < e; ++c)
-      if (keep[c / 3] && idOf[c] != c) vertexOf[c] = vertexOf[idOf[c]];
+      if (keep[c / 3] && !(idOf[c] & kDone)) idOf[c] = idOf[idOf[c]];
   });
-  idOf.reset();
+  std::unique_ptr<uint32_t[]> vertexOf = std::move(idOf);  // with kDone set
 
   // 4. Vertices within the tolerance are merged, greedy as one thread would do it: in order, each joins
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
@@ -316,7 +325,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   const size_t mask = cap - 1, buckets = std::max<size_t>(16, cap / 4);
   forPieces(uniqCount, threads, [&](size_t, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) {
-      const Corner c = cornerAt(uniq[u]);
+      const Corner c = uniq[u];
       Vertex& v = verts[u];
       v.p = positions[c.p];
       v.n = c.n < normals.size() ? normals[c.n] : gen[c.n - normals.size()];
@@ -326,10 +335,8 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       slotOf[u] = uint32_t(cellHash(a.cell[0], a.cell[1], a.cell[2]) & mask);
     }
   });
-  uniq.reset();
-  if (cornersDone) cornersDone();  // from here on only `keep` and the ids are read
-  genOf.reset();
-  std::vector<glm::vec3>().swap(gen);
+  freeOnAllCores(uniq, uniqCount, threads);
+  gen.reset();
   auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
   Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
@@ -364,8 +371,8 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       if (found == kAbsent) kept[u] = 1, found = u;
       target[u] = found;
     }
-  inBucket = Groups();
-  slotOf.reset();
+  freeGroups(inBucket, threads);
+  freeOnAllCores(slotOf, uniqCount, threads);
   std::vector<size_t> keptBefore(piecesOf(uniqCount), 0);
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) keptBefore[p] += kept[u];
@@ -379,10 +386,10 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
 
   // 5. Emit.
   const size_t n = counts.vertices;
-  out.positions.resize(n);
-  out.normals.resize(n);
-  out.texcoords.resize(hasTex ? n : 0);
-  out.colors.resize(colors.empty() ? 0 : n);
+  resizeOnAllCores(out.positions, n, threads);
+  resizeOnAllCores(out.normals, n, threads);
+  resizeOnAllCores(out.texcoords, hasTex ? n : 0, threads);
+  resizeOnAllCores(out.colors, colors.empty() ? 0 : n, threads);
   std::vector<Bounds> bounds(piecesOf(uniqCount));
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) {
@@ -396,10 +403,10 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
     }
   });
   for (const Bounds& b : bounds) out.bounds.extend(b);
-  verts.reset();
-  vcolor.reset();
+  freeOnAllCores(verts, uniqCount, threads);
+  freeOnAllCores(vcolor, colors.empty() ? 0 : uniqCount, threads);
   // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
-  auto corner = [&](size_t c) { return keptId[target[vertexOf[c]]]; };
+  auto corner = [&](size_t c) { return keptId[target[vertexOf[c] & ~kDone]]; };
   std::vector<size_t> written(pieces.size(), 0);
   forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t t = b; t < e; ++t) {
@@ -411,7 +418,7 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
   const size_t triangles = prefix(written);
   counts.degenerate += counts.triangles - triangles;
   counts.triangles = triangles;
-  out.indices.resize(triangles * 3);
+  resizeOnAllCores(out.indices, triangles * 3, threads);
   forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t t = b, at = written[p] * 3; t < e; ++t) {
       if (!keep[t]) continue;
@@ -419,6 +426,9 @@ WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> 
       if (x != y && y != z && x != z) out.indices[at] = x, out.indices[at + 1] = y, out.indices[at + 2] = z, at += 3;
     }
   });
+  freeOnAllCores(vertexOf, cornerCount, threads);
+  freeOnAllCores(target, uniqCount, threads);
+  freeOnAllCores(keptId, uniqCount, threads);
   return counts;
 }
 

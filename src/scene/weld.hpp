@@ -27,12 +27,13 @@ struct WeldCounts {
 
 constexpr float kDefaultCreaseDeg = 40.0f;
 
-// `corners` holds 3 per triangle. Fills out.positions/normals/texcoords/colors/indices/bounds (not name or
+// `corners` holds 3 per triangle; where a corner has no normal, its n is overwritten (the id of a
+// generated normal: the caller's corners are the weld's scratch space). Fills out.positions/normals/texcoords/colors/indices/bounds (not name or
 // material). A generated normal averages the faces at its position within `creaseDeg` of its own face (0:
 // flat, 180: smooth). `colors`: one per position, or empty. Runs on `threads` (0: all cores) in fixed
 // pieces: the mesh is the same for any thread count. `cornersDone`, when given, is called once `corners`
 // is read no more, before the mesh is made: its owner may free it there (memory at a large bake's peak).
-WeldCounts weldMesh(std::span<const Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg = kDefaultCreaseDeg,
                     std::span<const glm::vec4> colors = {}, unsigned threads = 1, const std::function<void()>& cornersDone = {});
 

@@ -52,7 +52,8 @@ Soup makeSoup(int side, unsigned seed) {
 
 Mesh weld(const Soup& s, unsigned threads, WeldCounts* counts = nullptr) {
   Mesh m;
-  const WeldCounts c = weldMesh(s.corners, s.positions, s.normals, s.texcoords, m, 40.0f, s.colors, threads);
+  std::vector<Corner> corners = s.corners;  // the weld writes generated normals' ids into them
+  const WeldCounts c = weldMesh(corners, s.positions, s.normals, s.texcoords, m, 40.0f, s.colors, threads);
   if (counts) *counts = c;
   return m;
 }
