@@ -30,6 +30,13 @@ layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
   uint largeCount, largeFirst, largeTriCount, largePad;
   uvec2 largeTiles[];  // (the triangle's record in largeTris, tile index)
 };
+// The triangles crossing the near plane or the guard band, for raster_clip.comp (raster.h); clipFirst: with
+// culling, the second phase's first.
+layout(set = 0, binding = 15, std430) RASTER_LIST_ACCESS buffer ClipList {
+  uint clipGroupsX, clipGroupsY, clipGroupsZ;  // VkDispatchIndirectCommand: a workgroup per RASTER_CLIP_GROUP entries
+  uint clipCount, clipFirst, clipPad0, clipPad1, clipPad2;
+  uint clipTriangles[];
+};
 // The large triangles' setup, largeTriCount records (raster.h).
 layout(set = 0, binding = 14, std430) RASTER_LIST_ACCESS buffer LargeTris { RasterLargeTri largeTris[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Instances { GpuInstance instances[]; };
