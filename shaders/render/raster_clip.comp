@@ -91,7 +91,7 @@ void main() {
   }
   GpuMaterial m;
   if (kAlphaMask && masked) {
-    m = materials[d.material];
+    m = maskMaterial(d.material);
     if (m.textures.w != NO_TEXTURE) {
       t.material = d.material;
       for (int i = 0; i < 3; ++i) uv[i] = texcoords[tri[i]];

@@ -12,6 +12,19 @@ layout(set = 0, binding = 8, std430) readonly buffer Materials { GpuMaterial mat
 layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
 layout(set = 1, binding = 0) uniform sampler2D textures[];
 
+// The members of material i that the alpha test reads, one by one: a copy of the whole record loads its
+// 304 bytes (the SPIR-V keeps the whole-struct load; dropping the unused parts is left to the driver).
+GpuMaterial maskMaterial(uint i) {
+  GpuMaterial m;
+  m.baseColor = materials[i].baseColor;
+  m.roughMetal = materials[i].roughMetal;
+  m.textures = materials[i].textures;
+  m.textures2 = materials[i].textures2;
+  m.uvTransform[2 * SLOT_MASK] = materials[i].uvTransform[2 * SLOT_MASK];
+  m.uvTransform[2 * SLOT_MASK + 1] = materials[i].uvTransform[2 * SLOT_MASK + 1];
+  return m;
+}
+
 const int kOne = 1 << RASTER_SUBPIXEL_BITS;
 const uint kSkip = 0u, kSmall = 1u, kLarge = 2u, kHardware = 3u;
 
@@ -95,7 +108,7 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
   bool swapped;
   const uint kind = project(p, c.flags, t, swapped);
   if (kAlphaMask && masked && (kind == kSmall || kind == kLarge)) {
-    const GpuMaterial m = materials[d.material];
+    const GpuMaterial m = maskMaterial(d.material);
     if (m.textures.w != NO_TEXTURE) {
       t.material = d.material;
       const uvec3 order = swapped ? tri.xzy : tri;
@@ -171,7 +184,7 @@ bool cutOut(Tri t, ivec2 px, vec3 e) {
   const float scale = exp2(frame.params.y);
   const vec2 gx = (maskUv(t, e + side.x * stepX) - uv) * (side.x * scale);
   const vec2 gy = (maskUv(t, e + side.y * stepY) - uv) * (side.y * scale);
-  const GpuMaterial m = materials[t.material];
+  const GpuMaterial m = maskMaterial(t.material);
   return maskCuts(m, textureGrad(textures[nonuniformEXT(m.textures.w)], uv, gx, gy));
 }
 
