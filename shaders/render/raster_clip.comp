@@ -71,7 +71,7 @@ void main() {
   if (e < clipFirst || e >= min(clipCount, RASTER_CLIP_CAPACITY)) return;
   const uint ref = clipTriangles[e], clusterIndex = ref >> RASTER_LOCAL_BITS, local = ref & ((1u << RASTER_LOCAL_BITS) - 1u);
   const GpuCluster c = listedCluster(clusterIndex);
-  const GpuInstance inst = instances[c.instance];
+  const GpuInstance inst = placedInstance(c.instance);
   const GpuDraw d = draws[inst.info.x];
   const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
   if (!kAlphaMask && masked) {

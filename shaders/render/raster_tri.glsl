@@ -91,7 +91,7 @@ uint project(vec4 p[3], uint flags, inout Tri t, out bool swapped) {
 
 uint setup(uint clusterIndex, uint local, out Tri t) {
   const GpuCluster c = listedCluster(clusterIndex);
-  const GpuInstance inst = instances[c.instance];
+  const GpuInstance inst = placedInstance(c.instance);
   const GpuDraw d = draws[inst.info.x];
   t.id = inst.info.z + c.firstTriangle + local;
   t.material = NO_TEXTURE;
