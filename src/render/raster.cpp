@@ -80,7 +80,7 @@ uint32_t ComputeRaster::clippedTriangles(uint32_t frame) const {
   handOffReadback_.invalidate();
   uint32_t clipped = 0;
   std::memcpy(&clipped, static_cast<const char*>(handOffReadback_.mapped()) + 8 * frame + 4, 4);
-  return clipped;
+  return std::min(clipped, RASTER_CLIP_CAPACITY);  // the count goes on past the list; those went to the hardware
 }
 
 std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame) const {
