@@ -85,10 +85,10 @@ vec3 barycentrics(vec3 dir, vec3 a, vec3 b, vec3 n) {
 }
 
 // Texcoords of both sets and their differences to the quad neighbours (x, y): uv[0..2] set 0, uv[3..5] set 1.
-vec4 sampleOr(GpuMaterial m, uint index, uint slot, vec2 uv[6], vec4 fallback) {
+vec4 sampleOr(uint material, uint index, uint slot, vec2 uv[6], vec4 fallback) {
   if (index == NO_TEXTURE) return fallback;
   if (!MATERIAL_EXTRAS) return textureGrad(textures[nonuniformEXT(index)], uv[0], uv[1], uv[2]);  // set 0, identity
-  const vec4 r0 = m.uvTransform[2 * slot], r1 = m.uvTransform[2 * slot + 1];
+  const vec4 r0 = materials[material].uvTransform[2 * slot], r1 = materials[material].uvTransform[2 * slot + 1];
   const int k = r0.w > 0.5 ? 3 : 0;
   const mat2 a = mat2(r0.x, r1.x, r0.y, r1.y);  // the transform's linear part (columns)
   return textureGrad(textures[nonuniformEXT(index)], a * uv[k] + vec2(r0.z, r1.z), a * uv[k + 1], a * uv[k + 2]);
@@ -137,7 +137,16 @@ void main() {
   const bool back = (dot(n, s) < 0.0) != ((inst.info.y & INSTANCE_MIRRORED) != 0u);
   if (back) nrm = -nrm;
 
-  const GpuMaterial m = materials[d.material];
+  // The record's members one by one, the texture transforms only where sampled (sampleOr): a copy of the
+  // whole record loads its 304 bytes (the SPIR-V keeps the whole-struct load; dropping the unused parts is
+  // left to the driver).
+  const uint mi = d.material;
+  GpuMaterial m;
+  m.baseColor = materials[mi].baseColor;
+  m.emissive = materials[mi].emissive;
+  m.roughMetal = materials[mi].roughMetal;
+  m.textures = materials[mi].textures;
+  m.textures2 = materials[mi].textures2;
   vec3 baseColor = m.baseColor.rgb, emissive = m.emissive.rgb;
   float roughness = m.roughMetal.x, metalness = m.roughMetal.y, occlusion = 1.0;
   if (MATERIAL_EXTRAS && (d.flags & DRAW_COLORS) != 0u) baseColor *= (colors[tri.x] * w.x + colors[tri.y] * w.y + colors[tri.z] * w.z).rgb;
@@ -159,15 +168,15 @@ void main() {
       uvs[4] = (s0 * wx.x + s1 * wx.y + s2 * wx.z - uvs[3]) * (side.x * scale);
       uvs[5] = (s0 * wy.x + s1 * wy.y + s2 * wy.z - uvs[3]) * (side.y * scale);
     }
-    baseColor *= sampleOr(m, m.textures.x, SLOT_BASE, uvs, vec4(1.0)).rgb;
-    roughness *= sampleOr(m, m.textures.y, SLOT_ROUGHNESS, uvs, vec4(1.0)).r;
-    metalness *= sampleOr(m, m.textures.z, SLOT_METALNESS, uvs, vec4(1.0)).r;
-    emissive *= sampleOr(m, m.textures2.x, SLOT_EMISSIVE, uvs, vec4(1.0)).rgb;
-    if (MATERIAL_EXTRAS && m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(m, m.textures2.y, SLOT_OCCLUSION, uvs, vec4(1.0)).r - 1.0);
+    baseColor *= sampleOr(mi, m.textures.x, SLOT_BASE, uvs, vec4(1.0)).rgb;
+    roughness *= sampleOr(mi, m.textures.y, SLOT_ROUGHNESS, uvs, vec4(1.0)).r;
+    metalness *= sampleOr(mi, m.textures.z, SLOT_METALNESS, uvs, vec4(1.0)).r;
+    emissive *= sampleOr(mi, m.textures2.x, SLOT_EMISSIVE, uvs, vec4(1.0)).rgb;
+    if (MATERIAL_EXTRAS && m.textures2.y != NO_TEXTURE) occlusion = 1.0 + m.roughMetal.w * (sampleOr(mi, m.textures2.y, SLOT_OCCLUSION, uvs, vec4(1.0)).r - 1.0);
     if (MATERIAL_EXTRAS && m.textures2.z != NO_TEXTURE && (d.flags & DRAW_TANGENTS) != 0u) {
       // As material.glsl: t, b = w (n x t), n; the map's xy scaled by normalScale.
       const vec4 tg = tangents[tri.x] * w.x + tangents[tri.y] * w.y + tangents[tri.z] * w.z;
-      const vec3 tn = (sampleOr(m, m.textures2.z, SLOT_NORMAL, uvs, vec4(0.5, 0.5, 1.0, 1.0)).xyz * 2.0 - 1.0) *
+      const vec3 tn = (sampleOr(mi, m.textures2.z, SLOT_NORMAL, uvs, vec4(0.5, 0.5, 1.0, 1.0)).xyz * 2.0 - 1.0) *
                       vec3(m.emissive.w, m.emissive.w, 1.0);
       const vec3 nn = normalize(back ? -nrm : nrm), t3 = mat3(inst.transform) * tg.xyz;
       const vec3 t = normalize(t3 - nn * dot(nn, t3));

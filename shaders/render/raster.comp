@@ -5,7 +5,8 @@
 // of (depth, id), alpha-masked ones after the mask's test (raster_tri.glsl). Triangles with a bounding box
 // over kSharedArea pixels are set up once in a record and go to the tile list (one entry per RASTER_TILE²
 // tile, raster_large.comp); those
-// touching w <= 0 or leaving the guard band go to the hardware hand-off list (raster_hw.vert/frag).
+// touching w <= 0 or leaving the guard band go to the clipping pass's list (raster_clip.comp) or, with
+// pc.clip off or that list full, to the hardware hand-off list (raster_hw.vert/frag).
 #extension GL_GOOGLE_include_directive : require
 // With culling (pc.fromList), workgroup k takes the k-th entry this phase added to the culling pass's
 // visible list (cull.comp; dispatched indirectly from its counts); without, the k-th of clusterList.
@@ -16,10 +17,15 @@ layout(local_size_x = RASTER_GROUP) in;
 
 layout(set = 0, binding = 12, std430) readonly buffer Counts { CullCounts cullCounts; };
 
-// Past the list's capacity a triangle is counted, not stored (the draw skips those entries).
-void handOff(uint ref) {
-  const uint n = atomicAdd(vertexCount, 3u) / 3u;
-  if (n < pc.handOffCapacity) hwTriangles[n] = ref;
+// The clipping pass's list, a workgroup per RASTER_CLIP_GROUP entries (its indirect dispatch); full: the hardware.
+void appendClip(uint ref) {
+  const uint n = atomicAdd(clipCount, 1u);
+  if (n >= RASTER_CLIP_CAPACITY) {
+    handOff(ref);
+    return;
+  }
+  clipTriangles[n] = ref;
+  if (n % RASTER_CLIP_GROUP == 0u) atomicAdd(clipGroupsX, 1u);
 }
 
 void main() {
@@ -34,14 +40,9 @@ void main() {
     for (int y = t.box.y; y <= t.box.w; ++y)
       for (int x = t.box.x; x <= t.box.z; ++x) rasterPixel(t, ivec2(x, y));
   } else if (kind == kLarge) {
-    const ivec2 tiles = (t.box.zw - t.box.xy + RASTER_TILE) / RASTER_TILE;
-    const uint n = uint(tiles.x * tiles.y), first = atomicAdd(largeCount, n), record = atomicAdd(largeTriCount, 1u);
-    // A full list hands the triangle to the hardware; its reserved entries that fit are marked empty.
-    const bool fits = first + n <= RASTER_LARGE_CAPACITY && record < RASTER_LARGE_TRIANGLES;
-    if (fits) storeLarge(record, t);
-    for (uint i = 0u; i < n && first + i < RASTER_LARGE_CAPACITY; ++i) largeTiles[first + i] = uvec2(fits ? record : ~0u, i);
-    if (!fits) handOff(ref);
+    appendLarge(t, ref);
   } else if (kind == kHardware) {
-    handOff(ref);
+    if (pc.clip != 0u) appendClip(ref);  // raster_clip.comp
+    else handOff(ref);
   }
 }

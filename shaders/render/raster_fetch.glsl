@@ -30,6 +30,13 @@ layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
   uint largeCount, largeFirst, largeTriCount, largePad;
   uvec2 largeTiles[];  // (the triangle's record in largeTris, tile index)
 };
+// The triangles crossing the near plane or the guard band, for raster_clip.comp (raster.h); clipFirst: with
+// culling, the second phase's first.
+layout(set = 0, binding = 15, std430) RASTER_LIST_ACCESS buffer ClipList {
+  uint clipGroupsX, clipGroupsY, clipGroupsZ;  // VkDispatchIndirectCommand: a workgroup per RASTER_CLIP_GROUP entries
+  uint clipCount, clipFirst, clipPad0, clipPad1, clipPad2;
+  uint clipTriangles[];
+};
 // The large triangles' setup, largeTriCount records (raster.h).
 layout(set = 0, binding = 14, std430) RASTER_LIST_ACCESS buffer LargeTris { RasterLargeTri largeTris[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Instances { GpuInstance instances[]; };
@@ -40,12 +47,26 @@ layout(set = 0, binding = 11, std430) readonly buffer ClusterList { uvec2 cluste
 layout(push_constant) uniform Push { RasterPush pc; };
 
 // The cluster at `entry` of clusterList, its instance and mirrored flag filled in (records are the mesh's).
+// Records are read member by member, only what the rasterisers use (not the bounds, not the normal
+// matrix): a copy of a whole record stays one whole-struct load in the SPIR-V, whose unused parts only the
+// driver may drop.
 GpuCluster listedCluster(uint entry) {
   const uvec2 e = clusterList[entry];
-  GpuCluster c = clusters[e.y];
+  GpuCluster c;
   c.instance = e.x;
+  c.firstTriangle = clusters[e.y].firstTriangle;
+  c.triangleCount = clusters[e.y].triangleCount;
+  c.flags = clusters[e.y].flags;
   if ((instances[e.x].info.y & INSTANCE_MIRRORED) != 0u) c.flags |= CLUSTER_MIRRORED;
   return c;
+}
+
+// Instance i's transform and info.
+GpuInstance placedInstance(uint i) {
+  GpuInstance inst;
+  inst.transform = instances[i].transform;
+  inst.info = instances[i].info;
+  return inst;
 }
 
 vec3 position(uint i) { return vec3(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]); }

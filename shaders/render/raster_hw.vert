@@ -22,7 +22,7 @@ void main() {
   }
   const uint entry = hwTriangles[gl_VertexIndex / 3];
   const GpuCluster c = listedCluster(entry >> RASTER_LOCAL_BITS);
-  const GpuInstance inst = instances[c.instance];
+  const GpuInstance inst = placedInstance(c.instance);
   const GpuDraw d = draws[inst.info.x];
   const uint local = entry & ((1u << RASTER_LOCAL_BITS) - 1u);
   const uint v = triangleVertices(c, d, local)[gl_VertexIndex % 3];

@@ -12,6 +12,19 @@ layout(set = 0, binding = 8, std430) readonly buffer Materials { GpuMaterial mat
 layout(set = 0, binding = 9, std430) readonly buffer Texcoords { vec2 texcoords[]; };
 layout(set = 1, binding = 0) uniform sampler2D textures[];
 
+// The members of material i that the alpha test reads, one by one: a copy of the whole record loads its
+// 304 bytes (the SPIR-V keeps the whole-struct load; dropping the unused parts is left to the driver).
+GpuMaterial maskMaterial(uint i) {
+  GpuMaterial m;
+  m.baseColor = materials[i].baseColor;
+  m.roughMetal = materials[i].roughMetal;
+  m.textures = materials[i].textures;
+  m.textures2 = materials[i].textures2;
+  m.uvTransform[2 * SLOT_MASK] = materials[i].uvTransform[2 * SLOT_MASK];
+  m.uvTransform[2 * SLOT_MASK + 1] = materials[i].uvTransform[2 * SLOT_MASK + 1];
+  return m;
+}
+
 const int kOne = 1 << RASTER_SUBPIXEL_BITS;
 const uint kSkip = 0u, kSmall = 1u, kLarge = 2u, kHardware = 3u;
 
@@ -39,22 +52,11 @@ int64_t edge(ivec2 a, ivec2 b, ivec2 p) {
 // Bounding boxes over this many pixels are rasterised tile by tile (raster_large.comp).
 layout(constant_id = 0) const uint kSharedArea = RASTER_SHARED_AREA;
 
-uint setup(uint clusterIndex, uint local, out Tri t) {
-  const GpuCluster c = listedCluster(clusterIndex);
-  const GpuInstance inst = instances[c.instance];
-  const GpuDraw d = draws[inst.info.x];
-  t.id = inst.info.z + c.firstTriangle + local;
-  t.material = NO_TEXTURE;
-  const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
-  if (!kAlphaMask && masked) return kHardware;
-  uvec3 tri = triangleVertices(c, d, local);
-  const vec4 p[3] = vec4[3](clipPosition(inst, tri.x), clipPosition(inst, tri.y), clipPosition(inst, tri.z));
-  // Outside one plane of the view volume (behind the camera included): nothing to draw.
-  for (int k = 0; k < 3; ++k) {
-    if (p[0][k] > p[0].w && p[1][k] > p[1].w && p[2][k] > p[2].w) return kSkip;
-    if (k < 2 && p[0][k] < -p[0].w && p[1][k] < -p[1].w && p[2][k] < -p[2].w) return kSkip;
-  }
-  if (p[0].z < 0.0 && p[1].z < 0.0 && p[2].z < 0.0) return kSkip;
+// From the clip-space vertices of a triangle in the view volume: kHardware where one has w <= 0 or leaves
+// the guard band, else the snapped vertices, depths and box (kSkip: back-facing, zero area or no pixel
+// centre; kSmall or kLarge by the box). `swapped`: vertices 1 and 2 exchanged (positive inside).
+uint project(vec4 p[3], uint flags, inout Tri t, out bool swapped) {
+  swapped = false;
   if (min(p[0].w, min(p[1].w, p[2].w)) <= 0.0) return kHardware;
   const vec2 size = vec2(pc.width, pc.height);
   ivec2 v[3];
@@ -68,14 +70,14 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
   // Vulkan's facing: counter-clockwise in framebuffer coordinates (y down) is front, i.e. area2 < 0 here;
   // the other way round for a mirrored instance (its draws' VK_FRONT_FACE_CLOCKWISE).
   t.area2 = int64_t(v[1].x - v[0].x) * int64_t(v[2].y - v[0].y) - int64_t(v[1].y - v[0].y) * int64_t(v[2].x - v[0].x);
-  const bool back = (t.area2 > 0l) != ((c.flags & CLUSTER_MIRRORED) != 0u);
-  if (t.area2 == 0l || (back && (c.flags & CLUSTER_DOUBLE_SIDED) == 0u)) return kSkip;
+  const bool back = (t.area2 > 0l) != ((flags & CLUSTER_MIRRORED) != 0u);
+  if (t.area2 == 0l || (back && (flags & CLUSTER_DOUBLE_SIDED) == 0u)) return kSkip;
   if (t.area2 < 0l) {  // the other order: positive inside
     t.area2 = -t.area2;
     const ivec2 tv = v[1]; v[1] = v[2]; v[2] = tv;
     const float tz = t.z[1]; t.z[1] = t.z[2]; t.z[2] = tz;
     const float tw = t.invW[1]; t.invW[1] = t.invW[2]; t.invW[2] = tw;
-    tri = tri.xzy;
+    swapped = true;
   }
   t.v = v;
   // Pixels whose centres (x + 0.5) lie in the snapped bounding box, clipped to the image.
@@ -83,15 +85,37 @@ uint setup(uint clusterIndex, uint local, out Tri t) {
   t.box.xy = max((lo - kOne / 2 + kOne - 1) >> RASTER_SUBPIXEL_BITS, ivec2(0));
   t.box.zw = min((hi - kOne / 2) >> RASTER_SUBPIXEL_BITS, ivec2(pc.width, pc.height) - 1);
   if (any(greaterThan(t.box.xy, t.box.zw))) return kSkip;
-  if (kAlphaMask && masked) {
-    const GpuMaterial m = materials[d.material];
-    if (m.textures.w != NO_TEXTURE) {
-      t.material = d.material;
-      for (int i = 0; i < 3; ++i) t.uv[i] = maskTexcoord(m, texcoords[tri[i]]);
-    }
-  }
   const ivec2 extent = t.box.zw - t.box.xy + 1;
   return uint(extent.x) * uint(extent.y) > kSharedArea ? kLarge : kSmall;
+}
+
+uint setup(uint clusterIndex, uint local, out Tri t) {
+  const GpuCluster c = listedCluster(clusterIndex);
+  const GpuInstance inst = placedInstance(c.instance);
+  const GpuDraw d = draws[inst.info.x];
+  t.id = inst.info.z + c.firstTriangle + local;
+  t.material = NO_TEXTURE;
+  const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
+  if (!kAlphaMask && masked) return kHardware;
+  const uvec3 tri = triangleVertices(c, d, local);
+  const vec4 p[3] = vec4[3](clipPosition(inst, tri.x), clipPosition(inst, tri.y), clipPosition(inst, tri.z));
+  // Outside one plane of the view volume (behind the camera included): nothing to draw.
+  for (int k = 0; k < 3; ++k) {
+    if (p[0][k] > p[0].w && p[1][k] > p[1].w && p[2][k] > p[2].w) return kSkip;
+    if (k < 2 && p[0][k] < -p[0].w && p[1][k] < -p[1].w && p[2][k] < -p[2].w) return kSkip;
+  }
+  if (p[0].z < 0.0 && p[1].z < 0.0 && p[2].z < 0.0) return kSkip;
+  bool swapped;
+  const uint kind = project(p, c.flags, t, swapped);
+  if (kAlphaMask && masked && (kind == kSmall || kind == kLarge)) {
+    const GpuMaterial m = maskMaterial(d.material);
+    if (m.textures.w != NO_TEXTURE) {
+      t.material = d.material;
+      const uvec3 order = swapped ? tri.xzy : tri;
+      for (int i = 0; i < 3; ++i) t.uv[i] = maskTexcoord(m, texcoords[order[i]]);
+    }
+  }
+  return kind;
 }
 
 // A large triangle's setup, kept for its tiles (raster.h's RasterLargeTri), and read back.
@@ -105,6 +129,23 @@ void storeLarge(uint k, Tri t) {
     largeTris[k].uv01 = vec4(t.uv[0], t.uv[1]);
     largeTris[k].uv2 = vec4(t.uv[2], 0.0, 0.0);
   }
+}
+
+// Past the list's capacity a triangle is counted, not stored (the draw skips those entries).
+void handOff(uint ref) {
+  const uint n = atomicAdd(vertexCount, 3u) / 3u;
+  if (n < pc.handOffCapacity) hwTriangles[n] = ref;
+}
+
+// A large triangle: its record and one tile-list entry per tile of its box; a full list hands it to the
+// hardware (its reserved entries that fit are marked empty).
+void appendLarge(Tri t, uint ref) {
+  const ivec2 tiles = (t.box.zw - t.box.xy + RASTER_TILE) / RASTER_TILE;
+  const uint n = uint(tiles.x * tiles.y), first = atomicAdd(largeCount, n), record = atomicAdd(largeTriCount, 1u);
+  const bool fits = first + n <= RASTER_LARGE_CAPACITY && record < RASTER_LARGE_TRIANGLES;
+  if (fits) storeLarge(record, t);
+  for (uint i = 0u; i < n && first + i < RASTER_LARGE_CAPACITY; ++i) largeTiles[first + i] = uvec2(fits ? record : ~0u, i);
+  if (!fits) handOff(ref);
 }
 
 Tri loadLarge(uint k) {
@@ -143,7 +184,7 @@ bool cutOut(Tri t, ivec2 px, vec3 e) {
   const float scale = exp2(frame.params.y);
   const vec2 gx = (maskUv(t, e + side.x * stepX) - uv) * (side.x * scale);
   const vec2 gy = (maskUv(t, e + side.y * stepY) - uv) * (side.y * scale);
-  const GpuMaterial m = materials[t.material];
+  const GpuMaterial m = maskMaterial(t.material);
   return maskCuts(m, textureGrad(textures[nonuniformEXT(m.textures.w)], uv, gx, gy));
 }
 

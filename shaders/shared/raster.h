@@ -28,6 +28,12 @@ using glm::vec4;
 // it, triangles are dropped and counted (ComputeRaster::handOffTriangles, which rtr-view prints).
 #define RASTER_HANDOFF_CAPACITY (1u << 24)
 
+#define RASTER_CLIP_GROUP 64u             // raster_clip.comp: a thread per triangle crossing the near plane or the guard band
+#define RASTER_CLIP_CAPACITY (1u << 16)   // its list's entries; past them a triangle goes to the hardware
+// The clipping planes' distance from the image centre in pixels: inside the guard band, so that a clipped
+// vertex's rounding never takes it out again.
+#define RASTER_CLIP_BAND (RASTER_GUARD_BAND - 64.0)
+
 // A large triangle as raster.comp set it up (raster_tri.glsl's Tri, less what follows from it), written
 // once for raster_large.comp's tiles: a tile reads it instead of fetching and transforming the triangle.
 struct RasterLargeTri {
@@ -46,7 +52,8 @@ struct RasterPush {
   uint clusterCount;
   uint fromList;       // raster.comp: clusters from the culling pass's visible list, not all of them
   uint handOffCapacity;  // entries of the hand-off list (at most RASTER_HANDOFF_CAPACITY)
-  uint pad0, pad1, pad2;
+  uint clip;  // raster.comp: triangles crossing w = 0 or the guard band to raster_clip.comp, not the hardware
+  uint pad1, pad2;
 };
 
 #ifdef __cplusplus

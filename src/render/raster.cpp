@@ -27,6 +27,7 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   // The alpha test in compute only where some material is masked (raster_tri.glsl's kAlphaMask).
   const std::vector<vk::SpecializationConstant> constants{{0, RASTER_SHARED_AREA}, {1, scene.hasDraws(DrawKind::AlphaMasked)}};
   raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, constants);
+  clip_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clip.comp"), options, constants);
   large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), options, constants);
   vk::GraphicsDesc d;
   d.modules = {vk::loadShader("raster_hw.vert"), vk::loadShader("raster_hw.frag")};
@@ -34,7 +35,7 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   d.depthTest = d.depthWrite = false;
   hardware_ = vk::makeGraphicsPipeline(ctx, d, options);
   // Written by the renderer (Renderer::writeTextures).
-  for (size_t i = 0; i < 3; ++i)
+  for (size_t i = 0; i < textured().size(); ++i)
     if (textured()[i]->layout.setCount() > 1) textures_[i] = vk::DescriptorSets(ctx, textured()[i]->layout, 1);
   // Every triangle at most once in the hand-off list, after its VkDrawIndirectCommand.
   uint64_t triangles = 0;
@@ -45,6 +46,10 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
       vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::clamp<uint64_t>(triangles, 1, RASTER_HANDOFF_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                  vk::MemoryUse::Device, "raster hand-off");
+  clipList_ = vk::Buffer(ctx, 32 + 4 * VkDeviceSize(RASTER_CLIP_CAPACITY),
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                             VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                         vk::MemoryUse::Device, "raster clipping list");
   largeList_ =
       vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -54,12 +59,12 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   cullReadback_ = vk::Buffer(ctx, 2 * sizeof(shader::CullCounts) * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryUse::Readback, "cull counts read-back");
   handOffReadback_ =
-      vk::Buffer(ctx, 4 * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "hand-off count read-back");
+      vk::Buffer(ctx, 8 * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "hand-off count read-back");
 }
 
 std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster::textureSets() const {
   std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> sets;
-  for (size_t i = 0; i < 3; ++i)
+  for (size_t i = 0; i < textured().size(); ++i)
     if (textured()[i]->layout.setCount() > 1) sets.emplace_back(&textured()[i]->layout, textures_[i].get(1));
   return sets;
 }
@@ -67,8 +72,15 @@ std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster
 uint32_t ComputeRaster::handOffTriangles(uint32_t frame) const {
   handOffReadback_.invalidate();
   uint32_t vertices = 0;
-  std::memcpy(&vertices, static_cast<const char*>(handOffReadback_.mapped()) + 4 * frame, 4);
+  std::memcpy(&vertices, static_cast<const char*>(handOffReadback_.mapped()) + 8 * frame, 4);
   return vertices / 3;
+}
+
+uint32_t ComputeRaster::clippedTriangles(uint32_t frame) const {
+  handOffReadback_.invalidate();
+  uint32_t clipped = 0;
+  std::memcpy(&clipped, static_cast<const char*>(handOffReadback_.mapped()) + 8 * frame + 4, 4);
+  return std::min(clipped, RASTER_CLIP_CAPACITY);  // the count goes on past the list; those went to the hardware
 }
 
 std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame) const {
@@ -95,7 +107,7 @@ void ComputeRaster::resize(VkExtent2D extent) {
 }
 
 void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
-                           const CullCamera& camera, bool cull) {
+                           const CullCamera& camera, bool cull, bool clip) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
@@ -130,14 +142,15 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
                                   list,
                                   counts,
                                   scene_.instances(),
-                                  largeTris_.handle()};
+                                  largeTris_.handle(),
+                                  clipList_.handle()};
       if (b.binding == 0) w.buffer(0, uniforms.buffer, uniforms.offset, sizeof(shader::FrameUniforms));
       else w.buffer(b.binding, buffers[b.binding]);
     }
     w.push(cb, p);
-    for (size_t i = 0; i < 3; ++i)
+    for (size_t i = 0; i < textured().size(); ++i)
       if (&p == textured()[i] && p.layout.setCount() > 1) p.bindSet(cb, 1, textures_[i].get(1));
-    p.push(cb, shader::RasterPush{extent_.width, extent_.height, clusterCount, fromList, handOffCapacity_, 0, 0, 0});
+    p.push(cb, shader::RasterPush{extent_.width, extent_.height, clusterCount, fromList, handOffCapacity_, clip, 0, 0});
   };
   // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.
   constexpr vk::BufferUse kReaders = vk::kComputeReadWrite | vk::kFragmentReadWrite | vk::kVertexReadWrite | vk::kIndirectRead;
@@ -151,7 +164,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   const VkDeviceSize countsSize = sizeof(shader::CullCounts);
   const VkBufferCopy toReadback[2] = {{0, 2 * countsSize * frame, countsSize}, {0, (2 * frame + 1) * countsSize, countsSize}};
   // Both rasteriser passes over the clusters: all of them, or (culling) the culler's list, indirectly.
-  auto rasterise = [&](const char* name, const char* largeName) {
+  auto rasterise = [&](const char* name, const char* clipName, const char* largeName) {
     bind(raster_, culling);
     if (culling) {
       vkCmdDispatchIndirect(cb, culler_->counts(), 0);
@@ -162,6 +175,12 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
       vkCmdDispatch(cb, x, (clusterCount + x - 1) / x, 1);
     }
     timer.mark(cb, name);
+    if (clip) {  // its list's entries and workgroup count are raster's
+      vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
+      bind(clip_);
+      vkCmdDispatchIndirect(cb, clipList_.handle(), 0);
+      timer.mark(cb, clipName);
+    }
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite);
     bind(large_);
     vkCmdDispatch(cb, RASTER_LARGE_GROUPS, 1, 1);
@@ -179,11 +198,13 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
                     scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
     vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[0]);
     timer.mark(cb, "cull early");
-    rasterise("raster early", "raster large early");
+    rasterise("raster early", "raster clip early", "raster large early");
     // The pyramid reads the depth drawn so far; the late phase's tile pass starts after the early tiles.
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kCopyRead);
     const VkBufferCopy firstLate{0, 4, 4};  // largeCount -> largeFirst (raster_fetch.glsl)
     vkCmdCopyBuffer(cb, largeList_.handle(), largeList_.handle(), 1, &firstLate);
+    const VkBufferCopy clipFirstLate{12, 16, 4};  // clipCount -> clipFirst (raster_fetch.glsl)
+    if (clip) vkCmdCopyBuffer(cb, clipList_.handle(), clipList_.handle(), 1, &clipFirstLate);
     pyramid_->buildFromBuffer(cb, vis_.handle());
     timer.mark(cb, "pyramid");
     // Its first barrier orders the copies above before its reset, its second makes them visible to compute.
@@ -193,10 +214,12 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
     timer.mark(cb, "cull");
   }
-  if (clusterCount > 0) rasterise("raster", "raster large");
+  if (clusterCount > 0) rasterise("raster", "raster clip", "raster large");
   vk::bufferBarrier(cb, vk::kComputeWrite, kReaders | vk::kCopyRead);
-  const VkBufferCopy handOffCount{0, 4 * VkDeviceSize(frame), 4};  // VkDrawIndirectCommand::vertexCount
+  const VkBufferCopy handOffCount{0, 8 * VkDeviceSize(frame), 4};  // VkDrawIndirectCommand::vertexCount
   vkCmdCopyBuffer(cb, hwList_.handle(), handOffReadback_.handle(), 1, &handOffCount);
+  const VkBufferCopy clipCount{12, 8 * VkDeviceSize(frame) + 4, 4};  // clipCount
+  vkCmdCopyBuffer(cb, clipList_.handle(), handOffReadback_.handle(), 1, &clipCount);
   vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};

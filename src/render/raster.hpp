@@ -1,8 +1,9 @@
 #pragma once
 // The compute rasteriser of the visibility buffer (docs/raster.md): a clear pass, one workgroup per
-// cluster writing (depth << 32 | id) per pixel with 64-bit atomicMin, a pass over the large triangles'
-// tiles, and an indirect hardware draw of the triangles it hands off (crossing w = 0, outside the guard
-// band) into the same buffer. A scene with alpha-masked materials gets the passes' variant that tests
+// cluster writing (depth << 32 | id) per pixel with 64-bit atomicMin, a pass clipping the triangles that
+// cross w = 0 or leave the guard band, a pass over the large triangles' tiles, and an indirect hardware draw
+// of what it hands off (those triangles where clipping is off, and what the lists cannot hold) into the
+// same buffer. A scene with alpha-masked materials gets the passes' variant that tests
 // the mask per pixel (docs/raster.md); others bind no texture.
 // RASTER_SHARED_AREA (raster.h, a specialization constant of both passes): the bounding-box area in pixels
 // above which a triangle is rasterised by tiles rather than by its own thread.
@@ -25,7 +26,7 @@ class ComputeRaster {
   ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight);
 
   void resize(VkExtent2D extent);  // the caller has waited for the device to be idle
-  // Records the passes, each timed ("clear", "raster", "raster large", "raster hw"); afterwards ids() is
+  // Records the passes, each timed ("clear", "raster", "raster clip", "raster large", "raster hw"); afterwards ids() is
   // written (compute and fragment stages), for a compute reader after a barrier the caller makes (vis_shade).
   // With `cull` (the frame's camera), two-phase cluster culling (docs/culling.md): "cull early" lists the
   // clusters visible last frame, "raster early" + "raster large early" draw them, "pyramid" reduces their
@@ -33,8 +34,10 @@ class ComputeRaster {
   // Level of detail (docs/virtual-geometry.md): with a scene hierarchy and camera.lodThreshold > 0, the
   // culling pass picks each instance's clusters of the cut (without `cull`: one pass, "cull", testing
   // nothing else); otherwise only the full-detail clusters are drawn.
+  // `clip`: the triangles crossing w = 0 or the guard band are clipped in compute ("raster clip", once per
+  // raster pass); otherwise the hardware draws them ("raster hw", the reference).
   void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
-              const CullCamera& camera, bool cull);
+              const CullCamera& camera, bool cull, bool clip);
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
   // The passes' texture arrays (set 1 of the layouts that have one), for the one writer of every texture set.
   std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> textureSets() const;
@@ -51,21 +54,23 @@ class ComputeRaster {
   // Triangles handed to the hardware by the last completed use of `frame` (both phases); those past
   // handOffCapacity() were not drawn.
   uint32_t handOffTriangles(uint32_t frame) const;
+  // Triangles clipped in compute by the last completed use of `frame` (both phases; 0 with clipping off).
+  uint32_t clippedTriangles(uint32_t frame) const;
   uint32_t handOffCapacity() const { return handOffCapacity_; }
 
  private:
   const vk::Context& ctx_;
   const GpuScene& scene_;
-  vk::Pipeline clear_, raster_, large_, hardware_;
-  vk::DescriptorSets textures_[3];  // set 1 of textured()'s pipelines where they have one
-  std::array<const vk::Pipeline*, 3> textured() const { return {&raster_, &large_, &hardware_}; }
-  vk::Buffer vis_, hwList_, largeList_, largeTris_;
+  vk::Pipeline clear_, raster_, clip_, large_, hardware_;
+  vk::DescriptorSets textures_[4];  // set 1 of textured()'s pipelines where they have one
+  std::array<const vk::Pipeline*, 4> textured() const { return {&raster_, &clip_, &large_, &hardware_}; }
+  vk::Buffer vis_, hwList_, clipList_, largeList_, largeTris_;
   uint32_t handOffCapacity_ = 1;
   VkExtent2D extent_{0, 0};
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
   std::optional<DepthPyramid> pyramid_;
   vk::Buffer cullReadback_;     // per frame in flight: the early and the late CullCounts
-  vk::Buffer handOffReadback_;  // per frame in flight: the hand-off's vertex count
+  vk::Buffer handOffReadback_;  // per frame in flight: the hand-off's vertex count, the clipped triangles
   std::vector<bool> culled_;    // per frame in flight: whether its last use culled
   std::vector<bool> twoPhase_;  // per frame in flight: whether that was in two phases
 };

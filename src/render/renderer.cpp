@@ -44,7 +44,7 @@ Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t frame
     : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), arrivalsSeen_(scene.textureArrivals()), post_(ctx) {
   makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
-    timers_.emplace_back(ctx, 13);  // at most: ComputeRaster::record's nine passes, shade, transparent, post
+    timers_.emplace_back(ctx, 15);  // at most: ComputeRaster::record's eleven passes, shade, transparent, post
   }
   VkPhysicalDeviceFeatures features{};
   vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
@@ -460,7 +460,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute) {
     const float pixelsPerUnit = float(target.extent.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
     const CullCamera cam{u.viewProj, pose.position, lens.orthographic, s.lodError, pixelsPerUnit, lens.zNear};
-    raster_->record(cb, uniforms_, timer, frame, cam, s.cull);
+    raster_->record(cb, uniforms_, timer, frame, cam, s.cull, s.clip);
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
   } else {
     rasterPass(cb, frame, set, pose.position, s.background, backdrop);

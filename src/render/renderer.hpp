@@ -48,6 +48,9 @@ struct RenderSettings {
   // on the H200 its fixed cost (depth pyramid + two cull passes) exceeded the raster time it saved in
   // every measured scene (docs/raster.md).
   bool cull = false;
+  // Compute raster: the triangles crossing the near plane (w = 0) or the guard band clipped in compute (a
+  // small pass, docs/raster.md) rather than drawn by the hardware (false: the reference, for comparison).
+  bool clip = true;
   // Compute raster, scenes with a cluster hierarchy: the level-of-detail cut's projected error in pixels
   // (docs/virtual-geometry.md); 0: full detail, exactly the image without a hierarchy.
   float lodError = 0.0f;  // rtr-view: --lod-error, default 1
@@ -133,6 +136,10 @@ class Renderer {
     return raster_ ? std::optional(raster_->handOffTriangles(frame)) : std::nullopt;
   }
   uint32_t handOffCapacity() const { return raster_ ? raster_->handOffCapacity() : 0; }
+  // Triangles the compute rasteriser clipped itself in the last completed use of `frame`.
+  std::optional<uint32_t> clippedTriangles(uint32_t frame) const {
+    return raster_ ? std::optional(raster_->clippedTriangles(frame)) : std::nullopt;
+  }
 
  private:
   struct ScenePipelines {

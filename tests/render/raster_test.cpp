@@ -82,24 +82,67 @@ bool idWithinOnePixel(const std::vector<uint32_t>& img, uint32_t w, int x, int y
   return false;
 }
 
+// Two id images of one view compared: pixels covered in either, the same id, differing off every edge
+// (below), differing only at the edge of an alpha mask's cut-out. A difference is allowed where the pixel
+// centre is within 1/64 pixel of an edge of one of the two triangles (vertices are snapped to 1/256 pixel;
+// a tie on a shared edge or a snapping difference) or is a depth tie (the two triangles' planes within 1e-5
+// in z/w there: where they interpenetrate or nearly coincide) or lies at a mask's edge; the first few
+// others are reported as failures.
+struct IdComparison {
+  size_t covered = 0, same = 0, offEdge = 0, maskEdges = 0;
+};
+IdComparison compareIds(const IdDecoder& decode, const glm::dmat4& vp, VkExtent2D extent, const std::vector<uint32_t>& hw,
+                        const std::vector<uint32_t>& cs) {
+  const glm::dvec2 size(extent.width, extent.height);
+  IdComparison r;
+  for (uint32_t y = 0; y < extent.height; ++y)
+    for (uint32_t x = 0; x < extent.width; ++x) {
+      const size_t i = size_t(y) * extent.width + x;
+      if (hw[i] == VIS_EMPTY && cs[i] == VIS_EMPTY) continue;
+      ++r.covered;
+      if (hw[i] == cs[i]) {
+        ++r.same;
+        continue;
+      }
+      double d = 1e30;
+      for (uint32_t id : {hw[i], cs[i]})
+        if (id != VIS_EMPTY) d = std::min(d, outlineDistance(vp, decode.triangle(id), size, {x + 0.5, y + 0.5}));
+      // Or a depth tie: the two triangles' planes meet (or nearly coincide) at the pixel centre.
+      const double dz = hw[i] == VIS_EMPTY || cs[i] == VIS_EMPTY
+                            ? 1.0
+                            : std::abs(planeDepth(vp, decode.triangle(hw[i]), size, {x + 0.5, y + 0.5}) -
+                                       planeDepth(vp, decode.triangle(cs[i]), size, {x + 0.5, y + 0.5}));
+      // Or the edge of an alpha-masked triangle's cut-out (the mask sampled by two rasterisers).
+      const bool maskEdge = (decode.masked(hw[i]) || decode.masked(cs[i])) &&
+                            (idWithinOnePixel(hw, extent.width, x, y, cs[i]) || idWithinOnePixel(cs, extent.width, x, y, hw[i]));
+      r.maskEdges += maskEdge && d > 1.0 / 64 && dz > 1e-5;
+      if (d > 1.0 / 64 && dz > 1e-5 && !maskEdge) {
+        if (++r.offEdge < 10)
+          ADD_FAILURE() << "pixel " << x << "," << y << ": " << hw[i] << " against " << cs[i] << ", " << d
+                        << " px from the nearest edge, depths " << dz << " apart";
+      }
+    }
+  return r;
+}
+
 class RasterTest : public test::VulkanTest {
  protected:
   void SetUp() override {
     VulkanTest::SetUp();
     if (!render::ComputeRaster::supported(*ctx)) GTEST_SKIP() << "no 64-bit buffer atomics";
   }
-  std::vector<uint32_t> ids(render::HeadlessRenderer& r, const CameraPose& pose, const Lens& lens, RasterPath raster) {
+  std::vector<uint32_t> ids(render::HeadlessRenderer& r, const CameraPose& pose, const Lens& lens, RasterPath raster,
+                            bool clip = true) {
     render::RenderSettings s;
     s.raster = raster;
+    s.clip = clip;
     s.mosaic = render::MosaicMode::Off;
     return r.ids(pose, lens, s);
   }
 };
 
 // Same views, both rasterisers: at least 99.9 % of covered pixels carry the same triangle, and every pixel
-// that differs has its centre within 1/64 pixel of an edge of one of the two triangles (vertices are snapped
-// to 1/256 pixel; a tie on a shared edge or a snapping difference) or is a depth tie (the two triangles'
-// planes within 1e-5 in z/w there: where they interpenetrate or nearly coincide), nothing else.
+// that differs is on an edge, a depth tie or a mask's edge (compareIds), nothing else.
 TEST_F(RasterTest, HardwareAndComputeIdsAgree) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
@@ -120,41 +163,53 @@ TEST_F(RasterTest, HardwareAndComputeIdsAgree) {
     ASSERT_EQ(r.renderer().rasterFor(asked), RasterPath::Compute);
     const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);
     const glm::dmat4 vp = glm::dmat4(projectionMatrix(lens, 320.0f / 180.0f) * viewMatrix(pose));
-    size_t covered = 0, same = 0, offEdge = 0, maskEdges = 0;
-    for (uint32_t y = 0; y < extent.height; ++y)
-      for (uint32_t x = 0; x < extent.width; ++x) {
-        const size_t i = size_t(y) * extent.width + x;
-        if (hw[i] == VIS_EMPTY && cs[i] == VIS_EMPTY) continue;
-        ++covered;
-        if (hw[i] == cs[i]) {
-          ++same;
-          continue;
-        }
-        double d = 1e30;
-        for (uint32_t id : {hw[i], cs[i]})
-          if (id != VIS_EMPTY) d = std::min(d, outlineDistance(vp, decode.triangle(id), {320, 180}, {x + 0.5, y + 0.5}));
-        // Or a depth tie: the two triangles' planes meet (or nearly coincide) at the pixel centre.
-        const double dz = hw[i] == VIS_EMPTY || cs[i] == VIS_EMPTY
-                              ? 1.0
-                              : std::abs(planeDepth(vp, decode.triangle(hw[i]), {320, 180}, {x + 0.5, y + 0.5}) -
-                                         planeDepth(vp, decode.triangle(cs[i]), {320, 180}, {x + 0.5, y + 0.5}));
-        // Or the edge of an alpha-masked triangle's cut-out (the mask sampled by two rasterisers).
-        const bool maskEdge =
-            (decode.masked(hw[i]) || decode.masked(cs[i])) &&
-            (idWithinOnePixel(hw, extent.width, x, y, cs[i]) || idWithinOnePixel(cs, extent.width, x, y, hw[i]));
-        maskEdges += maskEdge && d > 1.0 / 64 && dz > 1e-5;
-        if (d > 1.0 / 64 && dz > 1e-5 && !maskEdge) {
-          if (++offEdge < 10)
-            ADD_FAILURE() << "pixel " << x << "," << y << ": hardware " << hw[i] << ", compute " << cs[i] << ", " << d
-                          << " px from the nearest edge, depths " << dz << " apart";
-        }
-      }
+    const auto [covered, same, offEdge, maskEdges] = compareIds(decode, vp, extent, hw, cs);
     std::printf("ids: %zu of %zu covered pixels agree (%.4f %%), %zu differing off an edge, %zu at a mask's edge\n", same,
                 covered, 100.0 * same / covered, offEdge, maskEdges);
     EXPECT_GT(covered, size_t(extent.width) * extent.height / 4) << "too little drawn to compare";
     EXPECT_GE(double(same), 0.999 * double(covered));
     EXPECT_EQ(offEdge, 0u);
   }
+}
+
+// The triangles crossing w = 0 or leaving the guard band are clipped in compute (raster_clip.comp): the
+// temple's views above, and one low over the floor with the near plane at 0.01 (floor triangles beside the
+// camera leave the guard band with w > 0). None is handed to the hardware, the clipping pass counts them,
+// and the ids are those of the hardware's hand-off (RenderSettings::clip off) but on edges.
+TEST_F(RasterTest, CrossingTrianglesAreClippedInCompute) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  const VkExtent2D extent{320, 180};
+  render::HeadlessRenderer r(*ctx, gpu, extent);
+  const IdDecoder decode(scene, gpu);
+  const CameraPose framed = scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 320.0f / 180.0f));
+  const glm::vec3 c = scene.bounds().center(), lo = scene.bounds().min;
+  const CameraPose poses[] = {framed,
+                              {c + glm::vec3(0, 0.3f, 0), 70.0f, -10.0f},
+                              {c + glm::vec3(2, -0.5f, 1), 200.0f, -35.0f},
+                              {glm::vec3(c.x + 1, lo.y + 0.02f, c.z), 10.0f, 0.0f}};
+  uint32_t total = 0;
+  for (const CameraPose& pose : poses) {
+    SCOPED_TRACE(testing::Message() << "pose " << pose.position.x << "," << pose.position.y << "," << pose.position.z);
+    Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
+    lens.zNear = &pose == &poses[3] ? 0.01f : 0.05f;
+    const std::vector<uint32_t> hw = ids(r, pose, lens, RasterPath::Compute, false);
+    const uint32_t handedOff = r.renderer().handOffTriangles(0).value_or(0);
+    EXPECT_EQ(r.renderer().clippedTriangles(0), 0u) << "clipping off";
+    const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);
+    const uint32_t clipped = r.renderer().clippedTriangles(0).value_or(0);
+    EXPECT_EQ(r.renderer().handOffTriangles(0), 0u) << "a triangle handed to the hardware";
+    EXPECT_EQ(clipped, handedOff) << "the clipping pass takes what the hardware was handed";
+    total += clipped;
+    const glm::dmat4 vp = glm::dmat4(projectionMatrix(lens, 320.0f / 180.0f) * viewMatrix(pose));
+    const auto [covered, same, offEdge, maskEdges] = compareIds(decode, vp, extent, hw, cs);
+    std::printf(
+        "clipped %u triangles: %zu of %zu covered pixels as the hardware's hand-off (%.4f %%), %zu off an edge, %zu at a mask's edge\n",
+        clipped, same, covered, 100.0 * same / covered, offEdge, maskEdges);
+    EXPECT_GE(double(same), 0.999 * double(covered));
+    EXPECT_EQ(offEdge, 0u);
+  }
+  EXPECT_GT(total, 20u) << "too few crossing triangles to test";
 }
 
 // Hot reload (rebuildPipelines) replaces the compute rasteriser too: the next frame's ids are the same.
@@ -252,7 +307,7 @@ std::vector<uint32_t> owners(const Mesh& mesh, uint32_t count, uint32_t x, uint3
 
 // No pixel left uncovered from inside the closed cube: straight (vertices on pixel centres), turned, and
 // from near a corner (not nearer than the near plane reaches), where faces cross the plane w = 0 (handed to
-// the hardware) and lie behind the camera.
+// compute, raster_clip.comp) and lie behind the camera.
 TEST_F(RasterTest, ClosedMeshFromInsideLeavesNoHole) {
   const Scene scene = insideCube();
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
@@ -266,14 +321,17 @@ TEST_F(RasterTest, ClosedMeshFromInsideLeavesNoHole) {
                               {{0, 0, 0}, -45, 60},
                               {{0.7f, -0.6f, 0.5f}, 150, -30},
                               {{0.85f, 0.85f, -0.85f}, 45, 35}};
+  uint32_t clipped = 0;
   for (const CameraPose& pose : poses) {
     SCOPED_TRACE(testing::Message() << "yaw " << pose.yawDeg << ", pitch " << pose.pitchDeg);
     const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);
+    clipped += r.renderer().clippedTriangles(0).value_or(0);
     size_t holes = 0;
     for (uint32_t i = 0; i < cs.size(); ++i)
       if (cs[i] == VIS_EMPTY && ++holes <= 5) ADD_FAILURE() << "hole at " << i % kCubeSize << "," << i / kCubeSize;
     EXPECT_EQ(holes, 0u);
   }
+  EXPECT_GT(clipped, 0u) << "no face crosses w = 0: clipping untested";
 }
 
 // Seen straight, every pixel centre of the z = -1 face is owned by exactly one triangle by the rule, and the

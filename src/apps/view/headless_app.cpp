@@ -227,6 +227,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     if (settings.raster != render::RasterPath::Hardware)
       if (const auto h = renderer.renderer().handOffTriangles(0)) {
         std::printf("raster hw: %u triangles handed off\n", *h);
+        std::printf("raster clip: %u triangles clipped in compute\n", renderer.renderer().clippedTriangles(0).value_or(0));
         if (*h > renderer.renderer().handOffCapacity())
           std::fprintf(stderr, "rtr-view: warning: the hand-off list holds %u triangles: %u were not drawn\n",
                        renderer.renderer().handOffCapacity(), *h - renderer.renderer().handOffCapacity());

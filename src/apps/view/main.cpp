@@ -177,6 +177,11 @@ int main(int argc, char** argv) {
   app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
+  std::string nearClip = "compute";
+  app.add_option("--near-clip", nearClip,
+                 "compute raster: triangles crossing the near plane or the guard band clipped in compute | drawn by the hardware")
+      ->check(CLI::IsMember({"compute", "hardware"}))
+      ->capture_default_str();
   // Default 0 (full detail): measured on the GPU machine, a cut at 1 pixel still costs more than it saves
   // up to 1M triangles (simplified flat surfaces become large triangles; docs/virtual-geometry.md).
   app.add_option("--lod-error", o.settings.lodError,
@@ -271,6 +276,7 @@ int main(int argc, char** argv) {
     o.settings.sampler.filter = cli::enumOption<render::TextureFilter>("--filter", filter);
     o.settings.raster = cli::enumOption<render::RasterPath>("--raster", raster);
     o.settings.cull = cull == "on";
+    o.settings.clip = nearClip == "compute";
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
   } catch (const std::exception& e) { return cli::fail("rtr-view", e); }
 }
