@@ -79,7 +79,7 @@ uint32_t packsFor(uint32_t n) { return (n + kWidth - 1) / kWidth; }
 
 // The tree's SAH cost as the builder counts it: per node kNodeCost, per leaf its packs, each weighted by
 // its box's area relative to the root's (the expected work of a ray that meets the root box).
-double sahCost(const Node* nodes, uint32_t root) {
+double treeSahCost(const Node* nodes, uint32_t root) {
   const auto area = [](const Node& n, int k) {
     const double e[3] = {double(n.box[1][0][k]) - n.box[0][0][k], double(n.box[1][1][k]) - n.box[0][1][k],
                          double(n.box[1][2][k]) - n.box[0][2][k]};
@@ -660,9 +660,10 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   stats_.nodes = uint32_t(nodes_.size());
   stats_.packs = uint32_t(packs_.size());
   stats_.maxDepth = b.maxDepth.load();
-  stats_.sahCost = sahCost(nodes_.data(), root_);
   stats_.buildSeconds = since(start);
 }
+
+double Bvh::sahCost() const { return empty() ? 0.0 : treeSahCost(nodes_.data(), root_); }
 
 template <class T>
 HugeArray<T>::HugeArray(size_t n) : n_(n) {

@@ -28,7 +28,6 @@ struct BvhStats {
   uint32_t nodes = 0, packs = 0, triangles = 0, maxDepth = 0;
   double buildSeconds = 0.0;
   double refSeconds = 0.0, treeSeconds = 0.0;  // of it: the references, the tree (the rest: copy-out)
-  double sahCost = 0.0;                        // expected node and pack tests of a ray through the root box (bvh.cpp)
 };
 
 // What the traversals did, counted only while Bvh::setCounting(true) (a separate, counting copy of the
@@ -124,6 +123,9 @@ class Bvh {
   static BvhCounters& counters();
 
   const BvhStats& stats() const { return stats_; }
+  // The tree's expected node and pack tests of a ray through the root box (bvh.cpp): computed when asked,
+  // not by the build (a walk over every node, 2-4 % of a 16-thread build's time).
+  double sahCost() const;
   bool empty() const { return root_ == kEmpty; }
 
   // For tests and benchmarks: pick the ISA, or the best below it that the CPU supports; returns the one

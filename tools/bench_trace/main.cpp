@@ -345,7 +345,7 @@ void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
         "build %u threads: ours %.4f s (references %.4f, tree %.4f, copy-out %.4f), Embree %.4f s, ratio %.2f; "
         "SAH cost %.4f, %u nodes, %u packs, tree hash %016llx\n",
         o.threads, ours, st.refSeconds, st.treeSeconds, st.buildSeconds - st.refSeconds - st.treeSeconds, em.buildSeconds,
-        ours / em.buildSeconds, st.sahCost, st.nodes, st.packs, (unsigned long long)treeHash(bvh));
+        ours / em.buildSeconds, bvh.sahCost(), st.nodes, st.packs, (unsigned long long)treeHash(bvh));
   }
 }
 
@@ -464,7 +464,7 @@ void printBuilds(const std::vector<Triangle>& tris, const Bvh& bvh, double ourBu
   std::printf(
       "BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
       "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
-      ourBuild, st.nodes, st.packs, st.maxDepth, st.sahCost, st.refSeconds, st.treeSeconds,
+      ourBuild, st.nodes, st.packs, st.maxDepth, bvh.sahCost(), st.refSeconds, st.treeSeconds,
       st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
 }
 
