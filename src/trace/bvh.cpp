@@ -109,7 +109,14 @@ double treeSahCost(const Node* nodes, uint32_t root) {
   return rootArea > 0.0 ? kNodeCost + total / rootArea : 0.0;
 }
 
+std::atomic<uint32_t> buildGrain[2] = {Bvh::kSubtreeTask, Bvh::kParallelChunk};
+
 }  // namespace
+
+void Bvh::setBuildGrain(uint32_t subtreeTask, uint32_t parallelChunk) {
+  buildGrain[0] = std::max(1u, subtreeTask);
+  buildGrain[1] = std::max(1u, parallelChunk);
+}
 
 // Top-down build straight into 8-wide nodes: a node's range is split by binned SAH, and the child with
 // the largest area is split again until there are eight, as in Wald 2007 / Embree's BVH8 builder.
@@ -124,9 +131,10 @@ struct BvhBuilder {
   std::atomic<uint32_t> nodeCount{0}, leafCount{0}, packCount{0}, maxDepth{0};
   ThreadPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
-  static constexpr uint32_t kSubtreeTask = 4096;         // triangles from which a subtree is a task of its own
-  static constexpr uint32_t kParallelChunk = 16 * 1024;  // refs a chunk at least, when binned by many threads
-  static constexpr uint32_t kSmallRange = 24;            // ranges up to this size: findSplitSmall
+  // Triangles from which a subtree is a task of its own; refs a chunk at least, when binned by many threads
+  // (Bvh::kSubtreeTask, kParallelChunk; set for benchmarks by Bvh::setBuildGrain: the tree is the same).
+  const uint32_t subtreeTask = buildGrain[0].load(), parallelChunk = buildGrain[1].load();
+  static constexpr uint32_t kSmallRange = 24;  // ranges up to this size: findSplitSmall
 
   struct Split {
     int axis = -1, bin = 0;
@@ -172,10 +180,10 @@ struct BvhBuilder {
 
   // How many threads bin and partition a range of a node at `level` (the root: 0): while a level of the
   // tree has fewer nodes than there are threads, there are not yet subtrees enough to run side by side,
-  // so each node's splits are shared out (chunks of at least kParallelChunk references).
+  // so each node's splits are shared out (chunks of at least parallelChunk references).
   uint32_t chunksFor(const Range& r, uint32_t level) const {
     if (level < 10 && (1u << (3 * level)) >= threads) return 1;
-    return std::min(threads, r.size() / kParallelChunk);
+    return std::min(threads, r.size() / parallelChunk);
   }
 
   // Binned SAH over all three axes in one pass. Cost counts packs of eight, since a leaf's price is the
@@ -512,7 +520,7 @@ struct BvhBuilder {
         continue;
       }
       n.child[k] = nextNode;
-      if (pool && subtree[c][1] * kWidth >= kSubtreeTask)
+      if (pool && subtree[c][1] * kWidth >= subtreeTask)
         pool->run(g, [this, c, &bvh, nextNode, nextPack, &g] { relayout(c, bvh, nextNode, nextPack, g); });
       else relayout(c, bvh, nextNode, nextPack, g);
       nextNode += subtree[c][0];
@@ -565,10 +573,10 @@ struct BvhBuilder {
     // thread builds what (the copy-out orders it).
     ThreadPool::Group g;
     int last = count - 1;
-    while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < kSubtreeTask)) --last;
+    while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < subtreeTask)) --last;
     for (int k = 0; k < count; ++k) {
       if (c[k].leaf) node.child[k] = makeLeaf(c[k].r);
-      else if (pool && k != last && c[k].r.size() >= kSubtreeTask)
+      else if (pool && k != last && c[k].r.size() >= subtreeTask)
         pool->run(g, [this, &node, k, rr = c[k].r, level] { node.child[k] = build(rr, level + 1); });
       else node.child[k] = build(c[k].r, level + 1);
     }

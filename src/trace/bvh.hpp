@@ -85,6 +85,12 @@ class Bvh {
   // for more than kMaxTriangles triangles.
   Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShadow = {}, unsigned threads = 0);
 
+  // The build's grain: a subtree of this many triangles or more is a task of its own, and a range is
+  // binned and partitioned by many threads in chunks of at least this many references (while a level of
+  // the tree has fewer nodes than threads). The tree is the same for any values; for benchmarks only.
+  static constexpr uint32_t kSubtreeTask = 4096, kParallelChunk = 16 * 1024;
+  static void setBuildGrain(uint32_t subtreeTask, uint32_t parallelChunk);
+
   // Closest hit in (0, ray.tMax), front to back.
   Hit closest(const Ray& ray, IntersectMethod method = IntersectMethod::Watertight) const;
   // Any shadow-casting triangle in (0, ray.tMax); stops at the first.

@@ -205,9 +205,14 @@ TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
   }
   // 8 threads: the root's splits by all threads; 16: its children's too (a level of fewer nodes than threads).
   const Bvh one(tris, {}, 1), many(tris, {}, 8), more(tris, {}, 16);
+  // A finer grain (bench-trace's sweep): more subtree tasks, and chunks of 1 K references on every level
+  // with fewer nodes than threads.
+  Bvh::setBuildGrain(256, 1024);
+  const Bvh fine(tris, {}, 16);
+  Bvh::setBuildGrain(Bvh::kSubtreeTask, Bvh::kParallelChunk);
   ASSERT_GT(tris.size(), 300000u);
   const Bvh::View a = one.view();
-  for (const Bvh* other : {&many, &more}) {
+  for (const Bvh* other : {&many, &more, &fine}) {
     ASSERT_EQ(one.stats().nodes, other->stats().nodes);
     ASSERT_EQ(one.stats().packs, other->stats().packs);
     EXPECT_EQ(one.sahCost(), other->sahCost());

@@ -303,8 +303,9 @@ struct Options {
   unsigned threads = threadCount();
   int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
   int aloneRays[3] = {Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]};
-  std::vector<int> aloneSweep;   // --alone-sweep: our packets timed with each of these, same turns
-  std::vector<int> mirrorTiles;  // --mirror-tiles: the mirror rays also regrouped per tile of each size
+  std::vector<int> aloneSweep;                        // --alone-sweep: our packets timed with each of these, same turns
+  std::vector<int> mirrorTiles;                       // --mirror-tiles: the mirror rays also regrouped per tile of each size
+  std::vector<std::pair<uint32_t, uint32_t>> grains;  // --build-grain: also built with each (Bvh::setBuildGrain)
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
   bool buildOnly = false;    // time only the builds, ours and Embree's alternately
@@ -346,6 +347,15 @@ void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
         "SAH cost %.4f, %u nodes, %u packs, tree hash %016llx\n",
         o.threads, ours, st.refSeconds, st.treeSeconds, st.buildSeconds - st.refSeconds - st.treeSeconds, em.buildSeconds,
         ours / em.buildSeconds, bvh.sahCost(), st.nodes, st.packs, (unsigned long long)treeHash(bvh));
+    for (const auto& [task, chunk] : o.grains) {  // the same tree, other grains: timed right after
+      Bvh::setBuildGrain(task, chunk);
+      const auto t1 = Clock::now();
+      const Bvh other(tris, {}, o.threads);
+      const double s = seconds(t1);
+      Bvh::setBuildGrain(Bvh::kSubtreeTask, Bvh::kParallelChunk);
+      std::printf("  grain %u/%u (subtree task / chunk): ours %.4f s (tree %.4f), ratio %.2f%s\n", task, chunk, s,
+                  other.stats().treeSeconds, s / em.buildSeconds, treeHash(other) == treeHash(bvh) ? "" : ", ANOTHER TREE");
+    }
   }
 }
 
@@ -823,7 +833,7 @@ int main(int argc, char** argv) {
   int &res = o.res, &reps = o.reps, &leafRays = o.leafRays;
   bool &quick = o.quick, &explainAll = o.explainAll, &countOnly = o.countOnly;
   uint32_t rings = 707;
-  bool noSphere = false;
+  bool noSphere = false, badGrain = false;
   std::vector<std::string> scenes;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -841,6 +851,13 @@ int main(int argc, char** argv) {
     } else if (a == "--mirror-tiles" && i + 1 < argc) {
       for (const char* p = argv[++i]; *p; ++p)
         if (p == argv[i] || p[-1] == ',') o.mirrorTiles.push_back(std::max(1, std::atoi(p)));
+    } else if (a == "--build-grain" && i + 1 < argc) {
+      for (const char* p = argv[++i]; *p; ++p)
+        if (p == argv[i] || p[-1] == ',') {
+          unsigned t = 0, c = 0;
+          if (std::sscanf(p, "%u/%u", &t, &c) != 2 || t == 0 || c == 0) badGrain = true;
+          o.grains.push_back({t, c});
+        }
     } else if (a == "--quick") quick = true;
     else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--packets-only") quick = o.packetsOnly = true;
@@ -854,7 +871,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(
           stderr,
-          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile] [--mirror-tiles N,...]\n"
+          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile] [--mirror-tiles N,...] [--build-grain T/C,...]\n"
           "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
           "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
           "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
@@ -870,14 +887,16 @@ int main(int argc, char** argv) {
           "  --profile: where our and Embree's packets spend their time (first pass, again in cache, set-up)\n"
           "  --cpu-time: time by the threads' CPU time, not the wall clock (A/B runs on a shared machine)\n"
           "  --mirror-tiles N,...: also the mirror rays regrouped per tile of N × N pixels: in Z-order, by octant, by\n"
-          "    octant and major axis (counted and timed as rows of their own, ours and Embree's)\n");
+          "    octant and major axis (counted and timed as rows of their own, ours and Embree's)\n"
+          "  --build-grain T/C,...: with --build-only, our build also timed with subtree tasks from T triangles and\n"
+          "    chunks of C references (Bvh::setBuildGrain; the same tree)\n");
       return 2;
     }
   }
   bool badAlone = false;
   for (int n : o.aloneRays) badAlone |= n < 0 || n > 8;
   for (int n : o.aloneSweep) badAlone |= n < 0 || n > 8;
-  if (threads == 0 || res <= 0 || rings < 2 || reps < 1 || badAlone) {
+  if (threads == 0 || res <= 0 || rings < 2 || reps < 1 || badAlone || badGrain) {
     std::fprintf(stderr, "bench-trace: bad argument\n");
     return 2;
   }
