@@ -79,7 +79,7 @@ uint32_t packsFor(uint32_t n) { return (n + kWidth - 1) / kWidth; }
 
 // The tree's SAH cost as the builder counts it: per node kNodeCost, per leaf its packs, each weighted by
 // its box's area relative to the root's (the expected work of a ray that meets the root box).
-double sahCost(const Node* nodes, uint32_t root) {
+double treeSahCost(const Node* nodes, uint32_t root) {
   const auto area = [](const Node& n, int k) {
     const double e[3] = {double(n.box[1][0][k]) - n.box[0][0][k], double(n.box[1][1][k]) - n.box[0][1][k],
                          double(n.box[1][2][k]) - n.box[0][2][k]};
@@ -109,7 +109,14 @@ double sahCost(const Node* nodes, uint32_t root) {
   return rootArea > 0.0 ? kNodeCost + total / rootArea : 0.0;
 }
 
+std::atomic<uint32_t> buildGrain[2] = {Bvh::kSubtreeTask, Bvh::kParallelChunk};
+
 }  // namespace
+
+void Bvh::setBuildGrain(uint32_t subtreeTask, uint32_t parallelChunk) {
+  buildGrain[0] = std::max(1u, subtreeTask);
+  buildGrain[1] = std::max(1u, parallelChunk);
+}
 
 // Top-down build straight into 8-wide nodes: a node's range is split by binned SAH, and the child with
 // the largest area is split again until there are eight, as in Wald 2007 / Embree's BVH8 builder.
@@ -118,14 +125,16 @@ struct BvhBuilder {
   std::span<const uint8_t> casts;
   std::unique_ptr<PrimRef[]> refs;
   std::unique_ptr<Node[]> nodes;
-  std::unique_ptr<TriPack[]> packs;
+  // Per leaf its refs [begin, end): the packs are written once, straight into their place, by the copy-out.
+  std::unique_ptr<std::array<uint32_t, 2>[]> leaves;
   std::unique_ptr<std::array<uint32_t, 2>[]> subtree;  // per node: nodes and packs of its subtree, itself included
-  std::atomic<uint32_t> nodeCount{0}, packCount{0}, maxDepth{0};
+  std::atomic<uint32_t> nodeCount{0}, leafCount{0}, packCount{0}, maxDepth{0};
   ThreadPool* pool = nullptr;  // none for one thread
   uint32_t threads = 1;
-  static constexpr uint32_t kSubtreeTask = 4096;         // triangles from which a subtree is a task of its own
-  static constexpr uint32_t kParallelChunk = 16 * 1024;  // refs a chunk at least, when binned by many threads
-  static constexpr uint32_t kSmallRange = 24;            // ranges up to this size: findSplitSmall
+  // Triangles from which a subtree is a task of its own; refs a chunk at least, when binned by many threads
+  // (Bvh::kSubtreeTask, kParallelChunk; set for benchmarks by Bvh::setBuildGrain: the tree is the same).
+  const uint32_t subtreeTask = buildGrain[0].load(), parallelChunk = buildGrain[1].load();
+  static constexpr uint32_t kSmallRange = 24;  // ranges up to this size: findSplitSmall
 
   struct Split {
     int axis = -1, bin = 0;
@@ -171,10 +180,10 @@ struct BvhBuilder {
 
   // How many threads bin and partition a range of a node at `level` (the root: 0): while a level of the
   // tree has fewer nodes than there are threads, there are not yet subtrees enough to run side by side,
-  // so each node's splits are shared out (chunks of at least kParallelChunk references).
+  // so each node's splits are shared out (chunks of at least parallelChunk references).
   uint32_t chunksFor(const Range& r, uint32_t level) const {
     if (level < 10 && (1u << (3 * level)) >= threads) return 1;
-    return std::min(threads, r.size() / kParallelChunk);
+    return std::min(threads, r.size() / parallelChunk);
   }
 
   // Binned SAH over all three axes in one pass. Cost counts packs of eight, since a leaf's price is the
@@ -471,13 +480,21 @@ struct BvhBuilder {
     return true;
   }
 
+  // A leaf during the build: kLeafBit | (packs - 1) << 28 | its index in `leaves`.
   uint32_t makeLeaf(const Range& r) {
-    const uint32_t n = r.size(), np = packsFor(n);
-    const uint32_t first = packCount.fetch_add(np);
-    for (uint32_t p = 0; p < np; ++p) {
-      TriPack& pack = packs[first + p];
+    const uint32_t np = packsFor(r.size()), index = leafCount.fetch_add(1);
+    packCount.fetch_add(np);
+    leaves[index] = {r.begin, r.end};
+    return Bvh::kLeafBit | ((np - 1) << 28) | index;
+  }
+
+  // The packs of the leaf with refs [begin, end), from `out` on.
+  void writePacks(std::array<uint32_t, 2> range, TriPack* out) const {
+    const auto [begin, end] = range;
+    for (uint32_t p = 0; p < packsFor(end - begin); ++p) {
+      TriPack& pack = out[p];
       for (uint32_t lane = 0; lane < kWidth; ++lane) {
-        const uint32_t i = std::min(r.begin + p * kWidth + lane, r.end - 1);  // short packs repeat the last
+        const uint32_t i = std::min(begin + p * kWidth + lane, end - 1);  // short packs repeat the last
         const uint32_t id = refs[i].id();
         const Triangle& t = tris[id];
         const glm::vec3* v[3] = {&t.v0, &t.v1, &t.v2};
@@ -486,11 +503,10 @@ struct BvhBuilder {
         pack.prim[lane] = id | (casts.empty() || casts[id] ? 0u : Bvh::kNoShadowBit);
       }
     }
-    return Bvh::kLeafBit | ((np - 1) << 28) | first;
   }
 
   // Writes the subtree of node `ref` into bvh's arrays in depth-first order, its node at `node`, its packs
-  // from `pack` on: the subtree sizes place every child, so large subtrees are copied by the pool.
+  // (made here) from `pack` on: the subtree sizes place every child, so large subtrees are written by the pool.
   void relayout(uint32_t ref, Bvh& bvh, uint32_t node, uint32_t pack, ThreadPool::Group& g) const {
     Node n = nodes[ref];
     uint32_t nextNode = node + 1, nextPack = pack;
@@ -498,14 +514,13 @@ struct BvhBuilder {
       if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty
       const uint32_t c = n.child[k];
       if (c & Bvh::kLeafBit) {
-        const uint32_t first = c & 0x0FFFFFFFu, np = ((c >> 28) & 7u) + 1;
-        std::copy(&packs[first], &packs[first] + np, &bvh.packs_[nextPack]);
+        writePacks(leaves[c & 0x0FFFFFFFu], &bvh.packs_[nextPack]);
         n.child[k] = (c & ~0x0FFFFFFFu) | nextPack;
-        nextPack += np;
+        nextPack += ((c >> 28) & 7u) + 1;
         continue;
       }
       n.child[k] = nextNode;
-      if (pool && subtree[c][1] * kWidth >= kSubtreeTask)
+      if (pool && subtree[c][1] * kWidth >= subtreeTask)
         pool->run(g, [this, c, &bvh, nextNode, nextPack, &g] { relayout(c, bvh, nextNode, nextPack, g); });
       else relayout(c, bvh, nextNode, nextPack, g);
       nextNode += subtree[c][0];
@@ -558,10 +573,10 @@ struct BvhBuilder {
     // thread builds what (the copy-out orders it).
     ThreadPool::Group g;
     int last = count - 1;
-    while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < kSubtreeTask)) --last;
+    while (last >= 0 && (c[last].leaf || !pool || c[last].r.size() < subtreeTask)) --last;
     for (int k = 0; k < count; ++k) {
       if (c[k].leaf) node.child[k] = makeLeaf(c[k].r);
-      else if (pool && k != last && c[k].r.size() >= kSubtreeTask)
+      else if (pool && k != last && c[k].r.size() >= subtreeTask)
         pool->run(g, [this, &node, k, rr = c[k].r, level] { node.child[k] = build(rr, level + 1); });
       else node.child[k] = build(c[k].r, level + 1);
     }
@@ -630,18 +645,19 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   stats_.triangles = n;
   if (n == 0) return;
   b.nodes.reset(new Node[n + 1]);
-  b.packs.reset(new TriPack[n + 1]);
+  b.leaves.reset(new std::array<uint32_t, 2>[n + 1]);
   b.subtree.reset(new std::array<uint32_t, 2>[n + 1]);
   const auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   stats_.refSeconds = since(start);
   const auto treeStart = std::chrono::steady_clock::now();
   root_ = b.build(root);
   stats_.treeSeconds = since(treeStart);
-  // Copy out in depth-first order: the parallel build interleaved the subtrees of its threads.
+  // Copy out in depth-first order (the parallel build interleaved the subtrees of its threads), the packs
+  // written once, in place: 40 bytes a triangle less to write, read and fault in.
   nodes_ = HugeArray<Node>(b.nodeCount.load());
   packs_ = HugeArray<TriPack>(b.packCount.load());
   if (root_ & kLeafBit) {
-    std::copy(&b.packs[0], &b.packs[0] + packs_.size(), &packs_[0]);
+    b.writePacks(b.leaves[0], &packs_[0]);
     root_ &= ~0x0FFFFFFFu;
   } else {
     ThreadPool::Group g;
@@ -652,9 +668,10 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   stats_.nodes = uint32_t(nodes_.size());
   stats_.packs = uint32_t(packs_.size());
   stats_.maxDepth = b.maxDepth.load();
-  stats_.sahCost = sahCost(nodes_.data(), root_);
   stats_.buildSeconds = since(start);
 }
+
+double Bvh::sahCost() const { return empty() ? 0.0 : treeSahCost(nodes_.data(), root_); }
 
 template <class T>
 HugeArray<T>::HugeArray(size_t n) : n_(n) {

@@ -28,7 +28,6 @@ struct BvhStats {
   uint32_t nodes = 0, packs = 0, triangles = 0, maxDepth = 0;
   double buildSeconds = 0.0;
   double refSeconds = 0.0, treeSeconds = 0.0;  // of it: the references, the tree (the rest: copy-out)
-  double sahCost = 0.0;                        // expected node and pack tests of a ray through the root box (bvh.cpp)
 };
 
 // What the traversals did, counted only while Bvh::setCounting(true) (a separate, counting copy of the
@@ -86,6 +85,12 @@ class Bvh {
   // for more than kMaxTriangles triangles.
   Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShadow = {}, unsigned threads = 0);
 
+  // The build's grain: a subtree of this many triangles or more is a task of its own, and a range is
+  // binned and partitioned by many threads in chunks of at least this many references (while a level of
+  // the tree has fewer nodes than threads). The tree is the same for any values; for benchmarks only.
+  static constexpr uint32_t kSubtreeTask = 4096, kParallelChunk = 16 * 1024;
+  static void setBuildGrain(uint32_t subtreeTask, uint32_t parallelChunk);
+
   // Closest hit in (0, ray.tMax), front to back.
   Hit closest(const Ray& ray, IntersectMethod method = IntersectMethod::Watertight) const;
   // Any shadow-casting triangle in (0, ray.tMax); stops at the first.
@@ -124,6 +129,9 @@ class Bvh {
   static BvhCounters& counters();
 
   const BvhStats& stats() const { return stats_; }
+  // The tree's expected node and pack tests of a ray through the root box (bvh.cpp): computed when asked,
+  // not by the build (a walk over every node, 2-4 % of a 16-thread build's time).
+  double sahCost() const;
   bool empty() const { return root_ == kEmpty; }
 
   // For tests and benchmarks: pick the ISA, or the best below it that the CPU supports; returns the one

@@ -205,12 +205,17 @@ TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
   }
   // 8 threads: the root's splits by all threads; 16: its children's too (a level of fewer nodes than threads).
   const Bvh one(tris, {}, 1), many(tris, {}, 8), more(tris, {}, 16);
+  // A finer grain (bench-trace's sweep): more subtree tasks, and chunks of 1 K references on every level
+  // with fewer nodes than threads.
+  Bvh::setBuildGrain(256, 1024);
+  const Bvh fine(tris, {}, 16);
+  Bvh::setBuildGrain(Bvh::kSubtreeTask, Bvh::kParallelChunk);
   ASSERT_GT(tris.size(), 300000u);
   const Bvh::View a = one.view();
-  for (const Bvh* other : {&many, &more}) {
+  for (const Bvh* other : {&many, &more, &fine}) {
     ASSERT_EQ(one.stats().nodes, other->stats().nodes);
     ASSERT_EQ(one.stats().packs, other->stats().packs);
-    EXPECT_EQ(one.stats().sahCost, other->stats().sahCost);
+    EXPECT_EQ(one.sahCost(), other->sahCost());
     const Bvh::View b = other->view();
     EXPECT_EQ(a.root, b.root);
     for (uint32_t i = 0; i < one.stats().nodes; ++i)  // field by field: a Node has padding
@@ -222,7 +227,7 @@ TEST(Bvh, ParallelBuildMakesTheSingleThreadTree) {
                   !std::memcmp(a.packs[i].prim, b.packs[i].prim, sizeof a.packs[i].prim))
           << "pack " << i;
   }
-  EXPECT_GT(one.stats().sahCost, 1.0);
+  EXPECT_GT(one.sahCost(), 1.0);
   const Bvh::View b = many.view();
 
   std::vector<int> seen(tris.size(), 0);

@@ -14,10 +14,12 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <embree3/rtcore.h>
 
+#include <glm/common.hpp>
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 
@@ -301,7 +303,9 @@ struct Options {
   unsigned threads = threadCount();
   int res = 1024, reps = 3, leafRays = Bvh::kPacketLeafRays;
   int aloneRays[3] = {Bvh::kPacketAloneRays[0], Bvh::kPacketAloneRays[1], Bvh::kPacketAloneRays[2]};
-  std::vector<int> aloneSweep;  // --alone-sweep: our packets timed with each of these, same turns
+  std::vector<int> aloneSweep;                        // --alone-sweep: our packets timed with each of these, same turns
+  std::vector<int> mirrorTiles;                       // --mirror-tiles: the mirror rays also regrouped per tile of each size
+  std::vector<std::pair<uint32_t, uint32_t>> grains;  // --build-grain: also built with each (Bvh::setBuildGrain)
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
   bool buildOnly = false;    // time only the builds, ours and Embree's alternately
@@ -332,15 +336,26 @@ uint64_t treeHash(const Bvh& bvh) {
 void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
   for (int rep = 0; rep < o.reps; ++rep) {
     const auto t0 = Clock::now();
+    const double c0 = threadSeconds();
     const Bvh bvh(tris, {}, o.threads);
-    const double ours = seconds(t0);
+    // --cpu-time with one thread: the builder's CPU time (it runs on this thread), for A/B runs on a busy machine
+    const double ours = gCpuTime && o.threads == 1 ? threadSeconds() - c0 : seconds(t0);
     const Embree em(tris, o.threads);
     const BvhStats& st = bvh.stats();
     std::printf(
         "build %u threads: ours %.4f s (references %.4f, tree %.4f, copy-out %.4f), Embree %.4f s, ratio %.2f; "
         "SAH cost %.4f, %u nodes, %u packs, tree hash %016llx\n",
         o.threads, ours, st.refSeconds, st.treeSeconds, st.buildSeconds - st.refSeconds - st.treeSeconds, em.buildSeconds,
-        ours / em.buildSeconds, st.sahCost, st.nodes, st.packs, (unsigned long long)treeHash(bvh));
+        ours / em.buildSeconds, bvh.sahCost(), st.nodes, st.packs, (unsigned long long)treeHash(bvh));
+    for (const auto& [task, chunk] : o.grains) {  // the same tree, other grains: timed right after
+      Bvh::setBuildGrain(task, chunk);
+      const auto t1 = Clock::now();
+      const Bvh other(tris, {}, o.threads);
+      const double s = seconds(t1);
+      Bvh::setBuildGrain(Bvh::kSubtreeTask, Bvh::kParallelChunk);
+      std::printf("  grain %u/%u (subtree task / chunk): ours %.4f s (tree %.4f), ratio %.2f%s\n", task, chunk, s,
+                  other.stats().treeSeconds, s / em.buildSeconds, treeHash(other) == treeHash(bvh) ? "" : ", ANOTHER TREE");
+    }
   }
 }
 
@@ -349,15 +364,57 @@ void benchBuilds(const std::vector<Triangle>& tris, const Options& o) {
 // and a mirror ray each (the same rays go to both tracers).
 struct Rays {
   std::vector<Ray> primary, ortho, shadow, mirror;
+  std::vector<uint32_t> hitPixel;  // the pixel of each shadow and mirror ray
+  // --mirror-tiles: the mirror rays regrouped per tile of pixels (mirrorTiles below)
+  std::vector<std::pair<std::string, std::vector<Ray>>> regrouped;
   std::vector<RaySet> sets() const {
-    return {{"primary", &primary, false, PacketKind::Coherent},
-            {"primary, orthographic", &ortho, false, PacketKind::Coherent},
-            {"shadow (any hit)", &shadow, true, PacketKind::Coherent},
-            {"mirror", &mirror, false, PacketKind::Scattered}};
+    std::vector<RaySet> s{{"primary", &primary, false, PacketKind::Coherent},
+                          {"primary, orthographic", &ortho, false, PacketKind::Coherent},
+                          {"shadow (any hit)", &shadow, true, PacketKind::Coherent},
+                          {"mirror", &mirror, false, PacketKind::Scattered}};
+    for (const auto& [name, rays] : regrouped) s.push_back({name.c_str(), &rays, false, PacketKind::Scattered});
+    return s;
   }
 };
 
-Rays makeRays(const std::vector<Triangle>& tris, const Bounds& bounds, bool sphere, const Bvh& bvh, int res) {
+// Interleaves the low 16 bits of x and y (x in the even bits): the Z-order of a pixel.
+uint32_t zOrder(uint32_t x, uint32_t y) {
+  auto spread = [](uint32_t v) {
+    v &= 0xFFFFu;
+    v = (v | v << 8) & 0x00FF00FFu;
+    v = (v | v << 4) & 0x0F0F0F0Fu;
+    v = (v | v << 2) & 0x33333333u;
+    return (v | v << 1) & 0x55555555u;
+  };
+  return spread(x) | spread(y) << 1;
+}
+
+// Rays regrouped per tile of tile × tile pixels (tiles in row order), within a tile by a direction class
+// and then by the pixel's Z-order; packets are then eight consecutive rays. Classes: 0 none, 1 the
+// octant (the signs of the direction), 2 the octant and the axis of the largest component.
+std::vector<Ray> mirrorTiles(const std::vector<Ray>& rays, const std::vector<uint32_t>& pixel, int res, int tile, int classes) {
+  std::vector<std::pair<uint64_t, uint32_t>> key(rays.size());
+  const uint32_t tilesX = uint32_t((res + tile - 1) / tile);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const uint32_t x = pixel[i] % uint32_t(res), y = pixel[i] / uint32_t(res);
+    const glm::vec3 d = rays[i].direction;
+    uint32_t c = 0;
+    if (classes >= 1) c = (d.x < 0) | (d.y < 0) << 1 | (d.z < 0) << 2;
+    if (classes >= 2) {
+      const glm::vec3 a = glm::abs(d);
+      c = c * 3 + (a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2);
+    }
+    const uint64_t t = uint64_t(y / uint32_t(tile)) * tilesX + x / uint32_t(tile);
+    key[i] = {t << 40 | uint64_t(c) << 32 | zOrder(x % uint32_t(tile), y % uint32_t(tile)), uint32_t(i)};
+  }
+  std::sort(key.begin(), key.end());
+  std::vector<Ray> out(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) out[i] = rays[key[i].second];
+  return out;
+}
+
+Rays makeRays(const std::vector<Triangle>& tris, const Bounds& bounds, bool sphere, const Bvh& bvh, int res,
+              const std::vector<int>& tiles) {
   Lens lens;
   CameraPose pose = frameBounds(bounds, lens, 1.0f);
   // The unit sphere just inscribed in the square image (about 78 % of rays hit).
@@ -384,6 +441,7 @@ Rays makeRays(const std::vector<Triangle>& tris, const Bounds& bounds, bool sphe
   for (const Ray& ray : r.primary) {
     const Hit h = bvh.closest(ray);
     if (!h.hit()) continue;
+    r.hitPixel.push_back(uint32_t(&ray - r.primary.data()));
     ++nHit;
     const Triangle& t = tris[h.prim];
     const glm::vec3 p = (1 - h.b1 - h.b2) * t.v0 + h.b1 * t.v1 + h.b2 * t.v2;
@@ -392,6 +450,13 @@ Rays makeRays(const std::vector<Triangle>& tris, const Bounds& bounds, bool sphe
     r.shadow.push_back(spawnRay(p, ng, light - p, 1.0f));
     r.mirror.push_back(reflectRay(ray, ng, p, ng));
   }
+  for (int t : tiles)
+    for (int c = 0; c < 3; ++c)
+      r.regrouped.push_back({"mirror, " + std::to_string(t) + "² tiles" +
+                                 (c == 0   ? ", Z-order"
+                                  : c == 1 ? ", by octant"
+                                           : ", by octant and major axis"),
+                             mirrorTiles(r.mirror, r.hitPixel, res, t, c)});
   std::printf("%.1f %% of primary rays hit; %zu shadow rays to a point light, %zu mirror rays\n\n",
               100.0 * double(nHit) / double(r.primary.size()), r.shadow.size(), r.mirror.size());
   return r;
@@ -409,7 +474,7 @@ void printBuilds(const std::vector<Triangle>& tris, const Bvh& bvh, double ourBu
   std::printf(
       "BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
       "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
-      ourBuild, st.nodes, st.packs, st.maxDepth, st.sahCost, st.refSeconds, st.treeSeconds,
+      ourBuild, st.nodes, st.packs, st.maxDepth, bvh.sahCost(), st.refSeconds, st.treeSeconds,
       st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
 }
 
@@ -686,7 +751,7 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   const double ourBuild = seconds(t0);
   const Embree em(tris, o.threads);
   printBuilds(tris, bvh, ourBuild, em, o.threads);
-  const Rays rays = makeRays(tris, bounds, sphere, bvh, o.res);
+  const Rays rays = makeRays(tris, bounds, sphere, bvh, o.res, o.mirrorTiles);
   if (!o.packetsOnly) printAgreement(tris, bvh, em, rays, o.explainAll);
   printPacketAgreement(bvh, em, rays, o.leafRays);
   if (!o.packetsOnly) printCounters(bvh, rays.sets());
@@ -768,7 +833,7 @@ int main(int argc, char** argv) {
   int &res = o.res, &reps = o.reps, &leafRays = o.leafRays;
   bool &quick = o.quick, &explainAll = o.explainAll, &countOnly = o.countOnly;
   uint32_t rings = 707;
-  bool noSphere = false;
+  bool noSphere = false, badGrain = false;
   std::vector<std::string> scenes;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -783,6 +848,16 @@ int main(int argc, char** argv) {
     } else if (a == "--alone-sweep" && i + 1 < argc) {
       for (const char* p = argv[++i]; *p; ++p)
         if (p == argv[i] || p[-1] == ',') o.aloneSweep.push_back(std::atoi(p));
+    } else if (a == "--mirror-tiles" && i + 1 < argc) {
+      for (const char* p = argv[++i]; *p; ++p)
+        if (p == argv[i] || p[-1] == ',') o.mirrorTiles.push_back(std::max(1, std::atoi(p)));
+    } else if (a == "--build-grain" && i + 1 < argc) {
+      for (const char* p = argv[++i]; *p; ++p)
+        if (p == argv[i] || p[-1] == ',') {
+          unsigned t = 0, c = 0;
+          if (std::sscanf(p, "%u/%u", &t, &c) != 2 || t == 0 || c == 0) badGrain = true;
+          o.grains.push_back({t, c});
+        }
     } else if (a == "--quick") quick = true;
     else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--packets-only") quick = o.packetsOnly = true;
@@ -796,7 +871,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(
           stderr,
-          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile]\n"
+          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile] [--mirror-tiles N,...] [--build-grain T/C,...]\n"
           "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
           "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
           "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
@@ -810,14 +885,18 @@ int main(int argc, char** argv) {
           "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
           "  --no-sphere: only the --scene files\n"
           "  --profile: where our and Embree's packets spend their time (first pass, again in cache, set-up)\n"
-          "  --cpu-time: time by the threads' CPU time, not the wall clock (A/B runs on a shared machine)\n");
+          "  --cpu-time: time by the threads' CPU time, not the wall clock (A/B runs on a shared machine)\n"
+          "  --mirror-tiles N,...: also the mirror rays regrouped per tile of N × N pixels: in Z-order, by octant, by\n"
+          "    octant and major axis (counted and timed as rows of their own, ours and Embree's)\n"
+          "  --build-grain T/C,...: with --build-only, our build also timed with subtree tasks from T triangles and\n"
+          "    chunks of C references (Bvh::setBuildGrain; the same tree)\n");
       return 2;
     }
   }
   bool badAlone = false;
   for (int n : o.aloneRays) badAlone |= n < 0 || n > 8;
   for (int n : o.aloneSweep) badAlone |= n < 0 || n > 8;
-  if (threads == 0 || res <= 0 || rings < 2 || reps < 1 || badAlone) {
+  if (threads == 0 || res <= 0 || rings < 2 || reps < 1 || badAlone || badGrain) {
     std::fprintf(stderr, "bench-trace: bad argument\n");
     return 2;
   }
