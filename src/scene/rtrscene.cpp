@@ -1,6 +1,7 @@
 #include "scene/rtrscene.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -11,6 +12,7 @@
 
 #include "cluster.h"
 #include "core/bounds.hpp"
+#include "core/error.hpp"
 #include "scene/binio.hpp"
 #include "scene/rtrscene_lod.hpp"
 #include "core/parallel.hpp"
@@ -106,7 +108,18 @@ const char* lightFault(const Light& l) {
 
 // Where a mesh's arrays and clusters lie in the file: found by the first pass over the records, copied out
 // and checked by the second, on all cores.
-enum Stream : uint8_t { kPositions, kNormals, kTexcoords, kTexcoords1, kTangents, kColors, kIndices, kClusters };
+enum Stream : uint8_t {
+  kPositions,
+  kNormals,
+  kTexcoords,
+  kTexcoords1,
+  kTangents,
+  kColors,
+  kIndices,
+  kClusters,
+  kLodClusters,
+  kLodIndices
+};
 constexpr size_t kVertexStreams = kIndices;  // the per-vertex arrays, in file order
 constexpr size_t kVertexSize[kVertexStreams] = {12, 12, 8, 8, 16, 16};
 constexpr uint32_t kStreamFlag[kVertexStreams] = {0, kHasNormals, kHasTexcoords, kHasTexcoords1, kHasTangents, kHasColors};
@@ -119,12 +132,7 @@ struct MeshLayout {
   size_t elementSize(Stream s) const { return s == kIndices ? (flags & kIndex16 ? 2 : 4) : kVertexSize[s]; }
 };
 
-// A fault found by a worker. Of several, the one at the lowest offset is reported, so the message does
-// not depend on the thread count.
-struct Fault {
-  size_t at = SIZE_MAX;
-  std::string what;
-};
+using Fault = ReadFault;
 
 template <class T>
 T load(const uint8_t* p) {
@@ -174,7 +182,9 @@ void copyStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base) {
       if (l.flags & kIndex16) m.indices.assign(as<uint16_t>(base, l.indexAt), as<uint16_t>(base, l.indexAt) + n);
       else m.indices.assign(as<uint32_t>(base, l.indexAt), as<uint32_t>(base, l.indexAt) + n);
       break;
-    case kClusters: break;
+    case kClusters:
+    case kLodClusters:
+    case kLodIndices: break;
   }
 }
 
@@ -239,7 +249,9 @@ void checkArray(const Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_
     case kColors: return checkFiniteArray<4>(base, at, first, end, meshName(i) + ": a vertex colour");
     case kIndices:
       return l.flags & kIndex16 ? checkIndices<uint16_t>(l, base, i, first, end) : checkIndices<uint32_t>(l, base, i, first, end);
-    case kClusters: return;
+    case kClusters:
+    case kLodClusters:
+    case kLodIndices: return;
   }
 }
 
@@ -312,11 +324,11 @@ void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i
                 meshName(i) + ": clusters cover " + std::to_string(next) + " of " + std::to_string(triangles) + " triangles"};
 }
 
-// The second pass: every array copied out of the file and every value, index and cluster checked, in
-// pieces on `threads` threads, biggest first.
-void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<MeshLayout>& layout, unsigned threads,
-                const ByteReader& r) {
-  constexpr size_t kPiece = size_t(1) << 18, kClusterPiece = 2048;
+// The second pass: every array copied out of the file and every value, index and cluster checked, the
+// hierarchies' (`lods`, CLOD) too, in pieces on `threads` threads, biggest first.
+void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<MeshLayout>& layout,
+                const std::vector<LodLayout>& lods, unsigned threads, const ByteReader& r) {
+  constexpr size_t kPiece = size_t(1) << 18, kClusterPiece = 2048, kLodPiece = 4096;
   std::vector<Job> jobs;
   for (uint32_t i = 0; i < layout.size(); ++i) {
     const MeshLayout& l = layout[i];
@@ -334,19 +346,38 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
       jobs.push_back({i, kClusters, false, f, n, n * 1000});  // ~124 triangles' indices and ~64 positions each
     }
   }
+  for (uint32_t j = 0; j < lods.size(); ++j) {  // their jobs' `mesh` is the index in `lods`
+    const LodLayout& l = lods[j];
+    if (l.indexCount) jobs.push_back({j, kLodIndices, true, 0, l.indexCount, 8 * size_t(l.indexCount)});
+    for (size_t f = 0; f < l.indexCount; f += kPiece) {
+      const size_t n = std::min<size_t>(kPiece, l.indexCount - f);
+      jobs.push_back({j, kLodIndices, false, f, n, 4 * n});
+    }
+    for (size_t f = 0; f < l.count; f += kLodPiece) {
+      const size_t n = std::min<size_t>(kLodPiece, l.count - f);
+      jobs.push_back({j, kLodClusters, false, f, n, n * 200});  // a 96-byte record read, written and checked
+    }
+  }
   std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.cost > b.cost; });
   Fault first;
   std::mutex firstMutex;
   parallelFor(jobs.size(), threads, [&](size_t j) {
     const Job& job = jobs[j];
-    Mesh& m = scene.meshes[job.mesh];
-    const MeshLayout& l = layout[job.mesh];
+    const bool lod = job.stream == kLodClusters || job.stream == kLodIndices;
+    const uint32_t mesh = lod ? lods[job.mesh].mesh : job.mesh;
+    Mesh& m = scene.meshes[mesh];
+    const MeshLayout& l = layout[mesh];
+    const uint8_t* base = bytes.data();
     try {
-      if (job.copy) copyStream(m, l, job.stream, bytes.data());
+      if (job.stream == kLodIndices && job.copy) copyTo(m.lod.indices, base, lods[job.mesh].indicesAt, job.count);
+      else if (job.stream == kLodIndices) checkLodIndices(lods[job.mesh], base, l.vertices, job.first, job.first + job.count);
+      else if (job.stream == kLodClusters)
+        readLodClusters(m, lods[job.mesh], base, l.clusterAt, l.indices / 3, job.first, job.first + job.count);
+      else if (job.copy) copyStream(m, l, job.stream, base);
       else if (job.stream == kClusters && (l.flags & kIndex16))
-        checkClusters<uint16_t>(m, l, bytes.data(), job.mesh, job.first, job.first + job.count);
-      else if (job.stream == kClusters) checkClusters<uint32_t>(m, l, bytes.data(), job.mesh, job.first, job.first + job.count);
-      else checkArray(m, l, bytes.data(), job.mesh, job.stream, job.first, job.first + job.count);
+        checkClusters<uint16_t>(m, l, base, mesh, job.first, job.first + job.count);
+      else if (job.stream == kClusters) checkClusters<uint32_t>(m, l, base, mesh, job.first, job.first + job.count);
+      else checkArray(m, l, base, mesh, job.stream, job.first, job.first + job.count);
     } catch (Fault& f) {
       std::lock_guard lock(firstMutex);
       if (f.at < first.at) first = std::move(f);
@@ -784,12 +815,19 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
   }
   if (version < 6 && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
   const std::optional<ChunkSpan> clod = readChunks(r, bytes, scene, owner, file);
-  readArrays(bytes, scene, layout, threads, r);
+  // The hierarchies' mesh records are read first, their records and indices with the meshes' arrays. A
+  // fault in those mesh records waits: the arrays, before the chunk, may hold one at a lower offset.
+  std::vector<LodLayout> lods;
+  std::exception_ptr lodFault;
   if (clod) {
     ByteReader body(bytes.first(clod->body + clod->size), file);
     body.skip(clod->body, "a chunk");
-    readClusterLods(body, clod->size, scene);
+    try {
+      readClusterLodLayout(body, clod->size, scene, lods);
+    } catch (const Error&) { lodFault = std::current_exception(); }
   }
+  readArrays(bytes, scene, layout, lods, threads, r);
+  if (lodFault) std::rethrow_exception(lodFault);
   return scene;
 }
 
