@@ -8,6 +8,9 @@
 #include <optional>
 #include <vector>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include <glm/geometric.hpp>
 
 #include "cluster.h"
@@ -167,6 +170,40 @@ const T* as(const uint8_t* base, size_t at) {
 template <class T>
 void copyTo(std::vector<T>& v, const uint8_t* base, size_t at, size_t n) {
   v.assign(as<T>(base, at), as<T>(base, at) + n);
+}
+
+// The storage a copy job will write: allocated, not yet touched.
+template <class T>
+std::span<uint8_t> reserve(std::vector<T>& v, size_t n) {
+  v.reserve(n);
+  return {reinterpret_cast<uint8_t*>(v.data()), n * sizeof(T)};
+}
+
+std::span<uint8_t> reserveStream(Mesh& m, const MeshLayout& l, Stream s) {
+  const size_t v = l.vertices;
+  switch (s) {
+    case kPositions: return reserve(m.positions, v);
+    case kNormals: return reserve(m.normals, v);
+    case kTexcoords: return reserve(m.texcoords, v);
+    case kTexcoords1: return reserve(m.texcoords1, v);
+    case kTangents: return reserve(m.tangents, v);
+    case kColors: return reserve(m.colors, v);
+    case kIndices: return reserve(m.indices, l.indices);
+    default: return {};
+  }
+}
+
+// Makes the pages of [p, p + n) present and writable (MADV_POPULATE_WRITE, Linux 5.14); where the kernel
+// lacks it the first writes fault them in as before.
+void populate(uint8_t* p, size_t n) {
+  static const size_t page = size_t(sysconf(_SC_PAGESIZE));
+  const uintptr_t b = (reinterpret_cast<uintptr_t>(p) + page - 1) / page * page,
+                  e = (reinterpret_cast<uintptr_t>(p) + n) / page * page;
+#ifdef MADV_POPULATE_WRITE
+  if (b < e) madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_WRITE);
+#else
+  (void)b, (void)e;
+#endif
 }
 
 void copyStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base) {
@@ -359,21 +396,33 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
     }
   }
   std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.cost > b.cost; });
+  // A large copy's time went mostly to its fresh pages' faults (the kernel clearing each page), on the
+  // copying thread alone: each array is allocated first, its pages made present in pieces on all cores
+  // beside the checks, then the copies run (into present pages) once the checks have passed.
+  constexpr size_t kPagePiece = size_t(4) << 20;
+  std::vector<std::span<uint8_t>> pages;
+  const auto copies = std::stable_partition(jobs.begin(), jobs.end(), [](const Job& j) { return !j.copy; });
+  for (auto j = copies; j != jobs.end(); ++j) {
+    Mesh& m = scene.meshes[j->stream == kLodIndices ? lods[j->mesh].mesh : j->mesh];
+    const std::span<uint8_t> a =
+        j->stream == kLodIndices ? reserve(m.lod.indices, j->count) : reserveStream(m, layout[j->mesh], j->stream);
+    for (size_t b = 0; b < a.size(); b += kPagePiece) pages.push_back(a.subspan(b, std::min(kPagePiece, a.size() - b)));
+  }
+  const size_t checks = size_t(copies - jobs.begin());
   Fault first;
   std::mutex firstMutex;
-  parallelFor(jobs.size(), threads, [&](size_t j) {
-    const Job& job = jobs[j];
+  parallelFor(pages.size() + checks, threads, [&](size_t j) {
+    if (j < pages.size()) return populate(pages[j].data(), pages[j].size());
+    const Job& job = jobs[j - pages.size()];
     const bool lod = job.stream == kLodClusters || job.stream == kLodIndices;
     const uint32_t mesh = lod ? lods[job.mesh].mesh : job.mesh;
     Mesh& m = scene.meshes[mesh];
     const MeshLayout& l = layout[mesh];
     const uint8_t* base = bytes.data();
     try {
-      if (job.stream == kLodIndices && job.copy) copyTo(m.lod.indices, base, lods[job.mesh].indicesAt, job.count);
-      else if (job.stream == kLodIndices) checkLodIndices(lods[job.mesh], base, l.vertices, job.first, job.first + job.count);
+      if (job.stream == kLodIndices) checkLodIndices(lods[job.mesh], base, l.vertices, job.first, job.first + job.count);
       else if (job.stream == kLodClusters)
         readLodClusters(m, lods[job.mesh], base, l.clusterAt, l.indices / 3, job.first, job.first + job.count);
-      else if (job.copy) copyStream(m, l, job.stream, base);
       else if (job.stream == kClusters && (l.flags & kIndex16))
         checkClusters<uint16_t>(m, l, base, mesh, job.first, job.first + job.count);
       else if (job.stream == kClusters) checkClusters<uint32_t>(m, l, base, mesh, job.first, job.first + job.count);
@@ -384,6 +433,12 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
     }
   });
   if (first.at != SIZE_MAX) r.failAt(first.at, first.what);
+  parallelFor(jobs.size() - checks, threads, [&](size_t j) {
+    const Job& job = jobs[checks + j];
+    if (job.stream == kLodIndices)
+      copyTo(scene.meshes[lods[job.mesh].mesh].lod.indices, bytes.data(), lods[job.mesh].indicesAt, job.count);
+    else copyStream(scene.meshes[job.mesh], layout[job.mesh], job.stream, bytes.data());
+  });
 }
 
 // Version 6: chunks to the end of the payload. An unknown or repeated tag is refused, named with its offset.
