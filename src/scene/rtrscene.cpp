@@ -397,30 +397,35 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
   }
   std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.cost > b.cost; });
   // A large copy's time went mostly to its fresh pages' faults (the kernel clearing each page), on the
-  // copying thread alone: each array is allocated first, its pages made present in pieces on all cores
-  // beside the checks, then the copies run (into present pages) once the checks have passed.
+  // copying thread alone, as did the hierarchies' records made on one thread: each array is allocated
+  // first, its pages made present in pieces on all cores beside the checks, then the copies and the
+  // hierarchies' records (their vectors sized in between, into present pages) run.
   constexpr size_t kPagePiece = size_t(4) << 20;
   std::vector<std::span<uint8_t>> pages;
-  const auto copies = std::stable_partition(jobs.begin(), jobs.end(), [](const Job& j) { return !j.copy; });
-  for (auto j = copies; j != jobs.end(); ++j) {
-    Mesh& m = scene.meshes[j->stream == kLodIndices ? lods[j->mesh].mesh : j->mesh];
-    const std::span<uint8_t> a =
-        j->stream == kLodIndices ? reserve(m.lod.indices, j->count) : reserveStream(m, layout[j->mesh], j->stream);
+  auto addPages = [&](std::span<uint8_t> a) {
     for (size_t b = 0; b < a.size(); b += kPagePiece) pages.push_back(a.subspan(b, std::min(kPagePiece, a.size() - b)));
+  };
+  const auto second =
+      std::stable_partition(jobs.begin(), jobs.end(), [](const Job& j) { return !j.copy && j.stream != kLodClusters; });
+  for (auto j = second; j != jobs.end(); ++j) {
+    if (!j->copy) continue;
+    Mesh& m = scene.meshes[j->stream == kLodIndices ? lods[j->mesh].mesh : j->mesh];
+    addPages(j->stream == kLodIndices ? reserve(m.lod.indices, j->count) : reserveStream(m, layout[j->mesh], j->stream));
   }
-  const size_t checks = size_t(copies - jobs.begin());
+  for (const LodLayout& l : lods) addPages(reserve(scene.meshes[l.mesh].lod.clusters, l.count));
+  const size_t firstPhase = size_t(second - jobs.begin());
   Fault first;
   std::mutex firstMutex;
-  parallelFor(pages.size() + checks, threads, [&](size_t j) {
-    if (j < pages.size()) return populate(pages[j].data(), pages[j].size());
-    const Job& job = jobs[j - pages.size()];
+  auto run = [&](const Job& job) {
     const bool lod = job.stream == kLodClusters || job.stream == kLodIndices;
     const uint32_t mesh = lod ? lods[job.mesh].mesh : job.mesh;
     Mesh& m = scene.meshes[mesh];
     const MeshLayout& l = layout[mesh];
     const uint8_t* base = bytes.data();
     try {
-      if (job.stream == kLodIndices) checkLodIndices(lods[job.mesh], base, l.vertices, job.first, job.first + job.count);
+      if (job.copy && job.stream == kLodIndices) copyTo(m.lod.indices, base, lods[job.mesh].indicesAt, job.count);
+      else if (job.copy) copyStream(m, l, job.stream, base);
+      else if (job.stream == kLodIndices) checkLodIndices(lods[job.mesh], base, l.vertices, job.first, job.first + job.count);
       else if (job.stream == kLodClusters)
         readLodClusters(m, lods[job.mesh], base, l.clusterAt, l.indices / 3, job.first, job.first + job.count);
       else if (job.stream == kClusters && (l.flags & kIndex16))
@@ -431,14 +436,17 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
       std::lock_guard lock(firstMutex);
       if (f.at < first.at) first = std::move(f);
     }
+  };
+  parallelFor(pages.size() + firstPhase, threads, [&](size_t j) {
+    if (j < pages.size()) populate(pages[j].data(), pages[j].size());
+    else run(jobs[j - pages.size()]);
+  });
+  for (const LodLayout& l : lods) scene.meshes[l.mesh].lod.clusters.resize(l.count);
+  const bool faulty = first.at != SIZE_MAX;  // no copies then; the records may still hold a lower fault
+  parallelFor(jobs.size() - firstPhase, threads, [&](size_t j) {
+    if (!(faulty && jobs[firstPhase + j].copy)) run(jobs[firstPhase + j]);
   });
   if (first.at != SIZE_MAX) r.failAt(first.at, first.what);
-  parallelFor(jobs.size() - checks, threads, [&](size_t j) {
-    const Job& job = jobs[checks + j];
-    if (job.stream == kLodIndices)
-      copyTo(scene.meshes[lods[job.mesh].mesh].lod.indices, bytes.data(), lods[job.mesh].indicesAt, job.count);
-    else copyStream(scene.meshes[job.mesh], layout[job.mesh], job.stream, bytes.data());
-  });
 }
 
 // Version 6: chunks to the end of the payload. An unknown or repeated tag is refused, named with its offset.

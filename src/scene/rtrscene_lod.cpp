@@ -92,7 +92,7 @@ void readClusterLodLayout(ByteReader& r, uint64_t size, Scene& scene, std::vecto
     l.indicesAt = r.skipArray(indexCount, 4, "CLOD indices");
     r.align(16, "CLOD indices");
     m.lod.levels = levels;
-    m.lod.clusters.resize(count);
+
     layout.push_back(l);
   }
   if (r.pos() != end) r.fail("CLOD chunk: " + std::to_string(end - r.pos()) + " bytes after its last mesh");

@@ -30,8 +30,8 @@ struct ReadFault {
 };
 // Reads the mesh records of a body of `size` bytes at r.pos() (the meshes' records already read: their
 // vertex and cluster counts) into `out`, checking their counts against the meshes and the body (a fault
-// thrown naming its offset; `out` holds the records before it), setting each mesh's lod.levels and
-// sizing lod.clusters. Its records and indices are read by the two below.
+// thrown naming its offset; `out` holds the records before it), setting each mesh's lod.levels. Its
+// records (once lod.clusters holds `count`) and indices are read by the two below.
 void readClusterLodLayout(ByteReader& r, uint64_t size, Scene& scene, std::vector<LodLayout>& out);
 // Records [first, end) of a hierarchy read into m.lod.clusters and checked on their own and against the
 // record before (levels in order, triangles tiling the hierarchy's; level 0 the mesh's own clusters,
