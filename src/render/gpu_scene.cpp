@@ -37,6 +37,13 @@ struct MeshSlot {
   bool index16;
 };
 
+// A mesh's draw: its DrawItem, which pipeline, and its clusters' CLUSTER_* flags.
+struct MeshDraw {
+  DrawItem item;
+  DrawKind kind;
+  uint32_t flags;
+};
+
 // One mesh's cluster records once, in its own space (docs/culling.md): level 0 (the mesh's clusters), then
 // the levels above, their level-of-detail records, and a tree over each level, their roots first; made on
 // all cores, a mesh each, numbered from 0 (written into the scene-wide buffers at `first` and `firstLevel`).
@@ -52,7 +59,8 @@ struct MeshRecords {
 // A piece of the geometry writing small enough to spread a single large mesh over all cores: a mesh's
 // vertices or indices, a mesh's records or tree nodes, bytes of a buffer copied whole, or the base entries
 // of a run of instances.
-enum class Write : uint8_t { Vertices, Indices, Records, Nodes, Bytes, Entries };
+// Build: a mesh's records made (beside the streams' pieces, before their own writes).
+enum class Write : uint8_t { Build, Vertices, Indices, Records, Nodes, Bytes, Entries };
 struct WriteTask {
   Write what;
   uint32_t slot;  // mesh slot; mesh; target
@@ -65,10 +73,12 @@ struct GeometryPlan {
   std::vector<MeshSlot> slots;
   std::vector<shader::GpuDraw> draws;
   std::vector<shader::GpuInstance> instances;
-  std::vector<MeshRecords> records;  // per mesh (none for a mesh not drawn or blended)
-  size_t clusters = 0, nodes = 0;    // records and tree nodes of all meshes
-  bool lods = false;                 // some mesh has a hierarchy: a GpuClusterLod per record
-  std::vector<uint32_t> idPages;     // visIdPages(): the instance holding each page's first id
+  std::vector<std::optional<MeshDraw>> meshDraw;  // per mesh that has triangles
+  std::vector<uint32_t> order;                    // the meshes that get records, the largest first
+  std::vector<MeshRecords> records;               // per mesh (none for a mesh not drawn or blended)
+  size_t clusters = 0, nodes = 0;                 // records and tree nodes of all meshes
+  bool lods = false;                              // some mesh has a hierarchy: a GpuClusterLod per record
+  std::vector<uint32_t> idPages;                  // visIdPages(): the instance holding each page's first id
   std::vector<shader::GpuCullInstance> cullInstances;
   std::vector<uint64_t> queues;  // per tree depth: (instance, node) pairs at it
   struct Entries {               // per cull instance: where its base entries ((instance, record) of its level 0) go
@@ -83,6 +93,52 @@ struct GeometryPlan {
 };
 
 namespace {
+
+// Mesh mi's records (MeshRecords), numbered from 0.
+void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRecords& r) {
+  const Mesh& m = scene.meshes[mi];
+  // Sized once: grown by doubling, the largest mesh's records took twice the time (fresh pages).
+  const size_t above =
+      size_t(std::count_if(m.lod.clusters.begin(), m.lod.clusters.end(), [](const LodCluster& c) { return c.level > 0; }));
+  const size_t own =
+      m.clusters.empty() ? (m.indices.size() / 3 + CLUSTER_MAX_TRIANGLES - 1) / CLUSTER_MAX_TRIANGLES : m.clusters.size();
+  r.clusters.reserve(own + above);
+  if (p.lods) r.lods.reserve(own + above);
+  appendClusters(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, r.clusters);
+  r.level0 = uint32_t(r.clusters.size());
+  if (p.lods) {
+    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, false, 0, r.clusters, r.lods);
+    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, true, 0, r.clusters, r.lods);
+  }
+  r.count = uint32_t(r.clusters.size());
+  std::vector<glm::vec4> spheres;
+  spheres.reserve(2 * r.count);
+  for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
+  r.sphere = enclosingSphere(spheres);
+  if (r.lods.empty()) {
+    r.lodSphere = r.sphere;
+  } else {
+    spheres.clear();
+    for (const shader::GpuClusterLod& l : r.lods) {
+      spheres.push_back(l.sphere);
+      if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
+    }
+    r.lodSphere = enclosingSphere(spheres);
+  }
+  // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
+  // tree over each, their roots side by side.
+  std::vector<glm::uvec2> runs{{0, r.level0}};
+  uint32_t at = 0;
+  for (size_t k = 0, c = r.level0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
+    if (m.lod.clusters[k].level == 0) continue;
+    if (runs.size() == 1 || m.lod.clusters[k].level != at) runs.push_back({uint32_t(c), 0});
+    at = m.lod.clusters[k].level, ++runs.back().y, ++c;
+  }
+  r.levels = uint32_t(runs.size());
+  r.nodes.resize(runs.size());
+  for (size_t l = 0; l < runs.size(); ++l)
+    r.leaves += appendClusterTree(r.clusters, r.lods, runs[l].x, runs[l].y, uint32_t(l), r.nodes, r.depths);
+}
 
 shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
   // The identity stays exact (existing scenes' images do not move by a rounding).
@@ -107,7 +163,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
   const auto t = Clock::now();
-  const GeometryPlan plan = planGeometry(scene);
+  GeometryPlan plan = planGeometry(scene);
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   materialExtras_ = std::any_of(scene.materials.begin(), scene.materials.end(),
                                 [](const Material& m) {
@@ -123,7 +179,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
     shownMaterials_ = materials;
   }
-  uploadGeometry(plan, materials, upload);
+  uploadGeometry(scene, plan, materials, upload);
   stats_.geometryMs = msSince(t);
   if (!decoding_.valid()) {
     finishTextures();
@@ -147,12 +203,7 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   p.anyUv1 = any([](const Mesh& m) { return !m.texcoords1.empty(); });
   p.anyTangents = any([](const Mesh& m) { return !m.tangents.empty(); });
   p.anyColors = any([](const Mesh& m) { return !m.colors.empty(); });
-  struct MeshDraw {
-    DrawItem item;
-    DrawKind kind;
-    uint32_t flags;
-  };
-  std::vector<std::optional<MeshDraw>> meshDraw(scene.meshes.size());
+  p.meshDraw.resize(scene.meshes.size());
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     if (m.indices.empty()) continue;
@@ -178,65 +229,28 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     p.draws.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
                        (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u) | (m.colors.empty() ? 0u : DRAW_COLORS) |
                            (m.tangents.empty() ? 0u : DRAW_TANGENTS) | (m.texcoords1.empty() ? 0u : DRAW_UV1)});
-    meshDraw[mi] = MeshDraw{d, kind, flags};
+    p.meshDraw[mi] = MeshDraw{d, kind, flags};
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
   }
-  const std::vector<Instance> instances = gpuInstances(scene);
   p.lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
-  // Each mesh's records on all cores, the largest first.
-  std::vector<uint32_t> order;
+  // Each mesh's records are made on all cores, the largest first (uploadGeometry), then placed.
   for (uint32_t mi = 0; mi < scene.meshes.size(); ++mi)
-    if (meshDraw[mi] && !scene.materials.at(scene.meshes[mi].material).blended()) order.push_back(mi);  // else: transparency pass
+    if (p.meshDraw[mi] && !scene.materials.at(scene.meshes[mi].material).blended())
+      p.order.push_back(mi);  // else: transparency pass
   auto size = [&](uint32_t mi) { return scene.meshes[mi].indices.size() + scene.meshes[mi].lod.indices.size(); };
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return size(a) > size(b); });
+  std::stable_sort(p.order.begin(), p.order.end(), [&](uint32_t a, uint32_t b) { return size(a) > size(b); });
   p.records.resize(scene.meshes.size());
-  parallelFor(order.size(), 0, [&](size_t o) {
-    const uint32_t mi = order[o];
-    const Mesh& m = scene.meshes[mi];
-    MeshRecords& r = p.records[mi];
-    // Sized once: grown by doubling, the largest mesh's records took twice the time (fresh pages).
-    const size_t above =
-        size_t(std::count_if(m.lod.clusters.begin(), m.lod.clusters.end(), [](const LodCluster& c) { return c.level > 0; }));
-    const size_t own =
-        m.clusters.empty() ? (m.indices.size() / 3 + CLUSTER_MAX_TRIANGLES - 1) / CLUSTER_MAX_TRIANGLES : m.clusters.size();
-    r.clusters.reserve(own + above);
-    if (p.lods) r.lods.reserve(own + above);
-    appendClusters(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, r.clusters);
-    r.level0 = uint32_t(r.clusters.size());
-    if (p.lods) {
-      appendClusterLods(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, false, 0, r.clusters, r.lods);
-      appendClusterLods(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, true, 0, r.clusters, r.lods);
-    }
-    r.count = uint32_t(r.clusters.size());
-    std::vector<glm::vec4> spheres;
-    spheres.reserve(2 * r.count);
-    for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
-    r.sphere = enclosingSphere(spheres);
-    if (r.lods.empty()) {
-      r.lodSphere = r.sphere;
-    } else {
-      spheres.clear();
-      for (const shader::GpuClusterLod& l : r.lods) {
-        spheres.push_back(l.sphere);
-        if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
-      }
-      r.lodSphere = enclosingSphere(spheres);
-    }
-    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
-    // tree over each, their roots side by side.
-    std::vector<glm::uvec2> runs{{0, r.level0}};
-    uint32_t at = 0;
-    for (size_t k = 0, c = r.level0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
-      if (m.lod.clusters[k].level == 0) continue;
-      if (runs.size() == 1 || m.lod.clusters[k].level != at) runs.push_back({uint32_t(c), 0});
-      at = m.lod.clusters[k].level, ++runs.back().y, ++c;
-    }
-    r.levels = uint32_t(runs.size());
-    r.nodes.resize(runs.size());
-    for (size_t l = 0; l < runs.size(); ++l)
-      r.leaves += appendClusterTree(r.clusters, r.lods, runs[l].x, runs[l].y, uint32_t(l), r.nodes, r.depths);
-  });
+  stats_.vertices = uint32_t(p.vertices);
+  p.count16 += p.count16 % 2;  // keep the buffer size a multiple of 4
+  return p;
+}
+
+// Once every mesh's records are made: numbered mesh by mesh, each instance's culling record and draw,
+// the visibility ids.
+void GpuScene::placeRecords(const Scene& scene, GeometryPlan& p) {
+  const std::vector<Instance> instances = gpuInstances(scene);
+  std::vector<uint32_t> order = p.order;
   std::sort(order.begin(), order.end());
   for (uint32_t mi : order) {  // numbered mesh by mesh in the scene's order
     MeshRecords& r = p.records[mi];
@@ -248,7 +262,7 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
     const Mesh& m = scene.meshes[in.mesh];
-    const MeshDraw& md = *meshDraw[in.mesh];
+    const MeshDraw& md = *p.meshDraw[in.mesh];
     const bool flip = mirrored(in.transform);
     p.instances.push_back(gpuInstance(in.transform, md.item.id));
     // The identity keeps the box exact (the nearest-first order of existing scenes unchanged).
@@ -294,7 +308,7 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     const Mesh& m = scene.meshes[instances[i].mesh];
     firstIds_.push_back(ids);
     p.instances[i].info.z = uint32_t(ids);
-    if (!scene.materials.at(m.material).blended()) ids += meshDraw[instances[i].mesh]->item.primitives;
+    if (!scene.materials.at(m.material).blended()) ids += p.meshDraw[instances[i].mesh]->item.primitives;
   }
   visIdCount_ = ids;
   // Pages of 2^shift ids, at most 2^16 + 1 of them: page k's entry is the last instance whose range
@@ -307,9 +321,6 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     }
   if (p.idPages.empty()) p.idPages.push_back(0);
   stats_.instances = uint32_t(instances.size());
-  stats_.vertices = uint32_t(p.vertices);
-  p.count16 += p.count16 % 2;  // keep the buffer size a multiple of 4
-  return p;
 }
 
 std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const {
@@ -348,13 +359,14 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
 
 // Each buffer is device-local. Where the device lets the host write such memory (lavapipe, a GPU with a
 // large BAR) the data is written there directly, on all cores; else into one staging buffer, then copied.
-void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
+void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
                               GeometryUpload upload) {
   struct Target {
     vk::Buffer* buffer;
     size_t size;
     const void* data = nullptr;  // records copied whole; null: the streams, written below
     uint8_t* dst = nullptr;
+    const vk::Buffer* staging = nullptr;  // where it is written when not mappable
     size_t stagingOffset = 0;
   };
   const size_t vertices = plan.vertices;
@@ -382,23 +394,24 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     kTargets
   };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  // The streams' buffers first (their sizes are known); the records' once their meshes' are made.
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
                                         {&texcoords_, plan.anyTexcoords ? vertices * 8 : 0},
                                         {&indices16_, plan.count16 * 2},
                                         {&indices32_, plan.count32 * 4},
-                                        {&materials_, bytes(materials), materials.data()},
-                                        {&drawInfo_, bytes(plan.draws), plan.draws.data()},
-                                        {&instances_, bytes(plan.instances), plan.instances.data()},
-                                        {&clusters_, plan.clusters * sizeof(shader::GpuCluster)},
+                                        {&materials_},
+                                        {&drawInfo_},
+                                        {&instances_},
+                                        {&clusters_},
                                         {&texcoords1_, plan.anyUv1 ? vertices * 8 : 0},
                                         {&tangents_, plan.anyTangents ? vertices * 16 : 0},
                                         {&colors_, plan.anyColors ? vertices * 16 : 0},
-                                        {&clusterLods_, plan.lods ? plan.clusters * sizeof(shader::GpuClusterLod) : 0},
-                                        {&visIdPages_, bytes(plan.idPages), plan.idPages.data()},
-                                        {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()},
-                                        {&cullNodes_, plan.nodes * sizeof(shader::GpuCullNode)},
-                                        {&baseEntries_, plan.baseEntries * sizeof(glm::uvec2)}}};
+                                        {&clusterLods_},
+                                        {&visIdPages_},
+                                        {&cullInstances_},
+                                        {&cullNodes_},
+                                        {&baseEntries_}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
   const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
@@ -407,58 +420,42 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32",      "materials",
                                  "draws",        "instances", "clusters",       "texcoords1", "tangents",       "colours",
                                  "cluster lods", "id pages",  "cull instances", "cull nodes", "cluster entries"};
-  // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
-  clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
-  baseClusterCount_ = uint32_t(plan.baseEntries);
-  chunkCapacity_ = uint32_t(std::min<uint64_t>(plan.chunks, UINT32_MAX));
-  cullQueueCapacity_.clear();
-  for (uint64_t n : plan.queues) cullQueueCapacity_.push_back(uint32_t(std::min<uint64_t>(n, UINT32_MAX)));
-  cullInstanceCount_ = uint32_t(plan.cullInstances.size());
-  size_t stagingSize = 0;
-  for (size_t i = 0; i < kTargets; ++i) {
-    Target& tg = targets[i];
-    if (tg.size == 0) continue;
-    *tg.buffer = vk::Buffer(ctx_, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                            upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
-    tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
-    if (!tg.dst) {
-      tg.stagingOffset = stagingSize;
-      stagingSize += (tg.size + 15) & ~size_t(15);
+  // Makes the buffers of the targets sized and not yet made, mapped or placed in `staging`.
+  std::array<vk::Buffer, 2> staging;
+  auto make = [&](vk::Buffer& stage) {
+    size_t stagingSize = 0;
+    for (size_t i = 0; i < kTargets; ++i) {
+      Target& tg = targets[i];
+      if (tg.size == 0 || tg.buffer->handle()) continue;
+      *tg.buffer = vk::Buffer(ctx_, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                              upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
+      tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
+      if (!tg.dst) {
+        tg.staging = &stage, tg.stagingOffset = stagingSize;
+        stagingSize += (tg.size + 15) & ~size_t(15);
+      }
     }
-  }
-  vk::Buffer staging;
-  if (stagingSize) {
-    staging = vk::Buffer(ctx_, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
-    for (Target& tg : targets)
-      if (tg.size && !tg.dst) tg.dst = static_cast<uint8_t*>(staging.mapped()) + tg.stagingOffset;
-  }
+    if (stagingSize) {
+      stage = vk::Buffer(ctx_, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
+      for (Target& tg : targets)
+        if (tg.staging == &stage) tg.dst = static_cast<uint8_t*>(stage.mapped()) + tg.stagingOffset;
+    }
+  };
+  make(staging[0]);
 
   // Pieces of at most 256 Ki vertices, 1 Mi indices, 64 Ki records, 1 MiB or 1 Mi base entries, written
   // on all cores.
   constexpr size_t kVertexChunk = size_t(1) << 18, kIndexChunk = size_t(1) << 20, kRecordChunk = size_t(1) << 16;
+  // The meshes' records are made while the streams are written (the largest mesh's first).
   std::vector<WriteTask> tasks;
+  for (uint32_t mi : plan.order) tasks.push_back({Write::Build, mi, 0, 0});
   for (uint32_t s = 0; s < plan.slots.size(); ++s) {
     for (size_t b = 0, n = plan.slots[s].mesh->positions.size(); b < n; b += kVertexChunk)
       tasks.push_back({Write::Vertices, s, b, std::min(n, b + kVertexChunk)});
     for (size_t b = 0, n = plan.slots[s].mesh->indices.size() + plan.slots[s].mesh->lod.indices.size(); b < n; b += kIndexChunk)
       tasks.push_back({Write::Indices, s, b, std::min(n, b + kIndexChunk)});
   }
-  for (uint32_t mi = 0; mi < plan.records.size(); ++mi) {
-    for (size_t b = 0, n = plan.records[mi].count; b < n; b += kRecordChunk)
-      tasks.push_back({Write::Records, mi, b, std::min(n, b + kRecordChunk)});
-    if (!plan.records[mi].nodes.empty()) tasks.push_back({Write::Nodes, mi, 0, plan.records[mi].nodes.size()});
-  }
-  for (uint32_t t = 0; t < kTargets; ++t)
-    for (size_t b = 0; targets[t].data && b < targets[t].size; b += kIndexChunk)
-      tasks.push_back({Write::Bytes, t, b, std::min(targets[t].size, b + kIndexChunk)});
-  for (size_t j = 0; j < plan.entries.size();) {  // runs of instances holding at least 1 Mi entries (or the rest)
-    size_t e = j + 1;
-    while (e < plan.entries.size() && plan.entries[e].at - plan.entries[j].at < kIndexChunk) ++e;
-    tasks.push_back({Write::Entries, 0, j, e});
-    j = e;
-  }
-  parallelFor(tasks.size(), 0, [&](size_t i) {
-    const WriteTask& task = tasks[i];
+  auto writePiece = [&](const WriteTask& task) {
     if (task.what == Write::Bytes) {
       std::memcpy(targets[task.slot].dst + task.begin, static_cast<const uint8_t*>(targets[task.slot].data) + task.begin,
                   task.end - task.begin);
@@ -525,15 +522,55 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     if (plan.anyUv1) stream(targets[kUv1].dst, m.texcoords1, 8);
     if (plan.anyTangents) stream(targets[kTan].dst, m.tangents, 16);
     if (plan.anyColors) stream(targets[kCol].dst, m.colors, 16);
-  });
+  };
+  auto write = [&](const WriteTask& task) {
+    if (task.what == Write::Build) return buildRecords(scene, plan, task.slot, plan.records[task.slot]);
+    writePiece(task);
+  };
+  parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i]); });
+
+  placeRecords(scene, plan);
+  // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
+  clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
+  baseClusterCount_ = uint32_t(plan.baseEntries);
+  chunkCapacity_ = uint32_t(std::min<uint64_t>(plan.chunks, UINT32_MAX));
+  cullQueueCapacity_.clear();
+  for (uint64_t n : plan.queues) cullQueueCapacity_.push_back(uint32_t(std::min<uint64_t>(n, UINT32_MAX)));
+  cullInstanceCount_ = uint32_t(plan.cullInstances.size());
+  targets[kMat] = {&materials_, bytes(materials), materials.data()};
+  targets[kDraw] = {&drawInfo_, bytes(plan.draws), plan.draws.data()};
+  targets[kInst] = {&instances_, bytes(plan.instances), plan.instances.data()};
+  targets[kCluster] = {&clusters_, plan.clusters * sizeof(shader::GpuCluster)};
+  targets[kLod] = {&clusterLods_, plan.lods ? plan.clusters * sizeof(shader::GpuClusterLod) : 0};
+  targets[kIds] = {&visIdPages_, bytes(plan.idPages), plan.idPages.data()};
+  targets[kCullInst] = {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()};
+  targets[kCullNode] = {&cullNodes_, plan.nodes * sizeof(shader::GpuCullNode)};
+  targets[kBaseEntries] = {&baseEntries_, plan.baseEntries * sizeof(glm::uvec2)};
+  make(staging[1]);
+  tasks.clear();
+  for (uint32_t mi = 0; mi < plan.records.size(); ++mi) {
+    for (size_t b = 0, n = plan.records[mi].count; b < n; b += kRecordChunk)
+      tasks.push_back({Write::Records, mi, b, std::min(n, b + kRecordChunk)});
+    if (!plan.records[mi].nodes.empty()) tasks.push_back({Write::Nodes, mi, 0, plan.records[mi].nodes.size()});
+  }
+  for (uint32_t t = 0; t < kTargets; ++t)
+    for (size_t b = 0; targets[t].data && b < targets[t].size; b += kIndexChunk)
+      tasks.push_back({Write::Bytes, t, b, std::min(targets[t].size, b + kIndexChunk)});
+  for (size_t j = 0; j < plan.entries.size();) {  // runs of instances holding at least 1 Mi entries (or the rest)
+    size_t e = j + 1;
+    while (e < plan.entries.size() && plan.entries[e].at - plan.entries[j].at < kIndexChunk) ++e;
+    tasks.push_back({Write::Entries, 0, j, e});
+    j = e;
+  }
+  parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i]); });
   for (const Target& tg : targets)
-    if (tg.size) (tg.buffer->mapped() ? *tg.buffer : staging).flush();
-  if (staging.handle())
+    if (tg.size) (tg.staging ? *tg.staging : *tg.buffer).flush();
+  if (staging[0].handle() || staging[1].handle())
     vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
       for (const Target& tg : targets)
-        if (tg.size && !tg.buffer->mapped()) {
+        if (tg.size && tg.staging) {
           VkBufferCopy region{tg.stagingOffset, 0, tg.size};
-          vkCmdCopyBuffer(cb, staging.handle(), tg.buffer->handle(), 1, &region);
+          vkCmdCopyBuffer(cb, tg.staging->handle(), tg.buffer->handle(), 1, &region);
         }
       // Also orders the copies before the frames' reads, which come in later submissions.
       vk::bufferBarrier(cb, vk::kCopyWrite, vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
