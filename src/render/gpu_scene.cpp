@@ -277,7 +277,9 @@ void GpuScene::placeRecords(const Scene& scene, GeometryPlan& p) {
     // Its culling record: the mesh's spheres placed (a sphere holding the placed ones), how to place the
     // records, and its history slots.
     const MeshRecords& r = p.records[in.mesh];
-    const auto [stretch, similarity] = largestStretch(in.transform);
+    const std::pair<float, bool> st = largestStretch(in.transform);  // no structured binding: clang 14 lambdas
+    const float stretch = st.first;
+    const bool similarity = st.second;
     auto place = [&](glm::vec4 s) {
       return identity ? s : glm::vec4(glm::vec3(in.transform * glm::vec4(glm::vec3(s), 1.0f)), s.w * stretch * (1.0f + 1e-5f));
     };
