@@ -37,10 +37,33 @@ struct MeshSlot {
   bool index16;
 };
 
-// A piece of the geometry writing small enough to spread a single large mesh over all cores.
+// A mesh's draw: its DrawItem, which pipeline, and its clusters' CLUSTER_* flags.
+struct MeshDraw {
+  DrawItem item;
+  DrawKind kind;
+  uint32_t flags;
+};
+
+// One mesh's cluster records once, in its own space (docs/culling.md): level 0 (the mesh's clusters), then
+// the levels above, their level-of-detail records, and a tree over each level, their roots first; made on
+// all cores, a mesh each, numbered from 0 (written into the scene-wide buffers at `first` and `firstLevel`).
+struct MeshRecords {
+  uint32_t first = 0, count = 0, level0 = 0, firstLevel = 0, levels = 0, leaves = 0;
+  glm::vec4 sphere{0.0f}, lodSphere{0.0f};
+  std::vector<uint32_t> depths;  // its trees' nodes at each depth
+  std::vector<shader::GpuCluster> clusters;
+  std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
+  std::vector<shader::GpuCullNode> nodes;   // leaves name records, others nodes, both numbered from 0
+};
+
+// A piece of the geometry writing small enough to spread a single large mesh over all cores: a mesh's
+// vertices or indices, a mesh's records or tree nodes, bytes of a buffer copied whole, or the base entries
+// of a run of instances.
+// Build: a mesh's records made (beside the streams' pieces, before their own writes).
+enum class Write : uint8_t { Build, Vertices, Indices, Records, Nodes, Bytes, Entries };
 struct WriteTask {
-  uint32_t slot;
-  bool indices;
+  Write what;
+  uint32_t slot;  // mesh slot; mesh; target
   size_t begin, end;
 };
 
@@ -50,19 +73,72 @@ struct GeometryPlan {
   std::vector<MeshSlot> slots;
   std::vector<shader::GpuDraw> draws;
   std::vector<shader::GpuInstance> instances;
-  std::vector<shader::GpuCluster> clusters;
-  std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
-  std::vector<uint32_t> idPages;            // visIdPages(): the instance holding each page's first id
+  std::vector<std::optional<MeshDraw>> meshDraw;  // per mesh that has triangles
+  std::vector<uint32_t> order;                    // the meshes that get records, the largest first
+  std::vector<MeshRecords> records;               // per mesh (none for a mesh not drawn or blended)
+  size_t clusters = 0, nodes = 0;                 // records and tree nodes of all meshes
+  bool lods = false;                              // some mesh has a hierarchy: a GpuClusterLod per record
+  std::vector<uint32_t> idPages;                  // visIdPages(): the instance holding each page's first id
   std::vector<shader::GpuCullInstance> cullInstances;
-  std::vector<shader::GpuCullNode> cullNodes;  // each mesh's level trees, their roots first
-  std::vector<uint64_t> queues;                // per tree depth: (instance, node) pairs at it
-  std::vector<glm::uvec2> baseEntries;         // (instance, record) of every instance's level 0
-  uint64_t pairs = 0, chunks = 0;              // (instance, cluster) pairs; the culling pass's chunks at most
+  std::vector<uint64_t> queues;  // per tree depth: (instance, node) pairs at it
+  struct Entries {               // per cull instance: where its base entries ((instance, record) of its level 0) go
+    size_t at;
+    uint32_t instance, mesh;
+  };
+  std::vector<Entries> entries;
+  size_t baseEntries = 0;
+  uint64_t pairs = 0, chunks = 0;  // (instance, cluster) pairs; the culling pass's chunks at most
   size_t vertices = 0, count16 = 0, count32 = 0;
   bool anyTexcoords = false, anyUv1 = false, anyTangents = false, anyColors = false;  // glTF's streams
 };
 
 namespace {
+
+// Mesh mi's records (MeshRecords), numbered from 0.
+void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRecords& r) {
+  const Mesh& m = scene.meshes[mi];
+  // Sized once: grown by doubling, the largest mesh's records took twice the time (fresh pages).
+  const size_t above =
+      size_t(std::count_if(m.lod.clusters.begin(), m.lod.clusters.end(), [](const LodCluster& c) { return c.level > 0; }));
+  const size_t own =
+      m.clusters.empty() ? (m.indices.size() / 3 + CLUSTER_MAX_TRIANGLES - 1) / CLUSTER_MAX_TRIANGLES : m.clusters.size();
+  r.clusters.reserve(own + above);
+  if (p.lods) r.lods.reserve(own + above);
+  appendClusters(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, r.clusters);
+  r.level0 = uint32_t(r.clusters.size());
+  if (p.lods) {
+    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, false, 0, r.clusters, r.lods);
+    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, true, 0, r.clusters, r.lods);
+  }
+  r.count = uint32_t(r.clusters.size());
+  std::vector<glm::vec4> spheres;
+  spheres.reserve(2 * r.count);
+  for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
+  r.sphere = enclosingSphere(spheres);
+  if (r.lods.empty()) {
+    r.lodSphere = r.sphere;
+  } else {
+    spheres.clear();
+    for (const shader::GpuClusterLod& l : r.lods) {
+      spheres.push_back(l.sphere);
+      if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
+    }
+    r.lodSphere = enclosingSphere(spheres);
+  }
+  // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
+  // tree over each, their roots side by side.
+  std::vector<glm::uvec2> runs{{0, r.level0}};
+  uint32_t at = 0;
+  for (size_t k = 0, c = r.level0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
+    if (m.lod.clusters[k].level == 0) continue;
+    if (runs.size() == 1 || m.lod.clusters[k].level != at) runs.push_back({uint32_t(c), 0});
+    at = m.lod.clusters[k].level, ++runs.back().y, ++c;
+  }
+  r.levels = uint32_t(runs.size());
+  r.nodes.resize(runs.size());
+  for (size_t l = 0; l < runs.size(); ++l)
+    r.leaves += appendClusterTree(r.clusters, r.lods, runs[l].x, runs[l].y, uint32_t(l), r.nodes, r.depths);
+}
 
 shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
   // The identity stays exact (existing scenes' images do not move by a rounding).
@@ -87,7 +163,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
   const auto t = Clock::now();
-  const GeometryPlan plan = planGeometry(scene);
+  GeometryPlan plan = planGeometry(scene);
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   materialExtras_ = std::any_of(scene.materials.begin(), scene.materials.end(),
                                 [](const Material& m) {
@@ -103,7 +179,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
     shownMaterials_ = materials;
   }
-  uploadGeometry(plan, materials, upload);
+  uploadGeometry(scene, plan, materials, upload);
   stats_.geometryMs = msSince(t);
   if (!decoding_.valid()) {
     finishTextures();
@@ -127,12 +203,7 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
   p.anyUv1 = any([](const Mesh& m) { return !m.texcoords1.empty(); });
   p.anyTangents = any([](const Mesh& m) { return !m.tangents.empty(); });
   p.anyColors = any([](const Mesh& m) { return !m.colors.empty(); });
-  struct MeshDraw {
-    DrawItem item;
-    DrawKind kind;
-    uint32_t flags;
-  };
-  std::vector<std::optional<MeshDraw>> meshDraw(scene.meshes.size());
+  p.meshDraw.resize(scene.meshes.size());
   for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const Mesh& m = scene.meshes[mi];
     if (m.indices.empty()) continue;
@@ -158,66 +229,40 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     p.draws.push_back({d.material, d.firstIndex, uint32_t(d.vertexOffset),
                        (index16 ? DRAW_INDEX16 : 0u) | (textured ? DRAW_TEXTURED : 0u) | (m.colors.empty() ? 0u : DRAW_COLORS) |
                            (m.tangents.empty() ? 0u : DRAW_TANGENTS) | (m.texcoords1.empty() ? 0u : DRAW_UV1)});
-    meshDraw[mi] = MeshDraw{d, kind, flags};
+    p.meshDraw[mi] = MeshDraw{d, kind, flags};
     ++stats_.meshes;
     stats_.triangles += m.triangleCount();
   }
+  p.lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
+  // Each mesh's records are made on all cores, the largest first (uploadGeometry), then placed.
+  for (uint32_t mi = 0; mi < scene.meshes.size(); ++mi)
+    if (p.meshDraw[mi] && !scene.materials.at(scene.meshes[mi].material).blended())
+      p.order.push_back(mi);  // else: transparency pass
+  auto size = [&](uint32_t mi) { return scene.meshes[mi].indices.size() + scene.meshes[mi].lod.indices.size(); };
+  std::stable_sort(p.order.begin(), p.order.end(), [&](uint32_t a, uint32_t b) { return size(a) > size(b); });
+  p.records.resize(scene.meshes.size());
+  stats_.vertices = uint32_t(p.vertices);
+  p.count16 += p.count16 % 2;  // keep the buffer size a multiple of 4
+  return p;
+}
+
+// Once every mesh's records are made: numbered mesh by mesh, each instance's culling record and draw,
+// the visibility ids.
+void GpuScene::placeRecords(const Scene& scene, GeometryPlan& p) {
   const std::vector<Instance> instances = gpuInstances(scene);
-  const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
-  // Each mesh's cluster records once, in its own space (docs/culling.md): level 0 (the mesh's clusters),
-  // then the levels above; its spheres and its levels.
-  struct MeshRecords {
-    uint32_t first = 0, count = 0, level0 = 0, firstLevel = 0, levels = 0, leaves = 0;
-    glm::vec4 sphere{0.0f}, lodSphere{0.0f};
-    std::vector<uint32_t> depths;  // its trees' nodes at each depth
-  };
-  std::vector<MeshRecords> meshRecords(scene.meshes.size());
-  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-    const Mesh& m = scene.meshes[mi];
-    if (!meshDraw[mi] || scene.materials.at(m.material).blended()) continue;  // the transparency pass draws it
-    MeshRecords& r = meshRecords[mi];
-    r.first = uint32_t(p.clusters.size());
-    appendClusters(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, p.clusters);
-    r.level0 = uint32_t(p.clusters.size()) - r.first;
-    if (lods) {
-      appendClusterLods(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, false, r.first, p.clusters, p.lods);
-      appendClusterLods(m, glm::mat4(1.0f), 0, meshDraw[mi]->flags, true, 0, p.clusters, p.lods);
-    }
-    r.count = uint32_t(p.clusters.size()) - r.first;
-    const size_t end = r.first + r.count;
-    std::vector<glm::vec4> spheres;
-    for (size_t c = r.first; c < end; ++c) spheres.push_back(p.clusters[c].sphere);
-    r.sphere = enclosingSphere(spheres);
-    if (p.lods.empty()) {
-      r.lodSphere = r.sphere;
-    } else {
-      spheres.clear();
-      for (size_t c = r.first; c < end; ++c) {
-        spheres.push_back(p.lods[c].sphere);
-        if (p.lods[c].error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(p.lods[c].parentSphere);
-      }
-      r.lodSphere = enclosingSphere(spheres);
-    }
-    // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
-    // tree over each, their roots side by side.
-    std::vector<glm::uvec2> runs{{r.first, r.level0}};
-    uint32_t at = 0;
-    for (size_t k = 0, c = r.first + r.level0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
-      if (m.lod.clusters[k].level == 0) continue;
-      if (runs.size() == 1 || m.lod.clusters[k].level != at) runs.push_back({uint32_t(c), 0});
-      at = m.lod.clusters[k].level, ++runs.back().y, ++c;
-    }
-    r.firstLevel = uint32_t(p.cullNodes.size()), r.levels = uint32_t(runs.size());
-    p.cullNodes.resize(p.cullNodes.size() + runs.size());
-    for (size_t l = 0; l < runs.size(); ++l)
-      r.leaves += appendClusterTree(p.clusters, p.lods, runs[l].x, runs[l].y, r.firstLevel + uint32_t(l), p.cullNodes, r.depths);
+  std::vector<uint32_t> order = p.order;
+  std::sort(order.begin(), order.end());
+  for (uint32_t mi : order) {  // numbered mesh by mesh in the scene's order
+    MeshRecords& r = p.records[mi];
+    r.first = uint32_t(p.clusters), r.firstLevel = uint32_t(p.nodes);
+    p.clusters += r.count, p.nodes += r.nodes.size();
   }
   Bounds box;  // of the draw being extended
   uint64_t slots = 0, chunks = 0;
   for (uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
     const Mesh& m = scene.meshes[in.mesh];
-    const MeshDraw& md = *meshDraw[in.mesh];
+    const MeshDraw& md = *p.meshDraw[in.mesh];
     const bool flip = mirrored(in.transform);
     p.instances.push_back(gpuInstance(in.transform, md.item.id));
     // The identity keeps the box exact (the nearest-first order of existing scenes unchanged).
@@ -231,15 +276,18 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     }
     // Its culling record: the mesh's spheres placed (a sphere holding the placed ones), how to place the
     // records, and its history slots.
-    const MeshRecords& r = meshRecords[in.mesh];
-    const auto [stretch, similarity] = largestStretch(in.transform);
+    const MeshRecords& r = p.records[in.mesh];
+    const std::pair<float, bool> st = largestStretch(in.transform);  // no structured binding: clang 14 lambdas
+    const float stretch = st.first;
+    const bool similarity = st.second;
     auto place = [&](glm::vec4 s) {
       return identity ? s : glm::vec4(glm::vec3(in.transform * glm::vec4(glm::vec3(s), 1.0f)), s.w * stretch * (1.0f + 1e-5f));
     };
     p.cullInstances.push_back({place(r.sphere), place(r.lodSphere),
                                glm::uvec4(r.firstLevel, r.levels, i, uint32_t(slots - r.first)),
                                glm::vec4(identity ? 1.0f : stretch, similarity ? 1.0f : 0.0f, identity ? 1.0f : 0.0f, 0.0f)});
-    for (uint32_t k = 0; k < r.level0; ++k) p.baseEntries.push_back(glm::uvec2(i, r.first + k));
+    p.entries.push_back({p.baseEntries, i, in.mesh});
+    p.baseEntries += r.level0;
     slots += r.count;
     chunks += r.leaves;
     if (p.queues.size() < r.depths.size()) p.queues.resize(r.depths.size(), 0);
@@ -262,7 +310,7 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     const Mesh& m = scene.meshes[instances[i].mesh];
     firstIds_.push_back(ids);
     p.instances[i].info.z = uint32_t(ids);
-    if (!scene.materials.at(m.material).blended()) ids += meshDraw[instances[i].mesh]->item.primitives;
+    if (!scene.materials.at(m.material).blended()) ids += p.meshDraw[instances[i].mesh]->item.primitives;
   }
   visIdCount_ = ids;
   // Pages of 2^shift ids, at most 2^16 + 1 of them: page k's entry is the last instance whose range
@@ -275,9 +323,6 @@ GeometryPlan GpuScene::planGeometry(const Scene& scene) {
     }
   if (p.idPages.empty()) p.idPages.push_back(0);
   stats_.instances = uint32_t(instances.size());
-  stats_.vertices = uint32_t(p.vertices);
-  p.count16 += p.count16 % 2;  // keep the buffer size a multiple of 4
-  return p;
 }
 
 std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const {
@@ -316,13 +361,14 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
 
 // Each buffer is device-local. Where the device lets the host write such memory (lavapipe, a GPU with a
 // large BAR) the data is written there directly, on all cores; else into one staging buffer, then copied.
-void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
+void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
                               GeometryUpload upload) {
   struct Target {
     vk::Buffer* buffer;
     size_t size;
     const void* data = nullptr;  // records copied whole; null: the streams, written below
     uint8_t* dst = nullptr;
+    const vk::Buffer* staging = nullptr;  // where it is written when not mappable
     size_t stagingOffset = 0;
   };
   const size_t vertices = plan.vertices;
@@ -350,23 +396,24 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     kTargets
   };
   auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  // The streams' buffers first (their sizes are known); the records' once their meshes' are made.
   std::array<Target, kTargets> targets{{{&positions_, vertices * 12},
                                         {&normals_, vertices * 12},
                                         {&texcoords_, plan.anyTexcoords ? vertices * 8 : 0},
                                         {&indices16_, plan.count16 * 2},
                                         {&indices32_, plan.count32 * 4},
-                                        {&materials_, bytes(materials), materials.data()},
-                                        {&drawInfo_, bytes(plan.draws), plan.draws.data()},
-                                        {&instances_, bytes(plan.instances), plan.instances.data()},
-                                        {&clusters_, bytes(plan.clusters), plan.clusters.data()},
+                                        {&materials_},
+                                        {&drawInfo_},
+                                        {&instances_},
+                                        {&clusters_},
                                         {&texcoords1_, plan.anyUv1 ? vertices * 8 : 0},
                                         {&tangents_, plan.anyTangents ? vertices * 16 : 0},
                                         {&colors_, plan.anyColors ? vertices * 16 : 0},
-                                        {&clusterLods_, bytes(plan.lods), plan.lods.data()},
-                                        {&visIdPages_, bytes(plan.idPages), plan.idPages.data()},
-                                        {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()},
-                                        {&cullNodes_, bytes(plan.cullNodes), plan.cullNodes.data()},
-                                        {&baseEntries_, bytes(plan.baseEntries), plan.baseEntries.data()}}};
+                                        {&clusterLods_},
+                                        {&visIdPages_},
+                                        {&cullInstances_},
+                                        {&cullNodes_},
+                                        {&baseEntries_}}};
   // glTF's extra streams are read by the shaders from storage buffers (gl_VertexIndex), not bound as
   // vertex streams: OBJ scenes' pipelines stay as they were.
   const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
@@ -375,49 +422,80 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
   const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32",      "materials",
                                  "draws",        "instances", "clusters",       "texcoords1", "tangents",       "colours",
                                  "cluster lods", "id pages",  "cull instances", "cull nodes", "cluster entries"};
-  // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
-  clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
-  baseClusterCount_ = uint32_t(plan.baseEntries.size());
-  chunkCapacity_ = uint32_t(std::min<uint64_t>(plan.chunks, UINT32_MAX));
-  cullQueueCapacity_.clear();
-  for (uint64_t n : plan.queues) cullQueueCapacity_.push_back(uint32_t(std::min<uint64_t>(n, UINT32_MAX)));
-  cullInstanceCount_ = uint32_t(plan.cullInstances.size());
-  size_t stagingSize = 0;
-  for (size_t i = 0; i < kTargets; ++i) {
-    Target& tg = targets[i];
-    if (tg.size == 0) continue;
-    *tg.buffer = vk::Buffer(ctx_, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                            upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
-    tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
-    if (!tg.dst) {
-      tg.stagingOffset = stagingSize;
-      stagingSize += (tg.size + 15) & ~size_t(15);
+  // Makes the buffers of the targets sized and not yet made, mapped or placed in `staging`.
+  std::array<vk::Buffer, 2> staging;
+  auto make = [&](vk::Buffer& stage) {
+    size_t stagingSize = 0;
+    for (size_t i = 0; i < kTargets; ++i) {
+      Target& tg = targets[i];
+      if (tg.size == 0 || tg.buffer->handle()) continue;
+      *tg.buffer = vk::Buffer(ctx_, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                              upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
+      tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
+      if (!tg.dst) {
+        tg.staging = &stage, tg.stagingOffset = stagingSize;
+        stagingSize += (tg.size + 15) & ~size_t(15);
+      }
     }
-  }
-  vk::Buffer staging;
-  if (stagingSize) {
-    staging = vk::Buffer(ctx_, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
-    for (Target& tg : targets)
-      if (tg.size && !tg.dst) tg.dst = static_cast<uint8_t*>(staging.mapped()) + tg.stagingOffset;
-  }
-  for (const Target& tg : targets)
-    if (tg.size && tg.data) std::memcpy(tg.dst, tg.data, tg.size);
+    if (stagingSize) {
+      stage = vk::Buffer(ctx_, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
+      for (Target& tg : targets)
+        if (tg.staging == &stage) tg.dst = static_cast<uint8_t*>(stage.mapped()) + tg.stagingOffset;
+    }
+  };
+  make(staging[0]);
 
-  // Pieces of at most 256 Ki vertices or 1 Mi indices, written on all cores.
-  constexpr size_t kVertexChunk = size_t(1) << 18, kIndexChunk = size_t(1) << 20;
+  // Pieces of at most 256 Ki vertices, 1 Mi indices, 64 Ki records, 1 MiB or 1 Mi base entries, written
+  // on all cores.
+  constexpr size_t kVertexChunk = size_t(1) << 18, kIndexChunk = size_t(1) << 20, kRecordChunk = size_t(1) << 16;
+  // The meshes' records are made while the streams are written (the largest mesh's first).
   std::vector<WriteTask> tasks;
+  for (uint32_t mi : plan.order) tasks.push_back({Write::Build, mi, 0, 0});
   for (uint32_t s = 0; s < plan.slots.size(); ++s) {
     for (size_t b = 0, n = plan.slots[s].mesh->positions.size(); b < n; b += kVertexChunk)
-      tasks.push_back({s, false, b, std::min(n, b + kVertexChunk)});
+      tasks.push_back({Write::Vertices, s, b, std::min(n, b + kVertexChunk)});
     for (size_t b = 0, n = plan.slots[s].mesh->indices.size() + plan.slots[s].mesh->lod.indices.size(); b < n; b += kIndexChunk)
-      tasks.push_back({s, true, b, std::min(n, b + kIndexChunk)});
+      tasks.push_back({Write::Indices, s, b, std::min(n, b + kIndexChunk)});
   }
-  parallelFor(tasks.size(), 0, [&](size_t i) {
-    const WriteTask& task = tasks[i];
+  auto writePiece = [&](const WriteTask& task) {
+    if (task.what == Write::Bytes) {
+      std::memcpy(targets[task.slot].dst + task.begin, static_cast<const uint8_t*>(targets[task.slot].data) + task.begin,
+                  task.end - task.begin);
+      return;
+    }
+    if (task.what == Write::Entries) {
+      auto* dst = reinterpret_cast<glm::uvec2*>(targets[kBaseEntries].dst);
+      for (size_t j = task.begin; j < task.end; ++j) {
+        const GeometryPlan::Entries& e = plan.entries[j];
+        const MeshRecords& r = plan.records[e.mesh];
+        for (uint32_t k = 0; k < r.level0; ++k) dst[e.at + k] = glm::uvec2(e.instance, r.first + k);
+      }
+      return;
+    }
+    if (task.what == Write::Records) {  // in the scene-wide numbering
+      const MeshRecords& r = plan.records[task.slot];
+      const size_t n = task.end - task.begin;
+      std::memcpy(targets[kCluster].dst + (r.first + task.begin) * sizeof(shader::GpuCluster), &r.clusters[task.begin],
+                  n * sizeof(shader::GpuCluster));
+      if (plan.lods)
+        std::memcpy(targets[kLod].dst + (r.first + task.begin) * sizeof(shader::GpuClusterLod), &r.lods[task.begin],
+                    n * sizeof(shader::GpuClusterLod));
+      return;
+    }
+    if (task.what == Write::Nodes) {  // leaves name records, other nodes their children: both renumbered
+      const MeshRecords& r = plan.records[task.slot];
+      auto* dst = reinterpret_cast<shader::GpuCullNode*>(targets[kCullNode].dst) + r.firstLevel;
+      for (size_t k = 0; k < r.nodes.size(); ++k) {
+        shader::GpuCullNode node = r.nodes[k];
+        node.first += node.count & CULL_NODE_LEAF ? r.first : r.firstLevel;
+        dst[k] = node;
+      }
+      return;
+    }
     const MeshSlot& slot = plan.slots[task.slot];
     const Mesh& m = *slot.mesh;
     const size_t n = task.end - task.begin;
-    if (task.indices) {  // the mesh's indices, then its hierarchy's
+    if (task.what == Write::Indices) {  // the mesh's indices, then its hierarchy's
       const size_t own = m.indices.size();
       for (size_t b = task.begin; b < task.end;) {
         const bool lod = b >= own;
@@ -446,15 +524,55 @@ void GpuScene::uploadGeometry(const GeometryPlan& plan, const std::vector<shader
     if (plan.anyUv1) stream(targets[kUv1].dst, m.texcoords1, 8);
     if (plan.anyTangents) stream(targets[kTan].dst, m.tangents, 16);
     if (plan.anyColors) stream(targets[kCol].dst, m.colors, 16);
-  });
+  };
+  auto write = [&](const WriteTask& task) {
+    if (task.what == Write::Build) return buildRecords(scene, plan, task.slot, plan.records[task.slot]);
+    writePiece(task);
+  };
+  parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i]); });
+
+  placeRecords(scene, plan);
+  // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
+  clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
+  baseClusterCount_ = uint32_t(plan.baseEntries);
+  chunkCapacity_ = uint32_t(std::min<uint64_t>(plan.chunks, UINT32_MAX));
+  cullQueueCapacity_.clear();
+  for (uint64_t n : plan.queues) cullQueueCapacity_.push_back(uint32_t(std::min<uint64_t>(n, UINT32_MAX)));
+  cullInstanceCount_ = uint32_t(plan.cullInstances.size());
+  targets[kMat] = {&materials_, bytes(materials), materials.data()};
+  targets[kDraw] = {&drawInfo_, bytes(plan.draws), plan.draws.data()};
+  targets[kInst] = {&instances_, bytes(plan.instances), plan.instances.data()};
+  targets[kCluster] = {&clusters_, plan.clusters * sizeof(shader::GpuCluster)};
+  targets[kLod] = {&clusterLods_, plan.lods ? plan.clusters * sizeof(shader::GpuClusterLod) : 0};
+  targets[kIds] = {&visIdPages_, bytes(plan.idPages), plan.idPages.data()};
+  targets[kCullInst] = {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()};
+  targets[kCullNode] = {&cullNodes_, plan.nodes * sizeof(shader::GpuCullNode)};
+  targets[kBaseEntries] = {&baseEntries_, plan.baseEntries * sizeof(glm::uvec2)};
+  make(staging[1]);
+  tasks.clear();
+  for (uint32_t mi = 0; mi < plan.records.size(); ++mi) {
+    for (size_t b = 0, n = plan.records[mi].count; b < n; b += kRecordChunk)
+      tasks.push_back({Write::Records, mi, b, std::min(n, b + kRecordChunk)});
+    if (!plan.records[mi].nodes.empty()) tasks.push_back({Write::Nodes, mi, 0, plan.records[mi].nodes.size()});
+  }
+  for (uint32_t t = 0; t < kTargets; ++t)
+    for (size_t b = 0; targets[t].data && b < targets[t].size; b += kIndexChunk)
+      tasks.push_back({Write::Bytes, t, b, std::min(targets[t].size, b + kIndexChunk)});
+  for (size_t j = 0; j < plan.entries.size();) {  // runs of instances holding at least 1 Mi entries (or the rest)
+    size_t e = j + 1;
+    while (e < plan.entries.size() && plan.entries[e].at - plan.entries[j].at < kIndexChunk) ++e;
+    tasks.push_back({Write::Entries, 0, j, e});
+    j = e;
+  }
+  parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i]); });
   for (const Target& tg : targets)
-    if (tg.size) (tg.buffer->mapped() ? *tg.buffer : staging).flush();
-  if (staging.handle())
+    if (tg.size) (tg.staging ? *tg.staging : *tg.buffer).flush();
+  if (staging[0].handle() || staging[1].handle())
     vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
       for (const Target& tg : targets)
-        if (tg.size && !tg.buffer->mapped()) {
+        if (tg.size && tg.staging) {
           VkBufferCopy region{tg.stagingOffset, 0, tg.size};
-          vkCmdCopyBuffer(cb, staging.handle(), tg.buffer->handle(), 1, &region);
+          vkCmdCopyBuffer(cb, tg.staging->handle(), tg.buffer->handle(), 1, &region);
         }
       // Also orders the copies before the frames' reads, which come in later submissions.
       vk::bufferBarrier(cb, vk::kCopyWrite, vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);

@@ -203,9 +203,12 @@ class GpuScene {
 
  private:
   std::vector<uint32_t> startTextures(const Scene& scene, TextureLoad load);  // decode (or start to)
-  GeometryPlan planGeometry(const Scene& scene);                              // draws_, stats_ and the records
+  GeometryPlan planGeometry(const Scene& scene);                              // the streams' layout and the draws
+  void placeRecords(const Scene& scene, GeometryPlan& plan);                  // once made: draws_, instances, ids
   std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
-  void uploadGeometry(const GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials, GeometryUpload upload);
+  // Streams written and records made on all cores, then placed and written.
+  void uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
+                      GeometryUpload upload);
   void finishTextures();                                 // staging buffers to images, mips (a waited load)
   std::vector<uint32_t> nextBatch(bool wait);            // a deferred load's next textures, by the budget
   void startUpload(const std::vector<uint32_t>& batch);  // the same in one submission, not waited for

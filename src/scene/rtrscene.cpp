@@ -6,19 +6,23 @@
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <exception>
 #include <vector>
 
 #include <glm/geometric.hpp>
 
 #include "cluster.h"
 #include "core/bounds.hpp"
+#include "core/error.hpp"
 #include "scene/binio.hpp"
+#include "scene/rtrscene_arrays.hpp"
 #include "scene/rtrscene_lod.hpp"
 #include "core/parallel.hpp"
 #include "scene/baked_texels.hpp"
 #include "scene/rtrscene_texs.hpp"
 
 namespace rtr {
+using namespace rtrscene;
 namespace {
 
 constexpr char kMagic[8] = {'R', 'T', 'R', 'S', 'C', 'E', 'N', 'E'};
@@ -26,10 +30,8 @@ constexpr size_t kHeaderSize = 80;
 constexpr size_t kAlign = 16;
 constexpr uint32_t kMaxString = 32768;
 
-constexpr uint32_t kHasView = 1u << 0;                                                      // header flags
-constexpr uint32_t kLightFalloff = 1u << 0;                                                 // light flags
-constexpr uint32_t kHasNormals = 1u << 0, kHasTexcoords = 1u << 1, kIndex16 = 1u << 2;      // mesh flags
-constexpr uint32_t kHasTexcoords1 = 1u << 3, kHasTangents = 1u << 4, kHasColors = 1u << 5;  // version 5
+constexpr uint32_t kHasView = 1u << 0;       // header flags
+constexpr uint32_t kLightFalloff = 1u << 0;  // light flags
 constexpr uint32_t kKnownMaterialFlags4 = kMaterialAlphaMasked | kMaterialDoubleSided | kMaterialLight;
 constexpr uint32_t kKnownMaterialFlags = kKnownMaterialFlags4 | kMaterialBlend | kMaterialUnlit | kMaterialGltf;
 constexpr uint32_t kNearestMag = 1u << 0, kNearestMin = 1u << 1, kNearestMip = 1u << 2;  // texture filter bits
@@ -103,257 +105,6 @@ const char* lightFault(const Light& l) {
   if ((l.kind == Light::Kind::Spot || l.kind == Light::Kind::Directional) && std::abs(glm::length(l.direction) - 1.0f) > 1e-3f)
     return "direction is not a unit vector";
   return nullptr;
-}
-
-// Where a mesh's arrays and clusters lie in the file: found by the first pass over the records, copied out
-// and checked by the second, on all cores.
-enum Stream : uint8_t { kPositions, kNormals, kTexcoords, kTexcoords1, kTangents, kColors, kIndices, kClusters };
-constexpr size_t kVertexStreams = kIndices;  // the per-vertex arrays, in file order
-constexpr size_t kVertexSize[kVertexStreams] = {12, 12, 8, 8, 16, 16};
-constexpr uint32_t kStreamFlag[kVertexStreams] = {0, kHasNormals, kHasTexcoords, kHasTexcoords1, kHasTangents, kHasColors};
-constexpr const char* kStreamName[kVertexStreams] = {"positions", "normals", "texcoords", "texcoords1", "tangents", "colors"};
-
-struct MeshLayout {
-  uint32_t flags = 0, vertices = 0, indices = 0, clusters = 0;
-  size_t at[kVertexStreams] = {}, indexAt = 0, clusterHeaderAt = 0, clusterAt = 0;
-  size_t count(Stream s) const { return s == kIndices ? indices : s == kPositions || (flags & kStreamFlag[s]) ? vertices : 0; }
-  size_t elementSize(Stream s) const { return s == kIndices ? (flags & kIndex16 ? 2 : 4) : kVertexSize[s]; }
-};
-
-// A fault found by a worker. Of several, the one at the lowest offset is reported, so the message does
-// not depend on the thread count.
-struct Fault {
-  size_t at = SIZE_MAX;
-  std::string what;
-};
-
-template <class T>
-T load(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-std::string meshName(uint32_t i) { return "mesh " + std::to_string(i); }
-
-void checkFinite(const uint8_t* p, size_t at, int floats, const char* what) {
-  for (int k = 0; k < floats; ++k)
-    if (!std::isfinite(load<float>(p + 4 * k))) throw Fault{at + 4 * size_t(k), std::string(what) + " is not finite"};
-}
-
-// A piece of the second pass: copy one of a mesh's arrays out of the file, or check elements
-// [first, first + count) of one (the checks read the file's bytes, not the copies, so they need not wait).
-struct Job {
-  uint32_t mesh;
-  Stream stream;
-  bool copy;
-  size_t first, count, cost;
-};
-
-// The arrays are aligned in the file, and the file in memory (decodeRtrScene sees to it).
-template <class T>
-const T* as(const uint8_t* base, size_t at) {
-  return reinterpret_cast<const T*>(base + at);
-}
-
-// assign copies without first zeroing the vectors (a resize would write every byte twice).
-template <class T>
-void copyTo(std::vector<T>& v, const uint8_t* base, size_t at, size_t n) {
-  v.assign(as<T>(base, at), as<T>(base, at) + n);
-}
-
-void copyStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base) {
-  const size_t v = l.vertices, n = l.indices;
-  switch (s) {
-    case kPositions: copyTo(m.positions, base, l.at[s], v); break;
-    case kNormals: copyTo(m.normals, base, l.at[s], v); break;
-    case kTexcoords: copyTo(m.texcoords, base, l.at[s], v); break;
-    case kTexcoords1: copyTo(m.texcoords1, base, l.at[s], v); break;
-    case kTangents: copyTo(m.tangents, base, l.at[s], v); break;
-    case kColors: copyTo(m.colors, base, l.at[s], v); break;
-    case kIndices:
-      if (l.flags & kIndex16) m.indices.assign(as<uint16_t>(base, l.indexAt), as<uint16_t>(base, l.indexAt) + n);
-      else m.indices.assign(as<uint32_t>(base, l.indexAt), as<uint32_t>(base, l.indexAt) + n);
-      break;
-    case kClusters: break;
-  }
-}
-
-// Elements [first, end) of an array of T at p must pass `ok`, a test without branches so that the scan
-// runs at memory speed; a block that fails is scanned again by `exact`, which throws the fault.
-template <class T, class Ok, class Exact>
-void scan(const uint8_t* p, size_t first, size_t end, Ok ok, Exact exact) {
-  constexpr size_t kBlock = 1024;
-  for (size_t b = first; b < end; b += kBlock) {
-    const size_t e = std::min(end, b + kBlock);
-    bool good = true;
-    for (size_t k = b; k < e; ++k) good &= ok(load<T>(p + k * sizeof(T)));
-    if (!good)
-      for (size_t k = b; k < e; ++k) exact(k, load<T>(p + k * sizeof(T)));
-  }
-}
-
-template <class Index>
-void checkIndices(const MeshLayout& l, const uint8_t* base, uint32_t i, size_t first, size_t end) {
-  scan<Index>(
-      base + l.indexAt, first, end, [&](Index v) { return v < l.vertices; },
-      [&](size_t k, Index v) {
-        if (v >= l.vertices)
-          throw Fault{l.indexAt + k * sizeof(Index), meshName(i) + ": index " + std::to_string(v) + " out of range (" +
-                                                         std::to_string(l.vertices) + " vertices)"};
-      });
-}
-
-// Finite when every component times 0 is 0 (an infinity or a NaN gives NaN): no branch, no overflow.
-template <int N>
-bool allFinite(glm::vec<N, float> v) {
-  float z = 0.0f;
-  for (int c = 0; c < N; ++c) z += v[c] * 0.0f;
-  return z == 0.0f;
-}
-
-template <int N>
-void checkFiniteArray(const uint8_t* base, size_t at, size_t first, size_t end, const std::string& what) {
-  using V = glm::vec<N, float>;
-  scan<V>(base + at, first, end, allFinite<N>, [&](size_t k, V v) {
-    if (!allFinite<N>(v)) throw Fault{at + k * sizeof(V), what + " is not finite"};
-  });
-}
-
-void checkArray(const Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i, Stream s, size_t first, size_t end) {
-  const Bounds& b = m.bounds;  // finite (read as such): a NaN or an infinity is never inside
-  auto inside = [&](glm::vec3 p) {
-    return (p.x >= b.min.x) & (p.y >= b.min.y) & (p.z >= b.min.z) & (p.x <= b.max.x) & (p.y <= b.max.y) & (p.z <= b.max.z);
-  };
-  const size_t at = s < kVertexStreams ? l.at[s] : 0;
-  switch (s) {
-    case kPositions:
-      return scan<glm::vec3>(base + at, first, end, inside, [&](size_t k, glm::vec3 p) {
-        if (!allFinite<3>(p)) throw Fault{at + k * 12, meshName(i) + ": position " + std::to_string(k) + " is not finite"};
-        if (!inside(p))
-          throw Fault{at + k * 12, meshName(i) + ": position " + std::to_string(k) + " lies outside the mesh bounds"};
-      });
-    case kNormals: return checkFiniteArray<3>(base, at, first, end, meshName(i) + ": a normal");
-    case kTexcoords: return checkFiniteArray<2>(base, at, first, end, meshName(i) + ": a texcoord");
-    case kTexcoords1: return checkFiniteArray<2>(base, at, first, end, meshName(i) + ": a second-set texcoord");
-    case kTangents: return checkFiniteArray<4>(base, at, first, end, meshName(i) + ": a tangent");
-    case kColors: return checkFiniteArray<4>(base, at, first, end, meshName(i) + ": a vertex colour");
-    case kIndices:
-      return l.flags & kIndex16 ? checkIndices<uint16_t>(l, base, i, first, end) : checkIndices<uint32_t>(l, base, i, first, end);
-    case kClusters: return;
-  }
-}
-
-// Clusters [first, end) of mesh i, read into m.clusters. They must tile the mesh's triangles in order, each
-// within the GPU's limits, its sphere holding its vertices: the culling pass and the compute rasteriser
-// trust them.
-template <class Index>
-void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i, size_t first, size_t end) {
-  static_assert(CLUSTER_MAX_VERTICES < 128, "the vertex set below holds 128");
-  const uint32_t triangles = l.indices / 3;
-  auto fault = [&](size_t at, size_t k, const std::string& what) {
-    throw Fault{at, meshName(i) + ": cluster " + std::to_string(k) + ": " + what};
-  };
-  // Where cluster k must start: where the one before it ended (that one's faults are its own piece's).
-  uint64_t next = 0;
-  if (first > 0) {
-    const uint8_t* prev = base + l.clusterAt + (first - 1) * 40;
-    next = uint64_t(load<uint32_t>(prev + 32)) + load<uint32_t>(prev + 36);
-  }
-  for (size_t k = first; k < end; ++k) {
-    const size_t cAt = l.clusterAt + k * 40;
-    const uint8_t* p = base + cAt;
-    checkFinite(p, cAt, 4, "a cluster's sphere");
-    checkFinite(p + 16, cAt + 16, 4, "a cluster's cone");
-    Cluster& c = m.clusters[k];
-    c.center = load<glm::vec3>(p);
-    c.radius = load<float>(p + 12);
-    c.coneAxis = load<glm::vec3>(p + 16);
-    c.coneCutoff = load<float>(p + 28);
-    c.firstTriangle = load<uint32_t>(p + 32);
-    c.triangleCount = load<uint32_t>(p + 36);
-    if (!(c.radius >= 0.0f)) fault(cAt + 12, k, "negative radius");
-    // A cone that culls (cutoff < 1) has a unit axis and a cutoff >= 0 (meshoptimizer's); others would cull
-    // clusters that face the eye.
-    if (c.coneCutoff < 1.0f && (c.coneCutoff < 0.0f || std::abs(glm::length(c.coneAxis) - 1.0f) > 1e-3f))
-      fault(cAt + 16, k, "cone axis not a unit vector or cutoff below 0");
-    if (c.firstTriangle != next)
-      fault(cAt + 32, k,
-            "first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
-                " (clusters tile the triangles in order)");
-    // Past the end only when the cluster before is damaged: its piece reports that, at a lower offset.
-    const uint32_t left = next <= triangles ? triangles - uint32_t(next) : 0;
-    if (c.triangleCount < 1 || c.triangleCount > CLUSTER_MAX_TRIANGLES || c.triangleCount > left)
-      fault(cAt + 36, k,
-            "triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
-                std::to_string(std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, left)));
-    next += c.triangleCount;
-    // Its distinct vertices gathered first (a small open-addressed set: at most 65 of 128 slots filled),
-    // then their positions read together: they are scattered over the array, the loads overlap.
-    uint32_t seen[128], vertices[CLUSTER_MAX_VERTICES];
-    std::fill(std::begin(seen), std::end(seen), ~0u);
-    uint32_t distinct = 0;
-    for (size_t t = size_t(c.firstTriangle) * 3; t < size_t(next) * 3; ++t) {
-      const uint32_t v = load<Index>(base + l.indexAt + t * sizeof(Index));
-      if (v >= l.vertices) continue;  // refused by the index check, at a lower offset
-      uint32_t h = (v * 0x9E3779B1u) >> 25;
-      while (seen[h] != v && seen[h] != ~0u) h = (h + 1) & 127;
-      if (seen[h] == v) continue;
-      seen[h] = v;
-      if (distinct == CLUSTER_MAX_VERTICES) fault(cAt, k, "more than " + std::to_string(CLUSTER_MAX_VERTICES) + " vertices");
-      vertices[distinct++] = v;
-    }
-    const float slack = c.radius * 1e-4f + 1e-6f * (std::abs(c.center.x) + std::abs(c.center.y) + std::abs(c.center.z));
-    for (uint32_t j = 0; j < distinct; ++j)
-      if (!(glm::length(load<glm::vec3>(base + l.at[kPositions] + size_t(vertices[j]) * 12) - c.center) <= c.radius + slack))
-        fault(cAt, k, "vertex " + std::to_string(vertices[j]) + " lies outside its bounding sphere");
-  }
-  if (end == l.clusters && next != triangles)
-    throw Fault{l.clusterHeaderAt,
-                meshName(i) + ": clusters cover " + std::to_string(next) + " of " + std::to_string(triangles) + " triangles"};
-}
-
-// The second pass: every array copied out of the file and every value, index and cluster checked, in
-// pieces on `threads` threads, biggest first.
-void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<MeshLayout>& layout, unsigned threads,
-                const ByteReader& r) {
-  constexpr size_t kPiece = size_t(1) << 18, kClusterPiece = 2048;
-  std::vector<Job> jobs;
-  for (uint32_t i = 0; i < layout.size(); ++i) {
-    const MeshLayout& l = layout[i];
-    for (uint8_t s = kPositions; s <= kIndices; ++s) {
-      const size_t count = l.count(Stream(s)), size = l.elementSize(Stream(s));
-      if (count == 0) continue;
-      jobs.push_back({i, Stream(s), true, 0, count, 2 * count * size});  // writes cost more: fresh pages
-      for (size_t f = 0; f < count; f += kPiece) {
-        const size_t n = std::min(kPiece, count - f);
-        jobs.push_back({i, Stream(s), false, f, n, n * size});
-      }
-    }
-    for (size_t f = 0; f < l.clusters; f += kClusterPiece) {
-      const size_t n = std::min<size_t>(kClusterPiece, l.clusters - f);
-      jobs.push_back({i, kClusters, false, f, n, n * 1000});  // ~124 triangles' indices and ~64 positions each
-    }
-  }
-  std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.cost > b.cost; });
-  Fault first;
-  std::mutex firstMutex;
-  parallelFor(jobs.size(), threads, [&](size_t j) {
-    const Job& job = jobs[j];
-    Mesh& m = scene.meshes[job.mesh];
-    const MeshLayout& l = layout[job.mesh];
-    try {
-      if (job.copy) copyStream(m, l, job.stream, bytes.data());
-      else if (job.stream == kClusters && (l.flags & kIndex16))
-        checkClusters<uint16_t>(m, l, bytes.data(), job.mesh, job.first, job.first + job.count);
-      else if (job.stream == kClusters) checkClusters<uint32_t>(m, l, bytes.data(), job.mesh, job.first, job.first + job.count);
-      else checkArray(m, l, bytes.data(), job.mesh, job.stream, job.first, job.first + job.count);
-    } catch (Fault& f) {
-      std::lock_guard lock(firstMutex);
-      if (f.at < first.at) first = std::move(f);
-    }
-  });
-  if (first.at != SIZE_MAX) r.failAt(first.at, first.what);
 }
 
 // Version 6: chunks to the end of the payload. An unknown or repeated tag is refused, named with its offset.
@@ -807,12 +558,19 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
   }
   if (version < 6 && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
   const std::optional<ChunkSpan> clod = readChunks(r, bytes, scene, owner, file);
-  readArrays(bytes, scene, layout, threads, r);
+  // The hierarchies' mesh records are read first, their records and indices with the meshes' arrays. A
+  // fault in those mesh records waits: the arrays, before the chunk, may hold one at a lower offset.
+  std::vector<LodLayout> lods;
+  std::exception_ptr lodFault;
   if (clod) {
     ByteReader body(bytes.first(clod->body + clod->size), file);
     body.skip(clod->body, "a chunk");
-    readClusterLods(body, clod->size, scene);
+    try {
+      readClusterLodLayout(body, clod->size, scene, lods);
+    } catch (const Error&) { lodFault = std::current_exception(); }
   }
+  readArrays(bytes, scene, layout, lods, threads, r);
+  if (lodFault) std::rethrow_exception(lodFault);
   return scene;
 }
 

@@ -6,8 +6,6 @@
 #include <cstring>
 #include <vector>
 
-#include "core/parallel.hpp"
-
 #include "cluster.h"
 #include "cluster_lod.h"
 
@@ -59,7 +57,7 @@ void writeClusterLods(ByteWriter& w, const Scene& scene) {
   }
 }
 
-void readClusterLods(ByteReader& r, uint64_t size, Scene& scene) {
+void readClusterLodLayout(ByteReader& r, uint64_t size, Scene& scene, std::vector<LodLayout>& layout) {
   const size_t end = r.pos() + size;
   auto left = [&] { return end - r.pos(); };
   if (size < 16) r.fail("CLOD chunk: " + std::to_string(size) + " bytes, shorter than its 16-byte header");
@@ -89,95 +87,96 @@ void readClusterLods(ByteReader& r, uint64_t size, Scene& scene) {
     if ((uint64_t(count) * kClusterSize + uint64_t(indexCount) * 4) > left())
       r.failAt(at + 8, which + std::to_string(count) + " clusters and " + std::to_string(indexCount) +
                            " indices cannot fit in the chunk");
-    ClusterLod& lod = m.lod;
-    lod.levels = levels;
-    lod.clusters.resize(count);
-    const uint32_t triangles = m.triangleCount();
-    auto cl = [&](size_t k) { return which + "cluster " + std::to_string(k) + ": "; };  // built only for an error
-    // Each record read and checked on its own in pieces on all cores (a serial read of the fields was most of
-    // the chunk's time at 10 M triangles); the checks that chain records (levels, triangle runs) follow.
-    const size_t clustersAt = r.pos();
-    const auto* bytes = reinterpret_cast<const uint8_t*>(r.view(size_t(count) * kClusterSize, "CLOD clusters").data());
-    constexpr size_t kPiece = 4096;
-    parallelFor((size_t(count) + kPiece - 1) / kPiece, 0, [&](size_t piece) {
-      for (size_t k = piece * kPiece, e = std::min<size_t>(k + kPiece, count); k < e; ++k) {
-        const size_t cAt = clustersAt + k * kClusterSize;
-        const uint8_t* q = bytes + k * kClusterSize;
-        auto u32 = [&](size_t o) { return load<uint32_t>(q + o); };
-        auto f32 = [&](size_t o, const char* what) {
-          const float f = load<float>(q + o);
-          if (!std::isfinite(f)) r.failAt(cAt + o, std::string("CLOD chunk: ") + what + " is not finite");
-          return f;
-        };
-        auto v4 = [&](size_t o, const char* what) {
-          return glm::vec4(f32(o, what), f32(o + 4, what), f32(o + 8, what), f32(o + 12, what));
-        };
-        LodCluster& c = lod.clusters[k];
-        c.firstTriangle = u32(0);
-        c.triangleCount = u32(4);
-        c.level = u32(8);
-        c.error = f32(12, "a cluster's error");
-        const glm::vec4 bounds = v4(16, "a cluster's sphere"), cone = v4(32, "a cluster's cone");
-        c.center = glm::vec3(bounds);
-        c.radius = bounds.w;
-        c.coneAxis = glm::vec3(cone);
-        c.coneCutoff = cone.w;
-        c.sphere = v4(48, "a cluster's error sphere");
-        c.parentSphere = v4(64, "a cluster's parent sphere");
-        c.parentError = f32(80, "a cluster's parent error");
-        if (u32(84) != 0 || u32(88) != 0 || u32(92) != 0) r.failAt(cAt + 84, cl(k) + "reserved field is not 0");
-        if (k < base) {  // level 0: the mesh's own clusters
-          const Cluster& own = m.clusters[k];
-          if (c.level != 0 || c.firstTriangle != own.firstTriangle || c.triangleCount != own.triangleCount || c.error != 0.0f)
-            r.failAt(cAt, cl(k) + "level 0 must be the mesh's cluster " + std::to_string(k) + " with error 0");
-        }
-        if (!(c.radius >= 0.0f && c.sphere.w >= 0.0f && c.parentSphere.w >= 0.0f && c.error >= 0.0f))
-          r.failAt(cAt + 12, cl(k) + "negative radius or error");
-        if (!(c.parentError > c.error) || c.parentError > shader::LOD_ERROR_INFINITE)
-          r.failAt(cAt + 80, cl(k) + "parent error not above its own error");
-        if (c.coneCutoff < 1.0f && (c.coneCutoff < 0.0f || std::abs(glm::length(c.coneAxis) - 1.0f) > 1e-3f))
-          r.failAt(cAt + 32, cl(k) + "cone axis not a unit vector or cutoff below 0");
-      }
-    });
-    uint64_t next = triangles;  // where the next cluster above level 0 starts
-    for (size_t k = base; k < count; ++k) {
-      const size_t cAt = clustersAt + k * kClusterSize;
-      const LodCluster& c = lod.clusters[k];
-      const uint32_t prev = lod.clusters[k - 1].level;
-      if (c.level < std::max(prev, 1u) || c.level >= levels)
-        r.failAt(cAt + 8, cl(k) + "level " + std::to_string(c.level) + " not in " + std::to_string(std::max(prev, 1u)) + ".." +
-                              std::to_string(levels - 1));
-      if (c.firstTriangle != next)
-        r.failAt(cAt, cl(k) + "first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
-                          " (clusters tile the hierarchy's triangles in order)");
-      if (c.triangleCount < 1 || c.triangleCount > CLUSTER_MAX_TRIANGLES || next + c.triangleCount > triangles + indexCount / 3)
-        r.failAt(cAt + 4, cl(k) + "triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
-                              std::to_string(CLUSTER_MAX_TRIANGLES) + " or past the hierarchy's triangles");
-      next += c.triangleCount;
-    }
-    if (next != uint64_t(triangles) + indexCount / 3)
-      r.failAt(at + 12,
-               which + std::to_string(indexCount / 3) + " triangles, but its clusters hold " + std::to_string(next - triangles));
-    const size_t iAt = r.pos();
-    r.array(lod.indices, indexCount, "CLOD indices");
-    // Checked in pieces on all cores (the hierarchy holds about as many indices as the mesh); the first
-    // bad one is reported, as a serial check would.
-    constexpr size_t kIndexPiece = size_t(1) << 20;
-    std::vector<size_t> bad((lod.indices.size() + kIndexPiece - 1) / kIndexPiece, SIZE_MAX);
-    parallelFor(bad.size(), 0, [&](size_t p) {
-      for (size_t k = p * kIndexPiece, e = std::min(k + kIndexPiece, lod.indices.size()); k < e; ++k)
-        if (lod.indices[k] >= m.positions.size()) {
-          bad[p] = k;
-          return;
-        }
-    });
-    for (const size_t k : bad)
-      if (k != SIZE_MAX)
-        r.failAt(iAt + 4 * k, which + "index " + std::to_string(lod.indices[k]) + " out of range (" +
-                                  std::to_string(m.positions.size()) + " vertices)");
+    LodLayout l{mi, count, indexCount, at};
+    l.clustersAt = r.skipArray(count, kClusterSize, "CLOD clusters");
+    l.indicesAt = r.skipArray(indexCount, 4, "CLOD indices");
     r.align(16, "CLOD indices");
+    m.lod.levels = levels;
+
+    layout.push_back(l);
   }
   if (r.pos() != end) r.fail("CLOD chunk: " + std::to_string(end - r.pos()) + " bytes after its last mesh");
+}
+
+void readLodClusters(Mesh& m, const LodLayout& l, const uint8_t* file, size_t ownClustersAt, uint32_t triangles, size_t first,
+                     size_t end) {
+  const size_t base = m.clusters.size();
+  const uint64_t all = uint64_t(triangles) + l.indexCount / 3;
+  const std::string which = "CLOD chunk: mesh " + std::to_string(l.mesh) + ": ";
+  auto fault = [&](size_t at, size_t k, const std::string& what) {
+    throw ReadFault{at, which + "cluster " + std::to_string(k) + ": " + what};
+  };
+  auto u32 = [&](size_t k, size_t o) { return load<uint32_t>(file + l.clustersAt + k * kClusterSize + o); };
+  for (size_t k = first; k < end; ++k) {
+    const size_t cAt = l.clustersAt + k * kClusterSize;
+    const uint8_t* q = file + cAt;
+    // A record's checks in a fixed order (its first fault is thrown); of several records, rtrscene.cpp
+    // reports the lowest fault.
+    LodCluster& c = m.lod.clusters[k];
+    c.firstTriangle = u32(k, 0);
+    c.triangleCount = u32(k, 4);
+    c.level = u32(k, 8);
+    c.error = load<float>(q + 12);
+    if (k < base) {  // level 0: the mesh's own clusters (their records in the file: 40 bytes, triangles at 32)
+      const uint8_t* own = file + ownClustersAt + k * 40;
+      if (c.level != 0 || c.firstTriangle != load<uint32_t>(own + 32) || c.triangleCount != load<uint32_t>(own + 36) ||
+          c.error != 0.0f)
+        fault(cAt, k, "level 0 must be the mesh's cluster " + std::to_string(k) + " with error 0");
+    } else {  // above: levels in order, triangles tiling the hierarchy's after the mesh's own
+      const uint64_t next = k == base ? triangles : uint64_t(u32(k - 1, 0)) + u32(k - 1, 4);
+      if (c.firstTriangle != next)
+        fault(cAt, k,
+              "first triangle " + std::to_string(c.firstTriangle) + " is not " + std::to_string(next) +
+                  " (clusters tile the hierarchy's triangles in order)");
+      if (c.triangleCount < 1 || c.triangleCount > CLUSTER_MAX_TRIANGLES || next + c.triangleCount > all)
+        fault(cAt + 4, k,
+              "triangle count " + std::to_string(c.triangleCount) + " not in 1.." + std::to_string(CLUSTER_MAX_TRIANGLES) +
+                  " or past the hierarchy's triangles");
+      const uint32_t prev = u32(k - 1, 8);
+      if (c.level < std::max(prev, 1u) || c.level >= m.lod.levels)
+        fault(cAt + 8, k,
+              "level " + std::to_string(c.level) + " not in " + std::to_string(std::max(prev, 1u)) + ".." +
+                  std::to_string(m.lod.levels - 1));
+    }
+    for (size_t o = 12; o < 84; o += 4)
+      if (!std::isfinite(load<float>(q + o)))
+        throw ReadFault{cAt + o, std::string("CLOD chunk: ") +
+                                     (o == 12  ? "a cluster's error"
+                                      : o < 32 ? "a cluster's sphere"
+                                      : o < 48 ? "a cluster's cone"
+                                      : o < 64 ? "a cluster's error sphere"
+                                      : o < 80 ? "a cluster's parent sphere"
+                                               : "a cluster's parent error") +
+                                     " is not finite"};
+    const glm::vec4 bounds = load<glm::vec4>(q + 16), cone = load<glm::vec4>(q + 32);
+    c.center = glm::vec3(bounds);
+    c.radius = bounds.w;
+    c.coneAxis = glm::vec3(cone);
+    c.coneCutoff = cone.w;
+    c.sphere = load<glm::vec4>(q + 48);
+    c.parentSphere = load<glm::vec4>(q + 64);
+    c.parentError = load<float>(q + 80);
+    if (!(c.radius >= 0.0f && c.sphere.w >= 0.0f && c.parentSphere.w >= 0.0f && c.error >= 0.0f))
+      fault(cAt + 12, k, "negative radius or error");
+    if (c.coneCutoff < 1.0f && (c.coneCutoff < 0.0f || std::abs(glm::length(c.coneAxis) - 1.0f) > 1e-3f))
+      fault(cAt + 32, k, "cone axis not a unit vector or cutoff below 0");
+    if (!(c.parentError > c.error) || c.parentError > shader::LOD_ERROR_INFINITE)
+      fault(cAt + 80, k, "parent error not above its own error");
+    if (u32(k, 84) != 0 || u32(k, 88) != 0 || u32(k, 92) != 0) fault(cAt + 84, k, "reserved field is not 0");
+  }
+  if (end == l.count) {  // the clusters above level 0 hold the hierarchy's triangles
+    const uint64_t held = l.count > base ? uint64_t(u32(l.count - 1, 0)) + u32(l.count - 1, 4) - triangles : 0;
+    if (held != l.indexCount / 3)
+      throw ReadFault{l.at + 12,
+                      which + std::to_string(l.indexCount / 3) + " triangles, but its clusters hold " + std::to_string(held)};
+  }
+}
+
+void checkLodIndices(const LodLayout& l, const uint8_t* file, size_t vertices, size_t first, size_t end) {
+  for (size_t k = first; k < end; ++k)
+    if (const uint32_t v = load<uint32_t>(file + l.indicesAt + 4 * k); v >= vertices)
+      throw ReadFault{l.indicesAt + 4 * k, "CLOD chunk: mesh " + std::to_string(l.mesh) + ": index " + std::to_string(v) +
+                                               " out of range (" + std::to_string(vertices) + " vertices)"};
 }
 
 }  // namespace rtr

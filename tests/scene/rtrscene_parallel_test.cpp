@@ -206,3 +206,91 @@ TEST(RtrSceneParallel, Version4RefusesADamagedPieceAndOlderFilesStillLoad) {
   v7[8] = 7;
   EXPECT_THAT(decodeError(v7, 1), HasSubstr("byte 8: unsupported version 7 (this build reads 6)"));
 }
+
+namespace {
+
+// severalMeshes() with a hierarchy on its big mesh (made up, valid as the reader checks it): level 0 its
+// ~2 600 clusters, then `above` one-triangle clusters of level 1, so that its records and indices are
+// read in several pieces.
+Scene withHierarchy(uint32_t above) {
+  Scene s = severalMeshes();
+  Mesh& m = s.meshes[1];
+  m.lod.levels = 2;
+  for (const Cluster& c : m.clusters) {
+    LodCluster l;
+    l.firstTriangle = c.firstTriangle, l.triangleCount = c.triangleCount;
+    l.center = c.center, l.radius = c.radius, l.coneAxis = c.coneAxis, l.coneCutoff = c.coneCutoff;
+    l.sphere = glm::vec4(c.center, c.radius), l.parentSphere = glm::vec4(c.center, 2.0f * c.radius), l.parentError = 1.0f;
+    m.lod.clusters.push_back(l);
+  }
+  for (uint32_t k = 0; k < above; ++k) {
+    LodCluster l;
+    l.firstTriangle = m.triangleCount() + k, l.triangleCount = 1, l.level = 1, l.error = 1.0f, l.parentError = 2.0f;
+    l.radius = 1.0f, l.sphere = l.parentSphere = glm::vec4(0, 0, 0, 1);
+    m.lod.clusters.push_back(l);
+    m.lod.indices.insert(m.lod.indices.end(), {3 * k % 1000, 3 * k % 1000 + 1, 3 * k % 1000 + 2});
+  }
+  return s;
+}
+
+size_t lodRecordAt(const std::string& bytes, size_t k) { return bytes.rfind("CLOD") + 16 + 16 + 16 + 96 * k; }
+
+}  // namespace
+
+// The CLOD chunk is read with the meshes' arrays, in pieces: the hierarchy decoded is one thread's at any
+// thread count, records checked against the one before across pieces, and of several faults (records,
+// indices, the arrays before the chunk, a mesh record of the chunk) the one earliest in the file is reported.
+TEST(RtrSceneParallel, TheHierarchyIsReadInPiecesAsOneThreadReadsIt) {
+  const Scene s = withHierarchy(6000);
+  const ClusterLod& want = s.meshes[1].lod;
+  ASSERT_GT(want.clusters.size(), 2u * 4096u) << "records in several pieces";
+  const std::string good = encodeRtrScene(s);
+  for (unsigned threads : {1u, 2u, 3u, 8u, 0u}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const Scene got = decode(good, threads);
+    const ClusterLod& lod = got.meshes[1].lod;
+    EXPECT_EQ(lod.levels, 2u);
+    EXPECT_EQ(lod.indices, want.indices);
+    ASSERT_EQ(lod.clusters.size(), want.clusters.size());
+    EXPECT_EQ(std::memcmp(lod.clusters.data(), want.clusters.data(), want.clusters.size() * sizeof(LodCluster)), 0);
+    EXPECT_EQ(encodeRtrScene(got), good);
+  }
+  auto poke = [](std::string& b, size_t at, uint32_t v) { std::memcpy(b.data() + at, &v, 4); };
+  // The last record of the first piece covers two triangles: only the next one, in the next piece, sees it.
+  const size_t k = 4095, rec = lodRecordAt(good, k);
+  uint32_t first;
+  std::memcpy(&first, good.data() + rec, 4);
+  ASSERT_EQ(first, want.clusters[k].firstTriangle);
+  std::string b = good;
+  poke(b, rec + 4, 2);
+  reseal(b);
+  // A later record and a later index damaged too.
+  poke(b, lodRecordAt(good, 8000) + 8, 0);                                    // level 0 above level 0
+  const size_t indexAt = lodRecordAt(good, want.clusters.size()) + 4 * 9000;  // the indices follow the records
+  poke(b, indexAt, 1u << 30);
+  reseal(b);
+  const std::string expect = "p.rtrscene: byte " + std::to_string(rec + 96) +
+                             ": CLOD chunk: mesh 1: cluster 4096: first triangle " + std::to_string(first + 1) + " is not " +
+                             std::to_string(first + 2);
+  for (unsigned threads : {1u, 2u, 8u}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    EXPECT_THAT(decodeError(b, threads), HasSubstr(expect));
+  }
+  std::string idx = good;  // the index alone
+  poke(idx, indexAt, 1u << 30);
+  reseal(idx);
+  EXPECT_THAT(decodeError(idx, 8),
+              HasSubstr("byte " + std::to_string(indexAt) + ": CLOD chunk: mesh 1: index 1073741824 out of range"));
+  // A damaged mesh record of the chunk waits for the arrays before it: a position of mesh 0 is reported.
+  std::string both = good;
+  poke(both, good.rfind("CLOD") + 16 + 16 + 4, 0);  // level count 0
+  reseal(both);
+  EXPECT_THAT(decodeError(both, 8), HasSubstr("CLOD chunk: mesh 1: level count 0"));
+  const glm::vec3 p0 = s.meshes[0].positions[7];
+  const size_t posAt = good.find(std::string(reinterpret_cast<const char*>(&p0), 12));
+  const float nan = std::nanf("");
+  std::memcpy(both.data() + posAt, &nan, 4);
+  reseal(both);
+  for (unsigned threads : {1u, 8u})
+    EXPECT_THAT(decodeError(both, threads), HasSubstr("byte " + std::to_string(posAt) + ": mesh 0: position 7 is not finite"));
+}
