@@ -68,22 +68,36 @@ std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
 }
 
 // Each vertex's first vertex at the same position: clusters on the two sides of a seam (vertices split
-// by normal or uv) are neighbours, so a group may hold both sides and the simplifier sees the seam.
+// by normal or uv) are neighbours, so a group may hold both sides and the simplifier sees the seam. The
+// positions' bits are sorted with their vertices (a comparator that looked them up missed the cache at
+// every step), then each fixed piece of the sorted list names its runs from the run's first vertex.
 std::vector<uint32_t> positionIds(const Mesh& mesh, unsigned threads) {
-  using Key = std::array<uint32_t, 3>;
-  auto key = [&](uint32_t v) {
-    Key k;
-    std::memcpy(k.data(), &mesh.positions[v], sizeof(k));
-    return k;
+  struct Key {
+    std::array<uint32_t, 3> bits;
+    uint32_t vertex;
+    auto operator<=>(const Key&) const = default;
   };
-  std::vector<uint32_t> order(mesh.positions.size()), id(mesh.positions.size());
-  std::iota(order.begin(), order.end(), 0u);
-  parallelSort(order, threads, [&](uint32_t a, uint32_t b) {
-    const Key ka = key(a), kb = key(b);
-    return ka != kb ? ka < kb : a < b;
+  constexpr size_t kPiece = size_t(1) << 16;
+  const size_t n = mesh.positions.size(), pieces = (n + kPiece - 1) / kPiece;
+  std::vector<Key> keys(n);
+  std::vector<uint32_t> id(n);
+  parallelFor(pieces, threads, [&](size_t p) {
+    for (size_t v = p * kPiece; v < std::min(n, (p + 1) * kPiece); ++v) {
+      std::memcpy(keys[v].bits.data(), &mesh.positions[v], sizeof(keys[v].bits));
+      keys[v].vertex = uint32_t(v);
+    }
   });
-  for (size_t k = 0; k < order.size(); ++k)
-    id[order[k]] = k > 0 && key(order[k]) == key(order[k - 1]) ? id[order[k - 1]] : order[k];
+  parallelSort(keys, threads);
+  parallelFor(pieces, threads, [&](size_t p) {
+    const size_t begin = p * kPiece, end = std::min(n, begin + kPiece);
+    const auto run =
+        std::partition_point(keys.begin(), keys.begin() + begin, [&](const Key& k) { return k.bits < keys[begin].bits; });
+    uint32_t first = run->vertex;  // keys[begin]'s own where its run starts in this piece
+    for (size_t k = begin; k < end; ++k) {
+      if (k > begin && keys[k].bits != keys[k - 1].bits) first = keys[k].vertex;
+      id[keys[k].vertex] = first;
+    }
+  });
   return id;
 }
 
@@ -94,7 +108,23 @@ std::vector<uint32_t> positionIds(const Mesh& mesh, unsigned threads) {
 // clusters kept every group inside the strip of the mesh that one run of level-0 clusters covers, and
 // the strips' borders stayed locked at every level (the 100M temple's statue kept 12 M triangles).
 constexpr size_t kGroupSize = 4;
-constexpr uint32_t kEdgePiece = 1024;  // clusters per piece of the edge listing (all cores)
+constexpr uint32_t kEdgePiece = 1024;           // clusters per piece of the edge listing (all cores)
+constexpr size_t kListPiece = size_t(1) << 16;  // entries per piece of a whole-level list
+constexpr size_t kGroupPiece = 256;             // groups per piece of a level's assembly
+
+// The pieces one after another (copied on all cores); the pieces are emptied.
+template <class T>
+std::vector<T> joined(std::vector<std::vector<T>>& pieces, unsigned threads) {
+  std::vector<size_t> at(pieces.size() + 1, 0);
+  for (size_t p = 0; p < pieces.size(); ++p) at[p + 1] = at[p] + pieces[p].size();
+  std::vector<T> out(at.back());
+  parallelFor(pieces.size(), threads, [&](size_t p) {
+    std::copy(pieces[p].begin(), pieces[p].end(), out.begin() + at[p]);
+    pieces[p] = {};
+  });
+  return out;
+}
+
 std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& clusters, const std::vector<uint32_t>& pos,
                                               unsigned threads) {
   const uint32_t n = uint32_t(clusters.size());
@@ -121,16 +151,23 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
       }
     }
   });
-  std::vector<Entry> all;
-  for (auto& piece : perPiece) all.insert(all.end(), piece.begin(), piece.end()), piece = {};
+  std::vector<Entry> all = joined(perPiece, threads);
   parallelSort(all, threads);
-  std::vector<uint64_t> pairs;  // (a << 32 | b), a < b: one per edge the two share
-  for (size_t i = 0, j; i < all.size(); i = j) {
-    for (j = i + 1; j < all.size() && all[j].edge == all[i].edge;) ++j;
-    for (size_t a = i; a < j; ++a)
-      for (size_t b = a + 1; b < j; ++b) pairs.push_back(uint64_t(all[a].cluster) << 32 | all[b].cluster);
-  }
+  // The pairs of clusters that share each edge, in fixed pieces of the list, each taking the edges whose
+  // entries start in it.
+  std::vector<std::vector<uint64_t>> pairPieces((all.size() + kListPiece - 1) / kListPiece);
+  parallelFor(pairPieces.size(), threads, [&](size_t p) {
+    size_t i = p * kListPiece;
+    const size_t end = std::min(all.size(), i + kListPiece);
+    while (i > 0 && i < end && all[i].edge == all[i - 1].edge) ++i;
+    for (size_t j; i < end; i = j) {
+      for (j = i + 1; j < all.size() && all[j].edge == all[i].edge;) ++j;
+      for (size_t a = i; a < j; ++a)
+        for (size_t b = a + 1; b < j; ++b) pairPieces[p].push_back(uint64_t(all[a].cluster) << 32 | all[b].cluster);
+    }
+  });
   all = {};
+  std::vector<uint64_t> pairs = joined(pairPieces, threads);  // (a << 32 | b), a < b: one per edge the two share
   parallelSort(pairs, threads);
   // Neighbours per cluster, with the edges they share (in neighbour order).
   std::vector<uint32_t> first(n + 1, 0);
@@ -147,7 +184,10 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
     const uint32_t a = uint32_t(pairs[i] >> 32), b = uint32_t(pairs[i]), e = uint32_t(j - i);
     links[fill[a]++] = {b, e}, links[fill[b]++] = {a, e};
   }
-  for (uint32_t c = 0; c < n; ++c) std::sort(links.begin() + first[c], links.begin() + first[c + 1]);
+  parallelFor((n + kEdgePiece - 1) / kEdgePiece, threads, [&](size_t p) {
+    for (uint32_t c = uint32_t(p) * kEdgePiece; c < std::min<uint64_t>(n, uint64_t(p + 1) * kEdgePiece); ++c)
+      std::sort(links.begin() + first[c], links.begin() + first[c + 1]);
+  });
   auto neighbours = [&](uint32_t c) { return std::span(links.data() + first[c], first[c + 1] - first[c]); };
 
   std::vector<int> group(n, -1);
@@ -269,10 +309,10 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     const auto* t = mesh.indices.data() + size_t(mc.firstTriangle) * 3;
     current.emplace_back(t, t + size_t(mc.triangleCount) * 3);
   }
-  auto add = [&](const Indices& tris, const meshopt_Bounds& b, uint32_t level, glm::vec4 sphere, float error) {
+  auto made = [&](size_t tris, const meshopt_Bounds& b, uint32_t level, size_t firstIndex, glm::vec4 sphere, float error) {
     LodCluster c;
-    c.firstTriangle = base + uint32_t(lod.indices.size() / 3);
-    c.triangleCount = uint32_t(tris.size() / 3);
+    c.firstTriangle = base + uint32_t(firstIndex / 3);
+    c.triangleCount = uint32_t(tris);
     c.level = level;
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
@@ -282,9 +322,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     c.error = error;
     c.parentSphere = c.sphere;
     c.parentError = shader::LOD_ERROR_INFINITE;
-    lod.indices.insert(lod.indices.end(), tris.begin(), tris.end());
-    lod.clusters.push_back(c);
-    return uint32_t(lod.clusters.size() - 1);
+    return c;
   };
 
   const std::vector<uint32_t> pos = positionIds(mesh, threads);
@@ -328,30 +366,51 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       for (const Indices& c : r.clusters)
         r.bounds.push_back(clusterBounds(c.data(), c.size(), mesh.positions.data(), mesh.positions.size(), backfaceCone));
     });
-    std::vector<Indices> next;
-    std::vector<uint32_t> nextIds;
+    // The results in group order: where each group's go is counted first, then they are copied on all
+    // cores. A stuck group's clusters are grouped again with the next level's: their neighbours there are
+    // coarser and grouped differently, so the border that held them is mostly inside the new group. (As
+    // roots they were in every cut.)
+    struct Place {
+      size_t next = 0, cluster = 0, index = 0;
+    };
+    std::vector<Place> at(groups.size() + 1);
     bool progress = false;
     for (size_t gi = 0; gi < groups.size(); ++gi) {
-      Result& r = results[gi];
+      const Result& r = results[gi];
       if (stats) stats->push_back(r.stats);
-      // A stuck group's clusters are grouped again with the next level's: their neighbours there are
-      // coarser and grouped differently, so the border that held them is mostly inside the new group.
-      // (As roots they were in every cut.)
-      if (r.clusters.empty()) {
-        for (uint32_t k : groups[gi]) next.push_back(std::move(current[k])), nextIds.push_back(ids[k]);
-        continue;
-      }
-      progress = true;
-      for (uint32_t k : groups[gi]) {
-        lod.clusters[ids[k]].parentError = r.error;
-        lod.clusters[ids[k]].parentSphere = r.sphere;
-      }
-      for (size_t i = 0; i < r.clusters.size(); ++i) {
-        nextIds.push_back(add(r.clusters[i], r.bounds[i], level, r.sphere, r.error));
-        next.push_back(std::move(r.clusters[i]));
-      }
+      progress |= !r.clusters.empty();
+      size_t indices = 0;
+      for (const Indices& c : r.clusters) indices += c.size();
+      at[gi + 1] = {at[gi].next + (r.clusters.empty() ? groups[gi].size() : r.clusters.size()),
+                    at[gi].cluster + r.clusters.size(), at[gi].index + indices};
     }
     if (!progress) break;
+    std::vector<Indices> next(at.back().next);
+    std::vector<uint32_t> nextIds(at.back().next);
+    const size_t firstCluster = lod.clusters.size(), firstIndex = lod.indices.size();
+    lod.clusters.resize(firstCluster + at.back().cluster);
+    lod.indices.resize(firstIndex + at.back().index);
+    parallelFor((groups.size() + kGroupPiece - 1) / kGroupPiece, threads, [&](size_t p) {
+      for (size_t gi = p * kGroupPiece; gi < std::min(groups.size(), (p + 1) * kGroupPiece); ++gi) {
+        Result& r = results[gi];
+        size_t nx = at[gi].next, c = firstCluster + at[gi].cluster, ix = firstIndex + at[gi].index;
+        for (uint32_t k : groups[gi]) {
+          if (r.clusters.empty()) {
+            next[nx] = std::move(current[k]), nextIds[nx++] = ids[k];
+            continue;
+          }
+          lod.clusters[ids[k]].parentError = r.error;
+          lod.clusters[ids[k]].parentSphere = r.sphere;
+          current[k] = {};
+        }
+        for (size_t i = 0; i < r.clusters.size(); ++i, ++c) {
+          lod.clusters[c] = made(r.clusters[i].size() / 3, r.bounds[i], level, ix, r.sphere, r.error);
+          std::copy(r.clusters[i].begin(), r.clusters[i].end(), lod.indices.begin() + ix);
+          ix += r.clusters[i].size();
+          next[nx] = std::move(r.clusters[i]), nextIds[nx++] = uint32_t(c);
+        }
+      }
+    });
     lod.levels = level + 1;
     current = std::move(next);
     ids = std::move(nextIds);
