@@ -8,7 +8,6 @@
 #include <cstring>
 #include <numeric>
 #include <span>
-#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -34,29 +33,37 @@ glm::vec4 merge(glm::vec4 a, glm::vec4 b) {
 }
 
 // A triangle list over a vertex buffer of its own (meshoptimizer's builders cost per vertex they are
-// given, so a group's work must not scale with the whole mesh).
+// given, so a group's work must not scale with the whole mesh), numbered in order of first use.
 struct Local {
   std::vector<uint32_t> toMesh;  // local vertex -> mesh vertex
   std::vector<glm::vec3> positions;
   Indices indices;
   Local(const Indices& tris, const Mesh& mesh) : indices(tris.size()) {
-    std::unordered_map<uint32_t, uint32_t> toLocal;
+    // Open addressing over a power of two at least twice the corners: one allocation, not one per vertex.
+    size_t size = 64;
+    while (size < 2 * tris.size()) size *= 2;
+    std::vector<uint32_t> slot(size, UINT32_MAX);  // a local vertex, or none
+    toMesh.reserve(tris.size()), positions.reserve(tris.size());
     for (size_t i = 0; i < tris.size(); ++i) {
-      const auto [it, added] = toLocal.try_emplace(tris[i], uint32_t(toMesh.size()));
-      if (added) toMesh.push_back(tris[i]), positions.push_back(mesh.positions[tris[i]]);
-      indices[i] = it->second;
+      size_t h = (tris[i] * 0x9E3779B1u) & (size - 1);
+      while (slot[h] != UINT32_MAX && toMesh[slot[h]] != tris[i]) h = (h + 1) & (size - 1);
+      if (slot[h] == UINT32_MAX) {
+        slot[h] = uint32_t(toMesh.size());
+        toMesh.push_back(tris[i]), positions.push_back(mesh.positions[tris[i]]);
+      }
+      indices[i] = slot[h];
     }
   }
 };
 
-// Splits a triangle list into clusters of at most 64 vertices and 124 triangles (as the mesh's own).
-std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
+// Splits a group's simplified triangles (its local vertices) into clusters of at most 64 vertices and
+// 124 triangles (as the mesh's own), with the mesh's vertex indices.
+std::vector<Indices> split(const Indices& tris, const Local& l) {
   constexpr size_t kMaxV = CLUSTER_MAX_VERTICES, kMaxT = CLUSTER_MAX_TRIANGLES;
-  const Local l(tris, mesh);
   std::vector<meshopt_Meshlet> ml(meshopt_buildMeshletsBound(tris.size(), kMaxV, kMaxT));
   std::vector<unsigned> verts(ml.size() * kMaxV);
   std::vector<unsigned char> local(ml.size() * kMaxT * 3);
-  ml.resize(meshopt_buildMeshlets(ml.data(), verts.data(), local.data(), l.indices.data(), l.indices.size(), &l.positions[0].x,
+  ml.resize(meshopt_buildMeshlets(ml.data(), verts.data(), local.data(), tris.data(), tris.size(), &l.positions[0].x,
                                   l.positions.size(), sizeof(glm::vec3), kMaxV, kMaxT, 0.0f));
   std::vector<Indices> out;
   for (const meshopt_Meshlet& m : ml) {
@@ -234,8 +241,8 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
 }
 
 // The longest edge of the triangles of `out` that are not triangles of `in` (0 if none): what a
-// simplification made, as opposed to what it kept.
-float longestNewEdge(const Indices& in, const Indices& out, const Mesh& mesh) {
+// simplification made, as opposed to what it kept. Both over the same vertices.
+float longestNewEdge(const Indices& in, const Indices& out, const std::vector<glm::vec3>& positions) {
   auto key = [](const uint32_t* t) {  // the same triangle, same winding, whatever vertex comes first
     const int s = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
     return std::array<uint32_t, 3>{t[s], t[(s + 1) % 3], t[(s + 2) % 3]};
@@ -247,24 +254,22 @@ float longestNewEdge(const Indices& in, const Indices& out, const Mesh& mesh) {
   for (size_t t = 0; t < out.size(); t += 3) {
     if (std::binary_search(kept.begin(), kept.end(), key(&out[t]))) continue;
     for (int e = 0; e < 3; ++e)
-      longest = std::max(longest, glm::distance(mesh.positions[out[t + e]], mesh.positions[out[t + (e + 1) % 3]]));
+      longest = std::max(longest, glm::distance(positions[out[t + e]], positions[out[t + (e + 1) % 3]]));
   }
   return longest;
 }
 
-// Simplifies a group's triangles towards half, its border locked, in a vertex buffer of its own (the
-// simplifier's cost follows the vertex count it is given). Returns the triangles (mesh vertex indices)
-// and the error in object-space units.
-Indices simplifyGroup(const Indices& tris, const Mesh& mesh, float& error) {
-  const Local l(tris, mesh);
+// Simplifies a group's triangles towards half, its border locked, over the group's own vertices (the
+// simplifier's cost follows the vertex count it is given). Returns the triangles (local vertices) and the
+// error in object-space units.
+Indices simplifyGroup(const Local& l, float& error) {
   Indices out(l.indices.size());
-  const size_t target = (tris.size() / 6) * 3;
+  const size_t target = (l.indices.size() / 6) * 3;
   float relative = 0.0f;
   out.resize(meshopt_simplify(out.data(), l.indices.data(), l.indices.size(), &l.positions[0].x, l.positions.size(),
                               sizeof(glm::vec3), target, 1.0f, meshopt_SimplifyLockBorder, &relative));
   // The simplifier's error is relative to the extent of what it was given: back to object-space units.
   error = relative * meshopt_simplifyScale(&l.positions[0].x, l.positions.size(), sizeof(glm::vec3));
-  for (uint32_t& i : out) i = l.toMesh[i];
   return out;
 }
 
@@ -344,6 +349,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       r.stats = {level - 1, 1, uint32_t(current[g[0]].size() / 3)};
       if (g.size() < 2) return;  // alone: nothing around it to share a border with
       Indices tris;
+      tris.reserve(g.size() * CLUSTER_MAX_TRIANGLES * 3);
       r.sphere = lod.clusters[ids[g[0]]].sphere;
       float childError = 0.0f;
       for (uint32_t k : g) {
@@ -351,7 +357,8 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
         r.sphere = merge(r.sphere, lod.clusters[ids[k]].sphere);
         childError = std::max(childError, lod.clusters[ids[k]].error);
       }
-      const Indices simpler = simplifyGroup(tris, mesh, r.error);
+      const Local l(tris, mesh);
+      const Indices simpler = simplifyGroup(l, r.error);
       r.stats = {level - 1, uint32_t(g.size()), uint32_t(tris.size() / 3), 0, r.error, 0.0f, r.sphere.w};
       if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) return;  // stuck
       r.stats.trianglesOut = uint32_t(simpler.size() / 3);
@@ -359,10 +366,10 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       // surface (a flat floor: error 0) it would otherwise make triangles that are drawn at any distance,
       // however many pixels they cover. So a triangle of the cut spans at most kLodEdgePerError × the
       // threshold in pixels (fewer where it is farther than its sphere's nearest point).
-      r.stats.edgeError = longestNewEdge(tris, simpler, mesh) / kLodEdgePerError;
+      r.stats.edgeError = longestNewEdge(l.indices, simpler, l.positions) / kLodEdgePerError;
       r.error = std::max(r.error, r.stats.edgeError);
       r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
-      r.clusters = split(simpler, mesh);
+      r.clusters = split(simpler, l);
       for (const Indices& c : r.clusters)
         r.bounds.push_back(clusterBounds(c.data(), c.size(), mesh.positions.data(), mesh.positions.size(), backfaceCone));
     });
