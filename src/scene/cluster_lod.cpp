@@ -117,7 +117,7 @@ std::vector<uint32_t> positionIds(const Mesh& mesh, unsigned threads) {
 constexpr size_t kGroupSize = 4;
 constexpr uint32_t kEdgePiece = 1024;           // clusters per piece of the edge listing (all cores)
 constexpr size_t kListPiece = size_t(1) << 16;  // entries per piece of a whole-level list
-constexpr size_t kGroupPiece = 256;             // groups per piece of a level's assembly
+constexpr size_t kRecordPiece = 256;            // clusters or groups per piece of a level's records
 
 // The pieces one after another (copied on all cores); the pieces are emptied.
 template <class T>
@@ -296,24 +296,32 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
   const uint32_t base = mesh.triangleCount();
 
   // Level 0: the mesh's clusters as they are (the same triangles, ids and bounds the renderer draws).
-  std::vector<Indices> current;
-  std::vector<uint32_t> ids;
-  for (const Cluster& mc : mesh.clusters) {
-    LodCluster c;
-    c.firstTriangle = mc.firstTriangle;
-    c.triangleCount = mc.triangleCount;
-    c.center = mc.center;
-    c.radius = mc.radius;
-    c.coneAxis = mc.coneAxis;
-    c.coneCutoff = mc.coneCutoff;
-    c.sphere = glm::vec4(mc.center, mc.radius);
-    c.parentSphere = c.sphere;
-    c.parentError = shader::LOD_ERROR_INFINITE;
-    ids.push_back(uint32_t(lod.clusters.size()));
-    lod.clusters.push_back(c);
-    const auto* t = mesh.indices.data() + size_t(mc.firstTriangle) * 3;
-    current.emplace_back(t, t + size_t(mc.triangleCount) * 3);
-  }
+  // Room for all levels (levels above 0 hold about as many triangles as the mesh and twice its clusters;
+  // what is not used is never touched): no level copies the ones below it again.
+  const size_t n0 = mesh.clusters.size();
+  lod.clusters.reserve(3 * n0);
+  lod.indices.reserve(mesh.indices.size() * 3 / 2);
+  lod.clusters.resize(n0);
+  std::vector<Indices> current(n0);
+  std::vector<uint32_t> ids(n0);
+  parallelFor((n0 + kRecordPiece - 1) / kRecordPiece, threads, [&](size_t p) {
+    for (size_t i = p * kRecordPiece; i < std::min(n0, (p + 1) * kRecordPiece); ++i) {
+      const Cluster& mc = mesh.clusters[i];
+      LodCluster& c = lod.clusters[i];
+      c.firstTriangle = mc.firstTriangle;
+      c.triangleCount = mc.triangleCount;
+      c.center = mc.center;
+      c.radius = mc.radius;
+      c.coneAxis = mc.coneAxis;
+      c.coneCutoff = mc.coneCutoff;
+      c.sphere = glm::vec4(mc.center, mc.radius);
+      c.parentSphere = c.sphere;
+      c.parentError = shader::LOD_ERROR_INFINITE;
+      ids[i] = uint32_t(i);
+      const auto* t = mesh.indices.data() + size_t(mc.firstTriangle) * 3;
+      current[i].assign(t, t + size_t(mc.triangleCount) * 3);
+    }
+  });
   auto made = [&](size_t tris, const meshopt_Bounds& b, uint32_t level, size_t firstIndex, glm::vec4 sphere, float error) {
     LodCluster c;
     c.firstTriangle = base + uint32_t(firstIndex / 3);
@@ -397,8 +405,8 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     const size_t firstCluster = lod.clusters.size(), firstIndex = lod.indices.size();
     lod.clusters.resize(firstCluster + at.back().cluster);
     lod.indices.resize(firstIndex + at.back().index);
-    parallelFor((groups.size() + kGroupPiece - 1) / kGroupPiece, threads, [&](size_t p) {
-      for (size_t gi = p * kGroupPiece; gi < std::min(groups.size(), (p + 1) * kGroupPiece); ++gi) {
+    parallelFor((groups.size() + kRecordPiece - 1) / kRecordPiece, threads, [&](size_t p) {
+      for (size_t gi = p * kRecordPiece; gi < std::min(groups.size(), (p + 1) * kRecordPiece); ++gi) {
         Result& r = results[gi];
         size_t nx = at[gi].next, c = firstCluster + at[gi].cluster, ix = firstIndex + at[gi].index;
         for (uint32_t k : groups[gi]) {
