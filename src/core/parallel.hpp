@@ -6,15 +6,18 @@
 // spreads work many times (the BVH build); parallelFor on a pool runs the same loop on its threads.
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
 #include <exception>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <system_error>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace rtr {
@@ -114,21 +117,45 @@ void parallelFor(ThreadPool& pool, size_t count, Fn&& fn) {
   loop.rethrow();
 }
 
-// std::sort's result on all cores: fixed pieces sorted at once, then merged pairwise, round by round. The
-// order must be total (ties broken by something that tells elements apart, or equal elements identical),
-// so the result is std::sort's whatever the thread count.
+// std::sort's result on all cores, a sample sort: splitters taken from a fixed sample of the elements
+// bound the buckets, fixed pieces of the elements are counted and dealt into them in order, and the
+// buckets are sorted at once. The order must be total (ties broken by something that tells elements
+// apart, or equal elements identical): then the sorted result is unique, std::sort's whatever the thread
+// count. (Merging sorted pieces pairwise ended in one thread merging everything.)
 template <class T, class Less = std::less<>>
 void parallelSort(std::vector<T>& v, unsigned threads = 0, Less less = {}) {
-  constexpr size_t kPiece = size_t(1) << 16;
+  constexpr size_t kPiece = size_t(1) << 16, kMaxBuckets = 1024, kSamplesPerBucket = 16;
   const size_t n = v.size();
   if (n <= kPiece) return std::sort(v.begin(), v.end(), less);
-  parallelFor((n + kPiece - 1) / kPiece, threads,
-              [&](size_t p) { std::sort(v.begin() + p * kPiece, v.begin() + std::min(n, (p + 1) * kPiece), less); });
-  for (size_t run = kPiece; run < n; run *= 2)
-    parallelFor((n + 2 * run - 1) / (2 * run), threads, [&](size_t m) {
-      const size_t b = m * 2 * run;
-      std::inplace_merge(v.begin() + b, v.begin() + std::min(n, b + run), v.begin() + std::min(n, b + 2 * run), less);
-    });
+  const size_t piece = std::max(kPiece, (n + kMaxBuckets - 1) / kMaxBuckets), pieces = (n + piece - 1) / piece;
+  const size_t buckets = pieces, samples = buckets * kSamplesPerBucket;
+  std::vector<T> splitters(samples);  // bucket b: splitters[b - 1] <= e < splitters[b]
+  for (size_t k = 0; k < samples; ++k) splitters[k] = v[k * (n / samples)];
+  std::sort(splitters.begin(), splitters.end(), less);
+  for (size_t b = 1; b < buckets; ++b) splitters[b - 1] = splitters[b * kSamplesPerBucket];
+  splitters.resize(buckets - 1);
+  const auto bucketOf = std::make_unique_for_overwrite<uint16_t[]>(n);
+  std::vector<size_t> at(pieces * buckets, 0);  // [piece][bucket]: its count, then where it deals next
+  parallelFor(pieces, threads, [&](size_t p) {
+    for (size_t i = p * piece; i < std::min(n, (p + 1) * piece); ++i) {
+      bucketOf[i] = uint16_t(std::upper_bound(splitters.begin(), splitters.end(), v[i], less) - splitters.begin());
+      ++at[p * buckets + bucketOf[i]];
+    }
+  });
+  std::vector<size_t> first(buckets + 1, 0);
+  for (size_t b = 0, sum = 0; b < buckets; ++b) {
+    first[b] = sum;
+    for (size_t p = 0; p < pieces; ++p) sum += std::exchange(at[p * buckets + b], sum);
+  }
+  first[buckets] = n;
+  const auto dealt = std::make_unique_for_overwrite<T[]>(n);
+  parallelFor(pieces, threads, [&](size_t p) {
+    for (size_t i = p * piece; i < std::min(n, (p + 1) * piece); ++i) dealt[at[p * buckets + bucketOf[i]]++] = std::move(v[i]);
+  });
+  parallelFor(buckets, threads, [&](size_t b) {
+    std::sort(dealt.get() + first[b], dealt.get() + first[b + 1], less);
+    std::move(dealt.get() + first[b], dealt.get() + first[b + 1], v.begin() + first[b]);
+  });
 }
 
 }  // namespace rtr

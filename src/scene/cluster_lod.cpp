@@ -8,7 +8,6 @@
 #include <cstring>
 #include <numeric>
 #include <span>
-#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -34,29 +33,37 @@ glm::vec4 merge(glm::vec4 a, glm::vec4 b) {
 }
 
 // A triangle list over a vertex buffer of its own (meshoptimizer's builders cost per vertex they are
-// given, so a group's work must not scale with the whole mesh).
+// given, so a group's work must not scale with the whole mesh), numbered in order of first use.
 struct Local {
   std::vector<uint32_t> toMesh;  // local vertex -> mesh vertex
   std::vector<glm::vec3> positions;
   Indices indices;
   Local(const Indices& tris, const Mesh& mesh) : indices(tris.size()) {
-    std::unordered_map<uint32_t, uint32_t> toLocal;
+    // Open addressing over a power of two at least twice the corners: one allocation, not one per vertex.
+    size_t size = 64;
+    while (size < 2 * tris.size()) size *= 2;
+    std::vector<uint32_t> slot(size, UINT32_MAX);  // a local vertex, or none
+    toMesh.reserve(tris.size()), positions.reserve(tris.size());
     for (size_t i = 0; i < tris.size(); ++i) {
-      const auto [it, added] = toLocal.try_emplace(tris[i], uint32_t(toMesh.size()));
-      if (added) toMesh.push_back(tris[i]), positions.push_back(mesh.positions[tris[i]]);
-      indices[i] = it->second;
+      size_t h = (tris[i] * 0x9E3779B1u) & (size - 1);
+      while (slot[h] != UINT32_MAX && toMesh[slot[h]] != tris[i]) h = (h + 1) & (size - 1);
+      if (slot[h] == UINT32_MAX) {
+        slot[h] = uint32_t(toMesh.size());
+        toMesh.push_back(tris[i]), positions.push_back(mesh.positions[tris[i]]);
+      }
+      indices[i] = slot[h];
     }
   }
 };
 
-// Splits a triangle list into clusters of at most 64 vertices and 124 triangles (as the mesh's own).
-std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
+// Splits a group's simplified triangles (its local vertices) into clusters of at most 64 vertices and
+// 124 triangles (as the mesh's own), with the mesh's vertex indices.
+std::vector<Indices> split(const Indices& tris, const Local& l) {
   constexpr size_t kMaxV = CLUSTER_MAX_VERTICES, kMaxT = CLUSTER_MAX_TRIANGLES;
-  const Local l(tris, mesh);
   std::vector<meshopt_Meshlet> ml(meshopt_buildMeshletsBound(tris.size(), kMaxV, kMaxT));
   std::vector<unsigned> verts(ml.size() * kMaxV);
   std::vector<unsigned char> local(ml.size() * kMaxT * 3);
-  ml.resize(meshopt_buildMeshlets(ml.data(), verts.data(), local.data(), l.indices.data(), l.indices.size(), &l.positions[0].x,
+  ml.resize(meshopt_buildMeshlets(ml.data(), verts.data(), local.data(), tris.data(), tris.size(), &l.positions[0].x,
                                   l.positions.size(), sizeof(glm::vec3), kMaxV, kMaxT, 0.0f));
   std::vector<Indices> out;
   for (const meshopt_Meshlet& m : ml) {
@@ -68,22 +75,36 @@ std::vector<Indices> split(const Indices& tris, const Mesh& mesh) {
 }
 
 // Each vertex's first vertex at the same position: clusters on the two sides of a seam (vertices split
-// by normal or uv) are neighbours, so a group may hold both sides and the simplifier sees the seam.
+// by normal or uv) are neighbours, so a group may hold both sides and the simplifier sees the seam. The
+// positions' bits are sorted with their vertices (a comparator that looked them up missed the cache at
+// every step), then each fixed piece of the sorted list names its runs from the run's first vertex.
 std::vector<uint32_t> positionIds(const Mesh& mesh, unsigned threads) {
-  using Key = std::array<uint32_t, 3>;
-  auto key = [&](uint32_t v) {
-    Key k;
-    std::memcpy(k.data(), &mesh.positions[v], sizeof(k));
-    return k;
+  struct Key {
+    std::array<uint32_t, 3> bits;
+    uint32_t vertex;
+    auto operator<=>(const Key&) const = default;
   };
-  std::vector<uint32_t> order(mesh.positions.size()), id(mesh.positions.size());
-  std::iota(order.begin(), order.end(), 0u);
-  parallelSort(order, threads, [&](uint32_t a, uint32_t b) {
-    const Key ka = key(a), kb = key(b);
-    return ka != kb ? ka < kb : a < b;
+  constexpr size_t kPiece = size_t(1) << 16;
+  const size_t n = mesh.positions.size(), pieces = (n + kPiece - 1) / kPiece;
+  std::vector<Key> keys(n);
+  std::vector<uint32_t> id(n);
+  parallelFor(pieces, threads, [&](size_t p) {
+    for (size_t v = p * kPiece; v < std::min(n, (p + 1) * kPiece); ++v) {
+      std::memcpy(keys[v].bits.data(), &mesh.positions[v], sizeof(keys[v].bits));
+      keys[v].vertex = uint32_t(v);
+    }
   });
-  for (size_t k = 0; k < order.size(); ++k)
-    id[order[k]] = k > 0 && key(order[k]) == key(order[k - 1]) ? id[order[k - 1]] : order[k];
+  parallelSort(keys, threads);
+  parallelFor(pieces, threads, [&](size_t p) {
+    const size_t begin = p * kPiece, end = std::min(n, begin + kPiece);
+    const auto run =
+        std::partition_point(keys.begin(), keys.begin() + begin, [&](const Key& k) { return k.bits < keys[begin].bits; });
+    uint32_t first = run->vertex;  // keys[begin]'s own where its run starts in this piece
+    for (size_t k = begin; k < end; ++k) {
+      if (k > begin && keys[k].bits != keys[k - 1].bits) first = keys[k].vertex;
+      id[keys[k].vertex] = first;
+    }
+  });
   return id;
 }
 
@@ -94,7 +115,23 @@ std::vector<uint32_t> positionIds(const Mesh& mesh, unsigned threads) {
 // clusters kept every group inside the strip of the mesh that one run of level-0 clusters covers, and
 // the strips' borders stayed locked at every level (the 100M temple's statue kept 12 M triangles).
 constexpr size_t kGroupSize = 4;
-constexpr uint32_t kEdgePiece = 1024;  // clusters per piece of the edge listing (all cores)
+constexpr uint32_t kEdgePiece = 1024;           // clusters per piece of the edge listing (all cores)
+constexpr size_t kListPiece = size_t(1) << 16;  // entries per piece of a whole-level list
+constexpr size_t kRecordPiece = 256;            // clusters or groups per piece of a level's records
+
+// The pieces one after another (copied on all cores); the pieces are emptied.
+template <class T>
+std::vector<T> joined(std::vector<std::vector<T>>& pieces, unsigned threads) {
+  std::vector<size_t> at(pieces.size() + 1, 0);
+  for (size_t p = 0; p < pieces.size(); ++p) at[p + 1] = at[p] + pieces[p].size();
+  std::vector<T> out(at.back());
+  parallelFor(pieces.size(), threads, [&](size_t p) {
+    std::copy(pieces[p].begin(), pieces[p].end(), out.begin() + at[p]);
+    pieces[p] = {};
+  });
+  return out;
+}
+
 std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& clusters, const std::vector<uint32_t>& pos,
                                               unsigned threads) {
   const uint32_t n = uint32_t(clusters.size());
@@ -121,16 +158,23 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
       }
     }
   });
-  std::vector<Entry> all;
-  for (auto& piece : perPiece) all.insert(all.end(), piece.begin(), piece.end()), piece = {};
+  std::vector<Entry> all = joined(perPiece, threads);
   parallelSort(all, threads);
-  std::vector<uint64_t> pairs;  // (a << 32 | b), a < b: one per edge the two share
-  for (size_t i = 0, j; i < all.size(); i = j) {
-    for (j = i + 1; j < all.size() && all[j].edge == all[i].edge;) ++j;
-    for (size_t a = i; a < j; ++a)
-      for (size_t b = a + 1; b < j; ++b) pairs.push_back(uint64_t(all[a].cluster) << 32 | all[b].cluster);
-  }
+  // The pairs of clusters that share each edge, in fixed pieces of the list, each taking the edges whose
+  // entries start in it.
+  std::vector<std::vector<uint64_t>> pairPieces((all.size() + kListPiece - 1) / kListPiece);
+  parallelFor(pairPieces.size(), threads, [&](size_t p) {
+    size_t i = p * kListPiece;
+    const size_t end = std::min(all.size(), i + kListPiece);
+    while (i > 0 && i < end && all[i].edge == all[i - 1].edge) ++i;
+    for (size_t j; i < end; i = j) {
+      for (j = i + 1; j < all.size() && all[j].edge == all[i].edge;) ++j;
+      for (size_t a = i; a < j; ++a)
+        for (size_t b = a + 1; b < j; ++b) pairPieces[p].push_back(uint64_t(all[a].cluster) << 32 | all[b].cluster);
+    }
+  });
   all = {};
+  std::vector<uint64_t> pairs = joined(pairPieces, threads);  // (a << 32 | b), a < b: one per edge the two share
   parallelSort(pairs, threads);
   // Neighbours per cluster, with the edges they share (in neighbour order).
   std::vector<uint32_t> first(n + 1, 0);
@@ -147,7 +191,10 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
     const uint32_t a = uint32_t(pairs[i] >> 32), b = uint32_t(pairs[i]), e = uint32_t(j - i);
     links[fill[a]++] = {b, e}, links[fill[b]++] = {a, e};
   }
-  for (uint32_t c = 0; c < n; ++c) std::sort(links.begin() + first[c], links.begin() + first[c + 1]);
+  parallelFor((n + kEdgePiece - 1) / kEdgePiece, threads, [&](size_t p) {
+    for (uint32_t c = uint32_t(p) * kEdgePiece; c < std::min<uint64_t>(n, uint64_t(p + 1) * kEdgePiece); ++c)
+      std::sort(links.begin() + first[c], links.begin() + first[c + 1]);
+  });
   auto neighbours = [&](uint32_t c) { return std::span(links.data() + first[c], first[c + 1] - first[c]); };
 
   std::vector<int> group(n, -1);
@@ -194,8 +241,8 @@ std::vector<std::vector<uint32_t>> groupLevel(const std::vector<Indices>& cluste
 }
 
 // The longest edge of the triangles of `out` that are not triangles of `in` (0 if none): what a
-// simplification made, as opposed to what it kept.
-float longestNewEdge(const Indices& in, const Indices& out, const Mesh& mesh) {
+// simplification made, as opposed to what it kept. Both over the same vertices.
+float longestNewEdge(const Indices& in, const Indices& out, const std::vector<glm::vec3>& positions) {
   auto key = [](const uint32_t* t) {  // the same triangle, same winding, whatever vertex comes first
     const int s = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
     return std::array<uint32_t, 3>{t[s], t[(s + 1) % 3], t[(s + 2) % 3]};
@@ -207,24 +254,22 @@ float longestNewEdge(const Indices& in, const Indices& out, const Mesh& mesh) {
   for (size_t t = 0; t < out.size(); t += 3) {
     if (std::binary_search(kept.begin(), kept.end(), key(&out[t]))) continue;
     for (int e = 0; e < 3; ++e)
-      longest = std::max(longest, glm::distance(mesh.positions[out[t + e]], mesh.positions[out[t + (e + 1) % 3]]));
+      longest = std::max(longest, glm::distance(positions[out[t + e]], positions[out[t + (e + 1) % 3]]));
   }
   return longest;
 }
 
-// Simplifies a group's triangles towards half, its border locked, in a vertex buffer of its own (the
-// simplifier's cost follows the vertex count it is given). Returns the triangles (mesh vertex indices)
-// and the error in object-space units.
-Indices simplifyGroup(const Indices& tris, const Mesh& mesh, float& error) {
-  const Local l(tris, mesh);
+// Simplifies a group's triangles towards half, its border locked, over the group's own vertices (the
+// simplifier's cost follows the vertex count it is given). Returns the triangles (local vertices) and the
+// error in object-space units.
+Indices simplifyGroup(const Local& l, float& error) {
   Indices out(l.indices.size());
-  const size_t target = (tris.size() / 6) * 3;
+  const size_t target = (l.indices.size() / 6) * 3;
   float relative = 0.0f;
   out.resize(meshopt_simplify(out.data(), l.indices.data(), l.indices.size(), &l.positions[0].x, l.positions.size(),
                               sizeof(glm::vec3), target, 1.0f, meshopt_SimplifyLockBorder, &relative));
   // The simplifier's error is relative to the extent of what it was given: back to object-space units.
   error = relative * meshopt_simplifyScale(&l.positions[0].x, l.positions.size(), sizeof(glm::vec3));
-  for (uint32_t& i : out) i = l.toMesh[i];
   return out;
 }
 
@@ -251,28 +296,36 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
   const uint32_t base = mesh.triangleCount();
 
   // Level 0: the mesh's clusters as they are (the same triangles, ids and bounds the renderer draws).
-  std::vector<Indices> current;
-  std::vector<uint32_t> ids;
-  for (const Cluster& mc : mesh.clusters) {
+  // Room for all levels (levels above 0 hold about as many triangles as the mesh and twice its clusters;
+  // what is not used is never touched): no level copies the ones below it again.
+  const size_t n0 = mesh.clusters.size();
+  lod.clusters.reserve(3 * n0);
+  lod.indices.reserve(mesh.indices.size() * 3 / 2);
+  lod.clusters.resize(n0);
+  std::vector<Indices> current(n0);
+  std::vector<uint32_t> ids(n0);
+  parallelFor((n0 + kRecordPiece - 1) / kRecordPiece, threads, [&](size_t p) {
+    for (size_t i = p * kRecordPiece; i < std::min(n0, (p + 1) * kRecordPiece); ++i) {
+      const Cluster& mc = mesh.clusters[i];
+      LodCluster& c = lod.clusters[i];
+      c.firstTriangle = mc.firstTriangle;
+      c.triangleCount = mc.triangleCount;
+      c.center = mc.center;
+      c.radius = mc.radius;
+      c.coneAxis = mc.coneAxis;
+      c.coneCutoff = mc.coneCutoff;
+      c.sphere = glm::vec4(mc.center, mc.radius);
+      c.parentSphere = c.sphere;
+      c.parentError = shader::LOD_ERROR_INFINITE;
+      ids[i] = uint32_t(i);
+      const auto* t = mesh.indices.data() + size_t(mc.firstTriangle) * 3;
+      current[i].assign(t, t + size_t(mc.triangleCount) * 3);
+    }
+  });
+  auto made = [&](size_t tris, const meshopt_Bounds& b, uint32_t level, size_t firstIndex, glm::vec4 sphere, float error) {
     LodCluster c;
-    c.firstTriangle = mc.firstTriangle;
-    c.triangleCount = mc.triangleCount;
-    c.center = mc.center;
-    c.radius = mc.radius;
-    c.coneAxis = mc.coneAxis;
-    c.coneCutoff = mc.coneCutoff;
-    c.sphere = glm::vec4(mc.center, mc.radius);
-    c.parentSphere = c.sphere;
-    c.parentError = shader::LOD_ERROR_INFINITE;
-    ids.push_back(uint32_t(lod.clusters.size()));
-    lod.clusters.push_back(c);
-    const auto* t = mesh.indices.data() + size_t(mc.firstTriangle) * 3;
-    current.emplace_back(t, t + size_t(mc.triangleCount) * 3);
-  }
-  auto add = [&](const Indices& tris, const meshopt_Bounds& b, uint32_t level, glm::vec4 sphere, float error) {
-    LodCluster c;
-    c.firstTriangle = base + uint32_t(lod.indices.size() / 3);
-    c.triangleCount = uint32_t(tris.size() / 3);
+    c.firstTriangle = base + uint32_t(firstIndex / 3);
+    c.triangleCount = uint32_t(tris);
     c.level = level;
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
@@ -282,9 +335,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     c.error = error;
     c.parentSphere = c.sphere;
     c.parentError = shader::LOD_ERROR_INFINITE;
-    lod.indices.insert(lod.indices.end(), tris.begin(), tris.end());
-    lod.clusters.push_back(c);
-    return uint32_t(lod.clusters.size() - 1);
+    return c;
   };
 
   const std::vector<uint32_t> pos = positionIds(mesh, threads);
@@ -306,6 +357,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       r.stats = {level - 1, 1, uint32_t(current[g[0]].size() / 3)};
       if (g.size() < 2) return;  // alone: nothing around it to share a border with
       Indices tris;
+      tris.reserve(g.size() * CLUSTER_MAX_TRIANGLES * 3);
       r.sphere = lod.clusters[ids[g[0]]].sphere;
       float childError = 0.0f;
       for (uint32_t k : g) {
@@ -313,7 +365,8 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
         r.sphere = merge(r.sphere, lod.clusters[ids[k]].sphere);
         childError = std::max(childError, lod.clusters[ids[k]].error);
       }
-      const Indices simpler = simplifyGroup(tris, mesh, r.error);
+      const Local l(tris, mesh);
+      const Indices simpler = simplifyGroup(l, r.error);
       r.stats = {level - 1, uint32_t(g.size()), uint32_t(tris.size() / 3), 0, r.error, 0.0f, r.sphere.w};
       if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) return;  // stuck
       r.stats.trianglesOut = uint32_t(simpler.size() / 3);
@@ -321,37 +374,58 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       // surface (a flat floor: error 0) it would otherwise make triangles that are drawn at any distance,
       // however many pixels they cover. So a triangle of the cut spans at most kLodEdgePerError × the
       // threshold in pixels (fewer where it is farther than its sphere's nearest point).
-      r.stats.edgeError = longestNewEdge(tris, simpler, mesh) / kLodEdgePerError;
+      r.stats.edgeError = longestNewEdge(l.indices, simpler, l.positions) / kLodEdgePerError;
       r.error = std::max(r.error, r.stats.edgeError);
       r.error = std::max(r.error, childError + epsilon);  // monotone up the hierarchy, strictly
-      r.clusters = split(simpler, mesh);
+      r.clusters = split(simpler, l);
       for (const Indices& c : r.clusters)
         r.bounds.push_back(clusterBounds(c.data(), c.size(), mesh.positions.data(), mesh.positions.size(), backfaceCone));
     });
-    std::vector<Indices> next;
-    std::vector<uint32_t> nextIds;
+    // The results in group order: where each group's go is counted first, then they are copied on all
+    // cores. A stuck group's clusters are grouped again with the next level's: their neighbours there are
+    // coarser and grouped differently, so the border that held them is mostly inside the new group. (As
+    // roots they were in every cut.)
+    struct Place {
+      size_t next = 0, cluster = 0, index = 0;
+    };
+    std::vector<Place> at(groups.size() + 1);
     bool progress = false;
     for (size_t gi = 0; gi < groups.size(); ++gi) {
-      Result& r = results[gi];
+      const Result& r = results[gi];
       if (stats) stats->push_back(r.stats);
-      // A stuck group's clusters are grouped again with the next level's: their neighbours there are
-      // coarser and grouped differently, so the border that held them is mostly inside the new group.
-      // (As roots they were in every cut.)
-      if (r.clusters.empty()) {
-        for (uint32_t k : groups[gi]) next.push_back(std::move(current[k])), nextIds.push_back(ids[k]);
-        continue;
-      }
-      progress = true;
-      for (uint32_t k : groups[gi]) {
-        lod.clusters[ids[k]].parentError = r.error;
-        lod.clusters[ids[k]].parentSphere = r.sphere;
-      }
-      for (size_t i = 0; i < r.clusters.size(); ++i) {
-        nextIds.push_back(add(r.clusters[i], r.bounds[i], level, r.sphere, r.error));
-        next.push_back(std::move(r.clusters[i]));
-      }
+      progress |= !r.clusters.empty();
+      size_t indices = 0;
+      for (const Indices& c : r.clusters) indices += c.size();
+      at[gi + 1] = {at[gi].next + (r.clusters.empty() ? groups[gi].size() : r.clusters.size()),
+                    at[gi].cluster + r.clusters.size(), at[gi].index + indices};
     }
     if (!progress) break;
+    std::vector<Indices> next(at.back().next);
+    std::vector<uint32_t> nextIds(at.back().next);
+    const size_t firstCluster = lod.clusters.size(), firstIndex = lod.indices.size();
+    lod.clusters.resize(firstCluster + at.back().cluster);
+    lod.indices.resize(firstIndex + at.back().index);
+    parallelFor((groups.size() + kRecordPiece - 1) / kRecordPiece, threads, [&](size_t p) {
+      for (size_t gi = p * kRecordPiece; gi < std::min(groups.size(), (p + 1) * kRecordPiece); ++gi) {
+        Result& r = results[gi];
+        size_t nx = at[gi].next, c = firstCluster + at[gi].cluster, ix = firstIndex + at[gi].index;
+        for (uint32_t k : groups[gi]) {
+          if (r.clusters.empty()) {
+            next[nx] = std::move(current[k]), nextIds[nx++] = ids[k];
+            continue;
+          }
+          lod.clusters[ids[k]].parentError = r.error;
+          lod.clusters[ids[k]].parentSphere = r.sphere;
+          current[k] = {};
+        }
+        for (size_t i = 0; i < r.clusters.size(); ++i, ++c) {
+          lod.clusters[c] = made(r.clusters[i].size() / 3, r.bounds[i], level, ix, r.sphere, r.error);
+          std::copy(r.clusters[i].begin(), r.clusters[i].end(), lod.indices.begin() + ix);
+          ix += r.clusters[i].size();
+          next[nx] = std::move(r.clusters[i]), nextIds[nx++] = uint32_t(c);
+        }
+      }
+    });
     lod.levels = level + 1;
     current = std::move(next);
     ids = std::move(nextIds);

@@ -119,27 +119,30 @@ TEST(ParallelFor, OnAPoolNestsAndCarriesExceptions) {
   EXPECT_THROW(pool.wait(g), std::runtime_error);
 }
 
-// parallelSort is std::sort on any thread count: sizes around its piece (2^16) and merge rounds, many
-// duplicates (equal values are identical), and a comparator whose ties are broken by an index.
+// parallelSort is std::sort on any thread count: sizes around its piece (2^16) and many buckets, many
+// duplicates (equal values are identical), values that are all equal (one bucket holds them), input sorted
+// backwards, and a comparator whose ties are broken by an index.
 TEST(ParallelSort, IsStdSortOnAnyThreadCount) {
   uint64_t state = 12345;
   auto next = [&] { return state = state * 6364136223846793005ull + 1442695040888963407ull; };
-  for (size_t n : {size_t(0), size_t(1000), size_t(1) << 16, (size_t(1) << 16) + 1, size_t(300001)}) {
-    std::vector<uint64_t> values(n);
-    for (uint64_t& v : values) v = next() >> 50;  // 14 bits: many duplicates
-    std::vector<uint64_t> expected = values;
-    std::sort(expected.begin(), expected.end());
-    for (unsigned threads : {1u, 3u, 8u}) {
-      std::vector<uint64_t> got = values;
-      parallelSort(got, threads);
-      ASSERT_EQ(got, expected) << n << " values, " << threads << " threads";
+  for (size_t n : {size_t(0), size_t(1000), size_t(1) << 16, (size_t(1) << 16) + 1, size_t(300001), size_t(1234567)})
+    for (int pattern = 0; pattern < 3; ++pattern) {
+      std::vector<uint64_t> values(n);
+      for (size_t k = 0; k < n; ++k)  // 14 random bits (many duplicates), all equal, or falling
+        values[k] = pattern == 0 ? next() >> 50 : pattern == 1 ? 7 : n - k;
+      std::vector<uint64_t> expected = values;
+      std::sort(expected.begin(), expected.end());
+      for (unsigned threads : {1u, 3u, 8u}) {
+        std::vector<uint64_t> got = values;
+        parallelSort(got, threads);
+        ASSERT_EQ(got, expected) << n << " values, pattern " << pattern << ", " << threads << " threads";
+      }
+      std::vector<uint32_t> order(n);
+      for (uint32_t k = 0; k < n; ++k) order[k] = k;
+      auto byValue = [&](uint32_t a, uint32_t b) { return values[a] != values[b] ? values[a] < values[b] : a < b; };
+      std::vector<uint32_t> expectedOrder = order;
+      std::sort(expectedOrder.begin(), expectedOrder.end(), byValue);
+      parallelSort(order, 5, byValue);
+      ASSERT_EQ(order, expectedOrder) << n << " values, pattern " << pattern;
     }
-    std::vector<uint32_t> order(n);
-    for (uint32_t k = 0; k < n; ++k) order[k] = k;
-    auto byValue = [&](uint32_t a, uint32_t b) { return values[a] != values[b] ? values[a] < values[b] : a < b; };
-    std::vector<uint32_t> expectedOrder = order;
-    std::sort(expectedOrder.begin(), expectedOrder.end(), byValue);
-    parallelSort(order, 5, byValue);
-    ASSERT_EQ(order, expectedOrder) << n;
-  }
 }

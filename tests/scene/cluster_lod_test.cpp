@@ -278,11 +278,14 @@ TEST(ClusterLod, FarAwayAMeshOfLongRowsIsAFewClusters) {
   EXPECT_LE(cut(m, lod, {0, 0, 1000}, 1.0f).size() / 3, 8u * CLUSTER_MAX_TRIANGLES);
 }
 
-// The hierarchy is the same, byte for byte, whatever the thread count: a level's edges are listed and its
-// groups simplified in fixed pieces. The mesh has more than one piece of the edge listing (1024 clusters).
+// The hierarchy is the same, byte for byte, whatever the thread count: the vertices' position ids, a
+// level's edge listing, sorts and pairs, its groups' simplification and their assembly run in fixed
+// pieces. The mesh has more than one piece of each at level 0 (65 536 vertices, 1 024 clusters, 65 536
+// outer-edge entries and 65 536 pairs; 256 groups).
 TEST(ClusterLod, SameHierarchyOnOneThreadAndOnMany) {
-  const Mesh m = bumpySphere(160, 320);  // 101 760 triangles
-  ASSERT_GT(m.clusters.size(), 1024u);
+  const Mesh m = bumpySphere(320, 640);  // 408 320 triangles
+  ASSERT_GT(m.positions.size(), 3u << 16);
+  ASSERT_GT(m.clusters.size(), 4 * 1024u);
   const ClusterLod one = buildClusterLod(m, true, 1), many = buildClusterLod(m, true, 7);
   ASSERT_GE(one.levels, 5u);
   EXPECT_EQ(one.levels, many.levels);
