@@ -175,7 +175,8 @@ TEST(Bc, RefinementBeatsThePlainEndpoints) {
     ours4 += got, plain4 += e4;
   }
   std::printf("squared error, ours vs plain: BC1 %lld vs %lld, BC4 %lld vs %lld\n", ours, plain, ours4, plain4);
-  EXPECT_LT(double(ours), 0.8 * double(plain));
+  // BC1: the principal axis alone gives 0.43 of the box corners' error on these blocks, its refinement 0.39.
+  EXPECT_LT(double(ours), 0.41 * double(plain));
   EXPECT_LT(double(ours4), 0.9 * double(plain4));
 }
 
@@ -213,4 +214,8 @@ TEST(Bc, ALevelEncodesToTheSameBytesOnAnyThreadCountAndDecodesToItsSize) {
     EXPECT_LE(smoothMax, 40) << "format " << int(f);
     EXPECT_LT(sum / double(back.size()), 6.0) << "format " << int(f);
   }
+  // A block's texels outside a level are not read back: a 1 x 1 BC4 level takes texel 0's value (red_1
+  // here), whatever the other 15 indices say (a file from another encoder may set them to anything).
+  const uint8_t one[8] = {200, 60, 1, 0, 0, 0, 0, 0};
+  EXPECT_EQ(decodeBakedLevel(BakedFormat::Bc4, 1, 1, one), std::vector<uint8_t>{60});
 }
