@@ -115,6 +115,9 @@ std::shared_ptr<const BakedTexels> packBakedTexels(BakedFormat format, uint32_t 
     const size_t n = t->pieceBytes(k);
     const uint8_t* src = chain.data() + k * kBakedPiece;
     std::vector<uint8_t>& out = packed[k];
+    // Blocks are stored as they are: zstd halves them but unpacks them at about 0.4 GB/s a core, which
+    // cost lavapipe's 200-texture start a quarter of its CPU (docs/bench/textures.md).
+    if (bakedBlocks(format)) return out.assign(src, src + n);
     out.resize(ZSTD_compressBound(n));
     // Each frame carries its content checksum: a damaged piece is found when it is unpacked, even where
     // the file's checksum was not checked (fuzz builds).

@@ -51,7 +51,8 @@ struct BakedTexels {
   size_t pieceBytes(size_t k) const;  // texel bytes of piece k
 };
 
-// Packs a chain laid out as levelOffsets() says (`chain` holds bytes() bytes): pieces compressed on all cores.
+// Packs a chain laid out as levelOffsets() says (`chain` holds bytes() bytes): pieces compressed on all cores
+// (block-compressed chains: stored as they are).
 std::shared_ptr<const BakedTexels> packBakedTexels(BakedFormat format, uint32_t width, uint32_t height,
                                                    std::vector<uint8_t> chain, unsigned threads = 0);
 
