@@ -116,7 +116,7 @@ std::vector<uint8_t> referenceChain(const TexelData& level0, bool srgb) {
 
 // The chain in `format` (lossless, or each level block-compressed), its error per level added to `error`.
 std::vector<uint8_t> encodeChain(const std::vector<uint8_t>& lossless, BakedFormat format, uint32_t w, uint32_t h,
-                                 std::vector<LevelError>& error) {
+                                 std::vector<LevelError>& error, unsigned threads) {
   if (format == BakedFormat::Rgba8 || format == BakedFormat::R8) return lossless;
   BakedTexels from, to;
   from.format = bakedChannels(format) == 1 ? BakedFormat::R8 : BakedFormat::Rgba8;
@@ -128,7 +128,7 @@ std::vector<uint8_t> encodeChain(const std::vector<uint8_t>& lossless, BakedForm
   error.resize(std::max<size_t>(error.size(), from.levels()));
   for (uint32_t l = 0; l < from.levels(); ++l) {
     const uint32_t lw = mipLevelSize(w, l), lh = mipLevelSize(h, l);
-    const std::vector<uint8_t> blocks = encodeBakedLevel(format, lw, lh, lossless.data() + src[l]);
+    const std::vector<uint8_t> blocks = encodeBakedLevel(format, lw, lh, lossless.data() + src[l], threads);
     std::copy(blocks.begin(), blocks.end(), out.begin() + ptrdiff_t(dst[l]));
     const std::vector<uint8_t> back = decodeBakedLevel(format, lw, lh, blocks.data());
     LevelError& e = error[l];
@@ -147,7 +147,10 @@ void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn,
   std::vector<std::string> errors(plan.scene.textures.size());
   std::atomic<size_t> done{0};
   std::mutex progressMutex;
-  parallelFor(plan.scene.textures.size(), threads, [&](size_t i) {
+  // Textures on all cores; where there are fewer textures than cores, each one's levels in pieces too.
+  const size_t count = plan.scene.textures.size();
+  const unsigned inner = count ? std::max<unsigned>(1, unsigned(threadCount(threads) / count)) : 1;
+  parallelFor(count, threads, [&](size_t i) {
     Texture& t = plan.scene.textures[i];
     Texture src = t;  // the image it comes from: a file, bytes held in memory, or a course fallback (none here)
     src.path = plan.sources[i];
@@ -174,7 +177,7 @@ void bakeTexels(TexturePlan& plan, unsigned threads, const std::string& namedIn,
     }
     const uint32_t w = texels.width, h = texels.height;
     std::vector<LevelError> error;
-    t.baked = packBakedTexels(format, w, h, encodeChain(referenceChain(texels, decodeSrgb(t)), format, w, h, error), 1);
+    t.baked = packBakedTexels(format, w, h, encodeChain(referenceChain(texels, decodeSrgb(t)), format, w, h, error, inner), 1);
     const std::lock_guard lock(progressMutex);
     if (bcError) {
       bcError->resize(std::max(bcError->size(), error.size()));

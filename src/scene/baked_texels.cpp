@@ -1,6 +1,5 @@
 #include "scene/baked_texels.hpp"
 
-#include <squish.h>
 #include <zstd.h>
 
 #include <algorithm>
@@ -10,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/mip_reference.hpp"
 #include "core/parallel.hpp"
+#include "scene/bc.hpp"
 
 namespace rtr {
 
@@ -24,86 +24,64 @@ uint64_t bakedLevelBytes(BakedFormat f, uint32_t w, uint32_t h) {
 
 namespace {
 
-int squishFlags(BakedFormat f) { return f == BakedFormat::Bc1 ? squish::kDxt1 : squish::kDxt5; }
-
-// BC4 is ours: bookworm's libsquish 1.15 encodes and decodes its kBc4 as BC1 colour. A block: red_0, red_1,
-// then a 3-bit index per texel (row-major, little-endian from bit 0). red_0 > red_1: eight values from
-// red_0 to red_1 in sevenths; else six in fifths, then 0 and 255 (Vulkan's data format specification).
-void bc4Palette(const uint8_t* block, int v[8]) {
-  const int r0 = block[0], r1 = block[1];
-  v[0] = r0;
-  v[1] = r1;
-  if (r0 > r1)
-    for (int i = 1; i < 7; ++i) v[i + 1] = ((7 - i) * r0 + i * r1 + 3) / 7;
-  else {
-    for (int i = 1; i < 5; ++i) v[i + 1] = ((5 - i) * r0 + i * r1 + 2) / 5;
-    v[6] = 0;
-    v[7] = 255;
-  }
-}
-
-// Endpoints the block's extremes (eight-value mode), each texel the nearest value: the error is at most
-// (max − min) / 14 plus rounding.
-void bc4Encode(const uint8_t* texels, uint32_t w, uint32_t h, uint32_t bx, uint32_t by, uint8_t* block) {
-  uint8_t t[16];
-  int lo = 255, hi = 0;
-  for (uint32_t i = 0; i < 16; ++i) {
-    const uint32_t x = std::min(bx * 4 + i % 4, w - 1), y = std::min(by * 4 + i / 4, h - 1);  // edges repeat
-    t[i] = texels[size_t(y) * w + x];
-    lo = std::min<int>(lo, t[i]);
-    hi = std::max<int>(hi, t[i]);
-  }
-  block[0] = uint8_t(hi);
-  block[1] = uint8_t(lo);
-  int v[8];
-  bc4Palette(block, v);
-  uint64_t bits = 0;
-  for (uint32_t i = 0; i < 16; ++i) {
-    int best = 0;
-    for (int k = 1; k < 8; ++k)
-      if (std::abs(v[k] - t[i]) < std::abs(v[best] - t[i])) best = k;
-    bits |= uint64_t(best) << (3 * i);
-  }
-  for (int b = 0; b < 6; ++b) block[2 + b] = uint8_t(bits >> (8 * b));
-}
-
-void bc4Decode(const uint8_t* block, uint32_t w, uint32_t h, uint32_t bx, uint32_t by, uint8_t* texels) {
-  int v[8];
-  bc4Palette(block, v);
-  uint64_t bits = 0;
-  for (int b = 0; b < 6; ++b) bits |= uint64_t(block[2 + b]) << (8 * b);
-  for (uint32_t i = 0; i < 16; ++i) {
-    const uint32_t x = bx * 4 + i % 4, y = by * 4 + i / 4;
-    if (x < w && y < h) texels[size_t(y) * w + x] = uint8_t(v[(bits >> (3 * i)) & 7]);
-  }
+// Each block of a level with the offsets of its 16 texels; where the level is not a multiple of 4, the
+// offsets repeat its last column and row, and `inside` (bit i for texel i) marks the real ones.
+template <class Fn>
+void forBlocks(uint32_t w, uint32_t h, uint32_t channels, unsigned threads, Fn&& fn) {
+  constexpr uint32_t kRows = 16;  // rows of blocks per piece
+  const uint32_t bw = (w + 3) / 4, bh = (h + 3) / 4;
+  parallelFor((bh + kRows - 1) / kRows, threads, [&](size_t piece) {
+    for (uint32_t by = uint32_t(piece) * kRows; by < std::min(bh, uint32_t(piece + 1) * kRows); ++by)
+      for (uint32_t bx = 0; bx < bw; ++bx) {
+        size_t at[16];
+        uint32_t inside = 0;
+        for (uint32_t i = 0; i < 16; ++i) {
+          const uint32_t x = bx * 4 + i % 4, y = by * 4 + i / 4;
+          at[i] = (size_t(std::min(y, h - 1)) * w + std::min(x, w - 1)) * channels;
+          inside |= uint32_t(x < w && y < h) << i;
+        }
+        fn(size_t(by) * bw + bx, at, inside);
+      }
+  });
 }
 
 }  // namespace
 
 std::vector<uint8_t> decodeBakedLevel(BakedFormat f, uint32_t w, uint32_t h, const uint8_t* data) {
-  const size_t n = size_t(w) * h;
-  if (!bakedBlocks(f)) return std::vector<uint8_t>(data, data + n * bakedChannels(f));
-  if (f == BakedFormat::Bc4) {
-    std::vector<uint8_t> r(n);
-    for (uint32_t by = 0, bw = (w + 3) / 4; by < (h + 3) / 4; ++by)
-      for (uint32_t bx = 0; bx < bw; ++bx) bc4Decode(data + (size_t(by) * bw + bx) * 8, w, h, bx, by, r.data());
-    return r;
-  }
-  std::vector<uint8_t> rgba(n * 4);
-  squish::DecompressImage(rgba.data(), int(w), int(h), data, squishFlags(f));
-  return rgba;
+  const uint32_t ch = bakedChannels(f);
+  const size_t n = size_t(w) * h * ch;
+  if (!bakedBlocks(f)) return std::vector<uint8_t>(data, data + n);
+  std::vector<uint8_t> out(n);
+  const size_t blockBytes = f == BakedFormat::Bc3 ? 16 : 8;
+  forBlocks(w, h, ch, 1, [&](size_t b, const size_t at[16], uint32_t inside) {
+    uint8_t t[64];
+    const uint8_t* block = data + b * blockBytes;
+    if (f == BakedFormat::Bc4) bc::decodeChannel(block, t, 1);
+    if (f == BakedFormat::Bc1) bc::decodeColour(block, true, t);
+    if (f == BakedFormat::Bc3) bc::decodeChannel(block, t + 3, 4), bc::decodeColour(block + 8, false, t);
+    if (f == BakedFormat::Bc1)
+      for (int i = 0; i < 16; ++i) t[4 * i + 3] = 255;
+    for (int i = 0; i < 16; ++i)
+      if (inside >> i & 1) std::memcpy(&out[at[i]], t + i * ch, ch);
+  });
+  return out;
 }
 
-std::vector<uint8_t> encodeBakedLevel(BakedFormat f, uint32_t w, uint32_t h, const uint8_t* texels) {
-  const size_t n = size_t(w) * h;
-  if (!bakedBlocks(f)) return std::vector<uint8_t>(texels, texels + n * bakedChannels(f));
+std::vector<uint8_t> encodeBakedLevel(BakedFormat f, uint32_t w, uint32_t h, const uint8_t* texels, unsigned threads) {
+  const uint32_t ch = bakedChannels(f);
+  if (!bakedBlocks(f)) return std::vector<uint8_t>(texels, texels + size_t(w) * h * ch);
   std::vector<uint8_t> out(bakedLevelBytes(f, w, h));
-  if (f == BakedFormat::Bc4) {
-    for (uint32_t by = 0, bw = (w + 3) / 4; by < (h + 3) / 4; ++by)
-      for (uint32_t bx = 0; bx < bw; ++bx) bc4Encode(texels, w, h, bx, by, out.data() + (size_t(by) * bw + bx) * 8);
-    return out;
-  }
-  squish::CompressImage(texels, int(w), int(h), out.data(), squishFlags(f) | squish::kColourClusterFit);
+  const size_t blockBytes = f == BakedFormat::Bc3 ? 16 : 8;
+  forBlocks(w, h, ch, threads, [&](size_t b, const size_t at[16], uint32_t) {
+    uint8_t t[64], alpha[16];
+    for (int i = 0; i < 16; ++i) std::memcpy(t + i * ch, texels + at[i], ch);
+    uint8_t* block = out.data() + b * blockBytes;
+    if (f == BakedFormat::Bc4) return bc::encodeChannel(t, block);
+    if (f == BakedFormat::Bc1) return bc::encodeColour(t, block);
+    for (int i = 0; i < 16; ++i) alpha[i] = t[4 * i + 3];
+    bc::encodeChannel(alpha, block);
+    bc::encodeColour(t, block + 8);
+  });
   return out;
 }
 
@@ -137,6 +115,9 @@ std::shared_ptr<const BakedTexels> packBakedTexels(BakedFormat format, uint32_t 
     const size_t n = t->pieceBytes(k);
     const uint8_t* src = chain.data() + k * kBakedPiece;
     std::vector<uint8_t>& out = packed[k];
+    // Blocks are stored as they are: zstd halves them but unpacks them at about 0.4 GB/s a core, which
+    // cost lavapipe's 200-texture start a quarter of its CPU (docs/bench/textures.md).
+    if (bakedBlocks(format)) return out.assign(src, src + n);
     out.resize(ZSTD_compressBound(n));
     // Each frame carries its content checksum: a damaged piece is found when it is unpacked, even where
     // the file's checksum was not checked (fuzz builds).

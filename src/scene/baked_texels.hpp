@@ -21,10 +21,12 @@ bool bakedKnown(uint32_t format);
 uint32_t bakedChannels(BakedFormat f);  // of the decoded texels: 1 or 4
 bool bakedBlocks(BakedFormat f);        // block-compressed
 uint64_t bakedLevelBytes(BakedFormat f, uint32_t width, uint32_t height);
-// Decodes one level of `f` to 8-bit texels of bakedChannels(f) channels (BC: libsquish's decoder).
+// Decodes one level of `f` to 8-bit texels of bakedChannels(f) channels (BC: scene/bc.hpp's decoders).
 std::vector<uint8_t> decodeBakedLevel(BakedFormat f, uint32_t width, uint32_t height, const uint8_t* data);
-// Encodes one level of 8-bit texels (bakedChannels(f) channels) to `f` (BC: libsquish, cluster fit).
-std::vector<uint8_t> encodeBakedLevel(BakedFormat f, uint32_t width, uint32_t height, const uint8_t* texels);
+// Encodes one level of 8-bit texels (bakedChannels(f) channels) to `f` (BC: scene/bc.hpp's encoders), in
+// pieces of block rows on `threads` (0: all cores): the same bytes on any number.
+std::vector<uint8_t> encodeBakedLevel(BakedFormat f, uint32_t width, uint32_t height, const uint8_t* texels,
+                                      unsigned threads = 1);
 
 constexpr size_t kBakedPiece = size_t(1) << 18;  // bytes of texels per piece (the last one of a texture shorter)
 
@@ -49,7 +51,8 @@ struct BakedTexels {
   size_t pieceBytes(size_t k) const;  // texel bytes of piece k
 };
 
-// Packs a chain laid out as levelOffsets() says (`chain` holds bytes() bytes): pieces compressed on all cores.
+// Packs a chain laid out as levelOffsets() says (`chain` holds bytes() bytes): pieces compressed on all cores
+// (block-compressed chains: stored as they are).
 std::shared_ptr<const BakedTexels> packBakedTexels(BakedFormat format, uint32_t width, uint32_t height,
                                                    std::vector<uint8_t> chain, unsigned threads = 0);
 

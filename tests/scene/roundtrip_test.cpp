@@ -215,3 +215,46 @@ TEST(RoundTrip, LosslessTexturesAreTheReferenceChainsInTheFile) {
   EXPECT_TRUE(srgbSeen && greySeen) << "both kinds of texture are covered";
   fs::remove_all(dir);
 }
+
+// --textures bc: each level holds what the encoder makes of the reference chain's level, and the chains are
+// the same bytes on any thread count: textures in parallel, and a lone texture's levels in pieces of block
+// rows on the cores the textures leave free.
+TEST(RoundTrip, BlockCompressedChainsAreTheSameOnAnyThreadCount) {
+  const Scene source = loadScene(rtr::test::sourceDir() / "assets-src/temple/temple.obj.zst");
+  auto chains = [&](size_t textures, unsigned threads) {
+    TexturePlan plan = planTextures(source, "t", false);
+    plan.scene.textures.resize(textures), plan.sources.resize(textures), plan.bytes.resize(textures);
+    std::vector<LevelError> error;
+    bakeTexels(plan, threads, "MTL", {}, true, &error);
+    std::vector<std::vector<uint8_t>> out;
+    for (const Texture& t : plan.scene.textures) {
+      for (size_t k = 0; k < t.baked->pieces.size(); ++k)
+        EXPECT_EQ(t.baked->pieces[k].stored, t.baked->pieceBytes(k)) << "blocks are stored as they are, not zstd";
+      std::vector<uint8_t> chain(t.baked->bytes());
+      for (size_t k = 0; k < t.baked->pieces.size(); ++k) unpackBakedPiece(*t.baked, k, chain.data());
+      out.push_back(std::move(chain));
+    }
+    return out;
+  };
+  const auto all = chains(source.textures.size(), 1);
+  EXPECT_EQ(chains(source.textures.size(), 3), all);
+  EXPECT_EQ(chains(source.textures.size(), 0), all);
+  for (unsigned threads : {2u, 5u}) EXPECT_EQ(chains(1, threads), std::vector<std::vector<uint8_t>>{all[0]}) << threads;
+  // Texture 0's levels, each the encoder's blocks of the reference chain's level.
+  const TexelData level0 = decodeTexture(source, source.textures[0]);
+  ASSERT_EQ(level0.channels, 4u);
+  const std::vector<uint8_t> ref = referenceChain(level0, source.textures[0].srgb);
+  BakedTexels lossless, blocks;
+  lossless.width = blocks.width = level0.width;
+  lossless.height = blocks.height = level0.height;
+  bool opaque = true;
+  for (size_t k = 3; k < level0.texels.size(); k += 4) opaque &= level0.texels[k] == 255;
+  blocks.format = opaque ? BakedFormat::Bc1 : BakedFormat::Bc3;
+  const std::vector<uint64_t> from = lossless.levelOffsets(), to = blocks.levelOffsets();
+  ASSERT_EQ(all[0].size(), to.back());
+  for (uint32_t l = 0; l < blocks.levels(); ++l) {
+    const std::vector<uint8_t> want =
+        encodeBakedLevel(blocks.format, mipLevelSize(level0.width, l), mipLevelSize(level0.height, l), ref.data() + from[l]);
+    EXPECT_TRUE(std::equal(want.begin(), want.end(), all[0].begin() + ptrdiff_t(to[l]))) << "level " << l;
+  }
+}
