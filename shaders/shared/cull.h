@@ -162,13 +162,19 @@ RTR_FN vec4 placeSphere(mat4 transform, float stretch, vec4 s) {
 // texel of an odd-sized level below, 2t + 2 too. So texel min(p >> (L + 1), size_L - 1) of level L covers
 // pixel p, at every level and for any image size.
 
-// The pyramid level whose texels cover the box's pixels with at most 2 × 2 texels.
-RTR_FN int pyramidLevel(ivec4 px, int levels) {
+// The finest pyramid level whose texels cover the box's pixels with at most span × span texels.
+RTR_FN int pyramidLevelFor(ivec4 px, int levels, int span) {
   int shift = 1;
-  while (shift < levels && (((px.z >> shift) - (px.x >> shift)) > 1 || ((px.w >> shift) - (px.y >> shift)) > 1))
+  while (shift < levels && (((px.z >> shift) - (px.x >> shift)) >= span || ((px.w >> shift) - (px.y >> shift)) >= span))
     ++shift;
   return shift - 1;
 }
+
+// The occlusion test reads up to 4 × 4 texels: one level finer than 2 × 2, where a box's texels reach less
+// far past it (rtr-lod-cut --fates: on the 1M-triangle grid's three views the pass then lists 11-52 % fewer
+// triangles; docs/culling.md).
+#define CULL_PYRAMID_SPAN 4
+RTR_FN int pyramidLevel(ivec4 px, int levels) { return pyramidLevelFor(px, levels, CULL_PYRAMID_SPAN); }
 
 // The texels (min x, min y, max x, max y) of level `level`, of size `levelSize`, that cover the pixels.
 RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {

@@ -314,7 +314,7 @@ void printFates(const Scene& scene, const View& v, float threshold) {
   }
   // The depth pyramid of that depth (render/cull.cpp's DepthPyramid: farthest of each 2 × 2, level 0 half
   // the image, sizes rounding down, the odd last texel folded in), and the occlusion test of the culling
-  // pass on it (shared/cull.h), at the level where a box covers at most 2 × 2 texels (`span` 1) or more.
+  // pass on it (shared/cull.h), at the level where a box covers at most span × span texels (2, 4, 8).
   std::vector<std::vector<float>> levels;
   std::vector<glm::ivec2> sizes;
   glm::ivec2 below(v.width, v.height);
@@ -332,17 +332,14 @@ void printFates(const Scene& scene, const View& v, float threshold) {
   auto occluded = [&](glm::vec4 sphere, int span) {
     const shader::ProjectedBox b = shader::projectBox(sphere, v.viewProj, v.width, v.height);
     if (b.inFront == 0u) return false;
-    int level = shader::pyramidLevel(b.pixels, int(levels.size()));
-    while (level > 0 && ((b.pixels.z >> level) - (b.pixels.x >> level)) < span &&
-           ((b.pixels.w >> level) - (b.pixels.y >> level)) < span)
-      --level;
+    const int level = shader::pyramidLevelFor(b.pixels, int(levels.size()), span);
     const glm::ivec4 t = shader::pyramidTexels(b.pixels, level, sizes[level]);
     float farthest = 0.0f;
     for (int y = t.y; y <= t.w; ++y)
       for (int x = t.x; x <= t.z; ++x) farthest = std::max(farthest, levels[level][size_t(y) * sizes[level].x + x]);
     return b.nearestDepth > farthest;
   };
-  std::array<size_t, kFates> n{}, kept{};  // all listed; those of the clusters the pyramid (2 × 2) keeps
+  std::array<size_t, kFates> n{}, kept{};  // all listed; those of the clusters the pass's occlusion test keeps
   size_t idle = 0, idleClusters = 0, allBack = 0, allHidden = 0;
   std::array<size_t, 3> caught{}, caughtTris{}, wrong{};  // by the pyramid: 2 × 2, up to 4 × 4, 8 × 8 texels
   for (size_t c = 0; c + 1 < firstOf.size(); ++c) {
@@ -354,7 +351,7 @@ void printFates(const Scene& scene, const View& v, float threshold) {
     allBack += k[Back] == count ? count : 0, allHidden += k[Hidden] == count ? count : 0;
     for (int i = 0; i < 3; ++i)
       if (occluded(spheres[c], 2 << i)) ++caught[i], caughtTris[i] += count, wrong[i] += !drawsNothing;
-    for (int f = 0; f < kFates; ++f) n[f] += k[f], kept[f] += occluded(spheres[c], 2) ? 0 : k[f];
+    for (int f = 0; f < kFates; ++f) n[f] += k[f], kept[f] += occluded(spheres[c], CULL_PYRAMID_SPAN) ? 0 : k[f];
   }
   auto print = [&](const char* what, const std::array<size_t, kFates>& c) {
     size_t all = 0;
