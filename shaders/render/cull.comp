@@ -1,6 +1,6 @@
 #version 460
-// Cluster culling, second step: one workgroup per chunk of clusters that cull_instances.comp kept, a
-// thread per cluster; the records (the mesh's) placed by the chunk's instance, then the level-of-detail
+// Cluster culling, second step: CULL_CHUNKS_PER_GROUP chunks of clusters that cull_instances.comp kept
+// (a tree leaf each) per workgroup, a thread per cluster; the records (the mesh's) placed by the chunk's instance, then the level-of-detail
 // cut, frustum, back-face cone and occlusion against the depth pyramid (shaders/shared/cull.h has the
 // tests and the phases). Visible clusters are appended as (instance, record) to a compact list whose
 // length is the size of an indirect dispatch (one workgroup per visible cluster; cull.h); culled ones are
@@ -9,6 +9,7 @@
 #extension GL_EXT_samplerless_texture_functions : require
 #include "cull.h"
 #include "frame.h"
+#include "cull_subgroup.glsl"
 
 layout(local_size_x = CULL_GROUP_SIZE) in;
 
@@ -38,11 +39,13 @@ bool occluded(vec4 sphere) {
 }
 
 void main() {
-  const uint k = gl_WorkGroupID.y * max(pc.maxGroupsX, 1u) + gl_WorkGroupID.x;
+  const uint k = (gl_WorkGroupID.y * max(pc.maxGroupsX, 1u) + gl_WorkGroupID.x) * CULL_CHUNKS_PER_GROUP +
+                 gl_LocalInvocationID.x / CULL_LEAF_SIZE;
   if (k >= counts.chunks) return;
   const uvec4 chunk = chunks[k];
-  if (gl_LocalInvocationID.x >= chunk.z) return;
-  const uint i = chunk.y + gl_LocalInvocationID.x;
+  const uint lane = gl_LocalInvocationID.x % CULL_LEAF_SIZE;
+  if (lane >= chunk.z) return;
+  const uint i = chunk.y + lane;
   const GpuCullInstance ci = cullInstances[chunk.x];
   const uint slot = i + ci.levels.w;
   const bool wasVisible = pc.phase != CULL_SINGLE && (history[slot >> 5u] & (1u << (slot & 31u))) != 0u;
@@ -77,12 +80,15 @@ void main() {
   else if ((pc.flags & CULL_OCCLUSION) != 0u && pc.phase != CULL_EARLY && occluded(c.sphere)) reason = CULL_BY_OCCLUSION;
   if (pc.phase == CULL_LATE && (reason == CULL_VISIBLE) != wasVisible)
     atomicXor(history[slot >> 5u], 1u << (slot & 31u));
-  if (reason != CULL_VISIBLE) atomicAdd(counts.culled[reason - 1u], 1u);
-  else if (!(pc.phase == CULL_LATE && wasVisible)) {
-    const uint n = atomicAdd(counts.listed, 1u), maxX = max(pc.maxGroupsX, 1u);
-    visible[counts.listBase + n] = uvec2(instance, i);
-    atomicAdd(counts.triangles, c.triangleCount);
-    if (n < maxX) atomicMax(counts.dispatch[0], n + 1u);
-    if (n % maxX == 0u) atomicMax(counts.dispatch[1], n / maxX + 1u);
+  for (uint r = 0u; r < 4u; ++r) CULL_COUNT(counts.culled[r], reason == r + 1u ? 1u : 0u);
+  const bool listed = reason == CULL_VISIBLE && !(pc.phase == CULL_LATE && wasVisible);
+  uint n, last;
+  CULL_RESERVE(counts.listed, listed ? 1u : 0u, n, last);
+  CULL_COUNT(counts.triangles, listed ? c.triangleCount : 0u);
+  if (last != 0xFFFFFFFFu) {  // one workgroup per entry, two-dimensional past maxGroupsX
+    const uint maxX = max(pc.maxGroupsX, 1u);
+    atomicMax(counts.dispatch[0], min(last + 1u, maxX));
+    atomicMax(counts.dispatch[1], last / maxX + 1u);
   }
+  if (listed) visible[counts.listBase + n] = uvec2(instance, i);
 }

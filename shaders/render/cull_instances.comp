@@ -6,11 +6,13 @@
 // (instance, node); a node is descended only if it is in the frustum and, with the cut, some cluster below
 // can be in it (its least error, projected from the farthest point of its sphere, at most the threshold,
 // and its parents' largest, from the nearest, above it; docs/culling.md); its children go to the next
-// depth's queue, a leaf's clusters to the chunks (up to CULL_GROUP_SIZE), one workgroup each of the
-// cluster step (cull.comp), dispatched indirectly from counts.chunkDispatch.
+// depth's queue, a leaf's records to the chunks (up to CULL_LEAF_SIZE), CULL_CHUNKS_PER_GROUP to a
+// workgroup of the cluster step (cull.comp), dispatched indirectly from counts.chunkDispatch. Without
+// instances (pc.clusters > 0), the instance step makes the chunks of the records, one a thread.
 #extension GL_GOOGLE_include_directive : require
 #include "cull.h"
 #include "frame.h"
+#include "cull_subgroup.glsl"
 
 layout(local_size_x = CULL_GROUP_SIZE) in;
 
@@ -24,23 +26,30 @@ layout(set = 0, binding = 11, std430) buffer Items { uvec2 items[]; };  // (GpuC
 
 layout(push_constant) uniform Push { CullPush pc; };
 
-void emit(uint instance, uint first, uint count) {
-  const uint n = (count + CULL_GROUP_SIZE - 1u) / CULL_GROUP_SIZE;
-  if (n == 0u) return;
-  const uint base = atomicAdd(counts.chunks, n), maxX = max(pc.maxGroupsX, 1u), last = base + n - 1u;
-  for (uint k = 0u; k < n; ++k)
-    chunks[base + k] = uvec4(instance, first + k * CULL_GROUP_SIZE, min(uint(CULL_GROUP_SIZE), count - k * CULL_GROUP_SIZE), 0u);
-  atomicMax(counts.chunkDispatch[0], min(last + 1u, maxX));
-  atomicMax(counts.chunkDispatch[1], last / maxX + 1u);
-  atomicAdd(counts.tested, count);
+// Raises an indirect dispatch (workgroups of `per` items, two-dimensional past maxGroupsX) to cover item
+// `last` (0xFFFFFFFF: nothing to cover).
+#define CULL_COVER(dispatch, last, per)                                      \
+  if (last != 0xFFFFFFFFu) {                                                 \
+    const uint group_ = last / (per), maxX_ = max(pc.maxGroupsX, 1u);        \
+    atomicMax(dispatch[0], min(group_ + 1u, maxX_));                         \
+    atomicMax(dispatch[1], group_ / maxX_ + 1u);                             \
+  }
+
+// A leaf's records (up to CULL_LEAF_SIZE) as one chunk of the cluster step, where `on`.
+void emit(bool on, uint instance, uint first, uint count) {
+  uint k, last;
+  CULL_RESERVE(counts.chunks, on ? 1u : 0u, k, last);
+  CULL_COVER(counts.chunkDispatch, last, CULL_CHUNKS_PER_GROUP);
+  CULL_COUNT(counts.tested, on ? count : 0u);
+  if (on) chunks[k] = uvec4(instance, first, count, 0u);
 }
 
+// Nodes [first, first + count) of `instance` into the queue of `depth` (count 0: none).
 void enqueue(uint depth, uint instance, uint first, uint count) {
-  const uint n = atomicAdd(queues[depth].count, count), maxX = max(pc.maxGroupsX, 1u);
+  uint n, last;
+  CULL_RESERVE(queues[depth].count, count, n, last);
+  CULL_COVER(queues[depth].dispatch, last, CULL_GROUP_SIZE);
   for (uint k = 0u; k < count; ++k) items[queues[depth].base + n + k] = uvec2(instance, first + k);
-  const uint lastGroup = (n + count - 1u) / CULL_GROUP_SIZE;
-  atomicMax(queues[depth].dispatch[0], min(lastGroup + 1u, maxX));
-  atomicMax(queues[depth].dispatch[1], lastGroup / maxX + 1u);
 }
 
 // Whether some cluster below `node`, placed by the instance, can be listed (sphere and errors placed).
@@ -68,26 +77,28 @@ bool descend(GpuCullNode node, GpuCullInstance ci) {
 }
 
 void main() {
+  if (pc.depth == CULL_INSTANCE_STEP && pc.clusters > 0u) {  // records placed already: one chunk a thread
+    const uint at = gl_GlobalInvocationID.x * CULL_LEAF_SIZE;
+    if (at >= pc.clusters) return;
+    emit(true, 0u, at, min(CULL_LEAF_SIZE, pc.clusters - at));
+    return;
+  }
   if (pc.depth == CULL_INSTANCE_STEP) {
     const uint i = gl_GlobalInvocationID.x;
     if (i >= pc.count) return;
     const GpuCullInstance c = cullInstances[i];
     // Its clusters' spheres lie in its sphere: a plane that has it wholly outside has them too.
-    if ((pc.flags & CULL_FRUSTUM) != 0u && frustumCulls(c.sphere, pc.viewProj)) {
-      atomicAdd(counts.instancesCulled, 1u);
-      return;
-    }
-    if (c.levels.z == CULL_RECORD_INSTANCE) emit(i, 0u, pc.clusters);  // records as they are, no tree
-    else enqueue(0u, i, c.levels.x, (pc.flags & CULL_LOD) != 0u ? c.levels.y : 1u);
+    const bool culled = (pc.flags & CULL_FRUSTUM) != 0u && frustumCulls(c.sphere, pc.viewProj);
+    CULL_COUNT(counts.instancesCulled, culled ? 1u : 0u);
+    enqueue(0u, i, c.levels.x, culled ? 0u : (pc.flags & CULL_LOD) != 0u ? c.levels.y : 1u);
     return;
   }
   const uint k = (gl_WorkGroupID.y * max(pc.maxGroupsX, 1u) + gl_WorkGroupID.x) * CULL_GROUP_SIZE + gl_LocalInvocationID.x;
   if (k >= queues[pc.depth].count) return;
   const uvec2 item = items[queues[pc.depth].base + k];
-  const GpuCullInstance ci = cullInstances[item.x];
   const GpuCullNode node = nodes[item.y];
-  atomicAdd(counts.nodes, 1u);
-  if (!descend(node, ci)) return;
-  if ((node.count & CULL_NODE_LEAF) != 0u) emit(item.x, node.first, node.count & ~CULL_NODE_LEAF);
-  else if (pc.depth + 1u < CULL_MAX_DEPTH) enqueue(pc.depth + 1u, item.x, node.first, node.count);
+  CULL_COUNT(counts.nodes, 1u);
+  const bool on = descend(node, cullInstances[item.x]), leaf = (node.count & CULL_NODE_LEAF) != 0u;
+  emit(on && leaf, item.x, node.first, node.count & ~CULL_NODE_LEAF);
+  if (pc.depth + 1u < CULL_MAX_DEPTH) enqueue(pc.depth + 1u, item.x, node.first, on && !leaf ? node.count : 0u);
 }

@@ -13,6 +13,8 @@ namespace rtr::shader {
 #endif
 
 #define CULL_GROUP_SIZE 64
+// The cluster step's workgroup tests this many chunks (tree leaves, up to CULL_LEAF_SIZE records each).
+#define CULL_CHUNKS_PER_GROUP (CULL_GROUP_SIZE / CULL_LEAF_SIZE)
 #define HIZ_GROUP_SIZE 8
 
 // CullPush::flags: which tests run.
@@ -44,8 +46,8 @@ namespace rtr::shader {
 // Over CullPush::maxGroupsX visible clusters the dispatch is two-dimensional, {maxGroupsX, rows, 1}: a
 // workgroup's list entry is then gl_WorkGroupID.y * maxGroupsX + gl_WorkGroupID.x (below `listed`).
 // The pass runs in steps: instances, then the tree over each level of their meshes' clusters depth by
-// depth (cull_instances.comp), then the chunks of clusters of the leaves reached (cull.comp), dispatched
-// from chunkDispatch the same way.
+// depth (cull_instances.comp), then the chunks of clusters of the leaves reached (cull.comp,
+// CULL_CHUNKS_PER_GROUP chunks a workgroup), dispatched from chunkDispatch the same way.
 struct CullCounts {
   uint dispatch[3];
   uint culled[4];         // frustum, cone (back-facing), occlusion, level of detail
@@ -53,7 +55,7 @@ struct CullCounts {
   uint triangles;         // of the listed clusters
   uint tested;            // clusters the cluster step visited: those of the instances kept
   uint instancesCulled;   // instances culled whole by the frustum (one test each, none of their clusters)
-  uint chunks;            // runs of up to CULL_GROUP_SIZE clusters: the cluster step's workgroups
+  uint chunks;            // runs of up to CULL_LEAF_SIZE clusters (tree leaves), CULL_CHUNKS_PER_GROUP a workgroup
   uint chunkDispatch[3];  // its indirect dispatch
   uint listBase;          // where this pass's entries start: 0, or for LATE the entries EARLY listed
   uint nodes;             // tree nodes tested
@@ -83,7 +85,7 @@ struct CullPush {  // 128 bytes
   float lodThreshold;   // CULL_LOD: pixels of projected error
   float pixelsPerUnit;  // image height / (2 tan(fovY / 2))
   float zNear;
-  uint clusters;  // without instances (CULL_RECORD_INSTANCE): the records to test
+  uint clusters;  // without instances (CULL_RECORD_INSTANCE): the records to test; else 0
   uint depth;     // cull_instances.comp: CULL_INSTANCE_STEP, or the tree depth whose queue it tests
 };
 #define CULL_INSTANCE_STEP 0xFFFFFFFFu
@@ -160,13 +162,19 @@ RTR_FN vec4 placeSphere(mat4 transform, float stretch, vec4 s) {
 // texel of an odd-sized level below, 2t + 2 too. So texel min(p >> (L + 1), size_L - 1) of level L covers
 // pixel p, at every level and for any image size.
 
-// The pyramid level whose texels cover the box's pixels with at most 2 × 2 texels.
-RTR_FN int pyramidLevel(ivec4 px, int levels) {
+// The finest pyramid level whose texels cover the box's pixels with at most span × span texels.
+RTR_FN int pyramidLevelFor(ivec4 px, int levels, int span) {
   int shift = 1;
-  while (shift < levels && (((px.z >> shift) - (px.x >> shift)) > 1 || ((px.w >> shift) - (px.y >> shift)) > 1))
+  while (shift < levels && (((px.z >> shift) - (px.x >> shift)) >= span || ((px.w >> shift) - (px.y >> shift)) >= span))
     ++shift;
   return shift - 1;
 }
+
+// The occlusion test reads up to 4 × 4 texels: one level finer than 2 × 2, where a box's texels reach less
+// far past it (rtr-lod-cut --fates: on the 1M-triangle grid's three views the pass then lists 11-52 % fewer
+// triangles; docs/culling.md).
+#define CULL_PYRAMID_SPAN 4
+RTR_FN int pyramidLevel(ivec4 px, int levels) { return pyramidLevelFor(px, levels, CULL_PYRAMID_SPAN); }
 
 // The texels (min x, min y, max x, max y) of level `level`, of size `levelSize`, that cover the pixels.
 RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {

@@ -281,7 +281,16 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint3
                              const std::vector<uint32_t>& queueCapacity)
     : ctx_(ctx),
       maxClusters_(maxClusters),
-      maxChunks_(maxChunks ? maxChunks : (maxClusters + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE) {
+      maxChunks_(maxChunks ? maxChunks : (maxClusters + CULL_LEAF_SIZE - 1) / CULL_LEAF_SIZE) {
+  // The pass's counters and lists take one atomic per subgroup (cull_subgroup.glsl).
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &subgroup};
+  vkGetPhysicalDeviceProperties2(ctx.physicalDevice(), &props);
+  constexpr VkSubgroupFeatureFlags kNeeded =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
+  if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) || (subgroup.supportedOperations & kNeeded) != kNeeded)
+    throw Error(std::string("cluster culling: ") + props.properties.deviceName +
+                " has no subgroup arithmetic and ballot operations in compute shaders");
   if (queueCapacity.size() > CULL_MAX_DEPTH)
     throw Error("cluster culling: trees " + std::to_string(queueCapacity.size()) + " deep, at most " +
                 std::to_string(CULL_MAX_DEPTH));
@@ -327,7 +336,7 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint3
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
                            const DepthPyramid* pyramid, CullTests tests, CullPhase phase, VkBuffer lods, VkBuffer instances,
                            uint32_t instanceCount, VkBuffer nodes, VkBuffer placements) {
-  if (count > maxClusters_ || (!instances && (count + CULL_GROUP_SIZE - 1) / CULL_GROUP_SIZE > maxChunks_))
+  if (count > maxClusters_ || (!instances && (count + CULL_LEAF_SIZE - 1) / CULL_LEAF_SIZE > maxChunks_))
     throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
   // The last frame's consumers are done with both buffers before they are reset and rewritten.
@@ -345,7 +354,8 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
   std::array<shader::CullQueue, CULL_MAX_DEPTH> queues{};
   for (uint32_t d = 0; d < CULL_MAX_DEPTH; ++d) queues[d] = {{0, 1, 1}, 0, queueBases_[d], 0, 0, 0};
   vkCmdUpdateBuffer(cb, queues_.handle(), 0, sizeof(queues), queues.data());
-  if (!instances) {  // one instance of records placed already, never culled
+  const bool flat = !instances;
+  if (flat) {  // one instance of records placed already, never culled
     const shader::GpuCullInstance all{glm::vec4(0.0f, 0.0f, 0.0f, 1e30f), glm::vec4(0.0f, 0.0f, 0.0f, 1e30f),
                                       glm::uvec4(0, 1, CULL_RECORD_INSTANCE, 0), glm::vec4(1.0f, 1.0f, 1.0f, 0.0f)};
     vkCmdUpdateBuffer(cb, whole_.handle(), 0, sizeof(all), &all);
@@ -363,7 +373,7 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
                (tests.occlusion && pyramid ? CULL_OCCLUSION : 0u) |
                (tests.lod && lods && camera.lodThreshold > 0.0f && !camera.orthographic ? CULL_LOD : 0u) |
                (tests.nodes ? CULL_NODES : 0u);
-  push.clusters = count;
+  push.clusters = flat ? count : 0;
   push.lodThreshold = camera.lodThreshold;
   push.pixelsPerUnit = camera.pixelsPerUnit;
   push.zNear = camera.zNear;
@@ -387,7 +397,7 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
       .push(cb, instancePipeline_);
   push.depth = CULL_INSTANCE_STEP;
   instancePipeline_.push(cb, push);
-  instancePipeline_.dispatch(cb, instanceCount);
+  instancePipeline_.dispatch(cb, flat ? (count + CULL_LEAF_SIZE - 1) / CULL_LEAF_SIZE : instanceCount);
   for (uint32_t d = 0; nodes && d < depths_; ++d) {
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
     push.depth = d;

@@ -57,7 +57,7 @@ void appendClusterLods(const Mesh& mesh, const glm::mat4& transform, uint32_t in
 // The sphere around the box of `spheres` that holds each (rounded outwards).
 glm::vec4 enclosingSphere(const std::vector<glm::vec4>& spheres);
 // The culling tree over records [first, first + count), one level of a mesh (culling spheres in `clusters`,
-// level-of-detail records in `lods`, or none): leaves of up to CULL_GROUP_SIZE consecutive records, nodes
+// level-of-detail records in `lods`, or none): leaves of up to CULL_LEAF_SIZE consecutive records, nodes
 // of up to CULL_NODE_CHILDREN (cluster.h). Its root goes to nodes[root] (the caller's slot), the rest is
 // appended; adds its nodes at each depth (the root's 0) to `depthCounts`; returns its leaves.
 uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, const std::vector<shader::GpuClusterLod>& lods,
@@ -119,7 +119,7 @@ enum class CullPhase : uint32_t { Single = CULL_SINGLE, Early = CULL_EARLY, Late
 class ClusterCuller {
  public:
   // maxClusters: the (instance, cluster) pairs it may visit (list entries, history bits); maxChunks: the
-  // runs of up to CULL_GROUP_SIZE clusters it may emit (0: those of one instance of maxClusters, the
+  // runs of up to CULL_LEAF_SIZE clusters (tree leaves) it may emit (0: those of one instance of maxClusters, the
   // record() without instances); queueCapacity: per tree depth, the (instance, node) pairs at it
   // (GpuScene::cullQueueCapacity).
   ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint32_t maxChunks = 0,
