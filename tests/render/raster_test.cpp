@@ -322,15 +322,17 @@ TEST_F(RasterTest, ClosedMeshFromInsideLeavesNoHole) {
                               {{0.7f, -0.6f, 0.5f}, 150, -30},
                               {{0.85f, 0.85f, -0.85f}, 45, 35}};
   uint32_t clipped = 0;
-  for (const CameraPose& pose : poses) {
-    SCOPED_TRACE(testing::Message() << "yaw " << pose.yawDeg << ", pitch " << pose.pitchDeg);
-    const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute);
-    clipped += r.renderer().clippedTriangles(0).value_or(0);
-    size_t holes = 0;
-    for (uint32_t i = 0; i < cs.size(); ++i)
-      if (cs[i] == VIS_EMPTY && ++holes <= 5) ADD_FAILURE() << "hole at " << i % kCubeSize << "," << i / kCubeSize;
-    EXPECT_EQ(holes, 0u);
-  }
+  for (const bool clip : {true, false})  // clipped in compute, and handed to the hardware (the default)
+    for (const CameraPose& pose : poses) {
+      SCOPED_TRACE(testing::Message() << "yaw " << pose.yawDeg << ", pitch " << pose.pitchDeg
+                                      << (clip ? ", compute clip" : ", hardware"));
+      const std::vector<uint32_t> cs = ids(r, pose, lens, RasterPath::Compute, clip);
+      if (clip) clipped += r.renderer().clippedTriangles(0).value_or(0);
+      size_t holes = 0;
+      for (uint32_t i = 0; i < cs.size(); ++i)
+        if (cs[i] == VIS_EMPTY && ++holes <= 5) ADD_FAILURE() << "hole at " << i % kCubeSize << "," << i / kCubeSize;
+      EXPECT_EQ(holes, 0u);
+    }
   EXPECT_GT(clipped, 0u) << "no face crosses w = 0: clipping untested";
 }
 
