@@ -68,6 +68,7 @@ class Machine:
                 f"; CPU {self.meta.get('cpu', '?')}; {self.meta.get('date', '?')}; commit {self.meta.get('commit', '?')}" +
                 (f"; tracer rows: commit {self.meta['trace-commit']}" if "trace-commit" in self.meta else "") +
                 (f"; environment rows: commit {self.meta['env-commit']}" if "env-commit" in self.meta else "") +
+                (f"; texture rows: commit {self.meta['textures-commit']}" if "textures-commit" in self.meta else "") +
                 (f"; rows by commit: {self.meta['rows-commit']}" if "rows-commit" in self.meta else ""))
 
 
