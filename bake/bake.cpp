@@ -235,7 +235,7 @@ BakeReport bake(const BakeOptions& opt) {
     c0 = std::clock();
     if (opt.progress) opt.progress("clustering", 0.0);
     try {
-      stage("clustering " + input, [&] { buildMissingClusters(plan.scene); });
+      stage("clustering " + input, [&] { buildMissingClusters(plan.scene, threads); });
     } catch (const Error& e) { throw fileError(input, "", e.what()); }
     rep.clusterSeconds = since(t0);
     rep.clusterCpuSeconds = cpuSince(c0);

@@ -86,7 +86,7 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
 // big mesh, such as a scanned statue, would otherwise keep one core busy while the others wait).
 constexpr size_t kPieceTriangles = size_t(1) << 16;
 
-void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backfaceCone) {
+void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backfaceCone, unsigned threads) {
   // meshoptimizer asserts (aborts) on non-finite cone math, which huge coordinates produce; every reader
   // refuses them with its file and place, and nothing beyond the limit reaches it from elsewhere either.
   for (const Mesh* m : meshes) {
@@ -105,7 +105,7 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
     for (size_t t = 0, n = meshes[i]->indices.size() / 3; t < n; t += kPieceTriangles)
       jobs.push_back({i, t, std::min(n, t + kPieceTriangles)});
   std::vector<Piece> pieces(jobs.size());
-  parallelFor(jobs.size(), 0, [&](size_t j) {
+  parallelFor(jobs.size(), threads, [&](size_t j) {
     pieces[j] = clusterPiece(*meshes[jobs[j].mesh], jobs[j].first, jobs[j].end, backfaceCone[jobs[j].mesh]);
   });
   for (Mesh* m : meshes) m->clusters.clear(), m->lod = {};
@@ -123,7 +123,7 @@ void buildClusters(Mesh& mesh, bool backfaceCone) {
   mesh.lod = {};  // built over the old triangle order
   if (mesh.indices.empty()) return;
   Mesh* one = &mesh;
-  clusterMeshes({&one, 1}, {backfaceCone});
+  clusterMeshes({&one, 1}, {backfaceCone}, 0);
 }
 
 meshopt_Bounds clusterBounds(const uint32_t* indices, size_t count, const glm::vec3* positions, size_t vertexCount,
@@ -145,7 +145,7 @@ meshopt_Bounds clusterBounds(const uint32_t* indices, size_t count, const glm::v
 
 bool conesCull(const Material& material) { return !(material.flags & (kMaterialAlphaMasked | kMaterialDoubleSided)); }
 
-size_t buildMissingClusters(Scene& scene) {
+size_t buildMissingClusters(Scene& scene, unsigned threads) {
   std::vector<Mesh*> todo;
   std::vector<bool> cones;
   for (Mesh& m : scene.meshes)
@@ -153,7 +153,7 @@ size_t buildMissingClusters(Scene& scene) {
       todo.push_back(&m);
       cones.push_back(m.material >= scene.materials.size() || conesCull(scene.materials[m.material]));
     }
-  clusterMeshes(todo, cones);
+  clusterMeshes(todo, cones, threads);
   return todo.size();
 }
 

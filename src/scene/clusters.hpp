@@ -25,7 +25,8 @@ meshopt_Bounds clusterBounds(const uint32_t* indices, size_t count, const glm::v
 // Whether a mesh of this material may be back-face culled by its clusters' cones.
 bool conesCull(const Material& material);
 
-// Builds the clusters of every mesh that has triangles and none; returns how many meshes it built.
-size_t buildMissingClusters(Scene& scene);
+// Builds the clusters of every mesh that has triangles and none, on `threads` threads (0: all cores; the
+// result is the same for any count); returns how many meshes it built.
+size_t buildMissingClusters(Scene& scene, unsigned threads = 0);
 
 }  // namespace rtr

@@ -101,6 +101,7 @@ TEST(Clusters, BigMeshesAreClusteredInPiecesKeepingEveryTriangle) {
   Scene s;
   s.materials.resize(1);
   s.meshes = {m, bumpyGrid(190)};
+  Scene oneThread = s;
   buildClusters(m, true);
   EXPECT_EQ(canonicalTriangles(m.indices), before);
   expectValidClusters(m);
@@ -114,6 +115,13 @@ TEST(Clusters, BigMeshesAreClusteredInPiecesKeepingEveryTriangle) {
   for (size_t i = 0; i < m.clusters.size(); ++i)
     EXPECT_EQ(std::memcmp(&s.meshes[0].clusters[i], &m.clusters[i], sizeof(Cluster)), 0);
   expectValidClusters(s.meshes[1]);
+  EXPECT_EQ(buildMissingClusters(oneThread, 1), 2u);  // rtr-bake --threads 1: the same pieces, the same clusters
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(oneThread.meshes[k].indices, s.meshes[k].indices);
+    ASSERT_EQ(oneThread.meshes[k].clusters.size(), s.meshes[k].clusters.size());
+    for (size_t i = 0; i < s.meshes[k].clusters.size(); ++i)
+      EXPECT_EQ(std::memcmp(&oneThread.meshes[k].clusters[i], &s.meshes[k].clusters[i], sizeof(Cluster)), 0);
+  }
 }
 
 // Each piece is clustered over its own vertices only: a mesh whose vertices are numbered with gaps (the
