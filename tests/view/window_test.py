@@ -289,8 +289,11 @@ def main():
         time.sleep(0.5)
         check(screen_pixels(fbdir, 0, 0, SIZE[0], SIZE[1]) != frame, "the error map replaces the raster image")
         xdo("key", "x")
-        time.sleep(1.0)
-        check("error map" not in title() and screen_pixels(fbdir, 0, 0, SIZE[0], SIZE[1]) == frame, "X again hides it")
+        end, hidden = time.monotonic() + 30, False  # polled: a loaded machine may take over a second a frame
+        while time.monotonic() < end and not hidden:
+            time.sleep(0.2)
+            hidden = "error map" not in title() and screen_pixels(fbdir, 0, 0, SIZE[0], SIZE[1]) == frame
+        check(hidden, "X again hides it")
 
         # 100 resizes as fast as xdotool can issue them (one process, chained commands).
         t_resize = time.monotonic()
