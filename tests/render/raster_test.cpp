@@ -132,10 +132,11 @@ class RasterTest : public test::VulkanTest {
     if (!render::ComputeRaster::supported(*ctx)) GTEST_SKIP() << "no 64-bit buffer atomics";
   }
   std::vector<uint32_t> ids(render::HeadlessRenderer& r, const CameraPose& pose, const Lens& lens, RasterPath raster,
-                            bool clip = true) {
+                            bool clip = true, bool cull = false) {
     render::RenderSettings s;
     s.raster = raster;
     s.clip = clip;
+    s.cull = cull;
     s.mosaic = render::MosaicMode::Off;
     return r.ids(pose, lens, s);
   }
@@ -208,6 +209,12 @@ TEST_F(RasterTest, CrossingTrianglesAreClippedInCompute) {
         clipped, same, covered, 100.0 * same / covered, offEdge, maskEdges);
     EXPECT_GE(double(same), 0.999 * double(covered));
     EXPECT_EQ(offEdge, 0u);
+    // With two-phase culling the clipping pass runs in both phases: the first frame's late phase draws
+    // everything, the second's early phase (the late dispatch then skips the early entries). Same ids.
+    for (int frame = 0; frame < 2; ++frame) {
+      EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, true), cs) << "culled, frame " << frame;
+      EXPECT_EQ(r.renderer().handOffTriangles(0), 0u) << "culled, frame " << frame;
+    }
   }
   EXPECT_GT(total, 20u) << "too few crossing triangles to test";
 }
