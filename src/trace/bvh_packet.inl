@@ -234,18 +234,17 @@ struct PacketWalker {
   // (the exact FMA rounds monotonically, so the bounds' FMA bounds every ray's; no operand is NaN).
   RTR_INLINE unsigned intervalHits(const Node& n, F tHitV) const {
     RTR_COUNT(c.intervalTests += 1);
-    const float* b = &n.box[0][0][0];
     const F zero = set1(0.0f);
     F lo = zero, hi = allMax(tHitV);
     for (int i = 0; i < kSlabs; ++i) {
       const int a = kSlabAxes.axis[i];
-      const F nb = load(b + nearOff[a]), fb = load(b + farOff[a]);
+      const F nb = nodePlane(n, nearOff[a], a), fb = nodePlane(n, farOff[a], a);
       lo = vmax(lo, fmsub(nb, sel(lt(nb, zero), rnHi[a], rnLo[a]), qnHi[a]));
       hi = vmin(hi, fmsub(fb, sel(lt(fb, zero), rfLo[a], rfHi[a]), qfLo[a]));
     }
     F in = le(lo, hi);
     for (int a = 0; a < 3; ++a)  // an axis the rays run parallel to: some origin within the slab
-      if (Parallel >> a & 1) in = in & le(load(n.box[0][a]), oHi[a]) & ge(load(n.box[1][a]), oLo[a]);
+      if (Parallel >> a & 1) in = in & le(nodePlane(n, a * 8, a), oHi[a]) & ge(nodePlane(n, 24 + a * 8, a), oLo[a]);
     return bits(in);
   }
 #endif
@@ -259,7 +258,7 @@ struct PacketWalker {
     F tn[3], tf[3];
     for (int i = 0; i < kSlabs; ++i) {
       const int a = kSlabAxes.axis[i];
-      const F lo = set1(n.box[0][a][c]), hi = set1(n.box[1][a][c]);
+      const F lo = set1(n.lo(a, c)), hi = set1(n.hi(a, c));
       const F nearB = sel(neg[a], hi, lo), farB = sel(neg[a], lo, hi);
 #if RTR_BVH_AVX2
       tn[i] = fmsub(nearB, rNear[a], qNear[a]);
@@ -282,7 +281,7 @@ struct PacketWalker {
     }
     F hitBox = ngt(tNear, tFar);
     for (int a = 0; a < 3; ++a)
-      if (Parallel >> a & 1) hitBox = hitBox & le(set1(n.box[0][a][c]), oAxis[a]) & ge(set1(n.box[1][a][c]), oAxis[a]);
+      if (Parallel >> a & 1) hitBox = hitBox & le(set1(n.lo(a, c)), oAxis[a]) & ge(set1(n.hi(a, c)), oAxis[a]);
     tNearOut = tNear;
     hitBox = hitBox & activeV;
     const unsigned m = bits(hitBox);
@@ -296,7 +295,7 @@ struct PacketWalker {
     RTR_COUNT(c.packetNodes += 1; c.packetNodeRays += unsigned(__builtin_popcount(active)));
     const Node& n = bvh.nodes[ref];
     const F tHitV = load(cull);
-    unsigned slots = bits(le(load(n.box[0][0]), load(n.box[1][0])));  // empty slots have lo > hi
+    unsigned slots = n.slots;
 #if RTR_BVH_AVX2
     if (interval) slots &= intervalHits(n, tHitV);
 #endif
