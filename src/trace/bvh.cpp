@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -83,10 +84,11 @@ struct FloatNode {
   uint32_t child[8];
 };
 
-// The widest box a node's 8-bit grid covers: 255 steps of 2^120 (larger steps overflow q · scale).
-constexpr double kMaxExtent = 255.0 * 0x1p120;
+// The widest box a node's grid covers: kNodeSteps steps of 2^kMaxExp (larger steps overflow q · scale).
+constexpr int kMaxExp = 128 - 8 * int(sizeof(NodeQ));
+const double kMaxExtent = std::ldexp(double(kNodeSteps), kMaxExp);
 
-// The node with each child's box rounded outward onto a grid of 255 steps over the node's box: a
+// The node with each child's box rounded outward onto a grid of kNodeSteps steps over the node's box: a
 // quantised bound is never inside the float one (checked with the traversal's own arithmetic).
 Node quantise(const FloatNode& f) {
   Node n{};
@@ -98,28 +100,29 @@ Node quantise(const FloatNode& f) {
         lo = std::min(lo, f.box[0][a][k]);
         hi = std::max(hi, f.box[1][a][k]);
       }
-    // The smallest power-of-two step with 255 · step ≥ hi − lo (not below 2^-126: a normal float); the
-    // root's check keeps it at most 2^120 (Bvh::Bvh).
+    // The smallest power-of-two step with kNodeSteps · step ≥ hi − lo (not below 2^-126: a normal float); the
+    // root's check keeps it at most 2^kMaxExp (Bvh::Bvh).
     int e = -126;
-    const double step = (double(hi) - lo) / 255.0;
+    const double step = (double(hi) - lo) / kNodeSteps;
     if (step > 0x1p-126) {
       std::frexp(step, &e);  // step = m · 2^e, m in [0.5, 1)
       if (std::ldexp(1.0, e - 1) >= step) --e;
     }
-    while (e < 120 && lo + 255.0f * std::ldexp(1.0f, e) < hi) ++e;  // (hi − lo in double may have rounded)
+    while (e < kMaxExp && lo + float(kNodeSteps) * std::ldexp(1.0f, e) < hi) ++e;  // (hi − lo in double may have rounded)
     n.origin[a] = lo;
     n.scale[a] = std::ldexp(1.0f, e);
     for (int k = 0; k < int(kWidth); ++k) {
       if (!(n.slots >> k & 1)) {
-        n.q[0][a][k] = 255;  // never read: the slot mask leaves it out
+        n.q[0][a][k] = NodeQ(kNodeSteps);  // never read: the slot mask leaves it out
         continue;
       }
-      int qLo = int(std::clamp(std::floor((double(f.box[0][a][k]) - lo) / n.scale[a]), 0.0, 255.0));
-      int qHi = int(std::clamp(std::ceil((double(f.box[1][a][k]) - lo) / n.scale[a]), 0.0, 255.0));
-      n.q[0][a][k] = uint8_t(qLo);
-      n.q[1][a][k] = uint8_t(qHi);
-      while (qLo > 0 && n.lo(a, k) > f.box[0][a][k]) n.q[0][a][k] = uint8_t(--qLo);
-      while (qHi < 255 && n.hi(a, k) < f.box[1][a][k]) n.q[1][a][k] = uint8_t(++qHi);
+      const double steps = kNodeSteps;
+      int qLo = int(std::clamp(std::floor((double(f.box[0][a][k]) - lo) / n.scale[a]), 0.0, steps));
+      int qHi = int(std::clamp(std::ceil((double(f.box[1][a][k]) - lo) / n.scale[a]), 0.0, steps));
+      n.q[0][a][k] = NodeQ(qLo);
+      n.q[1][a][k] = NodeQ(qHi);
+      while (qLo > 0 && n.lo(a, k) > f.box[0][a][k]) n.q[0][a][k] = NodeQ(--qLo);
+      while (qHi < kNodeSteps && n.hi(a, k) < f.box[1][a][k]) n.q[1][a][k] = NodeQ(++qHi);
     }
   }
   std::memcpy(n.child, f.child, sizeof n.child);
@@ -691,10 +694,14 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   root.end = n;
   stats_.triangles = n;
   if (n == 0) return;
-  for (int a = 0; a < 3; ++a)  // a node's 8-bit grid spans at most kMaxExtent (quantise)
-    if (double(lane(root.bounds.hi, a)) - lane(root.bounds.lo, a) > kMaxExtent)
-      throw Error("BVH: the triangles span " + std::to_string(double(lane(root.bounds.hi, a)) - lane(root.bounds.lo, a)) +
-                  " along axis " + std::to_string(a) + ", at most 3.39e38");
+  for (int a = 0; a < 3; ++a) {  // a node's grid spans at most kMaxExtent (quantise)
+    const double extent = double(lane(root.bounds.hi, a)) - lane(root.bounds.lo, a);
+    if (extent > kMaxExtent) {
+      char text[128];
+      std::snprintf(text, sizeof text, "BVH: the triangles span %.3g along axis %d, at most %.3g", extent, a, kMaxExtent);
+      throw Error(text);
+    }
+  }
   b.nodes.reset(new FloatNode[n + 1]);
   b.leaves.reset(new std::array<uint32_t, 2>[n + 1]);
   b.subtree.reset(new std::array<uint32_t, 2>[n + 1]);

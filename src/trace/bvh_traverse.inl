@@ -99,15 +99,26 @@ inline F slabMin(F a, F b) { return vmin(a, b); }
 // index): origin + q · scale, the same float as Node::lo/hi (q · scale is exact, so one rounding either way).
 #if RTR_BVH_AVX2
 inline F nodePlane(const Node& n, int off, int a) {
-  const __m128i q = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(&n.q[0][0][0] + off));
-  return {_mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(q)), _mm256_set1_ps(n.scale[a]), _mm256_set1_ps(n.origin[a]))};
+  const void* p = &n.q[0][0][0] + off;
+  const __m256i q = sizeof(NodeQ) == 1 ? _mm256_cvtepu8_epi32(_mm_loadl_epi64(static_cast<const __m128i*>(p)))
+                                       : _mm256_cvtepu16_epi32(_mm_loadu_si128(static_cast<const __m128i*>(p)));
+  return {_mm256_fmadd_ps(_mm256_cvtepi32_ps(q), _mm256_set1_ps(n.scale[a]), _mm256_set1_ps(n.origin[a]))};
 }
 #else
 inline F nodePlane(const Node& n, int off, int a) {
-  const __m128i q = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(&n.q[0][0][0] + off));
+  const void* p = &n.q[0][0][0] + off;
+  __m128i lo, hi;
+  if constexpr (sizeof(NodeQ) == 1) {
+    lo = _mm_loadl_epi64(static_cast<const __m128i*>(p));
+    hi = _mm_cvtepu8_epi32(_mm_srli_si128(lo, 4));
+    lo = _mm_cvtepu8_epi32(lo);
+  } else {
+    lo = _mm_loadu_si128(static_cast<const __m128i*>(p));
+    hi = _mm_cvtepu16_epi32(_mm_srli_si128(lo, 8));
+    lo = _mm_cvtepu16_epi32(lo);
+  }
   const __m128 s = _mm_set1_ps(n.scale[a]), o = _mm_set1_ps(n.origin[a]);
-  return {_mm_add_ps(o, _mm_mul_ps(_mm_cvtepi32_ps(_mm_cvtepu8_epi32(q)), s)),
-          _mm_add_ps(o, _mm_mul_ps(_mm_cvtepi32_ps(_mm_cvtepu8_epi32(_mm_srli_si128(q, 4))), s))};
+  return {_mm_add_ps(o, _mm_mul_ps(_mm_cvtepi32_ps(lo), s)), _mm_add_ps(o, _mm_mul_ps(_mm_cvtepi32_ps(hi), s))};
 }
 #endif
 

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <string>
 
 #include <glm/geometric.hpp>
 
+#include "core/error.hpp"
 #include "trace/procedural.hpp"
 
 #include <gtest/gtest.h>
@@ -185,6 +187,24 @@ TEST(Bvh, EmptyAndDegenerateInputs) {
   // Non-finite coordinates are left out rather than poisoning the boxes.
   std::vector<Triangle> bad{{{NAN, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{-1, -1, -1}, {1, -1, -1}, {0, 1, -1}}};
   EXPECT_EQ(Bvh(bad).closest({{0, 0, 0}, {0, 0, -1}}).prim, 1u);
+}
+
+// Node boxes are stored on a grid of at most 2^16 steps of a power of two (Node): triangles spread
+// over nearly the whole float range still get boxes that hold them, and a wider spread is an error, not
+// a silent miss.
+TEST(Bvh, CoordinatesNearTheFloatLimit) {
+  // A few ulps wide in x at 1.6e38 (ulp 2^104), one unit in y: the watertight test's products stay finite.
+  const auto at = [](float x) { return Triangle{{x - 4e31f, -0.5f, -1}, {x + 4e31f, -0.5f, -1}, {x, 0.5f, -1}}; };
+  const std::vector<Triangle> wide{at(-1.6e38f), at(1.6e38f), {{-1, -1, -1}, {1, -1, -1}, {0, 1, -1}}};
+  const Bvh bvh(wide);
+  EXPECT_EQ(bvh.closest({{-1.6e38f, 0, 0}, {0, 0, -1}}).prim, 0u);
+  EXPECT_EQ(bvh.closest({{1.6e38f, 0, 0}, {0, 0, -1}}).prim, 1u);
+  EXPECT_EQ(bvh.closest({{0, 0, 0}, {0, 0, -1}}).prim, 2u);
+  EXPECT_FALSE(bvh.closest({{0, 0, 0}, {0, 0, 1}}).hit());
+  try {
+    const Bvh tooWide(std::vector<Triangle>{at(-3e38f), at(3e38f)});
+    ADD_FAILURE() << "no error for triangles spanning 6e38";
+  } catch (const Error& e) { EXPECT_NE(std::string(e.what()).find("along axis 0"), std::string::npos) << e.what(); }
 }
 
 // The parallel build (ranges near the root binned and partitioned by many threads, subtrees side by side)
