@@ -4,7 +4,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -78,62 +77,12 @@ struct Range {
 
 uint32_t packsFor(uint32_t n) { return (n + kWidth - 1) / kWidth; }
 
-// A node as the builder makes it: the children's boxes as floats (an empty slot: min = +inf, max = -inf).
-struct FloatNode {
-  float box[2][3][8];  // [min, max][axis][child]
-  uint32_t child[8];
-};
-
-// The widest box a node's grid covers: kNodeSteps steps of 2^kMaxExp (larger steps overflow q · scale).
-constexpr int kMaxExp = 128 - 8 * int(sizeof(NodeQ));
-const double kMaxExtent = std::ldexp(double(kNodeSteps), kMaxExp);
-
-// The node with each child's box rounded outward onto a grid of kNodeSteps steps over the node's box: a
-// quantised bound is never inside the float one (checked with the traversal's own arithmetic).
-Node quantise(const FloatNode& f) {
-  Node n{};
-  for (int k = 0; k < int(kWidth); ++k) n.slots |= uint8_t(f.box[0][0][k] <= f.box[1][0][k]) << k;
-  for (int a = 0; a < 3; ++a) {
-    float lo = kInf, hi = -kInf;
-    for (int k = 0; k < int(kWidth); ++k)
-      if (n.slots >> k & 1) {
-        lo = std::min(lo, f.box[0][a][k]);
-        hi = std::max(hi, f.box[1][a][k]);
-      }
-    // The smallest power-of-two step with kNodeSteps · step ≥ hi − lo (not below 2^-126: a normal float); the
-    // root's check keeps it at most 2^kMaxExp (Bvh::Bvh).
-    int e = -126;
-    const double step = (double(hi) - lo) / kNodeSteps;
-    if (step > 0x1p-126) {
-      std::frexp(step, &e);  // step = m · 2^e, m in [0.5, 1)
-      if (std::ldexp(1.0, e - 1) >= step) --e;
-    }
-    while (e < kMaxExp && lo + float(kNodeSteps) * std::ldexp(1.0f, e) < hi) ++e;  // (hi − lo in double may have rounded)
-    n.origin[a] = lo;
-    n.scale[a] = std::ldexp(1.0f, e);
-    for (int k = 0; k < int(kWidth); ++k) {
-      if (!(n.slots >> k & 1)) {
-        n.q[0][a][k] = NodeQ(kNodeSteps);  // never read: the slot mask leaves it out
-        continue;
-      }
-      const double steps = kNodeSteps;
-      int qLo = int(std::clamp(std::floor((double(f.box[0][a][k]) - lo) / n.scale[a]), 0.0, steps));
-      int qHi = int(std::clamp(std::ceil((double(f.box[1][a][k]) - lo) / n.scale[a]), 0.0, steps));
-      n.q[0][a][k] = NodeQ(qLo);
-      n.q[1][a][k] = NodeQ(qHi);
-      while (qLo > 0 && n.lo(a, k) > f.box[0][a][k]) n.q[0][a][k] = NodeQ(--qLo);
-      while (qHi < kNodeSteps && n.hi(a, k) < f.box[1][a][k]) n.q[1][a][k] = NodeQ(++qHi);
-    }
-  }
-  std::memcpy(n.child, f.child, sizeof n.child);
-  return n;
-}
-
 // The tree's SAH cost as the builder counts it: per node kNodeCost, per leaf its packs, each weighted by
 // its box's area relative to the root's (the expected work of a ray that meets the root box).
 double treeSahCost(const Node* nodes, uint32_t root) {
   const auto area = [](const Node& n, int k) {
-    const double e[3] = {double(n.hi(0, k)) - n.lo(0, k), double(n.hi(1, k)) - n.lo(1, k), double(n.hi(2, k)) - n.lo(2, k)};
+    const double e[3] = {double(n.box[1][0][k]) - n.box[0][0][k], double(n.box[1][1][k]) - n.box[0][1][k],
+                         double(n.box[1][2][k]) - n.box[0][2][k]};
     return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
   };
   if (root & Bvh::kLeafBit) return double(((root >> 28) & 7u) + 1);
@@ -144,9 +93,10 @@ double treeSahCost(const Node* nodes, uint32_t root) {
     const Node& n = nodes[stack.back()];
     stack.pop_back();
     for (int k = 0; k < int(kWidth); ++k) {
-      if (!(n.slots >> k & 1)) continue;  // empty slot
+      if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty slot
       if (&n == &nodes[root])
-        rootBox.grow(Box{_mm_set_ps(0, n.lo(2, k), n.lo(1, k), n.lo(0, k)), _mm_set_ps(0, n.hi(2, k), n.hi(1, k), n.hi(0, k))});
+        rootBox.grow(Box{_mm_set_ps(0, n.box[0][2][k], n.box[0][1][k], n.box[0][0][k]),
+                         _mm_set_ps(0, n.box[1][2][k], n.box[1][1][k], n.box[1][0][k])});
       const uint32_t c = n.child[k];
       if (c & Bvh::kLeafBit) total += area(n, k) * double(((c >> 28) & 7u) + 1);
       else {
@@ -174,7 +124,7 @@ struct BvhBuilder {
   std::span<const Triangle> tris;
   std::span<const uint8_t> casts;
   std::unique_ptr<PrimRef[]> refs;
-  std::unique_ptr<FloatNode[]> nodes;
+  std::unique_ptr<Node[]> nodes;
   // Per leaf its refs [begin, end): the packs are written once, straight into their place, by the copy-out.
   std::unique_ptr<std::array<uint32_t, 2>[]> leaves;
   std::unique_ptr<std::array<uint32_t, 2>[]> subtree;  // per node: nodes and packs of its subtree, itself included
@@ -558,7 +508,7 @@ struct BvhBuilder {
   // Writes the subtree of node `ref` into bvh's arrays in depth-first order, its node at `node`, its packs
   // (made here) from `pack` on: the subtree sizes place every child, so large subtrees are written by the pool.
   void relayout(uint32_t ref, Bvh& bvh, uint32_t node, uint32_t pack, ThreadPool::Group& g) const {
-    FloatNode n = nodes[ref];
+    Node n = nodes[ref];
     uint32_t nextNode = node + 1, nextPack = pack;
     for (int k = 0; k < int(kWidth); ++k) {
       if (!(n.box[0][0][k] <= n.box[1][0][k])) continue;  // empty
@@ -576,7 +526,7 @@ struct BvhBuilder {
       nextNode += subtree[c][0];
       nextPack += subtree[c][1];
     }
-    bvh.nodes_[node] = quantise(n);
+    bvh.nodes_[node] = n;
   }
 
   uint32_t build(const Range& r, uint32_t level = 0) {
@@ -611,7 +561,7 @@ struct BvhBuilder {
       c[count++].r = b;
     }
     const uint32_t index = nodeCount.fetch_add(1);
-    FloatNode node;
+    Node node;
     for (int k = 0; k < int(kWidth); ++k) {
       for (int a3 = 0; a3 < 3; ++a3) {
         node.box[0][a3][k] = k < count ? lane(c[k].r.bounds.lo, a3) : kInf;
@@ -694,15 +644,7 @@ Bvh::Bvh(std::span<const Triangle> triangles, std::span<const uint8_t> castsShad
   root.end = n;
   stats_.triangles = n;
   if (n == 0) return;
-  for (int a = 0; a < 3; ++a) {  // a node's grid spans at most kMaxExtent (quantise)
-    const double extent = double(lane(root.bounds.hi, a)) - lane(root.bounds.lo, a);
-    if (extent > kMaxExtent) {
-      char text[128];
-      std::snprintf(text, sizeof text, "BVH: the triangles span %.3g along axis %d, at most %.3g", extent, a, kMaxExtent);
-      throw Error(text);
-    }
-  }
-  b.nodes.reset(new FloatNode[n + 1]);
+  b.nodes.reset(new Node[n + 1]);
   b.leaves.reset(new std::array<uint32_t, 2>[n + 1]);
   b.subtree.reset(new std::array<uint32_t, 2>[n + 1]);
   const auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };

@@ -19,20 +19,9 @@ struct alignas(64) TriPack {
   uint32_t prim[8];  // triangle index per lane; the top bit set: the lane casts no shadow (a light)
 };
 
-// An inner node: its eight children's boxes with each bound rounded outward to 16 bits on a grid over the
-// node's own box (origin + q · scale per axis, scale a power of two, so q · scale is exact and the bound
-// the same with or without FMA), and the children. 192 bytes, three cache lines; boxes as floats took four.
-// A box only grows: a ray may visit more, never miss a triangle. An experiment (docs/bench/trace.md,
-// round 16): 8 bits (two lines) inflated flat leaves' boxes.
-using NodeQ = uint16_t;
-constexpr int kNodeSteps = (1 << 8 * sizeof(NodeQ)) - 1;
 struct alignas(64) Node {
-  NodeQ q[2][3][8];  // [min, max][axis][child]
-  float origin[3], scale[3];
-  uint32_t child[8];  // inner node index, or leaf: kLeafBit | (packs - 1) << 28 | first pack
-  uint8_t slots;      // bit k set: child k exists
-  float lo(int axis, int k) const { return origin[axis] + float(q[0][axis][k]) * scale[axis]; }
-  float hi(int axis, int k) const { return origin[axis] + float(q[1][axis][k]) * scale[axis]; }
+  float box[2][3][8];  // [min, max][axis][child]; an empty slot has min = +inf, max = -inf
+  uint32_t child[8];   // inner node index, or leaf: kLeafBit | (packs - 1) << 28 | first pack
 };
 
 struct BvhStats {

@@ -71,11 +71,6 @@ RTR_INLINE PacketRays gatherRays(const Ray* r, int n) {
 }
 
 constexpr float kTieWindow = 0x1p-10f;
-// A node's child boxes as floats, [min, max][axis][child] (Node's bounds, unpacked once per packet visit).
-struct alignas(32) Planes {
-  float box[2][3][8];
-};
-
 struct PacketEntry {
   F tNear;  // per ray; a ray whose entry is beyond its cull distance when popped drops out
   uint32_t ref, mask;
@@ -237,13 +232,14 @@ struct PacketWalker {
 #if RTR_BVH_AVX2
   // The children of n that some ray of the packet may meet: never one that a ray's own test would visit
   // (the exact FMA rounds monotonically, so the bounds' FMA bounds every ray's; no operand is NaN).
-  RTR_INLINE unsigned intervalHits(const Planes& n, F tHitV) const {
+  RTR_INLINE unsigned intervalHits(const Node& n, F tHitV) const {
     RTR_COUNT(c.intervalTests += 1);
+    const float* b = &n.box[0][0][0];
     const F zero = set1(0.0f);
     F lo = zero, hi = allMax(tHitV);
     for (int i = 0; i < kSlabs; ++i) {
       const int a = kSlabAxes.axis[i];
-      const F nb = load(&n.box[0][0][0] + nearOff[a]), fb = load(&n.box[0][0][0] + farOff[a]);
+      const F nb = load(b + nearOff[a]), fb = load(b + farOff[a]);
       lo = vmax(lo, fmsub(nb, sel(lt(nb, zero), rnHi[a], rnLo[a]), qnHi[a]));
       hi = vmin(hi, fmsub(fb, sel(lt(fb, zero), rfLo[a], rfHi[a]), qfLo[a]));
     }
@@ -256,7 +252,7 @@ struct PacketWalker {
 
   // The rays of `active` (activeV: as a lane mask) whose box test passes child c of node n, with their
   // entry distances and the nearest of those (a vector minimum: a loop over the rays mispredicts).
-  RTR_INLINE unsigned testChild(const Planes& n, int c, [[maybe_unused]] unsigned active, F activeV, F tHitV, F& tNearOut,
+  RTR_INLINE unsigned testChild(const Node& n, int c, [[maybe_unused]] unsigned active, F activeV, F tHitV, F& tNearOut,
                                 float& nearest) const {
     RTR_COUNT(c.childTests += 1; c.childTestRays += unsigned(__builtin_popcount(active)));
     const F zero = set1(0.0f);
@@ -298,12 +294,9 @@ struct PacketWalker {
   // the child to visit next and its rays, the other children are on the stack.
   RTR_INLINE bool visitNode(PacketEntry* stack, int& sp, uint32_t& ref, unsigned& active) const {
     RTR_COUNT(c.packetNodes += 1; c.packetNodeRays += unsigned(__builtin_popcount(active)));
-    const Node& node = bvh.nodes[ref];
+    const Node& n = bvh.nodes[ref];
     const F tHitV = load(cull);
-    unsigned slots = node.slots;
-    Planes n;  // the node's boxes as floats, once for all rays and children
-    for (int side = 0; side < 2; ++side)
-      for (int a = 0; a < 3; ++a) store(n.box[side][a], nodePlane(node, (side * 3 + a) * 8, a));
+    unsigned slots = bits(le(load(n.box[0][0]), load(n.box[1][0])));  // empty slots have lo > hi
 #if RTR_BVH_AVX2
     if (interval) slots &= intervalHits(n, tHitV);
 #endif
@@ -333,10 +326,10 @@ struct PacketWalker {
     if (k == 0) return false;
     for (int j = k - 1; j > 0; --j) {
       const int c = int(keys[j] & 7u);
-      stack[sp++] = {tn[c], node.child[c], mk[c]};
+      stack[sp++] = {tn[c], n.child[c], mk[c]};
     }
     const int c0 = int(keys[0] & 7u);
-    ref = node.child[c0];
+    ref = n.child[c0];
     active = mk[c0];
     return true;
   }

@@ -95,33 +95,6 @@ inline F slabMax(F a, F b) { return vmax(a, b); }
 inline F slabMin(F a, F b) { return vmin(a, b); }
 #endif
 
-// Node n's bounds of one side and axis for its eight children (off = (side · 3 + axis) · 8, as q's
-// index): origin + q · scale, the same float as Node::lo/hi (q · scale is exact, so one rounding either way).
-#if RTR_BVH_AVX2
-inline F nodePlane(const Node& n, int off, int a) {
-  const void* p = &n.q[0][0][0] + off;
-  const __m256i q = sizeof(NodeQ) == 1 ? _mm256_cvtepu8_epi32(_mm_loadl_epi64(static_cast<const __m128i*>(p)))
-                                       : _mm256_cvtepu16_epi32(_mm_loadu_si128(static_cast<const __m128i*>(p)));
-  return {_mm256_fmadd_ps(_mm256_cvtepi32_ps(q), _mm256_set1_ps(n.scale[a]), _mm256_set1_ps(n.origin[a]))};
-}
-#else
-inline F nodePlane(const Node& n, int off, int a) {
-  const void* p = &n.q[0][0][0] + off;
-  __m128i lo, hi;
-  if constexpr (sizeof(NodeQ) == 1) {
-    lo = _mm_loadl_epi64(static_cast<const __m128i*>(p));
-    hi = _mm_cvtepu8_epi32(_mm_srli_si128(lo, 4));
-    lo = _mm_cvtepu8_epi32(lo);
-  } else {
-    lo = _mm_loadu_si128(static_cast<const __m128i*>(p));
-    hi = _mm_cvtepu16_epi32(_mm_srli_si128(lo, 8));
-    lo = _mm_cvtepu16_epi32(lo);
-  }
-  const __m128 s = _mm_set1_ps(n.scale[a]), o = _mm_set1_ps(n.origin[a]);
-  return {_mm_add_ps(o, _mm_mul_ps(_mm_cvtepi32_ps(lo), s)), _mm_add_ps(o, _mm_mul_ps(_mm_cvtepi32_ps(hi), s))};
-}
-#endif
-
 constexpr float kInf = __builtin_inff();
 constexpr int kStackSize = 640;  // 7 entries per level, binary depth ≤ 48 + 32 (bvh.cpp)
 
@@ -323,16 +296,17 @@ struct Walker {
   RTR_INLINE bool visitNode(uint64_t* stack, Cursor& at, F tHitV) const {
     RTR_COUNT(c.nodes += 1);
     const Node& n = bvh.nodes[at.ref];
+    const float* b = &n.box[0][0][0];
     const F zero = set1(0.0f);
     F tn[3], tf[3];
     for (int i = 0; i < kSlabs; ++i) {
       const int a = kSlabAxes.axis[i];
 #if RTR_BVH_AVX2
-      tn[i] = fmsub(nodePlane(n, nearOff[a], a), rNear[a], qNear[a]);
-      tf[i] = fmsub(nodePlane(n, farOff[a], a), rFar[a], qFar[a]);
+      tn[i] = fmsub(load(b + nearOff[a]), rNear[a], qNear[a]);
+      tf[i] = fmsub(load(b + farOff[a]), rFar[a], qFar[a]);
 #else
-      tn[i] = (nodePlane(n, nearOff[a], a) - org[a]) * rdir[a];
-      tf[i] = (nodePlane(n, farOff[a], a) - org[a]) * rdirFar[a];
+      tn[i] = (load(b + nearOff[a]) - org[a]) * rdir[a];
+      tf[i] = (load(b + farOff[a]) - org[a]) * rdirFar[a];
 #endif
     }
     // At most two levels of min/max, not a chain: this is the loop's critical path. As floats, a NaN
@@ -354,8 +328,8 @@ struct Walker {
     }
     F hitBox = ngt(tNear, tFar);
     for (int a = 0; a < 3; ++a)
-      if (Parallel >> a & 1) hitBox = hitBox & le(nodePlane(n, a * 8, a), oAxis[a]) & ge(nodePlane(n, 24 + a * 8, a), oAxis[a]);
-    unsigned mask = bits(hitBox) & n.slots;
+      if (Parallel >> a & 1) hitBox = hitBox & le(load(n.box[0][a]), oAxis[a]) & ge(load(n.box[1][a]), oAxis[a]);
+    unsigned mask = bits(hitBox);
     if (mask == 0) return false;
     const int c0 = ctz(mask);
     mask &= mask - 1;

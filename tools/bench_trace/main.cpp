@@ -316,11 +316,8 @@ uint64_t treeHash(const Bvh& bvh) {
   const Bvh::View v = bvh.view();
   add(&v.root, sizeof v.root);
   for (uint32_t i = 0; i < bvh.stats().nodes; ++i) {
-    add(v.nodes[i].q, sizeof v.nodes[i].q);
-    add(v.nodes[i].origin, sizeof v.nodes[i].origin);
-    add(v.nodes[i].scale, sizeof v.nodes[i].scale);
+    add(v.nodes[i].box, sizeof v.nodes[i].box);
     add(v.nodes[i].child, sizeof v.nodes[i].child);
-    add(&v.nodes[i].slots, 1);
   }
   for (uint32_t i = 0; i < bvh.stats().packs; ++i) {
     add(v.packs[i].v, sizeof v.packs[i].v);
