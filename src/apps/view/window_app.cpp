@@ -97,7 +97,7 @@ int runWindowed(const ViewOptions& opts) {
   } catch (...) { failed = std::current_exception(); }
   auto scene = std::make_unique<Scene>(read.take(failed));
   clock.phase("waiting for the scene file read");
-  clock.beside("scene file read", read.ms(), "instance and device, window, surface and panel");
+  clock.beside("scene file read", read.ms(), "instance, device and window");
   const vk::Context& ctx = *device;
   Window& window = *windowSlot;
   app.settings = sceneSettings(o, *scene);
