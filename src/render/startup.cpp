@@ -29,15 +29,15 @@ double msSinceProcessStart() {
 
 std::string StartupTimeline::format(double totalMs) const {
   std::string out = "start-up phases (ms):\n";
-  char line[160];
+  char line[256];
   double sum = 0;
-  for (const auto& [name, ms] : phases_) {
-    std::snprintf(line, sizeof line, "  %-58s %9.1f\n", name.c_str(), ms);
+  for (size_t i = 0; i < phases_.size(); ++i) {
+    std::snprintf(line, sizeof line, "  %-58s %9.1f\n", phases_[i].first.c_str(), phases_[i].second);
     out += line;
-    sum += ms;
+    if (!beside_[i]) sum += phases_[i].second;
   }
-  std::snprintf(line, sizeof line, "  %-58s %9.1f\n  %-58s %9.1f\n", "sum of the phases", sum, "total from process start",
-                totalMs);
+  std::snprintf(line, sizeof line, "  %-58s %9.1f\n  %-58s %9.1f\n", "sum of the critical path's phases", sum,
+                "total from process start", totalMs);
   return out + line;
 }
 

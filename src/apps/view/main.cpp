@@ -1,6 +1,7 @@
 // rtr-view: the Vulkan viewer. Its options and what both paths share; headless_app.cpp renders offscreen
 // (--headless: no window, no display), window_app.cpp in a GLFW window.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 
 #include <CLI/CLI.hpp>
@@ -26,6 +27,33 @@ Scene loadForView(const ViewOptions& o, const std::string& path) {
   turnScene(scene, o.up);
   drawBothSides(scene);
   return scene;
+}
+
+SceneRead::SceneRead(const ViewOptions& o)
+    : read_(std::async(std::launch::async, [&o] {
+        const auto start = std::chrono::steady_clock::now();
+        Scene scene = loadForView(o, o.scene);
+        return std::pair(std::move(scene),
+                         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      })) {}
+
+Scene SceneRead::take(std::exception_ptr besideError) {
+  if (!besideError) {
+    auto [scene, ms] = read_.get();
+    ms_ = ms;
+    return std::move(scene);
+  }
+  try {
+    read_.get();
+  } catch (const std::exception& sceneError) {
+    try {
+      std::rethrow_exception(besideError);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rtr-view: note: the device's start failed too (the scene's error below): %s\n", e.what());
+    }
+    throw;
+  }
+  std::rethrow_exception(besideError);
 }
 
 CameraPose startPose(const ViewOptions& o, const Scene& scene) {
