@@ -342,19 +342,33 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
   auto kept = uninitialised<uint8_t>(uniqCount);
   auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
-  std::vector<std::vector<uint32_t>> open(piecesOf(uniqCount));
+  // Bucket by bucket: a vertex whose cells are its own alone (most: it lies within the tolerance of no
+  // cell face) needs only the bucket's vertices before it, which were just read; vertex by vertex, every
+  // look-up was a chain of cache misses (bucket, its items, their vertices).
+  forPieces(buckets, threads, [&](size_t, size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k)
+      for (uint32_t j = inBucket.start[k]; j < inBucket.start[k + 1]; ++j) {
+        const uint32_t u = inBucket.items[j];
+        const Around a(verts[u].p);
+        bool near_ = false;
+        if (a.lo[0] == a.hi[0] && a.lo[1] == a.hi[1] && a.lo[2] == a.hi[2]) {  // its own cell, in this bucket
+          for (uint32_t i = inBucket.start[k]; i < j && !near_; ++i) near_ = isNear(inBucket.items[i], u);
+        } else {
+          near_ = a.any([&](uint64_t h) {
+            const size_t c = h & (buckets - 1);
+            for (uint32_t i = inBucket.start[c]; i < inBucket.start[c + 1] && inBucket.items[i] < u; ++i)
+              if (isNear(inBucket.items[i], u)) return true;
+            return false;
+          });
+        }
+        kept[u] = !near_;
+        if (!near_) target[u] = u;
+      }
+  });
+  std::vector<std::vector<uint32_t>> open(piecesOf(uniqCount));  // near an earlier vertex: decided in order below
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
-    for (size_t u = b; u < e; ++u) {
-      const bool near_ = Around(verts[u].p).any([&](uint64_t h) {
-        const size_t k = h & (buckets - 1);
-        for (uint32_t i = inBucket.start[k]; i < inBucket.start[k + 1] && inBucket.items[i] < u; ++i)
-          if (isNear(inBucket.items[i], uint32_t(u))) return true;
-        return false;
-      });
-      kept[u] = !near_;
-      if (near_) open[p].push_back(uint32_t(u));
-      else target[u] = uint32_t(u);
-    }
+    for (size_t u = b; u < e; ++u)
+      if (!kept[u]) open[p].push_back(uint32_t(u));
   });
   for (const std::vector<uint32_t>& list : open)
     for (const uint32_t u : list) {
