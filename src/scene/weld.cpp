@@ -241,25 +241,49 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     std::vector<std::vector<glm::vec3>> made(piecesOf(atPos.count()));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
       std::vector<glm::vec3> crosses, units;  // of the faces at this position
+      // Up to 64 faces at a position: the faces each corner's normal averages as bits (a kept triangle has one
+      // corner at a position, so face i is corner i here). The crease test is symmetric (each product of
+      // the dot commutes), so each pair is tested once, and a corner whose faces are those of an earlier
+      // one here gets its normal: the same sum in the same order, so the same normal.
+      std::vector<uint64_t> faces;
+      std::vector<std::pair<uint64_t, uint32_t>> seen;  // faces, normal id
       for (size_t g = b; g < e; ++g) {
         const uint32_t *first = atPos.items.get() + atPos.start[g], *last = atPos.items.get() + atPos.start[g + 1];
-        const size_t here = made[p].size();  // the normals made at this position so far
+        const size_t here = made[p].size(), count = size_t(last - first);  // the normals made at this position so far
         crosses.clear();
         units.clear();
         for (const uint32_t* c = first; c != last; ++c) crosses.push_back(cross(*c / 3)), units.push_back(unit(crosses.back()));
+        const bool bits = count <= 64;
+        seen.clear();
+        if (bits) {
+          faces.assign(count, 0);
+          for (size_t i = 0; i < count; ++i) {
+            faces[i] |= uint64_t(1) << i;
+            if (creaseDeg > 0.0f)
+              for (size_t j = i + 1; j < count; ++j)
+                if (glm::dot(units[i], units[j]) >= cosCrease) faces[i] |= uint64_t(1) << j, faces[j] |= uint64_t(1) << i;
+          }
+        }
         for (const uint32_t* c = first; c != last; ++c) {
           if (corners[*c].n != kAbsent) continue;
-          const size_t t = *c / 3;
-          const glm::vec3 own = units[size_t(c - first)];
+          const size_t i = size_t(c - first);
+          if (bits) {
+            auto same = std::find_if(seen.begin(), seen.end(), [&](const auto& s) { return s.first == faces[i]; });
+            if (same != seen.end()) {
+              corners[*c].n = same->second;
+              continue;
+            }
+          }
           glm::vec3 sum(0.0f);
-          for (const uint32_t* o = first; o != last; ++o)
-            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, units[size_t(o - first)]) >= cosCrease))
-              sum += crosses[size_t(o - first)];
+          for (size_t o = 0; o < count; ++o)
+            if (bits ? (faces[i] >> o & 1) : o == i || (creaseDeg > 0.0f && glm::dot(units[i], units[o]) >= cosCrease))
+              sum += crosses[o];
           const glm::vec3 n = unit(sum);
           size_t k = here;
           while (k < made[p].size() && made[p][k] != n) ++k;
           if (k == made[p].size()) made[p].push_back(n);
           corners[*c].n = fileNormals + uint32_t(k);  // the piece's base is added below
+          if (bits) seen.emplace_back(faces[i], corners[*c].n);
         }
       }
     });
