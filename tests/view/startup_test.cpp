@@ -151,15 +151,23 @@ TEST_F(StartupTest, CpuDeviceGetsItsDefaultsAndFlagsOverride) {
   ASSERT_EQ(plain.status, 0) << plain.out;
   if (plain.out.find("llvmpipe") == std::string::npos) GTEST_SKIP() << "not on lavapipe: " << plain.out;
   // The documented choice (docs/startup.md), and the frame really took the forward path.
-  EXPECT_THAT(plain.out, HasSubstr(": forward shading (default), auto mips (default): the defaults for a CPU device"));
+  EXPECT_THAT(plain.out, HasSubstr(": forward shading (default), auto mips (default), near-plane crossings to the hardware "
+                                   "(default): the defaults for a CPU device"));
   EXPECT_THAT(plain.out, HasSubstr("  scene: "));
   EXPECT_THAT(plain.out, ::testing::Not(HasSubstr("  shade: ")));
 
-  const ViewRun flags = view("--shading-path visibility --mips compute");
+  const ViewRun flags = view("--shading-path visibility --mips compute --raster compute --near-clip compute");
   ASSERT_EQ(flags.status, 0) << flags.out;
-  EXPECT_THAT(flags.out, HasSubstr(": visibility shading (--shading-path), compute mips (--mips)\n"));
+  EXPECT_THAT(flags.out, HasSubstr(": visibility shading (--shading-path), compute mips (--mips), near-plane crossings "
+                                   "clipped in compute (--near-clip)\n"));
   EXPECT_THAT(flags.out, ::testing::Not(HasSubstr("the defaults for")));
   EXPECT_THAT(flags.out, HasSubstr("  shade: "));
+  EXPECT_THAT(flags.out, HasSubstr("  raster clip: "));  // the compute clipping pass ran
+  // lavapipe's default hands the crossings to the hardware: no clipping pass in the frame.
+  const ViewRun computeRaster = view("--shading-path visibility --raster compute");
+  ASSERT_EQ(computeRaster.status, 0) << computeRaster.out;
+  EXPECT_THAT(computeRaster.out, HasSubstr("  raster hw: "));
+  EXPECT_THAT(computeRaster.out, ::testing::Not(HasSubstr("  raster clip: ")));
 }
 
 TEST_F(StartupTest, PipelineCacheGoesWhereItIsToldAndNowhereWhenOff) {

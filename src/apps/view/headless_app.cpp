@@ -176,6 +176,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   const Lens lens = fitDepthRange(startLens(o, scene), scene.bounds(), pose);
   render::RenderSettings settings = sceneSettings(o, scene);
   settings.shading = choice.shading;
+  settings.clip = choice.computeClip;
   render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
   if (settings.shading == render::ShadingPath::Visibility && !renderer.renderer().visibilityRefusal().empty())
     std::fprintf(stderr, "rtr-view: warning: %s: frames take the forward path\n",

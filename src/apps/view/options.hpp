@@ -41,10 +41,10 @@ struct ViewOptions {
   bool orbit = false;      // start in orbit camera mode (windowed)
   std::string device;
   bool validation = false;
-  bool shadingGiven = false, mipsGiven = false;  // --shading-path / --mips given: no per-device default
-  bool timings = false;                          // print the start-up phases
-  bool pipelineCache = true;                     // keep compiled pipelines in the user's cache folder
-  bool textureCache = true;                      // keep decoded, mipped textures there (--no-cache: neither)
+  bool shadingGiven = false, mipsGiven = false, clipGiven = false;  // --shading-path / --mips given: no per-device default
+  bool timings = false;                                             // print the start-up phases
+  bool pipelineCache = true;                                        // keep compiled pipelines in the user's cache folder
+  bool textureCache = true;                                         // keep decoded, mipped textures there (--no-cache: neither)
   // The first frame waits for the textures (deterministic captures); unless given, on for --headless
   // (--screenshot, --bench), off in the window, whose frames show the factors until the textures are in.
   std::optional<bool> waitTextures;
@@ -97,6 +97,7 @@ vk::ContextOptions contextOptions(const ViewOptions& o);
 struct DeviceChoice {
   render::ShadingPath shading;
   render::MipMode mips;
+  bool computeClip;  // --near-clip compute
 };
 DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx);
 

@@ -102,6 +102,7 @@ int runWindowed(const ViewOptions& opts) {
   Window& window = *windowSlot;
   app.settings = sceneSettings(o, *scene);
   app.settings.shading = choice.shading;
+  app.settings.clip = choice.computeClip;
   app.mips = choice.mips;
   app.lens = startLens(o, *scene);
   app.panel = o.panel;
