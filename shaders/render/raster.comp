@@ -37,8 +37,8 @@ void main() {
   const uint kind = local < clusters[clusterList[clusterIndex].y].triangleCount ? setup(clusterIndex, local, t) : kSkip;
   const uint ref = (clusterIndex << RASTER_LOCAL_BITS) | local;
   if (kind == kSmall) {
-    for (int y = t.box.y; y <= t.box.w; ++y)
-      for (int x = t.box.x; x <= t.box.z; ++x) rasterPixel(t, ivec2(x, y));
+    if (kMeasure != RASTER_MEASURE_SETUP) rasterBox(t);
+    else if (t.id == ~0u) vis[t.box.x] = packVis(t.z.x, t.id);  // keeps the setup (kind and box), writes nothing
   } else if (kind == kLarge) {
     appendLarge(t, ref);
   } else if (kind == kHardware) {
