@@ -233,18 +233,14 @@ void rasterPixel(Tri t, ivec2 px) {
   rasterCovered(t, px, edge(t.v[1], t.v[2], c), edge(t.v[2], t.v[0], c), edge(t.v[0], t.v[1], c));
 }
 
-// Every pixel of t's box, row by row. Each edge function is affine in the pixel centre, so it is evaluated
-// once at the box's corner and stepped by its per-pixel differences: integer sums, the same values as
-// rasterPixel's per-pixel products, for three 64-bit additions a pixel instead of six multiplications.
-void rasterBox(Tri t) {
-  const ivec2 c = t.box.xy * kOne + kOne / 2;
-  const ivec3 dx = ivec3(t.v[2].x - t.v[1].x, t.v[0].x - t.v[2].x, t.v[1].x - t.v[0].x);
-  const ivec3 dy = ivec3(t.v[2].y - t.v[1].y, t.v[0].y - t.v[2].y, t.v[1].y - t.v[0].y);
-  const i64vec3 stepX = -i64vec3(dy) * kOne, stepY = i64vec3(dx) * kOne;  // edge(a, b, p) = d.x (p.y - a.y) - d.y (p.x - a.x)
-  i64vec3 row = i64vec3(edge(t.v[1], t.v[2], c), edge(t.v[2], t.v[0], c), edge(t.v[0], t.v[1], c));
-  for (int y = t.box.y; y <= t.box.w; ++y, row += stepY) {
-    i64vec3 e = row;
-    for (int x = t.box.x; x <= t.box.z; ++x, e += stepX) rasterCovered(t, ivec2(x, y), e.x, e.y, e.z);
-  }
+// Row y of t's box. Each edge function is affine in the pixel centre, so it is evaluated at the row's first
+// centre and stepped by its per-pixel difference: integer sums, the same values as rasterPixel's products,
+// for three 64-bit additions a pixel instead of six multiplications.
+void rasterRow(Tri t, int y) {
+  const ivec2 c = ivec2(t.box.x, y) * kOne + kOne / 2;
+  // edge(a, b, p) = d.x (p.y - a.y) - d.y (p.x - a.x): -d.y a pixel to the right
+  const i64vec3 stepX = -i64vec3(t.v[2].y - t.v[1].y, t.v[0].y - t.v[2].y, t.v[1].y - t.v[0].y) * kOne;
+  i64vec3 e = i64vec3(edge(t.v[1], t.v[2], c), edge(t.v[2], t.v[0], c), edge(t.v[0], t.v[1], c));
+  for (int x = t.box.x; x <= t.box.z; ++x, e += stepX) rasterCovered(t, ivec2(x, y), e.x, e.y, e.z);
 }
 
