@@ -36,6 +36,16 @@ std::vector<vk::SpecializationConstant> withMeasure(std::vector<vk::Specializati
   return constants;
 }
 
+// RTR_RASTER_ROW_QUEUE=1: the small triangles' rows shared out over raster.comp's workgroup (its kRowQueue;
+// the same ids), for comparison on the GPU machine (docs/raster.md, "What bounds each pass").
+std::vector<vk::SpecializationConstant> withRowQueue(std::vector<vk::SpecializationConstant> constants) {
+  const char* v = std::getenv("RTR_RASTER_ROW_QUEUE");
+  if (!v || !*v || std::strcmp(v, "0") == 0) return constants;
+  if (std::strcmp(v, "1") != 0) throw std::runtime_error(std::string("RTR_RASTER_ROW_QUEUE=") + v + ": expected 0 or 1");
+  constants.push_back({3, 1});
+  return constants;
+}
+
 }  // namespace
 
 ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
@@ -46,7 +56,7 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
   // The alpha test in compute only where some material is masked (raster_tri.glsl's kAlphaMask).
   const std::vector<vk::SpecializationConstant> constants{{0, RASTER_SHARED_AREA}, {1, scene.hasDraws(DrawKind::AlphaMasked)}};
-  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, withMeasure(constants));
+  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, withRowQueue(withMeasure(constants)));
   clip_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clip.comp"), options, constants);
   large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), options, constants);
   vk::GraphicsDesc d;

@@ -2,6 +2,7 @@
 // closed mesh seen from inside is covered exactly once per pixel (docs/raster.md).
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 #include <gtest/gtest.h>
 
@@ -224,6 +225,30 @@ TEST_F(RasterTest, RebuiltPipelinesGiveTheSameIds) {
   const std::vector<uint32_t> after = ids(r, pose, lens, RasterPath::Compute);
   EXPECT_EQ(before, after);
   EXPECT_GT(std::count_if(after.begin(), after.end(), [](uint32_t id) { return id != VIS_EMPTY; }), 160 * 90 / 4);
+}
+
+// The small triangles' rows shared out over the workgroup (RTR_RASTER_ROW_QUEUE=1, raster.comp's kRowQueue)
+// make the same atomics as each thread drawing its own box: the same ids, byte for byte, in three views.
+TEST_F(RasterTest, RowQueueGivesTheSameIds) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  const VkExtent2D extent{480, 270};
+  const glm::vec3 c = scene.bounds().center();
+  const CameraPose poses[] = {scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 480.0f / 270.0f)),
+                              {c + glm::vec3(0, 0.3f, 0), 70.0f, -10.0f},
+                              {c + glm::vec3(2, -0.5f, 1), 200.0f, -35.0f}};
+  std::vector<uint32_t> got[2];
+  for (int queue = 0; queue < 2; ++queue) {
+    ::setenv("RTR_RASTER_ROW_QUEUE", queue ? "1" : "0", 1);  // read when the renderer makes its pipelines
+    render::HeadlessRenderer r(*ctx, gpu, extent);
+    for (const CameraPose& pose : poses) {
+      const std::vector<uint32_t> v = ids(r, pose, fitDepthRange(Lens{}, scene.bounds(), pose), RasterPath::Compute);
+      got[queue].insert(got[queue].end(), v.begin(), v.end());
+    }
+  }
+  ::unsetenv("RTR_RASTER_ROW_QUEUE");
+  EXPECT_EQ(got[0], got[1]);
+  EXPECT_GT(std::count_if(got[1].begin(), got[1].end(), [](uint32_t id) { return id != VIS_EMPTY; }), 3 * 480 * 270 / 4);
 }
 
 // A closed cube [-1, 1]³ seen from inside: its faces wound to face the centre. Every axis is cut at the same
