@@ -36,13 +36,14 @@ std::vector<vk::SpecializationConstant> withMeasure(std::vector<vk::Specializati
   return constants;
 }
 
-// RTR_RASTER_ROW_QUEUE=1: the small triangles' rows shared out over raster.comp's workgroup (its kRowQueue;
-// the same ids), for comparison on the GPU machine (docs/raster.md, "What bounds each pass").
+// RTR_RASTER_ROW_QUEUE=0|1: raster.comp's small triangles' rows never or always shared out over the
+// subgroup (its kRowQueueFrom; the same ids), for measuring either path (docs/raster.md, "What bounds each pass").
 std::vector<vk::SpecializationConstant> withRowQueue(std::vector<vk::SpecializationConstant> constants) {
   const char* v = std::getenv("RTR_RASTER_ROW_QUEUE");
-  if (!v || !*v || std::strcmp(v, "0") == 0) return constants;
-  if (std::strcmp(v, "1") != 0) throw std::runtime_error(std::string("RTR_RASTER_ROW_QUEUE=") + v + ": expected 0 or 1");
-  constants.push_back({3, 1});
+  if (!v || !*v) return constants;
+  if (std::strcmp(v, "0") != 0 && std::strcmp(v, "1") != 0)
+    throw std::runtime_error(std::string("RTR_RASTER_ROW_QUEUE=") + v + ": expected 0 or 1");
+  constants.push_back({3, *v == '1' ? 0u : ~0u});
   return constants;
 }
 
