@@ -201,9 +201,13 @@ bool tileTouches(Tri t, ivec2 lo) {
   return true;
 }
 
-void rasterPixel(Tri t, ivec2 px) {
-  const ivec2 c = px * kOne + kOne / 2;
-  const int64_t e0 = edge(t.v[1], t.v[2], c), e1 = edge(t.v[2], t.v[0], c), e2 = edge(t.v[0], t.v[1], c);
+// Measuring only (RTR_RASTER_MEASURE, docs/raster.md "What bounds each pass"; raster.comp's variant, never
+// the default): RASTER_MEASURE_NO_ATOMICS leaves out the per-pixel atomicMin, RASTER_MEASURE_SETUP the
+// whole pixel loop. What is left is kept by a store no real id takes (~0u is never an id).
+layout(constant_id = 2) const uint kMeasure = RASTER_MEASURE_OFF;
+
+// Pixel px, whose centre has edge functions e0, e1, e2 (t's edges opposite vertices 0, 1, 2).
+void rasterCovered(Tri t, ivec2 px, int64_t e0, int64_t e1, int64_t e2) {
   if (e0 < 0l || e1 < 0l || e2 < 0l) return;
   // The bias is at most 1 of area2 (>= 1): barycentrics from the unbiased edges are not worth the cost.
   // Depth as z0 plus the weighted differences: depths crowd just below 1 (z/w of a far-away model), and
@@ -217,6 +221,26 @@ void rasterPixel(Tri t, ivec2 px) {
     if (z > uintBitsToFloat(uint(vis[i] >> 32))) return;
     if (cutOut(t, px, vec3(float(e0), float(e1), float(e2)))) return;
   }
+  if (kMeasure == RASTER_MEASURE_NO_ATOMICS) {
+    if (t.id == ~0u) vis[i] = packVis(z, t.id);
+    return;
+  }
   atomicMin(vis[i], packVis(z, t.id));
+}
+
+void rasterPixel(Tri t, ivec2 px) {
+  const ivec2 c = px * kOne + kOne / 2;
+  rasterCovered(t, px, edge(t.v[1], t.v[2], c), edge(t.v[2], t.v[0], c), edge(t.v[0], t.v[1], c));
+}
+
+// Row y of t's box. Each edge function is affine in the pixel centre, so it is evaluated at the row's first
+// centre and stepped by its per-pixel difference: integer sums, the same values as rasterPixel's products,
+// for three 64-bit additions a pixel instead of six multiplications.
+void rasterRow(Tri t, int y) {
+  const ivec2 c = ivec2(t.box.x, y) * kOne + kOne / 2;
+  // edge(a, b, p) = d.x (p.y - a.y) - d.y (p.x - a.x): -d.y a pixel to the right
+  const i64vec3 stepX = -i64vec3(t.v[2].y - t.v[1].y, t.v[0].y - t.v[2].y, t.v[1].y - t.v[0].y) * kOne;
+  i64vec3 e = i64vec3(edge(t.v[1], t.v[2], c), edge(t.v[2], t.v[0], c), edge(t.v[0], t.v[1], c));
+  for (int x = t.box.x; x <= t.box.z; ++x, e += stepX) rasterCovered(t, ivec2(x, y), e.x, e.y, e.z);
 }
 

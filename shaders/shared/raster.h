@@ -18,10 +18,17 @@ using glm::vec4;
 #define RASTER_SUBPIXEL_BITS 8   // fixed-point vertex positions: 1/256 pixel
 #define RASTER_GUARD_BAND 16384.0 // px from the image centre; beyond it (or w <= 0) the hardware draws it
 #define RASTER_SHARED_AREA 256u  // default: bounding boxes over this many pixels are rasterised tile by tile
+// raster.comp: a subgroup whose largest small box is over this many pixels shares its rows out (docs/raster.md)
+#define RASTER_ROW_QUEUE_FROM 64u
 #define RASTER_TILE 32           // raster_large.comp: a workgroup per tile of RASTER_TILE² pixels of a triangle
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
 #define RASTER_LARGE_TRIANGLES (1u << 17) // large triangles' records a frame; one that does not fit goes to the hardware
 #define RASTER_LARGE_GROUPS 1024u         // raster_large.comp's persistent workgroups
+// RTR_RASTER_MEASURE (render/raster.cpp; raster_tri.glsl's kMeasure): raster.comp without its atomics or
+// its pixel loop, to split its time. Measuring only: the ids are then wrong.
+#define RASTER_MEASURE_OFF 0u
+#define RASTER_MEASURE_NO_ATOMICS 1u
+#define RASTER_MEASURE_SETUP 2u
 #define RASTER_LOCAL_BITS 7u     // hand-off and tile entries: position in the cluster list << RASTER_LOCAL_BITS | triangle
 // Hand-off list entries at most (64 MiB): the near-plane and guard-band triangles of a frame, not every
 // triangle of a billion-triangle scene (a storage buffer's range is 4 GiB at most on many devices). Past

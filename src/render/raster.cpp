@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 
 #include "raster.h"
@@ -18,6 +20,35 @@ bool ComputeRaster::supported(const vk::Context& ctx) {
   return f2.features.shaderInt64 && f2.features.fragmentStoresAndAtomics && f12.shaderBufferInt64Atomics;
 }
 
+namespace {
+
+// RTR_RASTER_MEASURE=no-atomics|setup: raster.comp without its per-pixel atomics or its pixel loop, so that
+// a --timings run splits "raster" into fetch and setup, edge tests and atomics (docs/raster.md, "What bounds
+// each pass"). Measuring only: the ids are then wrong, so it says so.
+std::vector<vk::SpecializationConstant> withMeasure(std::vector<vk::SpecializationConstant> constants) {
+  const char* v = std::getenv("RTR_RASTER_MEASURE");
+  if (!v || !*v) return constants;
+  const std::string mode = v;
+  if (mode != "no-atomics" && mode != "setup")
+    throw std::runtime_error("RTR_RASTER_MEASURE=" + mode + ": expected no-atomics or setup");
+  std::fprintf(stderr, "RTR_RASTER_MEASURE=%s: the raster pass writes no ids (measuring only)\n", v);
+  constants.push_back({2, mode == "setup" ? RASTER_MEASURE_SETUP : RASTER_MEASURE_NO_ATOMICS});
+  return constants;
+}
+
+// RTR_RASTER_ROW_QUEUE=0|1: raster.comp's small triangles' rows never or always shared out over the
+// subgroup (its kRowQueueFrom; the same ids), for measuring either path (docs/raster.md, "What bounds each pass").
+std::vector<vk::SpecializationConstant> withRowQueue(std::vector<vk::SpecializationConstant> constants) {
+  const char* v = std::getenv("RTR_RASTER_ROW_QUEUE");
+  if (!v || !*v) return constants;
+  if (std::strcmp(v, "0") != 0 && std::strcmp(v, "1") != 0)
+    throw std::runtime_error(std::string("RTR_RASTER_ROW_QUEUE=") + v + ": expected 0 or 1");
+  constants.push_back({3, *v == '1' ? 0u : ~0u});
+  return constants;
+}
+
+}  // namespace
+
 ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
     : ctx_(ctx), scene_(scene), culled_(framesInFlight, false), twoPhase_(framesInFlight, false) {
   const vk::LayoutOptions push{.pushDescriptorSets = {0}};
@@ -26,7 +57,7 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
   // The alpha test in compute only where some material is masked (raster_tri.glsl's kAlphaMask).
   const std::vector<vk::SpecializationConstant> constants{{0, RASTER_SHARED_AREA}, {1, scene.hasDraws(DrawKind::AlphaMasked)}};
-  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, constants);
+  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, withRowQueue(withMeasure(constants)));
   clip_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clip.comp"), options, constants);
   large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), options, constants);
   vk::GraphicsDesc d;

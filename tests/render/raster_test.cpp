@@ -2,6 +2,7 @@
 // closed mesh seen from inside is covered exactly once per pixel (docs/raster.md).
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 
@@ -235,6 +236,94 @@ TEST_F(RasterTest, RebuiltPipelinesGiveTheSameIds) {
   const std::vector<uint32_t> after = ids(r, pose, lens, RasterPath::Compute);
   EXPECT_EQ(before, after);
   EXPECT_GT(std::count_if(after.begin(), after.end(), [](uint32_t id) { return id != VIS_EMPTY; }), 160 * 90 / 4);
+}
+
+// Ids with raster.comp's small triangles' rows never shared out (RTR_RASTER_ROW_QUEUE=0), always (=1)
+// and by its default choice per subgroup: `render` draws each, the three must be equal byte for byte.
+template <class Render>
+void expectSameIdsWithAndWithoutRowQueue(Render render, size_t minCovered) {
+  std::vector<uint32_t> got[3];
+  const char* settings[] = {"0", "1", nullptr};  // read when the renderer makes its pipelines
+  for (int i = 0; i < 3; ++i) {
+    if (settings[i]) ::setenv("RTR_RASTER_ROW_QUEUE", settings[i], 1);
+    else ::unsetenv("RTR_RASTER_ROW_QUEUE");
+    got[i] = render();
+  }
+  ::unsetenv("RTR_RASTER_ROW_QUEUE");
+  EXPECT_EQ(got[0], got[1]) << "the row queue changes ids";
+  EXPECT_EQ(got[0], got[2]) << "the per-subgroup choice changes ids";
+  EXPECT_GT(size_t(std::count_if(got[2].begin(), got[2].end(), [](uint32_t id) { return id != VIS_EMPTY; })), minCovered);
+}
+
+// The temple's three views: the same atomics in another order give the same ids, byte for byte.
+TEST_F(RasterTest, RowQueueGivesTheSameIds) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  const VkExtent2D extent{480, 270};
+  const glm::vec3 c = scene.bounds().center();
+  const CameraPose poses[] = {scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 480.0f / 270.0f)),
+                              {c + glm::vec3(0, 0.3f, 0), 70.0f, -10.0f},
+                              {c + glm::vec3(2, -0.5f, 1), 200.0f, -35.0f}};
+  expectSameIdsWithAndWithoutRowQueue(
+      [&] {
+        render::HeadlessRenderer r(*ctx, gpu, extent);
+        std::vector<uint32_t> all;
+        for (const CameraPose& pose : poses) {
+          const std::vector<uint32_t> v = ids(r, pose, fitDepthRange(Lens{}, scene.bounds(), pose), RasterPath::Compute);
+          all.insert(all.end(), v.begin(), v.end());
+        }
+        return all;
+      },
+      3 * 480 * 270 / 4);
+}
+
+// Both of raster.comp's paths in one workgroup: the triangles of each cluster (runs of 124, in order) come
+// in runs of a subgroup's size, alternately tiny (boxes of at most 2×2 pixels: drawn by their own lane)
+// and 14×14-pixel ones (over RASTER_ROW_QUEUE_FROM: the subgroup shares its rows out, and more rows than
+// its slice of the queue holds, so some are drawn by their own lane), at random places and depths,
+// overlapping, seen straight through an orthographic lens.
+TEST_F(RasterTest, RowQueueChosenPerSubgroupGivesTheSameIds) {
+  VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &sub};
+  vkGetPhysicalDeviceProperties2(ctx->physicalDevice(), &props);
+  const uint32_t lanes = sub.subgroupSize;
+  ASSERT_LE(lanes, 62u) << "a cluster of 124 triangles holds no two subgroups";
+  constexpr uint32_t kSize = 128, kTriangles = 124 * 12;
+  static_assert(14 * 14 > RASTER_ROW_QUEUE_FROM && 2 * 2 <= RASTER_ROW_QUEUE_FROM && 14 * 14 <= RASTER_SHARED_AREA);
+  Scene scene;
+  scene.materials.push_back(Material{});
+  Mesh m;
+  uint32_t seed = 12345;
+  auto random = [&](float lo, float hi) {
+    seed = seed * 1664525u + 1013904223u;
+    return lo + (hi - lo) * float(seed >> 8) / float(1u << 24);
+  };
+  for (uint32_t t = 0; t < kTriangles; ++t) {
+    const bool tiny = (t % 124 / lanes) % 2 == 0;
+    const float side = tiny ? 1.4f : 13.4f;  // pixels: boxes of at most 2 and 14 pixel centres a side
+    const float x = random(1, kSize - 15), y = random(1, kSize - 15), z = random(-2, -1);
+    auto world = [&](float sx, float sy) { return glm::vec3(sx / (kSize / 2) - 1, 1 - sy / (kSize / 2), z); };
+    const uint32_t v = uint32_t(m.positions.size());
+    // Counter-clockwise on screen (y down): front-facing.
+    for (const glm::vec3& p : {world(x, y), world(x, y + side), world(x + side, y)}) {
+      m.positions.push_back(p);
+      m.normals.push_back(glm::vec3(0, 0, 1));
+    }
+    m.indices.insert(m.indices.end(), {v, v + 1, v + 2});
+  }
+  for (const glm::vec3& p : m.positions) m.bounds.extend(p);
+  scene.meshes.push_back(std::move(m));
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  Lens lens;
+  lens.orthographic = true;
+  lens.zNear = 0.5f;
+  lens.zFar = 3.0f;
+  expectSameIdsWithAndWithoutRowQueue(
+      [&] {
+        render::HeadlessRenderer r(*ctx, gpu, {kSize, kSize});
+        return ids(r, {{0, 0, 0}, 0, 0}, lens, RasterPath::Compute);
+      },
+      kSize * kSize / 2);
 }
 
 // A closed cube [-1, 1]³ seen from inside: its faces wound to face the centre. Every axis is cut at the same

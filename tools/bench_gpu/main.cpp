@@ -1,9 +1,11 @@
 // rtr-bench-gpu: times mip generation (64 textures, blit and compute), the mosaic post-process
-// (compute, graphics, off) and the environment's prefiltering passes with GPU timestamps; min / median over --runs submissions after --warmup ones.
+// (compute, graphics, off), the environment's prefiltering passes and 64-bit atomicMin against plain stores
+// with GPU timestamps; min / median over --runs submissions after --warmup ones.
 // Mips also report the largest difference, in LSB, of any texel of any texture from the float64 reference.
 // Prints a Markdown table and "csv," lines. Headless: no window, no validation unless RTR_VALIDATION=1.
 #include <algorithm>
 #include <cstdio>
+#include <numeric>
 #include <cstring>
 #include <stdexcept>
 #include <random>
@@ -13,11 +15,13 @@
 #include <CLI/CLI.hpp>
 #include <glm/gtc/packing.hpp>
 
+#include "bench_atomics.h"
 #include "core/mip_reference.hpp"
 #include "render/environment_maps.hpp"
 #include "render/mips.hpp"
-#include "scene/environment.hpp"
 #include "render/post.hpp"
+#include "render/raster.hpp"
+#include "scene/environment.hpp"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
 
@@ -277,19 +281,93 @@ std::vector<Row> benchEnvironment(const vk::Context& ctx, VkExtent2D extent, int
   return rows;
 }
 
+// One 64-bit atomicMin (or store) a thread on a buffer of one word per pixel of `extent`, in each pattern of
+// bench_atomics.h: the rate the compute rasteriser's per-pixel write can reach. Each case's result is read
+// back after its last run and checked word by word against the CPU's (the minimum of each word's writers).
+std::vector<Row> benchAtomics(const vk::Context& ctx, VkExtent2D extent, int warmup, int runs) {
+  if (!render::ComputeRaster::supported(ctx)) throw std::runtime_error("atomics: the device has no 64-bit buffer atomics");
+  const uint32_t words = extent.width * extent.height;
+  uint32_t stride = 1000003;  // a prime, so coprime with any size but its multiples
+  while (std::gcd(stride, words) != 1) stride += 2;
+  const VkDeviceSize bytes = VkDeviceSize(words) * 8;
+  vk::Buffer buffer(ctx, bytes,
+                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                    vk::MemoryUse::Device, "atomics");
+  vk::Buffer readback(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "atomics read-back");
+  const uint32_t groups = (words + 255) / 256, x = std::min(groups, 65535u), y = (groups + x - 1) / x;
+  struct Case {
+    const char* name;
+    uint32_t pattern, contention;
+  };
+  const Case cases[] = {{"atomicMin, coherent", BENCH_ATOMIC_COHERENT, 1},
+                        {"atomicMin, scattered", BENCH_ATOMIC_SCATTERED, 1},
+                        {"atomicMin, 4 threads a word", BENCH_ATOMIC_CONTENDED, 4},
+                        {"atomicMin, 32 threads a word", BENCH_ATOMIC_CONTENDED, 32},
+                        {"store, coherent", BENCH_STORE_COHERENT, 1},
+                        {"store, scattered", BENCH_STORE_SCATTERED, 1}};
+  const vk::LayoutOptions push{.pushDescriptorSets = {0}};
+  std::vector<Row> rows;
+  const std::string size =
+      std::to_string(extent.width) + "x" + std::to_string(extent.height) + " (" + std::to_string(words) + " words)";
+  for (const Case& c : cases) {
+    const vk::Pipeline p = vk::makeComputePipeline(ctx, vk::loadShader("bench_atomics.comp"), push, {{0, c.pattern}});
+    auto prepare = [&](VkCommandBuffer cb) {  // every word to all ones, outside the timed region
+      vk::bufferBarrier(cb, vk::kComputeReadWrite | vk::kCopyRead, vk::kTransferWrite);
+      vkCmdFillBuffer(cb, buffer.handle(), 0, VK_WHOLE_SIZE, ~0u);
+      vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
+    };
+    Row r = measure(ctx, warmup, runs, prepare, [&](VkCommandBuffer cb, std::vector<render::MipViews>&) {
+      p.bind(cb);
+      vk::DescriptorWriter(ctx, p.layout, 0, VK_NULL_HANDLE).buffer(0, buffer.handle()).push(cb, p);
+      p.push(cb, shader::BenchAtomicsPush{words, stride, c.contention, 0});
+      vkCmdDispatch(cb, x, y, 1);
+    });
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+      vk::bufferBarrier(cb, vk::kComputeReadWrite, vk::kCopyRead);
+      const VkBufferCopy all{0, 0, bytes};
+      vkCmdCopyBuffer(cb, buffer.handle(), readback.handle(), 1, &all);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+    });
+    readback.invalidate();
+    std::vector<uint64_t> want(words, ~uint64_t(0));
+    for (uint32_t i = 0; i < words; ++i) {
+      uint32_t w = i;
+      if (c.pattern == BENCH_ATOMIC_SCATTERED || c.pattern == BENCH_STORE_SCATTERED) w = uint32_t(uint64_t(i) * stride % words);
+      if (c.pattern == BENCH_ATOMIC_CONTENDED) w = i / c.contention;
+      want[w] = std::min(want[w], uint64_t(shader::benchAtomicsKey(i)) << 32 | i);
+    }
+    const auto* got = static_cast<const uint64_t*>(readback.mapped());
+    const auto bad = std::mismatch(want.begin(), want.end(), got);
+    if (bad.first != want.end())
+      throw std::runtime_error(std::string("atomics: ") + c.name + ": word " + std::to_string(bad.first - want.begin()) +
+                               " is not its writers' minimum");
+    r.pass = "atomics";
+    r.size = size;
+    r.mode = c.name;
+    char note[128];
+    std::snprintf(note, sizeof note, "%.3g G ops/s (median), every word checked", words / (r.medianMs * 1e6));
+    r.error = note;
+    rows.push_back(r);
+    std::fprintf(stderr, "  atomics %s: median %.3f ms, %s\n", c.name, r.medianMs, note);
+  }
+  return rows;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("GPU timings of the mip and mosaic passes");
+  CLI::App app("GPU timings of the mip, mosaic and environment passes and of 64-bit atomics");
   int runs = 25, warmup = 3, textures = 64;
   std::string only;
   std::vector<std::string> sizes{"1024x1024", "1000x600"};
+  std::string atomicsSize = "3840x2160";
   bool perTexture = false;
   app.add_option("--runs", runs, "timed submissions per case (min / median)")->check(CLI::Range(1, 10000));
   app.add_option("--warmup", warmup, "untimed submissions first")->check(CLI::Range(0, 1000));
   app.add_option("--textures", textures, "textures per mip case")->check(CLI::Range(1, 1024));
-  app.add_option("--only", only, "mips, mosaic or env")->check(CLI::IsMember({"mips", "mosaic", "env"}));
+  app.add_option("--only", only, "mips, mosaic, env or atomics")->check(CLI::IsMember({"mips", "mosaic", "env", "atomics"}));
   app.add_option("--mip-sizes", sizes, "texture sizes of the mip cases (WxH ...)");
+  app.add_option("--atomics-size", atomicsSize, "the atomics cases' buffer: a word per pixel of WxH");
   app.add_flag("--mips-per-texture", perTexture, "one MipGenerator::record call per texture instead of one batch");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -310,6 +388,13 @@ int main(int argc, char** argv) {
       add(benchMosaic(ctx, {3840, 2160}, warmup, runs));
     }
     if (only.empty() || only == "env") add(benchEnvironment(ctx, {2048, 1024}, std::min(warmup, 1), std::min(runs, 10)));
+    // Without 64-bit buffer atomics only an explicit --only atomics fails (benchAtomics says why).
+    if (only == "atomics" || (only.empty() && render::ComputeRaster::supported(ctx))) {
+      unsigned w = 0, h = 0;
+      if (std::sscanf(atomicsSize.c_str(), "%ux%u", &w, &h) != 2 || !w || !h || uint64_t(w) * h >= (1ull << 28))
+        throw std::runtime_error("--atomics-size " + atomicsSize + ": expected WxH, under 2^28 pixels");
+      add(benchAtomics(ctx, {w, h}, warmup, runs));
+    }
     std::printf("Device: %s (%s)\n\n", ctx.deviceName().c_str(), ctx.driverInfo().c_str());
     std::printf("| pass | size | mode | min ms | median ms | runs | error |\n|---|---|---|---:|---:|---:|---|\n");
     for (const Row& r : rows)
@@ -319,6 +404,10 @@ int main(int argc, char** argv) {
     for (const Row& r : rows)
       std::printf("csv,%s,%s,%s,%.4f,%.4f,%d,%d\n", r.pass.c_str(), r.size.c_str(), r.mode.c_str(), r.minMs, r.medianMs, r.runs,
                   r.maxLsb);
+    if (const uint32_t n = vk::Context::validationMessageCount()) {  // with RTR_VALIDATION=1 (its test)
+      std::fprintf(stderr, "rtr-bench-gpu: %u validation messages\n", n);
+      return 1;
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rtr-bench-gpu: %s\n", e.what());
     return 1;
