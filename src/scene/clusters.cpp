@@ -111,7 +111,7 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
   for (Mesh* m : meshes) m->clusters.clear(), m->lod = {};
   for (size_t j = 0; j < jobs.size(); ++j) {  // pieces in order: every triangle once, in its mesh's place
     Mesh& m = *meshes[jobs[j].mesh];
-    std::copy(pieces[j].indices.begin(), pieces[j].indices.end(), m.indices.begin() + jobs[j].first * 3);
+    std::copy(pieces[j].indices.begin(), pieces[j].indices.end(), m.indices.writable().begin() + jobs[j].first * 3);
     m.clusters.insert(m.clusters.end(), pieces[j].clusters.begin(), pieces[j].clusters.end());
   }
 }
