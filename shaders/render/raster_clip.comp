@@ -1,87 +1,73 @@
 #version 460
 // Compute rasteriser, the triangles raster.comp could not set up (docs/raster.md): those crossing the near
-// plane (w <= 0 at a vertex) or leaving the guard band. A thread per triangle clips it in clip space against
+// plane (w <= 0 at a vertex) or leaving the guard band. A workgroup per (listed triangle, fan piece): its
+// threads all clip the triangle in clip space (the same inputs, the same result, no shared copy) against
 // z >= 0 (the near plane; w > 0 in front of it) and the four planes RASTER_CLIP_BAND pixels from the image
 // centre (Sutherland-Hodgman, texcoords carried along the edges as the hardware's clipper carries them),
-// then sets up the convex piece's fan as raster.comp sets up a triangle: small ones rasterised here, large
-// ones appended to the tile list for raster_large.comp (only their tiles that touch them), which runs after
-// this pass. The common setup of
-// raster.comp carries none of this; the pass is dispatched indirectly, one workgroup per
-// RASTER_CLIP_GROUP listed triangles (none: an empty dispatch).
+// then set up fan triangle gl_WorkGroupID.y + 1 of the convex piece as raster.comp sets up a triangle and
+// share its work: a small one's pixels, a large one's tile rows (only the tiles that touch it) appended to
+// the tile list for raster_large.comp, which runs after this pass. Dispatched indirectly from raster.comp's
+// count (none: an empty dispatch), so the common setup carries none of this.
 #extension GL_GOOGLE_include_directive : require
 #include "raster_tri.glsl"
+#include "raster_columns.glsl"
 
-layout(local_size_x = RASTER_CLIP_GROUP) in;
+layout(local_size_x = RASTER_CLIP_THREADS) in;
 
-const int kMaxVertices = 8;  // a triangle clipped by five planes
+const int kMaxVertices = int(RASTER_CLIP_PIECES) + 2;  // a triangle clipped by five planes
 
-int64_t floorDiv(int64_t a, int64_t b) { return a >= 0l ? a / b : -((-a + b - 1l) / b); }  // b > 0
-
-// The tile columns of tile row `row` of t's box that hold a pixel centre on the inner side of every edge's
-// extension over the row (x: first, y: last; x > y: none): exactly the tiles tileTouches accepts. Each edge
-// function is affine: over the row's centres its largest value at a given x is at the row's top or bottom
-// centre, and the x where that reaches 0 bounds the columns from one side.
-ivec2 touchedColumns(Tri t, int row) {
-  const int y0 = t.box.y + RASTER_TILE * row, y1 = min(y0 + RASTER_TILE - 1, t.box.w);
-  int64_t lo = int64_t(t.box.x) * kOne + kOne / 2, hi = int64_t(t.box.z) * kOne + kOne / 2;  // fixed-point centres
-  for (int k = 0; k < 3; ++k) {
-    const ivec2 a = t.v[k == 2 ? 0 : k + 1], b = t.v[k == 0 ? 2 : k - 1], d = b - a;
-    const bool topLeft = d.y < 0 || (d.y == 0 && d.x > 0);
-    // edge(a, b, (x, y)) = m(y) - d.y (x - a.x), m(y) = d.x (y - a.y) - bias; the larger m over the row:
-    const int64_t m = max(int64_t(d.x) * (int64_t(y0) * kOne + kOne / 2 - a.y), int64_t(d.x) * (int64_t(y1) * kOne + kOne / 2 - a.y)) -
-                      (topLeft ? 0l : 1l);
-    if (d.y == 0) {
-      if (m < 0l) return ivec2(1, 0);
-    } else if (d.y > 0) {
-      hi = min(hi, int64_t(a.x) + floorDiv(m, int64_t(d.y)));  // m - d.y (x - a.x) >= 0
-    } else {
-      lo = max(lo, int64_t(a.x) - floorDiv(m, int64_t(-d.y)));  // m + |d.y| (x - a.x) >= 0
-    }
-  }
-  // Pixels whose centres lie in [lo, hi], then their tile columns.
-  const int64_t first = -floorDiv(-(lo - kOne / 2), int64_t(kOne)), last = floorDiv(hi - kOne / 2, int64_t(kOne));
-  if (first > last) return ivec2(1, 0);
-  return (ivec2(int(first), int(last)) - t.box.x) / RASTER_TILE;
-}
+shared uint tileCount, firstTile, record;  // the piece's tile entries, their place in the list, its record
 
 // A large piece: its record and an entry for each tile that touches it only (appendLarge lists every tile
 // of the box: a piece reaching the image's edge from the near plane is a long sliver whose box is mostly
-// empty). A full list hands the triangle to the hardware.
+// empty). The workgroup's threads take a tile row each, count, reserve the piece's entries at once and
+// write their rows' entries. A full list hands the triangle to the hardware.
 void appendTouched(Tri t, uint ref) {
   const int tilesX = (t.box.z - t.box.x + RASTER_TILE) / RASTER_TILE, tilesY = (t.box.w - t.box.y + RASTER_TILE) / RASTER_TILE;
+  const int local = int(gl_LocalInvocationID.x);
+  if (local == 0) tileCount = 0u;
+  barrier();
   uint n = 0u;
-  for (int r = 0; r < tilesY; ++r) {
+  for (int r = local; r < tilesY; r += RASTER_CLIP_THREADS) {
     const ivec2 c = touchedColumns(t, r);
     n += uint(max(c.y - c.x + 1, 0));
   }
-  if (n == 0u) return;
-  const uint first = atomicAdd(largeCount, n), record = atomicAdd(largeTriCount, 1u);
-  const bool fits = first + n <= RASTER_LARGE_CAPACITY && record < RASTER_LARGE_TRIANGLES;
-  if (fits) storeLarge(record, t);
-  uint e = first;
-  for (int r = 0; r < tilesY && e < RASTER_LARGE_CAPACITY; ++r) {
+  uint e = n > 0u ? atomicAdd(tileCount, n) : 0u;
+  barrier();
+  const uint total = tileCount;
+  if (total == 0u) return;
+  if (local == 0) {
+    firstTile = atomicAdd(largeCount, total);
+    record = atomicAdd(largeTriCount, 1u);
+  }
+  barrier();
+  const bool fits = firstTile + total <= RASTER_LARGE_CAPACITY && record < RASTER_LARGE_TRIANGLES;
+  if (fits && local == 0) storeLarge(record, t);
+  e += firstTile;
+  for (int r = local; r < tilesY && n > 0u; r += RASTER_CLIP_THREADS) {
     const ivec2 c = touchedColumns(t, r);
     for (int x = c.x; x <= c.y && e < RASTER_LARGE_CAPACITY; ++x) largeTiles[e++] = uvec2(fits ? record : ~0u, uint(r * tilesX + x));
   }
-  if (!fits) handOff(ref);
+  if (!fits && local == 0) handOff(ref);
 }
 
+// Every branch below depends only on the workgroup's triangle and piece: uniform, as the barriers need.
 void main() {
-  const uint e = gl_GlobalInvocationID.x;
+  const uint e = gl_WorkGroupID.x, piece = gl_WorkGroupID.y + 1u, local = gl_LocalInvocationID.x;
   if (e < clipFirst || e >= min(clipCount, RASTER_CLIP_CAPACITY)) return;
-  const uint ref = clipTriangles[e], clusterIndex = ref >> RASTER_LOCAL_BITS, local = ref & ((1u << RASTER_LOCAL_BITS) - 1u);
+  const uint ref = clipTriangles[e], clusterIndex = ref >> RASTER_LOCAL_BITS, triangle = ref & ((1u << RASTER_LOCAL_BITS) - 1u);
   const GpuCluster c = listedCluster(clusterIndex);
   const GpuInstance inst = placedInstance(c.instance);
   const GpuDraw d = draws[inst.info.x];
   const bool masked = (c.flags & CLUSTER_ALPHA_MASKED) != 0u;
   if (!kAlphaMask && masked) {
-    handOff(ref);
+    if (piece == 1u && local == 0u) handOff(ref);
     return;
   }
   Tri t;
-  t.id = inst.info.z + c.firstTriangle + local;
+  t.id = inst.info.z + c.firstTriangle + triangle;
   t.material = NO_TEXTURE;
-  const uvec3 tri = triangleVertices(c, d, local);
+  const uvec3 tri = triangleVertices(c, d, triangle);
   vec4 poly[kMaxVertices];
   vec2 uv[kMaxVertices];
   int n = 3;
@@ -121,25 +107,32 @@ void main() {
     uv = outUv;
     n = count;
   }
-  // The fan over the convex piece: each triangle set up as raster.comp sets one up, with the same id.
-  for (int i = 1; i + 1 < n; ++i) {
-    const vec4 p[3] = vec4[3](poly[0], poly[i], poly[i + 1]);
-    bool swapped;
-    const uint kind = project(p, c.flags, t, swapped);
-    if (kind == kHardware) {  // a vertex rounded past the band or w = 0: the hardware draws the whole triangle
-      handOff(ref);
-      return;
-    }
-    if (kind == kSkip) continue;
-    if (t.material != NO_TEXTURE) {
-      const vec2 u[3] = vec2[3](uv[0], swapped ? uv[i + 1] : uv[i], swapped ? uv[i] : uv[i + 1]);
-      for (int v = 0; v < 3; ++v) t.uv[v] = maskTexcoord(m, u[v]);
-    }
-    if (kind == kSmall) {
-      for (int y = t.box.y; y <= t.box.w; ++y)
-        for (int x = t.box.x; x <= t.box.z; ++x) rasterPixel(t, ivec2(x, y));
-    } else {
-      appendTouched(t, ref);
-    }
+  // This workgroup's triangle of the fan over the convex piece, set up as raster.comp sets one up, with the
+  // same id. A piece the hardware must draw hands it the whole triangle (drawn by the piece's workgroup)
+  // and ends the fan: the pieces before it are drawn, those after it not.
+  const int i = int(piece);
+  if (i + 1 >= n) return;
+  bool swapped;
+  for (int j = 1; j < i; ++j) {
+    Tri s = t;
+    const vec4 q[3] = vec4[3](poly[0], poly[j], poly[j + 1]);
+    if (project(q, c.flags, s, swapped) == kHardware) return;
+  }
+  const vec4 p[3] = vec4[3](poly[0], poly[i], poly[i + 1]);
+  const uint kind = project(p, c.flags, t, swapped);
+  if (kind == kHardware) {  // a vertex rounded past the band or w = 0: the hardware draws the whole triangle
+    if (local == 0u) handOff(ref);
+    return;
+  }
+  if (kind == kSkip) return;
+  if (t.material != NO_TEXTURE) {
+    const vec2 u[3] = vec2[3](uv[0], swapped ? uv[i + 1] : uv[i], swapped ? uv[i] : uv[i + 1]);
+    for (int v = 0; v < 3; ++v) t.uv[v] = maskTexcoord(m, u[v]);
+  }
+  if (kind == kSmall) {  // at most RASTER_SHARED_AREA pixels, spread over the threads
+    const int w = t.box.z - t.box.x + 1, area = w * (t.box.w - t.box.y + 1);
+    for (int j = int(local); j < area; j += RASTER_CLIP_THREADS) rasterPixel(t, t.box.xy + ivec2(j % w, j / w));
+  } else {
+    appendTouched(t, ref);
   }
 }

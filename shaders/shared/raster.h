@@ -28,8 +28,12 @@ using glm::vec4;
 // it, triangles are dropped and counted (ComputeRaster::handOffTriangles, which rtr-view prints).
 #define RASTER_HANDOFF_CAPACITY (1u << 24)
 
-#define RASTER_CLIP_GROUP 64u             // raster_clip.comp: a thread per triangle crossing the near plane or the guard band
-#define RASTER_CLIP_CAPACITY (1u << 16)   // its list's entries; past them a triangle goes to the hardware
+// raster_clip.comp: a workgroup of RASTER_CLIP_THREADS per listed triangle (crossing the near plane or the
+// guard band; raster.comp counts the indirect dispatch's x by RASTER_CLIP_GROUP entries) and fan piece (y).
+#define RASTER_CLIP_GROUP 1u
+#define RASTER_CLIP_THREADS 128
+#define RASTER_CLIP_PIECES 6u             // a triangle clipped by five planes has at most 8 vertices
+#define RASTER_CLIP_CAPACITY 65535u       // its list's entries (a dispatch's x); past them a triangle goes to the hardware
 // The clipping planes' distance from the image centre in pixels: inside the guard band, so that a clipped
 // vertex's rounding never takes it out again.
 #define RASTER_CLIP_BAND (RASTER_GUARD_BAND - 64.0)

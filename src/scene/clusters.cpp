@@ -15,14 +15,10 @@ namespace rtr {
 
 namespace {
 
-// Clusters of the triangles [first, end) of `mesh`, in their own order, and those triangles' indices
-// reordered cluster by cluster (firstTriangle counts from the mesh's first triangle).
-struct Piece {
-  std::vector<Cluster> clusters;
-  std::vector<uint32_t> indices;
-};
-
-Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone) {
+// Clusters the triangles [first, end) of `mesh` and writes their indices back in place, reordered cluster by
+// cluster; returns the clusters (firstTriangle counts from the mesh's first triangle). A piece reads and
+// writes only its own triangles, so the pieces of a mesh run side by side.
+std::vector<Cluster> clusterPiece(Mesh& mesh, size_t first, size_t end, bool backfaceCone) {
   constexpr size_t kMaxV = CLUSTER_MAX_VERTICES, kMaxT = CLUSTER_MAX_TRIANGLES;
   const size_t count = (end - first) * 3;
   // meshoptimizer allocates and clears per-vertex arrays over the whole vertex range it is given, so each
@@ -30,10 +26,17 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
   // clusters of a 100 M-triangle mesh took 48 times those of 10 M). The local numbering keeps the global
   // order, so the clusters are the same as over the whole range: the span the piece uses when it is
   // narrow (welded meshes number vertices as their triangles come), else its sorted distinct vertices.
-  const uint32_t* src = mesh.indices.data() + first * 3;
+  uint32_t* src = mesh.indices.writable().data() + first * 3;  // a vector already (clusterMeshes)
   const auto [lo, hi] = std::minmax_element(src, src + count);
-  std::vector<uint32_t> global, local(count);
-  std::vector<glm::vec3> gathered;
+  // Scratch reused by the pieces a thread runs: these arrays are as large as the piece, and fresh ones
+  // cost a clear and page faults each time.
+  thread_local std::vector<uint32_t> global, local;
+  thread_local std::vector<glm::vec3> gathered;
+  thread_local std::vector<meshopt_Meshlet> meshlets;
+  thread_local std::vector<unsigned> vertices;
+  thread_local std::vector<unsigned char> triangles;
+  global.clear();
+  local.resize(count);
   const float* pos = &mesh.positions[*lo].x;
   size_t nv = size_t(*hi - *lo) + 1;
   if (nv <= 8 * count) {
@@ -49,35 +52,36 @@ Piece clusterPiece(const Mesh& mesh, size_t first, size_t end, bool backfaceCone
     pos = &gathered[0].x;
     nv = gathered.size();
   }
-  auto toGlobal = [&, base = *lo](uint32_t v) { return global.empty() ? v + base : global[v]; };
-  const uint32_t* in = local.data();
-  std::vector<meshopt_Meshlet> meshlets(meshopt_buildMeshletsBound(count, kMaxV, kMaxT));
-  std::vector<unsigned> vertices(meshlets.size() * kMaxV);
-  std::vector<unsigned char> triangles(meshlets.size() * kMaxT * 3);
+  const uint32_t base = *lo;
+  const size_t bound = meshopt_buildMeshletsBound(count, kMaxV, kMaxT);
+  meshlets.resize(bound);
+  vertices.resize(bound * kMaxV);
+  triangles.resize(bound * kMaxT * 3);
   // cone_weight 0.25 trades a little spatial compactness for tighter normal cones (meshoptimizer's advice).
-  meshlets.resize(meshopt_buildMeshlets(meshlets.data(), vertices.data(), triangles.data(), in, count, pos, nv, sizeof(glm::vec3),
-                                        kMaxV, kMaxT, backfaceCone ? 0.25f : 0.0f));
-  Piece out;
-  out.indices.reserve(count);
-  out.clusters.reserve(meshlets.size());
-  for (const meshopt_Meshlet& m : meshlets) {
+  const size_t made = meshopt_buildMeshlets(meshlets.data(), vertices.data(), triangles.data(), local.data(), count, pos, nv,
+                                            sizeof(glm::vec3), kMaxV, kMaxT, backfaceCone ? 0.25f : 0.0f);
+  std::vector<Cluster> out;
+  out.reserve(made);
+  size_t at = 0;  // local holds the reordered local ids from here on (every input index was read above)
+  for (size_t i = 0; i < made; ++i) {
+    const meshopt_Meshlet& m = meshlets[i];
     Cluster c;
-    c.firstTriangle = uint32_t(first + out.indices.size() / 3);
+    c.firstTriangle = uint32_t(first + at / 3);
     c.triangleCount = m.triangle_count;
-    const size_t at = out.indices.size();
-    for (size_t k = 0; k < size_t(m.triangle_count) * 3; ++k)
-      out.indices.push_back(vertices[m.vertex_offset + triangles[m.triangle_offset + k]]);
-    const meshopt_Bounds b = clusterBounds(out.indices.data() + at, size_t(m.triangle_count) * 3,
-                                           reinterpret_cast<const glm::vec3*>(pos), nv, backfaceCone);
-    for (size_t k = at; k < out.indices.size(); ++k) out.indices[k] = toGlobal(out.indices[k]);
+    const size_t n = size_t(m.triangle_count) * 3;
+    if (at + n > count) break;  // reported below
+    for (size_t k = 0; k < n; ++k) local[at + k] = vertices[m.vertex_offset + triangles[m.triangle_offset + k]];
+    const meshopt_Bounds b = clusterBounds(&local[at], n, reinterpret_cast<const glm::vec3*>(pos), nv, backfaceCone);
+    for (size_t k = at; k < at + n; ++k) src[k] = global.empty() ? local[k] + base : global[local[k]];
+    at += n;
     c.center = {b.center[0], b.center[1], b.center[2]};
     c.radius = b.radius;
     c.coneAxis = {b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};
     c.coneCutoff = b.cone_cutoff;
-    out.clusters.push_back(c);
+    out.push_back(c);
   }
   // meshoptimizer keeps every triangle, degenerate ones included; a mismatch would lose geometry.
-  if (out.indices.size() != count) throw Error("mesh '" + mesh.name + "': clustering lost triangles");
+  if (at != count) throw Error("mesh '" + mesh.name + "': clustering lost triangles");
   return out;
 }
 
@@ -89,31 +93,44 @@ constexpr size_t kPieceTriangles = size_t(1) << 16;
 void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backfaceCone, unsigned threads) {
   // meshoptimizer asserts (aborts) on non-finite cone math, which huge coordinates produce; every reader
   // refuses them with its file and place, and nothing beyond the limit reaches it from elsewhere either.
-  for (const Mesh* m : meshes) {
-    for (size_t k = 0; k < m->positions.size(); ++k)
-      if (!coordinateOk(m->positions[k]))
-        throw Error("mesh '" + m->name + "': position " + std::to_string(k) +
-                    " is not finite or beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
-    for (const uint32_t i : m->indices)  // meshoptimizer asserts this too
-      if (i >= m->positions.size()) throw Error("mesh '" + m->name + "': index " + std::to_string(i) + " out of range");
+  // Checked in pieces on all cores, each mesh's positions then its indices: the first failing piece is
+  // the one a single pass would have failed in.
+  struct Check {
+    size_t mesh, first, end;
+    bool indices;
+  };
+  std::vector<Check> checks;
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    for (size_t k = 0, n = meshes[i]->positions.size(); k < n; k += kPieceTriangles * 3)
+      checks.push_back({i, k, std::min(n, k + kPieceTriangles * 3), false});
+    for (size_t k = 0, n = meshes[i]->indices.size(); k < n; k += kPieceTriangles * 3)
+      checks.push_back({i, k, std::min(n, k + kPieceTriangles * 3), true});
   }
+  parallelFor(checks.size(), threads, [&](size_t j) {
+    const Check& c = checks[j];
+    const Mesh& m = *meshes[c.mesh];
+    for (size_t k = c.first; k < c.end; ++k)
+      if (!c.indices && !coordinateOk(m.positions[k]))
+        throw Error("mesh '" + m.name + "': position " + std::to_string(k) +
+                    " is not finite or beyond ±1e12 (the coordinate limit, docs/files-and-cli.md)");
+      else if (c.indices && m.indices[k] >= m.positions.size())  // meshoptimizer asserts this too
+        throw Error("mesh '" + m.name + "': index " + std::to_string(m.indices[k]) + " out of range");
+  });
   struct Job {
     size_t mesh, first, end;
   };
   std::vector<Job> jobs;
+  for (Mesh* m : meshes) m->indices.writable();  // reordered in place below: a view is copied first, once
   for (size_t i = 0; i < meshes.size(); ++i)
     for (size_t t = 0, n = meshes[i]->indices.size() / 3; t < n; t += kPieceTriangles)
       jobs.push_back({i, t, std::min(n, t + kPieceTriangles)});
-  std::vector<Piece> pieces(jobs.size());
+  std::vector<std::vector<Cluster>> pieces(jobs.size());
   parallelFor(jobs.size(), threads, [&](size_t j) {
     pieces[j] = clusterPiece(*meshes[jobs[j].mesh], jobs[j].first, jobs[j].end, backfaceCone[jobs[j].mesh]);
   });
   for (Mesh* m : meshes) m->clusters.clear(), m->lod = {};
-  for (size_t j = 0; j < jobs.size(); ++j) {  // pieces in order: every triangle once, in its mesh's place
-    Mesh& m = *meshes[jobs[j].mesh];
-    std::copy(pieces[j].indices.begin(), pieces[j].indices.end(), m.indices.writable().begin() + jobs[j].first * 3);
-    m.clusters.insert(m.clusters.end(), pieces[j].clusters.begin(), pieces[j].clusters.end());
-  }
+  for (size_t j = 0; j < jobs.size(); ++j)  // pieces in order: every triangle once, in its mesh's place
+    meshes[jobs[j].mesh]->clusters.insert(meshes[jobs[j].mesh]->clusters.end(), pieces[j].begin(), pieces[j].end());
 }
 
 }  // namespace

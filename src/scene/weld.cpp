@@ -241,25 +241,49 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     std::vector<std::vector<glm::vec3>> made(piecesOf(atPos.count()));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
       std::vector<glm::vec3> crosses, units;  // of the faces at this position
+      // Up to 64 faces at a position: the faces each corner's normal averages as bits (a kept triangle has one
+      // corner at a position, so face i is corner i here). The crease test is symmetric (each product of
+      // the dot commutes), so each pair is tested once, and a corner whose faces are those of an earlier
+      // one here gets its normal: the same sum in the same order, so the same normal.
+      std::vector<uint64_t> faces;
+      std::vector<std::pair<uint64_t, uint32_t>> seen;  // faces, normal id
       for (size_t g = b; g < e; ++g) {
         const uint32_t *first = atPos.items.get() + atPos.start[g], *last = atPos.items.get() + atPos.start[g + 1];
-        const size_t here = made[p].size();  // the normals made at this position so far
+        const size_t here = made[p].size(), count = size_t(last - first);  // the normals made at this position so far
         crosses.clear();
         units.clear();
         for (const uint32_t* c = first; c != last; ++c) crosses.push_back(cross(*c / 3)), units.push_back(unit(crosses.back()));
+        const bool bits = count <= 64;
+        seen.clear();
+        if (bits) {
+          faces.assign(count, 0);
+          for (size_t i = 0; i < count; ++i) {
+            faces[i] |= uint64_t(1) << i;
+            if (creaseDeg > 0.0f)
+              for (size_t j = i + 1; j < count; ++j)
+                if (glm::dot(units[i], units[j]) >= cosCrease) faces[i] |= uint64_t(1) << j, faces[j] |= uint64_t(1) << i;
+          }
+        }
         for (const uint32_t* c = first; c != last; ++c) {
           if (corners[*c].n != kAbsent) continue;
-          const size_t t = *c / 3;
-          const glm::vec3 own = units[size_t(c - first)];
+          const size_t i = size_t(c - first);
+          if (bits) {
+            auto same = std::find_if(seen.begin(), seen.end(), [&](const auto& s) { return s.first == faces[i]; });
+            if (same != seen.end()) {
+              corners[*c].n = same->second;
+              continue;
+            }
+          }
           glm::vec3 sum(0.0f);
-          for (const uint32_t* o = first; o != last; ++o)
-            if (*o / 3 == t || (creaseDeg > 0.0f && glm::dot(own, units[size_t(o - first)]) >= cosCrease))
-              sum += crosses[size_t(o - first)];
+          for (size_t o = 0; o < count; ++o)
+            if (bits ? (faces[i] >> o & 1) : o == i || (creaseDeg > 0.0f && glm::dot(units[i], units[o]) >= cosCrease))
+              sum += crosses[o];
           const glm::vec3 n = unit(sum);
           size_t k = here;
           while (k < made[p].size() && made[p][k] != n) ++k;
           if (k == made[p].size()) made[p].push_back(n);
           corners[*c].n = fileNormals + uint32_t(k);  // the piece's base is added below
+          if (bits) seen.emplace_back(faces[i], corners[*c].n);
         }
       }
     });
@@ -342,19 +366,33 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
   auto kept = uninitialised<uint8_t>(uniqCount);
   auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
-  std::vector<std::vector<uint32_t>> open(piecesOf(uniqCount));
+  // Bucket by bucket: a vertex whose cells are its own alone (most: it lies within the tolerance of no
+  // cell face) needs only the bucket's vertices before it, which were just read; vertex by vertex, every
+  // look-up was a chain of cache misses (bucket, its items, their vertices).
+  forPieces(buckets, threads, [&](size_t, size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k)
+      for (uint32_t j = inBucket.start[k]; j < inBucket.start[k + 1]; ++j) {
+        const uint32_t u = inBucket.items[j];
+        const Around a(verts[u].p);
+        bool near_ = false;
+        if (a.lo[0] == a.hi[0] && a.lo[1] == a.hi[1] && a.lo[2] == a.hi[2]) {  // its own cell, in this bucket
+          for (uint32_t i = inBucket.start[k]; i < j && !near_; ++i) near_ = isNear(inBucket.items[i], u);
+        } else {
+          near_ = a.any([&](uint64_t h) {
+            const size_t c = h & (buckets - 1);
+            for (uint32_t i = inBucket.start[c]; i < inBucket.start[c + 1] && inBucket.items[i] < u; ++i)
+              if (isNear(inBucket.items[i], u)) return true;
+            return false;
+          });
+        }
+        kept[u] = !near_;
+        if (!near_) target[u] = u;
+      }
+  });
+  std::vector<std::vector<uint32_t>> open(piecesOf(uniqCount));  // near an earlier vertex: decided in order below
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
-    for (size_t u = b; u < e; ++u) {
-      const bool near_ = Around(verts[u].p).any([&](uint64_t h) {
-        const size_t k = h & (buckets - 1);
-        for (uint32_t i = inBucket.start[k]; i < inBucket.start[k + 1] && inBucket.items[i] < u; ++i)
-          if (isNear(inBucket.items[i], uint32_t(u))) return true;
-        return false;
-      });
-      kept[u] = !near_;
-      if (near_) open[p].push_back(uint32_t(u));
-      else target[u] = uint32_t(u);
-    }
+    for (size_t u = b; u < e; ++u)
+      if (!kept[u]) open[p].push_back(uint32_t(u));
   });
   for (const std::vector<uint32_t>& list : open)
     for (const uint32_t u : list) {

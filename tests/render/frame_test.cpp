@@ -74,10 +74,12 @@ TEST_F(FrameTest, ShadedFrameIsFiniteAndLit) {
     EXPECT_GT(sum / (3.0 * kW * kH), 0.01) << "the shaded frame is (nearly) black";
     const bool vis = path == render::ShadingPath::Visibility;
     // Hardware ids: visibility, shade, post; compute: clear, raster, raster large, raster hw, shade, post;
-    // with culling also cull early, raster early, raster large early, pyramid, cull.
+    // with culling also cull early, raster early, raster large early, pyramid, cull; with clipping in
+    // compute raster clip (and raster clip early).
     const render::RenderSettings defaults;
     const bool compute = renderer->renderer().rasterFor(defaults) == render::RasterPath::Compute;
-    EXPECT_EQ(f.gpuTimes.size(), !vis ? 2u : !compute ? 3u : defaults.cull ? 11u : 6u);
+    const size_t clip = defaults.clip ? (defaults.cull ? 2u : 1u) : 0u;
+    EXPECT_EQ(f.gpuTimes.size(), !vis ? 2u : !compute ? 3u : (defaults.cull ? 11u : 6u) + clip);
     EXPECT_EQ(ranPass(f, "shade"), vis);
   }
   EXPECT_GT(gpu->stats().meshes16, 0u) << "small meshes should use 16-bit indices";

@@ -2,6 +2,8 @@
 // closed mesh seen from inside is covered exactly once per pixel (docs/raster.md).
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -12,6 +14,8 @@
 #include "render/headless.hpp"
 #include "scene/load.hpp"
 #include "scene/textures.hpp"
+#include "vk/commands.hpp"
+#include "vk/pipeline.hpp"
 #include "vk_fixture.hpp"
 
 namespace rtr {
@@ -132,10 +136,11 @@ class RasterTest : public test::VulkanTest {
     if (!render::ComputeRaster::supported(*ctx)) GTEST_SKIP() << "no 64-bit buffer atomics";
   }
   std::vector<uint32_t> ids(render::HeadlessRenderer& r, const CameraPose& pose, const Lens& lens, RasterPath raster,
-                            bool clip = true) {
+                            bool clip = true, bool cull = false) {
     render::RenderSettings s;
     s.raster = raster;
     s.clip = clip;
+    s.cull = cull;
     s.mosaic = render::MosaicMode::Off;
     return r.ids(pose, lens, s);
   }
@@ -208,6 +213,12 @@ TEST_F(RasterTest, CrossingTrianglesAreClippedInCompute) {
         clipped, same, covered, 100.0 * same / covered, offEdge, maskEdges);
     EXPECT_GE(double(same), 0.999 * double(covered));
     EXPECT_EQ(offEdge, 0u);
+    // With two-phase culling the clipping pass runs in both phases: the first frame's late phase draws
+    // everything, the second's early phase (the late dispatch then skips the early entries). Same ids.
+    for (int frame = 0; frame < 2; ++frame) {
+      EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, true), cs) << "culled, frame " << frame;
+      EXPECT_EQ(r.renderer().handOffTriangles(0), 0u) << "culled, frame " << frame;
+    }
   }
   EXPECT_GT(total, 20u) << "too few crossing triangles to test";
 }
@@ -489,6 +500,88 @@ TEST_F(RasterTest, MaskedFoliageStaysInCompute) {
     EXPECT_GT(masked, 0u) << "no foliage in view to test";
     EXPECT_LE(*handedOff, crossing);
   }
+}
+
+// The clipping pass lists a large piece's tiles row by row (raster_columns.glsl: per edge, the column
+// bound estimated in float and corrected by the exact integer test). For random snapped triangles, every
+// tile row's columns are those holding a pixel column inside each edge at the row's top or bottom centre,
+// found pixel by pixel: so every tile with a covered centre, within the run of tiles tileTouches accepts
+// (which may add a tile whose centres pass each edge but none all three). The triangles: slivers from the
+// guard band, vertices on pixel centres and tile edges, thin and axis-aligned ones.
+TEST_F(RasterTest, TouchedColumnsAreExact) {
+  constexpr int kOne = 1 << RASTER_SUBPIXEL_BITS, kWidth = 512, kHeight = 256, kRows = 8;  // tile_columns.comp
+  std::mt19937 rng(30);
+  const int band = int(RASTER_GUARD_BAND) * kOne;
+  std::uniform_int_distribution<int> far(-band, band), near(-64 * kOne, (kWidth + 64) * kOne), pixel(-8, kWidth + 8),
+      choice(0, 3);
+  std::vector<glm::ivec4> tris;
+  while (tris.size() < 3 * 40000) {
+    glm::ivec2 v[3];
+    const int kind = choice(rng);
+    for (int i = 0; i < 3; ++i) {
+      if (kind == 0) v[i] = {near(rng), near(rng) / 2};  // anywhere near the image
+      else if (kind == 1) v[i] = i == 0 ? glm::ivec2(far(rng), far(rng)) : glm::ivec2(near(rng), near(rng) / 2);  // slivers
+      else if (kind == 2) v[i] = glm::ivec2(pixel(rng), pixel(rng) / 2) * kOne + kOne / 2;  // on pixel centres
+      else v[i] = glm::ivec2(pixel(rng) / 32 * 32, pixel(rng) / 64 * 32) * kOne + (i == 2 ? choice(rng) - 1 : 0);  // tile edges
+    }
+    if (kind == 3 && choice(rng) == 0) v[2].x = v[1].x;  // vertical and horizontal edges
+    if (kind == 3 && choice(rng) == 1) v[2].y = v[0].y;
+    const int64_t area = int64_t(v[1].x - v[0].x) * (v[2].y - v[0].y) - int64_t(v[1].y - v[0].y) * (v[2].x - v[0].x);
+    if (area == 0) continue;
+    if (area < 0) std::swap(v[1], v[2]);  // positive inside, as raster_tri.glsl's project orders them
+    const glm::ivec2 lo = glm::min(v[0], glm::min(v[1], v[2])), hi = glm::max(v[0], glm::max(v[1], v[2]));
+    const glm::ivec4 box{std::max((lo.x - kOne / 2 + kOne - 1) >> RASTER_SUBPIXEL_BITS, 0),
+                         std::max((lo.y - kOne / 2 + kOne - 1) >> RASTER_SUBPIXEL_BITS, 0),
+                         std::min((hi.x - kOne / 2) >> RASTER_SUBPIXEL_BITS, kWidth - 1),
+                         std::min((hi.y - kOne / 2) >> RASTER_SUBPIXEL_BITS, kHeight - 1)};
+    if (box.x > box.z || box.y > box.w) continue;
+    tris.insert(tris.end(), {glm::ivec4(v[0], v[1]), glm::ivec4(v[2], 0, 0), box});
+  }
+  const size_t rows = tris.size() / 3 * kRows;
+  vk::Buffer in(*ctx, tris.size() * sizeof(glm::ivec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "triangles");
+  vk::Buffer columns(*ctx, rows * sizeof(glm::ivec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Readback, "columns");
+  vk::Buffer touches(*ctx, rows * sizeof(glm::ivec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Readback, "touches");
+  std::memcpy(in.mapped(), tris.data(), tris.size() * sizeof(glm::ivec4));
+  in.flush();
+  vk::LayoutOptions options;
+  options.pushDescriptorSets = {0};
+  options.runtimeArrayCounts[{1, 0}] = 1;  // raster_tri.glsl's textures, declared, not used here
+  vk::Pipeline p = vk::makeComputePipeline(*ctx, vk::loadShader("tile_columns.comp"), options);
+  vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
+    p.bind(cb);
+    vk::DescriptorWriter(*ctx, p.layout, 0, VK_NULL_HANDLE)
+        .buffer(16, in.handle())
+        .buffer(17, columns.handle())
+        .buffer(18, touches.handle())
+        .push(cb, p);
+    p.dispatch(cb, uint32_t(rows));
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kHostRead);
+  });
+  columns.invalidate();
+  touches.invalidate();
+  const auto* got = static_cast<const glm::ivec4*>(columns.mapped());
+  const auto* tt = static_cast<const glm::ivec4*>(touches.mapped());
+  size_t tested = 0, listed = 0, accepted = 0, wrong = 0, outside = 0;
+  for (size_t i = 0; i < rows; ++i) {
+    const glm::ivec4 c = got[i], t = tt[i];
+    const bool empty = c.x > c.y, bruteEmpty = c.z > c.w;
+    const bool same = empty ? bruteEmpty : c.x == c.z && c.y == c.w;
+    if (!same && ++wrong <= 5)
+      ADD_FAILURE() << "triangle " << i / kRows << ", row " << i % kRows << ": columns " << c.x << "-" << c.y
+                    << ", pixel by pixel " << c.z << "-" << c.w;
+    if (!empty && (c.x < t.x || c.y > t.y) && ++outside <= 5)
+      ADD_FAILURE() << "triangle " << i / kRows << ", row " << i % kRows << ": columns " << c.x << "-" << c.y
+                    << " past tileTouches' " << t.x << "-" << t.y;
+    if (t.z > 0) EXPECT_EQ(t.z, t.y - t.x + 1) << "row " << i << ": the tiles tileTouches accepts are not one run";
+    tested += t != glm::ivec4(1, 0, 0, 0);
+    listed += empty ? 0 : size_t(c.y - c.x + 1);
+    accepted += size_t(t.z);
+  }
+  std::printf("touched columns: %zu tile rows of %zu triangles, %zu tiles listed (tileTouches: %zu), %zu rows wrong\n", tested,
+              tris.size() / 3, listed, accepted, wrong);
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_EQ(outside, 0u);
+  EXPECT_GT(listed, tested) << "too few tiles to test";
 }
 
 }  // namespace

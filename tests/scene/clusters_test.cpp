@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <limits>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -146,6 +148,45 @@ TEST(Clusters, PiecesSeeOnlyTheirOwnVertices) {
     ASSERT_EQ(gapped.clusters.size(), a.clusters.size());
     for (size_t i = 0; i < a.clusters.size(); ++i)
       EXPECT_EQ(std::memcmp(&gapped.clusters[i], &a.clusters[i], sizeof(Cluster)), 0) << "cluster " << i;
+  }
+}
+
+// The input is checked in pieces on all cores, each mesh's positions before its indices: whatever the thread
+// count, the error is the one a single pass in that order meets first.
+TEST(Clusters, BadInputIsReportedAsOnePassWouldMeetIt) {
+  Scene good;
+  good.materials.resize(1);
+  good.meshes = {bumpyGrid(450), bumpyGrid(20)};  // 203 401 positions, 1.2 M indices: several pieces of each
+  good.meshes[1].name = "second";
+  auto errorOf = [](Scene s, unsigned threads) -> std::string {
+    try {
+      buildMissingClusters(s, threads);
+    } catch (const Error& e) { return e.what(); }
+    return "(no error)";
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  struct Case {
+    std::function<void(Scene&)> damage;
+    std::string error;
+  };
+  const std::vector<Case> cases = {
+      {[&](Scene& s) {
+         s.meshes[0].positions.writable()[200000].x = nan, s.meshes[0].positions.writable()[150000].y = 2e12f,
+         s.meshes[0].positions.writable()[150001].z = nan;
+       },
+       "mesh 'grid': position 150000 is not finite"},
+      {[&](Scene& s) { s.meshes[0].indices.writable().back() = 1u << 30, s.meshes[1].positions.writable()[0].x = nan; },
+       "mesh 'grid': index 1073741824 out of range"},
+      {[&](Scene& s) { s.meshes[0].indices.writable()[1000000] = 1u << 30, s.meshes[0].positions.writable().back().x = nan; },
+       "mesh 'grid': position 203400 is not finite"},
+      {[&](Scene& s) { s.meshes[0].indices.writable()[1000000] = 1u << 29, s.meshes[0].indices.writable()[1100000] = 1u << 30; },
+       "mesh 'grid': index 536870912 out of range"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    Scene bad = good;
+    cases[i].damage(bad);
+    for (unsigned threads : {1u, 2u, 8u})
+      EXPECT_THAT(errorOf(bad, threads), HasSubstr(cases[i].error)) << "case " << i << ", " << threads << " threads";
   }
 }
 

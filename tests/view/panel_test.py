@@ -74,12 +74,21 @@ def main():
             if name == "total from process start":
                 break
         total = rows.pop("total from process start")
-        rows.pop("sum of the phases")
-        for want in ("scene file read", "instance and device", "first frame (record, GPU, present)"):
-            check(want in rows, f"the start-up phases have '{want}' ({sorted(rows)})")
-        check(any(n.startswith("pipeline creation (") for n in rows), "the start-up phases count the pipelines")
-        check(all(v >= 0 for v in rows.values()) and abs(sum(rows.values()) - total) <= 3.0,
-              f"the start-up phases add up to the total ({sum(rows.values()):.1f} against {total:.1f} ms)")
+        check(rows.pop("sum of the critical path's phases", None) is not None, f"a critical path's sum ({sorted(rows)})")
+        # The scene file read ran on its own thread beside the device's and the window's start: its row is
+        # marked so, lies within the span it ran in, and is not part of the critical path's sum.
+        read = "scene file read (beside instance, device and window)"
+        beside = {n: v for n, v in rows.items() if " (beside " in n}
+        path = {n: v for n, v in rows.items() if n not in beside}
+        for want in ("instance and device", "window, surface and panel", "waiting for the scene file read",
+                     "first frame (record, GPU, present)"):
+            check(want in path, f"the start-up phases have '{want}' ({sorted(rows)})")
+        check(list(beside) == [read], f"the scene file read is the one row beside the others ({sorted(beside)})")
+        check(beside[read] <= path["instance and device"] + path["window, surface and panel"] +
+              path["waiting for the scene file read"] + 1.0, f"the read lies within the span it ran beside ({rows})")
+        check(any(n.startswith("pipeline creation (") for n in path), "the start-up phases count the pipelines")
+        check(all(v >= 0 for v in rows.values()) and abs(sum(path.values()) - total) <= 3.0,
+              f"the critical path's phases add up to the total ({sum(path.values()):.1f} against {total:.1f} ms)")
         win = xdo_out("search", "--sync", "--name", "^rtr-view").split()[0]
         xdo("windowfocus", "--sync", win)
 

@@ -364,9 +364,11 @@ void printBuilds(const std::vector<Triangle>& tris, const Bvh& bvh, double ourBu
   const BvhStats& st = bvh.stats();
   std::printf(
       "BVH build: ours %.3f s (%u nodes, %u packs, depth %u, SAH cost %.4f; references %.3f s, tree %.3f s, "
-      "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n\n",
+      "copy-out %.3f s; 1 thread %.3f s); Embree (quality high) %.3f s\n"
+      "Our tree's memory: nodes %zu B each, %.1f MB; triangle packs %zu B each, %.1f MB\n\n",
       ourBuild, st.nodes, st.packs, st.maxDepth, bvh.sahCost(), st.refSeconds, st.treeSeconds,
-      st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds);
+      st.buildSeconds - st.refSeconds - st.treeSeconds, oneThread, em.buildSeconds, sizeof(Node),
+      double(st.nodes) * sizeof(Node) * 1e-6, sizeof(TriPack), double(st.packs) * sizeof(TriPack) * 1e-6);
 }
 
 // Hit/miss and distance agreement with Embree on the primary, orthographic and mirror rays (and shadow rays).
@@ -448,6 +450,23 @@ void printPacketAgreement(const Bvh& bvh, const Embree& em, const Rays& rays, in
         "shadow, mirror): %zu of %zu rays differ\n",
         lr, differ, total);
   }
+  // Every single ray's answer hashed (FNV-1a over t, barycentrics and triangle; occluded or not): equal
+  // hashes from two binaries say a change of the tree's layout changed no hit.
+  uint64_t h = 1469598103934665603ull;
+  const auto add = [&h](const void* p, size_t n) {
+    for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<const unsigned char*>(p)[i]) * 1099511628211ull;
+  };
+  for (auto* set : {&primary, &ortho, &shadow, &mirror})
+    for (const Ray& r : *set) {
+      if (set == &shadow) {
+        const bool occ = bvh.occluded(r);
+        add(&occ, 1);
+        continue;
+      }
+      const Hit one = bvh.closest(r);
+      add(&one, sizeof one);
+    }
+  std::printf("Hash of our single rays' answers (primary, orthographic, shadow, mirror): %016llx\n", (unsigned long long)h);
 }
 
 // The speed table, on one and on all threads. Ours: one ray at a time (Bvh::closest, as rtcIntersect1), two

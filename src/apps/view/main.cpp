@@ -1,6 +1,7 @@
 // rtr-view: the Vulkan viewer. Its options and what both paths share; headless_app.cpp renders offscreen
 // (--headless: no window, no display), window_app.cpp in a GLFW window.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 
 #include <CLI/CLI.hpp>
@@ -26,6 +27,33 @@ Scene loadForView(const ViewOptions& o, const std::string& path) {
   turnScene(scene, o.up);
   drawBothSides(scene);
   return scene;
+}
+
+SceneRead::SceneRead(const ViewOptions& o)
+    : read_(std::async(std::launch::async, [&o] {
+        const auto start = std::chrono::steady_clock::now();
+        Scene scene = loadForView(o, o.scene);
+        return std::pair(std::move(scene),
+                         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      })) {}
+
+Scene SceneRead::take(std::exception_ptr besideError) {
+  if (!besideError) {
+    auto [scene, ms] = read_.get();
+    ms_ = ms;
+    return std::move(scene);
+  }
+  try {
+    read_.get();
+  } catch (const std::exception& sceneError) {
+    try {
+      std::rethrow_exception(besideError);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rtr-view: note: the device's start failed too (the scene's error below): %s\n", e.what());
+    }
+    throw;
+  }
+  std::rethrow_exception(besideError);
 }
 
 CameraPose startPose(const ViewOptions& o, const Scene& scene) {
@@ -80,11 +108,14 @@ vk::ContextOptions contextOptions(const ViewOptions& o) {
 
 DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
   const render::DeviceDefaults d = render::deviceDefaults(ctx.deviceType());
-  DeviceChoice c{o.shadingGiven ? o.settings.shading : d.shading, o.mipsGiven ? o.mips : d.mips};
+  DeviceChoice c{o.shadingGiven ? o.settings.shading : d.shading, o.mipsGiven ? o.mips : d.mips,
+                 o.clipGiven ? o.settings.clip : d.computeClip};
   // No " on " in this line: scripts take the first line with one for the device line below.
-  std::fprintf(stderr, "rtr-view: %s: %s shading (%s), %s mips (%s)", ctx.deviceName().c_str(), enumName(c.shading),
-               o.shadingGiven ? "--shading-path" : "default", enumName(c.mips), o.mipsGiven ? "--mips" : "default");
-  if (!o.shadingGiven || !o.mipsGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
+  std::fprintf(stderr, "rtr-view: %s: %s shading (%s), %s mips (%s), near-plane crossings %s (%s)", ctx.deviceName().c_str(),
+               enumName(c.shading), o.shadingGiven ? "--shading-path" : "default", enumName(c.mips),
+               o.mipsGiven ? "--mips" : "default", c.computeClip ? "clipped in compute" : "to the hardware",
+               o.clipGiven ? "--near-clip" : "default");
+  if (!o.shadingGiven || !o.mipsGiven || !o.clipGiven) std::fprintf(stderr, ": the defaults for %s (docs/startup.md)", d.why);
   std::fprintf(stderr, "\n");
   if (const float max = render::maxAnisotropy(ctx); o.settings.sampler.anisotropy > max)
     std::fprintf(stderr, "rtr-view: note: --anisotropy %g: %s samples with at most %g\n", o.settings.sampler.anisotropy,
@@ -177,11 +208,11 @@ int main(int argc, char** argv) {
   app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
-  std::string nearClip = "hardware";  // the compute pass measured slower on the GPU machine (docs/raster.md)
-  app.add_option("--near-clip", nearClip,
-                 "compute raster: triangles crossing the near plane or the guard band clipped in compute | drawn by the hardware")
-      ->check(CLI::IsMember({"compute", "hardware"}))
-      ->capture_default_str();
+  std::string nearClip = "compute";
+  auto* clipOpt = app.add_option("--near-clip", nearClip,
+                                 "compute raster: triangles crossing the near plane or the guard band clipped in "
+                                 "compute | drawn by the hardware (default: the device's fastest, docs/startup.md)")
+                      ->check(CLI::IsMember({"compute", "hardware"}));
   // Default 0 (full detail): measured on the GPU machine, a cut at 1 pixel still costs more than it saves
   // up to 1M triangles (simplified flat surfaces become large triangles; docs/virtual-geometry.md).
   app.add_option("--lod-error", o.settings.lodError,
@@ -277,6 +308,7 @@ int main(int argc, char** argv) {
     o.settings.raster = cli::enumOption<render::RasterPath>("--raster", raster);
     o.settings.cull = cull == "on";
     o.settings.clip = nearClip == "compute";
+    o.clipGiven = clipOpt->count() > 0;
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
   } catch (const std::exception& e) { return cli::fail("rtr-view", e); }
 }

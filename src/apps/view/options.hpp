@@ -1,5 +1,7 @@
 #pragma once
 // Command-line options of rtr-view, shared by the headless and the windowed paths.
+#include <exception>
+#include <future>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,10 +41,10 @@ struct ViewOptions {
   bool orbit = false;      // start in orbit camera mode (windowed)
   std::string device;
   bool validation = false;
-  bool shadingGiven = false, mipsGiven = false;  // --shading-path / --mips given: no per-device default
-  bool timings = false;                          // print the start-up phases
-  bool pipelineCache = true;                     // keep compiled pipelines in the user's cache folder
-  bool textureCache = true;                      // keep decoded, mipped textures there (--no-cache: neither)
+  bool shadingGiven = false, mipsGiven = false, clipGiven = false;  // --shading-path / --mips given: no per-device default
+  bool timings = false;                                             // print the start-up phases
+  bool pipelineCache = true;                                        // keep compiled pipelines in the user's cache folder
+  bool textureCache = true;                                         // keep decoded, mipped textures there (--no-cache: neither)
   // The first frame waits for the textures (deterministic captures); unless given, on for --headless
   // (--screenshot, --bench), off in the window, whose frames show the factors until the textures are in.
   std::optional<bool> waitTextures;
@@ -63,6 +65,21 @@ std::vector<std::string> sceneFiles(const std::vector<std::string>& given);
 // The scene file as every path of the viewer loads it: --mtl, --crease, --up, both sides drawn for models
 // (scene/first_look.hpp).
 Scene loadForView(const ViewOptions& o, const std::string& path);
+// o.scene read (loadForView) on a worker thread from construction, beside whatever this thread does
+// meanwhile: the instance, the device, the window need no scene (docs/startup.md "Phases side by side").
+class SceneRead {
+ public:
+  explicit SceneRead(const ViewOptions& o);
+  // Waits for the read. `besideError`: the work beside it failed. When both failed, the scene's error is
+  // thrown, the other's said in a note before it: a bad file is reported whatever the device; else the
+  // one that failed is thrown. Once.
+  Scene take(std::exception_ptr besideError);
+  double ms() const { return ms_; }  // the read's own duration, once taken
+
+ private:
+  std::future<std::pair<Scene, double>> read_;
+  double ms_ = 0;
+};
 
 // The start pose: --camera, else the scene's own view, else framing the scene (framingPose), as rtr-trace.
 CameraPose startPose(const ViewOptions& o, const Scene& scene);
@@ -80,6 +97,7 @@ vk::ContextOptions contextOptions(const ViewOptions& o);
 struct DeviceChoice {
   render::ShadingPath shading;
   render::MipMode mips;
+  bool computeClip;  // --near-clip compute
 };
 DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx);
 

@@ -1,7 +1,7 @@
 #pragma once
 // The window's start-up phases, as headless --timings prints them: each runs from the end of the one
 // before, less the pipelines it made (one row of their own), so the rows tile the time to the first frame
-// on screen.
+// on screen; work on other threads meanwhile has rows of its own, marked beside (not in the sum).
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -23,6 +23,8 @@ class StartupClock {
     pipelineMs_ = p;
     start_ = Clock::now();
   }
+  // Work that ran on another thread meanwhile: its own duration, marked, not in the sum.
+  void beside(const std::string& name, double ms, const std::string& besideWhat) { timeline_.addBeside(name, ms, besideWhat); }
   // The first frame is on screen: its phase and the pipelines' row; printed when `print`.
   void firstFrame(bool print) {
     phase("first frame (record, GPU, present)");

@@ -4,7 +4,9 @@
 // the frames themselves are view_frames.cpp's.
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <memory>
+#include <optional>
 
 #include <glm/trigonometric.hpp>
 #include <imgui.h>
@@ -70,29 +72,41 @@ void startErrorMap(ViewState& app, SceneSlot& slot, const Lens& lens, ImageRGBA8
 int runWindowed(const ViewOptions& opts) {
   ViewOptions o = opts;
   StartupClock clock;
-  GlfwSession glfw;
+  // The scene file is read on a worker thread while GLFW, the instance, the device and the window are
+  // made: none of them needs the scene.
+  SceneRead read(o);
   ViewState app;
-  auto scene = std::make_unique<Scene>(loadForView(o, o.scene));
-  clock.phase("scene file read");
+  std::optional<GlfwSession> glfw;
+  std::optional<vk::Context> device;
+  std::optional<Window> windowSlot;
+  DeviceChoice choice{};
+  std::exception_ptr failed;
+  try {
+    glfw.emplace();
+    vk::ContextOptions co = contextOptions(o);
+    co.instanceExtensions = glfw->instanceExtensions();
+    co.presentation = true;
+    device.emplace(co);
+    clock.watch(*device);
+    checkSizeFits(o, *device);
+    choice = chooseForDevice(o, *device);
+    clock.phase("instance and device");
+    windowSlot.emplace(*device, o.width, o.height, app);
+    setPanelTracking(o.testUi);
+    clock.phase("window, surface and panel");
+  } catch (...) { failed = std::current_exception(); }
+  auto scene = std::make_unique<Scene>(read.take(failed));
+  clock.phase("waiting for the scene file read");
+  clock.beside("scene file read", read.ms(), "instance, device and window");
+  const vk::Context& ctx = *device;
+  Window& window = *windowSlot;
   app.settings = sceneSettings(o, *scene);
+  app.settings.shading = choice.shading;
+  app.settings.clip = choice.computeClip;
+  app.mips = choice.mips;
   app.lens = startLens(o, *scene);
   app.panel = o.panel;
   if (o.orbit) app.camera.setMode(CameraMode::Orbit);
-
-  vk::ContextOptions co = contextOptions(o);
-  co.instanceExtensions = glfw.instanceExtensions();
-  co.presentation = true;
-  const vk::Context ctx(co);
-  clock.watch(ctx);
-  checkSizeFits(o, ctx);
-  const DeviceChoice choice = chooseForDevice(o, ctx);
-  app.settings.shading = choice.shading;
-  app.mips = choice.mips;
-  clock.phase("instance and device");
-
-  Window window(ctx, o.width, o.height, app);
-  setPanelTracking(o.testUi);
-  clock.phase("window, surface and panel");
 
   startScene(app, o, *scene);
   o.camera.reset();  // a dropped scene starts from its own view
