@@ -15,6 +15,7 @@
 #include "core/atomic_file.hpp"  // writeFileAtomic: every baked file is written through it
 #include "core/error.hpp"
 #include "core/input_file.hpp"  // MappedFile
+#include "core/view_or_vector.hpp"
 
 namespace rtr {
 
@@ -46,8 +47,16 @@ class ByteWriter {
   void u32(uint32_t v) { pod(v); }
   void f32(float v) { pod(v); }
   template <class T>
-  void array(const std::vector<T>& v) {
+  void array(std::span<const T> v) {
     bytes(v.data(), v.size() * sizeof(T));
+  }
+  template <class T>
+  void array(const std::vector<T>& v) {
+    array(std::span<const T>(v));
+  }
+  template <class T>
+  void array(const ViewOrVector<T>& v) {
+    array(v.span());
   }
   void zeros(size_t n);
   void pad(size_t align) { zeros((align - size() % align) % align); }
@@ -124,6 +133,10 @@ class ByteReader {
     const size_t at = skipArray(n, sizeof(T), what);
     v.resize(n);
     if (n) std::memcpy(v.data(), d_.data() + at, n * sizeof(T));
+  }
+  template <class T>
+  void array(ViewOrVector<T>& v, size_t n, const char* what) {
+    array(v.writable(), n, what);
   }
   void skip(size_t n, const char* what) {
     need(n, what);

@@ -290,6 +290,8 @@ std::span<const uint32_t> lodTriangles(const Mesh& mesh, const LodCluster& c) {
 ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads, std::vector<LodGroupStats>* stats) {
   ClusterLod lod;
   if (mesh.indices.empty() || mesh.positions.empty()) return lod;
+  std::vector<LodCluster> lodClusters;  // moved into `lod` once made
+  std::vector<uint32_t> lodIndices;
   if (mesh.clusters.empty()) throw Error("mesh '" + mesh.name + "': a cluster hierarchy needs the mesh's clusters");
   const float scale = meshopt_simplifyScale(&mesh.positions[0].x, mesh.positions.size(), sizeof(glm::vec3));
   const float epsilon = std::max(scale, 1e-30f) * 1e-7f;  // parents' errors rise at least by this
@@ -299,15 +301,15 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
   // Room for all levels (levels above 0 hold about as many triangles as the mesh and twice its clusters;
   // what is not used is never touched): no level copies the ones below it again.
   const size_t n0 = mesh.clusters.size();
-  lod.clusters.reserve(3 * n0);
-  lod.indices.reserve(mesh.indices.size() * 3 / 2);
-  lod.clusters.resize(n0);
+  lodClusters.reserve(3 * n0);
+  lodIndices.reserve(mesh.indices.size() * 3 / 2);
+  lodClusters.resize(n0);
   std::vector<Indices> current(n0);
   std::vector<uint32_t> ids(n0);
   parallelFor((n0 + kRecordPiece - 1) / kRecordPiece, threads, [&](size_t p) {
     for (size_t i = p * kRecordPiece; i < std::min(n0, (p + 1) * kRecordPiece); ++i) {
       const Cluster& mc = mesh.clusters[i];
-      LodCluster& c = lod.clusters[i];
+      LodCluster& c = lodClusters[i];
       c.firstTriangle = mc.firstTriangle;
       c.triangleCount = mc.triangleCount;
       c.center = mc.center;
@@ -358,12 +360,12 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       if (g.size() < 2) return;  // alone: nothing around it to share a border with
       Indices tris;
       tris.reserve(g.size() * CLUSTER_MAX_TRIANGLES * 3);
-      r.sphere = lod.clusters[ids[g[0]]].sphere;
+      r.sphere = lodClusters[ids[g[0]]].sphere;
       float childError = 0.0f;
       for (uint32_t k : g) {
         tris.insert(tris.end(), current[k].begin(), current[k].end());
-        r.sphere = merge(r.sphere, lod.clusters[ids[k]].sphere);
-        childError = std::max(childError, lod.clusters[ids[k]].error);
+        r.sphere = merge(r.sphere, lodClusters[ids[k]].sphere);
+        childError = std::max(childError, lodClusters[ids[k]].error);
       }
       const Local l(tris, mesh);
       const Indices simpler = simplifyGroup(l, r.error);
@@ -402,9 +404,9 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     if (!progress) break;
     std::vector<Indices> next(at.back().next);
     std::vector<uint32_t> nextIds(at.back().next);
-    const size_t firstCluster = lod.clusters.size(), firstIndex = lod.indices.size();
-    lod.clusters.resize(firstCluster + at.back().cluster);
-    lod.indices.resize(firstIndex + at.back().index);
+    const size_t firstCluster = lodClusters.size(), firstIndex = lodIndices.size();
+    lodClusters.resize(firstCluster + at.back().cluster);
+    lodIndices.resize(firstIndex + at.back().index);
     parallelFor((groups.size() + kRecordPiece - 1) / kRecordPiece, threads, [&](size_t p) {
       for (size_t gi = p * kRecordPiece; gi < std::min(groups.size(), (p + 1) * kRecordPiece); ++gi) {
         Result& r = results[gi];
@@ -414,13 +416,13 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
             next[nx] = std::move(current[k]), nextIds[nx++] = ids[k];
             continue;
           }
-          lod.clusters[ids[k]].parentError = r.error;
-          lod.clusters[ids[k]].parentSphere = r.sphere;
+          lodClusters[ids[k]].parentError = r.error;
+          lodClusters[ids[k]].parentSphere = r.sphere;
           current[k] = {};
         }
         for (size_t i = 0; i < r.clusters.size(); ++i, ++c) {
-          lod.clusters[c] = made(r.clusters[i].size() / 3, r.bounds[i], level, ix, r.sphere, r.error);
-          std::copy(r.clusters[i].begin(), r.clusters[i].end(), lod.indices.begin() + ix);
+          lodClusters[c] = made(r.clusters[i].size() / 3, r.bounds[i], level, ix, r.sphere, r.error);
+          std::copy(r.clusters[i].begin(), r.clusters[i].end(), lodIndices.begin() + ix);
           ix += r.clusters[i].size();
           next[nx] = std::move(r.clusters[i]), nextIds[nx++] = uint32_t(c);
         }
@@ -430,6 +432,8 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     current = std::move(next);
     ids = std::move(nextIds);
   }
+  lod.clusters = std::move(lodClusters);
+  lod.indices = std::move(lodIndices);
   return lod;
 }
 

@@ -26,7 +26,7 @@ std::vector<Cluster> clusterPiece(Mesh& mesh, size_t first, size_t end, bool bac
   // clusters of a 100 M-triangle mesh took 48 times those of 10 M). The local numbering keeps the global
   // order, so the clusters are the same as over the whole range: the span the piece uses when it is
   // narrow (welded meshes number vertices as their triangles come), else its sorted distinct vertices.
-  uint32_t* src = mesh.indices.data() + first * 3;
+  uint32_t* src = mesh.indices.writable().data() + first * 3;  // a vector already (clusterMeshes)
   const auto [lo, hi] = std::minmax_element(src, src + count);
   // Scratch reused by the pieces a thread runs: these arrays are as large as the piece, and fresh ones
   // cost a clear and page faults each time.
@@ -120,6 +120,7 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
     size_t mesh, first, end;
   };
   std::vector<Job> jobs;
+  for (Mesh* m : meshes) m->indices.writable();  // reordered in place below: a view is copied first, once
   for (size_t i = 0; i < meshes.size(); ++i)
     for (size_t t = 0, n = meshes[i]->indices.size() / 3; t < n; t += kPieceTriangles)
       jobs.push_back({i, t, std::min(n, t + kPieceTriangles)});

@@ -30,10 +30,11 @@ void turnScene(Scene& scene, const glm::mat3& r) {
   } else {
     for (Mesh& m : scene.meshes) {
       m.bounds = Bounds{};
-      for (glm::vec3& p : m.positions) p = r * p, m.bounds.extend(p);
-      for (glm::vec3& n : m.normals) n = r * n;
-      for (glm::vec4& t : m.tangents) t = glm::vec4(r * glm::vec3(t), t.w);
-      for (Cluster& c : m.clusters) c.center = r * c.center, c.coneAxis = r * c.coneAxis;
+      // Each array a view of a loaded file is copied here (once): the turned scene is a new one.
+      for (glm::vec3& p : m.positions.writable()) p = r * p, m.bounds.extend(p);
+      for (glm::vec3& n : m.normals.writable()) n = r * n;
+      for (glm::vec4& t : m.tangents.writable()) t = glm::vec4(r * glm::vec3(t), t.w);
+      for (Cluster& c : m.clusters.writable()) c.center = r * c.center, c.coneAxis = r * c.coneAxis;
     }
   }
   for (Light& l : scene.lights) {

@@ -296,7 +296,7 @@ class Loader {
     }
     checkIndices(indicesJ ? *indicesJ : p, m);
     checkPositions(attrs, m);
-    toTriangleList(p, m.indices, mode);
+    toTriangleList(p, m.indices.writable(), mode);
     if (m.indices.empty()) {
       ++skipped_;
       return std::nullopt;
@@ -345,25 +345,26 @@ class Loader {
                   bool deferred) {
     switch (stream) {
       case 0:
-        attribute(attrs, "POSITION", m.positions, count, {3});
+        attribute(attrs, "POSITION", m.positions.writable(), count, {3});
         if (deferred) checkPositions(attrs, m);
         break;
       case 1:
-        if (attribute(attrs, "NORMAL", m.normals, count, {3}) && deferred) unitNormals(m);
+        if (attribute(attrs, "NORMAL", m.normals.writable(), count, {3}) && deferred) unitNormals(m);
         break;
-      case 2: attribute(attrs, "TANGENT", m.tangents, count, {4}); break;
-      case 3: attribute(attrs, "TEXCOORD_0", m.texcoords, count, {2}); break;
-      case 4: attribute(attrs, "TEXCOORD_1", m.texcoords1, count, {2}); break;
+      case 2: attribute(attrs, "TANGENT", m.tangents.writable(), count, {4}); break;
+      case 3: attribute(attrs, "TEXCOORD_0", m.texcoords.writable(), count, {2}); break;
+      case 4: attribute(attrs, "TEXCOORD_1", m.texcoords1.writable(), count, {2}); break;
       case 5:
         m.colors.assign(attrs.get("COLOR_0") ? count : 0, glm::vec4(1.0f));
-        if (!m.colors.empty()) attribute(attrs, "COLOR_0", m.colors, count, {3, 4});
+        if (!m.colors.empty()) attribute(attrs, "COLOR_0", m.colors.writable(), count, {3, 4});
         break;
       default:
         if (indicesJ) {
-          acc_->readIndices(p.index("indices", acc_->accessorCount(), "accessors"), m.indices);
+          acc_->readIndices(p.index("indices", acc_->accessorCount(), "accessors"), m.indices.writable());
         } else {
-          m.indices.resize(count);
-          std::iota(m.indices.begin(), m.indices.end(), 0u);
+          std::vector<uint32_t>& indices = m.indices.writable();
+          indices.resize(count);
+          std::iota(indices.begin(), indices.end(), 0u);
         }
         if (!deferred) break;
         checkIndices(indicesJ ? *indicesJ : p, m, count);
@@ -410,7 +411,7 @@ class Loader {
   }
 
   static void unitNormals(Mesh& m) {  // quantized (or careless) normals are not unit length
-    for (glm::vec3& nrm : m.normals) {
+    for (glm::vec3& nrm : m.normals.writable()) {
       const float l = glm::length(nrm);
       if (l > 0 && std::isfinite(l)) nrm /= l;
       else nrm = glm::vec3(0, 0, 1);
@@ -421,7 +422,7 @@ class Loader {
   void finishMesh(Mesh& m) const {
     if (m.normals.empty()) flatNormals(m);
     const Material& mat = scene_.materials[m.material];
-    const std::vector<glm::vec2>& uv = mat.uv[uint32_t(TextureSlot::NormalMap)].texCoord ? m.texcoords1 : m.texcoords;
+    const ViewOrVector<glm::vec2>& uv = mat.uv[uint32_t(TextureSlot::NormalMap)].texCoord ? m.texcoords1 : m.texcoords;
     if (m.tangents.empty() && mat.texture(TextureSlot::NormalMap) != kNoTexture && !uv.empty()) generateTangents(m, uv);
   }
 
@@ -478,15 +479,15 @@ class Loader {
         for (uint32_t i = 0; i < n; ++i)
           for (int c = 0; c < a.components; ++c) out[i][c] = a.values[size_t(i) * a.components + c];
       };
-      if (a.name == "POSITION") take(m.positions, 3);
-      else if (a.name == "NORMAL") take(m.normals, 3);
-      else if (a.name == "TANGENT") take(m.tangents, 4);
-      else if (a.name == "TEXCOORD_0") take(m.texcoords, 2);
-      else if (a.name == "TEXCOORD_1") take(m.texcoords1, 2);
+      if (a.name == "POSITION") take(m.positions.writable(), 3);
+      else if (a.name == "NORMAL") take(m.normals.writable(), 3);
+      else if (a.name == "TANGENT") take(m.tangents.writable(), 4);
+      else if (a.name == "TEXCOORD_0") take(m.texcoords.writable(), 2);
+      else if (a.name == "TEXCOORD_1") take(m.texcoords1.writable(), 2);
       else if (a.name == "COLOR_0") {
-        take(m.colors, 4);
+        take(m.colors.writable(), 4);
         if (a.components == 3)
-          for (glm::vec4& c : m.colors) c.a = 1.0f;
+          for (glm::vec4& c : m.colors.writable()) c.a = 1.0f;
       }
     }
     if (m.positions.empty()) d.fail("the draco data has no POSITION");

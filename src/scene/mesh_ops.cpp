@@ -12,7 +12,7 @@ namespace rtr {
 namespace {
 
 template <class T>
-void gather(std::vector<T>& v, const std::vector<uint32_t>& from) {
+void gather(ViewOrVector<T>& v, const std::vector<uint32_t>& from) {
   if (v.empty()) return;
   std::vector<T> out(from.size());
   for (size_t i = 0; i < from.size(); ++i) out[i] = v[from[i]];
@@ -30,22 +30,23 @@ glm::vec3 perpendicular(glm::vec3 n) {
 }  // namespace
 
 void flatNormals(Mesh& m) {
-  const std::vector<uint32_t> corners = m.indices;
+  const std::vector<uint32_t> corners(m.indices.begin(), m.indices.end());
   gather(m.positions, corners);
   gather(m.texcoords, corners);
   gather(m.texcoords1, corners);
   gather(m.tangents, corners);
   gather(m.colors, corners);
-  m.normals.assign(m.positions.size(), glm::vec3(0, 0, 1));
-  for (size_t i = 0; i < corners.size(); ++i) m.indices[i] = uint32_t(i);
+  std::vector<glm::vec3>& normals = m.normals.writable();
+  normals.assign(m.positions.size(), glm::vec3(0, 0, 1));
+  for (size_t i = 0; i < corners.size(); ++i) m.indices.writable()[i] = uint32_t(i);
   for (size_t t = 0; t + 2 < corners.size(); t += 3) {
     const glm::vec3 n = glm::cross(m.positions[t + 1] - m.positions[t], m.positions[t + 2] - m.positions[t]);
     const float l = glm::length(n);
-    if (l > 0 && std::isfinite(l)) m.normals[t] = m.normals[t + 1] = m.normals[t + 2] = n / l;
+    if (l > 0 && std::isfinite(l)) normals[t] = normals[t + 1] = normals[t + 2] = n / l;
   }
 }
 
-void generateTangents(Mesh& m, const std::vector<glm::vec2>& uv) {
+void generateTangents(Mesh& m, const ViewOrVector<glm::vec2>& uv) {
   const size_t n = m.positions.size();
   // Angle-weighted tangent sums per vertex, one per handedness (0: +1, 1: -1), and which ones were used.
   std::vector<glm::vec3> sum[2] = {std::vector<glm::vec3>(n, glm::vec3(0)), std::vector<glm::vec3>(n, glm::vec3(0))};
@@ -94,15 +95,17 @@ void generateTangents(Mesh& m, const std::vector<glm::vec2>& uv) {
     append(m.texcoords);
     append(m.texcoords1);
     append(m.colors);
-    for (size_t i = 0; i < m.indices.size(); ++i)
-      if (cornerSide[i] == 1 && copyOf[m.indices[i]] != 0xFFFFFFFFu) m.indices[i] = copyOf[m.indices[i]];
+    std::vector<uint32_t>& indices = m.indices.writable();
+    for (size_t i = 0; i < indices.size(); ++i)
+      if (cornerSide[i] == 1 && copyOf[indices[i]] != 0xFFFFFFFFu) indices[i] = copyOf[indices[i]];
   }
-  m.tangents.assign(m.positions.size(), glm::vec4(0));
+  std::vector<glm::vec4>& tangents = m.tangents.writable();
+  tangents.assign(m.positions.size(), glm::vec4(0));
   auto finish = [&](uint32_t dst, glm::vec3 s, float w) {
     const glm::vec3 nrm = m.normals[dst];
     s -= nrm * glm::dot(nrm, s);
     const float l = glm::length(s);
-    m.tangents[dst] = glm::vec4(l > 0 && std::isfinite(l) ? s / l : perpendicular(nrm), w);
+    tangents[dst] = glm::vec4(l > 0 && std::isfinite(l) ? s / l : perpendicular(nrm), w);
   };
   for (size_t v = 0; v < n; ++v) {
     if (used[v] == 3) {
@@ -130,22 +133,22 @@ Scene flattenInstances(const Scene& in) {
     const glm::mat3 linear(x), normalMatrix = glm::transpose(glm::inverse(linear));
     const float det = glm::determinant(linear);
     m.bounds = {};
-    for (glm::vec3& p : m.positions) {
+    for (glm::vec3& p : m.positions.writable()) {
       p = glm::vec3(x * glm::vec4(p, 1.0f));
       m.bounds.extend(p);
     }
-    for (glm::vec3& nrm : m.normals) {
+    for (glm::vec3& nrm : m.normals.writable()) {
       const glm::vec3 v = normalMatrix * nrm;
       const float l = glm::length(v);
       nrm = l > 0 ? v / l : nrm;
     }
-    for (glm::vec4& t : m.tangents) {
+    for (glm::vec4& t : m.tangents.writable()) {
       const glm::vec3 v = linear * glm::vec3(t);
       const float l = glm::length(v);
       t = glm::vec4(l > 0 ? v / l : glm::vec3(t), det < 0 ? -t.w : t.w);
     }
     if (det < 0)  // a mirror turns the winding: swap two corners so front faces stay front faces
-      for (size_t i = 0; i + 2 < m.indices.size(); i += 3) std::swap(m.indices[i + 1], m.indices[i + 2]);
+      for (size_t i = 0; i + 2 < m.indices.size(); i += 3) std::swap(m.indices.writable()[i + 1], m.indices.writable()[i + 2]);
     m.clusters.clear();
     out.meshes.push_back(std::move(m));
   }

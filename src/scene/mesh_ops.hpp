@@ -18,7 +18,7 @@ void flatNormals(Mesh& mesh);
 // vertex's tangent plane, weighted by the corner's angle; a vertex whose triangles disagree in
 // handedness (a mirrored uv seam) is split so each side keeps its own. May append vertices and rewrite
 // indices. Needs normals and `uv` of the mesh's vertex count.
-void generateTangents(Mesh& mesh, const std::vector<glm::vec2>& uv);
+void generateTangents(Mesh& mesh, const ViewOrVector<glm::vec2>& uv);
 
 // A scene with every instance made a plain mesh (positions by the transform, normals by its inverse
 // transpose, winding flipped where the transform mirrors) and no instances: for a renderer that does

@@ -554,7 +554,7 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
                                       std::to_string(n / 3) + " triangles or the file");
     l.clusterAt = r.skipArray(l.clusters, 40, "clusters");
     r.align(kAlign, "clusters");
-    m.clusters.resize(l.clusters);
+    placeClusters(m, l, bytes.data(), owner);
   }
   if (version < 6 && r.remaining() != 0) r.fail(std::to_string(r.remaining()) + " bytes after the last mesh");
   const std::optional<ChunkSpan> clod = readChunks(r, bytes, scene, owner, file);
@@ -569,7 +569,7 @@ Scene decodeRtrScene(std::span<const uint8_t> bytes, const std::string& file, un
       readClusterLodLayout(body, clod->size, scene, lods);
     } catch (const Error&) { lodFault = std::current_exception(); }
   }
-  readArrays(bytes, scene, layout, lods, threads, r);
+  readArrays(bytes, scene, layout, lods, threads, r, owner);
   if (lodFault) std::rethrow_exception(lodFault);
   return scene;
 }

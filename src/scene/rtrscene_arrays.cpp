@@ -1,9 +1,12 @@
 #include "scene/rtrscene_arrays.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <mutex>
+#include <type_traits>
 
 #include <sys/mman.h>
 #include <unistd.h>
@@ -47,15 +50,15 @@ const T* as(const uint8_t* base, size_t at) {
 
 // assign copies without first zeroing the vectors (a resize would write every byte twice).
 template <class T>
-void copyTo(std::vector<T>& v, const uint8_t* base, size_t at, size_t n) {
-  v.assign(as<T>(base, at), as<T>(base, at) + n);
+void copyTo(ViewOrVector<T>& v, const uint8_t* base, size_t at, size_t n) {
+  v.writable().assign(as<T>(base, at), as<T>(base, at) + n);
 }
 
 // The storage a copy job will write: allocated, not yet touched.
 template <class T>
-std::span<uint8_t> reserve(std::vector<T>& v, size_t n) {
-  v.reserve(n);
-  return {reinterpret_cast<uint8_t*>(v.data()), n * sizeof(T)};
+std::span<uint8_t> reserve(ViewOrVector<T>& v, size_t n) {
+  v.writable().reserve(n);
+  return {reinterpret_cast<uint8_t*>(v.writable().data()), n * sizeof(T)};
 }
 
 std::span<uint8_t> reserveStream(Mesh& m, const MeshLayout& l, Stream s) {
@@ -69,6 +72,41 @@ std::span<uint8_t> reserveStream(Mesh& m, const MeshLayout& l, Stream s) {
     case kColors: return reserve(m.colors, v);
     case kIndices: return reserve(m.indices, l.indices);
     default: return {};
+  }
+}
+
+// An array made a view of the file's `n` elements at `at` where their bytes are its elements' (a
+// little-endian host, the address aligned for T) and an owner keeps the bytes: no copy. False: copy it.
+template <class T>
+bool viewOf(ViewOrVector<T>& v, const uint8_t* base, size_t at, size_t n, const std::shared_ptr<const void>& owner) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const uint8_t* p = base + at;
+  if (!owner || std::endian::native != std::endian::little || reinterpret_cast<uintptr_t>(p) % alignof(T) != 0) return false;
+  v = ViewOrVector<T>::view({reinterpret_cast<const T*>(p), n}, owner);
+  return true;
+}
+
+// The file's records are the structs' bytes (scene.hpp lays them out so).
+static_assert(sizeof(Cluster) == 40 && offsetof(Cluster, radius) == 12 && offsetof(Cluster, coneAxis) == 16 &&
+              offsetof(Cluster, coneCutoff) == 28 && offsetof(Cluster, firstTriangle) == 32 &&
+              offsetof(Cluster, triangleCount) == 36);
+static_assert(sizeof(LodCluster) == 96 && offsetof(LodCluster, error) == 12 && offsetof(LodCluster, center) == 16 &&
+              offsetof(LodCluster, coneAxis) == 32 && offsetof(LodCluster, sphere) == 48 &&
+              offsetof(LodCluster, parentSphere) == 64 && offsetof(LodCluster, parentError) == 80 &&
+              offsetof(LodCluster, reserved) == 84);
+
+bool viewStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base, const std::shared_ptr<const void>& owner) {
+  const size_t v = l.vertices;
+  switch (s) {
+    case kPositions: return viewOf(m.positions, base, l.at[s], v, owner);
+    case kNormals: return viewOf(m.normals, base, l.at[s], v, owner);
+    case kTexcoords: return viewOf(m.texcoords, base, l.at[s], v, owner);
+    case kTexcoords1: return viewOf(m.texcoords1, base, l.at[s], v, owner);
+    case kTangents: return viewOf(m.tangents, base, l.at[s], v, owner);
+    case kColors: return viewOf(m.colors, base, l.at[s], v, owner);
+    case kIndices: return !(l.flags & kIndex16) && viewOf(m.indices, base, l.indexAt, l.indices, owner);  // 16-bit: widened
+    case kClusters: return viewOf(m.clusters, base, l.clusterAt, l.clusters, owner);
+    default: return false;
   }
 }
 
@@ -95,8 +133,8 @@ void copyStream(Mesh& m, const MeshLayout& l, Stream s, const uint8_t* base) {
     case kTangents: copyTo(m.tangents, base, l.at[s], v); break;
     case kColors: copyTo(m.colors, base, l.at[s], v); break;
     case kIndices:
-      if (l.flags & kIndex16) m.indices.assign(as<uint16_t>(base, l.indexAt), as<uint16_t>(base, l.indexAt) + n);
-      else m.indices.assign(as<uint32_t>(base, l.indexAt), as<uint32_t>(base, l.indexAt) + n);
+      if (l.flags & kIndex16) m.indices.writable().assign(as<uint16_t>(base, l.indexAt), as<uint16_t>(base, l.indexAt) + n);
+      else copyTo(m.indices, base, l.indexAt, n);
       break;
     case kClusters:
     case kLodClusters:
@@ -171,11 +209,11 @@ void checkArray(const Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_
   }
 }
 
-// Clusters [first, end) of mesh i, read into m.clusters. They must tile the mesh's triangles in order, each
+// Clusters [first, end) of mesh i, read into `out` (null: m.clusters is a view of them). They must tile the mesh's triangles in order, each
 // within the GPU's limits, its sphere holding its vertices: the culling pass and the compute rasteriser
 // trust them.
 template <class Index>
-void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i, size_t first, size_t end) {
+void checkClusters(Cluster* out, const MeshLayout& l, const uint8_t* base, uint32_t i, size_t first, size_t end) {
   static_assert(CLUSTER_MAX_VERTICES < 128, "the vertex set below holds 128");
   const uint32_t triangles = l.indices / 3;
   auto fault = [&](size_t at, size_t k, const std::string& what) {
@@ -192,7 +230,7 @@ void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i
     const uint8_t* p = base + cAt;
     checkFinite(p, cAt, 4, "a cluster's sphere");
     checkFinite(p + 16, cAt + 16, 4, "a cluster's cone");
-    Cluster& c = m.clusters[k];
+    Cluster c;
     c.center = load<glm::vec3>(p);
     c.radius = load<float>(p + 12);
     c.coneAxis = load<glm::vec3>(p + 16);
@@ -215,6 +253,7 @@ void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i
             "triangle count " + std::to_string(c.triangleCount) + " not in 1.." +
                 std::to_string(std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, left)));
     next += c.triangleCount;
+    if (out) out[k] = c;
     // Its distinct vertices gathered first (a small open-addressed set: at most 65 of 128 slots filled),
     // then their positions read together: they are scattered over the array, the loads overlap.
     uint32_t seen[128], vertices[CLUSTER_MAX_VERTICES];
@@ -242,31 +281,48 @@ void checkClusters(Mesh& m, const MeshLayout& l, const uint8_t* base, uint32_t i
 
 }  // namespace
 
-// The second pass: every array copied out of the file and every value, index and cluster checked, the
-// hierarchies' (`lods`, CLOD) too, in pieces on `threads` threads, biggest first.
+void placeClusters(Mesh& m, const MeshLayout& l, const uint8_t* file, const std::shared_ptr<const void>& owner) {
+  if (!viewStream(m, l, kClusters, file, owner)) m.clusters.resize(l.clusters);
+}
+
+// The second pass: every array viewed or copied out of the file and every value, index and cluster
+// checked, the hierarchies' (`lods`, CLOD) too, in pieces on `threads` threads, biggest first.
 void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<MeshLayout>& layout,
-                const std::vector<LodLayout>& lods, unsigned threads, const ByteReader& r) {
+                const std::vector<LodLayout>& lods, unsigned threads, const ByteReader& r,
+                const std::shared_ptr<const void>& owner) {
   constexpr size_t kPiece = size_t(1) << 18, kClusterPiece = 2048, kLodPiece = 4096;
+  const uint8_t* base = bytes.data();
+  // Where the file's bytes are the arrays' (and `owner` keeps them), the arrays are views of them, set
+  // now: the checks below read the file either way, and a fault throws the scene away.
+  std::vector<Cluster*> clustersOut(layout.size());
+  std::vector<LodCluster*> lodOut(lods.size());
   std::vector<Job> jobs;
   for (uint32_t i = 0; i < layout.size(); ++i) {
     const MeshLayout& l = layout[i];
+    Mesh& m = scene.meshes[i];
     for (uint8_t s = kPositions; s <= kIndices; ++s) {
       const size_t count = l.count(Stream(s)), size = l.elementSize(Stream(s));
       if (count == 0) continue;
-      jobs.push_back({i, Stream(s), true, 0, count, 2 * count * size});  // writes cost more: fresh pages
+      if (!viewStream(m, l, Stream(s), base, owner))
+        jobs.push_back({i, Stream(s), true, 0, count, 2 * count * size});  // writes cost more: fresh pages
       for (size_t f = 0; f < count; f += kPiece) {
         const size_t n = std::min(kPiece, count - f);
         jobs.push_back({i, Stream(s), false, f, n, n * size});
       }
     }
+    if (l.clusters && !m.clusters.isView()) clustersOut[i] = m.clusters.writable().data();  // placeClusters sized it
     for (size_t f = 0; f < l.clusters; f += kClusterPiece) {
       const size_t n = std::min<size_t>(kClusterPiece, l.clusters - f);
       jobs.push_back({i, kClusters, false, f, n, n * 1000});  // ~124 triangles' indices and ~64 positions each
     }
   }
+  std::vector<bool> lodCopied(lods.size());
   for (uint32_t j = 0; j < lods.size(); ++j) {  // their jobs' `mesh` is the index in `lods`
     const LodLayout& l = lods[j];
-    if (l.indexCount) jobs.push_back({j, kLodIndices, true, 0, l.indexCount, 8 * size_t(l.indexCount)});
+    ClusterLod& lod = scene.meshes[l.mesh].lod;
+    if (l.indexCount && !viewOf(lod.indices, base, l.indicesAt, l.indexCount, owner))
+      jobs.push_back({j, kLodIndices, true, 0, l.indexCount, 8 * size_t(l.indexCount)});
+    lodCopied[j] = !viewOf(lod.clusters, base, l.clustersAt, l.count, owner);
     for (size_t f = 0; f < l.indexCount; f += kPiece) {
       const size_t n = std::min<size_t>(kPiece, l.indexCount - f);
       jobs.push_back({j, kLodIndices, false, f, n, 4 * n});
@@ -278,9 +334,9 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
   }
   std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.cost > b.cost; });
   // A large copy's time went mostly to its fresh pages' faults (the kernel clearing each page), on the
-  // copying thread alone, as did the hierarchies' records made on one thread: each array is allocated
-  // first, its pages made present in pieces on all cores beside the checks, then the copies and the
-  // hierarchies' records (their vectors sized in between, into present pages) run.
+  // copying thread alone, as did the hierarchies' records made on one thread: each array copied is
+  // allocated first, its pages made present in pieces on all cores beside the checks, then the copies
+  // and the hierarchies' records (their vectors sized in between, into present pages) run.
   constexpr size_t kPagePiece = size_t(4) << 20;
   std::vector<std::span<uint8_t>> pages;
   auto addPages = [&](std::span<uint8_t> a) {
@@ -293,7 +349,8 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
     Mesh& m = scene.meshes[j->stream == kLodIndices ? lods[j->mesh].mesh : j->mesh];
     addPages(j->stream == kLodIndices ? reserve(m.lod.indices, j->count) : reserveStream(m, layout[j->mesh], j->stream));
   }
-  for (const LodLayout& l : lods) addPages(reserve(scene.meshes[l.mesh].lod.clusters, l.count));
+  for (uint32_t j = 0; j < lods.size(); ++j)
+    if (lodCopied[j]) addPages(reserve(scene.meshes[lods[j].mesh].lod.clusters, lods[j].count));
   const size_t firstPhase = size_t(second - jobs.begin());
   Fault first;
   std::mutex firstMutex;
@@ -302,17 +359,17 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
     const uint32_t mesh = lod ? lods[job.mesh].mesh : job.mesh;
     Mesh& m = scene.meshes[mesh];
     const MeshLayout& l = layout[mesh];
-    const uint8_t* base = bytes.data();
+    const size_t end = job.first + job.count;
     try {
       if (job.copy && job.stream == kLodIndices) copyTo(m.lod.indices, base, lods[job.mesh].indicesAt, job.count);
       else if (job.copy) copyStream(m, l, job.stream, base);
-      else if (job.stream == kLodIndices) checkLodIndices(lods[job.mesh], base, l.vertices, job.first, job.first + job.count);
+      else if (job.stream == kLodIndices) checkLodIndices(lods[job.mesh], base, l.vertices, job.first, end);
       else if (job.stream == kLodClusters)
-        readLodClusters(m, lods[job.mesh], base, l.clusterAt, l.indices / 3, job.first, job.first + job.count);
+        readLodClusters(m, lodOut[job.mesh], lods[job.mesh], base, l.clusterAt, l.indices / 3, job.first, end);
       else if (job.stream == kClusters && (l.flags & kIndex16))
-        checkClusters<uint16_t>(m, l, base, mesh, job.first, job.first + job.count);
-      else if (job.stream == kClusters) checkClusters<uint32_t>(m, l, base, mesh, job.first, job.first + job.count);
-      else checkArray(m, l, base, mesh, job.stream, job.first, job.first + job.count);
+        checkClusters<uint16_t>(clustersOut[mesh], l, base, mesh, job.first, end);
+      else if (job.stream == kClusters) checkClusters<uint32_t>(clustersOut[mesh], l, base, mesh, job.first, end);
+      else checkArray(m, l, base, mesh, job.stream, job.first, end);
     } catch (Fault& f) {
       std::lock_guard lock(firstMutex);
       if (f.at < first.at) first = std::move(f);
@@ -322,7 +379,12 @@ void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<
     if (j < pages.size()) populate(pages[j].data(), pages[j].size());
     else run(jobs[j - pages.size()]);
   });
-  for (const LodLayout& l : lods) scene.meshes[l.mesh].lod.clusters.resize(l.count);
+  for (uint32_t j = 0; j < lods.size(); ++j) {
+    if (!lodCopied[j]) continue;
+    std::vector<LodCluster>& v = scene.meshes[lods[j].mesh].lod.clusters.writable();
+    v.resize(lods[j].count);
+    lodOut[j] = v.data();
+  }
   const bool faulty = first.at != SIZE_MAX;  // no copies then; the records may still hold a lower fault
   parallelFor(jobs.size() - firstPhase, threads, [&](size_t j) {
     if (!(faulty && jobs[firstPhase + j].copy)) run(jobs[firstPhase + j]);

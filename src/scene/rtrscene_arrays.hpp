@@ -4,6 +4,7 @@
 // every value, index and cluster, the hierarchies' (CLOD) too, in pieces on all cores.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -45,9 +46,16 @@ struct MeshLayout {
 
 inline std::string meshName(uint32_t i) { return "mesh " + std::to_string(i); }
 
-// The second pass: every array copied out of the file and every value, index and cluster checked, the
+// A mesh's clusters (their count known from its record, in the first pass), a view of the file's records
+// where `owner` keeps the file (rtrscene_arrays.cpp says when), else a vector of that size, filled by
+// readArrays once checked.
+void placeClusters(Mesh& m, const MeshLayout& l, const uint8_t* file, const std::shared_ptr<const void>& owner);
+
+// The second pass: every array copied out of the file, or made a view of it where `owner` keeps the file
+// and its bytes are the array's, and every value, index and cluster checked (reading the file), the
 // hierarchies' (`lods`, CLOD) too, in pieces on `threads` threads, biggest first.
 void readArrays(std::span<const uint8_t> bytes, Scene& scene, const std::vector<MeshLayout>& layout,
-                const std::vector<LodLayout>& lods, unsigned threads, const ByteReader& r);
+                const std::vector<LodLayout>& lods, unsigned threads, const ByteReader& r,
+                const std::shared_ptr<const void>& owner);
 
 }  // namespace rtr::rtrscene

@@ -98,8 +98,8 @@ void readClusterLodLayout(ByteReader& r, uint64_t size, Scene& scene, std::vecto
   if (r.pos() != end) r.fail("CLOD chunk: " + std::to_string(end - r.pos()) + " bytes after its last mesh");
 }
 
-void readLodClusters(Mesh& m, const LodLayout& l, const uint8_t* file, size_t ownClustersAt, uint32_t triangles, size_t first,
-                     size_t end) {
+void readLodClusters(const Mesh& m, LodCluster* out, const LodLayout& l, const uint8_t* file, size_t ownClustersAt,
+                     uint32_t triangles, size_t first, size_t end) {
   const size_t base = m.clusters.size();
   const uint64_t all = uint64_t(triangles) + l.indexCount / 3;
   const std::string which = "CLOD chunk: mesh " + std::to_string(l.mesh) + ": ";
@@ -112,7 +112,7 @@ void readLodClusters(Mesh& m, const LodLayout& l, const uint8_t* file, size_t ow
     const uint8_t* q = file + cAt;
     // A record's checks in a fixed order (its first fault is thrown); of several records, rtrscene.cpp
     // reports the lowest fault.
-    LodCluster& c = m.lod.clusters[k];
+    LodCluster c;
     c.firstTriangle = u32(k, 0);
     c.triangleCount = u32(k, 4);
     c.level = u32(k, 8);
@@ -163,6 +163,7 @@ void readLodClusters(Mesh& m, const LodLayout& l, const uint8_t* file, size_t ow
     if (!(c.parentError > c.error) || c.parentError > shader::LOD_ERROR_INFINITE)
       fault(cAt + 80, k, "parent error not above its own error");
     if (u32(k, 84) != 0 || u32(k, 88) != 0 || u32(k, 92) != 0) fault(cAt + 84, k, "reserved field is not 0");
+    if (out) out[k] = c;
   }
   if (end == l.count) {  // the clusters above level 0 hold the hierarchy's triangles
     const uint64_t held = l.count > base ? uint64_t(u32(l.count - 1, 0)) + u32(l.count - 1, 4) - triangles : 0;

@@ -33,12 +33,12 @@ struct ReadFault {
 // thrown naming its offset; `out` holds the records before it), setting each mesh's lod.levels. Its
 // records (once lod.clusters holds `count`) and indices are read by the two below.
 void readClusterLodLayout(ByteReader& r, uint64_t size, Scene& scene, std::vector<LodLayout>& out);
-// Records [first, end) of a hierarchy read into m.lod.clusters and checked on their own and against the
-// record before (levels in order, triangles tiling the hierarchy's; level 0 the mesh's own clusters,
-// read from the file at `ownClustersAt`; its `triangles` from its record: its arrays may be being copied
-// meanwhile); the last piece checks that they hold all its triangles.
-void readLodClusters(Mesh& m, const LodLayout& l, const uint8_t* file, size_t ownClustersAt, uint32_t triangles, size_t first,
-                     size_t end);
+// Records [first, end) of a hierarchy read into `out` (null: m.lod.clusters is a view of them) and checked
+// on their own and against the record before (levels in order, triangles tiling the hierarchy's; level 0
+// the mesh's own clusters, read from the file at `ownClustersAt`; its `triangles` from its record: its
+// arrays may be being copied meanwhile); the last piece checks that they hold all its triangles.
+void readLodClusters(const Mesh& m, LodCluster* out, const LodLayout& l, const uint8_t* file, size_t ownClustersAt,
+                     uint32_t triangles, size_t first, size_t end);
 // Indices [first, end) of a hierarchy checked against the mesh's `vertices` (read from the file).
 void checkLodIndices(const LodLayout& l, const uint8_t* file, size_t vertices, size_t first, size_t end);
 

@@ -17,6 +17,7 @@
 
 #include "core/bounds.hpp"
 #include "core/camera.hpp"
+#include "core/view_or_vector.hpp"
 
 namespace rtr {
 
@@ -98,33 +99,36 @@ struct Material {
 };
 
 // A run of at most 124 triangles of one mesh (scene/clusters.hpp), with the bounds culling tests it by.
+// Its members lie as .rtrscene's 40-byte record does, so that a loaded scene's clusters are the file's.
 struct Cluster {
-  uint32_t firstTriangle = 0, triangleCount = 0;  // triangles [first, first + count) of the mesh
-  glm::vec3 center{0.0f};                         // bounding sphere, scene space
+  glm::vec3 center{0.0f};  // bounding sphere, scene space
   float radius = 0.0f;
   glm::vec3 coneAxis{0.0f};  // normal cone (shaders/shared/cluster.h); cutoff >= 1: none
   float coneCutoff = 1.0f;
+  uint32_t firstTriangle = 0, triangleCount = 0;  // triangles [first, first + count) of the mesh
 };
 
 // A cluster of a mesh's level-of-detail hierarchy (scene/cluster_lod.hpp, docs/virtual-geometry.md).
 // Its triangles are numbered past the mesh's own: level 0 is the mesh's clusters (Mesh::clusters, the
 // same triangles), and triangle t of ClusterLod::indices is triangle triangleCount() + t of the mesh, so
 // a visibility id names any level's triangle as it names the mesh's.
+// Its members lie as .rtrscene's 96-byte CLOD record does (a loaded scene's records are the file's).
 struct LodCluster {
   uint32_t firstTriangle = 0, triangleCount = 0;
   uint32_t level = 0;      // 0: the mesh's own triangles
+  float error = 0.0f;      // object-space error of the simplification that made it (level 0: 0)
   glm::vec3 center{0.0f};  // bounds of its triangles (culling)
   float radius = 0.0f;
   glm::vec3 coneAxis{0.0f};  // normal cone as Cluster's; cutoff >= 1: none
   float coneCutoff = 1.0f;
   glm::vec4 sphere{0.0f};  // where `error` applies (the group that made it; level 0: its bounds)
-  float error = 0.0f;      // object-space error of the simplification that made it (level 0: 0)
   glm::vec4 parentSphere{0.0f};
-  float parentError = 0.0f;  // of the simplification that replaced it; LOD_ERROR_INFINITE: a root
+  float parentError = 0.0f;          // of the simplification that replaced it; LOD_ERROR_INFINITE: a root
+  uint32_t reserved[3] = {0, 0, 0};  // the record's; always 0
 };
 struct ClusterLod {
-  std::vector<uint32_t> indices;           // the triangles of levels 1 and up, cluster by cluster; mesh vertices
-  std::vector<LodCluster> clusters;        // level 0 first (Mesh::clusters' order), then level by level
+  ViewOrVector<uint32_t> indices;          // the triangles of levels 1 and up, cluster by cluster; mesh vertices
+  ViewOrVector<LodCluster> clusters;       // level 0 first (Mesh::clusters' order), then level by level
   uint32_t levels = 0;                     // 0: no hierarchy
   size_t triangles(uint32_t level) const;  // of that level's clusters
 };
@@ -132,16 +136,18 @@ struct ClusterLod {
 struct Mesh {
   std::string name;  // OBJ object/group name
   uint32_t material = 0;
-  std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;     // same count as positions
-  std::vector<glm::vec2> texcoords;   // empty when the source has none
-  std::vector<glm::vec2> texcoords1;  // a second uv set (glTF TEXCOORD_1); empty when none
-  std::vector<glm::vec4> tangents;    // xyz unit tangent, w ±1 bitangent sign (glTF); empty when none
-  std::vector<glm::vec4> colors;      // linear RGBA vertex colours (glTF COLOR_0, OBJ `v x y z r g b`); empty when none
-  std::vector<uint32_t> indices;      // triangle list, local to the mesh
-  Bounds bounds;                      // object space (before any instance transform)
-  std::vector<Cluster> clusters;      // tile the triangles in order; empty until built (scene/clusters.hpp)
-  ClusterLod lod;                     // the level-of-detail hierarchy; empty: none (scene/cluster_lod.hpp)
+  // The large arrays: owned vectors, or views of the mapped .rtrscene they were read from (a view is
+  // copied once by the first code that changes it: core/view_or_vector.hpp).
+  ViewOrVector<glm::vec3> positions;
+  ViewOrVector<glm::vec3> normals;     // same count as positions
+  ViewOrVector<glm::vec2> texcoords;   // empty when the source has none
+  ViewOrVector<glm::vec2> texcoords1;  // a second uv set (glTF TEXCOORD_1); empty when none
+  ViewOrVector<glm::vec4> tangents;    // xyz unit tangent, w ±1 bitangent sign (glTF); empty when none
+  ViewOrVector<glm::vec4> colors;      // linear RGBA vertex colours (glTF COLOR_0, OBJ `v x y z r g b`); empty when none
+  ViewOrVector<uint32_t> indices;      // triangle list, local to the mesh
+  Bounds bounds;                       // object space (before any instance transform)
+  ViewOrVector<Cluster> clusters;      // tile the triangles in order; empty until built (scene/clusters.hpp)
+  ClusterLod lod;                      // the level-of-detail hierarchy; empty: none (scene/cluster_lod.hpp)
 
   uint32_t triangleCount() const { return uint32_t(indices.size() / 3); }
 };

@@ -424,19 +424,23 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
 
   // 5. Emit.
   const size_t n = counts.vertices;
-  resizeOnAllCores(out.positions, n, threads);
-  resizeOnAllCores(out.normals, n, threads);
-  resizeOnAllCores(out.texcoords, hasTex ? n : 0, threads);
-  resizeOnAllCores(out.colors, colors.empty() ? 0 : n, threads);
+  std::vector<glm::vec3>&pos = out.positions.writable(), &nrm = out.normals.writable();
+  std::vector<glm::vec2>& tex = out.texcoords.writable();
+  std::vector<glm::vec4>& col = out.colors.writable();
+  std::vector<uint32_t>& idx = out.indices.writable();
+  resizeOnAllCores(pos, n, threads);
+  resizeOnAllCores(nrm, n, threads);
+  resizeOnAllCores(tex, hasTex ? n : 0, threads);
+  resizeOnAllCores(col, colors.empty() ? 0 : n, threads);
   std::vector<Bounds> bounds(piecesOf(uniqCount));
   forPieces(uniqCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t u = b; u < e; ++u) {
       if (!kept[u]) continue;
       const size_t r = keptId[u];
-      out.positions[r] = verts[u].p;
-      out.normals[r] = verts[u].n;
-      if (hasTex) out.texcoords[r] = verts[u].t;
-      if (!colors.empty()) out.colors[r] = vcolor[u];
+      pos[r] = verts[u].p;
+      nrm[r] = verts[u].n;
+      if (hasTex) tex[r] = verts[u].t;
+      if (!colors.empty()) col[r] = vcolor[u];
       bounds[p].extend(verts[u].p);
     }
   });
@@ -456,12 +460,12 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   const size_t triangles = prefix(written);
   counts.degenerate += counts.triangles - triangles;
   counts.triangles = triangles;
-  resizeOnAllCores(out.indices, triangles * 3, threads);
+  resizeOnAllCores(idx, triangles * 3, threads);
   forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t t = b, at = written[p] * 3; t < e; ++t) {
       if (!keep[t]) continue;
       const uint32_t x = corner(t * 3), y = corner(t * 3 + 1), z = corner(t * 3 + 2);
-      if (x != y && y != z && x != z) out.indices[at] = x, out.indices[at + 1] = y, out.indices[at + 2] = z, at += 3;
+      if (x != y && y != z && x != z) idx[at] = x, idx[at + 1] = y, idx[at + 2] = z, at += 3;
     }
   });
   freeOnAllCores(vertexOf, cornerCount, threads);

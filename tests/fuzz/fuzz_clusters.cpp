@@ -17,7 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   rtr::Mesh m;
   m.name = "fuzz";
   m.positions.resize(vertices);
-  std::memcpy(m.positions.data(), data, vertices * 12);
+  std::memcpy(m.positions.writable().data(), data, vertices * 12);
   data += vertices * 12, size -= vertices * 12;
   for (size_t i = 0; i + 3 <= size && m.indices.size() < 3 * 2048; i += 3)  // one byte an index, some out of range
     for (int k = 0; k < 3; ++k) m.indices.push_back(data[i + k] % (vertices + 2));

@@ -476,7 +476,7 @@ ReferenceScene makeScene(const std::string& name, const std::filesystem::path& w
       t.scale = {1.5f, 0.8f};
       t.texCoord = 1;
       panel.texcoords1 = panel.texcoords;
-      for (glm::vec2& uv : panel.texcoords1) uv = glm::vec2(uv.y, 1.0f - uv.x);
+      for (glm::vec2& uv : panel.texcoords1.writable()) uv = glm::vec2(uv.y, 1.0f - uv.x);
     }
     s.materials.push_back(m);
     s.meshes.push_back(grid("floor", 0, {-4, -1, 0}, {8, 0, 0}, {0, 0, -8}, 8, 8, false));

@@ -77,10 +77,10 @@ Scene flattened(const Scene& in) {
     Mesh m = in.meshes[inst.mesh];
     const glm::mat3 n = glm::inverseTranspose(glm::mat3(inst.transform));
     m.bounds = {};
-    for (glm::vec3& p : m.positions) p = glm::vec3(inst.transform * glm::vec4(p, 1.0f)), m.bounds.extend(p);
-    for (glm::vec3& v : m.normals) v = n * v;
+    for (glm::vec3& p : m.positions.writable()) p = glm::vec3(inst.transform * glm::vec4(p, 1.0f)), m.bounds.extend(p);
+    for (glm::vec3& v : m.normals.writable()) v = n * v;
     if (glm::determinant(glm::mat3(inst.transform)) < 0.0f)
-      for (size_t i = 0; i < m.indices.size(); i += 3) std::swap(m.indices[i + 1], m.indices[i + 2]);
+      for (size_t i = 0; i < m.indices.size(); i += 3) std::swap(m.indices.writable()[i + 1], m.indices.writable()[i + 2]);
     m.clusters.clear();  // runs of triangles in order (GpuScene's fallback): the primitive ids stay
     s.meshes.push_back(m);
   }

@@ -45,7 +45,7 @@ Mesh bumpyGrid(uint32_t n) {
 
 // Each triangle rotated so its smallest index comes first: the same triangle with the same winding
 // compares equal, a flipped one does not.
-std::vector<std::array<uint32_t, 3>> canonicalTriangles(const std::vector<uint32_t>& idx) {
+std::vector<std::array<uint32_t, 3>> canonicalTriangles(std::span<const uint32_t> idx) {
   std::vector<std::array<uint32_t, 3>> out;
   for (size_t i = 0; i < idx.size(); i += 3) {
     std::array<uint32_t, 3> t{idx[i], idx[i + 1], idx[i + 2]};
@@ -136,9 +136,9 @@ TEST(Clusters, PiecesSeeOnlyTheirOwnVertices) {
     SCOPED_TRACE("gap " + std::to_string(gap));
     Mesh gapped = plain;
     gapped.positions.assign(plain.positions.size() * gap, glm::vec3(1e6f, -1e6f, 1e6f));
-    for (size_t v = 0; v < plain.positions.size(); ++v) gapped.positions[v * gap] = plain.positions[v];
+    for (size_t v = 0; v < plain.positions.size(); ++v) gapped.positions.writable()[v * gap] = plain.positions[v];
     gapped.normals.assign(gapped.positions.size(), glm::vec3(0, 1, 0));
-    for (uint32_t& i : gapped.indices) i *= gap;
+    for (uint32_t& i : gapped.indices.writable()) i *= gap;
     Mesh a = plain;
     buildClusters(a, true);
     buildClusters(gapped, true);
@@ -171,14 +171,15 @@ TEST(Clusters, BadInputIsReportedAsOnePassWouldMeetIt) {
   };
   const std::vector<Case> cases = {
       {[&](Scene& s) {
-         s.meshes[0].positions[200000].x = nan, s.meshes[0].positions[150000].y = 2e12f, s.meshes[0].positions[150001].z = nan;
+         s.meshes[0].positions.writable()[200000].x = nan, s.meshes[0].positions.writable()[150000].y = 2e12f,
+         s.meshes[0].positions.writable()[150001].z = nan;
        },
        "mesh 'grid': position 150000 is not finite"},
-      {[&](Scene& s) { s.meshes[0].indices.back() = 1u << 30, s.meshes[1].positions[0].x = nan; },
+      {[&](Scene& s) { s.meshes[0].indices.writable().back() = 1u << 30, s.meshes[1].positions.writable()[0].x = nan; },
        "mesh 'grid': index 1073741824 out of range"},
-      {[&](Scene& s) { s.meshes[0].indices[1000000] = 1u << 30, s.meshes[0].positions.back().x = nan; },
+      {[&](Scene& s) { s.meshes[0].indices.writable()[1000000] = 1u << 30, s.meshes[0].positions.writable().back().x = nan; },
        "mesh 'grid': position 203400 is not finite"},
-      {[&](Scene& s) { s.meshes[0].indices[1000000] = 1u << 29, s.meshes[0].indices[1100000] = 1u << 30; },
+      {[&](Scene& s) { s.meshes[0].indices.writable()[1000000] = 1u << 29, s.meshes[0].indices.writable()[1100000] = 1u << 30; },
        "mesh 'grid': index 536870912 out of range"},
   };
   for (size_t i = 0; i < cases.size(); ++i) {
@@ -280,7 +281,7 @@ TEST(Clusters, ZeroAreaTrianglesGetAConeThatNeverCullsAndLoad) {
   Scene s;
   s.materials.push_back(Material{});
   Mesh m = bumpyGrid(4);
-  for (size_t i = 0; i + 2 < m.indices.size(); i += 3) m.indices[i + 2] = m.indices[i + 1];  // every triangle a line
+  for (size_t i = 0; i + 2 < m.indices.size(); i += 3) m.indices.writable()[i + 2] = m.indices[i + 1];  // every triangle a line
   s.meshes.push_back(m);
   buildMissingClusters(s);
   ASSERT_FALSE(s.meshes[0].clusters.empty());

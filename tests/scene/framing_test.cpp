@@ -71,7 +71,8 @@ TEST(Framing, ASheetIsSeenFromItsFrontAndOnlyADownwardSheetFromBelow) {
   EXPECT_EQ(p.pitchDeg, -25.0f) << "never from below while a view from above sees its front";
   EXPECT_GT(frontArea(slanted, toViewer(p)), 0.0);
   Mesh inward = cube();
-  for (size_t i = 0; i < inward.indices.size(); i += 3) std::swap(inward.indices[i + 1], inward.indices[i + 2]);
+  for (size_t i = 0; i < inward.indices.size(); i += 3)
+    std::swap(inward.indices.writable()[i + 1], inward.indices.writable()[i + 2]);
   const Scene box = sceneOf(inward);
   p = framingPose(box, Lens{}, 1.0f);
   EXPECT_EQ(p.pitchDeg, -25.0f) << "from above, its floor's inside in view, not from below (yaw " << p.yawDeg << ")";

@@ -218,9 +218,9 @@ TEST(GltfMaterial, TextureTransformAndSecondUvSet) {
     Mesh q = facing(2, addMaterial(s, m));
     q.texcoords1 = q.texcoords;
     // Set 0 is junk where set 1 is the one used; set 1 is the mirror of set 0.
-    for (glm::vec2& t : (set == 1 ? q.texcoords1 : q.texcoords)) t = glm::vec2(1.0f) - t;
+    for (glm::vec2& t : (set == 1 ? q.texcoords1 : q.texcoords).writable()) t = glm::vec2(1.0f) - t;
     if (set == 1)
-      for (glm::vec2& t : q.texcoords) t = glm::vec2(0.37f);
+      for (glm::vec2& t : q.texcoords.writable()) t = glm::vec2(0.37f);
     addMesh(s, std::move(q));
     const Tracer t(s);
     for (glm::vec2 p : {glm::vec2(0.1f, 0.2f), glm::vec2(-0.6f, 0.7f), glm::vec2(0.5f, -0.3f)}) {
@@ -257,7 +257,7 @@ TEST(GltfMaterial, SamplerWrapModes) {
     m.textures[uint32_t(TextureSlot::BaseColor)] = addTexture(s, "pattern", 4, 4, pattern, true, 4);
     s.textures.back().sampler.wrapU = c.wrap;
     Mesh q = facing(2, addMaterial(s, m));
-    for (glm::vec2& t : q.texcoords) t *= 2.0f;  // uv = (x + 1, y + 1)
+    for (glm::vec2& t : q.texcoords.writable()) t *= 2.0f;  // uv = (x + 1, y + 1)
     addMesh(s, std::move(q));
     const Tracer t(s);
     expectNear(at(t, baseView(), c.u - 1.0f, 0.375f - 1.0f), decoded(pattern(c.texel, 1)),

@@ -51,10 +51,10 @@ Scene flattened(const Scene& in) {
   for (const Instance& inst : in.instances) {
     Mesh m = in.meshes[inst.mesh];
     const glm::mat3 nm = glm::transpose(glm::inverse(glm::mat3(inst.transform)));
-    for (glm::vec3& p : m.positions) p = glm::vec3(inst.transform * glm::vec4(p, 1.0f));
-    for (glm::vec3& n : m.normals) n = nm * n;  // not normalised: then interpolation and transform commute
+    for (glm::vec3& p : m.positions.writable()) p = glm::vec3(inst.transform * glm::vec4(p, 1.0f));
+    for (glm::vec3& n : m.normals.writable()) n = nm * n;  // not normalised: then interpolation and transform commute
     if (glm::determinant(glm::mat3(inst.transform)) < 0.0f)
-      for (size_t i = 0; i < m.indices.size(); i += 3) std::swap(m.indices[i + 1], m.indices[i + 2]);
+      for (size_t i = 0; i < m.indices.size(); i += 3) std::swap(m.indices.writable()[i + 1], m.indices.writable()[i + 2]);
     addMesh(s, std::move(m));
   }
   return s;

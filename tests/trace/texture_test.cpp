@@ -60,7 +60,7 @@ TraceSettings baseColourView() {
 // A 2×2 quad at z = -depth facing +z, uv = ((x + 1) / 2, (y + 1) / 2) scaled by `uvScale`.
 Mesh facingQuad(float depth, uint32_t material, float uvScale = 1.0f) {
   Mesh m = quad({-1, -1, -depth}, {2, 0, 0}, {0, 2, 0}, material);
-  for (glm::vec2& t : m.texcoords) t *= uvScale;
+  for (glm::vec2& t : m.texcoords.writable()) t *= uvScale;
   return m;
 }
 
@@ -102,7 +102,7 @@ TEST(TracerTextures, TexelCentresGiveDecodedTexelTimesFactor) {
 TEST(TracerTextures, RepeatWrapsCoordinatesOutsideZeroOne) {
   Scene s;
   Mesh m = facingQuad(2, addMaterial(s, pbr(glm::vec3(1), addTexture(s, "pattern", 4, 4, pattern))), 3.0f);
-  for (glm::vec2& uv : m.texcoords) uv -= glm::vec2(1.0f);  // uv in [-1, 2]
+  for (glm::vec2& uv : m.texcoords.writable()) uv -= glm::vec2(1.0f);  // uv in [-1, 2]
   addMesh(s, std::move(m));
   const Tracer t(s);
   const TraceSettings ts = baseColourView();
