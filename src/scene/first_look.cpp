@@ -35,6 +35,12 @@ void turnScene(Scene& scene, const glm::mat3& r) {
       for (glm::vec3& n : m.normals.writable()) n = r * n;
       for (glm::vec4& t : m.tangents.writable()) t = glm::vec4(r * glm::vec3(t), t.w);
       for (Cluster& c : m.clusters.writable()) c.center = r * c.center, c.coneAxis = r * c.coneAxis;
+      // The hierarchy's bounds, cones and error spheres are object space too (the LOD cut and culling read them).
+      auto turned = [&r](glm::vec4 s) { return glm::vec4(r * glm::vec3(s), s.w); };
+      for (LodCluster& c : m.lod.clusters.writable()) {
+        c.center = r * c.center, c.coneAxis = r * c.coneAxis;
+        c.sphere = turned(c.sphere), c.parentSphere = turned(c.parentSphere);
+      }
     }
   }
   for (Light& l : scene.lights) {

@@ -661,7 +661,7 @@ TEST_F(RasterTest, TouchedColumnsAreExact) {
     if (!empty && (c.x < t.x || c.y > t.y) && ++outside <= 5)
       ADD_FAILURE() << "triangle " << i / kRows << ", row " << i % kRows << ": columns " << c.x << "-" << c.y
                     << " past tileTouches' " << t.x << "-" << t.y;
-    if (t.z > 0) EXPECT_EQ(t.z, t.y - t.x + 1) << "row " << i << ": the tiles tileTouches accepts are not one run";
+    if (t.z > 0) { EXPECT_EQ(t.z, t.y - t.x + 1) << "row " << i << ": the tiles tileTouches accepts are not one run"; }
     tested += t != glm::ivec4(1, 0, 0, 0);
     listed += empty ? 0 : size_t(c.y - c.x + 1);
     accepted += size_t(t.z);

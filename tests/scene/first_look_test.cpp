@@ -186,6 +186,9 @@ TEST(FirstLookUp, EachAxisTurnsToPlusY) {
   m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 2}};
   m.normals = {{0, -1, 0}, {0, -1, 0}, {0, -1, 0}};
   m.indices = {0, 1, 2};
+  LodCluster lc;
+  lc.center = {0, 0, 1}, lc.coneAxis = {0, 0, -1}, lc.sphere = {0, 0, 3, 0.5f}, lc.parentSphere = {0, 0, 4, 2.0f};
+  m.lod.clusters = std::vector<LodCluster>{lc};
   s.meshes.push_back(m);
   s.lights.push_back(Light{});
   s.lights[0].position = {0, 0, 5};
@@ -194,6 +197,11 @@ TEST(FirstLookUp, EachAxisTurnsToPlusY) {
   EXPECT_EQ(s.meshes[0].positions[2], glm::vec3(0, 2, 0));
   EXPECT_EQ(s.meshes[0].normals[0], glm::vec3(0, 0, 1));
   EXPECT_EQ(s.meshes[0].bounds.max.y, 2.0f);
+  const LodCluster& turned = s.meshes[0].lod.clusters[0];  // the hierarchy turned with its triangles
+  EXPECT_EQ(turned.center, glm::vec3(0, 1, 0));
+  EXPECT_EQ(turned.coneAxis, glm::vec3(0, -1, 0));
+  EXPECT_EQ(turned.sphere, glm::vec4(0, 3, 0, 0.5f));
+  EXPECT_EQ(turned.parentSphere, glm::vec4(0, 4, 0, 2.0f));
   EXPECT_EQ(s.lights[0].position, glm::vec3(0, 5, 0));
   EXPECT_FALSE(s.defaultView);
 }
