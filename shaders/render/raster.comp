@@ -37,8 +37,9 @@ void appendClip(uint ref) {
 // workgroup barrier. Boxes of a few pixels are cheaper drawn by their own lane, unstepped (docs/raster.md,
 // "What bounds each pass": the threshold's counts). Entries: the triangle's lane << 16 | the row in its box;
 // rows past the slice their own lane draws. The same atomics in another order: the same ids.
-// RTR_RASTER_ROW_QUEUE=0/1 (render/raster.cpp) forces either path for measuring.
-layout(constant_id = 3) const uint kRowQueueFrom = RASTER_ROW_QUEUE_FROM;
+// Off by default (measured on the H200: the pixel-sized triangles of large scenes lose 2x with it, chosen
+// per subgroup too); RTR_RASTER_ROW_QUEUE=0/1/auto (render/raster.cpp) chooses for measuring.
+layout(constant_id = 3) const uint kRowQueueFrom = 0xFFFFFFFFu;
 const uint kQueueSize = 1024u;
 shared uint rows[kQueueSize];
 shared Tri smallTris[RASTER_GROUP];

@@ -18,7 +18,8 @@ using glm::vec4;
 #define RASTER_SUBPIXEL_BITS 8   // fixed-point vertex positions: 1/256 pixel
 #define RASTER_GUARD_BAND 16384.0 // px from the image centre; beyond it (or w <= 0) the hardware draws it
 #define RASTER_SHARED_AREA 256u  // default: bounding boxes over this many pixels are rasterised tile by tile
-// raster.comp: a subgroup whose largest small box is over this many pixels shares its rows out (docs/raster.md)
+// raster.comp with RTR_RASTER_ROW_QUEUE=auto: a subgroup whose largest small box is over this many pixels
+// shares its rows out (off by default: docs/raster.md)
 #define RASTER_ROW_QUEUE_FROM 64u
 #define RASTER_TILE 32           // raster_large.comp: a workgroup per tile of RASTER_TILE² pixels of a triangle
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware

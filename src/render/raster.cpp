@@ -36,14 +36,16 @@ std::vector<vk::SpecializationConstant> withMeasure(std::vector<vk::Specializati
   return constants;
 }
 
-// RTR_RASTER_ROW_QUEUE=0|1: raster.comp's small triangles' rows never or always shared out over the
-// subgroup (its kRowQueueFrom; the same ids), for measuring either path (docs/raster.md, "What bounds each pass").
+// RTR_RASTER_ROW_QUEUE=0|1|auto: raster.comp's small triangles' rows never (the default), always, or per
+// subgroup over RASTER_ROW_QUEUE_FROM pixels shared out over the subgroup (its kRowQueueFrom; the same
+// ids), for measuring (docs/raster.md, "What bounds each pass": on the H200 the queue halves the default
+// temple's raster and doubles the 10M temple's, chosen per subgroup too).
 std::vector<vk::SpecializationConstant> withRowQueue(std::vector<vk::SpecializationConstant> constants) {
   const char* v = std::getenv("RTR_RASTER_ROW_QUEUE");
   if (!v || !*v) return constants;
-  if (std::strcmp(v, "0") != 0 && std::strcmp(v, "1") != 0)
-    throw std::runtime_error(std::string("RTR_RASTER_ROW_QUEUE=") + v + ": expected 0 or 1");
-  constants.push_back({3, *v == '1' ? 0u : ~0u});
+  if (std::strcmp(v, "0") != 0 && std::strcmp(v, "1") != 0 && std::strcmp(v, "auto") != 0)
+    throw std::runtime_error(std::string("RTR_RASTER_ROW_QUEUE=") + v + ": expected 0, 1 or auto");
+  constants.push_back({3, *v == '1' ? 0u : *v == '0' ? ~0u : RASTER_ROW_QUEUE_FROM});
   return constants;
 }
 
