@@ -63,16 +63,19 @@ class ViewOrVector {
   void assign(size_t n, const T& v) { forget().assign(n, v); }
   template <class It>
   void assign(It first, It last) {
+    const auto keep = owner_;  // [first, last) may lie in this view: its mapping lives until copied
     forget().assign(first, last);
   }
   void push_back(T v) { writable().push_back(v); }  // by value: `v` may be an element of the view
   template <class... A>
   T& emplace_back(A&&... a) {
+    const auto keep = owner_;  // the arguments may refer to this view's elements
     return writable().emplace_back(std::forward<A>(a)...);
   }
   template <class It>
   void insert(const T* at, It first, It last) {  // `at`: end() or a position in this array
     const auto k = at - data();
+    const auto keep = owner_;  // [first, last) may lie in this view
     std::vector<T>& v = writable();
     v.insert(v.begin() + k, first, last);
   }
