@@ -179,5 +179,28 @@ TEST(ViewOrVector, WritesToAViewCopyItAndLetTheOwnerGo) {
   EXPECT_EQ(*held, (std::vector<int>{1, 2, 3}));
 }
 
+// Copying from its own view: the owner (here one that "unmaps", overwriting the bytes, when let go) must
+// outlive the copy, though the array lets it go once it owns its elements.
+TEST(ViewOrVector, CopiesFromItsOwnViewBeforeLettingTheOwnerGo) {
+  std::vector<int> mapped;
+  auto mapping = [&mapped] {
+    mapped = {1, 2, 3};
+    return std::shared_ptr<const void>(&mapped, [](const void* p) {
+      auto* m = static_cast<std::vector<int>*>(const_cast<void*>(p));
+      std::fill(m->begin(), m->end(), -1);
+    });
+  };
+  ViewOrVector<int> a = ViewOrVector<int>::view(mapped, mapping());
+  a.emplace_back(a[0]);
+  EXPECT_EQ(a, (ViewOrVector<int>{1, 2, 3, 1}));
+  a = ViewOrVector<int>::view(mapped, mapping());
+  a.insert(a.end(), a.begin(), a.begin() + 2);
+  EXPECT_EQ(a, (ViewOrVector<int>{1, 2, 3, 1, 2}));
+  a = ViewOrVector<int>::view(mapped, mapping());
+  a.assign(a.begin() + 1, a.end());
+  EXPECT_EQ(a, (ViewOrVector<int>{2, 3}));
+  EXPECT_EQ(mapped, (std::vector<int>{-1, -1, -1})) << "the owner is let go once the array owns its elements";
+}
+
 }  // namespace
 }  // namespace rtr
