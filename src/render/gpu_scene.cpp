@@ -42,7 +42,7 @@ constexpr const char* kGeometryNames[] = {"positions",  "normals",        "texco
 GeometryUpload geometryUpload(const vk::Context& ctx) {
   const char* env = std::getenv("RTR_UPLOAD");
   const std::optional<GeometryUpload> named = enumFromName<GeometryUpload>(env ? env : "auto");
-  if (!named) throw Error(std::string("RTR_UPLOAD=") + env + ": expected " + enumChoices<GeometryUpload>());
+  if (!named) throw UsageError(std::string("RTR_UPLOAD=") + env + ": expected " + enumChoices<GeometryUpload>());
   return *named == GeometryUpload::Auto ? deviceDefaults(ctx.deviceType()).upload : *named;
 }
 

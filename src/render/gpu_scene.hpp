@@ -69,7 +69,7 @@ enum class GeometryUpload { Auto, Direct, Staged };
 constexpr std::array<EnumName<GeometryUpload>, 3> enumNames(GeometryUpload) {
   return {{{GeometryUpload::Auto, "auto"}, {GeometryUpload::Direct, "direct"}, {GeometryUpload::Staged, "staged"}}};
 }
-// What Auto means on this device: RTR_UPLOAD, else the device's default (an unknown RTR_UPLOAD: Error).
+// What Auto means on this device: RTR_UPLOAD, else the device's default (an unknown RTR_UPLOAD: UsageError).
 GeometryUpload geometryUpload(const vk::Context& ctx);
 
 // The loading phases, in order; they do not overlap, and together they are the constructor's time

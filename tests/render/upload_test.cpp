@@ -110,7 +110,7 @@ TEST_F(VulkanTest, RtrUploadChoosesTheGeometryPath) {
   try {
     render::geometryUpload(*ctx);
     ADD_FAILURE() << "RTR_UPLOAD=dma accepted";
-  } catch (const Error& e) { EXPECT_STREQ(e.what(), "RTR_UPLOAD=dma: expected auto, direct or staged"); }
+  } catch (const UsageError& e) { EXPECT_STREQ(e.what(), "RTR_UPLOAD=dma: expected auto, direct or staged"); }
   if (before) ::setenv("RTR_UPLOAD", saved.c_str(), 1);
   else ::unsetenv("RTR_UPLOAD");
 }
