@@ -484,8 +484,10 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
   };
 
   // Pieces of at most 256 Ki vertices, 1 Mi indices, 64 Ki records, 1 MiB or 1 Mi base entries, written
-  // on all cores.
-  constexpr size_t kVertexChunk = size_t(1) << 18, kIndexChunk = size_t(1) << 20, kRecordChunk = size_t(1) << 16;
+  // on all cores; an eighth of that through the ring, so that a slot's batch keeps every core busy.
+  const bool ringed = std::any_of(targets.begin(), targets.end(), [](const Target& t) { return t.size && !t.dst; });
+  const size_t kVertexChunk = size_t(1) << (ringed ? 15 : 18), kIndexChunk = size_t(1) << (ringed ? 17 : 20),
+               kRecordChunk = size_t(1) << (ringed ? 13 : 16);
   // The meshes' records are made while the streams are written (the largest mesh's first).
   std::vector<WriteTask> tasks;
   for (uint32_t mi : plan.order) tasks.push_back({Write::Build, mi, 0, 0});
@@ -581,7 +583,7 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     std::vector<Place> places(tasks.size(), direct);
     std::vector<size_t> staged(tasks.size(), 0), builds, pieces;  // staged: bytes of a piece in the ring
     for (size_t i = 0; i < tasks.size(); ++i) {
-      ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) { staged[i] += targets[k].dst ? 0 : (e - b + 15) & ~size_t(15); });
+      ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) { staged[i] += targets[k].dst ? 0 : e - b + 32; });
       (tasks[i].what == Write::Build ? builds : pieces).push_back(i);
     }
     if (std::all_of(staged.begin(), staged.end(), [](size_t b) { return b == 0; }))
@@ -596,15 +598,22 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
       for (j = i; j < pieces.size() && (j == i || batch + staged[pieces[j]] <= ring->slotBytes()); ++j)
         batch += staged[pieces[j]];
       const uint32_t slot = ring->acquire(batch);
+      // Target by target, each range placed at its byte's alignment (mod 16), right after the one before
+      // where it continues it: one copy region a run (lavapipe maps its memory once per region).
       std::array<std::vector<VkBufferCopy>, kTargets> copies;
-      size_t at = 0;
-      for (size_t q = i; q < j; ++q)
-        ranges(tasks[pieces[q]], [&](uint32_t k, size_t b, size_t e) {
-          if (targets[k].dst) return;
-          places[pieces[q]].at[k] = ring->data(slot) + at, places[pieces[q]].from[k] = b;
-          copies[k].push_back({ring->offset(slot) + at, b, e - b});
-          at += (e - b + 15) & ~size_t(15);
-        });
+      size_t at = ring->offset(slot);
+      for (uint32_t target = 0; target < kTargets; ++target)
+        for (size_t q = i; q < j && !targets[target].dst; ++q)
+          ranges(tasks[pieces[q]], [&](uint32_t k, size_t b, size_t e) {
+            if (k != target) return;
+            std::vector<VkBufferCopy>& c = copies[k];
+            if (c.empty() || c.back().dstOffset + c.back().size != b) {
+              at = ((at + 15) & ~size_t(15)) + b % 16;
+              c.push_back({at, b, 0});
+            }
+            places[pieces[q]].at[k] = ring->data(slot) + (at - ring->offset(slot)), places[pieces[q]].from[k] = b;
+            c.back().size += e - b, at += e - b;
+          });
       parallelFor(*pool, j - i, [&](size_t q) { write(tasks[pieces[i + q]], places[pieces[i + q]]); });
       ring->submit(slot, [&](VkCommandBuffer cb) {
         for (uint32_t k = 0; k < kTargets; ++k)
