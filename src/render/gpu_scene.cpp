@@ -4,8 +4,10 @@
 #include <atomic>
 #include <bit>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <future>
 #include <optional>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -14,6 +16,7 @@
 #include "cluster.h"
 #include "render/cull.hpp"
 #include "render/staging_ring.hpp"
+#include "render/startup.hpp"
 #include "core/error.hpp"
 #include "core/image.hpp"
 #include "core/parallel.hpp"
@@ -29,6 +32,19 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 }  // namespace
+
+// The geometry's buffers, in uploadGeometry's order (its targets) and geometryBuffers()'.
+constexpr const char* kGeometryNames[] = {"positions",  "normals",        "texcoords",    "indices16", "indices32",
+                                          "materials",  "draws",          "instances",    "clusters",  "texcoords1",
+                                          "tangents",   "colours",        "cluster lods", "id pages",  "cull instances",
+                                          "cull nodes", "cluster entries"};
+
+GeometryUpload geometryUpload(const vk::Context& ctx) {
+  const char* env = std::getenv("RTR_UPLOAD");
+  const std::optional<GeometryUpload> named = enumFromName<GeometryUpload>(env ? env : "auto");
+  if (!named) throw UsageError(std::string("RTR_UPLOAD=") + env + ": expected " + enumChoices<GeometryUpload>());
+  return *named == GeometryUpload::Auto ? deviceDefaults(ctx.deviceType()).upload : *named;
+}
 
 // Where one mesh's data goes in the scene-wide streams (counts of elements, not bytes).
 struct MeshSlot {
@@ -150,7 +166,8 @@ shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
 }  // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, const LoadProgress& progress,
-                   GeometryUpload upload, TextureLoad textureLoad, TextureCache* cache, size_t uploadBudget)
+                   GeometryUpload upload, TextureLoad textureLoad, TextureCache* cache, size_t uploadBudget,
+                   size_t geometrySlotBytes)
     : ctx_(ctx), mipMode_(mipMode), progress_(progress), uploadBudget_(uploadBudget), cache_(cache) {
   bounds_ = scene.bounds();
   if (cache_) {  // a chain is the mip mode's on this device and driver (blits and shaders run by it)
@@ -179,7 +196,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
     shownMaterials_ = materials;
   }
-  uploadGeometry(scene, plan, materials, upload);
+  uploadGeometry(scene, plan, materials, upload == GeometryUpload::Auto ? geometryUpload(ctx) : upload, geometrySlotBytes);
   stats_.geometryMs = msSince(t);
   if (!decoding_.valid()) {
     finishTextures();
@@ -359,23 +376,24 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
   return materials;
 }
 
-// Each buffer is device-local. Where the device lets the host write such memory (lavapipe, a GPU with a
-// large BAR) the data is written there directly, on all cores; else into one staging buffer, then copied.
+// Each buffer is device-local. Direct: the host writes it in place where the device lets it map such
+// memory (every CPU device, a GPU with a large BAR), on all cores, every byte crossing the bus as a CPU
+// store. Staged (and any buffer that is not mappable): the same pieces are written on all cores into a
+// ring of host staging slots, a batch of pieces a slot, and the GPU copies each slot into place (DMA)
+// while the next ones are written (docs/startup.md, "Geometry upload").
 void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
-                              GeometryUpload upload) {
+                              GeometryUpload upload, size_t slotBytes) {
   struct Target {
     vk::Buffer* buffer;
     size_t size;
     const void* data = nullptr;  // records copied whole; null: the streams, written below
-    uint8_t* dst = nullptr;
-    const vk::Buffer* staging = nullptr;  // where it is written when not mappable
-    size_t stagingOffset = 0;
+    uint8_t* dst = nullptr;      // mapped; null: written through the staging ring
   };
   const size_t vertices = plan.vertices;
   constexpr VkBufferUsageFlags kVertex = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kIndex = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  enum {
+  enum : uint32_t {
     kPos,
     kNrm,
     kUv,
@@ -419,35 +437,57 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
   const std::array<VkBufferUsageFlags, kTargets> usage{kVertex,  kVertex,  kVertex,  kIndex,   kIndex,   kStorage,
                                                        kStorage, kStorage, kStorage, kStorage, kStorage, kStorage,
                                                        kStorage, kStorage, kStorage, kStorage, kStorage};
-  const char* names[kTargets] = {"positions",    "normals",   "texcoords",      "indices16",  "indices32",      "materials",
-                                 "draws",        "instances", "clusters",       "texcoords1", "tangents",       "colours",
-                                 "cluster lods", "id pages",  "cull instances", "cull nodes", "cluster entries"};
-  // Makes the buffers of the targets sized and not yet made, mapped or placed in `staging`.
-  std::array<vk::Buffer, 2> staging;
-  auto make = [&](vk::Buffer& stage) {
-    size_t stagingSize = 0;
+  // Makes the buffers of the targets sized and not yet made (mapped where direct and the device allows);
+  // copied from too where tests read them back.
+  constexpr VkBufferUsageFlags kTransfer = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  const vk::MemoryUse memory = upload == GeometryUpload::Direct ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device;
+  auto make = [&] {
     for (size_t i = 0; i < kTargets; ++i) {
       Target& tg = targets[i];
       if (tg.size == 0 || tg.buffer->handle()) continue;
-      *tg.buffer = vk::Buffer(ctx_, tg.size, usage[i] | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                              upload == GeometryUpload::Auto ? vk::MemoryUse::DeviceWrite : vk::MemoryUse::Device, names[i]);
+      *tg.buffer = vk::Buffer(ctx_, tg.size, usage[i] | kTransfer, memory, kGeometryNames[i]);
       tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
-      if (!tg.dst) {
-        tg.staging = &stage, tg.stagingOffset = stagingSize;
-        stagingSize += (tg.size + 15) & ~size_t(15);
-      }
-    }
-    if (stagingSize) {
-      stage = vk::Buffer(ctx_, stagingSize, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "geometry staging");
-      for (Target& tg : targets)
-        if (tg.staging == &stage) tg.dst = static_cast<uint8_t*>(stage.mapped()) + tg.stagingOffset;
     }
   };
-  make(staging[0]);
+  make();
+
+  // The bytes of the buffers a piece writes, one range per buffer at most: fn(target, begin, end).
+  auto ranges = [&](const WriteTask& t, auto&& fn) {
+    auto range = [&](uint32_t k, size_t first, size_t end, size_t size) {
+      if (end > first) fn(k, first * size, end * size);
+    };
+    if (t.what == Write::Bytes) return range(t.slot, t.begin, t.end, 1);
+    if (t.what == Write::Entries) {
+      const size_t end = t.end < plan.entries.size() ? plan.entries[t.end].at : plan.baseEntries;
+      return range(kBaseEntries, plan.entries[t.begin].at, end, sizeof(glm::uvec2));
+    }
+    if (t.what == Write::Records) {
+      const size_t first = plan.records[t.slot].first;
+      range(kCluster, first + t.begin, first + t.end, sizeof(shader::GpuCluster));
+      if (plan.lods) range(kLod, first + t.begin, first + t.end, sizeof(shader::GpuClusterLod));
+      return;
+    }
+    if (t.what == Write::Nodes) {
+      const size_t first = plan.records[t.slot].firstLevel;
+      return range(kCullNode, first + t.begin, first + t.end, sizeof(shader::GpuCullNode));
+    }
+    if (t.what == Write::Build) return;
+    const MeshSlot& s = plan.slots[t.slot];
+    if (t.what == Write::Indices) return range(s.index16 ? kI16 : kI32, s.index + t.begin, s.index + t.end, s.index16 ? 2 : 4);
+    for (auto [k, stride] : {std::pair{kPos, 12}, {kNrm, 12}, {kUv, 8}, {kUv1, 8}, {kTan, 16}, {kCol, 16}})
+      if (targets[k].size) range(k, s.vertex + t.begin, s.vertex + t.end, size_t(stride));
+  };
+  // Where a piece writes byte b of target k: at[k] + (b - from[k]); in place, or in its slot of the ring.
+  struct Place {
+    std::array<uint8_t*, kTargets> at;
+    std::array<size_t, kTargets> from{};
+  };
 
   // Pieces of at most 256 Ki vertices, 1 Mi indices, 64 Ki records, 1 MiB or 1 Mi base entries, written
-  // on all cores.
-  constexpr size_t kVertexChunk = size_t(1) << 18, kIndexChunk = size_t(1) << 20, kRecordChunk = size_t(1) << 16;
+  // on all cores; an eighth of that through the ring, so that a slot's batch keeps every core busy.
+  const bool ringed = std::any_of(targets.begin(), targets.end(), [](const Target& t) { return t.size && !t.dst; });
+  const size_t kVertexChunk = size_t(1) << (ringed ? 15 : 18), kIndexChunk = size_t(1) << (ringed ? 17 : 20),
+               kRecordChunk = size_t(1) << (ringed ? 13 : 16);
   // The meshes' records are made while the streams are written (the largest mesh's first).
   std::vector<WriteTask> tasks;
   for (uint32_t mi : plan.order) tasks.push_back({Write::Build, mi, 0, 0});
@@ -457,34 +497,35 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     for (size_t b = 0, n = plan.slots[s].mesh->indices.size() + plan.slots[s].mesh->lod.indices.size(); b < n; b += kIndexChunk)
       tasks.push_back({Write::Indices, s, b, std::min(n, b + kIndexChunk)});
   }
-  auto writePiece = [&](const WriteTask& task) {
+  auto writePiece = [&](const WriteTask& task, const Place& place) {
+    auto to = [&](uint32_t k, size_t byte) { return place.at[k] + (byte - place.from[k]); };
     if (task.what == Write::Bytes) {
-      std::memcpy(targets[task.slot].dst + task.begin, static_cast<const uint8_t*>(targets[task.slot].data) + task.begin,
+      std::memcpy(to(task.slot, task.begin), static_cast<const uint8_t*>(targets[task.slot].data) + task.begin,
                   task.end - task.begin);
       return;
     }
     if (task.what == Write::Entries) {
-      auto* dst = reinterpret_cast<glm::uvec2*>(targets[kBaseEntries].dst);
       for (size_t j = task.begin; j < task.end; ++j) {
         const GeometryPlan::Entries& e = plan.entries[j];
         const MeshRecords& r = plan.records[e.mesh];
-        for (uint32_t k = 0; k < r.level0; ++k) dst[e.at + k] = glm::uvec2(e.instance, r.first + k);
+        auto* dst = reinterpret_cast<glm::uvec2*>(to(kBaseEntries, e.at * sizeof(glm::uvec2)));
+        for (uint32_t k = 0; k < r.level0; ++k) dst[k] = glm::uvec2(e.instance, r.first + k);
       }
       return;
     }
     if (task.what == Write::Records) {  // in the scene-wide numbering
       const MeshRecords& r = plan.records[task.slot];
       const size_t n = task.end - task.begin;
-      std::memcpy(targets[kCluster].dst + (r.first + task.begin) * sizeof(shader::GpuCluster), &r.clusters[task.begin],
+      std::memcpy(to(kCluster, (r.first + task.begin) * sizeof(shader::GpuCluster)), &r.clusters[task.begin],
                   n * sizeof(shader::GpuCluster));
       if (plan.lods)
-        std::memcpy(targets[kLod].dst + (r.first + task.begin) * sizeof(shader::GpuClusterLod), &r.lods[task.begin],
+        std::memcpy(to(kLod, (r.first + task.begin) * sizeof(shader::GpuClusterLod)), &r.lods[task.begin],
                     n * sizeof(shader::GpuClusterLod));
       return;
     }
     if (task.what == Write::Nodes) {  // leaves name records, other nodes their children: both renumbered
       const MeshRecords& r = plan.records[task.slot];
-      auto* dst = reinterpret_cast<shader::GpuCullNode*>(targets[kCullNode].dst) + r.firstLevel;
+      auto* dst = reinterpret_cast<shader::GpuCullNode*>(to(kCullNode, r.firstLevel * sizeof(shader::GpuCullNode)));
       for (size_t k = 0; k < r.nodes.size(); ++k) {
         shader::GpuCullNode node = r.nodes[k];
         node.first += node.count & CULL_NODE_LEAF ? r.first : r.firstLevel;
@@ -502,34 +543,91 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
         const uint32_t* src = lod ? &m.lod.indices[b - own] : &m.indices[b];
         const size_t run = std::min(task.end, lod ? task.end : own) - b;
         if (slot.index16) {
-          auto* dst = reinterpret_cast<uint16_t*>(targets[kI16].dst) + slot.index + b;
+          auto* dst = reinterpret_cast<uint16_t*>(to(kI16, (slot.index + b) * 2));
           for (size_t k = 0; k < run; ++k) dst[k] = uint16_t(src[k]);
         } else {
-          std::memcpy(targets[kI32].dst + (slot.index + b) * 4, src, run * 4);
+          std::memcpy(to(kI32, (slot.index + b) * 4), src, run * 4);
         }
         b += run;
       }
       return;
     }
     const size_t v = slot.vertex + task.begin;
-    std::memcpy(targets[kPos].dst + v * 12, &m.positions[task.begin], n * 12);
+    std::memcpy(to(kPos, v * 12), &m.positions[task.begin], n * 12);
     // A stream a mesh lacks reads as zeros, so that every stream stays aligned with the positions.
-    auto stream = [&](uint8_t* dst, const auto& src, size_t stride) {
+    auto stream = [&](uint32_t k, const auto& src, size_t stride) {
       const size_t have = std::min(n, src.size() > task.begin ? src.size() - task.begin : 0);
-      if (have) std::memcpy(dst + v * stride, &src[task.begin], have * stride);
-      if (have < n) std::memset(dst + (v + have) * stride, 0, (n - have) * stride);
+      if (have) std::memcpy(to(k, v * stride), &src[task.begin], have * stride);
+      if (have < n) std::memset(to(k, (v + have) * stride), 0, (n - have) * stride);
     };
-    stream(targets[kNrm].dst, m.normals, 12);
-    if (plan.anyTexcoords) stream(targets[kUv].dst, m.texcoords, 8);
-    if (plan.anyUv1) stream(targets[kUv1].dst, m.texcoords1, 8);
-    if (plan.anyTangents) stream(targets[kTan].dst, m.tangents, 16);
-    if (plan.anyColors) stream(targets[kCol].dst, m.colors, 16);
+    stream(kNrm, m.normals, 12);
+    if (plan.anyTexcoords) stream(kUv, m.texcoords, 8);
+    if (plan.anyUv1) stream(kUv1, m.texcoords1, 8);
+    if (plan.anyTangents) stream(kTan, m.tangents, 16);
+    if (plan.anyColors) stream(kCol, m.colors, 16);
   };
-  auto write = [&](const WriteTask& task) {
+  auto write = [&](const WriteTask& task, const Place& place) {
     if (task.what == Write::Build) return buildRecords(scene, plan, task.slot, plan.records[task.slot]);
-    writePiece(task);
+    writePiece(task, place);
   };
-  parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i]); });
+
+  std::optional<StagingRing> ring;
+  std::unique_ptr<ThreadPool> pool;
+  // Runs the pieces on all cores. Where a buffer is not mapped, its bytes go through the ring: the pieces
+  // in batches whose staged bytes fit a slot (at least one piece), each batch written into its slot and
+  // copied by a submission of its own, which runs while the next batches are written; a slot is written
+  // again once its copies have completed. The records are made beside the batches, on threads of their own.
+  auto run = [&](const std::vector<WriteTask>& tasks) {
+    Place direct;
+    for (uint32_t k = 0; k < kTargets; ++k) direct.at[k] = targets[k].dst;
+    std::vector<Place> places(tasks.size(), direct);
+    std::vector<size_t> staged(tasks.size(), 0), builds, pieces;  // staged: bytes of a piece in the ring
+    for (size_t i = 0; i < tasks.size(); ++i) {
+      ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) { staged[i] += targets[k].dst ? 0 : e - b + 32; });
+      (tasks[i].what == Write::Build ? builds : pieces).push_back(i);
+    }
+    if (std::all_of(staged.begin(), staged.end(), [](size_t b) { return b == 0; }))
+      return parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i], places[i]); });
+    auto building = std::async(std::launch::async, [&] {
+      parallelFor(builds.size(), 0, [&](size_t i) { write(tasks[builds[i]], places[builds[i]]); });
+    });
+    if (!ring) ring.emplace(ctx_, slotBytes, kGeometrySlots, vk::MemoryUse::Upload, "geometry staging ring");
+    if (!pool) pool = std::make_unique<ThreadPool>(threadCount() - 1);
+    for (size_t i = 0, j; i < pieces.size(); i = j) {
+      size_t batch = 0;
+      for (j = i; j < pieces.size() && (j == i || batch + staged[pieces[j]] <= ring->slotBytes()); ++j)
+        batch += staged[pieces[j]];
+      const uint32_t slot = ring->acquire(batch);
+      // Target by target, each range placed at its byte's alignment (mod 16), right after the one before
+      // where it continues it: one copy region a run (lavapipe maps its memory once per region).
+      std::array<std::vector<VkBufferCopy>, kTargets> copies;
+      size_t at = ring->offset(slot);
+      for (uint32_t target = 0; target < kTargets; ++target)
+        for (size_t q = i; q < j && !targets[target].dst; ++q)
+          ranges(tasks[pieces[q]], [&](uint32_t k, size_t b, size_t e) {
+            if (k != target) return;
+            std::vector<VkBufferCopy>& c = copies[k];
+            if (c.empty() || c.back().dstOffset + c.back().size != b) {
+              at = ((at + 15) & ~size_t(15)) + b % 16;
+              c.push_back({at, b, 0});
+            }
+            places[pieces[q]].at[k] = ring->data(slot) + (at - ring->offset(slot)), places[pieces[q]].from[k] = b;
+            c.back().size += e - b, at += e - b;
+          });
+      parallelFor(*pool, j - i, [&](size_t q) { write(tasks[pieces[i + q]], places[pieces[i + q]]); });
+      ring->submit(slot, [&](VkCommandBuffer cb) {
+        for (uint32_t k = 0; k < kTargets; ++k)
+          if (!copies[k].empty())
+            vkCmdCopyBuffer(cb, ring->buffer(), targets[k].buffer->handle(), uint32_t(copies[k].size()), copies[k].data());
+        // Orders the copies before the later ones and the frames' reads, which come in later submissions.
+        vk::bufferBarrier(cb, vk::kCopyWrite,
+                          vk::kCopyWrite | vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
+      });
+      ++stats_.geometryCopies;
+    }
+    building.get();
+  };
+  run(tasks);
 
   placeRecords(scene, plan);
   // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
@@ -548,7 +646,7 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
   targets[kCullInst] = {&cullInstances_, bytes(plan.cullInstances), plan.cullInstances.data()};
   targets[kCullNode] = {&cullNodes_, plan.nodes * sizeof(shader::GpuCullNode)};
   targets[kBaseEntries] = {&baseEntries_, plan.baseEntries * sizeof(glm::uvec2)};
-  make(staging[1]);
+  make();
   tasks.clear();
   for (uint32_t mi = 0; mi < plan.records.size(); ++mi) {
     for (size_t b = 0, n = plan.records[mi].count; b < n; b += kRecordChunk)
@@ -564,21 +662,22 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     tasks.push_back({Write::Entries, 0, j, e});
     j = e;
   }
-  parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i]); });
+  run(tasks);
   for (const Target& tg : targets)
-    if (tg.size) (tg.staging ? *tg.staging : *tg.buffer).flush();
-  if (staging[0].handle() || staging[1].handle())
-    vk::submitAndWait(ctx_, [&](VkCommandBuffer cb) {
-      for (const Target& tg : targets)
-        if (tg.size && tg.staging) {
-          VkBufferCopy region{tg.stagingOffset, 0, tg.size};
-          vkCmdCopyBuffer(cb, tg.staging->handle(), tg.buffer->handle(), 1, &region);
-        }
-      // Also orders the copies before the frames' reads, which come in later submissions.
-      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
-    });
+    if (tg.size && tg.dst) tg.buffer->flush();
+  ring.reset();                                                                     // waits for the last copies
+  stats_.geometryUpload = stats_.geometryCopies ? GeometryUpload::Staged : upload;  // direct: unless a buffer was not mappable
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
+}
+
+std::vector<std::pair<const char*, const vk::Buffer*>> GpuScene::geometryBuffers() const {
+  const vk::Buffer* in[] = {&positions_,   &normals_,    &texcoords_,     &indices16_,  &indices32_,  &materials_,
+                            &drawInfo_,    &instances_,  &clusters_,      &texcoords1_, &tangents_,   &colors_,
+                            &clusterLods_, &visIdPages_, &cullInstances_, &cullNodes_,  &baseEntries_};
+  std::vector<std::pair<const char*, const vk::Buffer*>> out;
+  for (size_t i = 0; i < std::size(in); ++i) out.emplace_back(kGeometryNames[i], in[i]);
+  return out;
 }
 
 std::pair<uint32_t, uint32_t> GpuScene::decodeVisId(uint32_t id) const {

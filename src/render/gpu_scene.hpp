@@ -4,8 +4,8 @@
 // that some drawn material uses (decoded on all cores, uploaded batch by batch through one staging ring,
 // mips generated on the GPU, or under MipMode::Auto on the CPU for small ones; baked and cached chains
 // unpacked straight into the ring: render/textures.cpp).
-// Geometry is written on all cores straight into device-local memory where the host can write it (every
-// CPU device, a GPU with a large BAR), else into one staging buffer and copied. Nothing unused is created.
+// Geometry is written on all cores straight into device-local memory where the host can write it (Direct),
+// or into a ring of staging slots that the GPU copies into place (Staged). Nothing unused is created.
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -61,6 +61,17 @@ struct BlendDraw {
 };
 struct GeometryPlan;
 
+// How the geometry reaches device memory (docs/startup.md, "Geometry upload"): Direct, written by the
+// CPU in place where the host can map it (a buffer that is not mappable goes as Staged); Staged, written
+// into a ring of host staging slots and copied by the GPU (DMA) while the next slots are written; Auto,
+// RTR_UPLOAD=direct|staged where set, else the device's default (render::deviceDefaults).
+enum class GeometryUpload { Auto, Direct, Staged };
+constexpr std::array<EnumName<GeometryUpload>, 3> enumNames(GeometryUpload) {
+  return {{{GeometryUpload::Auto, "auto"}, {GeometryUpload::Direct, "direct"}, {GeometryUpload::Staged, "staged"}}};
+}
+// What Auto means on this device: RTR_UPLOAD, else the device's default (an unknown RTR_UPLOAD: UsageError).
+GeometryUpload geometryUpload(const vk::Context& ctx);
+
 // The loading phases, in order; they do not overlap, and together they are the constructor's time
 // (pipeline creation for the mips aside, which the context's pipeline cache counts).
 struct GpuSceneStats {
@@ -78,6 +89,8 @@ struct GpuSceneStats {
   uint32_t stagingAllocations = 0;  // staging buffers made for textures (the ring's: 1 unless a texture outgrew it)
   size_t stagingBytes = 0;          // their size
   size_t geometryBytes = 0;
+  GeometryUpload geometryUpload = GeometryUpload::Direct;  // the path taken (Direct or Staged)
+  uint32_t geometryCopies = 0;                             // copy submissions from the geometry's staging ring
 };
 
 // Told how far a long load is: what it does, how many of how many are done (serialised calls).
@@ -103,10 +116,6 @@ float maxAnisotropy(const vk::Context& ctx);
 // to maxAnisotropy(ctx).
 vk::Sampler makeSampler(const vk::Context& ctx, const SamplerSettings& settings, const SamplerDesc& desc = {});
 
-// How the geometry reaches device memory: written in place where the host can map it (Auto), or always
-// through a staging buffer and a copy (what a device without host-visible device memory gets; tests).
-enum class GeometryUpload { Auto, Staging };
-
 // Whether the constructor returns with the textures on the GPU (Wait), or leaves them decoding on worker
 // threads (Deferred): updateTextures() takes them in as they are decoded, a batch at a time; until its
 // texture is in, a material's slot shows its factor alone.
@@ -121,9 +130,10 @@ class GpuScene {
   // first (a hit: the chain as this device made it, uploaded whole), and the chains of those not found are
   // stored once the GPU has made them (read back, then packed and written on a worker thread).
   // `uploadBudget`: bytes of texels per upload batch (setUploadBudget), which sizes the staging ring.
+  // `geometrySlotBytes`: the slots of a Staged geometry upload's ring (tests make them small).
   GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mips, const LoadProgress& progress = {},
            GeometryUpload upload = GeometryUpload::Auto, TextureLoad textures = TextureLoad::Wait, TextureCache* cache = nullptr,
-           size_t uploadBudget = kDefaultUploadBudget);
+           size_t uploadBudget = kDefaultUploadBudget, size_t geometrySlotBytes = kGeometrySlotBytes);
   ~GpuScene();
   GpuScene(const GpuScene&) = delete;
   GpuScene& operator=(const GpuScene&) = delete;
@@ -144,6 +154,10 @@ class GpuScene {
   // The per-batch budget (bytes of staged texels, every level included; a waited load's batches too). The
   // staging ring holds two batches; a change after the first batch changes the batches, not the ring.
   static constexpr size_t kDefaultUploadBudget = size_t(16) << 20;
+  // The geometry's staging ring (a Staged upload): kGeometrySlots slots of kGeometrySlotBytes (a piece larger
+  // than a slot makes them that large), freed once the upload is done.
+  static constexpr size_t kGeometrySlotBytes = size_t(32) << 20;
+  static constexpr uint32_t kGeometrySlots = 4;
   void setUploadBudget(size_t bytes) { uploadBudget_ = bytes; }
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
@@ -200,6 +214,8 @@ class GpuScene {
   const std::vector<SamplerDesc>& textureSamplers() const { return samplers_; }  // per texture, its own
   const Bounds& bounds() const { return bounds_; }
   const GpuSceneStats& stats() const { return stats_; }
+  // Every geometry buffer by name (null where the scene needs none): tests compare two uploads' bytes.
+  std::vector<std::pair<const char*, const vk::Buffer*>> geometryBuffers() const;
 
  private:
   std::vector<uint32_t> startTextures(const Scene& scene, TextureLoad load);  // decode (or start to)
@@ -208,7 +224,7 @@ class GpuScene {
   std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
   // Streams written and records made on all cores, then placed and written.
   void uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
-                      GeometryUpload upload);
+                      GeometryUpload upload, size_t slotBytes);
   void finishTextures();                                 // staging buffers to images, mips (a waited load)
   std::vector<uint32_t> nextBatch(bool wait);            // a deferred load's next textures, by the budget
   void startUpload(const std::vector<uint32_t>& batch);  // the same in one submission, not waited for

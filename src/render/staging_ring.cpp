@@ -4,8 +4,12 @@
 
 namespace rtr::render {
 
-StagingRing::StagingRing(const vk::Context& ctx, size_t slotBytes, uint32_t slots)
-    : ctx_(ctx), slotBytes_((std::max<size_t>(slotBytes, 1) + 255) & ~size_t(255)), reading_(std::max(slots, 1u)) {}
+StagingRing::StagingRing(const vk::Context& ctx, size_t slotBytes, uint32_t slots, vk::MemoryUse use, const char* name)
+    : ctx_(ctx),
+      slotBytes_((std::max<size_t>(slotBytes, 1) + 255) & ~size_t(255)),
+      use_(use),
+      name_(name),
+      reading_(std::max(slots, 1u)) {}
 
 StagingRing::~StagingRing() { waitAll(); }
 
@@ -19,12 +23,8 @@ uint32_t StagingRing::acquire(size_t bytes) {
     buffer_ = {};
     slotBytes_ = (bytes + 255) & ~size_t(255);
   }
-  // Host-cached memory where the device has it: zstd reads back what it wrote (its matches), which
-  // write-combined memory makes slow; the device's copies read it either way.
   if (!buffer_.handle())
-    buffer_ = vk::Buffer(ctx_, slotBytes_ * reading_.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Readback,
-                         "texture staging ring"),
-    ++allocations_;
+    buffer_ = vk::Buffer(ctx_, slotBytes_ * reading_.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, use_, name_), ++allocations_;
   const uint32_t slot = next_;
   next_ = (next_ + 1) % uint32_t(reading_.size());
   reading_[slot].reset();

@@ -1,5 +1,5 @@
 #pragma once
-// Staging memory for texture uploads, allocated once and reused batch after batch (docs/startup.md,
+// Staging memory for uploads (the textures', a Staged geometry upload's), allocated once and reused batch after batch (docs/startup.md,
 // "Staging ring"): one persistently mapped host buffer cut into slots; a batch's texels are written into a
 // slot (unpacked or copied on all cores) and copied to its images by one submission, and a slot is written
 // again only once the submission that read it has completed. A load allocates no staging memory per
@@ -17,8 +17,11 @@ namespace rtr::render {
 
 class StagingRing {
  public:
-  // `slots` slots of `slotBytes` each (rounded up to 256), made on first use.
-  StagingRing(const vk::Context& ctx, size_t slotBytes, uint32_t slots);
+  // `slots` slots of `slotBytes` each (rounded up to 256), made on first use: host-cached memory for the
+  // textures (Readback: zstd reads back what it wrote, which write-combined memory makes slow), Upload for
+  // data written once.
+  StagingRing(const vk::Context& ctx, size_t slotBytes, uint32_t slots, vk::MemoryUse use = vk::MemoryUse::Readback,
+              const char* name = "texture staging ring");
   ~StagingRing();  // waits for the submissions still reading it
   StagingRing(const StagingRing&) = delete;
   StagingRing& operator=(const StagingRing&) = delete;
@@ -42,6 +45,8 @@ class StagingRing {
  private:
   const vk::Context& ctx_;
   size_t slotBytes_;
+  vk::MemoryUse use_;
+  const char* name_;
   vk::Buffer buffer_;
   std::vector<std::optional<vk::Submission>> reading_;  // per slot: the submission that last read it
   uint32_t next_ = 0, allocations_ = 0, submissions_ = 0;

@@ -38,7 +38,8 @@ class StartupTimeline {
 struct DeviceDefaults {
   ShadingPath shading;
   MipMode mips;
-  bool computeClip;  // the compute rasteriser's near-plane crossings clipped in compute, not handed to the hardware
+  bool computeClip;       // the compute rasteriser's near-plane crossings clipped in compute, not handed to the hardware
+  GeometryUpload upload;  // Direct or Staged (RTR_UPLOAD overrides: render::geometryUpload)
   // The compute rasteriser's hardware|compute choice belongs in this table too, once it is measured.
   const char* why;  // one line: the device class and where the measurements are
 };

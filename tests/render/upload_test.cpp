@@ -1,11 +1,16 @@
-// The scene upload's two ways into device memory give the same frames: written in place where the host
-// maps device memory (every CPU device), or through a staging buffer and a copy (a GPU without a large
-// BAR). The scene has 16- and 32-bit indices, textured and untextured meshes.
+// The scene upload's two ways into device memory give the same bytes and frames: written in place where
+// the host maps device memory (direct), or through a ring of staging slots copied by the GPU (staged).
+// The scene has 16- and 32-bit indices, textured and untextured meshes, and a hierarchy.
+#include <cstdlib>
+#include <cstring>
+
 #include <gtest/gtest.h>
 
+#include "core/error.hpp"
 #include "render/headless.hpp"
 #include "scene/load.hpp"
 #include "test_paths.hpp"
+#include "vk/commands.hpp"
 #include "vk_fixture.hpp"
 
 namespace rtr {
@@ -37,13 +42,86 @@ Scene templeWithGrid() {
   return s;
 }
 
+std::vector<uint8_t> readBack(const vk::Context& ctx, const vk::Buffer& b) {
+  vk::Buffer host(ctx, b.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "read-back");
+  vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
+    const VkBufferCopy region{0, 0, b.size()};
+    vkCmdCopyBuffer(cb, b.handle(), host.handle(), 1, &region);
+    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+  });
+  host.invalidate();
+  const auto* p = static_cast<const uint8_t*>(host.mapped());
+  return {p, p + b.size()};
+}
+
+// Every geometry buffer read back equals the direct upload's byte for byte, whether the staged ring's
+// slots are the default's (a batch for each of the two passes here) or 64 KiB (more batches than slots,
+// each slot written again after its copies; pieces larger than a slot grow it). indices16's last two
+// bytes may be padding that nobody writes.
+TEST_F(VulkanTest, DirectAndStagedGeometryUploadsWriteTheSameBytes) {
+  const Scene scene = templeWithGrid();
+  size_t indices16 = 0;
+  for (const Mesh& m : scene.meshes)
+    if (m.positions.size() <= 65536) indices16 += m.indices.size() + m.lod.indices.size();
+  using render::GeometryUpload;
+  const render::GpuScene direct(*ctx, scene, render::MipMode::Compute, {}, GeometryUpload::Direct);
+  EXPECT_EQ(direct.stats().geometryUpload, GeometryUpload::Direct);
+  EXPECT_EQ(direct.stats().geometryCopies, 0u);
+  EXPECT_NE(direct.clusterLods(), VK_NULL_HANDLE) << "no hierarchy";
+  EXPECT_LT(direct.stats().meshes16, direct.stats().meshes) << "no mesh with 32-bit indices";
+  EXPECT_GT(direct.stats().meshes16, 0u) << "no mesh with 16-bit indices";
+  for (size_t slot : {render::GpuScene::kGeometrySlotBytes, size_t(64) << 10}) {
+    const render::GpuScene staged(*ctx, scene, render::MipMode::Compute, {}, GeometryUpload::Staged, render::TextureLoad::Wait,
+                                  nullptr, render::GpuScene::kDefaultUploadBudget, slot);
+    EXPECT_EQ(staged.stats().geometryUpload, GeometryUpload::Staged);
+    // Small slots: more batches than slots, so slots are written again.
+    EXPECT_GT(staged.stats().geometryCopies, slot < staged.stats().geometryBytes ? render::GpuScene::kGeometrySlots : 1u)
+        << "slot " << slot;
+    const auto a = direct.geometryBuffers(), b = staged.geometryBuffers();
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      SCOPED_TRACE(std::string(a[i].first) + ", slot " + std::to_string(slot));
+      ASSERT_EQ(a[i].second->handle() == VK_NULL_HANDLE, b[i].second->handle() == VK_NULL_HANDLE);
+      if (!a[i].second->handle()) continue;
+      ASSERT_EQ(a[i].second->size(), b[i].second->size());
+      std::vector<uint8_t> x = readBack(*ctx, *a[i].second), y = readBack(*ctx, *b[i].second);
+      if (std::string(a[i].first) == "indices16") x.resize(indices16 * 2), y.resize(indices16 * 2);
+      size_t first = 0;
+      while (first < x.size() && x[first] == y[first]) ++first;
+      EXPECT_EQ(first, x.size()) << "first differing byte";
+    }
+  }
+}
+
+// RTR_UPLOAD chooses where the caller leaves it to the device (Auto): lavapipe's default is direct.
+TEST_F(VulkanTest, RtrUploadChoosesTheGeometryPath) {
+  const char* before = std::getenv("RTR_UPLOAD");
+  const std::string saved = before ? before : "";
+  ::unsetenv("RTR_UPLOAD");
+  EXPECT_EQ(render::geometryUpload(*ctx),
+            ctx->deviceType() == VK_PHYSICAL_DEVICE_TYPE_CPU ? render::GeometryUpload::Direct : render::GeometryUpload::Staged);
+  ::setenv("RTR_UPLOAD", "staged", 1);
+  EXPECT_EQ(render::geometryUpload(*ctx), render::GeometryUpload::Staged);
+  Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  EXPECT_EQ(render::GpuScene(*ctx, scene, render::MipMode::Compute).stats().geometryUpload, render::GeometryUpload::Staged);
+  ::setenv("RTR_UPLOAD", "direct", 1);
+  EXPECT_EQ(render::geometryUpload(*ctx), render::GeometryUpload::Direct);
+  ::setenv("RTR_UPLOAD", "dma", 1);
+  try {
+    render::geometryUpload(*ctx);
+    ADD_FAILURE() << "RTR_UPLOAD=dma accepted";
+  } catch (const UsageError& e) { EXPECT_STREQ(e.what(), "RTR_UPLOAD=dma: expected auto, direct or staged"); }
+  if (before) ::setenv("RTR_UPLOAD", saved.c_str(), 1);
+  else ::unsetenv("RTR_UPLOAD");
+}
+
 TEST_F(VulkanTest, StagedAndInPlaceGeometryUploadsRenderTheSame) {
   const Scene scene = templeWithGrid();
   const CameraPose pose = scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 16.0f / 9.0f));
   const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
   // Both alive at once, so that neither reuses memory the other filled.
-  const render::GpuScene inPlace(*ctx, scene, render::MipMode::Compute, {}, render::GeometryUpload::Auto);
-  const render::GpuScene staged(*ctx, scene, render::MipMode::Compute, {}, render::GeometryUpload::Staging);
+  const render::GpuScene inPlace(*ctx, scene, render::MipMode::Compute, {}, render::GeometryUpload::Direct);
+  const render::GpuScene staged(*ctx, scene, render::MipMode::Compute, {}, render::GeometryUpload::Staged);
   std::vector<std::vector<uint8_t>> images[2];
   for (const render::GpuScene* gpu : {&inPlace, &staged}) {
     EXPECT_LT(gpu->stats().meshes16, gpu->stats().meshes) << "no mesh with 32-bit indices";
