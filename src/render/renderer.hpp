@@ -113,8 +113,8 @@ class Renderer {
     std::optional<ComputeRaster::Pipelines> raster;
     std::optional<vk::Pipeline> mosaic, backdrop;
   };
-  // Makes, in parallel, those that a frame with `first` will use (from this thread, not readSceneColor's)
-  // for a scene of these kinds, with an environment or none (setEnvironment).
+  // Makes, in parallel, those that a frame with `first` will use (one whose scene colour is not read back)
+  // for a scene of these kinds, with an environment or none (setEnvironment). Any thread.
   static Prepared prepare(const vk::Context& ctx, const SceneKinds& kinds, const RenderSettings& first, bool environment);
 
   // `prepared`: taken on their first use where made for this scene's kinds and environment; the rest is
