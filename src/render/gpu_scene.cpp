@@ -182,14 +182,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   const auto t = Clock::now();
   GeometryPlan plan = planGeometry(scene);
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
-  materialExtras_ = std::any_of(scene.materials.begin(), scene.materials.end(),
-                                [](const Material& m) {
-                                  return (m.flags & (kMaterialGltf | kMaterialUnlit)) ||
-                                         std::any_of(m.uv.begin(), m.uv.end(),
-                                                     [](const UvTransform& u) { return !u.identity() || u.texCoord != 0; });
-                                }) ||
-                    std::any_of(scene.meshes.begin(), scene.meshes.end(),
-                                [](const Mesh& m) { return !m.colors.empty() || !m.tangents.empty() || !m.texcoords1.empty(); });
+  materialExtras_ = sceneKinds(scene).materialExtras;
   if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
     texturedMaterials_ = materials;
     for (shader::GpuMaterial& g : materials)

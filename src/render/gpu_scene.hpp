@@ -72,6 +72,24 @@ constexpr std::array<EnumName<GeometryUpload>, 3> enumNames(GeometryUpload) {
 // What Auto means on this device: RTR_UPLOAD, else the device's default (an unknown RTR_UPLOAD: UsageError).
 GeometryUpload geometryUpload(const vk::Context& ctx);
 
+// What a renderer's pipelines and its choice of path depend on, of a scene: its kinds, not its bytes.
+// sceneKinds() computes them from the Scene (no GPU, microseconds), so that the pipelines can be made while
+// the scene uploads (Renderer::prepare); GpuScene::kinds() gives them from what the upload made, and the
+// two are equal (render_test SceneKindsAreWhatTheUploadMakes).
+struct SceneKinds {
+  std::array<bool, kDrawKindCount> draws{};  // by DrawKind: some instance draws a mesh of that kind
+  bool blended = false;                      // glTF BLEND draws (the transparency pass)
+  bool texcoords = false;                    // some mesh has texture coordinates (the stream exists)
+  bool materialExtras = false;               // GpuScene::materialExtras
+  uint32_t textures = 0;                     // textures a drawn material samples: the layouts' array sizes
+  uint32_t instances = 0;                    // drawn placements (GpuInstance records)
+  uint64_t triangles = 0;                    // of every drawn instance, blended ones aside
+  uint64_t visIds = 0;                       // GpuScene::visIdCount
+  bool clusterIdsFit = true;                 // the compute rasteriser's lists can name every (instance, cluster) record
+  bool operator==(const SceneKinds&) const = default;
+};
+SceneKinds sceneKinds(const Scene& scene);
+
 // The loading phases, in order; they do not overlap, and together they are the constructor's time
 // (pipeline creation for the mips aside, which the context's pipeline cache counts).
 struct GpuSceneStats {
@@ -173,6 +191,7 @@ class GpuScene {
   // Whether some draw needs what glTF adds to a material (texture transforms, the second uv set, vertex
   // colours, tangents, normal and occlusion maps, unlit, GGX): the shading pass's MATERIAL_EXTRAS variant.
   bool materialExtras() const { return materialExtras_; }
+  SceneKinds kinds() const;  // as uploaded: sceneKinds() of the scene
   VkBuffer indices16() const { return indices16_.handle(); }
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }

@@ -6,8 +6,8 @@
 
 namespace rtr::render {
 
-HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent)
-    : ctx_(ctx), extent_(extent), renderer_(ctx, scene, 1), ring_(ctx, 1) {
+HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent, Renderer::Prepared prepared)
+    : ctx_(ctx), extent_(extent), renderer_(ctx, scene, 1, std::move(prepared)), ring_(ctx, 1) {
   target_ = vk::Image(ctx, {extent, VK_FORMAT_R8G8B8A8_UNORM, 1,
                             VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0,
                             0, "headless target"});

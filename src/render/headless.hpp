@@ -17,7 +17,7 @@ struct HeadlessFrame {
 
 class HeadlessRenderer {
  public:
-  HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent);
+  HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent, Renderer::Prepared prepared = {});
 
   // Renders `frames` frames (the last one is read back).
   HeadlessFrame render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings, int frames = 1,

@@ -7,8 +7,10 @@
 
 namespace rtr::render {
 
-MosaicPass::MosaicPass(const vk::Context& ctx) : ctx_(ctx) {
-  compute_ = vk::makeComputePipeline(ctx, vk::loadShader("mosaic.comp"), {.pushDescriptorSets = {0}});
+MosaicPass::MosaicPass(const vk::Context& ctx, std::optional<vk::Pipeline> compute) : ctx_(ctx), compute_(std::move(compute)) {}
+
+vk::Pipeline MosaicPass::makeCompute(const vk::Context& ctx) {
+  return vk::makeComputePipeline(ctx, vk::loadShader("mosaic.comp"), {.pushDescriptorSets = {0}});
 }
 
 void MosaicPass::setBlock(VkExtent2D block) {
@@ -48,7 +50,8 @@ void MosaicPass::record(VkCommandBuffer cb, vk::TrackedImage input, VkImageView 
     vkCmdDraw(cb, 3, 1, 0, 0);
     vkCmdEndRendering(cb);
   } else {
-    const vk::Pipeline& c = compute_;
+    if (!compute_) compute_ = makeCompute(ctx_);
+    const vk::Pipeline& c = *compute_;
     c.bind(cb);
     vk::DescriptorWriter(ctx_, c.layout, 0, VK_NULL_HANDLE)
         .image(0, inputView, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)

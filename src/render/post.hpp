@@ -10,6 +10,7 @@
 // Graphics. The output is left as written; the caller requires what comes next (copy, present).
 #include <array>
 #include <map>
+#include <optional>
 
 #include <vulkan/vulkan.h>
 
@@ -25,7 +26,10 @@ constexpr std::array<EnumName<MosaicMode>, 3> enumNames(MosaicMode) {
 
 class MosaicPass {
  public:
-  explicit MosaicPass(const vk::Context& ctx);  // builds the compute pipeline; graphics ones per format
+  // The compute pipeline (Compute and Off): `compute` where made ahead (makeCompute), else on first use;
+  // graphics ones per format, on first use.
+  explicit MosaicPass(const vk::Context& ctx, std::optional<vk::Pipeline> compute = {});
+  static vk::Pipeline makeCompute(const vk::Context& ctx);
 
   void setBlock(VkExtent2D block);  // 5x3 by default
   VkExtent2D block() const { return block_; }
@@ -37,7 +41,7 @@ class MosaicPass {
   const vk::Pipeline& graphics(VkFormat format);
   const vk::Context& ctx_;
   VkExtent2D block_{5, 3};
-  vk::Pipeline compute_;
+  std::optional<vk::Pipeline> compute_;
   std::map<VkFormat, vk::Pipeline> graphics_;
 };
 

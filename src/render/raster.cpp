@@ -51,22 +51,38 @@ std::vector<vk::SpecializationConstant> withRowQueue(std::vector<vk::Specializat
 
 }  // namespace
 
-ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), culled_(framesInFlight, false), twoPhase_(framesInFlight, false) {
+ComputeRaster::Pipelines ComputeRaster::makePipelines(const vk::Context& ctx, const SceneKinds& kinds) {
   const vk::LayoutOptions push{.pushDescriptorSets = {0}};
   vk::LayoutOptions options = push;
-  options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene.textureCount());
-  clear_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push);
+  options.runtimeArrayCounts[{1, 0}] = std::max(1u, kinds.textures);
   // The alpha test in compute only where some material is masked (raster_tri.glsl's kAlphaMask).
-  const std::vector<vk::SpecializationConstant> constants{{0, RASTER_SHARED_AREA}, {1, scene.hasDraws(DrawKind::AlphaMasked)}};
-  raster_ = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, withRowQueue(withMeasure(constants)));
-  clip_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_clip.comp"), options, constants);
-  large_ = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), options, constants);
-  vk::GraphicsDesc d;
-  d.modules = {vk::loadShader("raster_hw.vert"), vk::loadShader("raster_hw.frag")};
-  d.cullMode = VK_CULL_MODE_NONE;  // the fragment stage culls by the cluster's flags
-  d.depthTest = d.depthWrite = false;
-  hardware_ = vk::makeGraphicsPipeline(ctx, d, options);
+  const std::vector<vk::SpecializationConstant> constants{{0, RASTER_SHARED_AREA},
+                                                          {1, kinds.draws[size_t(DrawKind::AlphaMasked)]}};
+  Pipelines p;
+  vk::inParallel({
+      [&] { p.clear = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push); },
+      [&] {
+        p.raster = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, withRowQueue(withMeasure(constants)));
+      },
+      [&] { p.clip = vk::makeComputePipeline(ctx, vk::loadShader("raster_clip.comp"), options, constants); },
+      [&] { p.large = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), options, constants); },
+      [&] {
+        vk::GraphicsDesc d;
+        d.modules = {vk::loadShader("raster_hw.vert"), vk::loadShader("raster_hw.frag")};
+        d.cullMode = VK_CULL_MODE_NONE;  // the fragment stage culls by the cluster's flags
+        d.depthTest = d.depthWrite = false;
+        p.hardware = vk::makeGraphicsPipeline(ctx, d, options);
+      },
+  });
+  return p;
+}
+
+ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight,
+                             std::optional<Pipelines> made)
+    : ctx_(ctx), scene_(scene), culled_(framesInFlight, false), twoPhase_(framesInFlight, false) {
+  Pipelines p = made ? std::move(*made) : makePipelines(ctx, scene.kinds());
+  clear_ = std::move(p.clear), raster_ = std::move(p.raster), clip_ = std::move(p.clip), large_ = std::move(p.large);
+  hardware_ = std::move(p.hardware);
   // Written by the renderer (Renderer::writeTextures).
   for (size_t i = 0; i < textured().size(); ++i)
     if (textured()[i]->layout.setCount() > 1) textures_[i] = vk::DescriptorSets(ctx, textured()[i]->layout, 1);

@@ -23,7 +23,13 @@ class ComputeRaster {
  public:
   // Whether the device has what it needs (64-bit buffer atomics, also in fragment shaders).
   static bool supported(const vk::Context& ctx);
-  ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight);
+  // Its pipelines, made from the scene's kinds alone (in parallel; Renderer::prepare, before the upload).
+  struct Pipelines {
+    vk::Pipeline clear, raster, clip, large, hardware;
+  };
+  static Pipelines makePipelines(const vk::Context& ctx, const SceneKinds& kinds);
+  // `made`: its pipelines made ahead for this scene's kinds; none: made here.
+  ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight, std::optional<Pipelines> made = {});
 
   void resize(VkExtent2D extent);  // the caller has waited for the device to be idle
   // Records the passes, each timed ("clear", "raster", "raster clip", "raster large", "raster hw"); afterwards ids() is

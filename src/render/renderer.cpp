@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 #include "core/error.hpp"
 #include "raster.h"
@@ -40,60 +41,149 @@ std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const
   return order;
 }
 
-Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
-    : ctx_(ctx), scene_(scene), framesInFlight_(framesInFlight), arrivalsSeen_(scene.textureArrivals()), post_(ctx) {
+Renderer::Choice::Choice(const vk::Context& ctx, const SceneKinds& k) : kinds(k) {
+  VkPhysicalDeviceFeatures features{};
+  vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
+  cpuDevice = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  canHardware = features.geometryShader;
+  canCompute = ComputeRaster::supported(ctx) && k.clusterIdsFit;
+  if (k.visIds > GpuScene::kMaxVisIds)
+    visibilityRefusal = "the scene's " + std::to_string(k.visIds) +
+                        " triangle ids (each instance's triangles, hierarchy included) do not fit the visibility "
+                        "buffer's 32 bits";
+  else if (!canHardware && !canCompute) visibilityRefusal = "the device has neither rasteriser of the visibility path";
+  canUseVisibility = k.instances > 0 && visibilityRefusal.empty();
+}
+
+ShadingPath Renderer::Choice::pathFor(const RenderSettings& s) const {
+  return s.shading == ShadingPath::Visibility && s.mode == VIEW_SHADED && canUseVisibility ? ShadingPath::Visibility
+                                                                                           : ShadingPath::Forward;
+}
+
+RasterPath Renderer::Choice::rasterFor(const RenderSettings& s) const {
+  // The default per device type, the faster one measured (docs/raster.md): compute on GPUs; on a CPU
+  // device (lavapipe) compute from about 100 k triangles, where the two cross.
+  const bool computeFaster = !cpuDevice || kinds.triangles >= 100000;
+  const RasterPath wanted = s.raster != RasterPath::Auto ? s.raster : computeFaster ? RasterPath::Compute : RasterPath::Hardware;
+  if (wanted == RasterPath::Compute) return canCompute ? RasterPath::Compute : RasterPath::Hardware;
+  return canHardware ? RasterPath::Hardware : RasterPath::Compute;
+}
+
+Renderer::Plan Renderer::plan(const Choice& c, const RenderSettings& s, bool environment, bool readSceneColor) {
+  Plan p{};
+  p.visibility = c.pathFor(s) == ShadingPath::Visibility;
+  p.raster = p.visibility ? c.rasterFor(s) : RasterPath::Auto;
+  p.set = p.visibility ? kVisibility : s.mode == VIEW_SHADED ? kShaded : kDebug;
+  // The shading pass writes the target's bytes itself where nothing else reads the linear image: the
+  // post pass would only copy and encode it (mosaic off), no transparent pass blends into it, no caller reads it.
+  p.display = p.visibility && s.mosaic == MosaicMode::Off && !c.kinds.blended && !readSceneColor;
+  p.backdrop = environment && p.set == kShaded && s.backdropBlur >= 0.0f;
+  return p;
+}
+
+std::array<bool, kDrawKindCount> Renderer::kindsOf(const SceneKinds& kinds, PipelineSet set) {
+  std::array<bool, kDrawKindCount> needed{};
+  for (size_t k = 0; k < kDrawKindCount; ++k)  // visibility: by any kind drawn with this one's pipeline
+    needed[set == kVisibility ? size_t(kKinds[k].visAs) : k] |= kinds.draws[k];
+  return needed;
+}
+
+vk::Pipeline Renderer::makeScenePipeline(const vk::Context& ctx, const SceneKinds& kinds, PipelineSet set, size_t kind,
+                                         bool environment) {
+  const KindInfo& info = kKinds[kind];
+  vk::GraphicsDesc d;
+  if (set == kVisibility) {
+    d.modules = {vk::loadShader("vis.vert"), vk::loadShader("vis.frag")};
+    d.specialization = {{VARIANT_ALPHA_MASK, info.alphaMasked}};
+  } else {
+    d.modules = {vk::loadShader(kSceneVert), vk::loadShader(kFrag[set])};
+    d.specialization = {{VARIANT_TEXCOORDS, info.textured}, {VARIANT_ALPHA_MASK, info.alphaMasked}, {VARIANT_ENV, environment}};
+  }
+  d.cullMode = info.cull;
+  d.dynamicFrontFace = true;  // per draw: mirrored instances' front faces are clockwise
+  d.colorFormats = {set == kVisibility ? kVisFormat : kColorFormat};
+  d.depthFormat = kDepthFormat;
+  vk::LayoutOptions options;
+  options.runtimeArrayCounts[{1, 0}] = std::max(1u, kinds.textures);
+  return vk::makeGraphicsPipeline(ctx, d, options);
+}
+
+vk::Pipeline Renderer::makeShadePipeline(const vk::Context& ctx, const SceneKinds& kinds, bool fromBuffer, bool display,
+                                         bool environment) {
+  vk::LayoutOptions options{.pushDescriptorSets = {0}};
+  options.runtimeArrayCounts[{1, 0}] = std::max(1u, kinds.textures);
+  return vk::makeComputePipeline(ctx, vk::loadShader("vis_shade.comp"), options,
+                                 {{VARIANT_TEXCOORDS, kinds.texcoords},
+                                  {VARIANT_VIS_BUFFER, fromBuffer},
+                                  {VARIANT_ENV, environment},
+                                  {VARIANT_MATERIAL_EXTRAS, kinds.materialExtras},
+                                  {VARIANT_DISPLAY, display}});
+}
+
+vk::Pipeline Renderer::makeBackdrop(const vk::Context& ctx) {
+  return vk::makeComputePipeline(ctx, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}});
+}
+
+Renderer::Prepared Renderer::prepare(const vk::Context& ctx, const SceneKinds& kinds, const RenderSettings& first,
+                                     bool environment) {
+  Prepared p;
+  p.kinds = kinds;
+  p.environment = environment;
+  const Plan f = plan(Choice(ctx, kinds), first, environment, false);
+  std::vector<std::function<void()>> jobs;
+  if (f.raster == RasterPath::Compute) {
+    jobs.push_back([&] { p.raster = ComputeRaster::makePipelines(ctx, kinds); });
+  } else {
+    const std::array<bool, kDrawKindCount> needed = kindsOf(kinds, f.set);
+    for (size_t k = 0; k < kDrawKindCount; ++k)
+      if (needed[k])
+        jobs.push_back([&, k] { p.scene[f.set * kDrawKindCount + k] = makeScenePipeline(ctx, kinds, f.set, k, environment); });
+  }
+  if (f.visibility)
+    jobs.push_back([&] {
+      p.shade[2 * size_t(f.raster) + f.display] =
+          makeShadePipeline(ctx, kinds, f.raster == RasterPath::Compute, f.display, environment);
+    });
+  if (f.backdrop) jobs.push_back([&] { p.backdrop = makeBackdrop(ctx); });
+  if (!f.display && first.mosaic != MosaicMode::Graphics) jobs.push_back([&] { p.mosaic = MosaicPass::makeCompute(ctx); });
+  vk::inParallel(jobs);
+  return p;
+}
+
+Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight, Prepared prepared)
+    : ctx_(ctx),
+      scene_(scene),
+      framesInFlight_(framesInFlight),
+      arrivalsSeen_(scene.textureArrivals()),
+      choice_(ctx, scene.kinds()),
+      // Made for another scene's kinds (a caller's mistake): none is taken, all are made here.
+      prepared_(prepared.kinds == choice_.kinds ? std::move(prepared) : Prepared{}),
+      post_(ctx, std::exchange(prepared_.mosaic, std::nullopt)) {
   makeTextureInfos();
   for (uint32_t i = 0; i < framesInFlight; ++i) {
     timers_.emplace_back(ctx, 15);  // at most: ComputeRaster::record's eleven passes, shade, transparent, post
   }
-  VkPhysicalDeviceFeatures features{};
-  vkGetPhysicalDeviceFeatures(ctx.physicalDevice(), &features);  // the context enables it where supported
-  for (size_t k = 0; k < kDrawKindCount; ++k)
-    for (const DrawItem& d : scene.draws(DrawKind(k))) triangles_ += uint64_t(d.indexCount / 3) * d.instanceCount;
-  cpuDevice_ = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  canHardware_ = features.geometryShader;
-  canCompute_ = ComputeRaster::supported(ctx);
   if (!scene.blendDraws().empty()) {
     transparency_.emplace(ctx, scene);
     writeTextureSets();
   }
-  // The compute rasteriser's hand-off and tile lists name a cluster record in the bits above a triangle's.
-  canCompute_ = canCompute_ && scene.clusterCount() < (1u << (32 - RASTER_LOCAL_BITS));
-  if (scene.visIdCount() > GpuScene::kMaxVisIds)
-    visibilityRefusal_ = "the scene's " + std::to_string(scene.visIdCount()) +
-                         " triangle ids (each instance's triangles, hierarchy included) do not fit the visibility "
-                         "buffer's 32 bits";
-  else if (!canHardware_ && !canCompute_) visibilityRefusal_ = "the device has neither rasteriser of the visibility path";
-  canUseVisibility_ = scene.instanceCount() > 0 && visibilityRefusal_.empty();
 }
 
-ShadingPath Renderer::pathFor(const RenderSettings& s) const {
-  return s.shading == ShadingPath::Visibility && s.mode == VIEW_SHADED && canUseVisibility_ ? ShadingPath::Visibility
-                                                                                            : ShadingPath::Forward;
+Renderer::Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight)
+    : Renderer(ctx, scene, framesInFlight, Prepared{}) {}
+
+ShadingPath Renderer::pathFor(const RenderSettings& s) const { return choice_.pathFor(s); }
+
+RasterPath Renderer::rasterFor(const RenderSettings& s) const { return choice_.rasterFor(s); }
+
+std::optional<vk::Pipeline> Renderer::takePrepared(std::optional<vk::Pipeline>& slot, bool dependsOnEnvironment) {
+  if (dependsOnEnvironment && prepared_.environment != (env_ != nullptr)) return std::nullopt;
+  return std::exchange(slot, std::nullopt);
 }
 
-RasterPath Renderer::rasterFor(const RenderSettings& s) const {
-  // The default per device type, the faster one measured (docs/raster.md): compute on GPUs; on a CPU
-  // device (lavapipe) compute from about 100 k triangles, where the two cross.
-  const bool computeFaster = !cpuDevice_ || triangles_ >= 100000;
-  const RasterPath wanted = s.raster != RasterPath::Auto ? s.raster : computeFaster ? RasterPath::Compute : RasterPath::Hardware;
-  if (wanted == RasterPath::Compute) return canCompute_ ? RasterPath::Compute : RasterPath::Hardware;
-  return canHardware_ ? RasterPath::Hardware : RasterPath::Compute;
-}
-
-Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull,
-                                                std::vector<vk::SpecializationConstant> variant) const {
-  vk::GraphicsDesc d;
-  d.modules = {vk::loadShader(vert), vk::loadShader(frag)};
-  d.specialization = std::move(variant);
-  d.cullMode = cull;
-  d.dynamicFrontFace = true;  // per draw: mirrored instances' front faces are clockwise
-  d.colorFormats = {colorFormat};
-  d.depthFormat = kDepthFormat;
-  vk::LayoutOptions options;
-  options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
+Renderer::ScenePipelines Renderer::withSets(vk::Pipeline pipeline) const {
   ScenePipelines p;
-  p.pipeline.emplace(vk::makeGraphicsPipeline(ctx_, d, options));
+  p.pipeline.emplace(std::move(pipeline));
   const vk::PipelineLayout& layout = p.pipeline->layout;
   p.sets = vk::DescriptorSets(ctx_, layout, framesInFlight_);
   for (uint32_t frame = 0; frame < framesInFlight_; ++frame) {
@@ -113,42 +203,28 @@ Renderer::ScenePipelines Renderer::makePipeline(const char* vert, const char* fr
   return p;
 }
 
-Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
-  // The kinds' pipelines are made in parallel, only those the scene needs.
+Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) {
+  // The kinds' pipelines are made in parallel, only those the scene needs (those prepared are taken).
   KindPipelines out;
+  const std::array<bool, kDrawKindCount> needed = kindsOf(choice_.kinds, set);
+  std::array<std::optional<vk::Pipeline>, kDrawKindCount> made;
+  for (size_t k = 0; k < kDrawKindCount; ++k)
+    if (needed[k]) made[k] = takePrepared(prepared_.scene[set * kDrawKindCount + k], set != kVisibility);
   std::vector<std::function<void()>> jobs;
-  for (size_t k = 0; k < kDrawKindCount; ++k) {
-    const KindInfo& info = kKinds[k];
-    bool needed = scene_.hasDraws(DrawKind(k));
-    if (set == kVisibility) {  // by any kind drawn with this one's visibility pipeline
-      needed = false;
-      for (size_t j = 0; j < kDrawKindCount; ++j) needed |= size_t(kKinds[j].visAs) == k && scene_.hasDraws(DrawKind(j));
-    }
-    if (!needed) continue;
-    jobs.push_back([this, set, &info, &slot = out[k]] {
-      slot = set == kVisibility
-                 ? makePipeline("vis.vert", "vis.frag", kVisFormat, info.cull, {{VARIANT_ALPHA_MASK, info.alphaMasked}})
-                 : makePipeline(kSceneVert, kFrag[set], kColorFormat, info.cull,
-                                {{VARIANT_TEXCOORDS, info.textured},
-                                 {VARIANT_ALPHA_MASK, info.alphaMasked},
-                                 {VARIANT_ENV, set != kVisibility && env_ != nullptr}});
-    });
-  }
+  for (size_t k = 0; k < kDrawKindCount; ++k)
+    if (needed[k])
+      jobs.push_back([this, set, k, &made, &slot = out[k]] {
+        slot = withSets(made[k] ? std::move(*made[k]) : makeScenePipeline(ctx_, choice_.kinds, set, k, env_ != nullptr));
+      });
   vk::inParallel(jobs);
   return out;
 }
 
-Renderer::VisShade Renderer::makeShade(bool fromBuffer, bool display) const {
-  const bool textured = scene_.texcoords() != VK_NULL_HANDLE;
-  vk::LayoutOptions options{.pushDescriptorSets = {0}};
-  options.runtimeArrayCounts[{1, 0}] = std::max(1u, scene_.textureCount());
+Renderer::VisShade Renderer::makeShade(bool fromBuffer, bool display) {
   VisShade v;
-  v.pipeline.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("vis_shade.comp"), options,
-                                             {{VARIANT_TEXCOORDS, textured},
-                                              {VARIANT_VIS_BUFFER, fromBuffer},
-                                              {VARIANT_ENV, env_ != nullptr},
-                                              {VARIANT_MATERIAL_EXTRAS, scene_.materialExtras()},
-                                              {VARIANT_DISPLAY, display}}));
+  std::optional<vk::Pipeline> made =
+      takePrepared(prepared_.shade[2 * size_t(fromBuffer ? RasterPath::Compute : RasterPath::Hardware) + display], true);
+  v.pipeline.emplace(made ? std::move(*made) : makeShadePipeline(ctx_, choice_.kinds, fromBuffer, display, env_ != nullptr));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
@@ -171,8 +247,8 @@ void Renderer::setEnvironment(std::shared_ptr<const EnvironmentMaps> env) {
 }
 
 void Renderer::backdropPass(VkCommandBuffer cb) {
-  if (!backdrop_)
-    backdrop_.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
+  if (!backdrop_) backdrop_ = takePrepared(prepared_.backdrop, false);
+  if (!backdrop_) backdrop_.emplace(makeBackdrop(ctx_));
   vk::require(cb, color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
   backdrop_->bind(cb);
   vk::DescriptorWriter w(ctx_, backdrop_->layout, 0, VK_NULL_HANDLE);
@@ -189,6 +265,7 @@ void Renderer::ensurePipelines(PipelineSet set) {
 
 void Renderer::rebuildPipelines() {
   // Build all that exist first, swap after: a failure leaves the running pipelines untouched.
+  prepared_ = {};  // made from the shaders of before
   std::array<std::optional<KindPipelines>, kPipelineSetCount> fresh;
   std::array<VisShade, 6> shade;
   std::optional<ComputeRaster> raster;
@@ -198,8 +275,7 @@ void Renderer::rebuildPipelines() {
     if (shade_[i].pipeline) shade[i] = makeShade(RasterPath(i / 2) == RasterPath::Compute, i % 2 != 0);
   if (raster_) raster.emplace(ctx_, scene_, framesInFlight_);
   std::optional<vk::Pipeline> backdrop;
-  if (backdrop_)
-    backdrop.emplace(vk::makeComputePipeline(ctx_, vk::loadShader("env_backdrop.comp"), {.pushDescriptorSets = {0}}));
+  if (backdrop_) backdrop.emplace(makeBackdrop(ctx_));
   std::optional<TransparencyPass> transparency;
   if (transparency_) transparency.emplace(ctx_, scene_, env_.get());
   vkDeviceWaitIdle(ctx_.device());
@@ -379,22 +455,20 @@ void Renderer::frame(FrameContext& fc) {
       if (views[i] && !textureInfos_[i].imageView) fresh[i] = 1, textureInfos_[i].imageView = views[i];
     writeTextureSets(&fresh);
   }
-  const bool visibility = pathFor(s) == ShadingPath::Visibility;
-  const RasterPath raster = visibility ? rasterFor(s) : RasterPath::Auto;
+  const Plan plan = Renderer::plan(choice_, s, env_ != nullptr, fc.readSceneColor);
+  const bool visibility = plan.visibility, display = plan.display, backdrop = plan.backdrop;
+  const RasterPath raster = plan.raster;
   const bool compute = raster == RasterPath::Compute;
-  const PipelineSet set = visibility ? kVisibility : s.mode == VIEW_SHADED ? kShaded : kDebug;
+  const PipelineSet set = plan.set;
   if (target.extent.width != extent_.width || target.extent.height != extent_.height ||
       (raster == RasterPath::Hardware && !vis_.handle()))
     createTargets(target.extent, raster == RasterPath::Hardware);
   if (compute && !raster_) {
-    raster_.emplace(ctx_, scene_, framesInFlight_);
+    raster_.emplace(ctx_, scene_, framesInFlight_, std::exchange(prepared_.raster, std::nullopt));
     raster_->resize(extent_);
     for (const auto& [layout, set] : raster_->textureSets()) writeTextures(*layout, set);
   }
   if (!compute) ensurePipelines(set);
-  // The shading pass writes the target's bytes itself where nothing else reads the linear image: the
-  // post pass would only copy and encode it (mosaic off), no transparent pass blends into it, no caller reads it.
-  const bool display = visibility && s.mosaic == MosaicMode::Off && !transparency_ && !fc.readSceneColor;
   if (!display && !color_.handle())
     color_ = vk::Image(ctx_, {extent_, kColorFormat, 1,
                               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
@@ -404,8 +478,6 @@ void Renderer::frame(FrameContext& fc) {
   if (visibility && !shade.pipeline) shade = makeShade(compute, display);
   lastRaster_ = raster;
   const float aspect = float(target.extent.width) / float(target.extent.height);
-  // The forward shaded view shows the environment behind the scene in a pass of its own.
-  const bool backdrop = env_ && set == kShaded && s.backdropBlur >= 0.0f;
 
   shader::FrameUniforms u{};
   u.view = viewMatrix(pose);

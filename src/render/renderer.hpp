@@ -95,11 +95,31 @@ struct FrameContext {
 std::vector<const DrawItem*> nearestFirst(std::span<const DrawItem> draws, const glm::vec3& eye);
 
 class Renderer {
+  enum PipelineSet { kShaded, kDebug, kVisibility, kPipelineSetCount };  // built on first use
+
  public:
   static constexpr VkFormat kColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
   static constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
   static constexpr VkFormat kVisFormat = VK_FORMAT_R32_UINT;  // draw index, primitive index (frame.h)
 
+  // The pipelines a first frame uses, made from the scene's kinds alone: creation only (reflection,
+  // layouts, the driver), no buffer and no descriptor, so that they can be made on another thread while
+  // the scene uploads (render/startup.hpp's PipelinesAhead; docs/startup.md "Phases side by side").
+  struct Prepared {
+    SceneKinds kinds;
+    bool environment = false;
+    std::array<std::optional<vk::Pipeline>, kPipelineSetCount * kDrawKindCount> scene;  // by set, then draw kind
+    std::array<std::optional<vk::Pipeline>, 6> shade;                                   // as shade_
+    std::optional<ComputeRaster::Pipelines> raster;
+    std::optional<vk::Pipeline> mosaic, backdrop;
+  };
+  // Makes, in parallel, those that a frame with `first` will use (one whose scene colour is not read back)
+  // for a scene of these kinds, with an environment or none (setEnvironment). Any thread.
+  static Prepared prepare(const vk::Context& ctx, const SceneKinds& kinds, const RenderSettings& first, bool environment);
+
+  // `prepared`: taken on their first use where made for this scene's kinds and environment; the rest is
+  // made on first use.
+  Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight, Prepared prepared);
   Renderer(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight);
 
   // Light from an environment, added to the lights by the shaded view of both paths, and the backdrop;
@@ -127,7 +147,7 @@ class Renderer {
   // returns the bytes per pixel written: 4 (hardware: the id) or 8 (compute: id in the low half).
   uint32_t copyIds(VkCommandBuffer cb, VkBuffer dst);
   // Why the scene cannot take the visibility path on this device (frames are forward); empty if it can.
-  const std::string& visibilityRefusal() const { return visibilityRefusal_; }
+  const std::string& visibilityRefusal() const { return choice_.visibilityRefusal; }
   // The culling counts of the last completed use of `frame`; none where it did not cull.
   std::optional<ComputeRaster::CullStats> cullStats(uint32_t frame) const {
     return raster_ ? raster_->cullStats(frame) : std::nullopt;
@@ -148,16 +168,42 @@ class Renderer {
     vk::DescriptorSets sets;
   };
   using KindPipelines = std::array<ScenePipelines, kDrawKindCount>;
-  enum PipelineSet { kShaded, kDebug, kVisibility, kPipelineSetCount };  // built on first use
   struct VisShade {
     std::optional<vk::Pipeline> pipeline;
     vk::DescriptorSets textures;  // set 1; set 0 is pushed per frame
   };
+  // What picks a frame's path and pipelines: the device's features and the scene's kinds (no buffers), so
+  // that prepare() picks what frame() will.
+  struct Choice {
+    Choice(const vk::Context& ctx, const SceneKinds& kinds);
+    ShadingPath pathFor(const RenderSettings& s) const;
+    RasterPath rasterFor(const RenderSettings& s) const;
+    SceneKinds kinds;
+    bool canUseVisibility = false, canHardware = false, canCompute = false, cpuDevice = false;
+    std::string visibilityRefusal;
+  };
+  // What a frame records: its path, whose ids, which scene pipelines; display: the shading pass writes the
+  // target; backdrop: the forward shaded view's environment pass.
+  struct Plan {
+    bool visibility;
+    RasterPath raster;
+    PipelineSet set;
+    bool display, backdrop;
+  };
+  static Plan plan(const Choice& c, const RenderSettings& s, bool environment, bool readSceneColor);
+  // The pipelines of the draw kinds that `set` draws for a scene of these kinds, by kind.
+  static std::array<bool, kDrawKindCount> kindsOf(const SceneKinds& kinds, PipelineSet set);
+  static vk::Pipeline makeScenePipeline(const vk::Context& ctx, const SceneKinds& kinds, PipelineSet set, size_t kind,
+                                        bool environment);
+  static vk::Pipeline makeShadePipeline(const vk::Context& ctx, const SceneKinds& kinds, bool fromBuffer, bool display,
+                                        bool environment);
+  static vk::Pipeline makeBackdrop(const vk::Context& ctx);
+  // A prepared pipeline, once, where made for this environment; else none.
+  std::optional<vk::Pipeline> takePrepared(std::optional<vk::Pipeline>& slot, bool dependsOnEnvironment);
   void createTargets(VkExtent2D extent, bool visibility);
-  ScenePipelines makePipeline(const char* vert, const char* frag, VkFormat colorFormat, VkCullModeFlags cull,
-                              std::vector<vk::SpecializationConstant> variant) const;
-  KindPipelines makePipelines(PipelineSet set) const;
-  VisShade makeShade(bool fromBuffer, bool display) const;
+  ScenePipelines withSets(vk::Pipeline pipeline) const;  // its descriptor sets, written
+  KindPipelines makePipelines(PipelineSet set);
+  VisShade makeShade(bool fromBuffer, bool display);
   void backdropPass(VkCommandBuffer cb);
   void ensurePipelines(PipelineSet set);
   void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye, const glm::vec3& background,
@@ -188,9 +234,8 @@ class Renderer {
   std::optional<vk::Pipeline> backdrop_;          // the forward path's environment backdrop, on first use
   std::optional<TransparencyPass> transparency_;  // a scene with blended draws only
   RasterPath lastRaster_ = RasterPath::Auto;
-  bool canUseVisibility_ = false, canHardware_ = false, canCompute_ = false, cpuDevice_ = false;
-  uint64_t triangles_ = 0;
-  std::string visibilityRefusal_;
+  Choice choice_;
+  Prepared prepared_;  // what is left of them
   MosaicPass post_;
   std::vector<vk::GpuTimer> timers_;
   vk::Image color_, depth_, vis_;  // color_ only once a frame needed it, vis_ once the hardware visibility path ran

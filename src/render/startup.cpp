@@ -27,6 +27,12 @@ double msSinceProcessStart() {
   return double(now.tv_sec) * 1e3 + double(now.tv_nsec) * 1e-6 - startMs;
 }
 
+std::string pipelineRow(const std::string& what, const vk::PipelineStats& made) {
+  return what + " (" + std::to_string(made.created) +
+         (made.reported == made.created ? ", " + std::to_string(made.cacheHits) + " from the cache)"
+                                        : ", cache hits not reported)");
+}
+
 std::string StartupTimeline::format(double totalMs) const {
   std::string out = "start-up phases (ms):\n";
   char line[256];
@@ -40,6 +46,18 @@ std::string StartupTimeline::format(double totalMs) const {
                 "total from process start", totalMs);
   return out + line;
 }
+
+PipelinesAhead::PipelinesAhead(const vk::Context& ctx, const Scene& scene, const RenderSettings& first, bool environment)
+    : made_(std::async(std::launch::async, [&ctx, &scene, first, environment] {
+        const vk::PipelineCache::BesideThread beside;
+        return Renderer::prepare(ctx, sceneKinds(scene), first, environment);
+      })) {}
+
+PipelinesAhead::~PipelinesAhead() {
+  if (made_.valid()) made_.wait();
+}
+
+Renderer::Prepared PipelinesAhead::take() { return made_.get(); }
 
 DeviceDefaults deviceDefaults(VkPhysicalDeviceType type) {
   // A CPU rasteriser (lavapipe) pays the same for fragment and compute work, so the visibility path's

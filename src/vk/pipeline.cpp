@@ -5,6 +5,7 @@
 #include <exception>
 #include <cstdlib>
 #include <mutex>
+#include <optional>
 #include <unistd.h>
 #include <unordered_map>
 
@@ -328,7 +329,12 @@ void Pipeline::dispatch(VkCommandBuffer cb, uint32_t x, uint32_t y, uint32_t z) 
 }
 
 void inParallel(const std::vector<std::function<void()>>& jobs) {
-  parallelFor(jobs.size(), unsigned(jobs.size()), [&](size_t i) { jobs[i](); });
+  const bool beside = PipelineCache::onBesideThread();  // the jobs count where their caller's pipelines do
+  parallelFor(jobs.size(), unsigned(jobs.size()), [&](size_t i) {
+    std::optional<PipelineCache::BesideThread> mark;
+    if (beside) mark.emplace();
+    jobs[i]();
+  });
 }
 
 DescriptorSets::DescriptorSets(const Context& ctx, const PipelineLayout& layout, uint32_t copies) : copies_(copies) {

@@ -105,26 +105,41 @@ PipelineCache::~PipelineCache() {
   vkDestroyPipelineCache(device_, cache_, nullptr);
 }
 
+namespace {
+thread_local int t_beside = 0;  // BesideThread marks alive on this thread
+}
+
+PipelineCache::BesideThread::BesideThread() { ++t_beside; }
+PipelineCache::BesideThread::~BesideThread() { --t_beside; }
+bool PipelineCache::onBesideThread() { return t_beside > 0; }
+
 void PipelineCache::begin() {
   const std::lock_guard lock(mutex_);
-  if (active_++ == 0) busySince_ = std::chrono::steady_clock::now();
+  Account& a = onBesideThread() ? beside_ : main_;
+  if (a.active++ == 0) a.busySince = std::chrono::steady_clock::now();
 }
 
 void PipelineCache::end(const VkPipelineCreationFeedback* f) {
   const std::lock_guard lock(mutex_);
-  if (--active_ == 0)
-    stats_.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - busySince_).count();
+  Account& a = onBesideThread() ? beside_ : main_;
+  if (--a.active == 0)
+    a.stats.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a.busySince).count();
   if (!f) return;
-  ++stats_.created;
+  ++a.stats.created;
   if (f->flags & VK_PIPELINE_CREATION_FEEDBACK_VALID_BIT) {
-    ++stats_.reported;
-    if (f->flags & VK_PIPELINE_CREATION_FEEDBACK_APPLICATION_PIPELINE_CACHE_HIT_BIT) ++stats_.cacheHits;
+    ++a.stats.reported;
+    if (f->flags & VK_PIPELINE_CREATION_FEEDBACK_APPLICATION_PIPELINE_CACHE_HIT_BIT) ++a.stats.cacheHits;
   }
 }
 
 PipelineStats PipelineCache::stats() const {
   const std::lock_guard lock(mutex_);
-  return stats_;
+  return main_.stats;
+}
+
+PipelineStats PipelineCache::besideStats() const {
+  const std::lock_guard lock(mutex_);
+  return beside_.stats;
 }
 
 void PipelineCache::save() {

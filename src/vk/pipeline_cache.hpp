@@ -39,10 +39,22 @@ class PipelineCache {
   bool loaded() const { return loaded_; }                      // a valid file was read
 
   // Around each pipeline's creation, from any thread: begin(), then end() with its creation feedback
-  // (nullptr when the creation failed).
+  // (nullptr when the creation failed), both on the same thread.
   void begin();
   void end(const VkPipelineCreationFeedback* feedback);
+  // Pipelines made on a thread marked beside (a BesideThread alive on it, or a job inParallel runs for
+  // one) count in besideStats(), all others in stats(): a timeline takes out of its phases only what its
+  // own thread made, and shows the pipelines made beside them as a row of their own (docs/startup.md).
   PipelineStats stats() const;
+  PipelineStats besideStats() const;
+  class BesideThread {
+   public:
+    BesideThread();
+    ~BesideThread();
+    BesideThread(const BesideThread&) = delete;
+    BesideThread& operator=(const BesideThread&) = delete;
+  };
+  static bool onBesideThread();
 
   // Writes the cache atomically when it holds more than was read; a failure is a note, not an error
   // (the cache only saves time). Called by the destructor too.
@@ -56,9 +68,12 @@ class PipelineCache {
   bool loaded_ = false;
   std::vector<uint8_t> loadedBytes_;  // the driver's bytes as read, to skip saving what is unchanged
   mutable std::mutex mutex_;
-  PipelineStats stats_;
-  uint32_t active_ = 0;  // creations under way
-  std::chrono::steady_clock::time_point busySince_;
+  struct Account {
+    PipelineStats stats;
+    uint32_t active = 0;  // creations under way
+    std::chrono::steady_clock::time_point busySince;
+  };
+  Account main_, beside_;
 };
 
 }  // namespace rtr::vk

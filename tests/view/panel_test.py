@@ -8,6 +8,7 @@ are handed to the window's drop callback (xdotool cannot drag files).
 """
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -75,17 +76,23 @@ def main():
                 break
         total = rows.pop("total from process start")
         check(rows.pop("sum of the critical path's phases", None) is not None, f"a critical path's sum ({sorted(rows)})")
-        # The scene file read ran on its own thread beside the device's and the window's start: its row is
-        # marked so, lies within the span it ran in, and is not part of the critical path's sum.
+        # The scene file read ran on its own thread beside the device's and the window's start, the pipelines
+        # on theirs beside the scene's upload: their rows are marked so, lie within the spans they ran in,
+        # and are not part of the critical path's sum.
         read = "scene file read (beside instance, device and window)"
         beside = {n: v for n, v in rows.items() if " (beside " in n}
         path = {n: v for n, v in rows.items() if n not in beside}
+        upload = "geometry to the GPU, swapchain"
         for want in ("instance and device", "window, surface and panel", "waiting for the scene file read",
-                     "first frame (record, GPU, present)"):
+                     upload, "waiting for the pipelines", "first frame (record, GPU, present)"):
             check(want in path, f"the start-up phases have '{want}' ({sorted(rows)})")
-        check(list(beside) == [read], f"the scene file read is the one row beside the others ({sorted(beside)})")
+        ahead = [n for n in beside if re.match(r"pipelines made ahead \([1-9]\d*, \d+ from the cache\) \(beside the scene upload\)$", n)]
+        check(sorted(beside) == sorted([read] + ahead) and len(ahead) == 1,
+              f"the scene file read and the pipelines made ahead are the rows beside the others ({sorted(beside)})")
         check(beside[read] <= path["instance and device"] + path["window, surface and panel"] +
               path["waiting for the scene file read"] + 1.0, f"the read lies within the span it ran beside ({rows})")
+        check(not ahead or beside[ahead[0]] <= path[upload] + path["waiting for the pipelines"] + 1.0,
+              f"the pipelines lie within the span they ran beside ({rows})")
         check(any(n.startswith("pipeline creation (") for n in path), "the start-up phases count the pipelines")
         check(all(v >= 0 for v in rows.values()) and abs(sum(path.values()) - total) <= 3.0,
               f"the critical path's phases add up to the total ({sum(path.values()):.1f} against {total:.1f} ms)")

@@ -72,19 +72,28 @@ std::map<std::string, double> phases(const std::string& out) {
 }
 
 // The critical path's rows tile the time; the scene file read, made on its own thread while the instance
-// and device are, has a row of its own marked beside them, within the span it ran in and not in the sum.
-TEST_F(StartupTest, TimingsCriticalPathAddsUpToTheTotalAndTheReadRunsBeside) {
+// and device are, and the pipelines, made on theirs while the scene uploads, have rows of their own marked
+// beside, each within the span it ran in and not in the sum.
+TEST_F(StartupTest, TimingsCriticalPathAddsUpToTheTotalAndTheReadAndPipelinesRunBeside) {
   const ViewRun r = view("--timings");
   ASSERT_EQ(r.status, 0) << r.out;
   const auto p = phases(r.out);
   const std::string read = "scene file read (beside instance and device)";
+  std::string ahead;  // "pipelines made ahead (N, H from the cache) (beside the scene upload)"
+  for (const auto& [name, ms] : p)
+    if (name.rfind("pipelines made ahead (", 0) == 0 && name.find(") (beside the scene upload)") != std::string::npos)
+      ahead = name;
+  ASSERT_FALSE(ahead.empty()) << "no row of the pipelines made beside the upload:\n" << r.out;
+  EXPECT_EQ(ahead.find("pipelines made ahead (0,"), std::string::npos) << r.out;
   const std::vector<std::string> expected = {"process start to Vulkan (exec, libraries, options)",
                                              "instance and device",
                                              "waiting for the scene file read",
                                              read,
+                                             "settings, the pipelines' thread started",
                                              "texture decode",
                                              "texture upload",
                                              "mips",
+                                             "waiting for the pipelines",
                                              "renderer setup (start pose, targets)",
                                              "first frame complete (record, GPU, read-back)",
                                              "sum of the critical path's phases",
@@ -105,13 +114,27 @@ TEST_F(StartupTest, TimingsCriticalPathAddsUpToTheTotalAndTheReadRunsBeside) {
     pipelineRows += name.rfind("pipeline creation (", 0) == 0;
   }
   EXPECT_EQ(pipelineRows, 1) << r.out;
-  EXPECT_EQ(besideRows, 1) << r.out;
+  EXPECT_EQ(besideRows, 2) << r.out;
   const double total = p.at("total from process start");
   EXPECT_GT(total, p.at("instance and device"));
   EXPECT_NEAR(sum, total, 3.0) << "time not in any phase, or a phase counted twice:\n" << r.out;
   EXPECT_NEAR(p.at("sum of the critical path's phases"), sum, 0.5) << r.out;
   // The read starts with the device's start and is waited for: it lies within those two rows.
   EXPECT_LE(p.at(read), p.at("instance and device") + p.at("waiting for the scene file read") + 1.0) << r.out;
+  // The pipelines start with the upload and are waited for after it.
+  EXPECT_LE(p.at(ahead), p.at("settings, the pipelines' thread started") + p.at("texture decode") + p.at("geometry upload") +
+                             p.at("texture upload") + p.at("mips") + p.at("waiting for the pipelines") + 1.0)
+      << r.out;
+}
+
+// A pipeline that cannot be made beside the upload is reported once the upload is done, with exit 1 (here:
+// a measuring variant asked for by a value the rasteriser does not know), and nothing crashes.
+TEST_F(StartupTest, APipelineFailureBesideTheUploadIsReported) {
+  const ViewRun r = view("--validation --shading-path visibility --raster compute", "RTR_RASTER_MEASURE=bogus RTR_VALIDATION=1");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("rtr-view: error: ")) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("RTR_RASTER_MEASURE=bogus: expected no-atomics or setup")) << r.out;
+  EXPECT_THAT(r.out, ::testing::Not(HasSubstr("alidation"))) << r.out;
 }
 
 // A bad scene file and a device that cannot start: the file's error is the one reported (exit 1), the

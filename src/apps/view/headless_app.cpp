@@ -149,6 +149,13 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   };
   const bool wait = o.waitTextures.value_or(true);
   const std::unique_ptr<TextureCache> textureCache = cli::textureCache(!o.textureCache);
+  render::RenderSettings settings = sceneSettings(o, scene);
+  settings.shading = choice.shading;
+  settings.clip = choice.computeClip;
+  // The first frame's pipelines need the scene's kinds, not its buffers: made on a thread of their own
+  // while the scene uploads, waited for after it.
+  render::PipelinesAhead ahead(ctx, scene, settings, o.env.hasEnvironment());
+  phase("settings, the pipelines' thread started");  // a thread's start may take this one off its core a while
   render::GpuScene gpuScene(ctx, scene, choice.mips, progress, render::GeometryUpload::Auto,
                             wait ? render::TextureLoad::Wait : render::TextureLoad::Deferred, textureCache.get(),
                             size_t(o.textureBatchMb) << 20);
@@ -161,6 +168,10 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   if (wait) timeline.add("texture upload", st.textureUploadMs), timeline.add("mips", st.mipsMs);
   if (wait && st.cacheReadbackMs > 0) timeline.add("texture cache read-back", st.cacheReadbackMs);
   last = Clock::now();
+  render::Renderer::Prepared prepared = ahead.take();
+  phase("waiting for the pipelines");
+  const vk::PipelineStats made = ctx.pipelineCache().besideStats();
+  timeline.addBeside(render::pipelineRow("pipelines made ahead", made), made.ms, "the scene upload");
   const double pipelineMsBefore = ctx.pipelineCache().stats().ms;
   std::fprintf(stderr,
                "rtr-view: %s on %s (%s): %u meshes (%u with 16-bit indices), %u triangles, %u textures; "
@@ -177,10 +188,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   std::fprintf(stderr, "\n");
   const CameraPose pose = startPose(o, scene);
   const Lens lens = fitDepthRange(startLens(o, scene), scene.bounds(), pose);
-  render::RenderSettings settings = sceneSettings(o, scene);
-  settings.shading = choice.shading;
-  settings.clip = choice.computeClip;
-  render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height});
+  render::HeadlessRenderer renderer(ctx, gpuScene, {o.width, o.height}, std::move(prepared));
   if (settings.shading == render::ShadingPath::Visibility && !renderer.renderer().visibilityRefusal().empty())
     std::fprintf(stderr, "rtr-view: warning: %s: frames take the forward path\n",
                  renderer.renderer().visibilityRefusal().c_str());
@@ -195,11 +203,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
   if (o.timings) {
     const double totalMs = render::msSinceProcessStart();
     const vk::PipelineStats ps = ctx.pipelineCache().stats();
-    char name[120];
-    if (ps.reported == ps.created)
-      std::snprintf(name, sizeof name, "pipeline creation (%u, %u from the cache)", ps.created, ps.cacheHits);
-    else std::snprintf(name, sizeof name, "pipeline creation (%u, cache hits not reported)", ps.created);
-    timeline.add(name, ps.ms);
+    timeline.add(render::pipelineRow("pipeline creation", ps), ps.ms);
     phase("first frame complete (record, GPU, read-back)", ps.ms - pipelineMsBefore - setupPipelineMs);
     std::fprintf(stderr, "rtr-view: %s", timeline.format(totalMs).c_str());
   }

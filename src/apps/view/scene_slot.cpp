@@ -1,5 +1,6 @@
 #include "scene_slot.hpp"
 
+#include <chrono>
 #include <cstdio>
 
 #include "render/startup.hpp"
@@ -25,11 +26,15 @@ void SceneSlot::release() {
   gpu_.reset();
 }
 
-void SceneSlot::build(VkExtent2D extent, render::MipMode mips) {
+void SceneSlot::build(VkExtent2D extent, render::MipMode mips, const render::RenderSettings& first) {
+  render::PipelinesAhead ahead(ctx_, *scene_, first, env_ != nullptr);  // while the scene uploads
   gpu_ = std::make_unique<render::GpuScene>(ctx_, *scene_, mips, render::LoadProgress{}, render::GeometryUpload::Auto,
                                             waitTextures_ ? render::TextureLoad::Wait : render::TextureLoad::Deferred, cache_,
                                             textureBatch_);
-  frames_ = std::make_unique<ViewFrames>(ctx_, surface_, extent, *gpu_);
+  const auto waitStart = std::chrono::steady_clock::now();
+  render::Renderer::Prepared prepared = ahead.take();
+  pipelineWaitMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - waitStart).count();
+  frames_ = std::make_unique<ViewFrames>(ctx_, surface_, extent, *gpu_, std::move(prepared));
   if (env_) frames_->renderer().setEnvironment(env_);
   traced_ = std::make_unique<TraceOverlay>(ctx_, *scene_);
 }
@@ -60,7 +65,7 @@ bool SceneSlot::update(ViewState& app) {
     const VkExtent2D e = frames_->extent();
     release();
     if (dropped) scene_ = std::move(dropped);
-    build(e, app.mips);
+    build(e, app.mips, app.settings);
     if (gpu_->texturesReady())
       std::fprintf(stderr, "rtr-view: mips (%s) %.3f ms GPU\n", enumName(app.mips), gpu_->stats().mipGpuMs);
   }

@@ -25,7 +25,9 @@ class SceneSlot {
             bool waitTextures, Loader load);
   ~SceneSlot() { release(); }  // the device idle, children first; before the surface and the device go
 
-  void build(VkExtent2D extent, render::MipMode mips);
+  // The scene to the GPU and its frames; the pipelines of a first frame with `first` made meanwhile.
+  void build(VkExtent2D extent, render::MipMode mips, const render::RenderSettings& first);
+  double pipelineWaitMs() const { return pipelineWaitMs_; }  // the last build's, after its upload
   // The texture cache every scene of the slot uses (null: none); it must outlive the slot.
   void setTextureCache(TextureCache* cache) { cache_ = cache; }
   void setTextureBatch(size_t bytes) { textureBatch_ = bytes; }  // GpuScene::setUploadBudget
@@ -64,6 +66,7 @@ class SceneSlot {
   std::string loadingPath_;
   size_t textureBatch_ = render::GpuScene::kDefaultUploadBudget;
   double texturesInAt_ = 0, firstTextureAt_ = 0;  // from process start; 0: not yet
+  double pipelineWaitMs_ = 0;
 };
 
 // --watch: edited shaders recompiled twice a second; a failure keeps the running pipelines and is shown.

@@ -17,12 +17,14 @@ class StartupClock {
   StartupClock() { timeline_.add("process start to the viewer (exec, libraries, options)", render::msSinceProcessStart()); }
   // From here on, pipeline creation on `ctx` is taken out of the phases.
   void watch(const vk::Context& ctx) { ctx_ = &ctx; }
-  void phase(const std::string& name) {
+  // `lessMs`: of its time, what has a row of its own (add()).
+  void phase(const std::string& name, double lessMs = 0) {
     const double p = ctx_ ? ctx_->pipelineCache().stats().ms : 0;
-    timeline_.add(name, std::chrono::duration<double, std::milli>(Clock::now() - start_).count() - (p - pipelineMs_));
+    timeline_.add(name, std::chrono::duration<double, std::milli>(Clock::now() - start_).count() - (p - pipelineMs_) - lessMs);
     pipelineMs_ = p;
     start_ = Clock::now();
   }
+  void add(const std::string& name, double ms) { timeline_.add(name, ms); }
   // Work that ran on another thread meanwhile: its own duration, marked, not in the sum.
   void beside(const std::string& name, double ms, const std::string& besideWhat) { timeline_.addBeside(name, ms, besideWhat); }
   // The first frame is on screen: its phase and the pipelines' row; printed when `print`.
@@ -30,8 +32,7 @@ class StartupClock {
     phase("first frame (record, GPU, present)");
     totalMs_ = render::msSinceProcessStart();
     const vk::PipelineStats ps = ctx_->pipelineCache().stats();
-    timeline_.add("pipeline creation (" + std::to_string(ps.created) + ", " + std::to_string(ps.cacheHits) + " from the cache)",
-                  ps.ms);
+    timeline_.add(render::pipelineRow("pipeline creation", ps), ps.ms);
     if (print) std::fprintf(stderr, "rtr-view: %s", timeline_.format(totalMs_).c_str());
     done_ = true;
   }

@@ -6,10 +6,11 @@
 
 namespace rtr::view {
 
-ViewFrames::ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent, const render::GpuScene& scene)
+ViewFrames::ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent, const render::GpuScene& scene,
+                       render::Renderer::Prepared prepared)
     : ctx_(ctx),
       swapchain_(ctx, surface, windowExtent),
-      renderer_(ctx, scene, kFramesInFlight),
+      renderer_(ctx, scene, kFramesInFlight, std::move(prepared)),
       panel_(ctx, kFramesInFlight),
       ring_(ctx, kFramesInFlight) {}
 

@@ -25,7 +25,8 @@ struct ViewFrameInput {
 class ViewFrames {
  public:
   static constexpr uint32_t kFramesInFlight = 2;
-  ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent, const render::GpuScene& scene);
+  ViewFrames(const vk::Context& ctx, VkSurfaceKHR surface, VkExtent2D windowExtent, const render::GpuScene& scene,
+             render::Renderer::Prepared prepared = {});
 
   // Renders and presents one frame. False: the swapchain was out of date, nothing was drawn. With
   // in.readBack, waits for the frame and fills `shot` (RGBA bytes).

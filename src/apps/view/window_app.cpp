@@ -118,7 +118,6 @@ int runWindowed(const ViewOptions& opts) {
                  [dropped](const std::string& path) { return loadForView(dropped, path); });
   slot.setTextureCache(textureCache.get());
   slot.setTextureBatch(size_t(o.textureBatchMb) << 20);
-  slot.build({o.width, o.height}, app.mips);
   // The environment as loaded, at intensity 1 and not turned: the panel's controls prefilter it again from this.
   ImageF envRadiance;
   const auto environment = [&] {
@@ -133,9 +132,14 @@ int runWindowed(const ViewOptions& opts) {
     app.hasEnvironment = true;
     app.envIntensity = o.env.settings.intensity;
     app.envRotationDeg = o.env.settings.rotationDeg;
-    slot.setEnvironment(environment());
+    slot.setEnvironment(environment());  // before the build: its pipelines are made with it
   }
-  clock.phase(waitTextures ? "scene to the GPU (geometry, textures, mips), swapchain" : "geometry to the GPU, swapchain");
+  slot.build({o.width, o.height}, app.mips, app.settings);
+  clock.phase(waitTextures ? "scene to the GPU (geometry, textures, mips), swapchain" : "geometry to the GPU, swapchain",
+              slot.pipelineWaitMs());
+  clock.add("waiting for the pipelines", slot.pipelineWaitMs());
+  const vk::PipelineStats ahead = ctx.pipelineCache().besideStats();
+  clock.beside(render::pipelineRow("pipelines made ahead", ahead), ahead.ms, "the scene upload");
 
   ShaderReload shaders(o.watch);
   Screenshots shots(o);
