@@ -86,6 +86,14 @@ class GrowArray {
     *this = GrowArray();
   }
 
+  // Elements below n are read no more: past 1 MiB their whole pages go back now (they read as zeros after).
+  void dropBelow(size_t n, unsigned threads = 1) {
+    const size_t bytes = std::min(n, size_) * sizeof(T) & ~size_t(4095);  // the mapping starts on a page
+    if (!mapped(cap_) || bytes == 0) return;
+    if (bytes < pages::kWorth || threads == 1) ::madvise(data_, bytes, MADV_DONTNEED);
+    else pages::advise(data_, bytes, MADV_DONTNEED, threads);
+  }
+
   size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
   T* data() { return data_; }
