@@ -347,6 +347,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   auto verts = uninitialised<Vertex>(uniqCount);
   auto vcolor = uninitialised<glm::vec4>(colors.empty() ? 0 : uniqCount);
   auto slotOf = uninitialised<uint32_t>(uniqCount);
+  auto kept = uninitialised<uint8_t>(uniqCount);  // first: whether its cells are its own alone
   size_t cap = 16;  // the hash slots one thread would use: their collisions decide which vertex is found first
   while (cap < uniqCount * 2) cap <<= 1;
   const size_t mask = cap - 1, buckets = std::max<size_t>(16, cap / 4);
@@ -365,6 +366,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       if (!colors.empty()) vcolor[u] = colors[c.p];
       const Around a(v.p);
       slotOf[u] = uint32_t(cellHash(a.cell[0], a.cell[1], a.cell[2]) & mask);
+      kept[u] = a.lo[0] == a.hi[0] && a.lo[1] == a.hi[1] && a.lo[2] == a.hi[2];
     }
   });
   freeOnAllCores(uniq, uniqCount, threads);
@@ -372,7 +374,6 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
   Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
-  auto kept = uninitialised<uint8_t>(uniqCount);
   auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
   // Bucket by bucket: a vertex whose cells are its own alone (most: it lies within the tolerance of no
   // cell face) needs only the bucket's vertices before it, which were just read; vertex by vertex, every
@@ -381,12 +382,11 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     for (size_t k = b; k < e; ++k)
       for (uint32_t j = inBucket.start[k]; j < inBucket.start[k + 1]; ++j) {
         const uint32_t u = inBucket.items[j];
-        const Around a(verts[u].p);
         bool near_ = false;
-        if (a.lo[0] == a.hi[0] && a.lo[1] == a.hi[1] && a.lo[2] == a.hi[2]) {  // its own cell, in this bucket
+        if (kept[u]) {  // its own cell, in this bucket: the first there reads no vertex (a cache miss each)
           for (uint32_t i = inBucket.start[k]; i < j && !near_; ++i) near_ = isNear(inBucket.items[i], u);
         } else {
-          near_ = a.any([&](uint64_t h) {
+          near_ = Around(verts[u].p).any([&](uint64_t h) {
             const size_t c = h & (buckets - 1);
             for (uint32_t i = inBucket.start[c]; i < inBucket.start[c + 1] && inBucket.items[i] < u; ++i)
               if (isNear(inBucket.items[i], u)) return true;
