@@ -35,6 +35,12 @@ inline void advise(void* p, size_t bytes, int advice, unsigned threads) {
     ::madvise(reinterpret_cast<void*>(a), std::min<uintptr_t>(kPiece, hi - a), advice);
   });
 }
+// The whole pages inside [p, p + bytes) given back now (their contents read as zeros after).
+inline void drop(void* p, size_t bytes) {
+  const uintptr_t page = 4096, lo = (reinterpret_cast<uintptr_t>(p) + page - 1) & ~(page - 1),
+                  hi = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(page - 1);
+  if (hi > lo) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_DONTNEED);
+}
 }  // namespace pages
 
 // v.resize(n) (value-initialised, as ever) with its new pages first touched on all cores.

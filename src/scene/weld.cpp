@@ -76,7 +76,7 @@ struct Around {
   }
 };
 
-constexpr size_t kMaxCorners = size_t(1) << 31;  // a mesh's corners (the limit docs/bench/bake.md states)
+constexpr uint32_t kDone = 0x80000000u;  // a corner's vertex id is set (weldMesh, step 3)
 
 // Every step runs over fixed pieces of kPiece elements, so the result does not depend on the thread count.
 constexpr size_t kPiece = size_t(1) << 16;
@@ -303,7 +303,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   // so its group is all a corner is compared with; the result is written into the corners themselves (a
   // per-corner array beside them and the groups would be the weld's peak of memory): a corner equal to an
   // earlier one gets that one's index in p and kAbsent in n (every kept corner has a normal by now).
-  if (cornerCount >= kMaxCorners) throw Error("a mesh of more than 715 million triangles cannot be welded");
+  if (cornerCount >= kDone) throw Error("a mesh of more than 715 million triangles cannot be welded");
   forPieces(atPos.count(), threads, [&](size_t, size_t b, size_t e) {
     std::vector<uint32_t> distinct;
     for (size_t g = b; g < e; ++g) {
@@ -327,18 +327,22 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   });
   const size_t uniqCount = prefix(firsts);
   // Each vertex's first corner is copied out, so that the corners can go before the vertices are made, and
-  // gets its vertex id in p; every other corner then gets the id of the first equal one.
+  // gets its vertex id (kDone set); every other corner the index of the first equal one, then that one's id.
+  // A piece's corners are read by it alone here, so their pages go back as it ends: the corners (12 bytes
+  // each) shrink while the ids (4) grow, at what was the weld's peak of memory.
   auto uniq = uninitialised<Corner>(uniqCount);
+  auto vertexOf = uninitialised<uint32_t>(cornerCount);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t c = b, id = firsts[p]; c < e; ++c)
-      if (first(c)) uniq[id] = corners[c], corners[c].p = uint32_t(id++);
+      if (first(c)) uniq[id] = corners[c], vertexOf[c] = uint32_t(id++) | kDone;
+      else if (keep[c / 3]) vertexOf[c] = corners[c].p;
+    pages::drop(&corners[b], (e - b) * sizeof(Corner));
   });
-  auto vertexOf = uninitialised<uint32_t>(cornerCount);
-  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the p of first corners only
+  if (cornersDone) cornersDone();                                    // from here on only `keep` and the ids are read
+  forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the entries of first corners only
     for (size_t c = b; c < e; ++c)
-      if (keep[c / 3]) vertexOf[c] = corners[c].n != kAbsent ? corners[c].p : corners[corners[c].p].p;
+      if (keep[c / 3] && !(vertexOf[c] & kDone)) vertexOf[c] = vertexOf[vertexOf[c]];
   });
-  if (cornersDone) cornersDone();  // from here on only `keep` and the ids are read
 
   // 4. Vertices within the tolerance are merged, greedy as one thread would do it: in order, each joins
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
@@ -456,7 +460,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   freeOnAllCores(verts, uniqCount, threads);
   freeOnAllCores(vcolor, colors.empty() ? 0 : uniqCount, threads);
   // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
-  auto corner = [&](size_t c) { return keptId[target[vertexOf[c]]]; };
+  auto corner = [&](size_t c) { return keptId[target[vertexOf[c] & ~kDone]]; };
   std::vector<size_t> written(pieces.size(), 0);
   forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t t = b; t < e; ++t) {

@@ -5,6 +5,8 @@
 // copy and its generated normal), plus a flag per triangle. A second array per corner (the first-equal
 // ids, the counting sort's copy of the groups) goes past it.
 #include <malloc.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cmath>
@@ -41,23 +43,35 @@ void operator delete[](void* p, size_t) noexcept { uncounted(p); }
 
 using namespace rtr;
 
-TEST(WeldMemory, HoldsAVertexIdPerCornerBesideTheCorners) {
-  // A smooth height field without normals (all generated), like the temple's statue: about six corners
-  // per vertex, no two vertices within the tolerance (so the vertices counted are the distinct corners).
-  const int side = 400;
+namespace {
+// A smooth height field without normals (all generated), like the temple's statue: about six corners
+// per vertex, no two vertices within the tolerance (so the vertices counted are the distinct corners).
+struct Field {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec2> texcoords;
+  std::vector<Corner> corners;
+};
+Field field(int side) {
+  Field f;
   for (int j = 0; j <= side; ++j)
     for (int i = 0; i <= side; ++i) {
-      positions.push_back({float(i) * 1e-2f, float(j) * 1e-2f, 0.1f * std::sin(float(i) * 0.05f) * std::cos(float(j) * 0.07f)});
-      texcoords.push_back({float(i) / side, float(j) / side});
+      f.positions.push_back({float(i) * 1e-2f, float(j) * 1e-2f, 0.1f * std::sin(float(i) * 0.05f) * std::cos(float(j) * 0.07f)});
+      f.texcoords.push_back({float(i) / float(side), float(j) / float(side)});
     }
-  auto corners = std::make_unique<std::vector<Corner>>();
   for (int j = 0; j < side; ++j)
     for (int i = 0; i < side; ++i) {
       const uint32_t a = uint32_t(j * (side + 1) + i), b = a + 1, c = a + side + 2, d = a + side + 1;
-      for (uint32_t p : {a, b, c, a, c, d}) corners->push_back({p, p, kAbsent});
+      for (uint32_t p : {a, b, c, a, c, d}) f.corners.push_back({p, p, kAbsent});
     }
+  return f;
+}
+}  // namespace
+
+TEST(WeldMemory, HoldsAVertexIdPerCornerBesideTheCorners) {
+  const Field f = field(400);
+  const std::vector<glm::vec3>& positions = f.positions;
+  const std::vector<glm::vec2>& texcoords = f.texcoords;
+  auto corners = std::make_unique<std::vector<Corner>>(f.corners);
   const size_t cornerCount = corners->size();
   for (unsigned threads : {1u, 2u}) {
     std::vector<Corner> copy = *corners;
@@ -74,4 +88,30 @@ TEST(WeldMemory, HoldsAVertexIdPerCornerBesideTheCorners) {
     EXPECT_LE(beside, design) << threads << " threads: " << double(beside) / double(cornerCount)
                               << " bytes per corner beside the corners' 12";
   }
+}
+
+// The corners' pages go back while the vertex ids are made (the ids grow as the corners shrink), not only
+// when the caller frees them: here the caller keeps them, in a mapping of their own.
+TEST(WeldMemory, GivesTheCornersPagesBackAsItGoes) {
+  const Field f = field(400);
+  const size_t bytes = f.corners.size() * sizeof(Corner), page = size_t(::sysconf(_SC_PAGESIZE));
+  void* map = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  ASSERT_NE(map, MAP_FAILED);
+  ::madvise(map, bytes, MADV_NOHUGEPAGE);  // residency counted page by page
+  std::copy(f.corners.begin(), f.corners.end(), static_cast<Corner*>(map));
+  std::vector<unsigned char> resident((bytes + page - 1) / page);
+  auto residentPages = [&] {
+    ::mincore(map, bytes, resident.data());
+    size_t n = 0;
+    for (unsigned char r : resident) n += r & 1;
+    return n;
+  };
+  ASSERT_EQ(residentPages(), resident.size());
+  Mesh mesh;
+  weldMesh({static_cast<Corner*>(map), f.corners.size()}, f.positions, {}, f.texcoords, mesh, 180.0f, {}, 2);
+  EXPECT_EQ(mesh.positions.size(), f.positions.size());
+  // A page shared by two of the weld's pieces of corners stays: at most one per piece.
+  const size_t pieces = (f.corners.size() + 65535) / 65536;
+  EXPECT_LE(residentPages(), pieces) << "of " << resident.size() << " pages";
+  ::munmap(map, bytes);
 }
