@@ -35,6 +35,12 @@ inline void advise(void* p, size_t bytes, int advice, unsigned threads) {
     ::madvise(reinterpret_cast<void*>(a), std::min<uintptr_t>(kPiece, hi - a), advice);
   });
 }
+// The whole pages inside [p, p + bytes) given back now (their contents read as zeros after).
+inline void drop(void* p, size_t bytes) {
+  const uintptr_t page = 4096, lo = (reinterpret_cast<uintptr_t>(p) + page - 1) & ~(page - 1),
+                  hi = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(page - 1);
+  if (hi > lo) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_DONTNEED);
+}
 }  // namespace pages
 
 // v.resize(n) (value-initialised, as ever) with its new pages first touched on all cores.
@@ -84,6 +90,14 @@ class GrowArray {
   void release(unsigned threads = 1) {
     if (mapped(cap_)) pages::advise(data_, cap_ * sizeof(T), MADV_DONTNEED, threads);
     *this = GrowArray();
+  }
+
+  // Elements below n are read no more: past 1 MiB their whole pages go back now (they read as zeros after).
+  void dropBelow(size_t n, unsigned threads = 1) {
+    const size_t bytes = std::min(n, size_) * sizeof(T) & ~size_t(4095);  // the mapping starts on a page
+    if (!mapped(cap_) || bytes == 0) return;
+    if (bytes < pages::kWorth || threads == 1) ::madvise(data_, bytes, MADV_DONTNEED);
+    else pages::advise(data_, bytes, MADV_DONTNEED, threads);
   }
 
   size_t size() const { return size_; }

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <ctime>
 #include <iostream>
+#include <malloc.h>
 #include <optional>
 #include <thread>
 #include <sstream>
@@ -43,7 +44,8 @@ struct MeshBuild {
   std::string name;
   uint32_t material = 0;
   GrowArray<Corner> corners;
-  size_t queued = 0;  // corners given a place so far
+  size_t queued = 0;                                         // corners given a place so far
+  std::array<uint32_t, 3> least{kAbsent, kAbsent, kAbsent};  // the smallest p, t and n of its corners
 };
 
 class ObjParser {
@@ -193,12 +195,17 @@ class ObjParser {
       GrowArray<Corner>& v = builds_[c.mesh].corners;
       v.resize(std::max(v.size(), c.at + (c.end - c.first)));
     }
+    std::vector<std::array<uint32_t, 3>> least(copies.size(), {kAbsent, kAbsent, kAbsent});
     parallelFor(copies.size(), opt_.threads, [&](size_t k) {
       const Copy& c = copies[k];
       const std::vector<Corner>& from = pieces[c.piece].corners;
       std::copy(from.begin() + ptrdiff_t(c.first), from.begin() + ptrdiff_t(c.end),
                 builds_[c.mesh].corners.begin() + ptrdiff_t(c.at));
+      for (size_t i = c.first; i < c.end; ++i)
+        least[k] = {std::min(least[k][0], from[i].p), std::min(least[k][1], from[i].t), std::min(least[k][2], from[i].n)};
     });
+    for (size_t k = 0; k < copies.size(); ++k)
+      for (int a = 0; a < 3; ++a) builds_[copies[k].mesh].least[a] = std::min(builds_[copies[k].mesh].least[a], least[k][a]);
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) { pieces[i] = objpiece::Piece(); });  // freed on all cores
   }
 
@@ -345,6 +352,7 @@ class ObjParser {
 };
 
 Scene ObjParser::finish() {
+  ::malloc_trim(0);  // the batches' pieces, freed, went back to the heap, not to the system
   stats_.positions = positions_.size();
   stats_.normals = normals_.size();
   stats_.texcoords = texcoords_.size();
@@ -387,8 +395,17 @@ Scene ObjParser::finish() {
   });
   for (size_t i = 0; i < builds_.size(); ++i) done += large(i) ? 0.0 : double(counts[i].triangles + counts[i].degenerate) * 3;
   progress(0);
+  // The file's arrays below what the meshes left to weld use go back before each large one (at 100 M, the
+  // floor's and columns' v and vt, 0.4 GB, at the statue's weld, the peak of memory).
+  std::vector<std::array<uint32_t, 3>> least(builds_.size() + 1, {kAbsent, kAbsent, kAbsent});
+  for (size_t i = builds_.size(); i-- > 0;)
+    for (int a = 0; a < 3; ++a) least[i][a] = std::min(least[i + 1][a], large(i) ? builds_[i].least[a] : kAbsent);
   for (size_t i = 0; i < builds_.size(); ++i)
     if (large(i)) {
+      positions_.dropBelow(least[i][0], opt_.threads);
+      colors_.dropBelow(least[i][0], opt_.threads);
+      texcoords_.dropBelow(least[i][1], opt_.threads);
+      normals_.dropBelow(least[i][2], opt_.threads);
       const double corners = double(builds_[i].corners.size());
       try {
         weld(i, opt_.threads);

@@ -1,8 +1,10 @@
 #include "scene/weld.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
+#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -113,39 +115,37 @@ Groups groupBy(size_t n, size_t keys, unsigned threads, const Key& key, bool den
     if (!pairs.empty()) g.start.push_back(uint32_t(pairs.size()));
     return g;
   }
-  // Counting sort: items to shards of kPiece keys (piece by piece, in order), then each shard by key.
-  const size_t shards = std::max<size_t>(1, (keys + kPiece - 1) / kPiece), pieces = piecesOf(n);
-  std::vector<uint32_t> at(pieces * shards, 0);
-  forPieces(n, threads, [&](size_t p, size_t b, size_t e) {
-    uint32_t* c = &at[p * shards];
+  // Counting sort in place of the counts, with no second array of the items (4 bytes an item: at 100 M
+  // triangles the weld's peak of memory was this sort's): the items are counted per key and scattered on
+  // all cores in whatever order the threads meet them, then each group is sorted (its items are few).
+  resizeOnAllCores(g.start, keys + 1, threads);  // zeros: the count of key k goes to start[k + 1]
+  auto bump = [threads](uint32_t& x) {
+    return threads == 1 ? x++ : std::atomic_ref<uint32_t>(x).fetch_add(1, std::memory_order_relaxed);
+  };
+  forPieces(n, threads, [&](size_t, size_t b, size_t e) {
     for (size_t i = b; i < e; ++i)
-      if (const uint32_t k = key(i); k != kAbsent) ++c[k / kPiece];
+      if (const uint32_t k = key(i); k != kAbsent) bump(g.start[k + 1]);
   });
-  std::vector<uint32_t> shardStart(shards + 1);
+  // start[k + 1] becomes the first place of group k (an exclusive sum), the cursor the scatter moves to
+  // group k's end, which is group k + 1's first place: what start[k + 1] must hold.
+  const size_t shards = piecesOf(keys);
+  std::vector<uint32_t> shardBase(shards);
+  forPieces(keys, threads, [&](size_t s, size_t b, size_t e) {
+    shardBase[s] = std::accumulate(g.start.begin() + ptrdiff_t(b + 1), g.start.begin() + ptrdiff_t(e + 1), uint32_t(0));
+  });
   uint32_t sum = 0;
-  for (size_t s = 0; s < shards; ++s) {
-    shardStart[s] = sum;
-    for (size_t p = 0; p < pieces; ++p) sum += std::exchange(at[p * shards + s], sum);
-  }
-  shardStart[shards] = sum;
-  auto byShard = uninitialised<uint32_t>(sum);
-  forPieces(n, threads, [&](size_t p, size_t b, size_t e) {
-    uint32_t* c = &at[p * shards];
-    for (size_t i = b; i < e; ++i)
-      if (const uint32_t k = key(i); k != kAbsent) byShard[c[k / kPiece]++] = uint32_t(i);
+  for (uint32_t& x : shardBase) sum += std::exchange(x, sum);
+  forPieces(keys, threads, [&](size_t s, size_t b, size_t e) {
+    for (size_t k = b, at = shardBase[s]; k < e; ++k) at += std::exchange(g.start[k + 1], uint32_t(at));
   });
-  resizeOnAllCores(g.start, keys + 1, threads);  // every entry is written below; its pages are first touched on all cores
   g.items = uninitialised<uint32_t>(sum);
-  parallelFor(shards, threads, [&](size_t s) {
-    const size_t k0 = s * kPiece, k1 = std::min(keys, k0 + kPiece);
-    std::vector<uint32_t> c(k1 - k0, 0);
-    for (uint32_t j = shardStart[s]; j < shardStart[s + 1]; ++j) ++c[key(byShard[j]) - k0];
-    uint32_t off = shardStart[s];
-    for (size_t x = 0; x < c.size(); ++x) g.start[k0 + x] = off, off += std::exchange(c[x], off);
-    for (uint32_t j = shardStart[s]; j < shardStart[s + 1]; ++j) g.items[c[key(byShard[j]) - k0]++] = byShard[j];
+  forPieces(n, threads, [&](size_t, size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i)
+      if (const uint32_t k = key(i); k != kAbsent) g.items[bump(g.start[k + 1])] = uint32_t(i);
   });
-  g.start[keys] = sum;
-  freeOnAllCores(byShard, sum, threads);
+  forPieces(keys, threads, [&](size_t, size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) std::sort(g.items.get() + g.start[k], g.items.get() + g.start[k + 1]);
+  });
   return g;
 }
 
@@ -225,7 +225,9 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   // gets the id normals.size() + genOf[c] of a generated normal; equal sums at a position share an id.
   // Those ids are written into the corners' n (a per-corner array would be the weld's peak of memory); the
   // faces' cross products are made again per position rather than held per triangle, for the same reason.
-  std::unique_ptr<glm::vec3[]> gen;
+  // The generated normals stay in their pieces' arrays (made[p], ids from base[p] on): not copied into one.
+  std::vector<std::vector<glm::vec3>> made;
+  std::vector<size_t> base;
   if (needNormals) {
     auto cross = [&](size_t t) {  // as step 1 computes it
       const Corner* c = &corners[t * 3];
@@ -238,7 +240,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       return l > 0.0f && std::isfinite(l) ? n / l : glm::vec3(0, 0, 1);
     };
     const uint32_t fileNormals = uint32_t(normals.size());
-    std::vector<std::vector<glm::vec3>> made(piecesOf(atPos.count()));
+    made.resize(piecesOf(atPos.count()));
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
       std::vector<glm::vec3> crosses, units;  // of the faces at this position
       // Up to 64 faces at a position: the faces each corner's normal averages as bits (a kept triangle has one
@@ -286,21 +288,22 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
           if (bits) seen.emplace_back(faces[i], corners[*c].n);
         }
       }
+      made[p].shrink_to_fit();  // held to the end of step 4
     });
-    std::vector<size_t> base(made.size());
+    base.resize(made.size());
     for (size_t p = 0; p < made.size(); ++p) base[p] = made[p].size();
-    gen = uninitialised<glm::vec3>(prefix(base));
+    prefix(base);
     forPieces(atPos.count(), threads, [&](size_t p, size_t b, size_t e) {
-      std::copy(made[p].begin(), made[p].end(), gen.get() + base[p]);
       for (uint32_t i = atPos.start[b]; i < atPos.start[e]; ++i)
         if (corners[atPos.items[i]].n >= fileNormals) corners[atPos.items[i]].n += uint32_t(base[p]);
     });
   }
 
-  // 3. Identical corners become one vertex (numbered as they first appear): each kept corner gets its
-  // vertex id in idOf, found through its position's group.
+  // 3. Identical corners become one vertex (numbered as they first appear). Equal corners share a position,
+  // so its group is all a corner is compared with; the result is written into the corners themselves (a
+  // per-corner array beside them and the groups would be the weld's peak of memory): a corner equal to an
+  // earlier one gets that one's index in p and kAbsent in n (every kept corner has a normal by now).
   if (cornerCount >= kDone) throw Error("a mesh of more than 715 million triangles cannot be welded");
-  auto idOf = uninitialised<uint32_t>(cornerCount);  // the first equal corner, then the vertex id
   forPieces(atPos.count(), threads, [&](size_t, size_t b, size_t e) {
     std::vector<uint32_t> distinct;
     for (size_t g = b; g < e; ++g) {
@@ -311,31 +314,35 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
         size_t k = 0;
         while (k < distinct.size() && !(corners[distinct[k]] == x)) ++k;
         if (k == distinct.size()) distinct.push_back(c);
-        idOf[c] = distinct[k];
+        else corners[c] = {distinct[k], kAbsent, kAbsent};
       }
     }
   });
   freeGroups(atPos, threads);
+  auto first = [&](size_t c) { return keep[c / 3] && corners[c].n != kAbsent; };
   const size_t cornerPieces = piecesOf(cornerCount);
   std::vector<size_t> firsts(cornerPieces, 0);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
-    for (size_t c = b; c < e; ++c) firsts[p] += keep[c / 3] && idOf[c] == c;
+    for (size_t c = b; c < e; ++c) firsts[p] += first(c);
   });
   const size_t uniqCount = prefix(firsts);
-  // Each vertex's first corner is copied out, so that the corners can go before the vertices are made (the
-  // weld's peak of memory), and gets its vertex id in idOf's place (top bit set: done); every other corner
-  // then gets the id of the first equal one, which lies before it.
+  // Each vertex's first corner is copied out, so that the corners can go before the vertices are made, and
+  // gets its vertex id (kDone set); every other corner the index of the first equal one, then that one's id.
+  // A piece's corners are read by it alone here, so their pages go back as it ends: the corners (12 bytes
+  // each) shrink while the ids (4) grow, at what was the weld's peak of memory.
   auto uniq = uninitialised<Corner>(uniqCount);
+  auto vertexOf = uninitialised<uint32_t>(cornerCount);
   forPieces(cornerCount, threads, [&](size_t p, size_t b, size_t e) {
     for (size_t c = b, id = firsts[p]; c < e; ++c)
-      if (keep[c / 3] && idOf[c] == c) uniq[id] = corners[c], idOf[c] = uint32_t(id++) | kDone;
+      if (first(c)) uniq[id] = corners[c], vertexOf[c] = uint32_t(id++) | kDone;
+      else if (keep[c / 3]) vertexOf[c] = corners[c].p;
+    pages::drop(&corners[b], (e - b) * sizeof(Corner));
   });
   if (cornersDone) cornersDone();                                    // from here on only `keep` and the ids are read
   forPieces(cornerCount, threads, [&](size_t, size_t b, size_t e) {  // reads the entries of first corners only
     for (size_t c = b; c < e; ++c)
-      if (keep[c / 3] && !(idOf[c] & kDone)) idOf[c] = idOf[idOf[c]];
+      if (keep[c / 3] && !(vertexOf[c] & kDone)) vertexOf[c] = vertexOf[vertexOf[c]];
   });
-  std::unique_ptr<uint32_t[]> vertexOf = std::move(idOf);  // with kDone set
 
   // 4. Vertices within the tolerance are merged, greedy as one thread would do it: in order, each joins
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
@@ -344,6 +351,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   auto verts = uninitialised<Vertex>(uniqCount);
   auto vcolor = uninitialised<glm::vec4>(colors.empty() ? 0 : uniqCount);
   auto slotOf = uninitialised<uint32_t>(uniqCount);
+  auto kept = uninitialised<uint8_t>(uniqCount);  // first: whether its cells are its own alone
   size_t cap = 16;  // the hash slots one thread would use: their collisions decide which vertex is found first
   while (cap < uniqCount * 2) cap <<= 1;
   const size_t mask = cap - 1, buckets = std::max<size_t>(16, cap / 4);
@@ -352,19 +360,24 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       const Corner c = uniq[u];
       Vertex& v = verts[u];
       v.p = positions[c.p];
-      v.n = c.n < normals.size() ? normals[c.n] : gen[c.n - normals.size()];
+      if (c.n < normals.size()) {
+        v.n = normals[c.n];
+      } else {
+        const size_t g = c.n - normals.size(), p = size_t(std::upper_bound(base.begin(), base.end(), g) - base.begin()) - 1;
+        v.n = made[p][g - base[p]];
+      }
       v.t = c.t != kAbsent ? texcoords[c.t] : glm::vec2(0.0f);
       if (!colors.empty()) vcolor[u] = colors[c.p];
       const Around a(v.p);
       slotOf[u] = uint32_t(cellHash(a.cell[0], a.cell[1], a.cell[2]) & mask);
+      kept[u] = a.lo[0] == a.hi[0] && a.lo[1] == a.hi[1] && a.lo[2] == a.hi[2];
     }
   });
   freeOnAllCores(uniq, uniqCount, threads);
-  gen.reset();
+  std::vector<std::vector<glm::vec3>>().swap(made);
   auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
   Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
-  auto kept = uninitialised<uint8_t>(uniqCount);
   auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
   // Bucket by bucket: a vertex whose cells are its own alone (most: it lies within the tolerance of no
   // cell face) needs only the bucket's vertices before it, which were just read; vertex by vertex, every
@@ -373,12 +386,11 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     for (size_t k = b; k < e; ++k)
       for (uint32_t j = inBucket.start[k]; j < inBucket.start[k + 1]; ++j) {
         const uint32_t u = inBucket.items[j];
-        const Around a(verts[u].p);
         bool near_ = false;
-        if (a.lo[0] == a.hi[0] && a.lo[1] == a.hi[1] && a.lo[2] == a.hi[2]) {  // its own cell, in this bucket
+        if (kept[u]) {  // its own cell, in this bucket: the first there reads no vertex (a cache miss each)
           for (uint32_t i = inBucket.start[k]; i < j && !near_; ++i) near_ = isNear(inBucket.items[i], u);
         } else {
-          near_ = a.any([&](uint64_t h) {
+          near_ = Around(verts[u].p).any([&](uint64_t h) {
             const size_t c = h & (buckets - 1);
             for (uint32_t i = inBucket.start[c]; i < inBucket.start[c + 1] && inBucket.items[i] < u; ++i)
               if (isNear(inBucket.items[i], u)) return true;

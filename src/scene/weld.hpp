@@ -28,7 +28,8 @@ struct WeldCounts {
 constexpr float kDefaultCreaseDeg = 40.0f;
 
 // `corners` holds 3 per triangle; where a corner has no normal, its n is overwritten (the id of a
-// generated normal: the caller's corners are the weld's scratch space). Fills out.positions/normals/texcoords/colors/indices/bounds (not name or
+// generated normal: the caller's corners are the weld's scratch space, and their pages are given back
+// as it goes: their contents are lost). Fills out.positions/normals/texcoords/colors/indices/bounds (not name or
 // material). A generated normal averages the faces at its position within `creaseDeg` of its own face (0:
 // flat, 180: smooth). `colors`: one per position, or empty. Runs on `threads` (0: all cores) in fixed
 // pieces: the mesh is the same for any thread count. `cornersDone`, when given, is called once `corners`
