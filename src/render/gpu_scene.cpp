@@ -173,6 +173,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
                                 }) ||
                     std::any_of(scene.meshes.begin(), scene.meshes.end(),
                                 [](const Mesh& m) { return !m.colors.empty() || !m.tangents.empty() || !m.texcoords1.empty(); });
+  identityInstances_ = std::all_of(scene.instances.begin(), scene.instances.end(),
+                                   [](const Instance& in) { return in.transform == glm::mat4(1.0f); });
   if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
     texturedMaterials_ = materials;
     for (shader::GpuMaterial& g : materials)

@@ -159,6 +159,8 @@ class GpuScene {
   // Whether some draw needs what glTF adds to a material (texture transforms, the second uv set, vertex
   // colours, tangents, normal and occlusion maps, unlit, GGX): the shading pass's MATERIAL_EXTRAS variant.
   bool materialExtras() const { return materialExtras_; }
+  // Whether every instance is the identity (a scene without instances): the shading pass's IDENTITY variant.
+  bool identityInstances() const { return identityInstances_; }
   VkBuffer indices16() const { return indices16_.handle(); }
   VkBuffer indices32() const { return indices32_.handle(); }
   VkBuffer materials() const { return materials_.handle(); }
@@ -254,6 +256,7 @@ class GpuScene {
   std::vector<std::optional<TextureCacheKey>> storeKeys_;  // per texture: a cache miss, stored once its chain is made
   std::vector<std::future<void>> storing_;                 // packing and writing them
   bool materialExtras_ = false;
+  bool identityInstances_ = false;
   bool ready_ = false;  // every texture is on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;

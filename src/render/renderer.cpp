@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "core/error.hpp"
@@ -138,6 +139,12 @@ Renderer::KindPipelines Renderer::makePipelines(PipelineSet set) const {
   return out;
 }
 
+// RTR_SHADE_IDENTITY=0: the instances' transforms applied even where all are the identity (comparing the two).
+static bool shadeIdentity() {
+  const char* v = std::getenv("RTR_SHADE_IDENTITY");
+  return !v || std::strcmp(v, "0") != 0;
+}
+
 Renderer::VisShade Renderer::makeShade(bool fromBuffer, bool display) const {
   const bool textured = scene_.texcoords() != VK_NULL_HANDLE;
   vk::LayoutOptions options{.pushDescriptorSets = {0}};
@@ -148,7 +155,8 @@ Renderer::VisShade Renderer::makeShade(bool fromBuffer, bool display) const {
                                               {VARIANT_VIS_BUFFER, fromBuffer},
                                               {VARIANT_ENV, env_ != nullptr},
                                               {VARIANT_MATERIAL_EXTRAS, scene_.materialExtras()},
-                                              {VARIANT_DISPLAY, display}}));
+                                              {VARIANT_DISPLAY, display},
+                                              {VARIANT_IDENTITY, scene_.identityInstances() && shadeIdentity()}}));
   if (v.pipeline->layout.setCount() > 1) {
     v.textures = vk::DescriptorSets(ctx_, v.pipeline->layout, 1);
     writeTextures(v.pipeline->layout, v.textures.get(1));
