@@ -1,6 +1,7 @@
 #include "vk/pipeline_executables.hpp"
 
 #include <cstdio>
+#include <cstring>
 
 #include "vk/check.hpp"
 
@@ -51,7 +52,13 @@ void PipelineExecutableLog::record(const std::string& name, VkPipeline pipeline)
     ei.executableIndex = i;
     uint32_t m = 0;
     VK_CHECK(statistics_(device_, &ei, &m, nullptr));
-    std::vector<VkPipelineExecutableStatisticKHR> stats(m, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+    // Zeroed whole: `{sType}` sets only the value union's first 32 bits, and NVIDIA 580's "Local Memory
+    // Size" (UINT64) read 2^36 + n from such records, as if the driver wrote only the low half.
+    std::vector<VkPipelineExecutableStatisticKHR> stats(m);
+    for (VkPipelineExecutableStatisticKHR& s : stats) {
+      std::memset(&s, 0, sizeof s);
+      s.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR;
+    }
     VK_CHECK(statistics_(device_, &ei, &m, stats.data()));
     for (const auto& s : stats) e.statistics.push_back({s.name, valueText(s)});
     report.executables.push_back(std::move(e));
