@@ -12,6 +12,7 @@
 #define VARIANT_MATERIAL_EXTRAS 5  // vis_shade: some draw has glTF's extras (texture transforms, the second uv set,
                                    // vertex colours, tangents, normal and occlusion maps, unlit, GGX; GpuScene)
 #define VARIANT_DISPLAY 6     // vis_shade writes the target's sRGB-encoded bytes, not the linear image (no post pass)
+#define VARIANT_IDENTITY 7    // vis_shade: every instance's transform is the identity (GpuScene): none applied
 
 #ifndef __cplusplus
 layout(constant_id = VARIANT_TEXCOORDS) const bool HAS_TEXCOORDS = true;
@@ -21,5 +22,6 @@ layout(constant_id = VARIANT_ENV) const bool HAS_ENV = false;
 layout(constant_id = VARIANT_BLEND) const bool BLEND = false;
 layout(constant_id = VARIANT_MATERIAL_EXTRAS) const bool MATERIAL_EXTRAS = true;
 layout(constant_id = VARIANT_DISPLAY) const bool DISPLAY = false;
+layout(constant_id = VARIANT_IDENTITY) const bool IDENTITY = false;
 #endif
 #endif

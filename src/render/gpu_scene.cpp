@@ -182,7 +182,9 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   const auto t = Clock::now();
   GeometryPlan plan = planGeometry(scene);
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
-  materialExtras_ = sceneKinds(scene).materialExtras;
+  const SceneKinds kinds = sceneKinds(scene);
+  materialExtras_ = kinds.materialExtras;
+  identityInstances_ = kinds.identityInstances;
   if (decoding_.valid()) {  // until the textures are in: the factors alone (NO_TEXTURE everywhere)
     texturedMaterials_ = materials;
     for (shader::GpuMaterial& g : materials)

@@ -86,6 +86,7 @@ struct SceneKinds {
   uint64_t triangles = 0;                    // of every drawn instance, blended ones aside
   uint64_t visIds = 0;                       // GpuScene::visIdCount
   bool clusterIdsFit = true;                 // the compute rasteriser's lists can name every (instance, cluster) record
+  bool identityInstances = true;             // every instance's transform is the identity (shade's IDENTITY variant)
   bool operator==(const SceneKinds&) const = default;
 };
 SceneKinds sceneKinds(const Scene& scene);
@@ -191,6 +192,8 @@ class GpuScene {
   // Whether some draw needs what glTF adds to a material (texture transforms, the second uv set, vertex
   // colours, tangents, normal and occlusion maps, unlit, GGX): the shading pass's MATERIAL_EXTRAS variant.
   bool materialExtras() const { return materialExtras_; }
+  // Whether every instance is the identity (a scene without instances): the shading pass's IDENTITY variant.
+  bool identityInstances() const { return identityInstances_; }
   SceneKinds kinds() const;  // as uploaded: sceneKinds() of the scene
   VkBuffer indices16() const { return indices16_.handle(); }
   VkBuffer indices32() const { return indices32_.handle(); }
@@ -289,6 +292,7 @@ class GpuScene {
   std::vector<std::optional<TextureCacheKey>> storeKeys_;  // per texture: a cache miss, stored once its chain is made
   std::vector<std::future<void>> storing_;                 // packing and writing them
   bool materialExtras_ = false;
+  bool identityInstances_ = false;
   bool ready_ = false;  // every texture is on the GPU and the materials point at them
   std::array<std::vector<DrawItem>, kDrawKindCount> draws_;
   std::vector<BlendDraw> blendDraws_;

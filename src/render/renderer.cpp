@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <utility>
 
@@ -108,6 +109,12 @@ vk::Pipeline Renderer::makeScenePipeline(const vk::Context& ctx, const SceneKind
   return vk::makeGraphicsPipeline(ctx, d, options);
 }
 
+// RTR_SHADE_IDENTITY=0: the instances' transforms applied even where all are the identity (comparing the two).
+static bool shadeIdentity() {
+  const char* v = std::getenv("RTR_SHADE_IDENTITY");
+  return !v || std::strcmp(v, "0") != 0;
+}
+
 vk::Pipeline Renderer::makeShadePipeline(const vk::Context& ctx, const SceneKinds& kinds, bool fromBuffer, bool display,
                                          bool environment) {
   vk::LayoutOptions options{.pushDescriptorSets = {0}};
@@ -117,7 +124,8 @@ vk::Pipeline Renderer::makeShadePipeline(const vk::Context& ctx, const SceneKind
                                   {VARIANT_VIS_BUFFER, fromBuffer},
                                   {VARIANT_ENV, environment},
                                   {VARIANT_MATERIAL_EXTRAS, kinds.materialExtras},
-                                  {VARIANT_DISPLAY, display}});
+                                  {VARIANT_DISPLAY, display},
+                                  {VARIANT_IDENTITY, kinds.identityInstances && shadeIdentity()}});
 }
 
 vk::Pipeline Renderer::makeBackdrop(const vk::Context& ctx) {

@@ -35,6 +35,8 @@ SceneKinds sceneKinds(const Scene& scene) {
                      std::any_of(scene.meshes.begin(), scene.meshes.end(),
                                  [](const Mesh& m) { return !m.colors.empty() || !m.tangents.empty() || !m.texcoords1.empty(); });
   k.textures = uint32_t(sampledTextures(scene).size());
+  k.identityInstances = std::all_of(scene.instances.begin(), scene.instances.end(),
+                                    [](const Instance& in) { return in.transform == glm::mat4(1.0f); });
   const bool lods = std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return m.lod.levels > 0; });
   const std::vector<Instance> instances = gpuInstances(scene);  // meshes with triangles only
   k.instances = uint32_t(instances.size());
@@ -78,6 +80,7 @@ SceneKinds GpuScene::kinds() const {
   }
   k.blended = !blendDraws_.empty();
   k.texcoords = texcoords() != VK_NULL_HANDLE;
+  k.identityInstances = identityInstances_;
   k.materialExtras = materialExtras_;
   k.textures = textureCount();
   k.instances = instanceCount();

@@ -12,6 +12,7 @@
 
 #include "vk/check.hpp"
 #include "vk/pipeline_cache.hpp"
+#include "vk/pipeline_executables.hpp"
 
 namespace rtr::vk {
 namespace {
@@ -229,6 +230,27 @@ Context::Context(const ContextOptions& options) {
     // Push descriptors: per-dispatch bindings without pools (post-process, mip generation).
     std::vector<const char*> deviceExtensions{VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
     if (options.presentation) deviceExtensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    // Pipeline statistics (registers, spills, ...: --pipeline-stats), enabled only when asked for.
+    uint32_t extensionCount = 0;
+    vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, nullptr);
+    std::vector<VkExtensionProperties> available(extensionCount);
+    vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extensionCount, available.data());
+    for (const VkExtensionProperties& e : available)
+      statisticsSupported_ |= std::strcmp(e.extensionName, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME) == 0;
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR fExec{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+    if (statisticsSupported_) {
+      VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &fExec};
+      vkGetPhysicalDeviceFeatures2(physical_, &query);
+      statisticsSupported_ = fExec.pipelineExecutableInfo;
+    }
+    const bool captureStatistics = options.pipelineStatistics && statisticsSupported_;
+    if (captureStatistics) {
+      deviceExtensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+      fExec.pipelineExecutableInfo = VK_TRUE;
+      fExec.pNext = f13.pNext;
+      f13.pNext = &fExec;
+    }
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &f2};
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &queueInfo;
@@ -247,6 +269,7 @@ Context::Context(const ContextOptions& options) {
     ai.vulkanApiVersion = VK_API_VERSION_1_3;
     VK_CHECK(vmaCreateAllocator(&ai, &allocator_));
     pipelineCache_ = std::make_unique<PipelineCache>(device_, properties_, options.pipelineCacheDir);
+    executables_ = std::make_unique<PipelineExecutableLog>(device_, options.pipelineStatistics, captureStatistics);
   } catch (...) {
     release();
     throw;

@@ -15,6 +15,7 @@ typedef struct VmaAllocator_T* VmaAllocator;
 namespace rtr::vk {
 
 class PipelineCache;
+class PipelineExecutableLog;
 
 struct ContextOptions {
   bool validation = false;                      // Khronos validation layer + debug messenger (fails loudly if missing)
@@ -23,6 +24,7 @@ struct ContextOptions {
   std::vector<const char*> instanceExtensions;  // e.g. those GLFW needs for a surface
   bool presentation = false;                    // enable VK_KHR_swapchain on the device
   std::filesystem::path pipelineCacheDir;       // where the pipeline cache file lives; empty: not on disk
+  bool pipelineStatistics = false;              // log every pipeline made, with its statistics where the device has them
 };
 
 // Options from the environment: RTR_VALIDATION=1 enables validation (+ sync validation),
@@ -63,6 +65,10 @@ class Context {
   VkDeviceSize deviceHeapBytes() const;
   // Every pipeline is created through it (vk/pipeline.cpp), which also counts them and their time.
   PipelineCache& pipelineCache() const { return *pipelineCache_; }
+  // Whether the device has VK_KHR_pipeline_executable_properties; the log captures only where it does and
+  // the options asked for it.
+  bool pipelineStatisticsSupported() const { return statisticsSupported_; }
+  PipelineExecutableLog& pipelineExecutables() const { return *executables_; }
 
   // Names an object in validation messages and debuggers (no-op without validation).
   void setName(uint64_t handle, VkObjectType type, const char* name) const;
@@ -80,6 +86,8 @@ class Context {
   uint32_t queueFamily_ = 0;
   VmaAllocator allocator_ = nullptr;
   std::unique_ptr<PipelineCache> pipelineCache_;
+  std::unique_ptr<PipelineExecutableLog> executables_;
+  bool statisticsSupported_ = false;
   PFN_vkCmdPushDescriptorSetKHR pushDescriptorFn_ = nullptr;
   bool updateUnusedWhilePending_ = false;
 };

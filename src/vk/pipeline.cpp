@@ -15,6 +15,7 @@
 #include "vk/check.hpp"
 #include "vk/context.hpp"
 #include "vk/pipeline_cache.hpp"
+#include "vk/pipeline_executables.hpp"
 
 namespace rtr::vk {
 
@@ -192,6 +193,19 @@ struct Feedback {
   Feedback& operator=(const Feedback&) = delete;
 };
 
+// A pipeline's name in the statistics: its shaders and specialization constants.
+std::string pipelineName(const std::vector<SpirvModule>& modules, const std::vector<SpecializationConstant>& constants) {
+  std::string name;
+  for (const SpirvModule& m : modules) name += (name.empty() ? "" : " + ") + m.name;
+  for (size_t i = 0; i < constants.size(); ++i)
+    name += (i ? ", " : " {") + std::to_string(constants[i].id) + "=" + std::to_string(constants[i].value);
+  return constants.empty() ? name : name + "}";
+}
+
+VkPipelineCreateFlags captureFlags(const Context& ctx) {
+  return ctx.pipelineExecutables().capturing() ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
+}
+
 }  // namespace
 
 Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, const LayoutOptions& options,
@@ -203,6 +217,7 @@ Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, cons
   p.layout = PipelineLayout(ctx, reflectPipeline({variant}), options);
   ShaderModuleHandle module = createModule(ctx.device(), variant);
   VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO, &feedback.info};
+  ci.flags = captureFlags(ctx);
   ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
   ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   ci.stage.module = module;
@@ -213,6 +228,7 @@ Pipeline makeComputePipeline(const Context& ctx, const SpirvModule& shader, cons
   p.pipeline = PipelineHandle(ctx.device(), raw);
   feedback.created = true;
   ctx.setName(uint64_t(raw), VK_OBJECT_TYPE_PIPELINE, shader.name.c_str());
+  ctx.pipelineExecutables().record(pipelineName({shader}, specialization), raw);
   return p;
 }
 
@@ -291,6 +307,7 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   ri.pNext = &feedback.info;
 
   VkGraphicsPipelineCreateInfo gi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, &ri};
+  gi.flags = captureFlags(ctx);
   gi.stageCount = uint32_t(stages.size());
   gi.pStages = stages.data();
   gi.pVertexInputState = &vi;
@@ -306,6 +323,7 @@ Pipeline makeGraphicsPipeline(const Context& ctx, const GraphicsDesc& d, const L
   VK_CHECK(vkCreateGraphicsPipelines(ctx.device(), ctx.pipelineCache().handle(), 1, &gi, nullptr, &raw));
   p.pipeline = PipelineHandle(ctx.device(), raw);
   feedback.created = true;
+  ctx.pipelineExecutables().record(pipelineName(d.modules, d.specialization), raw);
   return p;
 }
 

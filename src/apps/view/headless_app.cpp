@@ -264,6 +264,7 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
     });
     for (const auto& [name, ms] : frame.gpuTimes) std::fprintf(stderr, "  %s: %.3f ms GPU\n", name.c_str(), ms);
   }
+  printPipelineStats(o, ctx);
   return 0;
 }
 

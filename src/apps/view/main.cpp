@@ -19,6 +19,7 @@
 #include "scene/framing.hpp"
 #include "scene/load.hpp"
 #include "vk/context.hpp"
+#include "vk/pipeline_executables.hpp"
 
 namespace rtr::view {
 
@@ -103,7 +104,18 @@ vk::ContextOptions contextOptions(const ViewOptions& o) {
   if (o.validation) co.validation = true;
   if (!o.device.empty()) co.device = o.device;
   if (!o.pipelineCache) co.pipelineCacheDir.clear();
+  co.pipelineStatistics = o.pipelineStats;
   return co;
+}
+
+void printPipelineStats(const ViewOptions& o, const vk::Context& ctx) {
+  if (!o.pipelineStats) return;
+  const auto reports = ctx.pipelineExecutables().reports();
+  std::printf("pipeline statistics: %zu pipelines on %s (%s)%s\n%s", reports.size(), ctx.deviceName().c_str(),
+              ctx.driverInfo().c_str(),
+              ctx.pipelineStatisticsSupported() ? ", the driver's names"
+                                                : ": no statistics (the device lacks VK_KHR_pipeline_executable_properties)",
+              vk::formatReports(reports).c_str());
 }
 
 DeviceChoice chooseForDevice(const ViewOptions& o, const vk::Context& ctx) {
@@ -266,6 +278,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--timings", o.timings,
                "print the start-up phases in ms, from process start to the first frame (the window's panel shows them too)");
+  app.add_flag("--pipeline-stats", o.pipelineStats,
+               "print every pipeline the renderer made and the driver's statistics for each (registers, spills, "
+               "instructions; VK_KHR_pipeline_executable_properties), then run as asked");
   app.add_flag("--no-pipeline-cache", noPipelineCache,
                "neither read nor write the pipeline cache ($XDG_CACHE_HOME/rtr or ~/.cache/rtr; RTR_PIPELINE_CACHE=DIR|off)");
   cli::addCacheOptions(app, noCache, "; nor the pipeline cache");

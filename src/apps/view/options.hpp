@@ -44,6 +44,7 @@ struct ViewOptions {
   bool shadingGiven = false, mipsGiven = false, clipGiven = false;  // --shading-path / --mips given: no per-device default
   bool timings = false;                                             // print the start-up phases
   bool pipelineCache = true;                                        // keep compiled pipelines in the user's cache folder
+  bool pipelineStats = false;                                       // --pipeline-stats: print every pipeline made
   bool textureCache = true;                                         // keep decoded, mipped textures there (--no-cache: neither)
   // The first frame waits for the textures (deterministic captures); unless given, on for --headless
   // (--screenshot, --bench), off in the window, whose frames show the factors until the textures are in.
@@ -92,6 +93,8 @@ render::RenderSettings sceneSettings(const ViewOptions& o, const Scene& scene);
 
 // The Vulkan context options: the environment's (vk::optionsFromEnvironment), then the flags.
 vk::ContextOptions contextOptions(const ViewOptions& o);
+// --pipeline-stats: every pipeline made so far on stdout, with the driver's statistics where it gives them.
+void printPipelineStats(const ViewOptions& o, const vk::Context& ctx);
 // The shading path and mip mode for `ctx`'s device: the flags where given, else the per-device defaults
 // (render/startup.hpp), the choice and its reason said once on stderr.
 struct DeviceChoice {

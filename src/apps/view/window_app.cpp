@@ -212,6 +212,7 @@ int runWindowed(const ViewOptions& opts) {
     if (frameNumber++ == 0) {  // the first frame is on screen (presented; its GPU work waited for)
       VK_CHECK(vkDeviceWaitIdle(ctx.device()));
       clock.firstFrame(o.timings);
+      printPipelineStats(o, ctx);
     }
     if (shots.save(shot, slot.path())) window.close();
     if (errorMap) startErrorMap(app, slot, lens, std::move(shot));
