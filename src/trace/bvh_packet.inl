@@ -291,18 +291,6 @@ struct PacketWalker {
     return m;
   }
 
-#ifndef RTR_BVH_PF
-#define RTR_BVH_PF 0
-#endif
-  // Round 17's prefetch forms, for the 16-core host's A/B run only (docs/bench/trace.md; removed again in
-  // the next commit): RTR_BVH_PF=1 prefetches each child a packet pushes, 2 the top of the stack while a
-  // packet tests a leaf. The first line of a node, or a leaf's first pack.
-  RTR_INLINE void prefetchRef(uint32_t ref) const {
-    const char* p = ref & Bvh::kLeafBit ? reinterpret_cast<const char*>(&bvh.packs[ref & 0x0FFFFFFFu])
-                                        : reinterpret_cast<const char*>(&bvh.nodes[ref]);
-    _mm_prefetch(p, _MM_HINT_T0);
-  }
-
   // Tests node `ref`'s children against the packet: false when no ray meets any; else ref/active are
   // the child to visit next and its rays, the other children are on the stack.
   RTR_INLINE bool visitNode(PacketEntry* stack, int& sp, uint32_t& ref, unsigned& active) const {
@@ -340,9 +328,6 @@ struct PacketWalker {
     for (int j = k - 1; j > 0; --j) {
       const int c = int(keys[j] & 7u);
       stack[sp++] = {tn[c], n.child[c], mk[c]};
-#if RTR_BVH_PF == 1
-      prefetchRef(n.child[c]);
-#endif
     }
     const int c0 = int(keys[0] & 7u);
     ref = n.child[c0];
@@ -586,9 +571,6 @@ struct PacketWalker {
         }
         if (ref & Bvh::kLeafBit) {
           RTR_COUNT(c.packetLeaves += 1; c.packetLeafRays += unsigned(__builtin_popcount(active)));
-#if RTR_BVH_PF == 2
-          if (sp) prefetchRef(stack[sp - 1].ref);
-#endif
           if (__builtin_popcount(active) >= leafRays && shear()) {
             done |= leafAllRays(ref, active);
             break;
