@@ -541,7 +541,8 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
                                return s.any ? em.occluded8(&rays[8 * i], n) : em.closest8(&rays[8 * i], n);
                              }));
       }
-      char t8[32] = "not built in", r8[32] = "–";
+      char t8[32] = "–", r8[32] = "–";  // "–": not timed (--singles-only)
+      if (!packets) std::snprintf(t8, sizeof t8, "not built in");
       if (packets && theirs8 < 1e30) {
         std::snprintf(t8, sizeof t8, "%.2f", rays.size() / theirs8 * 1e-6);
         std::snprintf(r8, sizeof r8, "%.2f×", theirs8 / ours8);
