@@ -120,6 +120,7 @@ struct PacketWalker {
       new (walkers[i]) W(bvh, rays[i], method, i, oAxis, rNear, qNear, rFar, qFar, neg);
 #else
       new (walkers[i]) W(bvh, rays[i], method);
+      reinterpret_cast<const W*>(walkers[i])->initShear();  // leafCandidates reads its shear
 #endif
       built |= 1u << i;
     }

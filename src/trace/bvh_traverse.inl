@@ -123,6 +123,23 @@ constexpr SlabAxes slabAxesOf(unsigned parallel) {
   return s;
 }
 
+// Where a node's near and far planes lie for each axis (floats into Node::box), per sign pattern of
+// the ray's direction (bit a: negative along axis a): a table, so that a ray's set-up only picks a row.
+struct SlabOffsets {
+  int nearOff[3], farOff[3];
+};
+constexpr SlabOffsets slabOffsetsOf(unsigned negative) {
+  SlabOffsets s{};
+  for (int a = 0; a < 3; ++a) {
+    const int nearSide = int(negative >> a & 1);
+    s.nearOff[a] = (nearSide * 3 + a) * 8;
+    s.farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+  }
+  return s;
+}
+constexpr SlabOffsets kSlabOffsets[8] = {slabOffsetsOf(0), slabOffsetsOf(1), slabOffsetsOf(2), slabOffsetsOf(3),
+                                         slabOffsetsOf(4), slabOffsetsOf(5), slabOffsetsOf(6), slabOffsetsOf(7)};
+
 #define RTR_INLINE inline __attribute__((always_inline))
 
 // Counting (bvh_counted.cpp only): RTR_COUNT(c.nodes += 1) adds to the thread's BvhCounters; elsewhere
@@ -171,32 +188,37 @@ struct Walker {
   const Ray& ray;
   const IntersectMethod method;
   F oAxis[3];
-  int nearOff[3], farOff[3];
+  const SlabOffsets* off;  // a row of kSlabOffsets
 #if RTR_BVH_AVX2
   F rNear[3], qNear[3], rFar[3], qFar[3];
 #else
   F org[3], rdir[3], rdirFar[3];
 #endif
-  int kx, ky, kz;
-  F ox, oy, oz, sx, sy, sz;
+  // The watertight test's constants, made on the ray's first leaf (most rays of a view that miss, or
+  // end after a node or two, never reach one: docs/bench/trace.md, round 17).
+  mutable bool sheared = false;
+  mutable int kx, ky, kz;
+  mutable F ox, oy, oz, sx, sy, sz;
 
   RTR_INLINE Walker(const Bvh::View& view, const Ray& r, IntersectMethod m) : bvh(view), ray(r), method(m) {
     const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
     const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-    const float rcp[3] = {1.0f / d[0], 1.0f / d[1], 1.0f / d[2]};
     // Slab distances, conservative under rounding so that the BVH keeps the watertight test watertight:
     // a box the ray really meets is never culled. A NaN distance (an overflow) never culls either: the
     // test below is "not tNear > tFar". An axis the ray runs parallel to (orthographic views, axis-aligned
     // rays) has no slab distances (they would be infinite or NaN and cull nothing: every box across the
     // view visited); its test is exact instead, lo ≤ o ≤ hi.
-    for (int a = 0; a < 3; ++a) oAxis[a] = set1(o[a]);
+    for (int a = 0; a < 3; ++a)
+      if (Parallel >> a & 1) oAxis[a] = set1(o[a]);
 #if RTR_BVH_AVX2
     // One FMA per slab: t = box·r − o·r. The near distance uses r shrunk by 8 ulps and o·r pushed up by
     // 4 ulps, the far one r grown and o·r pushed down: enough to cover every rounding (of 1/d, of o·r, of
     // the FMA), so a near distance never ends up past the true one, nor a far one short of it.
-    // All three axes at once in one SSE register (the same operations per lane as one axis alone): the
-    // per-ray set-up is a good part of a ray's time (measured with rays that miss the root).
-    const __m128 r4 = _mm_setr_ps(rcp[0], rcp[1], rcp[2], 1.0f), o4 = _mm_setr_ps(o[0], o[1], o[2], 0.0f);
+    // All three axes at once in one SSE register, one division for the three reciprocals (the same
+    // operations per lane as one axis alone): the per-ray set-up is a good part of a ray's time
+    // (measured with rays that miss the root).
+    const __m128 r4 = _mm_div_ps(_mm_set1_ps(1.0f), _mm_setr_ps(d[0], d[1], d[2], 1.0f)),
+                 o4 = _mm_setr_ps(o[0], o[1], o[2], 0.0f);
     const __m128 rn4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f - 0x1p-21f)), rf4 = _mm_mul_ps(r4, _mm_set1_ps(1.0f + 0x1p-21f));
     const __m128 qn0 = _mm_mul_ps(o4, rn4), qf0 = _mm_mul_ps(o4, rf4), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
     const __m128 qn4 =
@@ -215,26 +237,20 @@ struct Walker {
     qFar[0] = lane<0>(qf4);
     qFar[1] = lane<1>(qf4);
     qFar[2] = lane<2>(qf4);
-    const unsigned negative = unsigned(_mm_movemask_ps(_mm_cmplt_ps(r4, _mm_setzero_ps())));
-    for (int a = 0; a < 3; ++a) {
-      const int nearSide = negative >> a & 1;
-      nearOff[a] = (nearSide * 3 + a) * 8;
-      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
-    }
+    off = &kSlabOffsets[unsigned(_mm_movemask_ps(_mm_cmplt_ps(r4, _mm_setzero_ps()))) & 7u];
 #else
     // (box − o)·r, the far one scaled by 1 + 2·gamma(4) (Ize 2013; the scale folded into r, one more rounding).
     constexpr float kFarScale = 1.0f + 2.0f * (4.0f * 0x1p-24f) / (1.0f - 4.0f * 0x1p-24f);
+    unsigned negative = 0;
     for (int a = 0; a < 3; ++a) {
-      const float inv = rcp[a];
+      const float inv = 1.0f / d[a];
       org[a] = set1(o[a]);
       rdir[a] = set1(inv);
       rdirFar[a] = set1(inv * kFarScale);
-      const int nearSide = inv < 0.0f ? 1 : 0;
-      nearOff[a] = (nearSide * 3 + a) * 8;
-      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+      negative |= unsigned(inv < 0.0f) << a;
     }
+    off = &kSlabOffsets[negative];
 #endif
-    initShear(o, d, rcp);
   }
 
 #if RTR_BVH_AVX2
@@ -246,37 +262,36 @@ struct Walker {
       : bvh(view), ray(r), method(m) {
     const __m256i idx = _mm256_set1_epi32(i);
     auto laneOf = [&](F v) { return F{_mm256_permutevar8x32_ps(v.v, idx)}; };
+    unsigned signs = 0;
     for (int a = 0; a < 3; ++a) {
       oAxis[a] = laneOf(o3[a]);
       rNear[a] = laneOf(rn[a]);
       qNear[a] = laneOf(qn[a]);
       rFar[a] = laneOf(rf[a]);
       qFar[a] = laneOf(qf[a]);
-      const int nearSide = bits(negative[a]) >> i & 1;
-      nearOff[a] = (nearSide * 3 + a) * 8;
-      farOff[a] = ((1 - nearSide) * 3 + a) * 8;
+      signs |= (bits(negative[a]) >> i & 1) << a;
     }
-    const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
-    const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-    initShear(o, d, nullptr);
+    off = &kSlabOffsets[signs];
+    initShear();
   }
 #endif
 
   // The watertight test's shear, constant per ray; vertex axes are loaded in its permuted order.
   // The same operations as WatertightRay's constructor (the scalar test of edge cases builds one and
-  // must shear identically), inline here and sharing the reciprocal with the slab test (rcp; null: one
-  // division here, the same).
-  RTR_INLINE void initShear(const float* o, const float* d, const float* rcp) {
+  // must shear identically), inline here.
+  RTR_INLINE void initShear() const {
+    const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+    const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
     shearAxes(d, 1, kx, ky, kz);
-    const float szs = rcp ? rcp[kz] : 1.0f / d[kz];
+    const float szs = 1.0f / d[kz];
     ox = set1(o[kx]);
     oy = set1(o[ky]);
     oz = set1(o[kz]);
     sx = set1(d[kx] * szs);
     sy = set1(d[ky] * szs);
     sz = set1(szs);
+    sheared = true;
   }
-
   // The watertight test's axis order for direction d[0], d[stride], d[2 * stride] (packets keep theirs
   // by axis): kz the largest component, kx and ky swapped where it is negative.
   RTR_INLINE static void shearAxes(const float* d, int stride, int& kx, int& ky, int& kz) {
@@ -302,11 +317,11 @@ struct Walker {
     for (int i = 0; i < kSlabs; ++i) {
       const int a = kSlabAxes.axis[i];
 #if RTR_BVH_AVX2
-      tn[i] = fmsub(load(b + nearOff[a]), rNear[a], qNear[a]);
-      tf[i] = fmsub(load(b + farOff[a]), rFar[a], qFar[a]);
+      tn[i] = fmsub(load(b + off->nearOff[a]), rNear[a], qNear[a]);
+      tf[i] = fmsub(load(b + off->farOff[a]), rFar[a], qFar[a]);
 #else
-      tn[i] = (load(b + nearOff[a]) - org[a]) * rdir[a];
-      tf[i] = (load(b + farOff[a]) - org[a]) * rdirFar[a];
+      tn[i] = (load(b + off->nearOff[a]) - org[a]) * rdir[a];
+      tf[i] = (load(b + off->farOff[a]) - org[a]) * rdirFar[a];
 #endif
     }
     // At most two levels of min/max, not a chain: this is the loop's critical path. As floats, a NaN
@@ -378,6 +393,7 @@ struct Walker {
     const F zero = set1(0.0f), signBit = set1(-0.0f);
     const uint32_t first = at.ref & 0x0FFFFFFFu, np = ((at.ref >> 28) & 7u) + 1;
     RTR_COUNT(c.leaves += 1);
+    if (!sheared) initShear();
     for (uint32_t p = first; p < first + np; ++p) {
       const TriPack& pk = bvh.packs[p];
       RTR_COUNT(c.packs += 1; c.triangles += unsigned(__builtin_popcount(realLanes(pk))));

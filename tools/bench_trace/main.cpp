@@ -302,6 +302,7 @@ struct Options {
   std::vector<std::pair<uint32_t, uint32_t>> grains;  // --build-grain: also built with each (Bvh::setBuildGrain)
   bool quick = false, explainAll = false, countOnly = false;
   bool packetsOnly = false;  // time only the packets, ours and Embree's; no agreement with Embree
+  bool singlesOnly = false;  // time only single rays and pairs, ours, and rtcIntersect1/Occluded1
   bool buildOnly = false;    // time only the builds, ours and Embree's alternately
   bool profile = false;      // where a packet's time goes (printProfile)
 };
@@ -519,8 +520,8 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
           for (int k = 0; k < n; ++k) acc += h[k].prim;
           return acc;
         };
-        ours8 = std::min(ours8, timed((rays.size() + 7) / 8, th, 2, packets8));
-        for (size_t k = 0; k < o.aloneSweep.size(); ++k) {  // this set's hand-off threshold set to each value
+        if (!o.singlesOnly) ours8 = std::min(ours8, timed((rays.size() + 7) / 8, th, 2, packets8));
+        for (size_t k = 0; k < o.aloneSweep.size() && !o.singlesOnly; ++k) {  // this set's hand-off threshold set to each value
           int a[3] = {o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]};
           a[s.any ? 2 : int(s.kind)] = o.aloneSweep[k];
           Bvh::setPacketAloneRays(a[0], a[1], a[2]);
@@ -528,20 +529,21 @@ void printSpeeds(const Bvh& bvh, const Embree& em, const Rays& all, const Option
           Bvh::setPacketAloneRays(o.aloneRays[0], o.aloneRays[1], o.aloneRays[2]);
         }
         Bvh::setPacketLeafRays(9);  // every leaf ray by ray (lanes = triangles), as before round 8
-        if (!o.packetsOnly) ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
+        if (!o.packetsOnly && !o.singlesOnly) ours8r = std::min(ours8r, timed((rays.size() + 7) / 8, th, 2, packets8));
         Bvh::setPacketLeafRays(leafRays);
         if (!o.packetsOnly)
           theirs = std::min(theirs, timed(rays.size(), th, 2, [&](size_t i) {
                               return s.any ? uint32_t(em.occluded(rays[i])) : em.closest(rays[i]).prim;
                             }));
-        if (packets)
+        if (packets && !o.singlesOnly)
           theirs8 = std::min(theirs8, timed((rays.size() + 7) / 8, th, 2, [&](size_t i) {
                                const int n = int(std::min<size_t>(8, rays.size() - 8 * i));
                                return s.any ? em.occluded8(&rays[8 * i], n) : em.closest8(&rays[8 * i], n);
                              }));
       }
-      char t8[32] = "not built in", r8[32] = "–";
-      if (packets) {
+      char t8[32] = "–", r8[32] = "–";  // "–": not timed (--singles-only)
+      if (!packets) std::snprintf(t8, sizeof t8, "not built in");
+      if (packets && theirs8 < 1e30) {
         std::snprintf(t8, sizeof t8, "%.2f", rays.size() / theirs8 * 1e-6);
         std::snprintf(r8, sizeof r8, "%.2f×", theirs8 / ours8);
       }
@@ -662,9 +664,9 @@ void benchScene(const char* label, const std::vector<Triangle>& tris, const Boun
   const Embree em(tris, o.threads);
   printBuilds(tris, bvh, ourBuild, em, o.threads);
   const Rays rays = makeRays(tris, bounds, sphere, bvh, o.res, o.mirrorTiles);
-  if (!o.packetsOnly) printAgreement(tris, bvh, em, rays, o.explainAll);
+  if (!o.packetsOnly && !o.singlesOnly) printAgreement(tris, bvh, em, rays, o.explainAll);
   printPacketAgreement(bvh, em, rays, o.leafRays);
-  if (!o.packetsOnly) printCounters(bvh, rays.sets());
+  if (!o.packetsOnly && !o.singlesOnly) printCounters(bvh, rays.sets());
   if (o.countOnly) {  // and the same with every leaf tested ray by ray
     std::printf("\nThe same, every leaf of a packet tested ray by ray (--leaf-rays 9):\n");
     Bvh::setPacketLeafRays(9);
@@ -771,6 +773,7 @@ int main(int argc, char** argv) {
     } else if (a == "--quick") quick = true;
     else if (a == "--count-only") quick = countOnly = true;
     else if (a == "--packets-only") quick = o.packetsOnly = true;
+    else if (a == "--singles-only") quick = o.singlesOnly = true;
     else if (a == "--no-sphere") noSphere = true;
     else if (a == "--build-only") quick = o.buildOnly = true;
     else if (a == "--explain") explainAll = true;
@@ -781,7 +784,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(
           stderr,
-          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--build-only] [--no-sphere] [--cpu-time] [--profile] [--mirror-tiles N,...] [--build-grain T/C,...]\n"
+          "usage: bench-trace [--threads N] [--res N] [--rings N] [--scene FILE]... [--quick] [--reps N] [--sse|--avx2] [--explain] [--leaf-rays N] [--alone-rays C,S,A] [--alone-sweep N,...] [--count-only] [--packets-only] [--singles-only] [--build-only] [--no-sphere] [--cpu-time] [--profile] [--mirror-tiles N,...] [--build-grain T/C,...]\n"
           "  --quick: only the tracers' table (no routine timings, no other routines through the BVH)\n"
           "  --reps N: time ours and Embree alternately N times, keep the best of each (default 3)\n"
           "  --sse, --avx2: our traversal with SSE4.2 or AVX2 even where a wider ISA is available\n"
@@ -792,6 +795,7 @@ int main(int argc, char** argv) {
           "    coherent (primary, orthographic), closest hit scattered (mirror), any hit (shadow)\n"
           "  --alone-sweep N,...: our packets also timed with each set's threshold at each N (same turns)\n"
           "  --packets-only: time only ours and Embree's packets (quick A/B runs; implies --quick)\n"
+          "  --singles-only: time only our single rays and pairs and Embree's single rays (the same; implies --quick)\n"
           "  --build-only: only our and Embree's BVH builds, --reps times alternately, phases and tree hash\n"
           "  --no-sphere: only the --scene files\n"
           "  --profile: where our and Embree's packets spend their time (first pass, again in cache, set-up)\n"
