@@ -587,13 +587,14 @@ class Report:
         self.w()
         self.w("The phases `--timings` prints (docs/startup.md), in ms. The critical path's rows tile the time and add "
                "up to the total; since session 15 the scene file read runs beside instance and device (its own "
-               "duration is shown; \"waiting\" is what it took beyond them, on the critical path). Cold: an empty pipeline cache; warm: the next start, the cache filled. Generated scenes: "
+               "duration is shown; \"waiting\" is what it took beyond them, on the critical path); since session 16 the first frame's pipelines are made beside the geometry upload (likewise). Cold: an empty pipeline cache; warm: the next start, the cache filled. Generated scenes: "
                "`scenegen --scale N` baked with a stored view. PNG writing is not included.")
         self.w()
         cols = [("instance and device", "instance"), ("scene file read", "scene file"), ("waiting for the read", "waiting for the scene file read"),
                 ("texture decode", "texture decode"),
                 ("geometry upload", "geometry upload"), ("texture upload", "texture upload"), ("mips", "mips"),
-                ("renderer setup", "renderer setup"), ("pipelines (made, cached)", "pipeline creation"),
+                ("renderer setup", "renderer setup"), ("pipelines ahead, beside the upload (made, cached)", "pipelines made ahead"),
+                ("waiting for the pipelines", "waiting for the pipelines"), ("pipelines (made, cached)", "pipeline creation"),
                 ("first frame", "first frame"), ("total", "total from process start")]
         names = {"default": "default temple (11k triangles)", "100": "scale 100 (1M)", "300": "scale 300 (3M)",
                  "1000": "scale 1000 (10M)", "10000": "scale 10000 (100M, the scale group)"}
@@ -617,7 +618,7 @@ class Report:
                     hit = [(n, v) for n, v in phases.items() if n.startswith(key)]
                     if not hit:
                         cells.append("–")
-                    elif key == "pipeline creation":
+                    elif key in ("pipeline creation", "pipelines made ahead"):
                         made = re.search(r"\((\d+), (\d+) from", hit[0][0])
                         cells.append(f"{hit[0][1]:.1f} ({made.group(1)}, {made.group(2)})" if made else f"{hit[0][1]:.1f}")
                     else:
