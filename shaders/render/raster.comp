@@ -1,17 +1,17 @@
 #version 460
-// Compute rasteriser (docs/raster.md): one workgroup per cluster, a thread per triangle (in a subgroup with
-// a large enough box, a thread per row of the small triangles' boxes, below). Vertices are snapped to 1/256 pixel; integer edge functions with the top-left rule decide which pixel centres a
+// Compute rasteriser (docs/raster.md): one workgroup per cluster, a thread per triangle. Vertices are
+// snapped to 1/256 pixel; integer edge functions with the top-left rule decide which pixel centres a
 // triangle covers, so a shared edge is covered exactly once; each covered pixel gets one 64-bit atomicMin
 // of (depth, id), alpha-masked ones after the mask's test (raster_tri.glsl). Triangles with a bounding box
 // over kSharedArea pixels are set up once in a record and go to the tile list (one entry per RASTER_TILE²
-// tile, raster_large.comp); those
+// tile, raster_large.comp), those over kMediumFrom to the medium list (below); those
 // touching w <= 0 or leaving the guard band go to the clipping pass's list (raster_clip.comp) or, with
 // pc.clip off or that list full, to the hardware hand-off list (raster_hw.vert/frag).
 #extension GL_GOOGLE_include_directive : require
 // With culling (pc.fromList), workgroup k takes the k-th entry this phase added to the culling pass's
 // visible list (cull.comp; dispatched indirectly from its counts); without, the k-th of clusterList.
 #extension GL_KHR_shader_subgroup_basic : require
-#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
 #include "raster_tri.glsl"
 #include "cull.h"
 
@@ -30,19 +30,13 @@ void appendClip(uint ref) {
   if (n % RASTER_CLIP_GROUP == 0u) atomicAdd(clipGroupsX, 1u);
 }
 
-// The small triangles' pixels. A lane looping over its own box keeps its warp as long as the warp's largest
-// box while most lanes are done or idle: where a subgroup's largest small box is over kRowQueueFrom pixels,
-// the subgroup shares its boxes' rows out (a row a lane, so a step costs the widest of the subgroup's
-// rows), in its own slice of a shared queue: offsets from a subgroup prefix sum, no shared atomic and no
-// workgroup barrier. Boxes of a few pixels are cheaper drawn by their own lane, unstepped (docs/raster.md,
-// "What bounds each pass": the threshold's counts). Entries: the triangle's lane << 16 | the row in its box;
-// rows past the slice their own lane draws. The same atomics in another order: the same ids.
-// Off by default (measured on the H200: the pixel-sized triangles of large scenes lose 2x with it, chosen
-// per subgroup too); RTR_RASTER_ROW_QUEUE=0/1/auto (render/raster.cpp) chooses for measuring.
-layout(constant_id = 3) const uint kRowQueueFrom = 0xFFFFFFFFu;
-const uint kQueueSize = 1024u;
-shared uint rows[kQueueSize];
-shared Tri smallTris[RASTER_GROUP];
+// Medium triangles (raster.h): a lane looping over its own box keeps its subgroup as long as the subgroup's
+// largest box while the other lanes are done, so a box over kMediumFrom pixels is set up in a record (one
+// atomic a subgroup) for raster_large.comp, which spreads its pixels over RASTER_MEDIUM_LANES threads; the
+// same atomics in another order: the same ids. A full list: its own lane draws it. Nothing else here waits
+// or shares memory (a queue in shared memory cost every workgroup occupancy: docs/raster.md).
+// RTR_RASTER_MEDIUM (render/raster.cpp) sets it for measuring; kSharedArea or more: none.
+layout(constant_id = 3) const uint kMediumFrom = RASTER_MEDIUM_FROM;
 
 void main() {
   const uint k = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -52,23 +46,22 @@ void main() {
   Tri t;
   const uint kind = local < clusters[clusterList[clusterIndex].y].triangleCount ? setup(clusterIndex, local, t) : kSkip;
   const uint ref = (clusterIndex << RASTER_LOCAL_BITS) | local;
-  const uvec2 extent = kind == kSmall && kMeasure != RASTER_MEASURE_SETUP ? uvec2(t.box.zw - t.box.xy + 1) : uvec2(0u);
-  if (subgroupMax(extent.x * extent.y) > kRowQueueFrom) {  // the same for the whole subgroup
-    const uint slice = kQueueSize / gl_NumSubgroups, base = gl_SubgroupID * slice;
-    const uint first = subgroupExclusiveAdd(extent.y), queued = min(subgroupAdd(extent.y), slice);
-    if (extent.y > 0u) smallTris[local] = t;
-    for (uint r = 0u; r < extent.y && first + r < slice; ++r) rows[base + first + r] = (local << 16) | r;
-    subgroupBarrier();  // an execution and (shared) memory barrier for the subgroup: its entries are written
-    for (uint i = gl_SubgroupInvocationID; i < queued; i += gl_SubgroupSize) {
-      const uint e = rows[base + i];
-      const Tri q = smallTris[e >> 16];
-      rasterRow(q, q.box.y + int(e & 0xFFFFu));
+  ivec2 extent = kind == kSmall && kMeasure != RASTER_MEASURE_SETUP ? t.box.zw - t.box.xy + 1 : ivec2(0);
+  if (kMediumFrom < kSharedArea) {  // a specialization constant: RTR_RASTER_MEDIUM=0 leaves this out
+    const bool medium = uint(extent.x * extent.y) > kMediumFrom;
+    const uvec4 ballot = subgroupBallot(medium);
+    if (subgroupBallotBitCount(ballot) > 0u) {  // the same for the whole subgroup
+      uint first = 0u;
+      if (subgroupElect()) first = atomicAdd(mediumCount, subgroupBallotBitCount(ballot));
+      const uint n = subgroupBroadcastFirst(first) + subgroupBallotExclusiveBitCount(ballot);
+      if (medium && n < RASTER_MEDIUM_TRIANGLES) {
+        storeLarge(RASTER_LARGE_TRIANGLES + n, t);
+        extent = ivec2(0);
+      }
     }
-    for (uint r = first < slice ? slice - first : 0u; r < extent.y; ++r) rasterRow(t, t.box.y + int(r));
-  } else {
-    for (int y = 0; y < int(extent.y); ++y)
-      for (int x = 0; x < int(extent.x); ++x) rasterPixel(t, t.box.xy + ivec2(x, y));
   }
+  for (int y = 0; y < extent.y; ++y)
+    for (int x = 0; x < extent.x; ++x) rasterPixel(t, t.box.xy + ivec2(x, y));
   if (kind == kSmall) {
     if (kMeasure == RASTER_MEASURE_SETUP && t.id == ~0u) vis[t.box.x] = packVis(t.z.x, t.id);  // keeps the setup, writes nothing
   } else if (kind == kLarge) {

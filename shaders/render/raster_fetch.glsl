@@ -25,9 +25,10 @@ layout(set = 0, binding = 7, std430) RASTER_LIST_ACCESS buffer HardwareList {
   uint hwTriangles[];
 };
 // Large triangles' tiles (raster.comp -> raster_large.comp): (triangle as in hwTriangles, tile index).
-// raster_large.comp takes entries [largeFirst, largeCount): with culling, the second phase's only.
+// raster_large.comp takes entries [largeFirst, largeCount): with culling, the second phase's only; and
+// likewise the medium triangles' records [mediumFirst, mediumCount) (at RASTER_LARGE_TRIANGLES + k in largeTris).
 layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
-  uint largeCount, largeFirst, largeTriCount, largePad;
+  uint largeCount, largeFirst, largeTriCount, mediumCount, mediumFirst, largePad0, largePad1, largePad2;
   uvec2 largeTiles[];  // (the triangle's record in largeTris, tile index)
 };
 // The triangles crossing the near plane or the guard band, for raster_clip.comp (raster.h); clipFirst: with
@@ -37,7 +38,7 @@ layout(set = 0, binding = 15, std430) RASTER_LIST_ACCESS buffer ClipList {
   uint clipCount, clipFirst, clipPad0, clipPad1, clipPad2;
   uint clipTriangles[];
 };
-// The large triangles' setup, largeTriCount records (raster.h).
+// The large triangles' setup, largeTriCount records, then the medium ones' (raster.h).
 layout(set = 0, binding = 14, std430) RASTER_LIST_ACCESS buffer LargeTris { RasterLargeTri largeTris[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Instances { GpuInstance instances[]; };
 // The clusters drawn, (GpuInstance, GpuCluster record) each: the culling pass's visible list or, without

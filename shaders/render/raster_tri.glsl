@@ -232,15 +232,3 @@ void rasterPixel(Tri t, ivec2 px) {
   const ivec2 c = px * kOne + kOne / 2;
   rasterCovered(t, px, edge(t.v[1], t.v[2], c), edge(t.v[2], t.v[0], c), edge(t.v[0], t.v[1], c));
 }
-
-// Row y of t's box. Each edge function is affine in the pixel centre, so it is evaluated at the row's first
-// centre and stepped by its per-pixel difference: integer sums, the same values as rasterPixel's products,
-// for three 64-bit additions a pixel instead of six multiplications.
-void rasterRow(Tri t, int y) {
-  const ivec2 c = ivec2(t.box.x, y) * kOne + kOne / 2;
-  // edge(a, b, p) = d.x (p.y - a.y) - d.y (p.x - a.x): -d.y a pixel to the right
-  const i64vec3 stepX = -i64vec3(t.v[2].y - t.v[1].y, t.v[0].y - t.v[2].y, t.v[1].y - t.v[0].y) * kOne;
-  i64vec3 e = i64vec3(edge(t.v[1], t.v[2], c), edge(t.v[2], t.v[0], c), edge(t.v[0], t.v[1], c));
-  for (int x = t.box.x; x <= t.box.z; ++x, e += stepX) rasterCovered(t, ivec2(x, y), e.x, e.y, e.z);
-}
-

@@ -18,9 +18,13 @@ using glm::vec4;
 #define RASTER_SUBPIXEL_BITS 8   // fixed-point vertex positions: 1/256 pixel
 #define RASTER_GUARD_BAND 16384.0 // px from the image centre; beyond it (or w <= 0) the hardware draws it
 #define RASTER_SHARED_AREA 256u  // default: bounding boxes over this many pixels are rasterised tile by tile
-// raster.comp with RTR_RASTER_ROW_QUEUE=auto: a subgroup whose largest small box is over this many pixels
-// shares its rows out (off by default: docs/raster.md)
-#define RASTER_ROW_QUEUE_FROM 64u
+// Medium triangles: a small one whose box is over RASTER_MEDIUM_FROM pixels (raster.comp's kMediumFrom;
+// RTR_RASTER_MEDIUM) is set up in a record and drawn by raster_large.comp, RASTER_MEDIUM_LANES threads
+// over its box's pixels, not by its own thread (whose subgroup would wait for it); past
+// RASTER_MEDIUM_TRIANGLES records a frame its own thread draws it.
+#define RASTER_MEDIUM_FROM 32u
+#define RASTER_MEDIUM_TRIANGLES (1u << 16)
+#define RASTER_MEDIUM_LANES 32u
 #define RASTER_TILE 32           // raster_large.comp: a workgroup per tile of RASTER_TILE² pixels of a triangle
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
 #define RASTER_LARGE_TRIANGLES (1u << 17) // large triangles' records a frame; one that does not fit goes to the hardware

@@ -1,6 +1,7 @@
 #include "render/raster.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <cstdio>
 #include <cstring>
@@ -36,16 +37,18 @@ std::vector<vk::SpecializationConstant> withMeasure(std::vector<vk::Specializati
   return constants;
 }
 
-// RTR_RASTER_ROW_QUEUE=0|1|auto: raster.comp's small triangles' rows never (the default), always, or per
-// subgroup over RASTER_ROW_QUEUE_FROM pixels shared out over the subgroup (its kRowQueueFrom; the same
-// ids), for measuring (docs/raster.md, "What bounds each pass": on the H200 the queue halves the default
-// temple's raster and doubles the 10M temple's, chosen per subgroup too).
-std::vector<vk::SpecializationConstant> withRowQueue(std::vector<vk::SpecializationConstant> constants) {
-  const char* v = std::getenv("RTR_RASTER_ROW_QUEUE");
+// RTR_RASTER_MEDIUM=T: raster.comp's medium triangles are those whose box is over T pixels (its kMediumFrom,
+// RASTER_MEDIUM_FROM by default; 0: none, each small triangle drawn by its own thread as before), for
+// measuring (docs/raster.md, "Medium triangles"). The same ids whatever T.
+std::vector<vk::SpecializationConstant> withMedium(std::vector<vk::SpecializationConstant> constants) {
+  const char* v = std::getenv("RTR_RASTER_MEDIUM");
   if (!v || !*v) return constants;
-  if (std::strcmp(v, "0") != 0 && std::strcmp(v, "1") != 0 && std::strcmp(v, "auto") != 0)
-    throw std::runtime_error(std::string("RTR_RASTER_ROW_QUEUE=") + v + ": expected 0, 1 or auto");
-  constants.push_back({3, *v == '1' ? 0u : *v == '0' ? ~0u : RASTER_ROW_QUEUE_FROM});
+  char* end = nullptr;
+  const unsigned long t = std::strtoul(v, &end, 10);
+  if (*end || t >= RASTER_SHARED_AREA || !std::isdigit(static_cast<unsigned char>(*v)))
+    throw std::runtime_error(std::string("RTR_RASTER_MEDIUM=") + v + ": expected a number of pixels below " +
+                             std::to_string(RASTER_SHARED_AREA) + " (0: no medium list)");
+  constants.push_back({3, t == 0 ? RASTER_SHARED_AREA : uint32_t(t)});
   return constants;
 }
 
@@ -62,7 +65,7 @@ ComputeRaster::Pipelines ComputeRaster::makePipelines(const vk::Context& ctx, co
   vk::inParallel({
       [&] { p.clear = vk::makeComputePipeline(ctx, vk::loadShader("raster_clear.comp"), push); },
       [&] {
-        p.raster = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, withRowQueue(withMeasure(constants)));
+        p.raster = vk::makeComputePipeline(ctx, vk::loadShader("raster.comp"), options, withMedium(withMeasure(constants)));
       },
       [&] { p.clip = vk::makeComputePipeline(ctx, vk::loadShader("raster_clip.comp"), options, constants); },
       [&] { p.large = vk::makeComputePipeline(ctx, vk::loadShader("raster_large.comp"), options, constants); },
@@ -100,15 +103,15 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                          vk::MemoryUse::Device, "raster clipping list");
   largeList_ =
-      vk::Buffer(ctx, 16 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
+      vk::Buffer(ctx, 32 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                  vk::MemoryUse::Device, "raster tiles");
-  largeTris_ = vk::Buffer(ctx, sizeof(shader::RasterLargeTri) * VkDeviceSize(RASTER_LARGE_TRIANGLES),
+  largeTris_ = vk::Buffer(ctx, sizeof(shader::RasterLargeTri) * VkDeviceSize(RASTER_LARGE_TRIANGLES + RASTER_MEDIUM_TRIANGLES),
                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device, "raster large triangles");
   cullReadback_ = vk::Buffer(ctx, 2 * sizeof(shader::CullCounts) * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryUse::Readback, "cull counts read-back");
   handOffReadback_ =
-      vk::Buffer(ctx, 8 * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "hand-off count read-back");
+      vk::Buffer(ctx, 16 * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "hand-off count read-back");
 }
 
 std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster::textureSets() const {
@@ -121,15 +124,22 @@ std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster
 uint32_t ComputeRaster::handOffTriangles(uint32_t frame) const {
   handOffReadback_.invalidate();
   uint32_t vertices = 0;
-  std::memcpy(&vertices, static_cast<const char*>(handOffReadback_.mapped()) + 8 * frame, 4);
+  std::memcpy(&vertices, static_cast<const char*>(handOffReadback_.mapped()) + 16 * frame, 4);
   return vertices / 3;
 }
 
 uint32_t ComputeRaster::clippedTriangles(uint32_t frame) const {
   handOffReadback_.invalidate();
   uint32_t clipped = 0;
-  std::memcpy(&clipped, static_cast<const char*>(handOffReadback_.mapped()) + 8 * frame + 4, 4);
+  std::memcpy(&clipped, static_cast<const char*>(handOffReadback_.mapped()) + 16 * frame + 4, 4);
   return std::min(clipped, RASTER_CLIP_CAPACITY);  // the count goes on past the list; those went to the hardware
+}
+
+uint32_t ComputeRaster::mediumTriangles(uint32_t frame) const {
+  handOffReadback_.invalidate();
+  uint32_t medium = 0;
+  std::memcpy(&medium, static_cast<const char*>(handOffReadback_.mapped()) + 16 * frame + 8, 4);
+  return medium;
 }
 
 std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame) const {
@@ -250,8 +260,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     rasterise("raster early", "raster clip early", "raster large early");
     // The pyramid reads the depth drawn so far; the late phase's tile pass starts after the early tiles.
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kCopyRead);
-    const VkBufferCopy firstLate{0, 4, 4};  // largeCount -> largeFirst (raster_fetch.glsl)
-    vkCmdCopyBuffer(cb, largeList_.handle(), largeList_.handle(), 1, &firstLate);
+    const VkBufferCopy firstLate[2] = {{0, 4, 4}, {12, 16, 4}};  // largeCount -> largeFirst, mediumCount -> mediumFirst
+    vkCmdCopyBuffer(cb, largeList_.handle(), largeList_.handle(), 2, firstLate);
     const VkBufferCopy clipFirstLate{12, 16, 4};  // clipCount -> clipFirst (raster_fetch.glsl)
     if (clip) vkCmdCopyBuffer(cb, clipList_.handle(), clipList_.handle(), 1, &clipFirstLate);
     pyramid_->buildFromBuffer(cb, vis_.handle());
@@ -265,10 +275,12 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   }
   if (clusterCount > 0) rasterise("raster", "raster clip", "raster large");
   vk::bufferBarrier(cb, vk::kComputeWrite, kReaders | vk::kCopyRead);
-  const VkBufferCopy handOffCount{0, 8 * VkDeviceSize(frame), 4};  // VkDrawIndirectCommand::vertexCount
+  const VkBufferCopy handOffCount{0, 16 * VkDeviceSize(frame), 4};  // VkDrawIndirectCommand::vertexCount
   vkCmdCopyBuffer(cb, hwList_.handle(), handOffReadback_.handle(), 1, &handOffCount);
-  const VkBufferCopy clipCount{12, 8 * VkDeviceSize(frame) + 4, 4};  // clipCount
+  const VkBufferCopy clipCount{12, 16 * VkDeviceSize(frame) + 4, 4};  // clipCount
   vkCmdCopyBuffer(cb, clipList_.handle(), handOffReadback_.handle(), 1, &clipCount);
+  const VkBufferCopy mediumCount{12, 16 * VkDeviceSize(frame) + 8, 4};  // mediumCount
+  vkCmdCopyBuffer(cb, largeList_.handle(), handOffReadback_.handle(), 1, &mediumCount);
   vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};

@@ -62,6 +62,9 @@ class ComputeRaster {
   uint32_t handOffTriangles(uint32_t frame) const;
   // Triangles clipped in compute by the last completed use of `frame` (both phases; 0 with clipping off).
   uint32_t clippedTriangles(uint32_t frame) const;
+  // Medium triangles found by the last completed use of `frame` (both phases; raster.h): those past
+  // RASTER_MEDIUM_TRIANGLES were drawn by their own thread.
+  uint32_t mediumTriangles(uint32_t frame) const;
   uint32_t handOffCapacity() const { return handOffCapacity_; }
 
  private:
@@ -76,7 +79,7 @@ class ComputeRaster {
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
   std::optional<DepthPyramid> pyramid_;
   vk::Buffer cullReadback_;     // per frame in flight: the early and the late CullCounts
-  vk::Buffer handOffReadback_;  // per frame in flight: the hand-off's vertex count, the clipped triangles
+  vk::Buffer handOffReadback_;  // per frame in flight: the hand-off's vertex count, the clipped and medium triangles
   std::vector<bool> culled_;    // per frame in flight: whether its last use culled
   std::vector<bool> twoPhase_;  // per frame in flight: whether that was in two phases
 };

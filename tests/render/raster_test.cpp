@@ -1,10 +1,13 @@
 // The compute rasteriser (render/raster.hpp) against the hardware's visibility ids, and on its own: a
 // closed mesh seen from inside is covered exactly once per pixel (docs/raster.md).
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <random>
+#include <tuple>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -238,25 +241,38 @@ TEST_F(RasterTest, RebuiltPipelinesGiveTheSameIds) {
   EXPECT_GT(std::count_if(after.begin(), after.end(), [](uint32_t id) { return id != VIS_EMPTY; }), 160 * 90 / 4);
 }
 
-// Ids with raster.comp's small triangles' rows never shared out (RTR_RASTER_ROW_QUEUE=0, the default),
-// always (=1) and by the choice per subgroup (=auto): `render` draws each, the three must be equal byte for byte.
+// Ids with raster.comp's medium triangles drawn by raster_large.comp (RTR_RASTER_MEDIUM unset: boxes over
+// RASTER_MEDIUM_FROM pixels; "1": every small box over a pixel) and by their own thread ("0", no list):
+// `render` draws each and returns the ids and the medium triangles counted; the ids must be equal byte
+// for byte. Returns the counts.
 template <class Render>
-void expectSameIdsWithAndWithoutRowQueue(Render render, size_t minCovered) {
+std::array<uint32_t, 3> expectSameIdsWithAndWithoutMedium(Render render, size_t minCovered) {
   std::vector<uint32_t> got[3];
-  const char* settings[] = {nullptr, "1", "auto"};  // read when the renderer makes its pipelines
+  std::array<uint32_t, 3> medium{};
+  const char* settings[] = {nullptr, "0", "1"};  // read when the renderer makes its pipelines
   for (int i = 0; i < 3; ++i) {
-    if (settings[i]) ::setenv("RTR_RASTER_ROW_QUEUE", settings[i], 1);
-    else ::unsetenv("RTR_RASTER_ROW_QUEUE");
-    got[i] = render();
+    if (settings[i]) ::setenv("RTR_RASTER_MEDIUM", settings[i], 1);
+    else ::unsetenv("RTR_RASTER_MEDIUM");
+    std::tie(got[i], medium[i]) = render();
   }
-  ::unsetenv("RTR_RASTER_ROW_QUEUE");
-  EXPECT_EQ(got[0], got[1]) << "the row queue changes ids";
-  EXPECT_EQ(got[0], got[2]) << "the per-subgroup choice changes ids";
-  EXPECT_GT(size_t(std::count_if(got[2].begin(), got[2].end(), [](uint32_t id) { return id != VIS_EMPTY; })), minCovered);
+  ::unsetenv("RTR_RASTER_MEDIUM");
+  std::printf("medium triangles: %u (default), %u (off), %u (over 1 pixel)\n", medium[0], medium[1], medium[2]);
+  auto differing = [](const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+    size_t n = a.size() == b.size() ? 0 : std::max(a.size(), b.size());
+    for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) n += a[i] != b[i];
+    return n;
+  };
+  EXPECT_EQ(differing(got[0], got[1]), 0u) << "pixels whose ids the medium list changes";
+  EXPECT_EQ(differing(got[2], got[1]), 0u) << "pixels whose ids the medium list over 1 pixel changes";
+  EXPECT_EQ(medium[1], 0u) << "RTR_RASTER_MEDIUM=0 lists none";
+  EXPECT_GT(medium[2], medium[0]);
+  EXPECT_GT(size_t(std::count_if(got[0].begin(), got[0].end(), [](uint32_t id) { return id != VIS_EMPTY; })), minCovered);
+  return medium;
 }
 
-// The temple's three views: the same atomics in another order give the same ids, byte for byte.
-TEST_F(RasterTest, RowQueueGivesTheSameIds) {
+// The temple's three views, with and without culling (both phases append to the list): the same atomics
+// in another order give the same ids, byte for byte.
+TEST_F(RasterTest, MediumTrianglesGiveTheSameIds) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
   const VkExtent2D extent{480, 270};
@@ -264,32 +280,35 @@ TEST_F(RasterTest, RowQueueGivesTheSameIds) {
   const CameraPose poses[] = {scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 480.0f / 270.0f)),
                               {c + glm::vec3(0, 0.3f, 0), 70.0f, -10.0f},
                               {c + glm::vec3(2, -0.5f, 1), 200.0f, -35.0f}};
-  expectSameIdsWithAndWithoutRowQueue(
+  const std::array<uint32_t, 3> medium = expectSameIdsWithAndWithoutMedium(
       [&] {
         render::HeadlessRenderer r(*ctx, gpu, extent);
         std::vector<uint32_t> all;
+        uint32_t medium = 0;
         for (const CameraPose& pose : poses) {
-          const std::vector<uint32_t> v = ids(r, pose, fitDepthRange(Lens{}, scene.bounds(), pose), RasterPath::Compute);
+          const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
+          const std::vector<uint32_t> v = ids(r, pose, lens, RasterPath::Compute);
+          medium += r.renderer().mediumTriangles(0).value_or(0);
           all.insert(all.end(), v.begin(), v.end());
+          for (int frame = 0; frame < 2; ++frame)  // the first frame's late phase draws all, the second's early phase
+            EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, true), v) << "culled, frame " << frame;
         }
-        return all;
+        return std::pair(all, medium);
       },
       3 * 480 * 270 / 4);
+  EXPECT_GT(medium[0], 100u) << "too few medium triangles to test";
 }
 
-// Both of raster.comp's paths in one workgroup: the triangles of each cluster (runs of 124, in order) come
-// in runs of a subgroup's size, alternately tiny (boxes of at most 2×2 pixels: drawn by their own lane)
-// and 14×14-pixel ones (over RASTER_ROW_QUEUE_FROM: the subgroup shares its rows out, and more rows than
-// its slice of the queue holds, so some are drawn by their own lane), at random places and depths,
-// overlapping, seen straight through an orthographic lens.
-TEST_F(RasterTest, RowQueueChosenPerSubgroupGivesTheSameIds) {
+// More medium triangles than the list holds (RASTER_MEDIUM_TRIANGLES): those past it are drawn by their own
+// thread. Boxes of 14×14 pixels (medium) and, in every third run of a subgroup's size, at most 2×2 (drawn
+// in place), at random places and depths, overlapping, seen straight through an orthographic lens.
+TEST_F(RasterTest, MediumTrianglesPastTheListAreDrawnInPlace) {
   VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &sub};
   vkGetPhysicalDeviceProperties2(ctx->physicalDevice(), &props);
   const uint32_t lanes = sub.subgroupSize;
-  ASSERT_LE(lanes, 62u) << "a cluster of 124 triangles holds no two subgroups";
-  constexpr uint32_t kSize = 128, kTriangles = 124 * 12;
-  static_assert(14 * 14 > RASTER_ROW_QUEUE_FROM && 2 * 2 <= RASTER_ROW_QUEUE_FROM && 14 * 14 <= RASTER_SHARED_AREA);
+  constexpr uint32_t kSize = 128, kTriangles = RASTER_MEDIUM_TRIANGLES * 2;
+  static_assert(14 * 14 > RASTER_MEDIUM_FROM && 2 * 2 <= RASTER_MEDIUM_FROM && 14 * 14 <= RASTER_SHARED_AREA);
   Scene scene;
   scene.materials.push_back(Material{});
   Mesh m;
@@ -298,8 +317,10 @@ TEST_F(RasterTest, RowQueueChosenPerSubgroupGivesTheSameIds) {
     seed = seed * 1664525u + 1013904223u;
     return lo + (hi - lo) * float(seed >> 8) / float(1u << 24);
   };
+  uint32_t mediumMade = 0;
   for (uint32_t t = 0; t < kTriangles; ++t) {
-    const bool tiny = (t % 124 / lanes) % 2 == 0;
+    const bool tiny = (t % 124 / lanes) % 3 == 2;
+    mediumMade += !tiny;
     const float side = tiny ? 1.4f : 13.4f;  // pixels: boxes of at most 2 and 14 pixel centres a side
     const float x = random(1, kSize - 15), y = random(1, kSize - 15), z = random(-2, -1);
     auto world = [&](float sx, float sy) { return glm::vec3(sx / (kSize / 2) - 1, 1 - sy / (kSize / 2), z); };
@@ -311,6 +332,7 @@ TEST_F(RasterTest, RowQueueChosenPerSubgroupGivesTheSameIds) {
     }
     m.indices.insert(m.indices.end(), {v, v + 1, v + 2});
   }
+  ASSERT_GT(mediumMade, RASTER_MEDIUM_TRIANGLES + 1000);
   for (const glm::vec3& p : m.positions) m.bounds.extend(p);
   scene.meshes.push_back(std::move(m));
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
@@ -318,12 +340,14 @@ TEST_F(RasterTest, RowQueueChosenPerSubgroupGivesTheSameIds) {
   lens.orthographic = true;
   lens.zNear = 0.5f;
   lens.zFar = 3.0f;
-  expectSameIdsWithAndWithoutRowQueue(
+  const std::array<uint32_t, 3> medium = expectSameIdsWithAndWithoutMedium(
       [&] {
         render::HeadlessRenderer r(*ctx, gpu, {kSize, kSize});
-        return ids(r, {{0, 0, 0}, 0, 0}, lens, RasterPath::Compute);
+        std::vector<uint32_t> v = ids(r, {{0, 0, 0}, 0, 0}, lens, RasterPath::Compute);
+        return std::pair(std::move(v), r.renderer().mediumTriangles(0).value_or(0));
       },
       kSize * kSize / 2);
+  EXPECT_EQ(medium[0], mediumMade) << "every 14×14 box counted, those past the list too";
 }
 
 // A closed cube [-1, 1]³ seen from inside: its faces wound to face the centre. Every axis is cut at the same
