@@ -20,6 +20,7 @@ OTHERS = {"--preset", "--build", "--target", "--build-only", "--quick", "--keep"
           "--benchmark", "--explain", "--no-check", "--avx2", "--sse", "--packets-only", "--leaf-rays",
           "--mip-sizes", "--mips-per-texture", "--textures", "--plain", "--gltf", "--alone-rays", "--alone-sweep", "--in-flight-sweep", "--profile",
           "--mirror-tiles", "--build-grain",  # bench-trace (docs/bench/trace.md, round 15)
+          "--reps", "--cpu-time", "--singles-only",  # bench-trace (docs/bench/trace.md, rounds 16 and 17)
           "--sphere-grid", "--env-cases", "--spp-curve", "--flip", "--flip-map", "--ppd",  # scenegen, rtr-frame-compare
            "--mesh", "--rebuild", "--fates", "--instances",  # rtr-lod-cut (docs/virtual-geometry.md), scenegen
           "--test-ui", "--test-drop"}  # rtr-view's test-only options, hidden from --help (docs/viewer.md)
