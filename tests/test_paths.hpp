@@ -4,6 +4,8 @@
 // tools/bundle_device.sh); $RTR_SOURCE_DIR, else that folder's src/ (a bundle's copy of the test data),
 // else two folders above it (build/<preset> in the repository); $RTR_ASSET_DIR, else <binary dir>/assets.
 // Compiled shaders: vk::shaderDir() ($RTR_SHADER_DIR, else <exe>/../shaders).
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -32,9 +34,12 @@ inline std::filesystem::path assetDir() { return envOr("RTR_ASSET_DIR", binaryDi
 // A tool built beside the tests (rtr-reflect).
 inline std::string toolPath(const std::string& name) { return (binaryDir() / "bin" / name).string(); }
 
-// Runs that tool with `args` (shell words); returns stdout and stderr together, the wait status in *status.
-inline std::string runTool(const std::string& name, const std::string& args, int* status) {
-  const std::string cmd = toolPath(name) + " " + args + " 2>&1";
+// Runs that tool with `args` (shell words), `env` (env(1)'s words: NAME=value, -u NAME) in front where given;
+// returns stdout and stderr together (stdout alone with `withStderr` false), the wait status in *status.
+inline std::string runTool(const std::string& name, const std::string& args, int* status, const std::string& env = "",
+                           bool withStderr = true) {
+  const std::string cmd =
+      (env.empty() ? "" : "env " + env + " ") + toolPath(name) + " " + args + (withStderr ? " 2>&1" : " 2>/dev/null");
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
   std::string out;
   std::array<char, 4096> buf;
@@ -42,5 +47,8 @@ inline std::string runTool(const std::string& name, const std::string& args, int
   *status = pclose(pipe.release());
   return out;
 }
+
+// A wait status as an exit code: -1 where the process did not exit (a signal).
+inline int exitCode(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
 
 }  // namespace rtr::test

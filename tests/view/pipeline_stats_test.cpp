@@ -1,9 +1,6 @@
 // rtr-view --pipeline-stats: every pipeline the renderer made, listed by its shaders, with the driver's
 // statistics where the device has VK_KHR_pipeline_executable_properties (lavapipe has not: names only,
 // and a note that says why; a GPU run checks the statistics themselves).
-#include <sys/wait.h>
-
-#include <cstdio>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -26,16 +23,12 @@ struct ViewRun {
 
 // The small temple on the compute rasteriser and the visibility path: the raster and shade pipelines.
 ViewRun view(const std::string& args) {
-  const std::string cmd = "env RTR_TEXTURE_CACHE=off " + rtr::test::toolPath("rtr-view") + " " +
-                          (rtr::test::assetDir() / "temple.rtrscene").string() +
-                          " --headless --size 160x90 --bench 1 --raster compute --shading-path visibility " + args +
-                          " 2>/dev/null";
   ViewRun r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, pipe)) r.out.append(buf, n);
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = rtr::test::runTool("rtr-view",
+                             (rtr::test::assetDir() / "temple.rtrscene").string() +
+                                 " --headless --size 160x90 --bench 1 --raster compute --shading-path visibility " + args,
+                             &r.status, "RTR_TEXTURE_CACHE=off", false);
+  r.status = rtr::test::exitCode(r.status);
   return r;
 }
 

@@ -1,9 +1,7 @@
 // rtr-view's start-up as a user meets it: --timings phases that account for the whole time, the defaults
 // chosen for the device (and flags that override them), the pipeline and texture caches kept where they are told.
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -40,15 +38,12 @@ class StartupTest : public ::testing::Test {
   ViewRun view(const std::string& args, const std::string& env = "",
                const fs::path& scene = rtr::test::assetDir() / "temple.rtrscene") {
     const std::string words = env.find("RTR_TEXTURE_CACHE") == std::string::npos ? env + " RTR_TEXTURE_CACHE=off" : env;
-    const std::string cmd = "env " + words + " " + rtr::test::toolPath("rtr-view") + " " + scene.string() +
-                            " --headless --size 320x180 " + "--screenshot " + (dir / "shot.png").string() + " --force " + args +
-                            " 2>&1";
     ViewRun r;
-    FILE* pipe = popen(cmd.c_str(), "r");
-    char buf[4096];
-    while (size_t n = fread(buf, 1, sizeof buf, pipe)) r.out.append(buf, n);
-    const int status = pclose(pipe);
-    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = rtr::test::runTool(
+        "rtr-view",
+        scene.string() + " --headless --size 320x180 --screenshot " + (dir / "shot.png").string() + " --force " + args, &r.status,
+        words);
+    r.status = rtr::test::exitCode(r.status);
     return r;
   }
   fs::path dir;
