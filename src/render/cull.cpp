@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <functional>
 #include <string>
 
@@ -329,8 +330,34 @@ ClusterCuller::ClusterCuller(const vk::Context& ctx, uint32_t maxClusters, uint3
     vk::barrier(cb, {{noPyramid_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE,
                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_SHADER_READ_BIT}});
   });
+  const char* walks = std::getenv("RTR_CULL_LATE_WALK");
+  lateWalks_ = walks && std::string(walks) == "1";
   pipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("cull.comp"), {.pushDescriptorSets = {0}});
   instancePipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("cull_instances.comp"), {.pushDescriptorSets = {0}});
+}
+
+// The instances, then the trees depth by depth (each step's queue filled by the one before), into the chunks.
+void ClusterCuller::walkTrees(VkCommandBuffer cb, shader::CullPush push, bool flat, uint32_t count, VkBuffer instances,
+                              uint32_t instanceCount, VkBuffer nodes, VkBuffer placements) {
+  instancePipeline_.bind(cb);
+  vk::DescriptorWriter(ctx_, instancePipeline_.layout, 0, VK_NULL_HANDLE)
+      .buffer(1, counts_.handle())
+      .buffer(6, instances)
+      .buffer(7, chunks_.handle())
+      .buffer(8, nodes ? nodes : instances)  // not read without a tree
+      .buffer(9, placements ? placements : instances)
+      .buffer(10, queues_.handle())
+      .buffer(11, items_.handle())
+      .push(cb, instancePipeline_);
+  push.depth = CULL_INSTANCE_STEP;
+  instancePipeline_.push(cb, push);
+  instancePipeline_.dispatch(cb, flat ? (count + CULL_LEAF_SIZE - 1) / CULL_LEAF_SIZE : instanceCount);
+  for (uint32_t d = 0; nodes && d < depths_; ++d) {
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
+    push.depth = d;
+    instancePipeline_.push(cb, push);
+    vkCmdDispatchIndirect(cb, queues_.handle(), d * sizeof(shader::CullQueue));
+  }
 }
 
 void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count, const CullCamera& camera,
@@ -339,31 +366,12 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
   if (count > maxClusters_ || (!instances && (count + CULL_LEAF_SIZE - 1) / CULL_LEAF_SIZE > maxChunks_))
     throw Error("cluster culling: " + std::to_string(count) + " clusters, room for " + std::to_string(maxClusters_));
   constexpr vk::BufferUse kConsumers = vk::kComputeRead | vk::kIndirectRead | vk::kCopyRead;
-  // The last frame's consumers are done with both buffers before they are reset and rewritten.
-  vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);
-  // Late appends to Early's list: its entries start where Early's end (the early ones stay valid).
-  size_t reset = sizeof(shader::CullCounts);
-  if (phase == CullPhase::Late) {
-    const VkBufferCopy base{offsetof(shader::CullCounts, listed), offsetof(shader::CullCounts, listBase), 4};
-    vkCmdCopyBuffer(cb, counts_.handle(), counts_.handle(), 1, &base);
-    vk::bufferBarrier(cb, vk::kTransferWrite | vk::kCopyRead, vk::kTransferWrite);
-    reset = offsetof(shader::CullCounts, listBase);
-  }
-  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, 0, 0, 0, {0, 1, 1}, 0, 0, 0, 0, 0};  // dispatches' y, z: 1
-  vkCmdUpdateBuffer(cb, counts_.handle(), 0, reset, &zero);
-  std::array<shader::CullQueue, CULL_MAX_DEPTH> queues{};
-  for (uint32_t d = 0; d < CULL_MAX_DEPTH; ++d) queues[d] = {{0, 1, 1}, 0, queueBases_[d], 0, 0, 0};
-  vkCmdUpdateBuffer(cb, queues_.handle(), 0, sizeof(queues), queues.data());
   const bool flat = !instances;
   if (flat) {  // one instance of records placed already, never culled
-    const shader::GpuCullInstance all{glm::vec4(0.0f, 0.0f, 0.0f, 1e30f), glm::vec4(0.0f, 0.0f, 0.0f, 1e30f),
-                                      glm::uvec4(0, 1, CULL_RECORD_INSTANCE, 0), glm::vec4(1.0f, 1.0f, 1.0f, 0.0f)};
-    vkCmdUpdateBuffer(cb, whole_.handle(), 0, sizeof(all), &all);
     instances = whole_.handle(), instanceCount = 1, nodes = VK_NULL_HANDLE;
   } else if (!nodes) {
     throw Error("cluster culling: instances without their trees");
   }
-  vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
 
   shader::CullPush push{};
   push.viewProj = camera.viewProj;
@@ -384,26 +392,52 @@ void ClusterCuller::record(VkCommandBuffer cb, VkBuffer clusters, uint32_t count
     push.height = pyramid->depthExtent().height;
     push.pyramidLevels = pyramid->levels();
   }
-  // The instances, then the trees depth by depth (each step's queue filled by the one before).
-  instancePipeline_.bind(cb);
-  vk::DescriptorWriter(ctx_, instancePipeline_.layout, 0, VK_NULL_HANDLE)
-      .buffer(1, counts_.handle())
-      .buffer(6, instances)
-      .buffer(7, chunks_.handle())
-      .buffer(8, nodes ? nodes : instances)  // not read without a tree
-      .buffer(9, placements ? placements : instances)
-      .buffer(10, queues_.handle())
-      .buffer(11, items_.handle())
-      .push(cb, instancePipeline_);
-  push.depth = CULL_INSTANCE_STEP;
-  instancePipeline_.push(cb, push);
-  instancePipeline_.dispatch(cb, flat ? (count + CULL_LEAF_SIZE - 1) / CULL_LEAF_SIZE : instanceCount);
-  for (uint32_t d = 0; nodes && d < depths_; ++d) {
-    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
-    push.depth = d;
-    instancePipeline_.push(cb, push);
-    vkCmdDispatchIndirect(cb, queues_.handle(), d * sizeof(shader::CullQueue));
+  // Early's chunks serve a Late pass that walks the same trees the same way (occlusion aside: Early has no pyramid).
+  const Walk walk{push.viewProj,
+                  push.eye,
+                  push.flags & ~CULL_OCCLUSION,
+                  count,
+                  instanceCount,
+                  push.lodThreshold,
+                  push.pixelsPerUnit,
+                  push.zNear,
+                  clusters,
+                  lods,
+                  instances,
+                  nodes,
+                  placements};
+  const bool reuse = phase == CullPhase::Late && !lateWalks_ && earlyWalk_ == walk;
+  earlyWalk_.reset();  // only the pass right after Early may reuse its chunks (placements may change by the next frame)
+  if (phase == CullPhase::Early) earlyWalk_ = walk;
+
+  // The last frame's consumers are done with both buffers before they are reset and rewritten.
+  vk::bufferBarrier(cb, kConsumers, vk::kTransferWrite);
+  // Late appends to Early's list: its entries start where Early's end (the early ones stay valid).
+  // Reusing Early's chunks keeps them, their dispatch and the counts of the walk (clusters in them,
+  // instances culled whole); the nodes tested in this pass are none.
+  size_t reset = sizeof(shader::CullCounts);
+  if (phase == CullPhase::Late) {
+    const VkBufferCopy base{offsetof(shader::CullCounts, listed), offsetof(shader::CullCounts, listBase), 4};
+    vkCmdCopyBuffer(cb, counts_.handle(), counts_.handle(), 1, &base);
+    vk::bufferBarrier(cb, vk::kTransferWrite | vk::kCopyRead, vk::kTransferWrite);
+    reset = reuse ? offsetof(shader::CullCounts, tested) : offsetof(shader::CullCounts, listBase);
   }
+  const shader::CullCounts zero{{0, 1, 1}, {0, 0, 0, 0}, 0, 0, 0, 0, 0, {0, 1, 1}, 0, 0, 0, 0, 0};  // dispatches' y, z: 1
+  vkCmdUpdateBuffer(cb, counts_.handle(), 0, reset, &zero);
+  if (reuse) vkCmdUpdateBuffer(cb, counts_.handle(), offsetof(shader::CullCounts, nodes), 4, &zero.nodes);
+  if (flat) {
+    const shader::GpuCullInstance all{glm::vec4(0.0f, 0.0f, 0.0f, 1e30f), glm::vec4(0.0f, 0.0f, 0.0f, 1e30f),
+                                      glm::uvec4(0, 1, CULL_RECORD_INSTANCE, 0), glm::vec4(1.0f, 1.0f, 1.0f, 0.0f)};
+    vkCmdUpdateBuffer(cb, whole_.handle(), 0, sizeof(all), &all);
+  }
+  if (!reuse) {
+    std::array<shader::CullQueue, CULL_MAX_DEPTH> queues{};
+    for (uint32_t d = 0; d < CULL_MAX_DEPTH; ++d) queues[d] = {{0, 1, 1}, 0, queueBases_[d], 0, 0, 0};
+    vkCmdUpdateBuffer(cb, queues_.handle(), 0, sizeof(queues), queues.data());
+  }
+  vk::bufferBarrier(cb, vk::kTransferWrite, vk::kComputeReadWrite);
+  if (!reuse) walkTrees(cb, push, flat, count, instances, instanceCount, nodes, placements);
+
   vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kIndirectRead);
   pipeline_.bind(cb);
   vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)

@@ -8,6 +8,7 @@
 // Use, per frame (two-phase, CullPhase below): culler.record(Early); dispatch indirect on counts() over
 // visible(); pyramid.build(depth of that); culler.record(Late, &pyramid); dispatch again. docs/culling.md.
 #include <array>
+#include <optional>
 #include <functional>
 #include <utility>
 #include <vector>
@@ -114,6 +115,8 @@ struct CullTests {
 // Early + Late: two-phase occlusion, conservative for any camera motion; per frame: record(Early), draw
 // visible(), build the pyramid from that depth, record(Late) with it, draw visible() (the clusters Early
 // did not list). The culler keeps the per-cluster history between frames (all "not visible" at first).
+// A Late pass with Early's camera, tests and buffers re-tests Early's chunks (the tree leaves in the frustum
+// and the cut) instead of walking the trees again: only the occlusion test and the history differ.
 enum class CullPhase : uint32_t { Single = CULL_SINGLE, Early = CULL_EARLY, Late = CULL_LATE };
 
 class ClusterCuller {
@@ -144,6 +147,9 @@ class ClusterCuller {
   uint32_t maxClusters() const { return maxClusters_; }
 
  private:
+  void walkTrees(VkCommandBuffer cb, shader::CullPush push, bool flat, uint32_t count, VkBuffer instances, uint32_t instanceCount,
+                 VkBuffer nodes, VkBuffer placements);
+
   const vk::Context& ctx_;
   uint32_t maxClusters_, maxChunks_;
   vk::Buffer visible_, counts_, history_, chunks_;
@@ -151,6 +157,19 @@ class ClusterCuller {
   vk::Buffer items_, queues_;  // the trees' (instance, node) queues and their counts (CullQueue)
   std::array<uint32_t, CULL_MAX_DEPTH> queueBases_{};
   uint32_t depths_ = 0;
+  // What decided the last Early pass's chunks (the leaves in the frustum and the cut, which do not depend on
+  // the phase): a Late pass that matches it tests those chunks again without walking the trees a second
+  // time. Any other pass forgets it. RTR_CULL_LATE_WALK=1: Late always walks (for measuring).
+  struct Walk {
+    glm::mat4 viewProj;
+    glm::vec4 eye;
+    uint32_t flags, count, instanceCount;
+    float lodThreshold, pixelsPerUnit, zNear;
+    VkBuffer clusters, lods, instances, nodes, placements;
+    bool operator==(const Walk&) const = default;
+  };
+  std::optional<Walk> earlyWalk_;
+  bool lateWalks_ = false;
   vk::Image noPyramid_;  // 1×1 stand-in so the pass always has a valid binding
   vk::Pipeline instancePipeline_, pipeline_;
 };
