@@ -174,6 +174,9 @@ RTR_FN int pyramidLevelFor(ivec4 px, int levels, int span) {
 // far past it (rtr-lod-cut --fates: on the 1M-triangle grid's three views the pass then lists 11-52 % fewer
 // triangles; docs/culling.md).
 #define CULL_PYRAMID_SPAN 4
+// The pyramid's levels at most: at 4K, level 6 has texels of 128 pixels (the five below it, each a dispatch
+// and a barrier, would serve only boxes wider than ~512 pixels, which read up to their width / 128 texels a row).
+#define CULL_PYRAMID_MAX_LEVELS 7u
 RTR_FN int pyramidLevel(ivec4 px, int levels) { return pyramidLevelFor(px, levels, CULL_PYRAMID_SPAN); }
 
 // The texels (min x, min y, max x, max y) of level `level`, of size `levelSize`, that cover the pixels.

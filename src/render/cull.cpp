@@ -20,10 +20,15 @@ namespace {
 
 constexpr VkFormat kPyramidFormat = VK_FORMAT_R32_SFLOAT;
 
+// Levels down to 1 × 1, at most CULL_PYRAMID_MAX_LEVELS (RTR_PYRAMID_LEVELS=N sets another cap, for
+// measuring): each level is a dispatch and a barrier, and only boxes wider than the last level's texels
+// reach past it (they read more of its texels instead).
 uint32_t levelCount(VkExtent2D e) {
   uint32_t n = 1;
   for (uint32_t m = std::max(e.width, e.height); m > 1; m /= 2) ++n;
-  return n;
+  uint32_t cap = CULL_PYRAMID_MAX_LEVELS;
+  if (const char* v = std::getenv("RTR_PYRAMID_LEVELS")) cap = std::max(1, std::atoi(v));
+  return std::min(n, cap);
 }
 
 }  // namespace
