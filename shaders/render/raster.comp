@@ -31,12 +31,16 @@ void appendClip(uint ref) {
 }
 
 // Medium triangles (raster.h): a lane looping over its own box keeps its subgroup as long as the subgroup's
-// largest box while the other lanes are done, so a box over kMediumFrom pixels is set up in a record (one
-// atomic a subgroup) for raster_large.comp, which spreads its pixels over RASTER_MEDIUM_LANES threads; the
-// same atomics in another order: the same ids. A full list: its own lane draws it. Nothing else here waits
-// or shares memory (a queue in shared memory cost every workgroup occupancy: docs/raster.md).
-// RTR_RASTER_MEDIUM (render/raster.cpp) sets it for measuring; kSharedArea or more: none.
+// largest box while the other lanes are done, so a box over kMediumFrom pixels is set up in a record for
+// raster_large.comp, which spreads its pixels over RASTER_MEDIUM_NARROW_LANES threads (a box of up to
+// kMediumNarrow pixels) or RASTER_MEDIUM_LANES; the same atomics in another order: the same ids. One 64-bit
+// atomic a subgroup reserves both kinds (LargeList's mediumFound); where the list's records would not all
+// hold the subgroup's, it notes where (mediumStored) and its lanes draw theirs. Nothing else here waits or
+// shares memory (a queue in shared memory cost every workgroup occupancy: docs/raster.md).
+// RTR_RASTER_MEDIUM and RTR_RASTER_MEDIUM_LANES (render/raster.cpp) set them for measuring; kMediumFrom of
+// kSharedArea or more: no list; kMediumNarrow 0: every record of RASTER_MEDIUM_LANES.
 layout(constant_id = 3) const uint kMediumFrom = RASTER_MEDIUM_FROM;
+layout(constant_id = 4) const uint kMediumNarrow = RASTER_MEDIUM_NARROW_AREA;
 
 void main() {
   const uint k = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -48,14 +52,23 @@ void main() {
   const uint ref = (clusterIndex << RASTER_LOCAL_BITS) | local;
   ivec2 extent = kind == kSmall && kMeasure != RASTER_MEASURE_SETUP ? t.box.zw - t.box.xy + 1 : ivec2(0);
   if (kMediumFrom < kSharedArea) {  // a specialization constant: RTR_RASTER_MEDIUM=0 leaves this out
-    const bool medium = uint(extent.x * extent.y) > kMediumFrom;
-    const uvec4 ballot = subgroupBallot(medium);
-    if (subgroupBallotBitCount(ballot) > 0u) {  // the same for the whole subgroup
-      uint first = 0u;
-      if (subgroupElect()) first = atomicAdd(mediumCount, subgroupBallotBitCount(ballot));
-      const uint n = subgroupBroadcastFirst(first) + subgroupBallotExclusiveBitCount(ballot);
-      if (medium && n < RASTER_MEDIUM_TRIANGLES) {
-        storeLarge(RASTER_LARGE_TRIANGLES + n, t);
+    const uint area = uint(extent.x * extent.y);
+    const bool medium = area > kMediumFrom, narrow = medium && area <= kMediumNarrow;
+    const uvec4 mediumBallot = subgroupBallot(medium);
+    if (subgroupBallotBitCount(mediumBallot) > 0u) {  // the same for the whole subgroup
+      const uvec4 narrowBallot = subgroupBallot(narrow), wideBallot = mediumBallot & ~narrowBallot;
+      const uint narrows = subgroupBallotBitCount(narrowBallot), wides = subgroupBallotBitCount(wideBallot);
+      uvec2 first = uvec2(0u);  // the counts before this subgroup's
+      if (subgroupElect()) {
+        const uint64_t before = atomicAdd(mediumFound, (uint64_t(wides) << 32) | uint64_t(narrows));
+        first = unpackUint2x32(before);
+        if (first.x + narrows + first.y + wides > pc.mediumCapacity) atomicMin(mediumStored, before);
+      }
+      first = subgroupBroadcastFirst(first);
+      const uint slot = narrow ? first.x + subgroupBallotExclusiveBitCount(narrowBallot)
+                               : pc.mediumCapacity - 1u - first.y - subgroupBallotExclusiveBitCount(wideBallot);
+      if (medium && first.x + narrows + first.y + wides <= pc.mediumCapacity) {
+        storeLarge(RASTER_LARGE_TRIANGLES + slot, t);
         extent = ivec2(0);
       }
     }

@@ -10,6 +10,6 @@ layout(local_size_x = RASTER_CLEAR_GROUP) in;
 void main() {
   const uint i = gl_GlobalInvocationID.x;
   if (i == 0u) vertexCount = 0u, instanceCount = 1u, firstVertex = 0u, firstInstance = 0u, largeCount = 0u, largeFirst = 0u,
-                 largeTriCount = 0u, mediumCount = 0u, mediumFirst = 0u, clipGroupsX = 0u, clipGroupsY = RASTER_CLIP_PIECES, clipGroupsZ = 1u, clipCount = 0u, clipFirst = 0u;
+                 largeTriCount = 0u, mediumFound = 0ul, mediumFirst = 0ul, mediumStored = ~0ul, clipGroupsX = 0u, clipGroupsY = RASTER_CLIP_PIECES, clipGroupsZ = 1u, clipCount = 0u, clipFirst = 0u;
   if (i < pc.width * pc.height) vis[i] = ~uint64_t(0);
 }

@@ -25,10 +25,16 @@ layout(set = 0, binding = 7, std430) RASTER_LIST_ACCESS buffer HardwareList {
   uint hwTriangles[];
 };
 // Large triangles' tiles (raster.comp -> raster_large.comp): (triangle as in hwTriangles, tile index).
-// raster_large.comp takes entries [largeFirst, largeCount): with culling, the second phase's only; and
-// likewise the medium triangles' records [mediumFirst, mediumCount) (at RASTER_LARGE_TRIANGLES + k in largeTris).
+// raster_large.comp takes entries [largeFirst, largeCount): with culling, the second phase's only.
+// The medium triangles (raster.h) found so far, two counts in one 64-bit word (one atomic a subgroup): x =
+// low half, those of RASTER_MEDIUM_NARROW_LANES, recorded from the list's front (record RASTER_LARGE_TRIANGLES
+// + k of largeTris), y = high half, those of RASTER_MEDIUM_LANES, from its back (RASTER_LARGE_TRIANGLES +
+// pc.mediumCapacity - 1 - k). mediumStored: the counts when the first subgroup's records did not fit (all
+// before it fit, none after it; all ones: none), so the records are [mediumFirst, min(mediumFound,
+// mediumStored)) of each kind; mediumFirst: with culling, the first phase's mediumFound.
 layout(set = 0, binding = 10, std430) RASTER_LIST_ACCESS buffer LargeList {
-  uint largeCount, largeFirst, largeTriCount, mediumCount, mediumFirst, largePad0, largePad1, largePad2;
+  uint largeCount, largeFirst, largeTriCount, largePad0;
+  uint64_t mediumFound, mediumFirst, mediumStored, largePad1;
   uvec2 largeTiles[];  // (the triangle's record in largeTris, tile index)
 };
 // The triangles crossing the near plane or the guard band, for raster_clip.comp (raster.h); clipFirst: with
@@ -38,7 +44,7 @@ layout(set = 0, binding = 15, std430) RASTER_LIST_ACCESS buffer ClipList {
   uint clipCount, clipFirst, clipPad0, clipPad1, clipPad2;
   uint clipTriangles[];
 };
-// The large triangles' setup, largeTriCount records, then the medium ones' (raster.h).
+// The large triangles' setup, largeTriCount records, then the medium ones' (raster.h, LargeList).
 layout(set = 0, binding = 14, std430) RASTER_LIST_ACCESS buffer LargeTris { RasterLargeTri largeTris[]; };
 layout(set = 0, binding = 13, std430) readonly buffer Instances { GpuInstance instances[]; };
 // The clusters drawn, (GpuInstance, GpuCluster record) each: the culling pass's visible list or, without

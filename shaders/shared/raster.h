@@ -19,12 +19,17 @@ using glm::vec4;
 #define RASTER_GUARD_BAND 16384.0 // px from the image centre; beyond it (or w <= 0) the hardware draws it
 #define RASTER_SHARED_AREA 256u  // default: bounding boxes over this many pixels are rasterised tile by tile
 // Medium triangles: a small one whose box is over RASTER_MEDIUM_FROM pixels (raster.comp's kMediumFrom;
-// RTR_RASTER_MEDIUM) is set up in a record and drawn by raster_large.comp, RASTER_MEDIUM_LANES threads
-// over its box's pixels, not by its own thread (whose subgroup would wait for it); past
-// RASTER_MEDIUM_TRIANGLES records a frame its own thread draws it.
+// RTR_RASTER_MEDIUM) is set up in a record and drawn by raster_large.comp, not by its own thread (whose
+// subgroup would wait for it): a box of up to RASTER_MEDIUM_NARROW_AREA pixels by RASTER_MEDIUM_NARROW_LANES
+// threads (two triangles a 32-lane subgroup; raster.comp's kMediumNarrow, RTR_RASTER_MEDIUM_LANES), a larger
+// one by RASTER_MEDIUM_LANES. The two kinds share the list from its two ends (RasterPush::mediumCapacity
+// records: the scene's triangles, at most RASTER_MEDIUM_TRIANGLES); a subgroup whose records do not all fit
+// draws its medium triangles itself.
 #define RASTER_MEDIUM_FROM 32u
-#define RASTER_MEDIUM_TRIANGLES (1u << 16)
+#define RASTER_MEDIUM_TRIANGLES (1u << 18)
 #define RASTER_MEDIUM_LANES 32u
+#define RASTER_MEDIUM_NARROW_LANES 16u
+#define RASTER_MEDIUM_NARROW_AREA 64u
 #define RASTER_TILE 32           // raster_large.comp: a workgroup per tile of RASTER_TILE² pixels of a triangle
 #define RASTER_LARGE_CAPACITY (1u << 20)  // tiles in the list; a triangle that does not fit goes to the hardware
 #define RASTER_LARGE_TRIANGLES (1u << 17) // large triangles' records a frame; one that does not fit goes to the hardware
@@ -69,7 +74,8 @@ struct RasterPush {
   uint fromList;       // raster.comp: clusters from the culling pass's visible list, not all of them
   uint handOffCapacity;  // entries of the hand-off list (at most RASTER_HANDOFF_CAPACITY)
   uint clip;  // raster.comp: triangles crossing w = 0 or the guard band to raster_clip.comp, not the hardware
-  uint pad1, pad2;
+  uint mediumCapacity;  // the medium triangles' records (at most RASTER_MEDIUM_TRIANGLES unless measuring)
+  uint pad2;
 };
 
 #ifdef __cplusplus

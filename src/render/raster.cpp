@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -37,18 +38,31 @@ std::vector<vk::SpecializationConstant> withMeasure(std::vector<vk::Specializati
   return constants;
 }
 
-// RTR_RASTER_MEDIUM=T: raster.comp's medium triangles are those whose box is over T pixels (its kMediumFrom,
-// RASTER_MEDIUM_FROM by default; 0: none, each small triangle drawn by its own thread as before), for
-// measuring (docs/raster.md, "Medium triangles"). The same ids whatever T.
-std::vector<vk::SpecializationConstant> withMedium(std::vector<vk::SpecializationConstant> constants) {
-  const char* v = std::getenv("RTR_RASTER_MEDIUM");
-  if (!v || !*v) return constants;
+// A number from the environment variable `name` in [lo, hi] (`what` says what it counts), or none where unset.
+std::optional<uint32_t> envNumber(const char* name, uint32_t lo, uint32_t hi, const char* what) {
+  const char* v = std::getenv(name);
+  if (!v || !*v) return std::nullopt;
   char* end = nullptr;
-  const unsigned long t = std::strtoul(v, &end, 10);
-  if (*end || t >= RASTER_SHARED_AREA || !std::isdigit(static_cast<unsigned char>(*v)))
-    throw std::runtime_error(std::string("RTR_RASTER_MEDIUM=") + v + ": expected a number of pixels below " +
-                             std::to_string(RASTER_SHARED_AREA) + " (0: no medium list)");
-  constants.push_back({3, t == 0 ? RASTER_SHARED_AREA : uint32_t(t)});
+  const unsigned long n = std::strtoul(v, &end, 10);
+  if (*end || n < lo || n > hi || !std::isdigit(static_cast<unsigned char>(*v)))
+    throw std::runtime_error(std::string(name) + "=" + v + ": expected " + what + " from " + std::to_string(lo) + " to " +
+                             std::to_string(hi));
+  return uint32_t(n);
+}
+
+// RTR_RASTER_MEDIUM=T: raster.comp's medium triangles are those whose box is over T pixels (its kMediumFrom,
+// RASTER_MEDIUM_FROM by default; 0: none, each small triangle drawn by its own thread as before), and
+// RTR_RASTER_MEDIUM_LANES=16|32: those of up to RASTER_MEDIUM_NARROW_AREA pixels drawn by 16 threads (the
+// default) or, like the larger ones, by 32 (its kMediumNarrow 0); for measuring (docs/raster.md, "Medium
+// triangles"). The same ids whatever they are.
+std::vector<vk::SpecializationConstant> withMedium(std::vector<vk::SpecializationConstant> constants) {
+  if (const auto t = envNumber("RTR_RASTER_MEDIUM", 0, RASTER_SHARED_AREA - 1, "a number of pixels (0: no medium list)"))
+    constants.push_back({3, *t == 0 ? RASTER_SHARED_AREA : *t});
+  if (const char* lanes = std::getenv("RTR_RASTER_MEDIUM_LANES"); lanes && *lanes) {
+    if (std::string(lanes) != "16" && std::string(lanes) != "32")
+      throw std::runtime_error(std::string("RTR_RASTER_MEDIUM_LANES=") + lanes + ": expected 16 or 32");
+    if (std::string(lanes) == "32") constants.push_back({4, 0u});
+  }
   return constants;
 }
 
@@ -94,6 +108,10 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
   for (size_t k = 0; k < kDrawKindCount; ++k)
     for (const DrawItem& di : scene.draws(DrawKind(k))) triangles += uint64_t(di.primitives) * di.instanceCount;
   handOffCapacity_ = uint32_t(std::clamp<uint64_t>(triangles, 1, RASTER_HANDOFF_CAPACITY));
+  // Medium triangles' records: as many as the scene has triangles, at most RASTER_MEDIUM_TRIANGLES (28 MiB);
+  // RTR_RASTER_MEDIUM_CAPACITY=N sets it (testing the list's overflow, measuring).
+  mediumCapacity_ = envNumber("RTR_RASTER_MEDIUM_CAPACITY", 1, 1u << 22, "a number of records")
+                        .value_or(uint32_t(std::clamp<uint64_t>(triangles, 1, RASTER_MEDIUM_TRIANGLES)));
   hwList_ =
       vk::Buffer(ctx, sizeof(VkDrawIndirectCommand) + 4 * std::clamp<uint64_t>(triangles, 1, RASTER_HANDOFF_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -103,15 +121,15 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                          vk::MemoryUse::Device, "raster clipping list");
   largeList_ =
-      vk::Buffer(ctx, 32 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
+      vk::Buffer(ctx, 48 + 8 * VkDeviceSize(RASTER_LARGE_CAPACITY),
                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                  vk::MemoryUse::Device, "raster tiles");
-  largeTris_ = vk::Buffer(ctx, sizeof(shader::RasterLargeTri) * VkDeviceSize(RASTER_LARGE_TRIANGLES + RASTER_MEDIUM_TRIANGLES),
+  largeTris_ = vk::Buffer(ctx, sizeof(shader::RasterLargeTri) * VkDeviceSize(RASTER_LARGE_TRIANGLES + mediumCapacity_),
                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Device, "raster large triangles");
   cullReadback_ = vk::Buffer(ctx, 2 * sizeof(shader::CullCounts) * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                              vk::MemoryUse::Readback, "cull counts read-back");
-  handOffReadback_ =
-      vk::Buffer(ctx, 16 * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "hand-off count read-back");
+  handOffReadback_ = vk::Buffer(ctx, kReadbackSize * framesInFlight, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback,
+                                "hand-off count read-back");
 }
 
 std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster::textureSets() const {
@@ -124,22 +142,22 @@ std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> ComputeRaster
 uint32_t ComputeRaster::handOffTriangles(uint32_t frame) const {
   handOffReadback_.invalidate();
   uint32_t vertices = 0;
-  std::memcpy(&vertices, static_cast<const char*>(handOffReadback_.mapped()) + 16 * frame, 4);
+  std::memcpy(&vertices, static_cast<const char*>(handOffReadback_.mapped()) + kReadbackSize * frame, 4);
   return vertices / 3;
 }
 
 uint32_t ComputeRaster::clippedTriangles(uint32_t frame) const {
   handOffReadback_.invalidate();
   uint32_t clipped = 0;
-  std::memcpy(&clipped, static_cast<const char*>(handOffReadback_.mapped()) + 16 * frame + 4, 4);
+  std::memcpy(&clipped, static_cast<const char*>(handOffReadback_.mapped()) + kReadbackSize * frame + 4, 4);
   return std::min(clipped, RASTER_CLIP_CAPACITY);  // the count goes on past the list; those went to the hardware
 }
 
-uint32_t ComputeRaster::mediumTriangles(uint32_t frame) const {
+ComputeRaster::MediumCounts ComputeRaster::mediumTriangles(uint32_t frame) const {
   handOffReadback_.invalidate();
-  uint32_t medium = 0;
-  std::memcpy(&medium, static_cast<const char*>(handOffReadback_.mapped()) + 16 * frame + 8, 4);
-  return medium;
+  uint32_t c[4] = {};  // LargeList's mediumFound and mediumStored (raster_fetch.glsl): 16 lanes, 32 lanes each
+  std::memcpy(c, static_cast<const char*>(handOffReadback_.mapped()) + kReadbackSize * frame + 8, sizeof c);
+  return {c[0], c[1], c[0] - std::min(c[0], c[2]) + c[1] - std::min(c[1], c[3])};
 }
 
 std::optional<ComputeRaster::CullStats> ComputeRaster::cullStats(uint32_t frame) const {
@@ -209,7 +227,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     w.push(cb, p);
     for (size_t i = 0; i < textured().size(); ++i)
       if (&p == textured()[i] && p.layout.setCount() > 1) p.bindSet(cb, 1, textures_[i].get(1));
-    p.push(cb, shader::RasterPush{extent_.width, extent_.height, clusterCount, fromList, handOffCapacity_, clip, 0, 0});
+    p.push(cb,
+           shader::RasterPush{extent_.width, extent_.height, clusterCount, fromList, handOffCapacity_, clip, mediumCapacity_, 0});
   };
   // The passes that read the rasteriser's buffers after it: shading and the hardware rasteriser's draw.
   constexpr vk::BufferUse kReaders = vk::kComputeReadWrite | vk::kFragmentReadWrite | vk::kVertexReadWrite | vk::kIndirectRead;
@@ -260,7 +279,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     rasterise("raster early", "raster clip early", "raster large early");
     // The pyramid reads the depth drawn so far; the late phase's tile pass starts after the early tiles.
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite | vk::kCopyRead);
-    const VkBufferCopy firstLate[2] = {{0, 4, 4}, {12, 16, 4}};  // largeCount -> largeFirst, mediumCount -> mediumFirst
+    const VkBufferCopy firstLate[2] = {{0, 4, 4}, {16, 24, 8}};  // largeCount -> largeFirst, mediumFound -> mediumFirst
     vkCmdCopyBuffer(cb, largeList_.handle(), largeList_.handle(), 2, firstLate);
     const VkBufferCopy clipFirstLate{12, 16, 4};  // clipCount -> clipFirst (raster_fetch.glsl)
     if (clip) vkCmdCopyBuffer(cb, clipList_.handle(), clipList_.handle(), 1, &clipFirstLate);
@@ -275,12 +294,13 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   }
   if (clusterCount > 0) rasterise("raster", "raster clip", "raster large");
   vk::bufferBarrier(cb, vk::kComputeWrite, kReaders | vk::kCopyRead);
-  const VkBufferCopy handOffCount{0, 16 * VkDeviceSize(frame), 4};  // VkDrawIndirectCommand::vertexCount
+  const VkDeviceSize at = kReadbackSize * VkDeviceSize(frame);
+  const VkBufferCopy handOffCount{0, at, 4};  // VkDrawIndirectCommand::vertexCount
   vkCmdCopyBuffer(cb, hwList_.handle(), handOffReadback_.handle(), 1, &handOffCount);
-  const VkBufferCopy clipCount{12, 16 * VkDeviceSize(frame) + 4, 4};  // clipCount
+  const VkBufferCopy clipCount{12, at + 4, 4};  // clipCount
   vkCmdCopyBuffer(cb, clipList_.handle(), handOffReadback_.handle(), 1, &clipCount);
-  const VkBufferCopy mediumCount{12, 16 * VkDeviceSize(frame) + 8, 4};  // mediumCount
-  vkCmdCopyBuffer(cb, largeList_.handle(), handOffReadback_.handle(), 1, &mediumCount);
+  const VkBufferCopy medium[2] = {{16, at + 8, 8}, {32, at + 16, 8}};  // mediumFound, mediumStored
+  vkCmdCopyBuffer(cb, largeList_.handle(), handOffReadback_.handle(), 2, medium);
   vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};

@@ -62,9 +62,14 @@ class ComputeRaster {
   uint32_t handOffTriangles(uint32_t frame) const;
   // Triangles clipped in compute by the last completed use of `frame` (both phases; 0 with clipping off).
   uint32_t clippedTriangles(uint32_t frame) const;
-  // Medium triangles found by the last completed use of `frame` (both phases; raster.h): those past
-  // RASTER_MEDIUM_TRIANGLES were drawn by their own thread.
-  uint32_t mediumTriangles(uint32_t frame) const;
+  // Medium triangles found by the last completed use of `frame` (both phases; raster.h): those of 16 lanes
+  // and of 32 (`narrow`, `wide`), and of those `pastList`, drawn by their own thread.
+  struct MediumCounts {
+    uint32_t narrow = 0, wide = 0, pastList = 0;
+    uint32_t total() const { return narrow + wide; }
+  };
+  MediumCounts mediumTriangles(uint32_t frame) const;
+  uint32_t mediumCapacity() const { return mediumCapacity_; }  // records (raster.h)
   uint32_t handOffCapacity() const { return handOffCapacity_; }
 
  private:
@@ -74,12 +79,15 @@ class ComputeRaster {
   vk::DescriptorSets textures_[4];  // set 1 of textured()'s pipelines where they have one
   std::array<const vk::Pipeline*, 4> textured() const { return {&raster_, &clip_, &large_, &hardware_}; }
   vk::Buffer vis_, hwList_, clipList_, largeList_, largeTris_;
-  uint32_t handOffCapacity_ = 1;
+  uint32_t handOffCapacity_ = 1, mediumCapacity_ = 1;
+  // Per frame in flight in handOffReadback_: the hand-off's vertex count, the clipped triangles, LargeList's
+  // mediumFound and mediumStored.
+  static constexpr VkDeviceSize kReadbackSize = 24;
   VkExtent2D extent_{0, 0};
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
   std::optional<DepthPyramid> pyramid_;
   vk::Buffer cullReadback_;     // per frame in flight: the early and the late CullCounts
-  vk::Buffer handOffReadback_;  // per frame in flight: the hand-off's vertex count, the clipped and medium triangles
+  vk::Buffer handOffReadback_;  // per frame in flight: kReadbackSize bytes
   std::vector<bool> culled_;    // per frame in flight: whether its last use culled
   std::vector<bool> twoPhase_;  // per frame in flight: whether that was in two phases
 };

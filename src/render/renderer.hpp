@@ -162,7 +162,7 @@ class Renderer {
     return raster_ ? std::optional(raster_->clippedTriangles(frame)) : std::nullopt;
   }
   // Medium triangles the compute rasteriser found in the last completed use of `frame` (ComputeRaster).
-  std::optional<uint32_t> mediumTriangles(uint32_t frame) const {
+  std::optional<ComputeRaster::MediumCounts> mediumTriangles(uint32_t frame) const {
     return raster_ ? std::optional(raster_->mediumTriangles(frame)) : std::nullopt;
   }
 

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <random>
+#include <string>
 #include <tuple>
 #include <utility>
 
@@ -241,37 +242,54 @@ TEST_F(RasterTest, RebuiltPipelinesGiveTheSameIds) {
   EXPECT_GT(std::count_if(after.begin(), after.end(), [](uint32_t id) { return id != VIS_EMPTY; }), 160 * 90 / 4);
 }
 
-// Ids with raster.comp's medium triangles drawn by raster_large.comp (RTR_RASTER_MEDIUM unset: boxes over
-// RASTER_MEDIUM_FROM pixels; "1": every small box over a pixel) and by their own thread ("0", no list):
-// `render` draws each and returns the ids and the medium triangles counted; the ids must be equal byte
-// for byte. Returns the counts.
+// The medium list's settings (render/raster.cpp; nullptr: unset), read when the renderer makes its pipelines.
+struct MediumSetting {
+  const char* from;      // RTR_RASTER_MEDIUM: boxes over this many pixels are medium ("0": no list)
+  const char* lanes;     // RTR_RASTER_MEDIUM_LANES: boxes of up to 64 pixels by 16 lanes (unset, "16") or 32
+  const char* capacity;  // RTR_RASTER_MEDIUM_CAPACITY: records (unset: the scene's triangles, at most 256 Ki)
+};
+using MediumCounts = render::ComputeRaster::MediumCounts;
+
+// Ids with raster.comp's medium triangles drawn by raster_large.comp and by their own thread: `render` draws
+// with each setting and returns the ids and the medium triangles counted; the ids must be those of the first
+// setting (the list off) byte for byte. Returns the counts.
 template <class Render>
-std::array<uint32_t, 3> expectSameIdsWithAndWithoutMedium(Render render, size_t minCovered) {
-  std::vector<uint32_t> got[3];
-  std::array<uint32_t, 3> medium{};
-  const char* settings[] = {nullptr, "0", "1"};  // read when the renderer makes its pipelines
-  for (int i = 0; i < 3; ++i) {
-    if (settings[i]) ::setenv("RTR_RASTER_MEDIUM", settings[i], 1);
-    else ::unsetenv("RTR_RASTER_MEDIUM");
-    std::tie(got[i], medium[i]) = render();
+std::vector<MediumCounts> expectSameIdsWithAndWithoutMedium(const std::vector<MediumSetting>& settings, Render render,
+                                                            size_t minCovered) {
+  std::vector<std::vector<uint32_t>> got;
+  std::vector<MediumCounts> medium;
+  for (const MediumSetting& m : settings) {
+    const std::pair<const char*, const char*> vars[] = {
+        {"RTR_RASTER_MEDIUM", m.from}, {"RTR_RASTER_MEDIUM_LANES", m.lanes}, {"RTR_RASTER_MEDIUM_CAPACITY", m.capacity}};
+    for (const auto& [name, value] : vars) {
+      if (value) ::setenv(name, value, 1);
+      else ::unsetenv(name);
+    }
+    auto [v, counts] = render();
+    got.push_back(std::move(v));
+    medium.push_back(counts);
+    for (const auto& [name, value] : vars) ::unsetenv(name);
+    std::printf(
+        "RTR_RASTER_MEDIUM=%s RTR_RASTER_MEDIUM_LANES=%s RTR_RASTER_MEDIUM_CAPACITY=%s: medium triangles %u of 16 "
+        "lanes, %u of 32, %u past the list\n",
+        m.from ? m.from : "", m.lanes ? m.lanes : "", m.capacity ? m.capacity : "", counts.narrow, counts.wide, counts.pastList);
   }
-  ::unsetenv("RTR_RASTER_MEDIUM");
-  std::printf("medium triangles: %u (default), %u (off), %u (over 1 pixel)\n", medium[0], medium[1], medium[2]);
   auto differing = [](const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
     size_t n = a.size() == b.size() ? 0 : std::max(a.size(), b.size());
     for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) n += a[i] != b[i];
     return n;
   };
-  EXPECT_EQ(differing(got[0], got[1]), 0u) << "pixels whose ids the medium list changes";
-  EXPECT_EQ(differing(got[2], got[1]), 0u) << "pixels whose ids the medium list over 1 pixel changes";
-  EXPECT_EQ(medium[1], 0u) << "RTR_RASTER_MEDIUM=0 lists none";
-  EXPECT_GT(medium[2], medium[0]);
+  EXPECT_EQ(std::string(settings.at(0).from), "0") << "the first setting: no medium list";
+  EXPECT_EQ(medium[0].total(), 0u) << "RTR_RASTER_MEDIUM=0 lists none";
+  for (size_t i = 1; i < settings.size(); ++i)
+    EXPECT_EQ(differing(got[i], got[0]), 0u) << "pixels whose ids the medium list changes, setting " << i;
   EXPECT_GT(size_t(std::count_if(got[0].begin(), got[0].end(), [](uint32_t id) { return id != VIS_EMPTY; })), minCovered);
   return medium;
 }
 
 // The temple's three views, with and without culling (both phases append to the list): the same atomics
-// in another order give the same ids, byte for byte.
+// in another order give the same ids, byte for byte, with the list off, at its default threshold with 16
+// and 32 lanes for the smaller boxes, and at 1 pixel.
 TEST_F(RasterTest, MediumTrianglesGiveTheSameIds) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
@@ -280,15 +298,17 @@ TEST_F(RasterTest, MediumTrianglesGiveTheSameIds) {
   const CameraPose poses[] = {scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 480.0f / 270.0f)),
                               {c + glm::vec3(0, 0.3f, 0), 70.0f, -10.0f},
                               {c + glm::vec3(2, -0.5f, 1), 200.0f, -35.0f}};
-  const std::array<uint32_t, 3> medium = expectSameIdsWithAndWithoutMedium(
+  const std::vector<MediumCounts> medium = expectSameIdsWithAndWithoutMedium(
+      {{"0", nullptr, nullptr}, {nullptr, nullptr, nullptr}, {nullptr, "32", nullptr}, {"1", nullptr, nullptr}},
       [&] {
         render::HeadlessRenderer r(*ctx, gpu, extent);
         std::vector<uint32_t> all;
-        uint32_t medium = 0;
+        MediumCounts medium;
         for (const CameraPose& pose : poses) {
           const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
           const std::vector<uint32_t> v = ids(r, pose, lens, RasterPath::Compute);
-          medium += r.renderer().mediumTriangles(0).value_or(0);
+          const MediumCounts m = r.renderer().mediumTriangles(0).value_or(MediumCounts{});
+          medium.narrow += m.narrow, medium.wide += m.wide, medium.pastList += m.pastList;
           all.insert(all.end(), v.begin(), v.end());
           for (int frame = 0; frame < 2; ++frame)  // the first frame's late phase draws all, the second's early phase
             EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, true), v) << "culled, frame " << frame;
@@ -296,19 +316,27 @@ TEST_F(RasterTest, MediumTrianglesGiveTheSameIds) {
         return std::pair(all, medium);
       },
       3 * 480 * 270 / 4);
-  EXPECT_GT(medium[0], 100u) << "too few medium triangles to test";
+  EXPECT_GT(medium[1].narrow, 100u) << "too few medium triangles of 16 lanes to test";
+  EXPECT_GT(medium[1].wide, 100u) << "too few medium triangles of 32 lanes to test";
+  EXPECT_EQ(medium[2].narrow, 0u) << "RTR_RASTER_MEDIUM_LANES=32: every record of 32 lanes";
+  EXPECT_EQ(medium[2].wide, medium[1].total());
+  EXPECT_GT(medium[3].total(), medium[1].total());
+  for (const MediumCounts& m : medium) EXPECT_EQ(m.pastList, 0u) << "the temple's triangles fit the list";
 }
 
-// More medium triangles than the list holds (RASTER_MEDIUM_TRIANGLES): those past it are drawn by their own
-// thread. Boxes of 14×14 pixels (medium) and, in every third run of a subgroup's size, at most 2×2 (drawn
-// in place), at random places and depths, overlapping, seen straight through an orthographic lens.
+// More medium triangles than the list holds (RTR_RASTER_MEDIUM_CAPACITY): a subgroup whose records would not
+// all fit draws them itself, with either lane count, without a record of one kind overwriting one of the
+// other (they fill the list from its two ends). Boxes of 6-7 pixels a side (16 lanes), 13-14 (32 lanes)
+// and, in every third run of a subgroup's size, at most 2×2 (drawn in place), at random places and depths,
+// overlapping, seen straight through an orthographic lens.
 TEST_F(RasterTest, MediumTrianglesPastTheListAreDrawnInPlace) {
   VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &sub};
   vkGetPhysicalDeviceProperties2(ctx->physicalDevice(), &props);
   const uint32_t lanes = sub.subgroupSize;
-  constexpr uint32_t kSize = 128, kTriangles = RASTER_MEDIUM_TRIANGLES * 2;
-  static_assert(14 * 14 > RASTER_MEDIUM_FROM && 2 * 2 <= RASTER_MEDIUM_FROM && 14 * 14 <= RASTER_SHARED_AREA);
+  constexpr uint32_t kSize = 128, kTriangles = 1u << 16, kCapacity = 20000;
+  static_assert(6 * 6 > RASTER_MEDIUM_FROM && 7 * 7 <= RASTER_MEDIUM_NARROW_AREA && 2 * 2 <= RASTER_MEDIUM_FROM &&
+                13 * 13 > RASTER_MEDIUM_NARROW_AREA && 14 * 14 <= RASTER_SHARED_AREA);
   Scene scene;
   scene.materials.push_back(Material{});
   Mesh m;
@@ -317,11 +345,12 @@ TEST_F(RasterTest, MediumTrianglesPastTheListAreDrawnInPlace) {
     seed = seed * 1664525u + 1013904223u;
     return lo + (hi - lo) * float(seed >> 8) / float(1u << 24);
   };
-  uint32_t mediumMade = 0;
+  uint32_t narrowMade = 0, wideMade = 0;
   for (uint32_t t = 0; t < kTriangles; ++t) {
-    const bool tiny = (t % 124 / lanes) % 3 == 2;
-    mediumMade += !tiny;
-    const float side = tiny ? 1.4f : 13.4f;  // pixels: boxes of at most 2 and 14 pixel centres a side
+    const bool tiny = (t % 124 / lanes) % 3 == 2, narrow = !tiny && random(0, 1) < 0.5f;
+    narrowMade += narrow;
+    wideMade += !tiny && !narrow;
+    const float side = tiny ? 1.4f : narrow ? 6.4f : 13.4f;  // pixels: boxes of 1-2, 6-7 and 13-14 pixel centres a side
     const float x = random(1, kSize - 15), y = random(1, kSize - 15), z = random(-2, -1);
     auto world = [&](float sx, float sy) { return glm::vec3(sx / (kSize / 2) - 1, 1 - sy / (kSize / 2), z); };
     const uint32_t v = uint32_t(m.positions.size());
@@ -332,7 +361,7 @@ TEST_F(RasterTest, MediumTrianglesPastTheListAreDrawnInPlace) {
     }
     m.indices.insert(m.indices.end(), {v, v + 1, v + 2});
   }
-  ASSERT_GT(mediumMade, RASTER_MEDIUM_TRIANGLES + 1000);
+  ASSERT_GT(std::min(narrowMade, wideMade), kCapacity);
   for (const glm::vec3& p : m.positions) m.bounds.extend(p);
   scene.meshes.push_back(std::move(m));
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
@@ -340,14 +369,32 @@ TEST_F(RasterTest, MediumTrianglesPastTheListAreDrawnInPlace) {
   lens.orthographic = true;
   lens.zNear = 0.5f;
   lens.zFar = 3.0f;
-  const std::array<uint32_t, 3> medium = expectSameIdsWithAndWithoutMedium(
+  const std::string capacity = std::to_string(kCapacity);
+  const std::vector<MediumCounts> medium = expectSameIdsWithAndWithoutMedium(
+      {{"0", nullptr, nullptr},
+       {nullptr, nullptr, nullptr},
+       {nullptr, nullptr, capacity.c_str()},
+       {nullptr, "32", capacity.c_str()},
+       {"1", nullptr, capacity.c_str()}},
       [&] {
         render::HeadlessRenderer r(*ctx, gpu, {kSize, kSize});
         std::vector<uint32_t> v = ids(r, {{0, 0, 0}, 0, 0}, lens, RasterPath::Compute);
-        return std::pair(std::move(v), r.renderer().mediumTriangles(0).value_or(0));
+        return std::pair(std::move(v), r.renderer().mediumTriangles(0).value_or(MediumCounts{}));
       },
       kSize * kSize / 2);
-  EXPECT_EQ(medium[0], mediumMade) << "every 14×14 box counted, those past the list too";
+  EXPECT_EQ(medium[1].narrow, narrowMade) << "every 6-7 pixel box counted";
+  EXPECT_EQ(medium[1].wide, wideMade) << "every 13-14 pixel box counted";
+  EXPECT_EQ(medium[1].pastList, 0u) << "the list holds as many records as the scene has triangles";
+  for (size_t i = 2; i < medium.size(); ++i) {
+    EXPECT_GE(medium[i].total(), narrowMade + wideMade) << "setting " << i;
+    EXPECT_GT(medium[i].pastList, 0u) << "setting " << i;
+    // The subgroups before the first that did not fit filled the list but for less than a subgroup's records.
+    EXPECT_LE(medium[i].total() - medium[i].pastList, kCapacity) << "setting " << i;
+    EXPECT_GT(medium[i].total() - medium[i].pastList + lanes, kCapacity) << "setting " << i;
+  }
+  EXPECT_EQ(medium[2].narrow, narrowMade);
+  EXPECT_EQ(medium[3].narrow, 0u);
+  EXPECT_EQ(medium[3].wide, narrowMade + wideMade);
 }
 
 // A closed cube [-1, 1]³ seen from inside: its faces wound to face the centre. Every axis is cut at the same

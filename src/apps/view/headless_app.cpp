@@ -13,7 +13,6 @@
 
 #include "apps/common/cache_options.hpp"
 #include "options.hpp"
-#include "raster.h"
 #include "render/headless.hpp"
 #include "render/startup.hpp"
 #include "scene/first_look.hpp"
@@ -247,9 +246,10 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
       if (const auto h = renderer.renderer().handOffTriangles(0)) {
         std::printf("raster hw: %u triangles handed off\n", *h);
         std::printf("raster clip: %u triangles clipped in compute\n", renderer.renderer().clippedTriangles(0).value_or(0));
-        const uint32_t medium = renderer.renderer().mediumTriangles(0).value_or(0);
-        std::printf("raster medium: %u triangles (%u past the list, drawn by their own thread)\n", medium,
-                    medium - std::min(medium, RASTER_MEDIUM_TRIANGLES));
+        const render::ComputeRaster::MediumCounts m =
+            renderer.renderer().mediumTriangles(0).value_or(render::ComputeRaster::MediumCounts{});
+        std::printf("raster medium: %u triangles (%u past the list, drawn by their own thread; %u of 16 lanes, %u of 32)\n",
+                    m.total(), m.pastList, m.narrow, m.wide);
         if (*h > renderer.renderer().handOffCapacity())
           std::fprintf(stderr, "rtr-view: warning: the hand-off list holds %u triangles: %u were not drawn\n",
                        renderer.renderer().handOffCapacity(), *h - renderer.renderer().handOffCapacity());
