@@ -151,8 +151,13 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
       progress->meshDone(ids[job.mesh]);
     }
   });
-  if (!progress)
-    for (size_t i = 0; i < meshes.size(); ++i) setClusters(i);
+  for (size_t i = 0; i < meshes.size(); ++i)
+    if (!progress) {
+      setClusters(i);
+    } else if (firstJob[i] == firstJob[i + 1]) {  // fewer than 3 indices: no piece, nothing to wait for
+      setClusters(i);
+      progress->meshDone(ids[i]);
+    }
 }
 
 }  // namespace
@@ -238,7 +243,7 @@ void ClusterProgress::meshDone(size_t mesh) {
 void ClusterProgress::wait(size_t mesh, size_t triangles) {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [&] {
-    if (stopped_ || mesh >= meshes_.size()) return stopped_ || finished_;
+    if (stopped_ || finished_ || mesh >= meshes_.size()) return stopped_ || finished_;
     const State& s = meshes_[mesh];
     return s.final >= triangles && (triangles < s.triangles || s.complete);
   });

@@ -42,7 +42,7 @@ class ClusterProgress {
   // rtr::Error once stop() is called (the build failed).
   void wait(size_t mesh, size_t triangles);
   size_t finalTriangles(size_t mesh);  // how many of its triangles are final now
-  void finish();                       // everything built (the hierarchy too): what comes after the meshes may be written
+  void finish();                       // everything built (the hierarchy too): every wait returns
   void stop();                         // the build failed: waiters throw
 
   // Used by the build: piece `piece` of mesh `mesh` (pieces numbered in index order, `pieces` in all) is

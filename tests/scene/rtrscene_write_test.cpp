@@ -272,6 +272,19 @@ TEST(RtrSceneWrite, ClusterProgressFollowsThePiecesInOrder) {
   chunks.join();
 }
 
+// A mesh of fewer than 3 indices has no piece: it is complete once the build has run (no writer waits on).
+TEST(RtrSceneWrite, AMeshWithoutATriangleIsDoneWhenTheBuildIs) {
+  Scene s;
+  s.meshes = {grid(2, 0.0f), grid(2, 5.0f)};
+  s.meshes[0].indices = std::vector<uint32_t>{0, 1};
+  ClusterProgress p(s);
+  buildMissingClusters(s, 2, &p);
+  p.wait(0, 0);
+  p.wait(1, 8);
+  EXPECT_TRUE(s.meshes[0].clusters.empty());
+  EXPECT_FALSE(s.meshes[1].clusters.empty());
+}
+
 // A build that fails lets a waiting writer go with an error (rtr-bake then reports the build's error).
 TEST(RtrSceneWrite, AFailedClusterBuildStopsTheWriter) {
   Scene s;
