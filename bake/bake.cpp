@@ -7,6 +7,7 @@
 #include <ctime>
 #include <memory>
 #include <new>
+#include <optional>
 #include <set>
 #include <system_error>
 #include <thread>
@@ -125,6 +126,10 @@ BakeReport bake(const BakeOptions& opt) {
   const unsigned threads = threadCount(opt.threads);
 
   // 1. Parse and weld (OBJ), or read the glTF (instances kept, embedded images held in memory).
+  auto step = [&](const char* name) {
+    if (opt.step) opt.step(name);
+  };
+  step("parse");
   Scene scene;
   if (gltf) {
     if (opt.progress) opt.progress("reading", 0.0);
@@ -140,6 +145,7 @@ BakeReport bake(const BakeOptions& opt) {
     rep.gltf = true;
   } else {
     ObjOptions oo;
+    oo.step = opt.step;
     oo.warn = opt.warn;
     oo.threads = threads;
     oo.mtl = opt.mtl;
@@ -165,6 +171,7 @@ BakeReport bake(const BakeOptions& opt) {
   // (step 4): a bake that fails anywhere, a full disk included, leaves an older output and its textures
   // as they were.
   const std::string input = opt.input.string();
+  step("textures");
   auto t0 = Clock::now();
   std::clock_t c0 = std::clock();
   std::string sceneName = opt.output.filename().string();
@@ -229,45 +236,72 @@ BakeReport bake(const BakeOptions& opt) {
   rep.textureSeconds = since(t0);
   rep.textureCpuSeconds = cpuSince(c0);
 
-  // 3. Clusters (.rtrscene stores them; the course format has no place for them, its loader builds them).
+  // 3. Clusters (.rtrscene stores them; the course format has no place for them, its loader builds them),
+  // and the hierarchy over them (docs/virtual-geometry.md), on all cores. An .rtrscene is written beside
+  // them by a thread of its own: what comes before a mesh's indices in the file is final already, and
+  // its indices and clusters are written as the build makes them final, piece by piece (ClusterProgress).
+  AtomicFile sceneFile(opt.output);
+  std::optional<ClusterProgress> built;
+  std::exception_ptr writeFailed;
+  Clock::time_point writerEnd;
+  std::jthread writer;  // declared last: joined first if anything below throws
   if (!course) {
-    t0 = Clock::now();
-    c0 = std::clock();
-    if (opt.progress) opt.progress("clustering", 0.0);
+    built.emplace(plan.scene);
+    writer = std::jthread([&] {
+      try {
+        rep.outputBytes = stage("writing " + opt.output.string(), [&] {
+          return writeRtrScene(plan.scene, sceneFile, threads, size_t(64) << 20,
+                               [&](size_t mesh, size_t triangles) { built->wait(mesh, triangles); });
+        });
+      } catch (...) { writeFailed = std::current_exception(); }
+      writerEnd = Clock::now();
+    });
     try {
-      stage("clustering " + input, [&] { buildMissingClusters(plan.scene, threads); });
-    } catch (const Error& e) { throw fileError(input, "", e.what()); }
-    rep.clusterSeconds = since(t0);
-    rep.clusterCpuSeconds = cpuSince(c0);
-    // The level-of-detail hierarchy over those clusters (docs/virtual-geometry.md), on all cores.
-    if (opt.lod) {
       t0 = Clock::now();
       c0 = std::clock();
-      if (opt.progress) opt.progress("cluster hierarchy", 0.0);
+      if (opt.progress) opt.progress("clustering", 0.0);
+      step("clusters");
       try {
-        stage("cluster hierarchy of " + input, [&] { buildMissingClusterLods(plan.scene, threads); });
+        stage("clustering " + input, [&] { buildMissingClusters(plan.scene, threads, &*built); });
       } catch (const Error& e) { throw fileError(input, "", e.what()); }
-      rep.lodSeconds = since(t0);
-      rep.lodCpuSeconds = cpuSince(c0);
+      rep.clusterSeconds = since(t0);
+      rep.clusterCpuSeconds = cpuSince(c0);
+      if (opt.lod) {
+        t0 = Clock::now();
+        c0 = std::clock();
+        if (opt.progress) opt.progress("cluster hierarchy", 0.0);
+        step("hierarchy");
+        try {
+          stage("cluster hierarchy of " + input, [&] { buildMissingClusterLods(plan.scene, threads); });
+        } catch (const Error& e) { throw fileError(input, "", e.what()); }
+        rep.lodSeconds = since(t0);
+        rep.lodCpuSeconds = cpuSince(c0);
+      }
+      built->finish();
+    } catch (...) {
+      built->stop();  // the writer stops too; the build's error is the one reported
+      throw;
     }
   }
 
-  // 4. Encode and write the scene to its temporary, then put the textures and the scene in place. Without
-  // --force each goes in by link, so that an output another run made meanwhile is kept (and this run's
-  // textures already placed are removed again).
+  // 4. The write's rest (the course format: all of it), then the textures and the scene put in place.
+  // Without --force each goes in by link, so that an output another run made meanwhile is kept (and this
+  // run's textures already placed are removed again).
   t0 = Clock::now();
   c0 = std::clock();
   if (opt.progress) opt.progress("writing", 0.0);
-  AtomicFile sceneFile(opt.output);
+  step("write");
   if (course) {
     const std::string bytes = stage("encoding " + opt.output.string(), [&] { return encodeCourseMesh(plan.scene); });
     rep.encodeSeconds = since(t0);
     sceneFile.write(bytes.data(), bytes.size());
     rep.outputBytes = bytes.size();
-  } else {  // made, summed and written in windows on all cores: the file is never whole in memory
-    rep.outputBytes = stage("writing " + opt.output.string(), [&] { return writeRtrScene(plan.scene, sceneFile, threads); });
+    rep.fileWriteSeconds = since(t0) - rep.encodeSeconds;
+  } else {
+    writer.join();
+    if (writeFailed) std::rethrow_exception(writeFailed);
+    rep.fileWriteSeconds = std::max(0.0, std::chrono::duration<double>(writerEnd - t0).count());
   }
-  rep.fileWriteSeconds = since(t0) - rep.encodeSeconds;
   sceneFile.sync();
   for (size_t k = 0; k < textures.size(); ++k) {
     const bool existed = std::filesystem::exists(textures[k]->target(), ec);

@@ -47,6 +47,7 @@ struct BakeOptions {
   std::function<void(const std::string&)> warn;
   std::function<void(const std::string&)> note;  // glTF: what the reader chose on its own (LoadOptions::note)
   std::function<void(const char* phase, double fraction)> progress;
+  std::function<void(const char* step)> step;  // each phase and step as it begins (rtr-bake --profile)
   unsigned threads = 0;
   TextureStore textures = TextureStore::Files;  // .rtrscene only
   bool lod = true;                              // --no-lod: no cluster hierarchy (.rtrscene's CLOD chunk)

@@ -2,17 +2,46 @@
 // .rtrscene / .comp5892mesh, glTF (.gltf, .glb) to .rtrscene.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
 #include <cstdio>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 
 #include "bake.hpp"
+#include "cores.hpp"
 #include "core/cli.hpp"
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "scene/first_look.hpp"
+
+namespace {
+
+// --profile: each phase (its steps summed), then each step, in the order they first ran.
+void printCores(const std::vector<rtr::CoreUse>& use, unsigned threads) {
+  std::vector<rtr::CoreUse> phases;
+  for (const rtr::CoreUse& u : use) {
+    const std::string phase = u.step.substr(0, u.step.find(':'));
+    auto it = std::find_if(phases.begin(), phases.end(), [&](const rtr::CoreUse& p) { return p.step == phase; });
+    if (it == phases.end()) it = phases.insert(phases.end(), rtr::CoreUse{phase});
+    it->wall += u.wall, it->cpu += u.cpu, it->notAll += u.notAll, it->oneOrNone += u.oneOrNone, it->idle += u.idle;
+  }
+  std::printf("  cores busy of %u (sampled every 2 ms; wall s with fewer than all busy / with at most one; core-s idle):\n",
+              threads);
+  auto line = [](const char* indent, const rtr::CoreUse& u) {
+    std::printf("%s%-44s %8.3f s wall %6.2f cores  not all busy %7.3f  at most one %7.3f  idle %8.3f\n", indent, u.step.c_str(),
+                u.wall, u.cores(), u.notAll, u.oneOrNone, u.idle);
+  };
+  for (const rtr::CoreUse& p : phases) line("    ", p);
+  for (const rtr::CoreUse& u : use)
+    if (u.step.find(':') != std::string::npos) line("      ", u);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -38,6 +67,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-lod", noLod, "store no cluster hierarchy (level of detail; docs/virtual-geometry.md)");
   bool progress = false;
   app.add_flag("--progress", progress, "show the progress line on stderr also when it is not a terminal");
+  bool profile = false;
+  app.add_flag("--profile", profile,
+               "after the summary, the cores each phase and step kept busy (sampled every 2 ms): where the "
+               "wall time passed with fewer than all threads busy");
   app.add_option("--threads", opt.threads, "worker threads (0: all cores)")->check(rtr::cli::integer(0, 1024));
   std::string up = "+Y";
   app.add_option("--up", up, "the model's up axis, turned to +Y: +X | +Y | +Z | -X | -Y | -Z (a Z-up model: +Z)")
@@ -81,7 +114,13 @@ int main(int argc, char** argv) {
       if (!lightColor.empty()) l.color = rtr::cli::parseColor("--light-color", lightColor);
       opt.lights = {l};
     }
+    std::optional<rtr::CoreSampler> sampler;
+    if (profile) {
+      sampler.emplace(rtr::threadCount(opt.threads));
+      opt.step = [&](const char* step) { sampler->mark(step); };
+    }
     const rtr::BakeReport r = rtr::bake(opt);
+    const std::vector<rtr::CoreUse> use = sampler ? sampler->stop() : std::vector<rtr::CoreUse>();
     if (tty) std::fprintf(stderr, "\r%40s\r", "");  // the progress line cleared
     const auto& o = r.obj;
     const double mb = double(o.textBytes) / 1e6;
@@ -114,6 +153,7 @@ int main(int argc, char** argv) {
     std::printf(
         "  cpu (all threads): parse %.3f s, weld %.3f s, textures %.3f s, clusters %.3f s, hierarchy %.3f s, write %.3f s\n",
         r.parseCpuSeconds, r.weldCpuSeconds, r.textureCpuSeconds, r.clusterCpuSeconds, r.lodCpuSeconds, r.writeCpuSeconds);
+    if (sampler) printCores(use, sampler->threads());
     return 0;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\n");

@@ -90,7 +90,9 @@ std::vector<Cluster> clusterPiece(Mesh& mesh, size_t first, size_t end, bool bac
 // big mesh, such as a scanned statue, would otherwise keep one core busy while the others wait).
 constexpr size_t kPieceTriangles = size_t(1) << 16;
 
-void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backfaceCone, unsigned threads) {
+// `ids`: each mesh's index in what `progress` follows (with progress only).
+void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backfaceCone, unsigned threads,
+                   ClusterProgress* progress = nullptr, std::span<const size_t> ids = {}) {
   // meshoptimizer asserts (aborts) on non-finite cone math, which huge coordinates produce; every reader
   // refuses them with its file and place, and nothing beyond the limit reaches it from elsewhere either.
   // Checked in pieces on all cores, each mesh's positions then its indices: the first failing piece is
@@ -117,20 +119,45 @@ void clusterMeshes(std::span<Mesh* const> meshes, const std::vector<bool>& backf
         throw Error("mesh '" + m.name + "': index " + std::to_string(m.indices[k]) + " out of range");
   });
   struct Job {
-    size_t mesh, first, end;
+    size_t mesh, first, end, piece;
   };
   std::vector<Job> jobs;
+  std::vector<size_t> firstJob(meshes.size() + 1);
   for (Mesh* m : meshes) m->indices.writable();  // reordered in place below: a view is copied first, once
-  for (size_t i = 0; i < meshes.size(); ++i)
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    firstJob[i] = jobs.size();
     for (size_t t = 0, n = meshes[i]->indices.size() / 3; t < n; t += kPieceTriangles)
-      jobs.push_back({i, t, std::min(n, t + kPieceTriangles)});
+      jobs.push_back({i, t, std::min(n, t + kPieceTriangles), jobs.size() - firstJob[i]});
+  }
+  firstJob[meshes.size()] = jobs.size();
   std::vector<std::vector<Cluster>> pieces(jobs.size());
+  auto setClusters = [&](size_t i) {  // pieces in order: every triangle once, in its mesh's place
+    Mesh& m = *meshes[i];
+    m.lod = {};
+    m.clusters.clear();
+    for (size_t j = firstJob[i]; j < firstJob[i + 1]; ++j) {
+      m.clusters.insert(m.clusters.end(), pieces[j].begin(), pieces[j].end());
+      std::vector<Cluster>().swap(pieces[j]);
+    }
+  };
   parallelFor(jobs.size(), threads, [&](size_t j) {
-    pieces[j] = clusterPiece(*meshes[jobs[j].mesh], jobs[j].first, jobs[j].end, backfaceCone[jobs[j].mesh]);
+    const Job& job = jobs[j];
+    pieces[j] = clusterPiece(*meshes[job.mesh], job.first, job.end, backfaceCone[job.mesh]);
+    // A writer following the build gets each mesh's triangles as the pieces before them are done; the
+    // mesh's clusters are set by the thread that completes it.
+    const size_t count = firstJob[job.mesh + 1] - firstJob[job.mesh];
+    if (progress && progress->pieceDone(ids[job.mesh], job.piece, count, job.end)) {
+      setClusters(job.mesh);
+      progress->meshDone(ids[job.mesh]);
+    }
   });
-  for (Mesh* m : meshes) m->clusters.clear(), m->lod = {};
-  for (size_t j = 0; j < jobs.size(); ++j)  // pieces in order: every triangle once, in its mesh's place
-    meshes[jobs[j].mesh]->clusters.insert(meshes[jobs[j].mesh]->clusters.end(), pieces[j].begin(), pieces[j].end());
+  for (size_t i = 0; i < meshes.size(); ++i)
+    if (!progress) {
+      setClusters(i);
+    } else if (firstJob[i] == firstJob[i + 1]) {  // fewer than 3 indices: no piece, nothing to wait for
+      setClusters(i);
+      progress->meshDone(ids[i]);
+    }
 }
 
 }  // namespace
@@ -162,16 +189,82 @@ meshopt_Bounds clusterBounds(const uint32_t* indices, size_t count, const glm::v
 
 bool conesCull(const Material& material) { return !(material.flags & (kMaterialAlphaMasked | kMaterialDoubleSided)); }
 
-size_t buildMissingClusters(Scene& scene, unsigned threads) {
+namespace {
+bool missesClusters(const Mesh& m) { return m.clusters.empty() && !m.indices.empty(); }
+}  // namespace
+
+size_t buildMissingClusters(Scene& scene, unsigned threads, ClusterProgress* progress) {
   std::vector<Mesh*> todo;
+  std::vector<size_t> ids;
   std::vector<bool> cones;
   for (Mesh& m : scene.meshes)
-    if (m.clusters.empty() && !m.indices.empty()) {
+    if (missesClusters(m)) {
       todo.push_back(&m);
+      ids.push_back(size_t(&m - scene.meshes.data()));
       cones.push_back(m.material >= scene.materials.size() || conesCull(scene.materials[m.material]));
     }
-  clusterMeshes(todo, cones, threads);
+  try {
+    clusterMeshes(todo, cones, threads, progress, ids);
+  } catch (...) {
+    if (progress) progress->stop();
+    throw;
+  }
   return todo.size();
+}
+
+ClusterProgress::ClusterProgress(Scene& scene) : meshes_(scene.meshes.size()) {
+  for (size_t i = 0; i < scene.meshes.size(); ++i) {
+    Mesh& m = scene.meshes[i];
+    State& s = meshes_[i];
+    s.triangles = m.indices.size() / 3;
+    s.complete = !missesClusters(m);
+    s.final = s.complete ? s.triangles : 0;
+    if (!s.complete) m.indices.writable();
+  }
+}
+
+bool ClusterProgress::pieceDone(size_t mesh, size_t piece, size_t pieces, size_t end) {
+  std::lock_guard lock(mutex_);
+  State& s = meshes_[mesh];
+  if (s.ends.empty()) s.ends.assign(pieces, 0);
+  s.ends[piece] = end;
+  const size_t was = s.final;
+  for (; s.next < pieces && s.ends[s.next]; ++s.next) s.final = s.ends[s.next];
+  if (s.final != was) changed_.notify_all();
+  return s.next == pieces && was != s.final && s.final == s.triangles;
+}
+
+void ClusterProgress::meshDone(size_t mesh) {
+  std::lock_guard lock(mutex_);
+  meshes_[mesh].complete = true;
+  changed_.notify_all();
+}
+
+void ClusterProgress::wait(size_t mesh, size_t triangles) {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [&] {
+    if (stopped_ || finished_ || mesh >= meshes_.size()) return stopped_ || finished_;
+    const State& s = meshes_[mesh];
+    return s.final >= triangles && (triangles < s.triangles || s.complete);
+  });
+  if (stopped_) throw Error("the clusters were not built");
+}
+
+size_t ClusterProgress::finalTriangles(size_t mesh) {
+  std::lock_guard lock(mutex_);
+  return meshes_[mesh].final;
+}
+
+void ClusterProgress::finish() {
+  std::lock_guard lock(mutex_);
+  finished_ = true;
+  changed_.notify_all();
+}
+
+void ClusterProgress::stop() {
+  std::lock_guard lock(mutex_);
+  stopped_ = true;
+  changed_.notify_all();
 }
 
 }  // namespace rtr

@@ -5,6 +5,10 @@
 // contiguous, which keeps a triangle's primitive id equal to firstTriangle + its index in the cluster.
 #include <meshoptimizer.h>
 
+#include <condition_variable>
+#include <mutex>
+#include <vector>
+
 #include "scene/scene.hpp"
 
 namespace rtr {
@@ -25,8 +29,43 @@ meshopt_Bounds clusterBounds(const uint32_t* indices, size_t count, const glm::v
 // Whether a mesh of this material may be back-face culled by its clusters' cones.
 bool conesCull(const Material& material);
 
+// How far the clusters of each mesh are built, for a writer that follows the build on another thread
+// (rtr-bake writes the file beside the clusters: writeRtrScene's gate). A mesh's triangles are final in
+// order, piece by piece, as the pieces before them are done too; its clusters once all are.
+class ClusterProgress {
+ public:
+  // The meshes buildMissingClusters will build (triangles and no clusters) have nothing final yet; the
+  // others are final. Their indices are made writable here (a view copied now, before a reader looks).
+  explicit ClusterProgress(Scene& scene);
+  // Returns once triangles [0, triangles) of mesh `mesh` are in their final order and, for all of its
+  // triangles, its clusters are set; for mesh >= the mesh count, once finish() is called. Throws
+  // rtr::Error once stop() is called (the build failed).
+  void wait(size_t mesh, size_t triangles);
+  size_t finalTriangles(size_t mesh);  // how many of its triangles are final now
+  void finish();                       // everything built (the hierarchy too): every wait returns
+  void stop();                         // the build failed: waiters throw
+
+  // Used by the build: piece `piece` of mesh `mesh` (pieces numbered in index order, `pieces` in all) is
+  // done up to triangle `end`; returns true to the one caller that completes the mesh, which then calls
+  // meshDone(mesh) once its clusters are set.
+  bool pieceDone(size_t mesh, size_t piece, size_t pieces, size_t end);
+  void meshDone(size_t mesh);
+
+ private:
+  struct State {
+    size_t final = 0, triangles = 0, next = 0;  // triangles final; in all; the first piece not yet done
+    std::vector<size_t> ends;                   // per piece: its end once done, else 0
+    bool complete = false;
+  };
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<State> meshes_;
+  bool finished_ = false, stopped_ = false;
+};
+
 // Builds the clusters of every mesh that has triangles and none, on `threads` threads (0: all cores; the
-// result is the same for any count); returns how many meshes it built.
-size_t buildMissingClusters(Scene& scene, unsigned threads = 0);
+// result is the same for any count); returns how many meshes it built. With `progress` (made from this
+// scene), each mesh's triangles are reported final as their pieces end (stop() is called if it throws).
+size_t buildMissingClusters(Scene& scene, unsigned threads = 0, ClusterProgress* progress = nullptr);
 
 }  // namespace rtr

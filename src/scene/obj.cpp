@@ -75,6 +75,7 @@ class ObjParser {
       }
     };
     auto t = Clock::now();
+    step("parse: the first text read");
     fill(buf, have);
     stats_.textWaitSeconds += since(t);
     while (have) {
@@ -109,6 +110,7 @@ class ObjParser {
         const auto p = Clock::now();
         parseBatch(pieces);
         parsed = since(p);
+        step("parse: waiting for the text");
       });
       stats_.textWaitSeconds += since(t) - parsed;
       std::swap(buf, next);
@@ -120,6 +122,9 @@ class ObjParser {
   Scene finish();
 
  private:
+  void step(const char* name) const {
+    if (opt_.step) opt_.step(name);
+  }
   Error error(const std::string& what) const { return fileError(name_, std::to_string(line_), what); }
   void warn(const std::string& what) { warnRaw(name_ + ":" + std::to_string(line_) + ": " + what); }
   // Every warning is counted; the first few are passed on, finish() reports the total.
@@ -151,8 +156,10 @@ class ObjParser {
   // Parses the pieces on all cores, appends their records, resolves their faces on all cores, then
   // replays their events in file order.
   void parseBatch(std::vector<objpiece::Piece>& pieces) {
+    step("parse: pieces");
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) { objpiece::parsePiece(pieces[i]); });
     // Where each piece's records go (serial, a few numbers a piece), then copied there on all cores.
+    step("parse: records placed (one thread)");
     std::vector<objpiece::Counts> before(pieces.size());
     objpiece::Counts end{positions_.size(), texcoords_.size(), normals_.size()};
     for (size_t i = 0; i < pieces.size(); ++i) {
@@ -170,6 +177,7 @@ class ObjParser {
     if (coloured_) colors_.resize(end.positions);
     if (coloured_ && before.size())
       std::fill(colors_.begin() + uncoloured, colors_.begin() + before[0].positions, glm::vec4(1.0f));
+    step("parse: records copied");
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) {
       objpiece::Piece& p = pieces[i];
       std::copy(p.positions.begin(), p.positions.end(), positions_.begin() + ptrdiff_t(before[i].positions));
@@ -183,6 +191,7 @@ class ObjParser {
       std::vector<glm::vec2>().swap(p.texcoords);
       std::vector<glm::vec3>().swap(p.normals);
     });
+    step("parse: faces resolved");
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) { objpiece::resolvePiece(pieces[i], before[i], positions_); });
     // The events in file order (serial: state, warnings, the first error); each run's corners are given
     // their place in their mesh and copied there on all cores.
@@ -190,12 +199,14 @@ class ObjParser {
       size_t piece, first, end, mesh, at;
     };
     std::vector<Copy> copies;
+    step("parse: events replayed (one thread)");
     for (size_t i = 0; i < pieces.size(); ++i) replay(pieces[i], i, copies);
     for (const Copy& c : copies) {
       GrowArray<Corner>& v = builds_[c.mesh].corners;
       v.resize(std::max(v.size(), c.at + (c.end - c.first)));
     }
     std::vector<std::array<uint32_t, 3>> least(copies.size(), {kAbsent, kAbsent, kAbsent});
+    step("parse: corners copied");
     parallelFor(copies.size(), opt_.threads, [&](size_t k) {
       const Copy& c = copies[k];
       const std::vector<Corner>& from = pieces[c.piece].corners;
@@ -206,6 +217,7 @@ class ObjParser {
     });
     for (size_t k = 0; k < copies.size(); ++k)
       for (int a = 0; a < 3; ++a) builds_[copies[k].mesh].least[a] = std::min(builds_[copies[k].mesh].least[a], least[k][a]);
+    step("parse: pieces freed");
     parallelFor(pieces.size(), opt_.threads, [&](size_t i) { pieces[i] = objpiece::Piece(); });  // freed on all cores
   }
 
@@ -352,6 +364,7 @@ class ObjParser {
 };
 
 Scene ObjParser::finish() {
+  step("weld: heap trimmed (one thread)");
   ::malloc_trim(0);  // the batches' pieces, freed, went back to the heap, not to the system
   stats_.positions = positions_.size();
   stats_.normals = normals_.size();
@@ -377,9 +390,11 @@ Scene ObjParser::finish() {
   // Weld: small meshes one per thread, then each large one on all threads (the same meshes either way).
   std::vector<Mesh> meshes(builds_.size());
   std::vector<WeldCounts> counts(builds_.size());
-  auto weld = [&](size_t i, unsigned threads) {
-    counts[i] = weldMesh(builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads,
-                         [&] { builds_[i].corners.release(threads); });
+  const std::function<void(const char*)> none;
+  auto weld = [&](size_t i, unsigned threads, const std::function<void(const char*)>& steps) {
+    counts[i] = weldMesh(
+        builds_[i].corners, positions_, normals_, texcoords_, meshes[i], opt_.creaseDeg, colors_, threads,
+        [&] { builds_[i].corners.release(threads); }, steps);
     builds_[i].corners.release(threads);
   };
   const auto large = [&](size_t i) { return builds_[i].corners.size() > kLargeMesh; };
@@ -390,8 +405,9 @@ Scene ObjParser::finish() {
     if (opt_.weldProgress) opt_.weldProgress(all > 0 ? done / all : 1.0);
   };
   progress(0);
+  step("weld: small meshes (one a thread)");
   parallelFor(builds_.size(), opt_.threads, [&](size_t i) {
-    if (!large(i)) weld(i, 1);
+    if (!large(i)) weld(i, 1, none);
   });
   for (size_t i = 0; i < builds_.size(); ++i) done += large(i) ? 0.0 : double(counts[i].triangles + counts[i].degenerate) * 3;
   progress(0);
@@ -402,19 +418,21 @@ Scene ObjParser::finish() {
     for (int a = 0; a < 3; ++a) least[i][a] = std::min(least[i + 1][a], large(i) ? builds_[i].least[a] : kAbsent);
   for (size_t i = 0; i < builds_.size(); ++i)
     if (large(i)) {
+      step("weld: the file's arrays dropped below");
       positions_.dropBelow(least[i][0], opt_.threads);
       colors_.dropBelow(least[i][0], opt_.threads);
       texcoords_.dropBelow(least[i][1], opt_.threads);
       normals_.dropBelow(least[i][2], opt_.threads);
       const double corners = double(builds_[i].corners.size());
       try {
-        weld(i, opt_.threads);
+        weld(i, opt_.threads, opt_.step);
       } catch (const Error& e) {  // a mesh beyond the weld's limit
         throw fileError(name_, "object '" + builds_[i].name + "'", e.what());
       }
       progress(corners);
     }
 
+  step("weld: the scene made");
   for (size_t i = 0; i < builds_.size(); ++i) {
     stats_.verticesBeforeWeld += (counts[i].triangles + counts[i].degenerate) * 3;
     stats_.degenerateSkipped += counts[i].degenerate;

@@ -21,6 +21,9 @@ struct ObjOptions : LoadOptions {
   std::function<void(uint64_t, uint64_t)> progress;
   // Called now and then while welding with the fraction of the corners welded.
   std::function<void(double)> weldProgress;
+  // Called on the reading thread as each step of the parse and the weld begins, with its name (rtr-bake
+  // --profile counts the cores each keeps busy).
+  std::function<void(const char*)> step;
   unsigned threads = 0;   // parse and weld workers; 0 = all cores
   size_t pieceBytes = 0;  // text parsed as one piece (0: 1 MiB); tests force tiny pieces to put boundaries everywhere
 };

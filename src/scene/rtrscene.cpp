@@ -28,6 +28,7 @@ namespace {
 constexpr char kMagic[8] = {'R', 'T', 'R', 'S', 'C', 'E', 'N', 'E'};
 constexpr size_t kHeaderSize = 80;
 constexpr size_t kAlign = 16;
+constexpr size_t kGateTriangles = size_t(1) << 16;  // the indices a writer beside the clusters' build takes at once
 constexpr uint32_t kMaxString = 32768;
 
 constexpr uint32_t kHasView = 1u << 0;       // header flags
@@ -164,7 +165,7 @@ size_t sizeBound(const Scene& scene) {
 }
 
 // The whole file into `w` (in memory, or streaming to a file), its header's size and checksum patched last.
-void encode(ByteWriter& w, const Scene& scene, uint32_t version, unsigned threads) {
+void encode(ByteWriter& w, const Scene& scene, uint32_t version, unsigned threads, const WriteGate& ready = {}) {
   if (version < 1 || version > kRtrSceneVersion || (version < 2 && !scene.lights.empty()))
     throw Error("cannot encode .rtrscene version " + std::to_string(version) + (scene.lights.empty() ? "" : " with lights"));
   if (const std::string what = newerThan4(scene); version < 5 && !what.empty())
@@ -285,19 +286,27 @@ void encode(ByteWriter& w, const Scene& scene, uint32_t version, unsigned thread
       w.array(m.colors);
       w.pad(kAlign);
     }
-    if (small) {
+    // The indices in blocks of whole triangles, each once it is final (ready: the clusters may still be
+    // reordering the ones after it).
+    const size_t mesh = size_t(&m - scene.meshes.data()), triangles = m.indices.size() / 3;
+    for (size_t f = 0; f < m.indices.size(); f += kGateTriangles * 3) {
+      const size_t e = std::min(m.indices.size(), f + kGateTriangles * 3);
+      if (ready) ready(mesh, e / 3);
+      if (!small) {
+        w.bytes(m.indices.data() + f, (e - f) * 4);
+        continue;
+      }
       uint16_t part[4096];
-      for (size_t f = 0; f < m.indices.size(); f += std::size(part)) {
-        const size_t n = std::min(std::size(part), m.indices.size() - f);
-        std::copy_n(m.indices.begin() + ptrdiff_t(f), n, part);
+      for (size_t k = f; k < e; k += std::size(part)) {
+        const size_t n = std::min(std::size(part), e - k);
+        std::copy_n(m.indices.begin() + ptrdiff_t(k), n, part);
         w.bytes(part, n * 2);
       }
-    } else {
-      w.array(m.indices);
     }
     w.pad(kAlign);
     // Version 3: the clusters (zero: none stored, built at load).
     if (version < 3) continue;
+    if (ready) ready(mesh, triangles);
     w.u32(uint32_t(m.clusters.size()));
     w.zeros(12);
     for (const Cluster& c : m.clusters) {  // 40 bytes each
@@ -320,6 +329,7 @@ void encode(ByteWriter& w, const Scene& scene, uint32_t version, unsigned thread
     w.patch(sizeAt, &body, 8);
     w.pad(kAlign);
   };
+  if (ready) ready(scene.meshes.size(), 0);
   if (hasBakedTextures(scene)) chunk("TEXS", [&] { writeTexs(w, scene); });
   if (version >= 6 && hasClusterLods(scene)) chunk("CLOD", [&] { writeClusterLods(w, scene); });
   const uint64_t payload = w.size() - kHeaderSize;
@@ -343,9 +353,9 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version) {
   return std::move(w.data());
 }
 
-uint64_t writeRtrScene(const Scene& scene, AtomicFile& file, unsigned threads, size_t window) {
+uint64_t writeRtrScene(const Scene& scene, AtomicFile& file, unsigned threads, size_t window, const WriteGate& ready) {
   ByteWriter w(file.fd(), file.target().string(), kHeaderSize, threads, window);
-  encode(w, scene, kRtrSceneVersion, threads);
+  encode(w, scene, kRtrSceneVersion, threads, ready);
   return w.size();
 }
 

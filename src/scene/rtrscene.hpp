@@ -2,6 +2,7 @@
 // Our baked format (.rtrscene): versioned, scalar factors instead of fallback textures, 16-bit indices where
 // a mesh allows, 16-byte aligned arrays, a checksum over the payload. Byte table: docs/rtrscene-format.md.
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -26,7 +27,13 @@ std::string encodeRtrScene(const Scene& scene, uint32_t version = kRtrSceneVersi
 // bytes (a multiple of 1 MiB) summed on `threads` threads and written while the next fills: the file is
 // never whole in memory. Returns its size; the caller syncs and commits `file`. Throws rtr::Error naming
 // the file on a write error (the temporary is then the caller's to drop).
-uint64_t writeRtrScene(const Scene& scene, AtomicFile& file, unsigned threads = 0, size_t window = size_t(64) << 20);
+// `ready`, when given, lets the write run beside the build of the meshes' clusters (rtr-bake: the clusters
+// reorder each mesh's indices, and everything before them in the file is final already): before the
+// writer reads the indices of mesh m up to triangle t it calls ready(m, t) (t = all of them: its clusters
+// too), and before the chunks ready(mesh count, 0). It returns once those are final, or throws to stop.
+using WriteGate = std::function<void(size_t mesh, size_t triangles)>;
+uint64_t writeRtrScene(const Scene& scene, AtomicFile& file, unsigned threads = 0, size_t window = size_t(64) << 20,
+                       const WriteGate& ready = {});
 // Validates everything (sizes, counts, strings, indices, texture ids, finite values, clusters, checksum).
 // The checksum (version 4), the arrays and their checks run on `threads` threads (0: one per core, or
 // one for a file under 4 MiB); the scene and any fault reported do not depend on the count. Baked texels

@@ -165,8 +165,12 @@ size_t prefix(std::vector<size_t>& v) {
 
 WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg, std::span<const glm::vec4> colors,
-                    unsigned threads, const std::function<void()>& cornersDone) {
+                    unsigned threads, const std::function<void()>& cornersDone, const std::function<void(const char*)>& stepFn) {
+  auto step = [&](const char* name) {
+    if (stepFn) stepFn(name);
+  };
   WeldCounts counts;
+  step("weld: 1 degenerate triangles");
   const size_t triCount = corners.size() / 3, cornerCount = triCount * 3;
 
   // 1. Drop triangles with a repeated corner position or zero area.
@@ -215,6 +219,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   if (counts.triangles == 0) return counts;
 
   // The kept corners at each position, in order.
+  step("weld: 1 corners grouped by position");
   Groups atPos = groupBy(
       cornerCount, size_t(pmax - pmin) + 1, threads, [&](size_t c) { return keep[c / 3] ? corners[c].p - pmin : kAbsent; },
       false);
@@ -229,6 +234,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   std::vector<std::vector<glm::vec3>> made;
   std::vector<size_t> base;
   if (needNormals) {
+    step("weld: 2 generated normals");
     auto cross = [&](size_t t) {  // as step 1 computes it
       const Corner* c = &corners[t * 3];
       const glm::vec3 a = positions[c[0].p];
@@ -304,6 +310,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   // per-corner array beside them and the groups would be the weld's peak of memory): a corner equal to an
   // earlier one gets that one's index in p and kAbsent in n (every kept corner has a normal by now).
   if (cornerCount >= kDone) throw Error("a mesh of more than 715 million triangles cannot be welded");
+  step("weld: 3 exact duplicates");
   forPieces(atPos.count(), threads, [&](size_t, size_t b, size_t e) {
     std::vector<uint32_t> distinct;
     for (size_t g = b; g < e; ++g) {
@@ -319,6 +326,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     }
   });
   freeGroups(atPos, threads);
+  step("weld: 3 vertex ids");
   auto first = [&](size_t c) { return keep[c / 3] && corners[c].n != kAbsent; };
   const size_t cornerPieces = piecesOf(cornerCount);
   std::vector<size_t> firsts(cornerPieces, 0);
@@ -348,6 +356,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   // the first earlier kept vertex found near it (cells in a fixed order, a cell's hash slot newest first),
   // else is kept. A vertex with no earlier vertex near it at all is kept for sure, which all cores decide
   // at once; the rest (rare: near but not equal) are decided in order afterwards.
+  step("weld: 4 vertices gathered");
   auto verts = uninitialised<Vertex>(uniqCount);
   auto vcolor = uninitialised<glm::vec4>(colors.empty() ? 0 : uniqCount);
   auto slotOf = uninitialised<uint32_t>(uniqCount);
@@ -376,6 +385,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   freeOnAllCores(uniq, uniqCount, threads);
   std::vector<std::vector<glm::vec3>>().swap(made);
   auto isNear = [&](uint32_t a, uint32_t b) { return near(verts[a], verts[b]) && (colors.empty() || vcolor[a] == vcolor[b]); };
+  step("weld: 4 near test");
   Groups inBucket = groupBy(
       uniqCount, buckets, threads, [&](size_t u) { return slotOf[u] & (buckets - 1); }, true);
   auto target = uninitialised<uint32_t>(uniqCount);  // the vertex each one joins (itself when kept)
@@ -406,6 +416,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
     for (size_t u = b; u < e; ++u)
       if (!kept[u]) open[p].push_back(uint32_t(u));
   });
+  step("weld: 4 near but not equal (one thread)");
   for (const std::vector<uint32_t>& list : open)
     for (const uint32_t u : list) {
       uint32_t found = kAbsent;
@@ -421,6 +432,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
       if (found == kAbsent) kept[u] = 1, found = u;
       target[u] = found;
     }
+  step("weld: 4 kept ids");
   freeGroups(inBucket, threads);
   freeOnAllCores(slotOf, uniqCount, threads);
   std::vector<size_t> keptBefore(piecesOf(uniqCount), 0);
@@ -435,6 +447,7 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   });
 
   // 5. Emit.
+  step("weld: 5 mesh emitted");
   const size_t n = counts.vertices;
   std::vector<glm::vec3>&pos = out.positions.writable(), &nrm = out.normals.writable();
   std::vector<glm::vec2>& tex = out.texcoords.writable();

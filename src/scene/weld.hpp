@@ -34,8 +34,10 @@ constexpr float kDefaultCreaseDeg = 40.0f;
 // flat, 180: smooth). `colors`: one per position, or empty. Runs on `threads` (0: all cores) in fixed
 // pieces: the mesh is the same for any thread count. `cornersDone`, when given, is called once `corners`
 // is read no more, before the mesh is made: its owner may free it there (memory at a large bake's peak).
+// `step`, when given, is called with each step's name as it begins (rtr-bake --profile).
 WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                     std::span<const glm::vec2> texcoords, Mesh& out, float creaseDeg = kDefaultCreaseDeg,
-                    std::span<const glm::vec4> colors = {}, unsigned threads = 1, const std::function<void()>& cornersDone = {});
+                    std::span<const glm::vec4> colors = {}, unsigned threads = 1, const std::function<void()>& cornersDone = {},
+                    const std::function<void(const char*)>& step = {});
 
 }  // namespace rtr

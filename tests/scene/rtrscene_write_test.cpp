@@ -1,12 +1,18 @@
 // The .rtrscene written while it is made (writeRtrScene: windows summed on all cores, written by a thread
 // of their own, chunk sizes patched into pieces held back) is byte for byte the in-memory encoding, at any
 // thread count and window size; a streaming ByteWriter gives the bytes and the piece checksum of one in
-// memory for any sequence of writes, holes and patches; a write error names the file.
+// memory for any sequence of writes, holes and patches; a write error names the file; written beside the
+// clusters' build (rtr-bake), it is the file written after them.
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <random>
+#include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -183,3 +189,115 @@ TEST(RtrSceneWrite, WriteErrorNamesTheFile) {
 }
 
 }  // namespace
+
+// rtr-bake writes the file beside the clusters' build: the writer takes each mesh's indices as the build
+// makes them final (ClusterProgress) and gives the bytes of a file written after it. The writer is let run
+// until it waits for the first indices (or ends: a writer that does not wait writes the indices unclustered).
+TEST(RtrSceneWrite, WrittenBesideTheClustersIsTheFileWrittenAfterThem) {
+  for (unsigned threads : {1u, 3u}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    Scene s = everything();
+    for (Mesh& m : s.meshes) m.clusters.clear(), m.lod = {};
+    s.meshes[4].clusters.push_back(Cluster{});  // built already: not waited for
+    Scene after = s;
+    buildMissingClusters(after, threads);
+    after.meshes[2].lod = buildClusterLod(after.meshes[2]);
+    const std::string expected = encodeRtrScene(after);
+    TempDir tmp;
+    const auto out = tmp.dir / "beside.rtrscene";
+    AtomicFile f(out);
+    ClusterProgress built(s);
+    std::mutex m;
+    std::condition_variable cv;
+    bool waiting = false, ended = false;
+    std::vector<std::pair<size_t, size_t>> gates;
+    std::thread writer([&] {
+      writeRtrScene(s, f, threads, kMiB, [&](size_t mesh, size_t triangles) {
+        {
+          std::lock_guard lock(m);
+          waiting = true;
+          gates.push_back({mesh, triangles});
+        }
+        cv.notify_all();
+        built.wait(mesh, triangles);
+      });
+      std::lock_guard lock(m);
+      ended = true;
+      cv.notify_all();
+    });
+    {
+      std::unique_lock lock(m);
+      cv.wait(lock, [&] { return waiting || ended; });
+    }
+    buildMissingClusters(s, threads, &built);
+    s.meshes[2].lod = buildClusterLod(s.meshes[2]);
+    built.finish();
+    writer.join();
+    f.commit();
+    EXPECT_TRUE(fileBytes(out) == expected);
+    // The big mesh (180 000 triangles) in three blocks, then its clusters; the chunks last.
+    const std::vector<std::pair<size_t, size_t>> big = {{1, 65536}, {1, 131072}, {1, 180000}, {1, 180000}};
+    EXPECT_TRUE(std::search(gates.begin(), gates.end(), big.begin(), big.end()) != gates.end());
+    ASSERT_FALSE(gates.empty());
+    EXPECT_EQ(gates.back(), std::make_pair(s.meshes.size(), size_t(0)));
+  }
+}
+
+// Pieces end in any order; a mesh's triangles are final up to the first piece not yet done, and the one
+// call that completes it is told so (it sets the clusters; meshDone then lets the last indices go).
+TEST(RtrSceneWrite, ClusterProgressFollowsThePiecesInOrder) {
+  Scene s;
+  s.meshes = {grid(4, 0.0f), grid(2, 5.0f), Mesh{}};
+  s.meshes[1].clusters.push_back(Cluster{});
+  ClusterProgress p(s);
+  EXPECT_EQ(p.finalTriangles(0), 0u);
+  EXPECT_EQ(p.finalTriangles(1), 8u);  // has clusters: final
+  EXPECT_EQ(p.finalTriangles(2), 0u);
+  p.wait(1, 8);
+  p.wait(2, 0);
+  EXPECT_FALSE(p.pieceDone(0, 2, 3, 32));
+  EXPECT_EQ(p.finalTriangles(0), 0u);
+  EXPECT_FALSE(p.pieceDone(0, 0, 3, 10));
+  EXPECT_EQ(p.finalTriangles(0), 10u);
+  p.wait(0, 10);
+  EXPECT_TRUE(p.pieceDone(0, 1, 3, 20));
+  EXPECT_EQ(p.finalTriangles(0), 32u);
+  std::atomic<bool> through{false};
+  std::thread last([&] { p.wait(0, 32), through = true; });  // waits for meshDone: the clusters
+  p.meshDone(0);
+  last.join();
+  EXPECT_TRUE(through);
+  std::thread chunks([&] { p.wait(3, 0); });  // the chunks: after finish()
+  p.finish();
+  chunks.join();
+}
+
+// A mesh of fewer than 3 indices has no piece: it is complete once the build has run (no writer waits on).
+TEST(RtrSceneWrite, AMeshWithoutATriangleIsDoneWhenTheBuildIs) {
+  Scene s;
+  s.meshes = {grid(2, 0.0f), grid(2, 5.0f)};
+  s.meshes[0].indices = std::vector<uint32_t>{0, 1};
+  ClusterProgress p(s);
+  buildMissingClusters(s, 2, &p);
+  p.wait(0, 0);
+  p.wait(1, 8);
+  EXPECT_TRUE(s.meshes[0].clusters.empty());
+  EXPECT_FALSE(s.meshes[1].clusters.empty());
+}
+
+// A build that fails lets a waiting writer go with an error (rtr-bake then reports the build's error).
+TEST(RtrSceneWrite, AFailedClusterBuildStopsTheWriter) {
+  Scene s;
+  s.meshes = {grid(4, 0.0f)};
+  s.meshes[0].indices.writable()[7] = 1000;  // out of range
+  ClusterProgress p(s);
+  std::string waited;
+  std::thread writer([&] {
+    try {
+      p.wait(0, 32);
+    } catch (const Error& e) { waited = e.what(); }
+  });
+  EXPECT_THROW(buildMissingClusters(s, 2, &p), Error);
+  writer.join();
+  EXPECT_THAT(waited, HasSubstr("clusters were not built"));
+}
