@@ -16,11 +16,12 @@ namespace rtr::shader {
 // The cluster step's workgroup tests this many chunks (tree leaves, up to CULL_LEAF_SIZE records each).
 #define CULL_CHUNKS_PER_GROUP (CULL_GROUP_SIZE / CULL_LEAF_SIZE)
 #define HIZ_GROUP_SIZE 8
-// The fused pyramid (hiz_fused.glsl): a workgroup of HIZ_FUSED_GROUP threads per tile of HIZ_TILE ×
-// HIZ_TILE source texels writes the HIZ_FUSED_LEVELS levels above it (HIZ_TILE = 2^HIZ_FUSED_LEVELS).
-#define HIZ_FUSED_GROUP 256
-#define HIZ_TILE 64
-#define HIZ_FUSED_LEVELS 6
+// The fused pyramid (hiz_fused.glsl): a workgroup of HIZ_FUSED_SIDE² threads per tile of HIZ_TILE ×
+// HIZ_TILE source texels writes the HIZ_FUSED_LEVELS levels above it (HIZ_TILE = 2^HIZ_FUSED_LEVELS, at
+// most 6 levels).
+#define HIZ_FUSED_SIDE 8
+#define HIZ_TILE 32
+#define HIZ_FUSED_LEVELS 5
 
 // CullPush::flags: which tests run.
 #define CULL_FRUSTUM 1u
