@@ -16,6 +16,12 @@ namespace rtr::shader {
 // The cluster step's workgroup tests this many chunks (tree leaves, up to CULL_LEAF_SIZE records each).
 #define CULL_CHUNKS_PER_GROUP (CULL_GROUP_SIZE / CULL_LEAF_SIZE)
 #define HIZ_GROUP_SIZE 8
+// The fused pyramid (hiz_fused.glsl): a workgroup of HIZ_FUSED_SIDE² threads per tile of HIZ_TILE ×
+// HIZ_TILE source texels writes the HIZ_FUSED_LEVELS levels above it (HIZ_TILE = 2^HIZ_FUSED_LEVELS, at
+// most 6 levels).
+#define HIZ_FUSED_SIDE 8
+#define HIZ_TILE 32
+#define HIZ_FUSED_LEVELS 5
 
 // CullPush::flags: which tests run.
 #define CULL_FRUSTUM 1u
@@ -89,6 +95,15 @@ struct CullPush {  // 128 bytes
   uint depth;     // cull_instances.comp: CULL_INSTANCE_STEP, or the tree depth whose queue it tests
 };
 #define CULL_INSTANCE_STEP 0xFFFFFFFFu
+
+// hiz_fused.glsl's push constants: the source's size (pixels, or the level below the first one written)
+// and how many levels this dispatch writes (1 to HIZ_FUSED_LEVELS).
+struct HizPush {
+  uint width;
+  uint height;
+  uint levels;
+  uint pad;
+};
 
 RTR_FN vec4 matrixRow(mat4 m, int i) { return vec4(m[0][i], m[1][i], m[2][i], m[3][i]); }
 
@@ -186,7 +201,7 @@ RTR_FN ivec4 pyramidTexels(ivec4 px, int level, ivec2 levelSize) {
 }
 
 #ifdef __cplusplus
-static_assert(sizeof(CullPush) == 128 && sizeof(CullCounts) == 80 && sizeof(CullQueue) == 32);
+static_assert(sizeof(CullPush) == 128 && sizeof(CullCounts) == 80 && sizeof(CullQueue) == 32 && sizeof(HizPush) == 16);
 }  // namespace rtr::shader
 #endif
 #endif

@@ -217,20 +217,37 @@ uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, cons
   return uint32_t(layers[0].size());
 }
 
-DepthPyramid::DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent) : ctx_(ctx), depthExtent_(depthExtent) {
+PyramidPasses pyramidPassesFromEnv() {
+  const char* v = std::getenv("RTR_PYRAMID_PASSES");
+  if (!v || std::string(v) == "fused") return PyramidPasses::Fused;
+  if (std::string(v) == "levels") return PyramidPasses::Levels;
+  throw Error(std::string("RTR_PYRAMID_PASSES=") + v + ": levels or fused");
+}
+
+DepthPyramid::DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent, PyramidPasses passes)
+    : ctx_(ctx), depthExtent_(depthExtent), passes_(passes) {
   vk::ImageDesc d;
   d.extent = pyramidExtent(depthExtent);
   d.format = kPyramidFormat;
   d.mipLevels = levelCount(d.extent);
-  d.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+  // Copies and clears: the tests read it back and poison it.
+  d.usage =
+      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   d.name = "depth pyramid";
   image_ = vk::Image(ctx, d);
   for (uint32_t l = 0; l < d.mipLevels; ++l)
     levelViews_.push_back(image_.createView(kPyramidFormat, l, 1, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT));
-  pipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("hiz.comp"), {.pushDescriptorSets = {0}});
+  if (passes_ == PyramidPasses::Levels)
+    pipeline_ = vk::makeComputePipeline(ctx, vk::loadShader("hiz.comp"), {.pushDescriptorSets = {0}});
+  else fused_ = vk::makeComputePipeline(ctx, vk::loadShader("hiz_fused.comp"), {.pushDescriptorSets = {0}});
+}
+
+uint32_t DepthPyramid::dispatches() const {
+  return passes_ == PyramidPasses::Levels ? levels() : (levels() + HIZ_FUSED_LEVELS - 1) / HIZ_FUSED_LEVELS;
 }
 
 void DepthPyramid::build(VkCommandBuffer cb, VkImageView depth, VkImageLayout depthLayout) {
+  if (passes_ == PyramidPasses::Fused) return buildFused(cb, VK_NULL_HANDLE, depth, depthLayout);
   buildLevels(cb, [&](VkImageView level0) -> const vk::Pipeline& {
     pipeline_.bind(cb);
     vk::DescriptorWriter(ctx_, pipeline_.layout, 0, VK_NULL_HANDLE)
@@ -242,6 +259,7 @@ void DepthPyramid::build(VkCommandBuffer cb, VkImageView depth, VkImageLayout de
 }
 
 void DepthPyramid::buildFromBuffer(VkCommandBuffer cb, VkBuffer vis) {
+  if (passes_ == PyramidPasses::Fused) return buildFused(cb, vis, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED);
   if (!fromBuffer_.layout.handle())
     fromBuffer_ = vk::makeComputePipeline(ctx_, vk::loadShader("hiz_buffer.comp"), {.pushDescriptorSets = {0}});
   buildLevels(cb, [&](VkImageView level0) -> const vk::Pipeline& {
@@ -255,7 +273,7 @@ void DepthPyramid::buildFromBuffer(VkCommandBuffer cb, VkBuffer vis) {
   });
 }
 
-void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk::Pipeline&(VkImageView)>& bindLevel0) {
+void DepthPyramid::begin(VkCommandBuffer cb) {
   constexpr auto kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   constexpr auto kReadWrite = VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT;
   if (!initialised_) {
@@ -265,6 +283,10 @@ void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk:
   } else {  // the last frame's culling read it
     vk::bufferBarrier(cb, vk::kComputeRead | vk::kCopyRead, vk::kComputeReadWrite);
   }
+}
+
+void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk::Pipeline&(VkImageView)>& bindLevel0) {
+  begin(cb);
   for (uint32_t l = 0; l < levelViews_.size(); ++l) {
     const VkExtent2D e{std::max(1u, image_.extent().width >> l), std::max(1u, image_.extent().height >> l)};
     const vk::Pipeline* bound = &pipeline_;
@@ -279,6 +301,33 @@ void DepthPyramid::buildLevels(VkCommandBuffer cb, const std::function<const vk:
     }
     bound->dispatch(cb, e.width, e.height);
     // Each level is the next one's source; the last is the culling pass's (and a read-back's) input.
+    vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead | vk::kCopyRead);
+  }
+}
+
+// A dispatch per HIZ_FUSED_LEVELS levels, one workgroup per HIZ_TILE × HIZ_TILE texels of its source (the
+// depth or the visibility buffer, then the level below its first); each dispatch's levels are the next one's
+// source.
+void DepthPyramid::buildFused(VkCommandBuffer cb, VkBuffer vis, VkImageView depth, VkImageLayout depthLayout) {
+  if (vis && !fusedFromBuffer_.layout.handle())
+    fusedFromBuffer_ = vk::makeComputePipeline(ctx_, vk::loadShader("hiz_fused_buffer.comp"), {.pushDescriptorSets = {0}});
+  begin(cb);
+  const uint32_t levels = this->levels();
+  for (uint32_t first = 0; first < levels; first += HIZ_FUSED_LEVELS) {
+    const vk::Pipeline& p = first == 0 && vis ? fusedFromBuffer_ : fused_;
+    const VkExtent2D src = first == 0 ? depthExtent_
+                                      : VkExtent2D{std::max(1u, image_.extent().width >> (first - 1)),
+                                                   std::max(1u, image_.extent().height >> (first - 1))};
+    p.bind(cb);
+    vk::DescriptorWriter w(ctx_, p.layout, 0, VK_NULL_HANDLE);
+    if (first == 0 && vis) w.buffer(0, vis);
+    else if (first == 0) w.image(0, depth, depthLayout);
+    else w.image(0, levelViews_[first - 1], VK_IMAGE_LAYOUT_GENERAL);
+    for (uint32_t j = 0; j < HIZ_FUSED_LEVELS; ++j)  // past the last level: bound, never written
+      w.image(1 + j, levelViews_[std::min(first + j, levels - 1)], VK_IMAGE_LAYOUT_GENERAL);
+    w.push(cb, p);
+    p.push(cb, shader::HizPush{src.width, src.height, std::min<uint32_t>(HIZ_FUSED_LEVELS, levels - first), 0});
+    vkCmdDispatch(cb, std::max(1u, src.width / HIZ_TILE), std::max(1u, src.height / HIZ_TILE), 1);
     vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeRead | vk::kCopyRead);
   }
 }

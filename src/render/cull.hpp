@@ -67,11 +67,17 @@ uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, cons
 // Every GpuCluster of a scene, numbered as GpuScene numbers its instances.
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
 
+// How DepthPyramid records its build: Levels, one dispatch and one barrier per level (hiz.comp,
+// hiz_buffer.comp); Fused, up to HIZ_FUSED_LEVELS levels a dispatch (hiz_fused.glsl: two dispatches for
+// CULL_PYRAMID_MAX_LEVELS). The same texels either way. RTR_PYRAMID_PASSES=levels|fused (default fused).
+enum class PyramidPasses { Levels, Fused };
+PyramidPasses pyramidPassesFromEnv();
+
 // The farthest depth per texel of a depth image, level by level (level 0 half the image; which pixels a
 // texel covers: shaders/shared/cull.h).
 class DepthPyramid {
  public:
-  DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent);
+  DepthPyramid(const vk::Context& ctx, VkExtent2D depthExtent, PyramidPasses passes = pyramidPassesFromEnv());
   // Records the build from `depth` (a sampled view whose .r is depth: a D32 depth-aspect view or an R32F
   // image, in `depthLayout`, written before this by the compute or fragment stage with the barrier the
   // writer owes). Leaves the pyramid readable by compute shaders.
@@ -84,14 +90,20 @@ class DepthPyramid {
   uint32_t levels() const { return image_.mipLevels(); }
   const vk::Image& image() const { return image_; }
   static VkExtent2D pyramidExtent(VkExtent2D depth);  // level 0's
+  PyramidPasses passes() const { return passes_; }
+  uint32_t dispatches() const;  // the dispatches (and barriers) a build records
 
  private:
   const vk::Context& ctx_;
   VkExtent2D depthExtent_;
   vk::Image image_;
   std::vector<vk::ImageView> levelViews_;  // per level: storage (write) and sampled (read by the next level)
-  vk::Pipeline pipeline_, fromBuffer_;     // fromBuffer_: level 0 from a visibility buffer, made on first use
+  PyramidPasses passes_;
+  vk::Pipeline pipeline_, fromBuffer_;    // Levels (fromBuffer_: level 0 from a visibility buffer, made on first use)
+  vk::Pipeline fused_, fusedFromBuffer_;  // Fused, the same way
+  void begin(VkCommandBuffer cb);
   void buildLevels(VkCommandBuffer cb, const std::function<const vk::Pipeline&(VkImageView)>& bindLevel0);
+  void buildFused(VkCommandBuffer cb, VkBuffer vis, VkImageView depth, VkImageLayout depthLayout);
   bool initialised_ = false;
 };
 

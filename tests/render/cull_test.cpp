@@ -2,6 +2,7 @@
 // pyramid is the exact farthest-depth reduction, and culling never removes a visible cluster: the temple's
 // id image drawn from the kept clusters equals the one drawn from all of them, bit for bit.
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <set>
@@ -251,6 +252,91 @@ TEST_F(CullTest, GpuMatchesCpuForRandomClustersAndCameras) {
   EXPECT_GT(byReason[CULL_VISIBLE], 50u);
   std::printf("random clusters over 6 views: visible %u, frustum %u, cone %u, occlusion %u, borderline %u\n", byReason[0],
               byReason[1], byReason[2], byReason[3], borderline);
+}
+
+// Random depths (some pixels empty: the far plane) as an R32F image and as a 64-bit visibility buffer:
+// the pyramid built from either, level by level and fused, is the CPU reduction exactly. Sizes: odd ones,
+// one pixel wide or high, tiles of the fused build that end in a wider last one, 4K with the usual levels
+// and with all of them, and long strips whose fused build takes three dispatches (the second of several
+// tiles).
+TEST_F(CullTest, PyramidEqualsCpuReductionBothWays) {
+  struct Case {
+    VkExtent2D e;
+    const char* levels;  // RTR_PYRAMID_LEVELS, or the default cap
+  };
+  const Case cases[] = {{{203, 117}, nullptr}, {{1, 57}, nullptr},    {{57, 1}, nullptr},      {{1, 1}, nullptr},
+                        {{2, 3}, nullptr},     {{191, 129}, nullptr}, {{3840, 2160}, nullptr}, {{3840, 2160}, "20"},
+                        {{8250, 5}, "20"},     {{3, 8339}, "20"}};
+  const char* before = std::getenv("RTR_PYRAMID_LEVELS");
+  const std::string saved = before ? before : "";
+  std::mt19937 rng(30);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (const Case& c : cases) {
+    const VkExtent2D e = c.e;
+    const size_t n = size_t(e.width) * e.height;
+    std::vector<float> depth(n);
+    vk::Buffer vis(*ctx, n * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUse::Upload, "visibility");
+    vk::Buffer up(*ctx, n * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Upload, "depth up");
+    uint32_t* words = static_cast<uint32_t*>(vis.mapped());
+    for (size_t i = 0; i < n; ++i) {
+      const bool empty = u(rng) < 0.005f;
+      depth[i] = empty ? 1.0f : u(rng);
+      std::memcpy(&words[2 * i + 1], &depth[i], 4);
+      if (empty) words[2 * i + 1] = ~0u;
+      words[2 * i] = uint32_t(i);
+    }
+    std::memcpy(up.mapped(), depth.data(), n * 4);
+    vis.flush(), up.flush();
+    vk::Image image(*ctx,
+                    {e, VK_FORMAT_R32_SFLOAT, 1, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, 0, 0, "depth"});
+    vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
+      vk::barrier(cb, {{image.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE,
+                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+      VkBufferImageCopy r{};
+      r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      r.imageExtent = {e.width, e.height, 1};
+      vkCmdCopyBufferToImage(cb, up.handle(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &r);
+      vk::barrier(cb, {{image.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_ACCESS_2_SHADER_READ_BIT}});
+    });
+    if (c.levels) setenv("RTR_PYRAMID_LEVELS", c.levels, 1);
+    else unsetenv("RTR_PYRAMID_LEVELS");
+    HostPyramid want;
+    for (const render::PyramidPasses passes : {render::PyramidPasses::Levels, render::PyramidPasses::Fused}) {
+      DepthPyramid pyramid(*ctx, e, passes);
+      const bool fused = passes == render::PyramidPasses::Fused;
+      const uint32_t levels = pyramid.levels();
+      EXPECT_EQ(pyramid.dispatches(), fused ? (levels + HIZ_FUSED_LEVELS - 1) / HIZ_FUSED_LEVELS : levels);
+      if (fused && !c.levels) { EXPECT_LE(pyramid.dispatches(), 2u); }
+      vk::submitAndWait(*ctx,
+                        [&](VkCommandBuffer cb) { pyramid.build(cb, image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL); });
+      for (const bool fromBuffer : {false, true}) {
+        vk::submitAndWait(*ctx, [&](VkCommandBuffer cb) {
+          // Every texel -1 first: one the build leaves alone cannot keep a right value from before.
+          vk::barrier(cb, {{pyramid.image().handle(), VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
+                            VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                            VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT}});
+          const VkClearColorValue poison{{-1.0f, -1.0f, -1.0f, -1.0f}};
+          const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, VK_REMAINING_MIP_LEVELS, 0, 1};
+          vkCmdClearColorImage(cb, pyramid.image().handle(), VK_IMAGE_LAYOUT_GENERAL, &poison, 1, &all);
+          vk::barrier(cb, {{pyramid.image().handle(), VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
+                            VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT}});
+          if (fromBuffer) pyramid.buildFromBuffer(cb, vis.handle());
+          else pyramid.build(cb, image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        });
+        const HostPyramid got = readPyramid(pyramid);
+        if (want.levels.empty()) want = cpuPyramid(depth, e, got.sizes);
+        ASSERT_EQ(got.levels.size(), want.levels.size());
+        for (size_t l = 0; l < want.levels.size(); ++l)
+          ASSERT_EQ(got.levels[l], want.levels[l]) << e.width << "x" << e.height << (fused ? " fused" : " by levels")
+                                                   << (fromBuffer ? " from the buffer" : " from the image") << ", level " << l;
+      }
+    }
+  }
+  if (before) setenv("RTR_PYRAMID_LEVELS", saved.c_str(), 1);
+  else unsetenv("RTR_PYRAMID_LEVELS");
 }
 
 // Draws a scene's clusters with the hardware rasteriser (one vkCmdDrawIndexed per cluster, firstInstance
