@@ -96,7 +96,11 @@ ComputeRaster::Pipelines ComputeRaster::makePipelines(const vk::Context& ctx, co
 
 ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint32_t framesInFlight,
                              std::optional<Pipelines> made)
-    : ctx_(ctx), scene_(scene), culled_(framesInFlight, false), twoPhase_(framesInFlight, false) {
+    : ctx_(ctx),
+      scene_(scene),
+      culled_(framesInFlight, false),
+      twoPhase_(framesInFlight, false),
+      counted_(framesInFlight, false) {
   Pipelines p = made ? std::move(*made) : makePipelines(ctx, scene.kinds());
   clear_ = std::move(p.clear), raster_ = std::move(p.raster), clip_ = std::move(p.clip), large_ = std::move(p.large);
   hardware_ = std::move(p.hardware);
@@ -184,7 +188,7 @@ void ComputeRaster::resize(VkExtent2D extent) {
 }
 
 void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
-                           const CullCamera& camera, bool cull, bool clip) {
+                           const CullCamera& camera, bool cull, bool clip, bool counters) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
@@ -197,6 +201,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   if (twoPhase && !pyramid_) pyramid_.emplace(ctx_, extent_);
   culled_.at(frame) = culling;
   twoPhase_.at(frame) = twoPhase;
+  counted_.at(frame) = counters;
   const VkBuffer lods = lod ? scene_.clusterLods() : VK_NULL_HANDLE;
   auto bind = [&](const vk::Pipeline& p, bool fromList = false) {
     p.bind(cb);
@@ -267,14 +272,16 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   if (culling && !twoPhase) {  // the level-of-detail cut alone
     culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {false, false, false, true}, CullPhase::Single, lods,
                     scene_.cullInstances(), scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
-    vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
-    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+    if (counters) {
+      vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+    }
     timer.mark(cb, "cull");
   }
   if (twoPhase) {
     culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {}, CullPhase::Early, lods, scene_.cullInstances(),
                     scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
-    vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[0]);
+    if (counters) vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[0]);
     timer.mark(cb, "cull early");
     rasterise("raster early", "raster clip early", "raster large early");
     // The pyramid reads the depth drawn so far; the late phase's tile pass starts after the early tiles.
@@ -288,20 +295,24 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     // Its first barrier orders the copies above before its reset, its second makes them visible to compute.
     culler_->record(cb, scene_.clusters(), clusterCount, camera, &*pyramid_, {}, CullPhase::Late, lods, scene_.cullInstances(),
                     scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
-    vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
-    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+    if (counters) {
+      vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);
+      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+    }
     timer.mark(cb, "cull");
   }
   if (clusterCount > 0) rasterise("raster", "raster clip", "raster large");
   vk::bufferBarrier(cb, vk::kComputeWrite, kReaders | vk::kCopyRead);
-  const VkDeviceSize at = kReadbackSize * VkDeviceSize(frame);
-  const VkBufferCopy handOffCount{0, at, 4};  // VkDrawIndirectCommand::vertexCount
-  vkCmdCopyBuffer(cb, hwList_.handle(), handOffReadback_.handle(), 1, &handOffCount);
-  const VkBufferCopy clipCount{12, at + 4, 4};  // clipCount
-  vkCmdCopyBuffer(cb, clipList_.handle(), handOffReadback_.handle(), 1, &clipCount);
-  const VkBufferCopy medium[2] = {{16, at + 8, 8}, {32, at + 16, 8}};  // mediumFound, mediumStored
-  vkCmdCopyBuffer(cb, largeList_.handle(), handOffReadback_.handle(), 2, medium);
-  vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+  if (counters) {  // the counters of this frame (RenderSettings::counters)
+    const VkDeviceSize at = kReadbackSize * VkDeviceSize(frame);
+    const VkBufferCopy handOffCount{0, at, 4};  // VkDrawIndirectCommand::vertexCount
+    vkCmdCopyBuffer(cb, hwList_.handle(), handOffReadback_.handle(), 1, &handOffCount);
+    const VkBufferCopy clipCount{12, at + 4, 4};  // clipCount
+    vkCmdCopyBuffer(cb, clipList_.handle(), handOffReadback_.handle(), 1, &clipCount);
+    const VkBufferCopy medium[2] = {{16, at + 8, 8}, {32, at + 16, 8}};  // mediumFound, mediumStored
+    vkCmdCopyBuffer(cb, largeList_.handle(), handOffReadback_.handle(), 2, medium);
+    vk::bufferBarrier(cb, vk::kCopyWrite, vk::kHostRead);
+  }
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};  // no attachments: fragments only do the atomic
   ri.renderArea = {{0, 0}, extent_};
   ri.layerCount = 1;

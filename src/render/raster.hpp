@@ -43,7 +43,9 @@ class ComputeRaster {
   // `clip`: the triangles crossing w = 0 or the guard band are clipped in compute ("raster clip", once per
   // raster pass); otherwise the hardware draws them ("raster hw", the reference).
   void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
-              const CullCamera& camera, bool cull, bool clip);
+              const CullCamera& camera, bool cull, bool clip, bool counters = true);
+  // Whether the last use of `frame` read its counters back (record's `counters`).
+  bool counted(uint32_t frame) const { return counted_.at(frame); }
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
   // The passes' texture arrays (set 1 of the layouts that have one), for the one writer of every texture set.
   std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> textureSets() const;
@@ -90,6 +92,7 @@ class ComputeRaster {
   vk::Buffer handOffReadback_;  // per frame in flight: kReadbackSize bytes
   std::vector<bool> culled_;    // per frame in flight: whether its last use culled
   std::vector<bool> twoPhase_;  // per frame in flight: whether that was in two phases
+  std::vector<bool> counted_;   // per frame in flight: whether its counters were read back
 };
 
 }  // namespace rtr::render

@@ -540,7 +540,7 @@ void Renderer::frame(FrameContext& fc) {
   if (compute) {
     const float pixelsPerUnit = float(target.extent.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
     const CullCamera cam{u.viewProj, pose.position, lens.orthographic, s.lodError, pixelsPerUnit, lens.zNear};
-    raster_->record(cb, uniforms_, timer, frame, cam, s.cull, s.clip);
+    raster_->record(cb, uniforms_, timer, frame, cam, s.cull, s.clip, s.counters);
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kComputeRead);
   } else {
     rasterPass(cb, frame, set, pose.position, s.background, backdrop);

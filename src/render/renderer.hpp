@@ -55,6 +55,10 @@ struct RenderSettings {
   // Compute raster, scenes with a cluster hierarchy: the level-of-detail cut's projected error in pixels
   // (docs/virtual-geometry.md); 0: full detail, exactly the image without a hierarchy.
   float lodError = 0.0f;  // rtr-view: --lod-error, default 1
+  // Compute raster: the frame's counters (hand-off, clipped and medium triangles, culling) read back for
+  // cullStats() and the like: small copies between the passes (9 µs a frame on the H200). rtr-view --bench
+  // times its frames without them and reads them in one frame after.
+  bool counters = true;
   float lodBias = 0.0f;
   SamplerSettings sampler;  // how scene textures are filtered (mip experiments)
   MosaicMode mosaic = MosaicMode::Compute;
@@ -149,24 +153,26 @@ class Renderer {
   // Why the scene cannot take the visibility path on this device (frames are forward); empty if it can.
   const std::string& visibilityRefusal() const { return choice_.visibilityRefusal; }
   // The culling counts of the last completed use of `frame`; none where it did not cull.
+  // (None either, here and below, where that frame's counters were not read: RenderSettings::counters.)
   std::optional<ComputeRaster::CullStats> cullStats(uint32_t frame) const {
-    return raster_ ? raster_->cullStats(frame) : std::nullopt;
+    return counted(frame) ? raster_->cullStats(frame) : std::nullopt;
   }
   // Triangles the compute rasteriser handed to the hardware in the last completed use of `frame`.
   std::optional<uint32_t> handOffTriangles(uint32_t frame) const {
-    return raster_ ? std::optional(raster_->handOffTriangles(frame)) : std::nullopt;
+    return counted(frame) ? std::optional(raster_->handOffTriangles(frame)) : std::nullopt;
   }
   uint32_t handOffCapacity() const { return raster_ ? raster_->handOffCapacity() : 0; }
   // Triangles the compute rasteriser clipped itself in the last completed use of `frame`.
   std::optional<uint32_t> clippedTriangles(uint32_t frame) const {
-    return raster_ ? std::optional(raster_->clippedTriangles(frame)) : std::nullopt;
+    return counted(frame) ? std::optional(raster_->clippedTriangles(frame)) : std::nullopt;
   }
   // Medium triangles the compute rasteriser found in the last completed use of `frame` (ComputeRaster).
   std::optional<ComputeRaster::MediumCounts> mediumTriangles(uint32_t frame) const {
-    return raster_ ? std::optional(raster_->mediumTriangles(frame)) : std::nullopt;
+    return counted(frame) ? std::optional(raster_->mediumTriangles(frame)) : std::nullopt;
   }
 
  private:
+  bool counted(uint32_t frame) const { return raster_ && raster_->counted(frame); }
   struct ScenePipelines {
     std::optional<vk::Pipeline> pipeline;
     vk::DescriptorSets sets;

@@ -242,6 +242,36 @@ TEST_F(RasterTest, RebuiltPipelinesGiveTheSameIds) {
   EXPECT_GT(std::count_if(after.begin(), after.end(), [](uint32_t id) { return id != VIS_EMPTY; }), 160 * 90 / 4);
 }
 
+// RenderSettings::counters off (rtr-view --bench's timed frames): the frame reads no counter back, so none
+// is reported for it, and its ids are those of a counted frame, with and without two-phase culling.
+TEST_F(RasterTest, FramesWithoutCountersDrawTheSameIdsAndReportNone) {
+  const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
+  render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
+  render::HeadlessRenderer r(*ctx, gpu, {160, 90});
+  const CameraPose pose = scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 160.0f / 90.0f));
+  const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
+  for (bool cull : {false, true}) {
+    SCOPED_TRACE(cull ? "two-phase culling" : "no culling");
+    render::RenderSettings s;
+    s.raster = RasterPath::Compute;
+    s.clip = true;
+    s.cull = cull;
+    s.mosaic = render::MosaicMode::Off;
+    const std::vector<uint32_t> counted = r.ids(pose, lens, s);
+    ASSERT_TRUE(r.renderer().handOffTriangles(0) && r.renderer().mediumTriangles(0));
+    EXPECT_EQ(r.renderer().cullStats(0).has_value(), cull);
+    const uint32_t medium = r.renderer().mediumTriangles(0)->total();
+    s.counters = false;
+    EXPECT_EQ(r.ids(pose, lens, s), counted);
+    EXPECT_FALSE(r.renderer().handOffTriangles(0) || r.renderer().clippedTriangles(0) || r.renderer().mediumTriangles(0) ||
+                 r.renderer().cullStats(0));
+    s.counters = true;
+    EXPECT_EQ(r.ids(pose, lens, s), counted);
+    ASSERT_TRUE(r.renderer().mediumTriangles(0));
+    EXPECT_EQ(r.renderer().mediumTriangles(0)->total(), medium) << "the counters after an uncounted frame";
+  }
+}
+
 // The medium list's settings (render/raster.cpp; nullptr: unset), read when the renderer makes its pipelines.
 struct MediumSetting {
   const char* from;      // RTR_RASTER_MEDIUM: boxes over this many pixels are medium ("0": no list)

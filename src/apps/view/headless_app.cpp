@@ -230,8 +230,12 @@ int renderHeadless(const ViewOptions& o, std::future<void>& writing) {
                  "ms (worker threads), upload and mips %.0f ms (mips %.3f ms GPU); texture cache: %u hits, %u misses\n",
                  allInAt, firstTexturedAt, st.decodeMs, st.textureUploadMs, st.mipGpuMs, st.cacheHits, st.cacheMisses);
   if (o.bench > 0) {
-    renderer.bench(pose, lens, settings, 10);  // warm-up
-    printBench(renderer.bench(pose, lens, settings, o.bench), ctx.deviceName());
+    // The timed frames read no counters back (RenderSettings::counters); one frame after them does, for the lines below.
+    render::RenderSettings timed = settings;
+    timed.counters = false;
+    renderer.bench(pose, lens, timed, 10);  // warm-up
+    printBench(renderer.bench(pose, lens, timed, o.bench), ctx.deviceName());
+    renderer.bench(pose, lens, settings, 1);
     if (const auto c = renderer.renderer().cullStats(0)) {
       const double n = std::max(1u, c->clusters);
       std::printf(
