@@ -491,31 +491,34 @@ WeldCounts weldMesh(std::span<Corner> corners, std::span<const glm::vec3> positi
   for (const Bounds& b : bounds) out.bounds.extend(b);
   freeOnAllCores(verts, uniqCount, threads);
   freeOnAllCores(vcolor, colors.empty() ? 0 : uniqCount, threads);
-  // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too.
-  auto corner = [&](size_t c) { return keptId[target[vertexOf[c] & ~kDone]]; };
-  auto sliver = [&](size_t t, uint32_t& x, uint32_t& y, uint32_t& z) {
-    x = corner(t * 3), y = corner(t * 3 + 1), z = corner(t * 3 + 2);
-    return x == y || y == z || x == z;
-  };
+  // Welding can collapse a sliver triangle onto an edge; such triangles are dropped too. The count turns
+  // each kept corner's vertex id into its kept vertex's (in place: no corner reads another's by now), so
+  // that the write reads them in order.
+  auto sliver = [](uint32_t x, uint32_t y, uint32_t z) { return x == y || y == z || x == z; };
   const size_t idxBound = counts.triangles * 3;
   reserveOnAllCores(idx, idxBound, threads);
   std::vector<size_t> written(pieces.size(), 0);
   forPiecesBeside({[&] { idx.resize(idxBound); }}, triCount, threads, [&](size_t p, size_t b, size_t e) {
-    uint32_t x, y, z;
-    for (size_t t = b; t < e; ++t) written[p] += keep[t] && !sliver(t, x, y, z);
+    for (size_t t = b; t < e; ++t) {
+      if (!keep[t]) continue;
+      uint32_t* v = &vertexOf[t * 3];
+      for (int k = 0; k < 3; ++k) v[k] = keptId[target[v[k] & ~kDone]];
+      written[p] += !sliver(v[0], v[1], v[2]);
+    }
   });
+  freeOnAllCores(target, uniqCount, threads);
+  freeOnAllCores(keptId, uniqCount, threads);
   const size_t triangles = prefix(written);
   counts.degenerate += counts.triangles - triangles;
   counts.triangles = triangles;
   forPieces(triCount, threads, [&](size_t p, size_t b, size_t e) {
-    uint32_t x, y, z;
-    for (size_t t = b, at = written[p] * 3; t < e; ++t)
-      if (keep[t] && !sliver(t, x, y, z)) idx[at] = x, idx[at + 1] = y, idx[at + 2] = z, at += 3;
+    for (size_t t = b, at = written[p] * 3; t < e; ++t) {
+      const uint32_t* v = &vertexOf[t * 3];
+      if (keep[t] && !sliver(v[0], v[1], v[2])) idx[at] = v[0], idx[at + 1] = v[1], idx[at + 2] = v[2], at += 3;
+    }
   });
   idx.resize(triangles * 3);  // a shrink: nothing written
   freeOnAllCores(vertexOf, cornerCount, threads);
-  freeOnAllCores(target, uniqCount, threads);
-  freeOnAllCores(keptId, uniqCount, threads);
   return counts;
 }
 
