@@ -43,14 +43,21 @@ inline void drop(void* p, size_t bytes) {
 }
 }  // namespace pages
 
-// v.resize(n) (value-initialised, as ever) with its new pages first touched on all cores.
+// Room for n elements in v, its new pages first touched on all cores (what v held is lost if it grows).
+// A resize to n after it is then one thread's memset over pages already there.
 template <class T>
-void resizeOnAllCores(std::vector<T>& v, size_t n, unsigned threads) {
+void reserveOnAllCores(std::vector<T>& v, size_t n, unsigned threads) {
   if (n * sizeof(T) >= pages::kWorth && threads != 1 && n > v.capacity()) {
     std::vector<T>().swap(v);
     v.reserve(n);
     pages::advise(v.data(), n * sizeof(T), MADV_POPULATE_WRITE, threads);
   }
+}
+
+// v.resize(n) (value-initialised, as ever) with its new pages first touched on all cores.
+template <class T>
+void resizeOnAllCores(std::vector<T>& v, size_t n, unsigned threads) {
+  reserveOnAllCores(v, n, threads);
   v.resize(n);
 }
 

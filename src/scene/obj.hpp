@@ -25,7 +25,7 @@ struct ObjOptions : LoadOptions {
   // --profile counts the cores each keeps busy).
   std::function<void(const char*)> step;
   unsigned threads = 0;   // parse and weld workers; 0 = all cores
-  size_t pieceBytes = 0;  // text parsed as one piece (0: 1 MiB); tests force tiny pieces to put boundaries everywhere
+  size_t pieceBytes = 0;  // text parsed as one piece (0: 256 KiB); tests force tiny pieces to put boundaries everywhere
 };
 
 struct ObjStats {

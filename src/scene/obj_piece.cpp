@@ -264,6 +264,12 @@ void resolvePiece(Piece& p, const Counts& before, std::span<const glm::vec3> pos
   std::vector<Corner> poly;
   std::vector<glm::vec3> polyPos;
   std::vector<std::array<uint32_t, 3>> tris;
+  // Room for every corner at once (a bound: a polygon of n corners gives n - 2 triangles at most): grown
+  // by doubling, the corners were copied and their pages made again about twice over, while 15 other
+  // threads did the same.
+  size_t bound = 0;
+  for (const RawFace& f : p.faces) bound += f.corners >= 3 ? (size_t(f.corners) - 2) * 3 : 0;
+  p.corners.reserve(bound);
   bool warnedDangling = false;
   size_t warnings = 0;
   for (Event& e : p.events) {
