@@ -1,6 +1,9 @@
 #include "scene/triangulate.hpp"
 
+#include <array>
 #include <cmath>
+#include <span>
+#include <vector>
 
 namespace rtr {
 namespace {
@@ -24,9 +27,7 @@ bool triangulatePolygon(std::span<const glm::vec3> poly, std::vector<std::array<
   auto fan = [&](const std::vector<uint32_t>& v) {
     for (size_t k = 1; k + 1 < v.size(); ++k) out.push_back({v[0], v[k], v[k + 1]});
   };
-  std::vector<uint32_t> v(n);
-  for (uint32_t i = 0; i < n; ++i) v[i] = i;
-  if (n == 3) return fan(v), true;
+  if (n == 3) return out.push_back({0, 1, 2}), true;
 
   // Newell normal; project onto the plane of its largest axis, oriented so the polygon turns left.
   glm::dvec3 nn(0.0);
@@ -38,13 +39,21 @@ bool triangulatePolygon(std::span<const glm::vec3> poly, std::vector<std::array<
   const int axis = an.x > an.y && an.x > an.z ? 0 : an.y > an.z ? 1 : 2;
   const int u = (axis + 1) % 3, w = (axis + 2) % 3;
   const double flip = nn[axis] < 0 ? -1.0 : 1.0;
-  std::vector<P2> p(n);
+  // Polygons of up to 8 corners (nearly every face) project on the stack: no allocation for the common case.
+  std::array<P2, 8> small;
+  std::vector<P2> large(n > small.size() ? n : 0);
+  const std::span<P2> p = n <= small.size() ? std::span<P2>(small.data(), n) : std::span<P2>(large);
   for (uint32_t i = 0; i < n; ++i) p[i] = {double(poly[i][u]), flip * double(poly[i][w])};
 
   // Convex (no right turn): the fan, exactly as before ear clipping existed.
   bool convex = true;
   for (uint32_t i = 0; i < n && convex; ++i) convex = cross(p[(i + n - 1) % n], p[i], p[(i + 1) % n]) >= 0;
-  if (convex || nn == glm::dvec3(0.0)) return fan(v), true;
+  if (convex || nn == glm::dvec3(0.0)) {
+    for (uint32_t k = 1; k + 1 < n; ++k) out.push_back({0, k, k + 1});
+    return true;
+  }
+  std::vector<uint32_t> v(n);
+  for (uint32_t i = 0; i < n; ++i) v[i] = i;
 
   // Ear clipping: a corner is an ear when it turns left and no other remaining corner lies in or on its
   // triangle (corners at the same place as the triangle's, as in polygons with bridged holes, don't count).
