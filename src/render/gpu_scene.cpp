@@ -609,7 +609,9 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
             places[pieces[q]].at[k] = ring->data(slot) + (at - ring->offset(slot)), places[pieces[q]].from[k] = b;
             c.back().size += e - b, at += e - b;
           });
+      const auto writing = Clock::now();
       parallelFor(*pool, j - i, [&](size_t q) { write(tasks[pieces[i + q]], places[pieces[i + q]]); });
+      stats_.geometryWriteMs += msSince(writing);
       ring->submit(slot, [&](VkCommandBuffer cb) {
         for (uint32_t k = 0; k < kTargets; ++k)
           if (!copies[k].empty())
@@ -620,7 +622,9 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
       });
       ++stats_.geometryCopies;
     }
+    const auto built = Clock::now();
     building.get();
+    stats_.geometryBuildWaitMs += msSince(built);
   };
   run(tasks);
 
@@ -660,7 +664,13 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
   run(tasks);
   for (const Target& tg : targets)
     if (tg.size && tg.dst) tg.buffer->flush();
-  ring.reset();                                                                     // waits for the last copies
+  if (ring) {
+    stats_.geometryRingMs = ring->allocationMs(), stats_.geometrySubmitMs = ring->submitMs();
+    stats_.geometryWaitMs = ring->waitMs();
+    const auto last = Clock::now();
+    ring.reset();  // waits for the last copies
+    stats_.geometryWaitMs += msSince(last);
+  }
   stats_.geometryUpload = stats_.geometryCopies ? GeometryUpload::Staged : upload;  // direct: unless a buffer was not mappable
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;
