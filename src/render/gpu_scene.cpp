@@ -5,7 +5,9 @@
 #include <bit>
 #include <chrono>
 #include <cstdlib>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <functional>
 #include <future>
 #include <optional>
@@ -566,65 +568,108 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     writePiece(task, place);
   };
 
+  // Runs the tasks on all cores, the records' builds first (as direct's). Where a buffer is not mapped,
+  // its bytes go through the ring: the pieces, in order, in batches whose staged bytes fit a slot (at
+  // least one piece), batch k (counted over both runs) in slot k % slots, placed before any is written.
+  // No thread waits for a batch: a thread takes the next task, waits only where its piece's slot is still
+  // read by the copies of the batch before it there, writes, and the thread that writes a batch's last
+  // piece submits its copies, which run while the next batches are written.
   std::optional<StagingRing> ring;
-  std::unique_ptr<ThreadPool> pool;
-  // Runs the pieces on all cores. Where a buffer is not mapped, its bytes go through the ring: the pieces
-  // in batches whose staged bytes fit a slot (at least one piece), each batch written into its slot and
-  // copied by a submission of its own, which runs while the next batches are written; a slot is written
-  // again once its copies have completed. The records are made beside the batches, on threads of their own.
+  std::deque<std::optional<vk::Submission>> copied;  // per batch through the ring: its copies (guarded by copiedMutex)
+  std::mutex copiedMutex;
+  std::condition_variable copiedChanged;
+  std::atomic<int64_t> waitUs{0}, submitUs{0};
   auto run = [&](const std::vector<WriteTask>& tasks) {
     Place direct;
     for (uint32_t k = 0; k < kTargets; ++k) direct.at[k] = targets[k].dst;
     std::vector<Place> places(tasks.size(), direct);
-    std::vector<size_t> staged(tasks.size(), 0), builds, pieces;  // staged: bytes of a piece in the ring
-    for (size_t i = 0; i < tasks.size(); ++i) {
+    std::vector<size_t> staged(tasks.size(), 0);  // bytes of a piece in the ring
+    for (size_t i = 0; i < tasks.size(); ++i)
       ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) { staged[i] += targets[k].dst ? 0 : e - b + 32; });
-      (tasks[i].what == Write::Build ? builds : pieces).push_back(i);
+    const size_t largest = *std::max_element(staged.begin(), staged.end());
+    if (largest == 0) return parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i], places[i]); });
+    if (ring && largest > ring->slotBytes()) copied.clear(), ring.reset();  // waits for the copies, then larger slots
+    if (!ring) {
+      ring.emplace(ctx_, std::max(slotBytes, largest), kGeometrySlots, vk::MemoryUse::Upload, "geometry staging ring");
+      ring->allocate();
     }
-    if (std::all_of(staged.begin(), staged.end(), [](size_t b) { return b == 0; }))
-      return parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i], places[i]); });
-    auto building = std::async(std::launch::async, [&] {
-      parallelFor(builds.size(), 0, [&](size_t i) { write(tasks[builds[i]], places[builds[i]]); });
-    });
-    if (!ring) ring.emplace(ctx_, slotBytes, kGeometrySlots, vk::MemoryUse::Upload, "geometry staging ring");
-    if (!pool) pool = std::make_unique<ThreadPool>(threadCount() - 1);
-    for (size_t i = 0, j; i < pieces.size(); i = j) {
-      size_t batch = 0;
-      for (j = i; j < pieces.size() && (j == i || batch + staged[pieces[j]] <= ring->slotBytes()); ++j)
-        batch += staged[pieces[j]];
-      const uint32_t slot = ring->acquire(batch);
+    const size_t first = copied.size(), slots = ring->slots();
+    std::vector<size_t> batchOf(tasks.size(), SIZE_MAX);
+    std::vector<std::vector<size_t>> batches;  // the staged pieces of each batch, in order
+    for (size_t i = 0, used = ring->slotBytes(); i < tasks.size(); ++i) {
+      if (!staged[i]) continue;
+      if (used + staged[i] > ring->slotBytes()) batches.emplace_back(), used = 0;
+      used += staged[i];
+      batchOf[i] = batches.size() - 1;
+      batches.back().push_back(i);
+    }
+    std::vector<std::array<std::vector<VkBufferCopy>, kTargets>> copies(batches.size());
+    for (size_t batch = 0; batch < batches.size(); ++batch) {
+      const uint32_t slot = uint32_t((first + batch) % slots);
       // Target by target, each range placed at its byte's alignment (mod 16), right after the one before
       // where it continues it: one copy region a run (lavapipe maps its memory once per region).
-      std::array<std::vector<VkBufferCopy>, kTargets> copies;
       size_t at = ring->offset(slot);
       for (uint32_t target = 0; target < kTargets; ++target)
-        for (size_t q = i; q < j && !targets[target].dst; ++q)
-          ranges(tasks[pieces[q]], [&](uint32_t k, size_t b, size_t e) {
-            if (k != target) return;
-            std::vector<VkBufferCopy>& c = copies[k];
+        for (size_t i : batches[batch])
+          ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) {
+            if (k != target || targets[k].dst) return;
+            std::vector<VkBufferCopy>& c = copies[batch][k];
             if (c.empty() || c.back().dstOffset + c.back().size != b) {
               at = ((at + 15) & ~size_t(15)) + b % 16;
               c.push_back({at, b, 0});
             }
-            places[pieces[q]].at[k] = ring->data(slot) + (at - ring->offset(slot)), places[pieces[q]].from[k] = b;
+            places[i].at[k] = ring->data(slot) + (at - ring->offset(slot)), places[i].from[k] = b;
             c.back().size += e - b, at += e - b;
           });
-      const auto writing = Clock::now();
-      parallelFor(*pool, j - i, [&](size_t q) { write(tasks[pieces[i + q]], places[pieces[i + q]]); });
-      stats_.geometryWriteMs += msSince(writing);
-      ring->submit(slot, [&](VkCommandBuffer cb) {
-        for (uint32_t k = 0; k < kTargets; ++k)
-          if (!copies[k].empty())
-            vkCmdCopyBuffer(cb, ring->buffer(), targets[k].buffer->handle(), uint32_t(copies[k].size()), copies[k].data());
-        // Orders the copies before the later ones and the frames' reads, which come in later submissions.
-        vk::bufferBarrier(cb, vk::kCopyWrite,
-                          vk::kCopyWrite | vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
-      });
-      ++stats_.geometryCopies;
     }
-    const auto built = Clock::now();
-    building.get();
-    stats_.geometryBuildWaitMs += msSince(built);
+    std::vector<std::atomic<size_t>> left(batches.size());  // pieces not yet written
+    for (size_t batch = 0; batch < batches.size(); ++batch) left[batch] = batches[batch].size();
+    {
+      std::lock_guard lock(copiedMutex);
+      copied.resize(first + copies.size());
+    }
+    bool failed = false;  // a piece failed: nobody waits for its batch (guarded by copiedMutex)
+    auto waitFor = [&](size_t k) {
+      const auto t = Clock::now();
+      const vk::Submission* s;
+      {
+        std::unique_lock lock(copiedMutex);
+        copiedChanged.wait(lock, [&] { return copied[k].has_value() || failed; });
+        if (!copied[k]) throw Error("geometry upload: an earlier piece failed");
+        s = &*copied[k];
+      }
+      s->wait();
+      waitUs += int64_t(msSince(t) * 1e3);
+    };
+    parallelFor(tasks.size(), 0, [&](size_t i) {
+      if (!staged[i]) return write(tasks[i], places[i]);
+      const size_t batch = batchOf[i], k = first + batch;
+      try {
+        if (k >= slots) waitFor(k - slots);
+        write(tasks[i], places[i]);
+        if (left[batch].fetch_sub(1) != 1) return;
+        const auto t = Clock::now();
+        std::lock_guard lock(copiedMutex);  // also keeps the queue to one thread
+        ring->flush();
+        copied[k].emplace(ctx_, [&](VkCommandBuffer cb) {
+          for (uint32_t target = 0; target < kTargets; ++target)
+            if (!copies[batch][target].empty())
+              vkCmdCopyBuffer(cb, ring->buffer(), targets[target].buffer->handle(), uint32_t(copies[batch][target].size()),
+                              copies[batch][target].data());
+          // Orders the copies before the later ones and the frames' reads, which come in later submissions.
+          vk::bufferBarrier(cb, vk::kCopyWrite,
+                            vk::kCopyWrite | vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
+        });
+        copiedChanged.notify_all();
+        submitUs += int64_t(msSince(t) * 1e3);
+      } catch (...) {
+        std::lock_guard lock(copiedMutex);
+        failed = true;
+        copiedChanged.notify_all();
+        throw;
+      }
+    });
+    stats_.geometryCopies += uint32_t(batches.size());
   };
   run(tasks);
 
@@ -665,11 +710,11 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
   for (const Target& tg : targets)
     if (tg.size && tg.dst) tg.buffer->flush();
   if (ring) {
-    stats_.geometryRingMs = ring->allocationMs(), stats_.geometrySubmitMs = ring->submitMs();
-    stats_.geometryWaitMs = ring->waitMs();
     const auto last = Clock::now();
-    ring.reset();  // waits for the last copies
-    stats_.geometryWaitMs += msSince(last);
+    copied.clear();  // waits for the last copies
+    stats_.geometryRingMs = ring->allocationMs(), stats_.geometrySubmitMs = double(submitUs) * 1e-3;
+    stats_.geometryWaitMs = double(waitUs) * 1e-3 + msSince(last);
+    ring.reset();
   }
   stats_.geometryUpload = stats_.geometryCopies ? GeometryUpload::Staged : upload;  // direct: unless a buffer was not mappable
   stats_.geometryBytes = 0;

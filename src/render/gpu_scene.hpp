@@ -110,10 +110,9 @@ struct GpuSceneStats {
   size_t geometryBytes = 0;
   GeometryUpload geometryUpload = GeometryUpload::Direct;  // the path taken (Direct or Staged)
   uint32_t geometryCopies = 0;                             // copy submissions from the geometry's staging ring
-  // A Staged upload's time on the calling thread (ms): the ring made, waits for a slot (and, at the end,
-  // for the last copies), the batches written on all cores, their submissions, and the wait for the
-  // records made beside the first pass's batches.
-  double geometryRingMs = 0, geometryWaitMs = 0, geometryWriteMs = 0, geometrySubmitMs = 0, geometryBuildWaitMs = 0;
+  // Where a Staged upload's time went (ms): the ring made; the writing threads' waits for a slot still
+  // read by earlier copies, summed over threads, and the wait for the last copies; the submissions.
+  double geometryRingMs = 0, geometryWaitMs = 0, geometrySubmitMs = 0;
 };
 
 // Told how far a long load is: what it does, how many of how many are done (serialised calls).

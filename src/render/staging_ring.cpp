@@ -33,17 +33,20 @@ uint32_t StagingRing::acquire(size_t bytes) {
     slotBytes_ = (bytes + 255) & ~size_t(255);
   }
   waitMs_ += msSince(t);
-  if (!buffer_.handle()) {
-    t = Clock::now();
-    buffer_ = vk::Buffer(ctx_, slotBytes_ * reading_.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, use_, name_), ++allocations_;
-    allocMs_ += msSince(t);
-  }
+  allocate();
   const uint32_t slot = next_;
   next_ = (next_ + 1) % uint32_t(reading_.size());
   t = Clock::now();
   reading_[slot].reset();
   waitMs_ += msSince(t);
   return slot;
+}
+
+void StagingRing::allocate() {
+  if (buffer_.handle()) return;
+  const auto t = Clock::now();
+  buffer_ = vk::Buffer(ctx_, slotBytes_ * reading_.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, use_, name_), ++allocations_;
+  allocMs_ += msSince(t);
 }
 
 const vk::Submission& StagingRing::submit(uint32_t slot, const std::function<void(VkCommandBuffer)>& record) {

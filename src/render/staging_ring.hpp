@@ -37,6 +37,12 @@ class StagingRing {
   // submission completed.
   const vk::Submission& submit(uint32_t slot, const std::function<void(VkCommandBuffer)>& record);
   void waitAll();
+  // For a caller that fills every slot from several threads and tracks the submissions reading them
+  // itself (GpuScene's geometry; acquire() and submit() are then not used): the buffer made now, and the
+  // host's writes made visible before such a submission.
+  void allocate();
+  void flush() const { buffer_.flush(); }
+  uint32_t slots() const { return uint32_t(reading_.size()); }
 
   size_t slotBytes() const { return slotBytes_; }
   uint32_t allocations() const { return allocations_; }  // buffers made (1 unless a batch outgrew a slot)

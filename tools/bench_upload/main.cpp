@@ -14,7 +14,7 @@
 //      the waits for a slot, the writes and the submissions.
 //  (e) with --scene FILE: the scene's real upload (render::GpuScene, Direct and Staged, alternating; the
 //      other phases of its construction aside): the geometry's bytes, time and GB/s, and for Staged where
-//      the calling thread's time went (GpuSceneStats: ring made, slot waits, writes, submits, records).
+//      its time went (GpuSceneStats: ring made, slot waits, submits).
 // Each case runs --reps times: first (cold), best and median; GB/s from the best (10^9 bytes). The copies'
 // bytes are read back and compared (exit 1 on a difference), and any validation message fails the run.
 #include <algorithm>
@@ -408,11 +408,8 @@ void sceneUpload(const vk::Context& ctx, const Scene& scene, const std::string& 
     const render::GpuSceneStats& st = best[p];
     char extra[200] = "";
     if (st.geometryCopies)
-      std::snprintf(
-          extra, sizeof extra,
-          "  (best: ring made %.1f, slot waits %.1f, writes %.1f, submits %.1f, records waited for %.1f ms; %u submits)",
-          st.geometryRingMs, st.geometryWaitMs, st.geometryWriteMs, st.geometrySubmitMs, st.geometryBuildWaitMs,
-          st.geometryCopies);
+      std::snprintf(extra, sizeof extra, "  (best: ring made %.1f, slot waits %.1f (threads' sum), submits %.1f ms; %u submits)",
+                    st.geometryRingMs, st.geometryWaitMs, st.geometrySubmitMs, st.geometryCopies);
     // MiB in the line's column; the exact bytes in the name.
     runs[p].print("(e) " + name + " " + std::to_string(bytes) + " B, GpuScene " + (st.geometryCopies ? "staged" : "direct"),
                   bytes, extra);
