@@ -182,6 +182,16 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
   const auto t = Clock::now();
+  const GeometryUpload path = upload == GeometryUpload::Auto ? geometryUpload(ctx) : upload;
+  // A staged upload's ring (host memory the driver allocates and pins) is made while the geometry is planned.
+  std::future<std::unique_ptr<StagingRing>> ring;
+  if (path == GeometryUpload::Staged)
+    ring = std::async(std::launch::async, [&ctx, geometrySlotBytes] {
+      auto made =
+          std::make_unique<StagingRing>(ctx, geometrySlotBytes, kGeometrySlots, kGeometryRingMemory, "geometry staging ring");
+      made->allocate();
+      return made;
+    });
   GeometryPlan plan = planGeometry(scene);
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   const SceneKinds kinds = sceneKinds(scene);
@@ -193,7 +203,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
     shownMaterials_ = materials;
   }
-  uploadGeometry(scene, plan, materials, upload == GeometryUpload::Auto ? geometryUpload(ctx) : upload, geometrySlotBytes);
+  uploadGeometry(scene, plan, materials, path, geometrySlotBytes, std::move(ring));
   stats_.geometryMs = msSince(t);
   if (!decoding_.valid()) {
     finishTextures();
@@ -379,7 +389,7 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
 // ring of host staging slots, a batch of pieces a slot, and the GPU copies each slot into place (DMA)
 // while the next ones are written (docs/startup.md, "Geometry upload").
 void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
-                              GeometryUpload upload, size_t slotBytes) {
+                              GeometryUpload upload, size_t slotBytes, std::future<std::unique_ptr<StagingRing>> ringMade) {
   struct Target {
     vk::Buffer* buffer;
     size_t size;
@@ -574,7 +584,7 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
   // No thread waits for a batch: a thread takes the next task, waits only where its piece's slot is still
   // read by the copies of the batch before it there, writes, and the thread that writes a batch's last
   // piece submits its copies, which run while the next batches are written.
-  std::optional<StagingRing> ring;
+  std::unique_ptr<StagingRing> ring;                 // made beside the plan (Staged), else where a buffer is not mapped
   std::deque<std::optional<vk::Submission>> copied;  // per batch through the ring: its copies (guarded by copiedMutex)
   std::mutex copiedMutex;
   std::condition_variable copiedChanged;
@@ -588,9 +598,11 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
       ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) { staged[i] += targets[k].dst ? 0 : e - b + 32; });
     const size_t largest = *std::max_element(staged.begin(), staged.end());
     if (largest == 0) return parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i], places[i]); });
+    if (!ring && ringMade.valid()) ring = ringMade.get();
     if (ring && largest > ring->slotBytes()) copied.clear(), ring.reset();  // waits for the copies, then larger slots
     if (!ring) {
-      ring.emplace(ctx_, std::max(slotBytes, largest), kGeometrySlots, vk::MemoryUse::Upload, "geometry staging ring");
+      ring = std::make_unique<StagingRing>(ctx_, std::max(slotBytes, largest), kGeometrySlots, kGeometryRingMemory,
+                                           "geometry staging ring");
       ring->allocate();
     }
     const size_t first = copied.size(), slots = ring->slots();

@@ -180,6 +180,7 @@ class GpuScene {
   // than a slot makes them that large), freed once the upload is done.
   static constexpr size_t kGeometrySlotBytes = size_t(32) << 20;
   static constexpr uint32_t kGeometrySlots = 4;
+  static constexpr vk::MemoryUse kGeometryRingMemory = vk::MemoryUse::Upload;  // written once, in order
   void setUploadBudget(size_t bytes) { uploadBudget_ = bytes; }
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
@@ -249,7 +250,7 @@ class GpuScene {
   std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
   // Streams written and records made on all cores, then placed and written.
   void uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
-                      GeometryUpload upload, size_t slotBytes);
+                      GeometryUpload upload, size_t slotBytes, std::future<std::unique_ptr<StagingRing>> ringMade);
   void finishTextures();                                 // staging buffers to images, mips (a waited load)
   std::vector<uint32_t> nextBatch(bool wait);            // a deferred load's next textures, by the budget
   void startUpload(const std::vector<uint32_t>& batch);  // the same in one submission, not waited for
