@@ -193,6 +193,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       return made;
     });
   GeometryPlan plan = planGeometry(scene);
+  stats_.geometryPlanMs = msSince(t);
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   const SceneKinds kinds = sceneKinds(scene);
   materialExtras_ = kinds.materialExtras;
@@ -456,7 +457,9 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
       tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
     }
   };
+  auto phase = Clock::now();
   make();
+  stats_.geometryBuffersMs = msSince(phase);
 
   // The bytes of the buffers a piece writes, one range per buffer at most: fn(target, begin, end).
   auto ranges = [&](const WriteTask& t, auto&& fn) {
@@ -573,8 +576,15 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     if (plan.anyTangents) stream(kTan, m.tangents, 16);
     if (plan.anyColors) stream(kCol, m.colors, 16);
   };
+  std::atomic<int64_t> longestBuildUs{0};
   auto write = [&](const WriteTask& task, const Place& place) {
-    if (task.what == Write::Build) return buildRecords(scene, plan, task.slot, plan.records[task.slot]);
+    if (task.what == Write::Build) {
+      const auto t = Clock::now();
+      buildRecords(scene, plan, task.slot, plan.records[task.slot]);
+      const int64_t us = int64_t(msSince(t) * 1e3);
+      for (int64_t was = longestBuildUs; us > was && !longestBuildUs.compare_exchange_weak(was, us);) {}
+      return;
+    }
     writePiece(task, place);
   };
 
@@ -683,8 +693,11 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     });
     stats_.geometryCopies += uint32_t(batches.size());
   };
+  phase = Clock::now();
   run(tasks);
+  stats_.geometryStreamsMs = msSince(phase);
 
+  phase = Clock::now();
   placeRecords(scene, plan);
   // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
   clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
@@ -719,6 +732,7 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     j = e;
   }
   run(tasks);
+  stats_.geometryRecordsMs = msSince(phase);
   for (const Target& tg : targets)
     if (tg.size && tg.dst) tg.buffer->flush();
   if (ring) {
@@ -728,6 +742,7 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     stats_.geometryWaitMs = double(waitUs) * 1e-3 + msSince(last);
     ring.reset();
   }
+  stats_.geometryLongestBuildMs = double(longestBuildUs) * 1e-3;
   stats_.geometryUpload = stats_.geometryCopies ? GeometryUpload::Staged : upload;  // direct: unless a buffer was not mappable
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;

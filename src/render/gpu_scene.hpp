@@ -113,6 +113,10 @@ struct GpuSceneStats {
   // Where a Staged upload's time went (ms): the ring made; the writing threads' waits for a slot still
   // read by earlier copies, summed over threads, and the wait for the last copies; the submissions.
   double geometryRingMs = 0, geometryWaitMs = 0, geometrySubmitMs = 0;
+  // geometryMs by phase: the plan; the streams' buffers made (and mapped); the streams written and the
+  // records made beside them (the longest single mesh's records: geometryLongestBuildMs); the records
+  // placed, their buffers made and written. What is left of geometryMs is the materials and kinds.
+  double geometryPlanMs = 0, geometryBuffersMs = 0, geometryStreamsMs = 0, geometryLongestBuildMs = 0, geometryRecordsMs = 0;
 };
 
 // Told how far a long load is: what it does, how many of how many are done (serialised calls).
