@@ -41,13 +41,6 @@ constexpr const char* kGeometryNames[] = {"positions",  "normals",        "texco
                                           "tangents",   "colours",        "cluster lods", "id pages",  "cull instances",
                                           "cull nodes", "cluster entries"};
 
-GeometryUpload geometryUpload(const vk::Context& ctx) {
-  const char* env = std::getenv("RTR_UPLOAD");
-  const std::optional<GeometryUpload> named = enumFromName<GeometryUpload>(env ? env : "auto");
-  if (!named) throw UsageError(std::string("RTR_UPLOAD=") + env + ": expected " + enumChoices<GeometryUpload>());
-  return *named == GeometryUpload::Auto ? deviceDefaults(ctx.deviceType()).upload : *named;
-}
-
 // Where one mesh's data goes in the scene-wide streams (counts of elements, not bytes).
 struct MeshSlot {
   const Mesh* mesh;
@@ -182,7 +175,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
   const auto t = Clock::now();
-  const GeometryUpload path = upload == GeometryUpload::Auto ? geometryUpload(ctx) : upload;
+  const GeometryUpload path = upload == GeometryUpload::Auto ? GeometryUpload::Direct : upload;
   // A staged upload's ring (host memory the driver allocates and pins) is made while the geometry is planned.
   std::future<std::unique_ptr<StagingRing>> ring;
   if (path == GeometryUpload::Staged)

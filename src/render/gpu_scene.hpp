@@ -61,16 +61,15 @@ struct BlendDraw {
 };
 struct GeometryPlan;
 
-// How the geometry reaches device memory (docs/startup.md, "Geometry upload"): Direct, written by the
-// CPU in place where the host can map it (a buffer that is not mappable goes as Staged); Staged, written
-// into a ring of host staging slots and copied by the GPU (DMA) while the next slots are written; Auto,
-// RTR_UPLOAD=direct|staged where set, else the device's default (render::deviceDefaults).
+// How the geometry reaches device memory (docs/startup.md, "Geometry upload"): Direct (and Auto, the
+// same), written by the CPU in place where the host can map it, the fastest way measured on every device
+// (docs/startup.md, "What the bus allows"); a buffer that is not mappable (no large BAR) goes through a
+// ring of host staging slots that the GPU copies (DMA) while the next slots are written. Staged sends
+// every buffer that way: what tests and rtr-bench-upload use to run and measure that path.
 enum class GeometryUpload { Auto, Direct, Staged };
 constexpr std::array<EnumName<GeometryUpload>, 3> enumNames(GeometryUpload) {
   return {{{GeometryUpload::Auto, "auto"}, {GeometryUpload::Direct, "direct"}, {GeometryUpload::Staged, "staged"}}};
 }
-// What Auto means on this device: RTR_UPLOAD, else the device's default (an unknown RTR_UPLOAD: UsageError).
-GeometryUpload geometryUpload(const vk::Context& ctx);
 
 // What a renderer's pipelines and its choice of path depend on, of a scene: its kinds, not its bytes.
 // sceneKinds() computes them from the Scene (no GPU, microseconds), so that the pipelines can be made while
