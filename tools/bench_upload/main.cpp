@@ -1,7 +1,8 @@
 // rtr-bench-upload: what the bus allows for the geometry upload (docs/startup.md, "What the bus allows").
 // For --mib bytes from a host array that was touched first, on the first device (or RTR_DEVICE):
 //  (a) CPU writes (memcpy, 1 MiB pieces on N threads) into mapped device-local memory (MemoryUse::DeviceWrite,
-//      the Direct geometry upload), where the device has some;
+//      the Direct geometry upload), where the device has some: into one buffer again and again, and into a
+//      buffer made for each run (every page touched for the first time, as an upload's are);
 //  (b) the same into host staging memory: MemoryUse::Upload (write-combined where the device has it) and
 //      ::Readback (cached);
 //  (c) GPU copies (vkCmdCopyBuffer) host -> device-local: one copy, N copies of each --chunks size in one
@@ -114,6 +115,24 @@ void cpuWrites(const vk::Context& ctx, const std::vector<uint8_t>& src, const st
         r.ms.push_back(msSince(t0));
       }
       r.print(std::string(name) + ", " + std::to_string(t) + " threads", src.size());
+    }
+    // As an upload writes it: a buffer made for each run, so that every store touches a fresh page (the
+    // making timed apart).
+    for (unsigned t : threads) {
+      Runs r;
+      double made = 0;
+      for (int i = 0; i < reps; ++i) {
+        auto t0 = Clock::now();
+        vk::Buffer fresh(ctx, src.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, use, name);
+        made += msSince(t0);
+        t0 = Clock::now();
+        writeAll(static_cast<uint8_t*>(fresh.mapped()), src, t);
+        fresh.flush();
+        r.ms.push_back(msSince(t0));
+      }
+      char extra[64];
+      std::snprintf(extra, sizeof extra, "  (buffer made in %.1f ms on average)", made / reps);
+      r.print(std::string(name) + ", fresh, " + std::to_string(t) + " threads", src.size(), extra);
     }
   }
 }
