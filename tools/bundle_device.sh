@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib"
 bins=()
-for b in rtr-view rtr-bench-gpu rtr-trace bench-trace rtr-bake scenegen rtr-frame-compare bench_bake rtr-reflect \
+for b in rtr-view rtr-bench-gpu rtr-trace bench-trace rtr-bake scenegen rtr-frame-compare bench_bake rtr-reflect rtr-bench-upload \
          vk_test render_test view_test reference_test rtr-bench-cull rtr-lod-cut bench-load; do
   [[ -x $B/bin/$b ]] && cp "$B/bin/$b" "$out/bin/" && bins+=("$B/bin/$b")
 done

@@ -5,7 +5,9 @@
 #include <bit>
 #include <chrono>
 #include <cstdlib>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <functional>
 #include <future>
 #include <optional>
@@ -38,13 +40,6 @@ constexpr const char* kGeometryNames[] = {"positions",  "normals",        "texco
                                           "materials",  "draws",          "instances",    "clusters",  "texcoords1",
                                           "tangents",   "colours",        "cluster lods", "id pages",  "cull instances",
                                           "cull nodes", "cluster entries"};
-
-GeometryUpload geometryUpload(const vk::Context& ctx) {
-  const char* env = std::getenv("RTR_UPLOAD");
-  const std::optional<GeometryUpload> named = enumFromName<GeometryUpload>(env ? env : "auto");
-  if (!named) throw UsageError(std::string("RTR_UPLOAD=") + env + ": expected " + enumChoices<GeometryUpload>());
-  return *named == GeometryUpload::Auto ? deviceDefaults(ctx.deviceType()).upload : *named;
-}
 
 // Where one mesh's data goes in the scene-wide streams (counts of elements, not bytes).
 struct MeshSlot {
@@ -110,6 +105,9 @@ struct GeometryPlan {
 
 namespace {
 
+// Records from which a mesh's build is split (buildRecords); small, so that the test scenes split too.
+constexpr size_t kSplitRecords = 64;
+
 // Mesh mi's records (MeshRecords), numbered from 0.
 void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRecords& r) {
   const Mesh& m = scene.meshes[mi];
@@ -118,29 +116,62 @@ void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRe
       size_t(std::count_if(m.lod.clusters.begin(), m.lod.clusters.end(), [](const LodCluster& c) { return c.level > 0; }));
   const size_t own =
       m.clusters.empty() ? (m.indices.size() / 3 + CLUSTER_MAX_TRIANGLES - 1) / CLUSTER_MAX_TRIANGLES : m.clusters.size();
+  const uint32_t flags = p.meshDraw[mi]->flags;
+  // A mesh with a hierarchy and many records (the 100M temple's statue: most of them) is built in three
+  // parts at once, joined in the same order: its level 0's records, their level-of-detail records (taken
+  // from the hierarchy, not from the records), and the records above level 0 with theirs.
+  const bool split = p.lods && m.lod.levels > 0 && own + above >= kSplitRecords;
   r.clusters.reserve(own + above);
   if (p.lods) r.lods.reserve(own + above);
-  appendClusters(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, r.clusters);
-  r.level0 = uint32_t(r.clusters.size());
-  if (p.lods) {
-    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, false, 0, r.clusters, r.lods);
-    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, true, 0, r.clusters, r.lods);
+  if (split) {
+    std::vector<shader::GpuCluster> upper;
+    std::vector<shader::GpuClusterLod> upperLods;
+    auto level0Lods = std::async(std::launch::async, [&] {
+      std::vector<shader::GpuCluster> none;
+      std::vector<shader::GpuClusterLod> lods;
+      lods.reserve(own);
+      appendClusterLods(m, glm::mat4(1.0f), 0, flags, false, 0, none, lods);
+      return lods;
+    });
+    auto aboveMade = std::async(std::launch::async, [&] {
+      upper.reserve(above), upperLods.reserve(above);
+      appendClusterLods(m, glm::mat4(1.0f), 0, flags, true, 0, upper, upperLods);
+    });
+    appendClusters(m, glm::mat4(1.0f), 0, flags, r.clusters);
+    r.level0 = uint32_t(r.clusters.size());
+    r.lods = level0Lods.get();
+    aboveMade.get();
+    r.clusters.insert(r.clusters.end(), upper.begin(), upper.end());
+    r.lods.insert(r.lods.end(), upperLods.begin(), upperLods.end());
+  } else {
+    appendClusters(m, glm::mat4(1.0f), 0, flags, r.clusters);
+    r.level0 = uint32_t(r.clusters.size());
+    if (p.lods) {
+      appendClusterLods(m, glm::mat4(1.0f), 0, flags, false, 0, r.clusters, r.lods);
+      appendClusterLods(m, glm::mat4(1.0f), 0, flags, true, 0, r.clusters, r.lods);
+    }
   }
   r.count = uint32_t(r.clusters.size());
-  std::vector<glm::vec4> spheres;
-  spheres.reserve(2 * r.count);
-  for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
-  r.sphere = enclosingSphere(spheres);
-  if (r.lods.empty()) {
-    r.lodSphere = r.sphere;
-  } else {
-    spheres.clear();
-    for (const shader::GpuClusterLod& l : r.lods) {
-      spheres.push_back(l.sphere);
-      if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
+  // The mesh's spheres (split: beside its trees, which do not read them).
+  auto spheresOf = [&r] {
+    std::vector<glm::vec4> spheres;
+    spheres.reserve(2 * r.count);
+    for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
+    r.sphere = enclosingSphere(spheres);
+    if (r.lods.empty()) {
+      r.lodSphere = r.sphere;
+    } else {
+      spheres.clear();
+      for (const shader::GpuClusterLod& l : r.lods) {
+        spheres.push_back(l.sphere);
+        if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
+      }
+      r.lodSphere = enclosingSphere(spheres);
     }
-    r.lodSphere = enclosingSphere(spheres);
-  }
+  };
+  std::future<void> spheresMade;
+  if (split) spheresMade = std::async(std::launch::async, spheresOf);
+  else spheresOf();
   // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
   // tree over each, their roots side by side.
   std::vector<glm::uvec2> runs{{0, r.level0}};
@@ -154,6 +185,7 @@ void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRe
   r.nodes.resize(runs.size());
   for (size_t l = 0; l < runs.size(); ++l)
     r.leaves += appendClusterTree(r.clusters, r.lods, runs[l].x, runs[l].y, uint32_t(l), r.nodes, r.depths);
+  if (spheresMade.valid()) spheresMade.get();
 }
 
 shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
@@ -180,7 +212,18 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
   const auto t = Clock::now();
+  const GeometryUpload path = upload == GeometryUpload::Auto ? GeometryUpload::Direct : upload;
+  // A staged upload's ring (host memory the driver allocates and pins) is made while the geometry is planned.
+  std::future<std::unique_ptr<StagingRing>> ring;
+  if (path == GeometryUpload::Staged)
+    ring = std::async(std::launch::async, [&ctx, geometrySlotBytes] {
+      auto made =
+          std::make_unique<StagingRing>(ctx, geometrySlotBytes, kGeometrySlots, kGeometryRingMemory, "geometry staging ring");
+      made->allocate();
+      return made;
+    });
   GeometryPlan plan = planGeometry(scene);
+  stats_.geometryPlanMs = msSince(t);
   std::vector<shader::GpuMaterial> materials = gpuMaterials(scene, gpuIndex);
   const SceneKinds kinds = sceneKinds(scene);
   materialExtras_ = kinds.materialExtras;
@@ -191,7 +234,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
       g.textures = glm::uvec4(NO_TEXTURE), g.textures2.x = g.textures2.y = g.textures2.z = NO_TEXTURE;
     shownMaterials_ = materials;
   }
-  uploadGeometry(scene, plan, materials, upload == GeometryUpload::Auto ? geometryUpload(ctx) : upload, geometrySlotBytes);
+  uploadGeometry(scene, plan, materials, path, geometrySlotBytes, std::move(ring));
   stats_.geometryMs = msSince(t);
   if (!decoding_.valid()) {
     finishTextures();
@@ -377,7 +420,7 @@ std::vector<shader::GpuMaterial> GpuScene::gpuMaterials(const Scene& scene, cons
 // ring of host staging slots, a batch of pieces a slot, and the GPU copies each slot into place (DMA)
 // while the next ones are written (docs/startup.md, "Geometry upload").
 void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
-                              GeometryUpload upload, size_t slotBytes) {
+                              GeometryUpload upload, size_t slotBytes, std::future<std::unique_ptr<StagingRing>> ringMade) {
   struct Target {
     vk::Buffer* buffer;
     size_t size;
@@ -444,7 +487,9 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
       tg.dst = static_cast<uint8_t*>(tg.buffer->mapped());
     }
   };
+  auto phase = Clock::now();
   make();
+  stats_.geometryBuffersMs = msSince(phase);
 
   // The bytes of the buffers a piece writes, one range per buffer at most: fn(target, begin, end).
   auto ranges = [&](const WriteTask& t, auto&& fn) {
@@ -561,69 +606,128 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     if (plan.anyTangents) stream(kTan, m.tangents, 16);
     if (plan.anyColors) stream(kCol, m.colors, 16);
   };
+  std::atomic<int64_t> longestBuildUs{0};
   auto write = [&](const WriteTask& task, const Place& place) {
-    if (task.what == Write::Build) return buildRecords(scene, plan, task.slot, plan.records[task.slot]);
+    if (task.what == Write::Build) {
+      const auto t = Clock::now();
+      buildRecords(scene, plan, task.slot, plan.records[task.slot]);
+      const int64_t us = int64_t(msSince(t) * 1e3);
+      for (int64_t was = longestBuildUs; us > was && !longestBuildUs.compare_exchange_weak(was, us);) {}
+      return;
+    }
     writePiece(task, place);
   };
 
-  std::optional<StagingRing> ring;
-  std::unique_ptr<ThreadPool> pool;
-  // Runs the pieces on all cores. Where a buffer is not mapped, its bytes go through the ring: the pieces
-  // in batches whose staged bytes fit a slot (at least one piece), each batch written into its slot and
-  // copied by a submission of its own, which runs while the next batches are written; a slot is written
-  // again once its copies have completed. The records are made beside the batches, on threads of their own.
+  // Runs the tasks on all cores, the records' builds first (as direct's). Where a buffer is not mapped,
+  // its bytes go through the ring: the pieces, in order, in batches whose staged bytes fit a slot (at
+  // least one piece), batch k (counted over both runs) in slot k % slots, placed before any is written.
+  // No thread waits for a batch: a thread takes the next task, waits only where its piece's slot is still
+  // read by the copies of the batch before it there, writes, and the thread that writes a batch's last
+  // piece submits its copies, which run while the next batches are written.
+  std::unique_ptr<StagingRing> ring;                 // made beside the plan (Staged), else where a buffer is not mapped
+  std::deque<std::optional<vk::Submission>> copied;  // per batch through the ring: its copies (guarded by copiedMutex)
+  std::mutex copiedMutex;
+  std::condition_variable copiedChanged;
+  std::atomic<int64_t> waitUs{0}, submitUs{0};
   auto run = [&](const std::vector<WriteTask>& tasks) {
     Place direct;
     for (uint32_t k = 0; k < kTargets; ++k) direct.at[k] = targets[k].dst;
     std::vector<Place> places(tasks.size(), direct);
-    std::vector<size_t> staged(tasks.size(), 0), builds, pieces;  // staged: bytes of a piece in the ring
-    for (size_t i = 0; i < tasks.size(); ++i) {
+    std::vector<size_t> staged(tasks.size(), 0);  // bytes of a piece in the ring
+    for (size_t i = 0; i < tasks.size(); ++i)
       ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) { staged[i] += targets[k].dst ? 0 : e - b + 32; });
-      (tasks[i].what == Write::Build ? builds : pieces).push_back(i);
+    const size_t largest = *std::max_element(staged.begin(), staged.end());
+    if (largest == 0) return parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i], places[i]); });
+    if (!ring && ringMade.valid()) ring = ringMade.get();
+    if (ring && largest > ring->slotBytes()) copied.clear(), ring.reset();  // waits for the copies, then larger slots
+    if (!ring) {
+      ring = std::make_unique<StagingRing>(ctx_, std::max(slotBytes, largest), kGeometrySlots, kGeometryRingMemory,
+                                           "geometry staging ring");
+      ring->allocate();
     }
-    if (std::all_of(staged.begin(), staged.end(), [](size_t b) { return b == 0; }))
-      return parallelFor(tasks.size(), 0, [&](size_t i) { write(tasks[i], places[i]); });
-    auto building = std::async(std::launch::async, [&] {
-      parallelFor(builds.size(), 0, [&](size_t i) { write(tasks[builds[i]], places[builds[i]]); });
-    });
-    if (!ring) ring.emplace(ctx_, slotBytes, kGeometrySlots, vk::MemoryUse::Upload, "geometry staging ring");
-    if (!pool) pool = std::make_unique<ThreadPool>(threadCount() - 1);
-    for (size_t i = 0, j; i < pieces.size(); i = j) {
-      size_t batch = 0;
-      for (j = i; j < pieces.size() && (j == i || batch + staged[pieces[j]] <= ring->slotBytes()); ++j)
-        batch += staged[pieces[j]];
-      const uint32_t slot = ring->acquire(batch);
+    const size_t first = copied.size(), slots = ring->slots();
+    std::vector<size_t> batchOf(tasks.size(), SIZE_MAX);
+    std::vector<std::vector<size_t>> batches;  // the staged pieces of each batch, in order
+    for (size_t i = 0, used = ring->slotBytes(); i < tasks.size(); ++i) {
+      if (!staged[i]) continue;
+      if (used + staged[i] > ring->slotBytes()) batches.emplace_back(), used = 0;
+      used += staged[i];
+      batchOf[i] = batches.size() - 1;
+      batches.back().push_back(i);
+    }
+    std::vector<std::array<std::vector<VkBufferCopy>, kTargets>> copies(batches.size());
+    for (size_t batch = 0; batch < batches.size(); ++batch) {
+      const uint32_t slot = uint32_t((first + batch) % slots);
       // Target by target, each range placed at its byte's alignment (mod 16), right after the one before
       // where it continues it: one copy region a run (lavapipe maps its memory once per region).
-      std::array<std::vector<VkBufferCopy>, kTargets> copies;
       size_t at = ring->offset(slot);
       for (uint32_t target = 0; target < kTargets; ++target)
-        for (size_t q = i; q < j && !targets[target].dst; ++q)
-          ranges(tasks[pieces[q]], [&](uint32_t k, size_t b, size_t e) {
-            if (k != target) return;
-            std::vector<VkBufferCopy>& c = copies[k];
+        for (size_t i : batches[batch])
+          ranges(tasks[i], [&](uint32_t k, size_t b, size_t e) {
+            if (k != target || targets[k].dst) return;
+            std::vector<VkBufferCopy>& c = copies[batch][k];
             if (c.empty() || c.back().dstOffset + c.back().size != b) {
               at = ((at + 15) & ~size_t(15)) + b % 16;
               c.push_back({at, b, 0});
             }
-            places[pieces[q]].at[k] = ring->data(slot) + (at - ring->offset(slot)), places[pieces[q]].from[k] = b;
+            places[i].at[k] = ring->data(slot) + (at - ring->offset(slot)), places[i].from[k] = b;
             c.back().size += e - b, at += e - b;
           });
-      parallelFor(*pool, j - i, [&](size_t q) { write(tasks[pieces[i + q]], places[pieces[i + q]]); });
-      ring->submit(slot, [&](VkCommandBuffer cb) {
-        for (uint32_t k = 0; k < kTargets; ++k)
-          if (!copies[k].empty())
-            vkCmdCopyBuffer(cb, ring->buffer(), targets[k].buffer->handle(), uint32_t(copies[k].size()), copies[k].data());
-        // Orders the copies before the later ones and the frames' reads, which come in later submissions.
-        vk::bufferBarrier(cb, vk::kCopyWrite,
-                          vk::kCopyWrite | vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
-      });
-      ++stats_.geometryCopies;
     }
-    building.get();
+    std::vector<std::atomic<size_t>> left(batches.size());  // pieces not yet written
+    for (size_t batch = 0; batch < batches.size(); ++batch) left[batch] = batches[batch].size();
+    {
+      std::lock_guard lock(copiedMutex);
+      copied.resize(first + copies.size());
+    }
+    bool failed = false;  // a piece failed: nobody waits for its batch (guarded by copiedMutex)
+    auto waitFor = [&](size_t k) {
+      const auto t = Clock::now();
+      const vk::Submission* s;
+      {
+        std::unique_lock lock(copiedMutex);
+        copiedChanged.wait(lock, [&] { return copied[k].has_value() || failed; });
+        if (!copied[k]) throw Error("geometry upload: an earlier piece failed");
+        s = &*copied[k];
+      }
+      s->wait();
+      waitUs += int64_t(msSince(t) * 1e3);
+    };
+    parallelFor(tasks.size(), 0, [&](size_t i) {
+      if (!staged[i]) return write(tasks[i], places[i]);
+      const size_t batch = batchOf[i], k = first + batch;
+      try {
+        if (k >= slots) waitFor(k - slots);
+        write(tasks[i], places[i]);
+        if (left[batch].fetch_sub(1) != 1) return;
+        const auto t = Clock::now();
+        std::lock_guard lock(copiedMutex);  // also keeps the queue to one thread
+        ring->flush();
+        copied[k].emplace(ctx_, [&](VkCommandBuffer cb) {
+          for (uint32_t target = 0; target < kTargets; ++target)
+            if (!copies[batch][target].empty())
+              vkCmdCopyBuffer(cb, ring->buffer(), targets[target].buffer->handle(), uint32_t(copies[batch][target].size()),
+                              copies[batch][target].data());
+          // Orders the copies before the later ones and the frames' reads, which come in later submissions.
+          vk::bufferBarrier(cb, vk::kCopyWrite,
+                            vk::kCopyWrite | vk::kVertexInput | vk::kVertexRead | vk::kFragmentRead | vk::kComputeRead);
+        });
+        copiedChanged.notify_all();
+        submitUs += int64_t(msSince(t) * 1e3);
+      } catch (...) {
+        std::lock_guard lock(copiedMutex);
+        failed = true;
+        copiedChanged.notify_all();
+        throw;
+      }
+    });
+    stats_.geometryCopies += uint32_t(batches.size());
   };
+  phase = Clock::now();
   run(tasks);
+  stats_.geometryStreamsMs = msSince(phase);
 
+  phase = Clock::now();
   placeRecords(scene, plan);
   // Past 32 bits of (instance, cluster) pairs the compute rasteriser is not used (Renderer).
   clusterCount_ = uint32_t(std::min<uint64_t>(plan.pairs, UINT32_MAX));
@@ -658,9 +762,17 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     j = e;
   }
   run(tasks);
+  stats_.geometryRecordsMs = msSince(phase);
   for (const Target& tg : targets)
     if (tg.size && tg.dst) tg.buffer->flush();
-  ring.reset();                                                                     // waits for the last copies
+  if (ring) {
+    const auto last = Clock::now();
+    copied.clear();  // waits for the last copies
+    stats_.geometryRingMs = ring->allocationMs(), stats_.geometrySubmitMs = double(submitUs) * 1e-3;
+    stats_.geometryWaitMs = double(waitUs) * 1e-3 + msSince(last);
+    ring.reset();
+  }
+  stats_.geometryLongestBuildMs = double(longestBuildUs) * 1e-3;
   stats_.geometryUpload = stats_.geometryCopies ? GeometryUpload::Staged : upload;  // direct: unless a buffer was not mappable
   stats_.geometryBytes = 0;
   for (const Target& tg : targets) stats_.geometryBytes += tg.size;

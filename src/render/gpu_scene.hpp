@@ -61,16 +61,15 @@ struct BlendDraw {
 };
 struct GeometryPlan;
 
-// How the geometry reaches device memory (docs/startup.md, "Geometry upload"): Direct, written by the
-// CPU in place where the host can map it (a buffer that is not mappable goes as Staged); Staged, written
-// into a ring of host staging slots and copied by the GPU (DMA) while the next slots are written; Auto,
-// RTR_UPLOAD=direct|staged where set, else the device's default (render::deviceDefaults).
+// How the geometry reaches device memory (docs/startup.md, "Geometry upload"): Direct (and Auto, the
+// same), written by the CPU in place where the host can map it, the fastest way measured on every device
+// (docs/startup.md, "What the bus allows"); a buffer that is not mappable (no large BAR) goes through a
+// ring of host staging slots that the GPU copies (DMA) while the next slots are written. Staged sends
+// every buffer that way: what tests and rtr-bench-upload use to run and measure that path.
 enum class GeometryUpload { Auto, Direct, Staged };
 constexpr std::array<EnumName<GeometryUpload>, 3> enumNames(GeometryUpload) {
   return {{{GeometryUpload::Auto, "auto"}, {GeometryUpload::Direct, "direct"}, {GeometryUpload::Staged, "staged"}}};
 }
-// What Auto means on this device: RTR_UPLOAD, else the device's default (an unknown RTR_UPLOAD: UsageError).
-GeometryUpload geometryUpload(const vk::Context& ctx);
 
 // What a renderer's pipelines and its choice of path depend on, of a scene: its kinds, not its bytes.
 // sceneKinds() computes them from the Scene (no GPU, microseconds), so that the pipelines can be made while
@@ -110,6 +109,13 @@ struct GpuSceneStats {
   size_t geometryBytes = 0;
   GeometryUpload geometryUpload = GeometryUpload::Direct;  // the path taken (Direct or Staged)
   uint32_t geometryCopies = 0;                             // copy submissions from the geometry's staging ring
+  // Where a Staged upload's time went (ms): the ring made; the writing threads' waits for a slot still
+  // read by earlier copies, summed over threads, and the wait for the last copies; the submissions.
+  double geometryRingMs = 0, geometryWaitMs = 0, geometrySubmitMs = 0;
+  // geometryMs by phase: the plan; the streams' buffers made (and mapped); the streams written and the
+  // records made beside them (the longest single mesh's records: geometryLongestBuildMs); the records
+  // placed, their buffers made and written. What is left of geometryMs is the materials and kinds.
+  double geometryPlanMs = 0, geometryBuffersMs = 0, geometryStreamsMs = 0, geometryLongestBuildMs = 0, geometryRecordsMs = 0;
 };
 
 // Told how far a long load is: what it does, how many of how many are done (serialised calls).
@@ -177,6 +183,7 @@ class GpuScene {
   // than a slot makes them that large), freed once the upload is done.
   static constexpr size_t kGeometrySlotBytes = size_t(32) << 20;
   static constexpr uint32_t kGeometrySlots = 4;
+  static constexpr vk::MemoryUse kGeometryRingMemory = vk::MemoryUse::Upload;  // written once, in order
   void setUploadBudget(size_t bytes) { uploadBudget_ = bytes; }
 
   const std::vector<DrawItem>& draws(DrawKind k) const { return draws_[size_t(k)]; }
@@ -246,7 +253,7 @@ class GpuScene {
   std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
   // Streams written and records made on all cores, then placed and written.
   void uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,
-                      GeometryUpload upload, size_t slotBytes);
+                      GeometryUpload upload, size_t slotBytes, std::future<std::unique_ptr<StagingRing>> ringMade);
   void finishTextures();                                 // staging buffers to images, mips (a waited load)
   std::vector<uint32_t> nextBatch(bool wait);            // a deferred load's next textures, by the budget
   void startUpload(const std::vector<uint32_t>& batch);  // the same in one submission, not waited for

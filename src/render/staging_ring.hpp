@@ -37,10 +37,21 @@ class StagingRing {
   // submission completed.
   const vk::Submission& submit(uint32_t slot, const std::function<void(VkCommandBuffer)>& record);
   void waitAll();
+  // For a caller that fills every slot from several threads and tracks the submissions reading them
+  // itself (GpuScene's geometry; acquire() and submit() are then not used): the buffer made now, and the
+  // host's writes made visible before such a submission.
+  void allocate();
+  void flush() const { buffer_.flush(); }
+  uint32_t slots() const { return uint32_t(reading_.size()); }
 
   size_t slotBytes() const { return slotBytes_; }
   uint32_t allocations() const { return allocations_; }  // buffers made (1 unless a batch outgrew a slot)
   uint32_t submissions() const { return submissions_; }
+  // Where the caller's time went (ms): making the buffer, waiting in acquire() for a slot's submission,
+  // recording and submitting (rtr-bench-upload and GpuSceneStats report them).
+  double allocationMs() const { return allocMs_; }
+  double waitMs() const { return waitMs_; }
+  double submitMs() const { return submitMs_; }
 
  private:
   const vk::Context& ctx_;
@@ -50,6 +61,7 @@ class StagingRing {
   vk::Buffer buffer_;
   std::vector<std::optional<vk::Submission>> reading_;  // per slot: the submission that last read it
   uint32_t next_ = 0, allocations_ = 0, submissions_ = 0;
+  double allocMs_ = 0, waitMs_ = 0, submitMs_ = 0;
 };
 
 }  // namespace rtr::render

@@ -65,12 +65,9 @@ DeviceDefaults deviceDefaults(VkPhysicalDeviceType type) {
   // are cheapest made on the CPU (no pipeline or blit shader to compile): Auto. Clipping in compute runs a
   // 128-thread workgroup per crossing triangle: 0.019 ms against the hardware hand-off's 0.122 on the H100
   // at 4K, but 2.6-3.9 ms against 0.2 on lavapipe (docs/raster.md).
-  // The geometry: a CPU device's "device memory" is host memory, where staging is one more copy; on a GPU
-  // (an H100, session 16) the staged path took 96-101 ms against direct's 43-46 at 10M and was even at 100M
-  // (375-409 against 386-429): direct until staging beats it (docs/startup.md, "Geometry upload").
   if (type == VK_PHYSICAL_DEVICE_TYPE_CPU)
-    return {ShadingPath::Forward, MipMode::Auto, false, GeometryUpload::Direct, "a CPU device, measured fastest there"};
-  return {ShadingPath::Visibility, MipMode::Compute, true, GeometryUpload::Direct, "a GPU, measured fastest with a discrete one"};
+    return {ShadingPath::Forward, MipMode::Auto, false, "a CPU device, measured fastest there"};
+  return {ShadingPath::Visibility, MipMode::Compute, true, "a GPU, measured fastest with a discrete one"};
 }
 
 }  // namespace rtr::render

@@ -60,8 +60,7 @@ class PipelinesAhead {
 struct DeviceDefaults {
   ShadingPath shading;
   MipMode mips;
-  bool computeClip;       // the compute rasteriser's near-plane crossings clipped in compute, not handed to the hardware
-  GeometryUpload upload;  // Direct or Staged (RTR_UPLOAD overrides: render::geometryUpload)
+  bool computeClip;  // the compute rasteriser's near-plane crossings clipped in compute, not handed to the hardware
   // The compute rasteriser's hardware|compute choice belongs in this table too, once it is measured.
   const char* why;  // one line: the device class and where the measurements are
 };
