@@ -105,9 +105,6 @@ struct GeometryPlan {
 
 namespace {
 
-// Records from which a mesh's build is split (buildRecords); small, so that the test scenes split too.
-constexpr size_t kSplitRecords = 64;
-
 // Mesh mi's records (MeshRecords), numbered from 0.
 void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRecords& r) {
   const Mesh& m = scene.meshes[mi];
@@ -116,62 +113,29 @@ void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRe
       size_t(std::count_if(m.lod.clusters.begin(), m.lod.clusters.end(), [](const LodCluster& c) { return c.level > 0; }));
   const size_t own =
       m.clusters.empty() ? (m.indices.size() / 3 + CLUSTER_MAX_TRIANGLES - 1) / CLUSTER_MAX_TRIANGLES : m.clusters.size();
-  const uint32_t flags = p.meshDraw[mi]->flags;
-  // A mesh with a hierarchy and many records (the 100M temple's statue: most of them) is built in three
-  // parts at once, joined in the same order: its level 0's records, their level-of-detail records (taken
-  // from the hierarchy, not from the records), and the records above level 0 with theirs.
-  const bool split = p.lods && m.lod.levels > 0 && own + above >= kSplitRecords;
   r.clusters.reserve(own + above);
   if (p.lods) r.lods.reserve(own + above);
-  if (split) {
-    std::vector<shader::GpuCluster> upper;
-    std::vector<shader::GpuClusterLod> upperLods;
-    auto level0Lods = std::async(std::launch::async, [&] {
-      std::vector<shader::GpuCluster> none;
-      std::vector<shader::GpuClusterLod> lods;
-      lods.reserve(own);
-      appendClusterLods(m, glm::mat4(1.0f), 0, flags, false, 0, none, lods);
-      return lods;
-    });
-    auto aboveMade = std::async(std::launch::async, [&] {
-      upper.reserve(above), upperLods.reserve(above);
-      appendClusterLods(m, glm::mat4(1.0f), 0, flags, true, 0, upper, upperLods);
-    });
-    appendClusters(m, glm::mat4(1.0f), 0, flags, r.clusters);
-    r.level0 = uint32_t(r.clusters.size());
-    r.lods = level0Lods.get();
-    aboveMade.get();
-    r.clusters.insert(r.clusters.end(), upper.begin(), upper.end());
-    r.lods.insert(r.lods.end(), upperLods.begin(), upperLods.end());
-  } else {
-    appendClusters(m, glm::mat4(1.0f), 0, flags, r.clusters);
-    r.level0 = uint32_t(r.clusters.size());
-    if (p.lods) {
-      appendClusterLods(m, glm::mat4(1.0f), 0, flags, false, 0, r.clusters, r.lods);
-      appendClusterLods(m, glm::mat4(1.0f), 0, flags, true, 0, r.clusters, r.lods);
-    }
+  appendClusters(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, r.clusters);
+  r.level0 = uint32_t(r.clusters.size());
+  if (p.lods) {
+    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, false, 0, r.clusters, r.lods);
+    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, true, 0, r.clusters, r.lods);
   }
   r.count = uint32_t(r.clusters.size());
-  // The mesh's spheres (split: beside its trees, which do not read them).
-  auto spheresOf = [&r] {
-    std::vector<glm::vec4> spheres;
-    spheres.reserve(2 * r.count);
-    for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
-    r.sphere = enclosingSphere(spheres);
-    if (r.lods.empty()) {
-      r.lodSphere = r.sphere;
-    } else {
-      spheres.clear();
-      for (const shader::GpuClusterLod& l : r.lods) {
-        spheres.push_back(l.sphere);
-        if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
-      }
-      r.lodSphere = enclosingSphere(spheres);
+  std::vector<glm::vec4> spheres;
+  spheres.reserve(2 * r.count);
+  for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
+  r.sphere = enclosingSphere(spheres);
+  if (r.lods.empty()) {
+    r.lodSphere = r.sphere;
+  } else {
+    spheres.clear();
+    for (const shader::GpuClusterLod& l : r.lods) {
+      spheres.push_back(l.sphere);
+      if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
     }
-  };
-  std::future<void> spheresMade;
-  if (split) spheresMade = std::async(std::launch::async, spheresOf);
-  else spheresOf();
+    r.lodSphere = enclosingSphere(spheres);
+  }
   // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
   // tree over each, their roots side by side.
   std::vector<glm::uvec2> runs{{0, r.level0}};
@@ -185,7 +149,6 @@ void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRe
   r.nodes.resize(runs.size());
   for (size_t l = 0; l < runs.size(); ++l)
     r.leaves += appendClusterTree(r.clusters, r.lods, runs[l].x, runs[l].y, uint32_t(l), r.nodes, r.depths);
-  if (spheresMade.valid()) spheresMade.get();
 }
 
 shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {

@@ -1,13 +1,10 @@
 // The scene upload's two ways into device memory give the same bytes and frames: written in place where
 // the host maps device memory (direct), or through a ring of staging slots copied by the GPU (staged).
 // The scene has 16- and 32-bit indices, textured and untextured meshes, and a hierarchy.
-#include <algorithm>
 #include <cstdlib>
-#include <span>
 
 #include <gtest/gtest.h>
 
-#include "render/cull.hpp"
 #include "render/headless.hpp"
 #include "scene/load.hpp"
 #include "test_paths.hpp"
@@ -92,40 +89,6 @@ TEST_F(VulkanTest, DirectAndStagedGeometryUploadsWriteTheSameBytes) {
       EXPECT_EQ(first, x.size()) << "first differing byte";
     }
   }
-}
-
-// A mesh with a hierarchy and at least 64 records has its records built in three parts at once
-// (GpuScene's buildRecords: level 0's records, their level-of-detail records, the levels above): the
-// cluster and level-of-detail buffers equal the records built one after another (appendClusters, then
-// appendClusterLods below and above level 0), mesh by mesh in the scene's order.
-TEST_F(VulkanTest, RecordsBuiltInPartsEqualThoseBuiltInOrder) {
-  const Scene scene = templeWithGrid();
-  const render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
-  std::vector<shader::GpuCluster> clusters;
-  std::vector<shader::GpuClusterLod> lods;
-  size_t split = 0, largest = 0;  // meshes split; the most records of a mesh with a hierarchy
-  for (const Mesh& m : scene.meshes) {
-    const Material& material = scene.materials.at(m.material);
-    if (m.indices.empty() || material.blended()) continue;
-    const uint32_t flags = render::clusterFlags(m, material);
-    const size_t first = clusters.size();
-    render::appendClusters(m, glm::mat4(1.0f), 0, flags, clusters);
-    render::appendClusterLods(m, glm::mat4(1.0f), 0, flags, false, first, clusters, lods);
-    render::appendClusterLods(m, glm::mat4(1.0f), 0, flags, true, first, clusters, lods);
-    if (m.lod.levels > 0) split += clusters.size() - first >= 64, largest = std::max(largest, clusters.size() - first);
-  }
-  EXPECT_GT(split, 0u) << "no mesh's build was split (largest with a hierarchy: " << largest << " records)";
-  for (auto [name, want] :
-       {std::pair{"clusters", std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(clusters.data()),
-                                                       clusters.size() * sizeof(clusters[0]))},
-        {"cluster lods", std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(lods.data()), lods.size() * sizeof(lods[0]))}})
-    for (const auto& [bufferName, buffer] : gpu.geometryBuffers())
-      if (std::string(bufferName) == name) {
-        SCOPED_TRACE(name);
-        const std::vector<uint8_t> got = readBack(*ctx, *buffer);
-        ASSERT_EQ(got.size(), want.size());
-        EXPECT_TRUE(std::equal(got.begin(), got.end(), want.begin()));
-      }
 }
 
 // The caller's default (Auto) is the direct path on every device: staging measured slower on the GPU
