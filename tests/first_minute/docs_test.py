@@ -23,7 +23,7 @@ OTHERS = {"--preset", "--build", "--target", "--build-only", "--quick", "--keep"
           "--reps", "--cpu-time", "--singles-only",  # bench-trace (docs/bench/trace.md, rounds 16 and 17)
           "--sphere-grid", "--env-cases", "--spp-curve", "--flip", "--flip-map", "--ppd",  # scenegen, rtr-frame-compare
            "--mesh", "--rebuild", "--fates", "--instances",  # rtr-lod-cut (docs/virtual-geometry.md), scenegen
-          "--mib", "--chunks", "--rings",  # rtr-bench-upload (docs/startup.md, "What the bus allows")
+          "--mib", "--chunks",  # rtr-bench-upload (docs/startup.md, "What the bus allows")
           "--test-ui", "--test-drop"}  # rtr-view's test-only options, hidden from --help (docs/viewer.md)
 failures = []
 

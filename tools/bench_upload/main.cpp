@@ -9,11 +9,7 @@
 //      submission, and one submission per chunk; on the renderer's queue family and on every transfer-only
 //      and compute-only family (a device of the tool's own holding one queue of each): wall clock and, where the
 //      family has timestamps, GPU time;
-//  (d) the staging ring as the Staged geometry upload drives it (render::StagingRing, a slot written on all
-//      cores by a thread pool, then its copy submitted; the ring made per run, as per upload), for each
-//      --rings SLOT_MIBxSLOTS, in Upload and Readback memory: wall clock, and of it the ring's allocation,
-//      the waits for a slot, the writes and the submissions; as it drove it until issue 29's probe (a
-//      barrier at each slot) and as it does now (continuous: no thread waits for a slot's other pieces).
+//  ((d), the staging ring on its own, measured issue 29's probe: gone with staging as a choice; (e) keeps its letter.)
 //  (e) with --scene FILE: the scene's real upload (render::GpuScene, Direct and Staged, alternating; the
 //      other phases of its construction aside): the geometry's bytes, time and GB/s, and for Staged where
 //      its time went (GpuSceneStats: ring made, slot waits, submits).
@@ -22,15 +18,10 @@
 #include <algorithm>
 #include <bit>
 #include <array>
-#include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdio>
 #include <cstring>
-#include <deque>
 #include <filesystem>
-#include <mutex>
-#include <optional>
 #include <functional>
 #include <string>
 #include <vector>
@@ -40,7 +31,6 @@
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "render/gpu_scene.hpp"
-#include "render/staging_ring.hpp"
 #include "scene/load.hpp"
 #include "vk/check.hpp"
 #include "vk/commands.hpp"
@@ -347,138 +337,6 @@ void gpuCopies(CopyRig& rig, const std::vector<uint8_t>& src, const std::vector<
     }
 }
 
-// (d), continuous: GpuScene's staged loop since issue 29's probe. One loop on all cores over the 1 MiB
-// pieces, batch k (a slot's pieces) in slot k % slots: a thread waits only where its piece's slot is still
-// read by earlier copies, and the thread that writes a batch's last piece submits its copy. Returns the
-// ring's allocation, the threads' summed waits and the submissions' time (ms).
-std::array<double, 3> continuousRing(const vk::Context& ctx, const std::vector<uint8_t>& src, VkBuffer dst, size_t slotBytes,
-                                     uint32_t slots, vk::MemoryUse use) {
-  render::StagingRing ring(ctx, slotBytes, slots, use, "bench ring");
-  ring.allocate();
-  const size_t perBatch = std::max<size_t>(1, ring.slotBytes() / kPiece), pieces = (src.size() + kPiece - 1) / kPiece;
-  const size_t batches = (pieces + perBatch - 1) / perBatch;
-  std::deque<std::optional<vk::Submission>> copied(batches);
-  std::vector<std::atomic<size_t>> left(batches);
-  for (size_t b = 0; b < batches; ++b) left[b] = std::min(perBatch, pieces - b * perBatch);
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::atomic<int64_t> waitUs{0}, submitUs{0};
-  parallelFor(pieces, 0, [&](size_t p) {
-    const size_t b = p / perBatch, slot = b % ring.slots();
-    if (b >= ring.slots()) {
-      const auto t = Clock::now();
-      const vk::Submission* s;
-      {
-        std::unique_lock lock(mutex);
-        changed.wait(lock, [&] { return copied[b - ring.slots()].has_value(); });
-        s = &*copied[b - ring.slots()];
-      }
-      s->wait();
-      waitUs += int64_t(msSince(t) * 1e3);
-    }
-    const size_t n = std::min(kPiece, src.size() - p * kPiece);
-    std::memcpy(ring.data(uint32_t(slot)) + (p % perBatch) * kPiece, src.data() + p * kPiece, n);
-    if (left[b].fetch_sub(1) != 1) return;
-    const auto t = Clock::now();
-    std::lock_guard lock(mutex);
-    ring.flush();
-    copied[b].emplace(ctx, [&](VkCommandBuffer cb) {
-      const size_t at = b * perBatch * kPiece;
-      const VkBufferCopy c{ring.offset(uint32_t(slot)), at, std::min(perBatch * kPiece, src.size() - at)};
-      vkCmdCopyBuffer(cb, ring.buffer(), dst, 1, &c);
-      vk::bufferBarrier(cb, vk::kCopyWrite, vk::kCopyWrite | vk::kCopyRead);
-    });
-    changed.notify_all();
-    submitUs += int64_t(msSince(t) * 1e3);
-  });
-  const auto t = Clock::now();
-  copied.clear();
-  return {ring.allocationMs(), double(waitUs) * 1e-3 + msSince(t), double(submitUs) * 1e-3};
-}
-
-// (d): the ring as GpuScene's Staged upload drove it until issue 29's probe: per slot, acquire (waits for the copy that last
-// read it), the slot written in 1 MiB pieces on all cores (the pool's threads and this one), submit.
-void ringUpload(const vk::Context& ctx, const std::vector<uint8_t>& src, const std::vector<std::string>& rings, int reps) {
-  vk::Buffer dst(ctx, src.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryUse::Device,
-                 "ring target");
-  // Each case's result read back and compared with the source, then cleared (each case checked on its own).
-  vk::Buffer back(ctx, src.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "ring check");
-  auto check = [&](const std::string& what) {
-    vk::submitAndWait(ctx, [&](VkCommandBuffer cb) {
-      const VkBufferCopy c{0, 0, src.size()};
-      vkCmdCopyBuffer(cb, dst.handle(), back.handle(), 1, &c);
-      vk::bufferBarrier(cb, vk::kCopyRead | vk::kCopyWrite, vk::kHostRead | vk::kTransferWrite);
-      vkCmdFillBuffer(cb, dst.handle(), 0, VK_WHOLE_SIZE, 0);
-      vk::bufferBarrier(cb, vk::kTransferWrite, vk::kCopyWrite);
-    });
-    back.invalidate();
-    if (std::memcmp(back.mapped(), src.data(), src.size()) != 0)
-      throw Error(what + ": the device's bytes differ from the source");
-  };
-  ThreadPool pool(threadCount() - 1);
-  for (const std::string& spec : rings)
-    for (auto [use, kind] : {std::pair{vk::MemoryUse::Upload, "Upload"}, {vk::MemoryUse::Readback, "Readback"}}) {
-      unsigned slotMiB = 0, slots = 0;
-      if (std::sscanf(spec.c_str(), "%ux%u", &slotMiB, &slots) != 2 || !slotMiB || !slots)
-        throw UsageError("--rings " + spec + ": expected SLOT_MIBxSLOTS");
-      Runs r;
-      double made = 0, waited = 0, written = 0, submitted = 0;  // of the best run
-      uint32_t submissions = 0;
-      for (int i = 0; i < reps; ++i) {
-        double m = 0, w = 0, wr = 0, s = 0;
-        const auto t0 = Clock::now();
-        {
-          render::StagingRing ring(ctx, slotMiB * kMiB, slots, use, "bench ring");
-          for (size_t at = 0; at < src.size(); at += ring.slotBytes()) {
-            const size_t n = std::min(ring.slotBytes(), src.size() - at);
-            auto t = Clock::now();
-            const uint32_t slot = ring.acquire(n);
-            (at == 0 ? m : w) += msSince(t);
-            t = Clock::now();
-            parallelFor(pool, (n + kPiece - 1) / kPiece, [&](size_t p) {
-              std::memcpy(ring.data(slot) + p * kPiece, src.data() + at + p * kPiece, std::min(kPiece, n - p * kPiece));
-            });
-            wr += msSince(t);
-            t = Clock::now();
-            ring.submit(slot, [&](VkCommandBuffer cb) {
-              const VkBufferCopy c{ring.offset(slot), at, n};
-              vkCmdCopyBuffer(cb, ring.buffer(), dst.handle(), 1, &c);
-              vk::bufferBarrier(cb, vk::kCopyWrite, vk::kCopyWrite | vk::kCopyRead);
-            });
-            s += msSince(t);
-          }
-          const auto t = Clock::now();
-          ring.waitAll();
-          w += msSince(t);
-          submissions = ring.submissions();
-        }
-        r.ms.push_back(msSince(t0));
-        if (r.ms.back() <= *std::min_element(r.ms.begin(), r.ms.end())) made = m, waited = w, written = wr, submitted = s;
-      }
-      char extra[160];
-      std::snprintf(extra, sizeof extra, "  (best: ring made %.1f, slot waits %.1f, writes %.1f, submits %.1f ms; %u submits)",
-                    made, waited, written, submitted, submissions);
-      const std::string what =
-          "(d) staging ring " + spec + " MiB " + kind + ", " + std::to_string(pool.workers() + 1) + " threads, a barrier a slot";
-      r.print(what, src.size(), extra);
-      check(what);
-      Runs c;
-      std::array<double, 3> parts{}, bestParts{};
-      for (int i = 0; i < reps; ++i) {
-        const auto t0 = Clock::now();
-        parts = continuousRing(ctx, src, dst.handle(), slotMiB * kMiB, slots, use);
-        c.ms.push_back(msSince(t0));
-        if (c.ms.back() <= *std::min_element(c.ms.begin(), c.ms.end())) bestParts = parts;
-      }
-      std::snprintf(extra, sizeof extra, "  (best: ring made %.1f, slot waits %.1f (threads' sum), submits %.1f ms)",
-                    bestParts[0], bestParts[1], bestParts[2]);
-      const std::string cwhat =
-          "(d) staging ring " + spec + " MiB " + kind + ", " + std::to_string(threadCount()) + " threads, continuous";
-      c.print(cwhat, src.size(), extra);
-      check(cwhat);
-    }
-}
-
 // (e): GpuScene's own upload of `scene` (textures as its defaults load them), the two paths alternating.
 void sceneUpload(const vk::Context& ctx, const Scene& scene, const std::string& name, int reps) {
   using render::GeometryUpload;
@@ -513,12 +371,11 @@ void sceneUpload(const vk::Context& ctx, const Scene& scene, const std::string& 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtr-bench-upload: CPU writes, GPU copies and the staging ring, host to device (GB/s)"};
+  CLI::App app{"rtr-bench-upload: CPU writes and GPU copies host to device, and a scene's upload (GB/s)"};
   size_t mib = 1024;
   int reps = 3;
   std::vector<unsigned> threads{1, 2, 4, 8, 16}, chunks{4, 16, 64};
-  std::vector<std::string> rings{"32x4", "8x4", "64x4", "128x4", "32x8", "256x2"};
-  std::string only = "abcd", sceneFile;
+  std::string only = "abc", sceneFile;
   app.add_option("--mib", mib, "bytes to move, in MiB (default 1024)")->check(CLI::Range(1, 65536));
   app.add_option("--reps", reps, "runs per case (default 3): first, best and median are printed")->check(CLI::Range(1, 1000));
   app.add_option("--threads", threads, "(a), (b): thread counts (default 1,2,4,8,16)")
@@ -527,9 +384,7 @@ int main(int argc, char** argv) {
   app.add_option("--chunks", chunks, "(c): copy sizes in MiB besides the one copy (default 4,16,64)")
       ->delimiter(',')
       ->check(CLI::Range(1, 65536));
-  app.add_option("--rings", rings, "(d): staging rings, SLOT_MIBxSLOTS (default 32x4 (GpuScene's),8x4,64x4,128x4,32x8,256x2)")
-      ->delimiter(',');
-  app.add_option("--only", only, "which cases: letters of abcd (default all; e runs where --scene is given)");
+  app.add_option("--only", only, "which cases: letters of abc (default all; e runs where --scene is given)");
   app.add_option("--scene", sceneFile, "(e): a scene whose GpuScene upload is timed, direct and staged");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -542,7 +397,7 @@ int main(int argc, char** argv) {
                   double(mp.memoryHeaps[mp.memoryTypes[i].heapIndex].size) / double(1u << 30),
                   flagNames(mp.memoryTypes[i].propertyFlags).c_str());
     // The source: touched first, so that no page fault is timed; a pattern the copies are checked against.
-    std::vector<uint8_t> src(only.find_first_of("abcd") == std::string::npos ? 0 : mib * kMiB);
+    std::vector<uint8_t> src(only.find_first_of("abc") == std::string::npos ? 0 : mib * kMiB);
     parallelFor((src.size() + kPiece - 1) / kPiece, 0, [&](size_t p) {
       for (size_t i = p * kPiece; i < std::min(src.size(), (p + 1) * kPiece); ++i) src[i] = uint8_t(i * 2654435761u >> 13);
     });
@@ -551,7 +406,6 @@ int main(int argc, char** argv) {
       CopyRig rig(ctx);
       gpuCopies(rig, src, chunks, reps);
     }
-    if (only.find('d') != std::string::npos) ringUpload(ctx, src, rings, reps);
     if (!sceneFile.empty()) {
       src = {};
       const Scene scene = loadScene(sceneFile);
