@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/env.hpp"
 #include "core/error.hpp"
 #include "scene/textures.hpp"
 #include "vk/commands.hpp"
@@ -26,9 +27,7 @@ constexpr VkFormat kPyramidFormat = VK_FORMAT_R32_SFLOAT;
 uint32_t levelCount(VkExtent2D e) {
   uint32_t n = 1;
   for (uint32_t m = std::max(e.width, e.height); m > 1; m /= 2) ++n;
-  uint32_t cap = CULL_PYRAMID_MAX_LEVELS;
-  if (const char* v = std::getenv("RTR_PYRAMID_LEVELS")) cap = std::max(1, std::atoi(v));
-  return std::min(n, cap);
+  return std::min(n, envNumber("RTR_PYRAMID_LEVELS", 1, 32, "a number of levels").value_or(CULL_PYRAMID_MAX_LEVELS));
 }
 
 }  // namespace

@@ -1,7 +1,6 @@
 #include "render/raster.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdlib>
 #include <cstdio>
 #include <cstring>
@@ -9,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/env.hpp"
 #include "raster.h"
 #include "vk/commands.hpp"
 #include "vk/context.hpp"
@@ -36,18 +36,6 @@ std::vector<vk::SpecializationConstant> withMeasure(std::vector<vk::Specializati
   std::fprintf(stderr, "RTR_RASTER_MEASURE=%s: the raster pass writes no ids (measuring only)\n", v);
   constants.push_back({2, mode == "setup" ? RASTER_MEASURE_SETUP : RASTER_MEASURE_NO_ATOMICS});
   return constants;
-}
-
-// A number from the environment variable `name` in [lo, hi] (`what` says what it counts), or none where unset.
-std::optional<uint32_t> envNumber(const char* name, uint32_t lo, uint32_t hi, const char* what) {
-  const char* v = std::getenv(name);
-  if (!v || !*v) return std::nullopt;
-  char* end = nullptr;
-  const unsigned long n = std::strtoul(v, &end, 10);
-  if (*end || n < lo || n > hi || !std::isdigit(static_cast<unsigned char>(*v)))
-    throw std::runtime_error(std::string(name) + "=" + v + ": expected " + what + " from " + std::to_string(lo) + " to " +
-                             std::to_string(hi));
-  return uint32_t(n);
 }
 
 // RTR_RASTER_MEDIUM=T: raster.comp's medium triangles are those whose box is over T pixels (its kMediumFrom,

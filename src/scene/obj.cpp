@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "core/bounds.hpp"
+#include "core/env.hpp"
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "core/parallel.hpp"
@@ -39,9 +40,8 @@ constexpr size_t kBatch = size_t(64) << 20;
 // RTR_OBJ_PIECE_KIB=N sets it for measuring (the parse is the same for any).
 constexpr size_t kPieceBytes = size_t(256) << 10;
 size_t pieceBytesFromEnv() {
-  const char* v = std::getenv("RTR_OBJ_PIECE_KIB");
-  const long kib = v ? std::atol(v) : 0;
-  return kib > 0 ? size_t(kib) << 10 : kPieceBytes;
+  const auto kib = envNumber("RTR_OBJ_PIECE_KIB", 1, 1u << 20, "a piece size in KiB");
+  return kib ? size_t(*kib) << 10 : kPieceBytes;
 }
 constexpr size_t kMaxLine = size_t(64) << 20;
 constexpr uint64_t kMaxMtlBytes = uint64_t(64) << 20;  // real ones are kilobytes; /dev/zero is refused anyway
