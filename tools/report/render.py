@@ -715,10 +715,10 @@ class Report:
                 mb = f"{int(size.group(1)) / 1e6:.0f}" if size else "–"
                 self.w(f"| {form} | {bt.group(1) if bt else '–'} | {mb} | {cell('texture decode')} | "
                        f"{cell('texture upload')} | {cell('mips')} | {cell('total from process start')} |")
-                if form == "bc" and not m.label.startswith("vm"):
-                    total = best["total from process start"]
-                    self.goals.append((f"200-texture scene, first frame with textures ≤ 0.35 s ({m.label}, bc)",
-                                       f"{total:.0f} ms", total <= 350))
+                if form == "bc":  # the goals: 0.35 s on the GPU machines, 0.6 s on lavapipe (2 cores)
+                    total, goal = best["total from process start"], 600 if m.label.startswith("vm") else 350
+                    self.goals.append((f"200-texture scene, first frame with textures ≤ {goal / 1000:.2f} s ({m.label}, bc)",
+                                       f"{total:.0f} ms", total <= goal))
             self.direct_open(m)
             self.w()
             self.source(m, "textures-bc-1")
