@@ -148,6 +148,9 @@ MeshRecords buildMeshRecords(const Mesh& m, uint32_t flags, bool lods, unsigned 
     // it), then the layers above them.
     ClusterTreeLayers layers(nodeLayers + 1);
     for (size_t i = 0; i <= nodeLayers; ++i) {
+      size_t size = 0;
+      for (size_t p = firstPiece[l]; p < firstPiece[l + 1]; ++p) size += subtrees[p][i].size();
+      layers[i].reserve(size);
       uint32_t below = 0;
       for (size_t p = firstPiece[l]; p < firstPiece[l + 1]; ++p) {
         for (shader::GpuCullNode node : subtrees[p][i]) {
