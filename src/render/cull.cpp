@@ -149,20 +149,22 @@ std::vector<shader::GpuCluster> gpuClusters(const Scene& scene) {
   return out;
 }
 
-glm::vec4 enclosingSphere(const std::vector<glm::vec4>& spheres) {
-  Bounds b;
-  for (const glm::vec4& s : spheres) b.extend(glm::vec3(s) - s.w), b.extend(glm::vec3(s) + s.w);
-  float r = 0.0f;
-  for (const glm::vec4& s : spheres) r = std::max(r, glm::length(glm::vec3(s) - b.center()) + s.w);
-  return b.empty() ? glm::vec4(0.0f) : glm::vec4(b.center(), r * (1.0f + 1e-6f));  // rounding: never smaller
+glm::vec4 enclosingSphere(const Bounds& box, float reach) {
+  return box.empty() ? glm::vec4(0.0f) : glm::vec4(box.center(), reach * (1.0f + 1e-6f));  // rounding: never smaller
 }
 
-uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, const std::vector<shader::GpuClusterLod>& lods,
-                           uint32_t first, uint32_t count, uint32_t root, std::vector<shader::GpuCullNode>& nodes,
-                           std::vector<uint32_t>& depthCounts) {
-  // Bottom up: leaves of CULL_GROUP_SIZE consecutive records, then nodes of CULL_NODE_CHILDREN consecutive
-  // nodes (first: an index in the layer below until stored), up to one.
-  std::vector<std::vector<shader::GpuCullNode>> layers(1);
+glm::vec4 enclosingSphere(std::span<const glm::vec4> spheres) {
+  Bounds b;
+  for (const glm::vec4& s : spheres) extendBySphere(b, s);
+  float r = 0.0f;
+  for (const glm::vec4& s : spheres) r = std::max(r, sphereReach(b, s));
+  return enclosingSphere(b, r);
+}
+
+ClusterTreeLayers clusterTreeLayers(std::span<const shader::GpuCluster> clusters, std::span<const shader::GpuClusterLod> lods,
+                                    uint32_t first, uint32_t count, size_t nodeLayers) {
+  // Leaves of CULL_LEAF_SIZE consecutive records, then nodes of CULL_NODE_CHILDREN consecutive nodes.
+  ClusterTreeLayers layers(1);
   std::vector<glm::vec4> spheres, lodSpheres;
   for (uint32_t at = first; at < first + count || (count == 0 && layers[0].empty()); at += CULL_LEAF_SIZE) {
     const uint32_t n = std::min<uint32_t>(CULL_LEAF_SIZE, first + count - at);
@@ -183,23 +185,31 @@ uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, cons
     layers[0].push_back(leaf);
     if (count == 0) break;
   }
-  while (layers.back().size() > 1) {
-    const std::vector<shader::GpuCullNode>& below = layers.back();
-    std::vector<shader::GpuCullNode> up;
-    for (uint32_t at = 0; at < below.size(); at += CULL_NODE_CHILDREN) {
-      const uint32_t n = std::min<uint32_t>(CULL_NODE_CHILDREN, uint32_t(below.size()) - at);
-      shader::GpuCullNode node{{}, {}, shader::LOD_ERROR_INFINITE, 0.0f, at, n};
-      spheres.clear(), lodSpheres.clear();
-      for (uint32_t c = at; c < at + n; ++c) {
-        spheres.push_back(below[c].sphere), lodSpheres.push_back(below[c].lodSphere);
-        node.minError = std::min(node.minError, below[c].minError);
-        node.maxParentError = std::max(node.maxParentError, below[c].maxParentError);
-      }
-      node.sphere = enclosingSphere(spheres), node.lodSphere = enclosingSphere(lodSpheres);
-      up.push_back(node);
+  while (nodeLayers == SIZE_MAX ? layers.back().size() > 1 : layers.size() <= nodeLayers) addClusterTreeLayer(layers);
+  return layers;
+}
+
+void addClusterTreeLayer(ClusterTreeLayers& layers) {
+  const std::vector<shader::GpuCullNode>& below = layers.back();
+  std::vector<shader::GpuCullNode> up;
+  std::vector<glm::vec4> spheres, lodSpheres;
+  for (uint32_t at = 0; at < below.size(); at += CULL_NODE_CHILDREN) {
+    const uint32_t n = std::min<uint32_t>(CULL_NODE_CHILDREN, uint32_t(below.size()) - at);
+    shader::GpuCullNode node{{}, {}, shader::LOD_ERROR_INFINITE, 0.0f, at, n};
+    spheres.clear(), lodSpheres.clear();
+    for (uint32_t c = at; c < at + n; ++c) {
+      spheres.push_back(below[c].sphere), lodSpheres.push_back(below[c].lodSphere);
+      node.minError = std::min(node.minError, below[c].minError);
+      node.maxParentError = std::max(node.maxParentError, below[c].maxParentError);
     }
-    layers.push_back(std::move(up));
+    node.sphere = enclosingSphere(spheres), node.lodSphere = enclosingSphere(lodSpheres);
+    up.push_back(node);
   }
+  layers.push_back(std::move(up));
+}
+
+uint32_t storeClusterTree(const ClusterTreeLayers& layers, uint32_t root, std::vector<shader::GpuCullNode>& nodes,
+                          std::vector<uint32_t>& depthCounts) {
   // Stored top down: the root in its slot, each layer below in one run, parents pointed at their children.
   const size_t top = layers.size() - 1;
   if (depthCounts.size() < layers.size()) depthCounts.resize(layers.size(), 0);
@@ -214,6 +224,12 @@ uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, cons
     parents = base;
   }
   return uint32_t(layers[0].size());
+}
+
+uint32_t appendClusterTree(std::span<const shader::GpuCluster> clusters, std::span<const shader::GpuClusterLod> lods,
+                           uint32_t first, uint32_t count, uint32_t root, std::vector<shader::GpuCullNode>& nodes,
+                           std::vector<uint32_t>& depthCounts) {
+  return storeClusterTree(clusterTreeLayers(clusters, lods, first, count), root, nodes, depthCounts);
 }
 
 PyramidPasses pyramidPassesFromEnv() {

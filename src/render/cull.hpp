@@ -8,16 +8,20 @@
 // Use, per frame (two-phase, CullPhase below): culler.record(Early); dispatch indirect on counts() over
 // visible(); pyramid.build(depth of that); culler.record(Late, &pyramid); dispatch again. docs/culling.md.
 #include <array>
-#include <optional>
+#include <cstdint>
 #include <functional>
+#include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/enum_names.hpp"
 #include "cull.h"
+#include "core/bounds.hpp"
 #include "scene/scene.hpp"
 #include "vk/pipeline.hpp"
 #include "vk/resources.hpp"
@@ -57,14 +61,32 @@ void appendClusters(const Mesh& mesh, const glm::mat4& transform, uint32_t insta
 void appendClusterLods(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above, size_t first,
                        std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods);
 // The sphere around the box of `spheres` that holds each (rounded outwards).
-glm::vec4 enclosingSphere(const std::vector<glm::vec4>& spheres);
+glm::vec4 enclosingSphere(std::span<const glm::vec4> spheres);
+// The same in steps, for spheres spread over pieces (render/mesh_records.cpp): each piece's box
+// (extendBySphere), joined in order; each piece's farthest reach from the joined box's centre
+// (sphereReach), the largest; then the sphere. The same bits as enclosingSphere over all of them.
+inline void extendBySphere(Bounds& box, glm::vec4 s) { box.extend(glm::vec3(s) - s.w), box.extend(glm::vec3(s) + s.w); }
+inline float sphereReach(const Bounds& box, glm::vec4 s) { return glm::length(glm::vec3(s) - box.center()) + s.w; }
+glm::vec4 enclosingSphere(const Bounds& box, float reach);
 // The culling tree over records [first, first + count), one level of a mesh (culling spheres in `clusters`,
 // level-of-detail records in `lods`, or none): leaves of up to CULL_LEAF_SIZE consecutive records, nodes
 // of up to CULL_NODE_CHILDREN (cluster.h). Its root goes to nodes[root] (the caller's slot), the rest is
 // appended; adds its nodes at each depth (the root's 0) to `depthCounts`; returns its leaves.
-uint32_t appendClusterTree(const std::vector<shader::GpuCluster>& clusters, const std::vector<shader::GpuClusterLod>& lods,
+uint32_t appendClusterTree(std::span<const shader::GpuCluster> clusters, std::span<const shader::GpuClusterLod> lods,
                            uint32_t first, uint32_t count, uint32_t root, std::vector<shader::GpuCullNode>& nodes,
                            std::vector<uint32_t>& depthCounts);
+// appendClusterTree in steps, for a tree built in pieces (render/mesh_records.cpp). Its layers bottom up,
+// layer 0 the leaves (their `first` a record), each node's `first` an index in the layer below:
+// clusterTreeLayers makes the leaves and the layers above them up to one node, or exactly `nodeLayers`
+// layers of nodes (a piece of CULL_LEAF_SIZE * CULL_NODE_CHILDREN^nodeLayers records: its subtree);
+// addClusterTreeLayer makes one layer over the top one; storeClusterTree stores them as appendClusterTree
+// does and returns the leaves.
+using ClusterTreeLayers = std::vector<std::vector<shader::GpuCullNode>>;
+ClusterTreeLayers clusterTreeLayers(std::span<const shader::GpuCluster> clusters, std::span<const shader::GpuClusterLod> lods,
+                                    uint32_t first, uint32_t count, size_t nodeLayers = SIZE_MAX);
+void addClusterTreeLayer(ClusterTreeLayers& layers);
+uint32_t storeClusterTree(const ClusterTreeLayers& layers, uint32_t root, std::vector<shader::GpuCullNode>& nodes,
+                          std::vector<uint32_t>& depthCounts);
 // Every GpuCluster of a scene, numbered as GpuScene numbers its instances.
 std::vector<shader::GpuCluster> gpuClusters(const Scene& scene);
 

@@ -17,6 +17,7 @@
 
 #include "cluster.h"
 #include "render/cull.hpp"
+#include "render/mesh_records.hpp"
 #include "render/staging_ring.hpp"
 #include "render/startup.hpp"
 #include "core/error.hpp"
@@ -53,18 +54,6 @@ struct MeshDraw {
   DrawItem item;
   DrawKind kind;
   uint32_t flags;
-};
-
-// One mesh's cluster records once, in its own space (docs/culling.md): level 0 (the mesh's clusters), then
-// the levels above, their level-of-detail records, and a tree over each level, their roots first; made on
-// all cores, a mesh each, numbered from 0 (written into the scene-wide buffers at `first` and `firstLevel`).
-struct MeshRecords {
-  uint32_t first = 0, count = 0, level0 = 0, firstLevel = 0, levels = 0, leaves = 0;
-  glm::vec4 sphere{0.0f}, lodSphere{0.0f};
-  std::vector<uint32_t> depths;  // its trees' nodes at each depth
-  std::vector<shader::GpuCluster> clusters;
-  std::vector<shader::GpuClusterLod> lods;  // empty: no mesh has a hierarchy
-  std::vector<shader::GpuCullNode> nodes;   // leaves name records, others nodes, both numbered from 0
 };
 
 // A piece of the geometry writing small enough to spread a single large mesh over all cores: a mesh's
@@ -104,52 +93,6 @@ struct GeometryPlan {
 };
 
 namespace {
-
-// Mesh mi's records (MeshRecords), numbered from 0.
-void buildRecords(const Scene& scene, const GeometryPlan& p, uint32_t mi, MeshRecords& r) {
-  const Mesh& m = scene.meshes[mi];
-  // Sized once: grown by doubling, the largest mesh's records took twice the time (fresh pages).
-  const size_t above =
-      size_t(std::count_if(m.lod.clusters.begin(), m.lod.clusters.end(), [](const LodCluster& c) { return c.level > 0; }));
-  const size_t own =
-      m.clusters.empty() ? (m.indices.size() / 3 + CLUSTER_MAX_TRIANGLES - 1) / CLUSTER_MAX_TRIANGLES : m.clusters.size();
-  r.clusters.reserve(own + above);
-  if (p.lods) r.lods.reserve(own + above);
-  appendClusters(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, r.clusters);
-  r.level0 = uint32_t(r.clusters.size());
-  if (p.lods) {
-    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, false, 0, r.clusters, r.lods);
-    appendClusterLods(m, glm::mat4(1.0f), 0, p.meshDraw[mi]->flags, true, 0, r.clusters, r.lods);
-  }
-  r.count = uint32_t(r.clusters.size());
-  std::vector<glm::vec4> spheres;
-  spheres.reserve(2 * r.count);
-  for (const shader::GpuCluster& c : r.clusters) spheres.push_back(c.sphere);
-  r.sphere = enclosingSphere(spheres);
-  if (r.lods.empty()) {
-    r.lodSphere = r.sphere;
-  } else {
-    spheres.clear();
-    for (const shader::GpuClusterLod& l : r.lods) {
-      spheres.push_back(l.sphere);
-      if (l.error.y < shader::LOD_ERROR_INFINITE) spheres.push_back(l.parentSphere);
-    }
-    r.lodSphere = enclosingSphere(spheres);
-  }
-  // Level 0, then the levels above in the order the hierarchy lists its clusters (level by level); a
-  // tree over each, their roots side by side.
-  std::vector<glm::uvec2> runs{{0, r.level0}};
-  uint32_t at = 0;
-  for (size_t k = 0, c = r.level0; k < m.lod.clusters.size() && r.count > r.level0; ++k) {
-    if (m.lod.clusters[k].level == 0) continue;
-    if (runs.size() == 1 || m.lod.clusters[k].level != at) runs.push_back({uint32_t(c), 0});
-    at = m.lod.clusters[k].level, ++runs.back().y, ++c;
-  }
-  r.levels = uint32_t(runs.size());
-  r.nodes.resize(runs.size());
-  for (size_t l = 0; l < runs.size(); ++l)
-    r.leaves += appendClusterTree(r.clusters, r.lods, runs[l].x, runs[l].y, uint32_t(l), r.nodes, r.depths);
-}
 
 shader::GpuInstance gpuInstance(const glm::mat4& t, uint32_t draw) {
   // The identity stays exact (existing scenes' images do not move by a rounding).
@@ -573,7 +516,8 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
   auto write = [&](const WriteTask& task, const Place& place) {
     if (task.what == Write::Build) {
       const auto t = Clock::now();
-      buildRecords(scene, plan, task.slot, plan.records[task.slot]);
+      // A large mesh's on all cores (beside the streams' writers), in fixed pieces (render/mesh_records.hpp).
+      plan.records[task.slot] = buildMeshRecords(scene.meshes[task.slot], plan.meshDraw[task.slot]->flags, plan.lods);
       const int64_t us = int64_t(msSince(t) * 1e3);
       for (int64_t was = longestBuildUs; us > was && !longestBuildUs.compare_exchange_weak(was, us);) {}
       return;
@@ -725,6 +669,7 @@ void GpuScene::uploadGeometry(const Scene& scene, GeometryPlan& plan, const std:
     j = e;
   }
   run(tasks);
+  for (MeshRecords& r : plan.records) r.clusters.release(0), r.lods.release(0);  // a large one's pages freed on all cores
   stats_.geometryRecordsMs = msSince(phase);
   for (const Target& tg : targets)
     if (tg.size && tg.dst) tg.buffer->flush();
