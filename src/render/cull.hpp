@@ -16,6 +16,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/enum_names.hpp"
 #include "cull.h"
 #include "scene/scene.hpp"
 #include "vk/pipeline.hpp"
@@ -116,6 +117,15 @@ struct CullCamera {
   // (the caller then passes only the full-detail clusters).
   float lodThreshold = 0.0f, pixelsPerUnit = 0.0f, zNear = 0.0f;
 };
+
+// Compute raster only: which clusters are tested before they are drawn (docs/culling.md); none changes the
+// image. Frustum: one pass of the frustum and back-face cone tests (with the level-of-detail cut where one is
+// drawn); TwoPhase: those and the depth pyramid's occlusion test, in two phases. Off: no test, but the cut
+// alone where one is drawn.
+enum class Culling { Off, Frustum, TwoPhase };
+constexpr std::array<EnumName<Culling>, 3> enumNames(Culling) {
+  return {{{Culling::Off, "off"}, {Culling::Frustum, "frustum"}, {Culling::TwoPhase, "on"}}};
+}
 
 struct CullTests {
   bool frustum = true, cone = true, occlusion = true;  // occlusion only when a pyramid is given

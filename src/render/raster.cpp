@@ -179,7 +179,7 @@ void ComputeRaster::resize(VkExtent2D extent) {
 }
 
 void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
-                           const CullCamera& camera, bool cull, bool clip, bool counters) {
+                           const CullCamera& camera, Culling cull, bool clip, bool counters) {
   // A scene may lack one index width or texcoords: any storage buffer fills that binding (nothing reads it).
   const VkBuffer i16 = scene_.indices16() ? scene_.indices16() : scene_.indices32();
   const VkBuffer i32 = scene_.indices32() ? scene_.indices32() : scene_.indices16();
@@ -187,7 +187,8 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   // Level 0 only (the first baseClusterCount() records) unless a cut is chosen.
   const bool lod = scene_.clusterLods() && camera.lodThreshold > 0.0f && !camera.orthographic;
   const uint32_t clusterCount = lod ? scene_.clusterCount() : scene_.baseClusterCount();
-  const bool twoPhase = cull && clusterCount > 0, culling = (cull || lod) && clusterCount > 0;
+  const bool twoPhase = cull == Culling::TwoPhase && clusterCount > 0;
+  const bool culling = (cull != Culling::Off || lod) && clusterCount > 0;
   if (culling && !culler_) culler_.emplace(ctx_, scene_.clusterCount(), scene_.chunkCapacity(), scene_.cullQueueCapacity());
   if (twoPhase && !pyramid_) pyramid_.emplace(ctx_, extent_);
   culled_.at(frame) = culling;
@@ -262,8 +263,9 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
     vkCmdDispatch(cb, RASTER_LARGE_GROUPS, 1, 1);
     timer.mark(cb, largeName);
   };
-  if (culling && !twoPhase) {  // the level-of-detail cut alone
-    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {false, false, false, true}, CullPhase::Single, lods,
+  if (culling && !twoPhase) {  // one pass: frustum and cones (Culling::Frustum), the level-of-detail cut
+    const bool tests = cull == Culling::Frustum;
+    culler_->record(cb, scene_.clusters(), clusterCount, camera, nullptr, {tests, tests, false, true}, CullPhase::Single, lods,
                     scene_.cullInstances(), scene_.cullInstanceCount(), scene_.cullNodes(), scene_.instances());
     if (counters) {
       vkCmdCopyBuffer(cb, culler_->counts(), cullReadback_.handle(), 1, &toReadback[1]);

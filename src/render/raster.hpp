@@ -43,7 +43,7 @@ class ComputeRaster {
   // `clip`: the triangles crossing w = 0 or the guard band are clipped in compute ("raster clip", once per
   // raster pass); otherwise the hardware draws them ("raster hw", the reference).
   void record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
-              const CullCamera& camera, bool cull, bool clip, bool counters = true);
+              const CullCamera& camera, Culling cull, bool clip, bool counters = true);
   // Whether the last use of `frame` read its counters back (record's `counters`).
   bool counted(uint32_t frame) const { return counted_.at(frame); }
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row

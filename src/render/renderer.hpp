@@ -44,10 +44,9 @@ struct RenderSettings {
   int mode = VIEW_SHADED;                         // VIEW_* from frame.h
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   RasterPath raster = RasterPath::Auto;
-  // Compute raster only: two-phase cluster culling (docs/culling.md); never changes the image. Off by default:
-  // on the H200 its fixed cost (depth pyramid + two cull passes) exceeded the raster time it saved in
-  // every measured scene (docs/raster.md).
-  bool cull = false;
+  // Off by default: on the H200 the passes' fixed cost exceeded the raster time they saved in the default
+  // scene (docs/raster.md); scenes with a cut gain from them (docs/virtual-geometry.md).
+  Culling cull = Culling::Off;
   // Compute raster: the triangles crossing the near plane (w = 0) or the guard band clipped in compute (a
   // small pass, docs/raster.md) rather than drawn by the hardware. Off by default: on the H100 the pass
   // took 0.48 ms for the default temple's 16 walls, the hardware 0.12 ms (docs/raster.md).

@@ -78,8 +78,9 @@ TEST_F(FrameTest, ShadedFrameIsFiniteAndLit) {
     // compute raster clip (and raster clip early).
     const render::RenderSettings defaults;
     const bool compute = renderer->renderer().rasterFor(defaults) == render::RasterPath::Compute;
-    const size_t clip = defaults.clip ? (defaults.cull ? 2u : 1u) : 0u;
-    EXPECT_EQ(f.gpuTimes.size(), !vis ? 2u : !compute ? 3u : (defaults.cull ? 11u : 6u) + clip);
+    const bool twoPhase = defaults.cull == render::Culling::TwoPhase, onePass = defaults.cull == render::Culling::Frustum;
+    const size_t clip = defaults.clip ? (twoPhase ? 2u : 1u) : 0u;
+    EXPECT_EQ(f.gpuTimes.size(), !vis ? 2u : !compute ? 3u : (twoPhase ? 11u : onePass ? 7u : 6u) + clip);
     EXPECT_EQ(ranPass(f, "shade"), vis);
   }
   EXPECT_GT(gpu->stats().meshes16, 0u) << "small meshes should use 16-bit indices";
@@ -252,9 +253,9 @@ TEST_F(FrameTest, OneFrameRecordsExactlyTheBarriersItNeeds) {
   for (auto path : {render::ShadingPath::Forward, render::ShadingPath::Visibility})
     for (auto raster : {render::RasterPath::Hardware, render::RasterPath::Compute})
       for (auto mosaic : {render::MosaicMode::Off, render::MosaicMode::Compute, render::MosaicMode::Graphics})
-        for (bool cull : {true, false}) {
+        for (auto cull : {render::Culling::TwoPhase, render::Culling::Frustum, render::Culling::Off}) {
           SCOPED_TRACE(std::string(rtr::enumName(path)) + ", mosaic " + rtr::enumName(mosaic) + ", " + rtr::enumName(raster) +
-                       " raster, cull " + (cull ? "on" : "off"));
+                       " raster, cull " + rtr::enumName(cull));
           RenderSettings s;
           s.cull = cull;
           s.shading = path;

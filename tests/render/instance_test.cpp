@@ -132,7 +132,7 @@ TEST_F(InstanceTest, InstancesDrawLikeTheFlattenedScene) {
       render::RenderSettings s;
       s.shading = p.shading;
       s.raster = p.raster;
-      s.cull = p.cull;
+      s.cull = p.cull ? render::Culling::TwoPhase : render::Culling::Off;
       s.mosaic = render::MosaicMode::Off;
       for (int mode : {VIEW_SHADED, VIEW_NORMAL}) {
         if (mode != VIEW_SHADED && p.shading == render::ShadingPath::Visibility) continue;  // debug views are forward
@@ -182,7 +182,7 @@ TEST_F(InstanceTest, ComputeIdsEqualHardwareIdsAndCullingChangesNothing) {
     const std::vector<uint32_t> hw = r.ids(pose, lens, s);
     s.raster = render::RasterPath::Compute;
     const std::vector<uint32_t> cs = r.ids(pose, lens, s);
-    s.cull = true;
+    s.cull = render::Culling::TwoPhase;
     culled.ids(pose, lens, s);  // a first frame: history
     const std::vector<uint32_t> cc = culled.ids(pose, lens, s);
     const auto stats = culled.renderer().cullStats(0);
@@ -215,7 +215,7 @@ TEST_F(InstanceTest, CulledInstancesCostNoClusterTests) {
   render::RenderSettings s;
   s.mosaic = render::MosaicMode::Off;
   s.raster = render::RasterPath::Compute;
-  s.cull = true;
+  s.cull = render::Culling::TwoPhase;
   const Bounds b = inst.bounds();
   // Looking away from the grid: every instance culled, no cluster tested, nothing drawn.
   const CameraPose away{glm::vec3(0.0f, 0.0f, 20.0f), 180.0f, 0.0f};
@@ -285,7 +285,7 @@ TEST_F(InstanceTest, ManyInstancesPastTheOldIdBudgetStayOnTheVisibilityPath) {
     const ImageRGBA8 vis = r.render(pose, lens, s, 1).image;
     s.raster = render::RasterPath::Compute;
     const std::vector<uint32_t> cs = r.ids(pose, lens, s);
-    s.cull = true;
+    s.cull = render::Culling::TwoPhase;
     culled.ids(pose, lens, s);  // a first frame: history
     const std::vector<uint32_t> cc = culled.ids(pose, lens, s);
     size_t covered = 0, carpet = 0, differ = 0, cullDiffer = 0;

@@ -27,7 +27,7 @@ namespace {
 
 class LodTest : public test::VulkanTest {};
 
-render::RenderSettings settings(float lodError, bool cull) {
+render::RenderSettings settings(float lodError, render::Culling cull = render::Culling::Off) {
   render::RenderSettings s;
   s.raster = render::RasterPath::Compute;
   s.mosaic = render::MosaicMode::Off;
@@ -67,7 +67,7 @@ TEST_F(LodTest, ThresholdZeroIsExactlyTheImageWithoutAHierarchy) {
   const VkExtent2D e{320, 200};
   render::HeadlessRenderer a(*ctx, gpu, e), b(*ctx, gpuPlain, e);
   for (const CameraPose& pose : templeViews(scene, 1.6f))
-    for (bool cull : {false, true}) {
+    for (render::Culling cull : {render::Culling::Off, render::Culling::TwoPhase}) {
       const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
       // The same (instance, triangle) at every pixel; the ids themselves differ (the hierarchy's triangles
       // lengthen each instance's id range, frame.h).
@@ -89,21 +89,30 @@ TEST_F(LodTest, CulledFramesEqualUnculledOnesWithACut) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
   const VkExtent2D e{320, 200};
-  render::HeadlessRenderer culled(*ctx, gpu, e), unculled(*ctx, gpu, e);
-  uint32_t byLod = 0;
+  render::HeadlessRenderer culled(*ctx, gpu, e), frustum(*ctx, gpu, e), unculled(*ctx, gpu, e);
+  uint32_t byLod = 0, byFrustum = 0, byCone = 0;
   for (const CameraPose& pose : templeViews(scene, 1.6f)) {
     const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
-    const std::vector<uint32_t> want = unculled.ids(pose, lens, settings(2.0f, false)),
-                                got = culled.ids(pose, lens, settings(2.0f, true));
-    size_t differ = 0;
-    for (size_t i = 0; i < want.size(); ++i) differ += want[i] != got[i];
+    const std::vector<uint32_t> want = unculled.ids(pose, lens, settings(2.0f)),
+                                got = culled.ids(pose, lens, settings(2.0f, render::Culling::TwoPhase)),
+                                single = frustum.ids(pose, lens, settings(2.0f, render::Culling::Frustum));
+    size_t differ = 0, differSingle = 0;
+    for (size_t i = 0; i < want.size(); ++i) differ += want[i] != got[i], differSingle += want[i] != single[i];
     EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(differSingle, 0u) << "frustum and cones in the cut's pass";
     const auto c = unculled.renderer().cullStats(0);
     ASSERT_TRUE(c);
     byLod += c->lod;
     EXPECT_EQ(c->frustum + c->cone + c->occlusion, 0u) << "without --cull only the cut is chosen";
+    const auto f = frustum.renderer().cullStats(0);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->occlusion, 0u) << "one pass, no pyramid";
+    EXPECT_EQ(f->early, 0u);
+    byFrustum += f->frustum, byCone += f->cone;
   }
   EXPECT_GT(byLod, 0u);
+  EXPECT_GT(byFrustum, 0u) << "--cull frustum tested no frustum";
+  EXPECT_GT(byCone, 0u) << "--cull frustum tested no cone";
 }
 
 // The level window (cull_instances.comp): the temple placed 36 times in a 6 x 6 grid, seen from beside it
@@ -126,7 +135,7 @@ TEST_F(LodTest, LevelWindowVisitsFewerClustersAndKeepsTheCut) {
   const Bounds b = scene.bounds();
   for (const CameraPose& pose : {orbitFrame(b, Lens{}, 1.6f, 200.0f, -10.0f), CameraPose{one.center(), 200.0f, -5.0f}}) {
     const Lens lens = fitDepthRange(Lens{}, b, pose);
-    r.ids(pose, lens, settings(2.0f, false));
+    r.ids(pose, lens, settings(2.0f));
     const auto c = r.renderer().cullStats(0);
     ASSERT_TRUE(c);
     const float ppu = float(e.height) / (2.0f * std::tan(glm::radians(lens.fovYDeg) * 0.5f));
@@ -223,9 +232,9 @@ TEST_F(LodTest, ImageErrorAgainstFullDetailIsSmall) {
   render::HeadlessRenderer r(*ctx, gpu, e);
   for (const CameraPose& pose : templeViews(scene, 1.6f)) {
     const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
-    const render::HeadlessFrame full = r.render(pose, lens, settings(0.0f, false));
+    const render::HeadlessFrame full = r.render(pose, lens, settings(0.0f));
     for (float threshold : {1.0f, 4.0f}) {
-      const render::HeadlessFrame cut = r.render(pose, lens, settings(threshold, false));
+      const render::HeadlessFrame cut = r.render(pose, lens, settings(threshold));
       const auto c = r.renderer().cullStats(0);
       ASSERT_TRUE(c);
       double sum = 0;
@@ -290,15 +299,15 @@ TEST_F(LodTest, ClosedMeshFromInsideShowsNoCrack) {
   size_t holes = 0;
   for (const CameraPose& pose : {CameraPose{{0.5f, 0.2f, 0.1f}, -90.0f, 0.0f}, CameraPose{{0.5f, 0.2f, 0.1f}, 90.0f, 10.0f},
                                  CameraPose{{0, 0, 0}, 30.0f, -40.0f}, CameraPose{{-0.7f, -0.3f, 0.2f}, 45.0f, 60.0f}})
-    for (bool cull : {false, true}) {
+    for (render::Culling cull : {render::Culling::Off, render::Culling::Frustum, render::Culling::TwoPhase}) {
       const std::vector<uint32_t> ids = r.ids(pose, lens, settings(4.0f, cull));
       const auto c = r.renderer().cullStats(0);
       ASSERT_TRUE(c);
       size_t empty = 0;
       for (uint32_t id : ids) empty += id == VIS_EMPTY;
-      std::printf("inside, yaw %.0f cull %d: %u of %u clusters listed, %u triangles; %zu px empty\n", pose.yawDeg, int(cull),
+      std::printf("inside, yaw %.0f cull %s: %u of %u clusters listed, %u triangles; %zu px empty\n", pose.yawDeg, enumName(cull),
                   c->early + c->late, c->clusters, c->triangles, empty);
-      EXPECT_EQ(empty, 0u) << "yaw " << pose.yawDeg << " cull " << cull;
+      EXPECT_EQ(empty, 0u) << "yaw " << pose.yawDeg << " cull " << enumName(cull);
       EXPECT_LT(c->triangles, m.triangleCount() / 2) << "coarser levels are drawn";
       holes += empty;
     }

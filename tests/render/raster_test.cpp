@@ -141,7 +141,7 @@ class RasterTest : public test::VulkanTest {
     if (!render::ComputeRaster::supported(*ctx)) GTEST_SKIP() << "no 64-bit buffer atomics";
   }
   std::vector<uint32_t> ids(render::HeadlessRenderer& r, const CameraPose& pose, const Lens& lens, RasterPath raster,
-                            bool clip = true, bool cull = false) {
+                            bool clip = true, render::Culling cull = render::Culling::Off) {
     render::RenderSettings s;
     s.raster = raster;
     s.clip = clip;
@@ -221,7 +221,7 @@ TEST_F(RasterTest, CrossingTrianglesAreClippedInCompute) {
     // With two-phase culling the clipping pass runs in both phases: the first frame's late phase draws
     // everything, the second's early phase (the late dispatch then skips the early entries). Same ids.
     for (int frame = 0; frame < 2; ++frame) {
-      EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, true), cs) << "culled, frame " << frame;
+      EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, render::Culling::TwoPhase), cs) << "culled, frame " << frame;
       EXPECT_EQ(r.renderer().handOffTriangles(0), 0u) << "culled, frame " << frame;
     }
   }
@@ -250,8 +250,8 @@ TEST_F(RasterTest, FramesWithoutCountersDrawTheSameIdsAndReportNone) {
   render::HeadlessRenderer r(*ctx, gpu, {160, 90});
   const CameraPose pose = scene.defaultView.value_or(frameBounds(scene.bounds(), Lens{}, 160.0f / 90.0f));
   const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
-  for (bool cull : {false, true}) {
-    SCOPED_TRACE(cull ? "two-phase culling" : "no culling");
+  for (render::Culling cull : {render::Culling::Off, render::Culling::Frustum, render::Culling::TwoPhase}) {
+    SCOPED_TRACE(std::string("culling ") + enumName(cull));
     render::RenderSettings s;
     s.raster = RasterPath::Compute;
     s.clip = true;
@@ -259,7 +259,7 @@ TEST_F(RasterTest, FramesWithoutCountersDrawTheSameIdsAndReportNone) {
     s.mosaic = render::MosaicMode::Off;
     const std::vector<uint32_t> counted = r.ids(pose, lens, s);
     ASSERT_TRUE(r.renderer().handOffTriangles(0) && r.renderer().mediumTriangles(0));
-    EXPECT_EQ(r.renderer().cullStats(0).has_value(), cull);
+    EXPECT_EQ(r.renderer().cullStats(0).has_value(), cull != render::Culling::Off);
     const uint32_t medium = r.renderer().mediumTriangles(0)->total();
     s.counters = false;
     EXPECT_EQ(r.ids(pose, lens, s), counted);
@@ -341,7 +341,7 @@ TEST_F(RasterTest, MediumTrianglesGiveTheSameIds) {
           medium.narrow += m.narrow, medium.wide += m.wide, medium.pastList += m.pastList;
           all.insert(all.end(), v.begin(), v.end());
           for (int frame = 0; frame < 2; ++frame)  // the first frame's late phase draws all, the second's early phase
-            EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, true), v) << "culled, frame " << frame;
+            EXPECT_EQ(ids(r, pose, lens, RasterPath::Compute, true, render::Culling::TwoPhase), v) << "culled, frame " << frame;
         }
         return std::pair(all, medium);
       },

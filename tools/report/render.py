@@ -385,7 +385,9 @@ class Report:
             names = {"pbr": "PBR, visibility path (default) + mosaic compute",
                      "pbr-forward": "PBR, forward path + mosaic compute",
                      "pbr-env": "PBR + environment (`--env sky`), visibility path + mosaic compute",
-                     "pbr-graphics": "PBR, visibility path + mosaic graphics", "textured": "plain textured (mode 13)"}
+                     "pbr-graphics": "PBR, visibility path + mosaic graphics", "textured": "plain textured (mode 13)",
+                     "display": "rtr-view's defaults (compute raster, no mosaic), stored view",
+                     "display-inside": "rtr-view's defaults, inside view", "display-outside": "rtr-view's defaults, outside view"}
             scenes = {"default": "default (11k triangles)", "big": "Sun-Temple size (1M triangles)"}
             self.w("| scene | size | frame | " + " | ".join(passes) + " | total |")
             self.w("|---|---|---|" + "---:|" * (len(passes) + 1))
@@ -404,6 +406,12 @@ class Report:
                     if pbr and env and scene == "default":
                         self.goals.append((f"environment on adds ≤ 0.05 ms to the 4K default-scene frame ({m.label})",
                                            f"{env:.3f} vs {pbr:.3f} ms: +{env - pbr:.3f} ms", env - pbr <= 0.05))
+                    for view in ("display", "display-inside", "display-outside"):  # issue 30
+                        t = tot.get(("3840x2160", view))
+                        if t and scene == "default":
+                            where = {"display": "stored", "display-inside": "inside", "display-outside": "outside"}[view]
+                            self.goals.append((f"default temple ≤ 0.35 ms at 4K with rtr-view's defaults, {where} view "
+                                               f"({m.label})", f"{t:.3f} ms", t <= 0.35))
                     if pbr and tex:
                         self.goals.append((f"whole frame ≤ 1.1× plain textured at 4K, {scene} scene ({m.label})",
                                            f"{pbr:.3f} vs {tex:.3f} ms = {pbr / tex:.2f}×", pbr / tex <= 1.1))
@@ -715,10 +723,10 @@ class Report:
                 mb = f"{int(size.group(1)) / 1e6:.0f}" if size else "–"
                 self.w(f"| {form} | {bt.group(1) if bt else '–'} | {mb} | {cell('texture decode')} | "
                        f"{cell('texture upload')} | {cell('mips')} | {cell('total from process start')} |")
-                if form == "bc" and not m.label.startswith("vm"):
-                    total = best["total from process start"]
-                    self.goals.append((f"200-texture scene, first frame with textures ≤ 0.35 s ({m.label}, bc)",
-                                       f"{total:.0f} ms", total <= 350))
+                if form == "bc":  # the issue's goals: 0.35 s on the GPU machines, 0.6 s on lavapipe (2 cores)
+                    total, goal = best["total from process start"], 600 if m.label.startswith("vm") else 350
+                    self.goals.append((f"200-texture scene, first frame with textures ≤ {goal / 1000:.2f} s ({m.label}, bc)",
+                                       f"{total:.0f} ms", total <= goal))
             self.direct_open(m)
             self.w()
             self.source(m, "textures-bc-1")

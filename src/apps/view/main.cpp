@@ -217,8 +217,10 @@ int main(int argc, char** argv) {
       ->check(cli::oneOf<render::RasterPath>())
       ->capture_default_str();
   std::string cull = "off";
-  app.add_option("--cull", cull, "compute raster: two-phase cluster culling (frustum, back-face cones, depth pyramid) on | off")
-      ->check(CLI::IsMember({"on", "off"}))
+  app.add_option("--cull", cull,
+                 "compute raster: cluster culling: on (frustum, back-face cones and the depth pyramid, two phases) | "
+                 "frustum (frustum and cones, one pass) | off")
+      ->check(cli::oneOf<render::Culling>())
       ->capture_default_str();
   std::string nearClip = "compute";
   auto* clipOpt = app.add_option("--near-clip", nearClip,
@@ -321,7 +323,7 @@ int main(int argc, char** argv) {
     o.settings.shading = cli::enumOption<render::ShadingPath>("--shading-path", shadingPath);
     o.settings.sampler.filter = cli::enumOption<render::TextureFilter>("--filter", filter);
     o.settings.raster = cli::enumOption<render::RasterPath>("--raster", raster);
-    o.settings.cull = cull == "on";
+    o.settings.cull = cli::enumOption<render::Culling>("--cull", cull);
     o.settings.clip = nearClip == "compute";
     o.clipGiven = clipOpt->count() > 0;
     return o.headless ? view::runHeadless(o) : view::runWindowed(o);
