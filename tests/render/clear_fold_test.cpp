@@ -1,7 +1,7 @@
 // The visibility buffer cleared by the shading pass (docs/raster.md, "The clear left to shading"): a frame
 // whose shading pass wrote RASTER_CLEAR back into every word lets the next frame skip the full clear, so each
 // frame must still give exactly what a fresh renderer gives for its camera, whatever came before it: other
-// views, a resize, a read-back of the ids, a pipeline reload, bench frames, two-phase culling, a
+// views, a resize, a read-back of the ids, a pipeline reload, bench frames, culling (one pass or two), a
 // transparency pass reading the ids after shading. References: a fresh renderer per view and size with
 // RTR_CLEAR_IN_SHADE=0 (the full clear every frame, as before the fold). Each test runs with the fold
 // (RTR_CLEAR_IN_SHADE=1) and without it (=0).
@@ -23,7 +23,10 @@
 namespace rtr {
 namespace {
 
+using render::Culling;
 using render::MosaicMode;
+
+constexpr Culling kCullings[] = {Culling::Off, Culling::Frustum, Culling::TwoPhase};
 
 // What one camera gives: the ids (HeadlessRenderer::ids) and the images without and with the post pass
 // (mosaic off: the shading pass writes the target; compute: the linear image, then the post pass).
@@ -57,7 +60,7 @@ class ClearFoldTest : public test::VulkanTest, public testing::WithParamInterfac
     ::unsetenv("RTR_CLEAR_IN_SHADE");
     VulkanTest::TearDown();
   }
-  static render::RenderSettings settings(MosaicMode mosaic, bool cull = false) {
+  static render::RenderSettings settings(MosaicMode mosaic, Culling cull = Culling::Off) {
     render::RenderSettings s;
     s.raster = render::RasterPath::Compute;
     s.mosaic = mosaic;
@@ -82,7 +85,7 @@ class ClearFoldTest : public test::VulkanTest, public testing::WithParamInterfac
 };
 
 // The default temple: its stored view, outside (rtr-view --camera 0,3,8,0,-15) and inside (0,1.5,0,30,-5),
-// one renderer frame after frame, with and without the post pass and two-phase culling: each frame's image
+// one renderer frame after frame, with and without the post pass and culling (off, frustum, two-phase): each frame's image
 // and ids equal a fresh renderer's for that camera, through other views, a read-back of the ids (which keeps
 // them: the next frame clears in full), a resize (a new buffer) and a pipeline reload (a new rasteriser).
 TEST_P(ClearFoldTest, ConsecutiveViewsMatchAFreshRenderer) {
@@ -94,9 +97,9 @@ TEST_P(ClearFoldTest, ConsecutiveViewsMatchAFreshRenderer) {
   auto lens = [&](const CameraPose& pose) { return fitDepthRange(Lens{}, scene.bounds(), pose); };
   render::HeadlessRenderer r(*ctx, gpu, small);
   r.render(views[2], lens(views[2]), settings(MosaicMode::Off));
-  for (bool cull : {false, true})
+  for (Culling cull : kCullings)
     for (MosaicMode mosaic : {MosaicMode::Off, MosaicMode::Compute}) {
-      SCOPED_TRACE(testing::Message() << (cull ? "two-phase culling" : "no culling") << ", mosaic " << enumName(mosaic));
+      SCOPED_TRACE(testing::Message() << "--cull " << enumName(cull) << ", mosaic " << enumName(mosaic));
       const render::RenderSettings s = settings(mosaic, cull);
       auto image = [&](VkExtent2D e, int v) {
         SCOPED_TRACE(testing::Message() << "image of view " << v << " at " << e.width << "x" << e.height);
@@ -142,8 +145,8 @@ TEST_P(ClearFoldTest, IdsAfterBenchFramesEqualAFreshRenderer) {
   const Lens lensStored = fitDepthRange(Lens{}, scene.bounds(), stored),
              lensOutside = fitDepthRange(Lens{}, scene.bounds(), outside);
   render::HeadlessRenderer r(*ctx, gpu, e);
-  for (bool cull : {false, true}) {
-    SCOPED_TRACE(cull ? "two-phase culling" : "no culling");
+  for (Culling cull : kCullings) {
+    SCOPED_TRACE(testing::Message() << "--cull " << enumName(cull));
     render::RenderSettings timed = settings(MosaicMode::Off, cull);
     timed.counters = false;
     r.bench(stored, lensStored, timed, 3);
@@ -193,8 +196,8 @@ TEST_P(ClearFoldTest, FramesWithATransparencyPassMatchAFreshRenderer) {
   render::HeadlessRenderer r(*ctx, gpu, small);
   r.render(views[1], lens, settings(MosaicMode::Off));
   VkExtent2D now = small;
-  for (bool cull : {false, true}) {
-    SCOPED_TRACE(cull ? "two-phase culling" : "no culling");
+  for (Culling cull : kCullings) {
+    SCOPED_TRACE(testing::Message() << "--cull " << enumName(cull));
     const render::RenderSettings s = settings(MosaicMode::Off, cull);
     for (auto [e, v, what] : {std::tuple{small, 0, "image"},
                               {small, 1, "image"},
