@@ -187,6 +187,7 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   // Level 0 only (the first baseClusterCount() records) unless a cut is chosen.
   const bool lod = scene_.clusterLods() && camera.lodThreshold > 0.0f && !camera.orthographic;
   const uint32_t clusterCount = lod ? scene_.clusterCount() : scene_.baseClusterCount();
+  if (cull == Culling::Auto) cull = lod ? Culling::Frustum : Culling::Off;
   const bool twoPhase = cull == Culling::TwoPhase && clusterCount > 0;
   const bool culling = (cull != Culling::Off || lod) && clusterCount > 0;
   if (culling && !culler_) culler_.emplace(ctx_, scene_.clusterCount(), scene_.chunkCapacity(), scene_.cullQueueCapacity());

@@ -44,9 +44,10 @@ struct RenderSettings {
   int mode = VIEW_SHADED;                         // VIEW_* from frame.h
   ShadingPath shading = ShadingPath::Visibility;  // fastest measured (docs/bench/gpu-passes.md)
   RasterPath raster = RasterPath::Auto;
-  // Off by default: on the H200 the passes' fixed cost exceeded the raster time they saved in the default
-  // scene (docs/raster.md); scenes with a cut gain from them (docs/virtual-geometry.md).
-  Culling cull = Culling::Off;
+  // Auto: one pass of frustum and cones where a level-of-detail cut is drawn, none otherwise; measured on
+  // the H200, a culling pass costs more than it saves in the default scene and two phases more than one
+  // with a cut (docs/culling.md).
+  Culling cull = Culling::Auto;
   // Compute raster: the triangles crossing the near plane (w = 0) or the guard band clipped in compute (a
   // small pass, docs/raster.md) rather than drawn by the hardware. Off by default: on the H100 the pass
   // took 0.48 ms for the default temple's 16 walls, the hardware 0.12 ms (docs/raster.md).

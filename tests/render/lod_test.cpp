@@ -89,7 +89,7 @@ TEST_F(LodTest, CulledFramesEqualUnculledOnesWithACut) {
   const Scene scene = loadScene(test::assetDir() / "temple.rtrscene");
   render::GpuScene gpu(*ctx, scene, render::MipMode::Compute);
   const VkExtent2D e{320, 200};
-  render::HeadlessRenderer culled(*ctx, gpu, e), frustum(*ctx, gpu, e), unculled(*ctx, gpu, e);
+  render::HeadlessRenderer culled(*ctx, gpu, e), frustum(*ctx, gpu, e), unculled(*ctx, gpu, e), automatic(*ctx, gpu, e);
   uint32_t byLod = 0, byFrustum = 0, byCone = 0;
   for (const CameraPose& pose : templeViews(scene, 1.6f)) {
     const Lens lens = fitDepthRange(Lens{}, scene.bounds(), pose);
@@ -109,6 +109,15 @@ TEST_F(LodTest, CulledFramesEqualUnculledOnesWithACut) {
     EXPECT_EQ(f->occlusion, 0u) << "one pass, no pyramid";
     EXPECT_EQ(f->early, 0u);
     byFrustum += f->frustum, byCone += f->cone;
+    // The default, auto: with a cut, the one pass of frustum and cones; at full detail, no pass.
+    EXPECT_EQ(automatic.ids(pose, lens, settings(2.0f, render::Culling::Auto)), want);
+    const auto a = automatic.renderer().cullStats(0);
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->frustum, f->frustum);
+    EXPECT_EQ(a->cone, f->cone);
+    EXPECT_EQ(a->occlusion + a->early, 0u);
+    automatic.ids(pose, lens, settings(0.0f, render::Culling::Auto));
+    EXPECT_FALSE(automatic.renderer().cullStats(0)) << "auto culls nothing without a cut";
   }
   EXPECT_GT(byLod, 0u);
   EXPECT_GT(byFrustum, 0u) << "--cull frustum tested no frustum";

@@ -216,10 +216,10 @@ int main(int argc, char** argv) {
   app.add_option("--raster", raster, "visibility ids: hardware | compute (64-bit atomics) | auto (the device's default)")
       ->check(cli::oneOf<render::RasterPath>())
       ->capture_default_str();
-  std::string cull = "off";
+  std::string cull = enumName(o.settings.cull);
   app.add_option("--cull", cull,
                  "compute raster: cluster culling: on (frustum, back-face cones and the depth pyramid, two phases) | "
-                 "frustum (frustum and cones, one pass) | off")
+                 "frustum (frustum and cones, one pass) | off | auto (frustum with a level-of-detail cut, else off)")
       ->check(cli::oneOf<render::Culling>())
       ->capture_default_str();
   std::string nearClip = "compute";
