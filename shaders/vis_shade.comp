@@ -31,7 +31,10 @@ layout(set = 0, binding = 6, std430) readonly buffer Indices16 { uint indices16[
 // The ids, by VIS_BUFFER: the hardware rasteriser's image, or the compute rasteriser's (depth << 32 | id)
 // per pixel, row by row (raster.h).
 layout(set = 0, binding = 7) uniform utexture2D visibilityImage;
-layout(set = 0, binding = 14, std430) readonly buffer Visibility { uvec2 visibilityBuffer[]; };  // x: the low half
+// pc.clearIds: each word read is written back clear (RASTER_CLEAR), so that the next frame's compute
+// rasteriser need not clear the buffer (ComputeRaster::foldClear): set where nothing reads the ids after this
+// pass. A store to the 8 bytes just read (an empty pixel's are clear already), waited for by nothing here.
+layout(set = 0, binding = 14, std430) buffer Visibility { uvec2 visibilityBuffer[]; };  // x: the low half
 layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D sceneColor;
 layout(set = 0, binding = 16) writeonly uniform image2D displayImage;  // DISPLAY: the target (UNORM; BGRA too)
 // HAS_TEXCOORDS only:
@@ -113,8 +116,14 @@ void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(p, outputSize()))) return;
   uint packed;
-  if (VIS_BUFFER) packed = visibilityBuffer[p.y * outputSize().x + p.x].x;
-  else packed = texelFetch(visibilityImage, p, 0).x;
+  if (VIS_BUFFER) {
+    const uint i = p.y * outputSize().x + p.x;
+    const uvec2 word = visibilityBuffer[i];
+    packed = word.x;
+    if (pc.clearIds != 0u && word != uvec2(~0u)) visibilityBuffer[i] = uvec2(~0u);
+  } else {
+    packed = texelFetch(visibilityImage, p, 0).x;
+  }
   const vec3 dir = frame.rayDir.xyz + (vec2(p) + 0.5).x * frame.rayDx.xyz + (vec2(p) + 0.5).y * frame.rayDy.xyz;
   if (packed == VIS_EMPTY) {  // the backdrop: the forward pass's clear colour, or the environment
     store(p, HAS_ENV ? envBackdrop(dir) : frame.background.rgb);

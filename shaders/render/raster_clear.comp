@@ -1,6 +1,7 @@
 #version 460
 // Compute rasteriser, first pass: every pixel to RASTER_CLEAR (depth bits and id all ones) and the
-// hand-off, tile, medium and clipping lists to none.
+// hand-off, tile, medium and clipping lists to none. Where the shading pass of the frame before cleared the
+// pixels (ComputeRaster::shadingCleared), it runs as one workgroup: the lists, and the first pixels again.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "raster_fetch.glsl"

@@ -122,6 +122,7 @@ struct GpuDraw {
 #define VIS_EMPTY 0xFFFFFFFFu
 struct VisShadePush {
   uint idPageShift;
+  uint clearIds;  // VIS_BUFFER: each word read written back to all ones (ComputeRaster::foldClear)
 };
 #define VIS_GROUP_X 8     // shading pass workgroup
 #define VIS_GROUP_Y 8

@@ -8,11 +8,18 @@ namespace rtr::render {
 
 HeadlessRenderer::HeadlessRenderer(const vk::Context& ctx, const GpuScene& scene, VkExtent2D extent, Renderer::Prepared prepared)
     : ctx_(ctx), extent_(extent), renderer_(ctx, scene, 1, std::move(prepared)), ring_(ctx, 1) {
-  target_ = vk::Image(ctx, {extent, VK_FORMAT_R8G8B8A8_UNORM, 1,
-                            VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 0,
-                            0, "headless target"});
+  resize(extent);
+}
+
+void HeadlessRenderer::resize(VkExtent2D extent) {
+  ring_.waitIdle();  // every frame is waited for already; the images and buffers below are free
+  extent_ = extent;
+  target_ = vk::Image(ctx_, {extent, VK_FORMAT_R8G8B8A8_UNORM, 1,
+                             VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                             0, 0, "headless target"});
   const VkDeviceSize pixels = VkDeviceSize(extent.width) * extent.height;
-  readback_ = vk::Buffer(ctx, pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "target readback");
+  readback_ = vk::Buffer(ctx_, pixels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "target readback");
+  colorReadback_ = {}, idReadback_ = {};  // made at the new size when next needed
 }
 
 void HeadlessRenderer::frame(const CameraPose& pose, const Lens& lens, const RenderSettings& settings,
@@ -65,7 +72,9 @@ std::vector<uint32_t> HeadlessRenderer::ids(const CameraPose& pose, const Lens& 
   if (!idReadback_.handle())
     idReadback_ = vk::Buffer(ctx_, pixels * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryUse::Readback, "id readback");
   uint32_t bytes = 0;
-  frame(pose, lens, settings, [&](VkCommandBuffer cb) { bytes = renderer_.copyIds(cb, idReadback_.handle()); });
+  RenderSettings keep = settings;
+  keep.keepIds = true;  // not cleared by the shading pass
+  frame(pose, lens, keep, [&](VkCommandBuffer cb) { bytes = renderer_.copyIds(cb, idReadback_.handle()); });
   idReadback_.invalidate();
   const auto* words = static_cast<const uint32_t*>(idReadback_.mapped());
   std::vector<uint32_t> out(pixels);

@@ -22,8 +22,11 @@ class HeadlessRenderer {
   // Renders `frames` frames (the last one is read back).
   HeadlessFrame render(const CameraPose& pose, const Lens& lens, const RenderSettings& settings, int frames = 1,
                        bool readSceneColor = false);
-  // Renders one frame and returns its visibility ids, row by row (VIS_EMPTY where nothing was drawn).
+  // Renders one frame and returns its visibility ids, row by row (VIS_EMPTY where nothing was drawn); the
+  // frame keeps them (RenderSettings::keepIds).
   std::vector<uint32_t> ids(const CameraPose& pose, const Lens& lens, const RenderSettings& settings);
+  // The target made again at `extent` (the next frame's renderer resizes its buffers, as a window's would).
+  void resize(VkExtent2D extent);
   const Renderer& renderer() const { return renderer_; }
   Renderer& renderer() { return renderer_; }
   // Renders `frames` frames, one submission each, and returns every frame's per-pass GPU times.

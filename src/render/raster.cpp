@@ -89,6 +89,8 @@ ComputeRaster::ComputeRaster(const vk::Context& ctx, const GpuScene& scene, uint
       culled_(framesInFlight, false),
       twoPhase_(framesInFlight, false),
       counted_(framesInFlight, false) {
+  // RTR_CLEAR_IN_SHADE=0: the full clear every frame, as before the fold (A/B on a GPU; docs/raster.md).
+  foldClear_ = envNumber("RTR_CLEAR_IN_SHADE", 0, 1, "0 (a full clear every frame) or 1").value_or(1) != 0;
   Pipelines p = made ? std::move(*made) : makePipelines(ctx, scene.kinds());
   clear_ = std::move(p.clear), raster_ = std::move(p.raster), clip_ = std::move(p.clip), large_ = std::move(p.large);
   hardware_ = std::move(p.hardware);
@@ -173,6 +175,7 @@ void ComputeRaster::resize(VkExtent2D extent) {
                     "visibility (64-bit)");
   pyramid_.reset();
   extent_ = extent;
+  visClear_ = false;  // a new buffer: its contents undefined
 }
 
 void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uniforms, vk::GpuTimer& timer, uint32_t frame,
@@ -229,9 +232,11 @@ void ComputeRaster::record(VkCommandBuffer cb, const vk::UploadArena::Slice& uni
   constexpr vk::BufferUse kReaders = vk::kComputeReadWrite | vk::kFragmentReadWrite | vk::kVertexReadWrite | vk::kIndirectRead;
   // The previous frame's readers of both buffers (shading, the indirect draw) before they are cleared.
   vk::bufferBarrier(cb, kReaders | vk::kCopyRead, vk::kComputeWrite);
+  // Every pixel, or where the shading pass of the frame before cleared them (shadingCleared), one workgroup:
+  // its threads rewrite the first pixels' RASTER_CLEAR and its thread 0 resets the lists.
   bind(clear_);
-  const uint32_t pixels = extent_.width * extent_.height;
-  clear_.dispatch(cb, pixels);
+  clear_.dispatch(cb, visClear_ ? 1 : extent_.width * extent_.height);
+  visClear_ = false;  // this frame's ids, until its shading pass clears them
   timer.mark(cb, "clear");
   vk::bufferBarrier(cb, vk::kComputeWrite, vk::kComputeReadWrite);
   const VkDeviceSize countsSize = sizeof(shader::CullCounts);

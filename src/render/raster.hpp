@@ -47,6 +47,19 @@ class ComputeRaster {
   // Whether the last use of `frame` read its counters back (record's `counters`).
   bool counted(uint32_t frame) const { return counted_.at(frame); }
   VkBuffer ids() const { return vis_.handle(); }  // uint64 per pixel, row by row
+  // The clear folded into shading (docs/raster.md, "The clear left to shading"). The rule: record() clears
+  // every pixel unless the buffer is known clear (RASTER_CLEAR in every word), which it is only after a
+  // frame whose ids' one reader, the shading pass, wrote RASTER_CLEAR back into every word it read (the
+  // caller says so with shadingCleared()); then "clear" only resets the lists (one workgroup). Not known
+  // clear: the first frame, after resize() (a new buffer), after a frame that kept its ids for a later
+  // reader (the transparency pass, a read-back), and in a rasteriser made again (a pipeline reload).
+  // foldClear(): whether the shading may clear them (RTR_CLEAR_IN_SHADE, read when made; 0: never, so the
+  // full clear every frame).
+  bool foldClear() const { return foldClear_; }
+  // The caller recorded, after this frame's record(), a shading pass that cleared every word it read.
+  void shadingCleared() { visClear_ = true; }
+  // Whether ids() holds no ids now (the last frame's were cleared by its shading pass).
+  bool idsCleared() const { return visClear_; }
   // The passes' texture arrays (set 1 of the layouts that have one), for the one writer of every texture set.
   std::vector<std::pair<const vk::PipelineLayout*, VkDescriptorSet>> textureSets() const;
   // The culling counts of the last completed use of `frame` (none if it did not cull).
@@ -86,6 +99,8 @@ class ComputeRaster {
   // mediumFound and mediumStored.
   static constexpr VkDeviceSize kReadbackSize = 24;
   VkExtent2D extent_{0, 0};
+  bool foldClear_ = true;                // RTR_CLEAR_IN_SHADE
+  bool visClear_ = false;                // vis_ holds RASTER_CLEAR in every word once the frames recorded so far have run
   std::optional<ClusterCuller> culler_;  // made on the first culled frame; the pyramid per size
   std::optional<DepthPyramid> pyramid_;
   vk::Buffer cullReadback_;     // per frame in flight: the early and the late CullCounts

@@ -401,7 +401,7 @@ void Renderer::drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, co
   }
 }
 
-void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster, VkImageView display) {
+void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster, VkImageView display, bool clearIds) {
   const VisShade& shade = shade_[2 * size_t(raster) + (display != VK_NULL_HANDLE)];
   const vk::Pipeline& c = *shade.pipeline;
   c.bind(cb);
@@ -431,7 +431,7 @@ void Renderer::shadeVisibility(VkCommandBuffer cb, RasterPath raster, VkImageVie
     if (c.layout.hasBinding(0, 12)) w.buffer(12, scene_.tangents() ? scene_.tangents() : scene_.positions());
   }
   w.push(cb, c);
-  c.push(cb, shader::VisShadePush{scene_.visIdPageShift()});
+  c.push(cb, shader::VisShadePush{scene_.visIdPageShift(), clearIds});
   if (c.layout.setCount() > 1) c.bindSet(cb, 1, shade.textures.get(1));
   c.dispatch(cb, extent_.width, extent_.height);  // one thread per pixel
 }
@@ -550,16 +550,21 @@ void Renderer::frame(FrameContext& fc) {
       timer.mark(cb, "backdrop");
     }
   }
+  const bool transparent = !display && transparency_ && s.mode == VIEW_SHADED;  // debug views show the opaque surfaces only
+  // The shading pass is the compute ids' last reader unless the transparency pass or a read-back comes after
+  // it: then it clears them behind it and the next frame's rasteriser skips its clear (ComputeRaster::foldClear).
+  const bool clearIds = compute && raster_->foldClear() && !transparent && !s.keepIds;
   if (visibility) {
     const vk::Requirement out{display ? target.image : color_.tracked(), vk::Use::Storage, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                               true};
     if (compute) vk::require(cb, {out});
     else vk::require(cb, {{vis_.tracked(), vk::Use::Sampled, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT}, out});
-    shadeVisibility(cb, raster, display ? target.view : VK_NULL_HANDLE);
+    shadeVisibility(cb, raster, display ? target.view : VK_NULL_HANDLE, clearIds);
+    if (clearIds) raster_->shadingCleared();
     timer.mark(cb, "shade");
   }
   if (display) return;
-  if (transparency_ && s.mode == VIEW_SHADED) {  // debug views show the opaque surfaces only
+  if (transparent) {
     transparency_->record(cb, uniforms_, color_, depth_, extent_, pose.position, compute ? raster_->ids() : VK_NULL_HANDLE);
     timer.mark(cb, "transparent");
   }
@@ -607,6 +612,7 @@ namespace rtr::render {
 
 uint32_t Renderer::copyIds(VkCommandBuffer cb, VkBuffer dst) {
   if (lastRaster_ == RasterPath::Compute) {
+    if (idsCleared()) throw Error("copyIds: the last frame's shading pass cleared its ids (RenderSettings::keepIds)");
     vk::bufferBarrier(cb, vk::kComputeWrite | vk::kFragmentWrite, vk::kCopyRead);
     const VkBufferCopy region{0, 0, VkDeviceSize(extent_.width) * extent_.height * 8};
     vkCmdCopyBuffer(cb, raster_->ids(), dst, 1, &region);

@@ -59,6 +59,10 @@ struct RenderSettings {
   // cullStats() and the like: small copies between the passes (9 µs a frame on the H200). rtr-view --bench
   // times its frames without them and reads them in one frame after.
   bool counters = true;
+  // Compute raster: the frame's ids are left in the visibility buffer for a read-back after it (copyIds;
+  // HeadlessRenderer::ids sets it). Otherwise, where no transparency pass reads them either, the shading pass
+  // clears them behind it, so that the next frame skips the clear (ComputeRaster::foldClear, docs/raster.md).
+  bool keepIds = false;
   float lodBias = 0.0f;
   SamplerSettings sampler;  // how scene textures are filtered (mip experiments)
   MosaicMode mosaic = MosaicMode::Compute;
@@ -148,8 +152,11 @@ class Renderer {
   // asked for where the device can, else the other.
   RasterPath rasterFor(const RenderSettings& settings) const;
   // Records a copy of the last frame's visibility ids into `dst` (host-visible, 8 bytes a pixel at most);
-  // returns the bytes per pixel written: 4 (hardware: the id) or 8 (compute: id in the low half).
+  // returns the bytes per pixel written: 4 (hardware: the id) or 8 (compute: id in the low half). The compute
+  // ids only of a frame with RenderSettings::keepIds (or a transparency pass): an Error otherwise.
   uint32_t copyIds(VkCommandBuffer cb, VkBuffer dst);
+  // Whether the last frame's shading pass cleared the compute rasteriser's ids behind it (RenderSettings::keepIds).
+  bool idsCleared() const { return lastRaster_ == RasterPath::Compute && raster_->idsCleared(); }
   // Why the scene cannot take the visibility path on this device (frames are forward); empty if it can.
   const std::string& visibilityRefusal() const { return choice_.visibilityRefusal; }
   // The culling counts of the last completed use of `frame`; none where it did not cull.
@@ -219,8 +226,9 @@ class Renderer {
   void rasterPass(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye, const glm::vec3& background,
                   bool backdrop);
   void drawScene(VkCommandBuffer cb, uint32_t frame, PipelineSet set, const glm::vec3& eye);
-  // display: the target's view, written sRGB-encoded (no post pass); null: the linear image.
-  void shadeVisibility(VkCommandBuffer cb, RasterPath raster, VkImageView display);
+  // display: the target's view, written sRGB-encoded (no post pass); null: the linear image. clearIds: the
+  // compute rasteriser's ids cleared behind it (VisShadePush::clearIds).
+  void shadeVisibility(VkCommandBuffer cb, RasterPath raster, VkImageView display, bool clearIds);
   // The scene's texture array, as every pipeline that samples it binds it (set 1, binding 0): each
   // texture with a sampler made from its own SamplerDesc and the settings (one per distinct pair).
   void makeTextureInfos();
