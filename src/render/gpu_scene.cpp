@@ -116,7 +116,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
     for (uint8_t b : p.pipelineCacheUUID) std::snprintf(id, sizeof id, "%02x", b), cacheVariant_ += id;
     cacheVariant_ += std::string("; mips ") + enumName(mipMode) + " " + std::to_string(kMipChainVersion);
   }
-  const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad);
+  std::future<void> decodeBeside;  // a waited-for load's decode, on a thread of its own beside the geometry
+  const std::vector<uint32_t> gpuIndex = startTextures(scene, textureLoad, decodeBeside);
   const auto t = Clock::now();
   const GeometryUpload path = upload == GeometryUpload::Auto ? GeometryUpload::Direct : upload;
   // A staged upload's ring (host memory the driver allocates and pins) is made while the geometry is planned.
@@ -142,6 +143,11 @@ GpuScene::GpuScene(const vk::Context& ctx, const Scene& scene, MipMode mipMode, 
   }
   uploadGeometry(scene, plan, materials, path, geometrySlotBytes, std::move(ring));
   stats_.geometryMs = msSince(t);
+  if (decodeBeside.valid()) {
+    const auto w = Clock::now();
+    decodeBeside.get();  // rethrows the decode's error
+    stats_.decodeWaitMs = msSince(w);
+  }
   if (!decoding_.valid()) {
     finishTextures();
     std::vector<std::pair<uint32_t, TextureCacheKey>> misses;

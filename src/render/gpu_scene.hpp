@@ -91,11 +91,14 @@ struct SceneKinds {
 SceneKinds sceneKinds(const Scene& scene);
 
 // The loading phases, in order; they do not overlap, and together they are the constructor's time
-// (pipeline creation for the mips aside, which the context's pipeline cache counts).
+// (pipeline creation for the mips aside, which the context's pipeline cache counts), but for a waited-for
+// load's decode, which runs beside the geometry (decodeBesideMs of decodeMs; decodeWaitMs waited for it after).
 struct GpuSceneStats {
   uint32_t meshes = 0, triangles = 0, vertices = 0, textures = 0, meshes16 = 0;  // stored once each
   uint32_t instances = 0;                                                        // placements drawn (GpuInstance records)
   double decodeMs = 0;              // texture files decoded on all cores, into staging memory
+  double decodeBesideMs = 0;        // of decodeMs: the decode beside the geometry upload (TextureLoad::Wait)
+  double decodeWaitMs = 0;          // waiting for that decode once the geometry was in
   double geometryMs = 0;            // vertex and index streams laid out, written and (where needed) copied
   double textureUploadMs = 0;       // staging memory to level 0 of each texture
   double mipsMs = 0, mipGpuMs = 0;  // mip chains: wall time, and the GPU's share of it
@@ -247,9 +250,11 @@ class GpuScene {
   std::vector<std::pair<const char*, const vk::Buffer*>> geometryBuffers() const;
 
  private:
-  std::vector<uint32_t> startTextures(const Scene& scene, TextureLoad load);  // decode (or start to)
-  GeometryPlan planGeometry(const Scene& scene);                              // the streams' layout and the draws
-  void placeRecords(const Scene& scene, GeometryPlan& plan);                  // once made: draws_, instances, ids
+  // Decodes, or starts to: a deferred load's decode in decoding_, a waited-for one's in `beside` (to be
+  // waited for after the geometry upload), else here.
+  std::vector<uint32_t> startTextures(const Scene& scene, TextureLoad load, std::future<void>& beside);
+  GeometryPlan planGeometry(const Scene& scene);              // the streams' layout and the draws
+  void placeRecords(const Scene& scene, GeometryPlan& plan);  // once made: draws_, instances, ids
   std::vector<shader::GpuMaterial> gpuMaterials(const Scene& scene, const std::vector<uint32_t>& gpuIndex) const;
   // Streams written and records made on all cores, then placed and written.
   void uploadGeometry(const Scene& scene, GeometryPlan& plan, const std::vector<shader::GpuMaterial>& materials,

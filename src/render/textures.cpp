@@ -46,7 +46,7 @@ bool blockCompressed(VkFormat f) { return f >= VK_FORMAT_BC1_RGB_UNORM_BLOCK && 
 // they are, to be unpacked straight into the ring. Deferred: on a worker thread while the caller goes on
 // (frames render with the materials' factors until updateTextures()). Returns each scene texture's index
 // in the GPU's array (NO_TEXTURE: not sampled).
-std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad load) {
+std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad load, std::future<void>& beside) {
   const std::vector<uint32_t> used = sampledTextures(scene);  // scene texture indices, in GPU array order
   std::vector<uint32_t> gpuIndex(scene.textures.size(), NO_TEXTURE);
   for (uint32_t i = 0; i < used.size(); ++i) gpuIndex[used[i]] = i;
@@ -135,7 +135,10 @@ std::vector<uint32_t> GpuScene::startTextures(const Scene& scene, TextureLoad lo
         {}, &fellBack);
     stats_.decodeMs = msSince(t);
   };
+  // Waited for: the decode (cache reads, PNG decodes) overlaps the geometry upload, which needs none of it.
   if (load == TextureLoad::Deferred && !used.empty()) decoding_ = std::async(std::launch::async, decode);
+  else if (!used.empty())
+    beside = std::async(std::launch::async, [this, decode] { decode(), stats_.decodeBesideMs = stats_.decodeMs; });
   else decode();
   return gpuIndex;
 }
