@@ -192,6 +192,7 @@ if ! skipped scale; then  # issues 29 and 30 at scale: the temple at 100M triang
     row "$id-1f" "${f[@]}" --cull frustum --lod-error 1 "$@"
   }
   if bin scenegen --out "$sd/big" --scale $big >/dev/null 2>&1; then
+    sync  # the OBJ written out before the timed bakes read it
     timed=1 row "scale-bake-$big-nolod" rtr-bake "$sd/big/temple.obj.zst" "$sd/big/nolod.rtrscene" --no-lod --view 0,2.2,-2.5,0,-3
     ls -l "$sd/big/nolod.rtrscene" >>"$out/scale-bake-$big-nolod.txt"
     rm -f "$sd/big/nolod.rtrscene"
