@@ -10,6 +10,7 @@
 #include "render/environment_maps.hpp"
 #include "render/headless.hpp"
 #include "render/transparency.hpp"
+#include "quads.hpp"
 #include "vk_fixture.hpp"
 
 namespace rtr {
@@ -17,24 +18,8 @@ namespace {
 
 constexpr uint32_t kSize = 64;
 
-// A quad facing +z at depth z over [x0, x1] × [y0, y1].
-Mesh quad(float x0, float x1, float y0, float y1, float z, uint32_t material) {
-  Mesh q;
-  q.material = material;
-  q.positions = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
-  q.normals.assign(4, glm::vec3(0, 0, 1));
-  q.indices = {0, 1, 2, 0, 2, 3};
-  for (auto& p : q.positions) q.bounds.extend(p);
-  return q;
-}
-
-Material unlit(glm::vec3 color, float opacity, bool blend) {
-  Material m;
-  m.flags = kMaterialGltf | kMaterialUnlit | (blend ? kMaterialBlend : 0u);
-  m.baseColor = color;
-  m.opacity = opacity;
-  return m;
-}
+using test::quad;
+using test::unlit;
 
 using test::VulkanTest;
 
