@@ -88,43 +88,38 @@ void place(const glm::mat4& transform, size_t first, std::vector<shader::GpuClus
 
 }  // namespace
 
+shader::GpuCluster triangleRunRecord(const Mesh& m, uint32_t first, uint32_t instance, uint32_t flags) {
+  constexpr float kNoCone = 2.0f;
+  const uint32_t count = std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, uint32_t(m.indices.size() / 3) - first);
+  Bounds b;
+  for (uint32_t i = 3 * first; i < 3 * (first + count); ++i) b.extend(m.positions[m.indices[i]]);
+  const glm::vec3 c = 0.5f * (b.min + b.max);
+  float r = 0.0f;
+  for (uint32_t i = 3 * first; i < 3 * (first + count); ++i) r = std::max(r, glm::length(m.positions[m.indices[i]] - c));
+  return {glm::vec4(c, r), glm::vec4(0, 0, 1, kNoCone), instance, first, count, flags};
+}
+
 void appendClusters(const Mesh& m, const glm::mat4& transform, uint32_t instance, uint32_t flags,
                     std::vector<shader::GpuCluster>& out) {
-  const float noCone = 2.0f;
   const size_t first = out.size();
-  for (const Cluster& c : m.clusters)
-    out.push_back({glm::vec4(c.center, c.radius), glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff),
-                   instance, c.firstTriangle, c.triangleCount, flags});
-  if (m.clusters.empty()) {
-    const uint32_t triangles = uint32_t(m.indices.size() / 3);
-    for (uint32_t f = 0; f < triangles; f += CLUSTER_MAX_TRIANGLES) {
-      const uint32_t count = std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - f);
-      Bounds b;
-      for (uint32_t i = 3 * f; i < 3 * (f + count); ++i) b.extend(m.positions[m.indices[i]]);
-      const glm::vec3 c = 0.5f * (b.min + b.max);
-      float r = 0.0f;
-      for (uint32_t i = 3 * f; i < 3 * (f + count); ++i) r = std::max(r, glm::length(m.positions[m.indices[i]] - c));
-      out.push_back({glm::vec4(c, r), glm::vec4(0, 0, 1, noCone), instance, f, count, flags});
-    }
-  }
+  for (const Cluster& c : m.clusters) out.push_back(clusterRecord(c, instance, flags));
+  if (m.clusters.empty())
+    for (uint32_t f = 0; f < m.indices.size() / 3; f += CLUSTER_MAX_TRIANGLES)
+      out.push_back(triangleRunRecord(m, f, instance, flags));
   place(transform, first, out);
 }
 
 void appendClusterLods(const Mesh& m, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above, size_t first,
                        std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods) {
-  const float noCone = 2.0f;
   const size_t firstOut = out.size(), firstLod = lods.size();
-  if (!above && m.lod.levels == 0) {  // always in the cut: its own error 0, no parent
-    for (size_t i = first; i < out.size(); ++i)
-      lods.push_back({out[i].sphere, out[i].sphere, glm::vec4(0.0f, shader::LOD_ERROR_INFINITE, 0.0f, 0.0f)});
+  if (!above && m.lod.levels == 0) {
+    for (size_t i = first; i < out.size(); ++i) lods.push_back(alwaysInCut(out[i].sphere));
     return;
   }
   for (const LodCluster& c : m.lod.clusters) {
     if ((c.level > 0) != above) continue;
-    lods.push_back({c.sphere, c.parentSphere, glm::vec4(c.error, c.parentError, 0.0f, 0.0f)});
-    if (above)
-      out.push_back({glm::vec4(c.center, c.radius), glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? noCone : c.coneCutoff),
-                     instance, c.firstTriangle, c.triangleCount, flags});
+    lods.push_back(lodRecord(c));
+    if (above) out.push_back(clusterRecord(c, instance, flags));
   }
   if (above) place(transform, firstOut, out);
   if (transform == glm::mat4(1.0f)) return;

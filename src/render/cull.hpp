@@ -60,6 +60,27 @@ void appendClusters(const Mesh& mesh, const glm::mat4& transform, uint32_t insta
 // placed by `transform` as appendClusters places them, errors scaled by its largest stretch.
 void appendClusterLods(const Mesh& mesh, const glm::mat4& transform, uint32_t instance, uint32_t flags, bool above, size_t first,
                        std::vector<shader::GpuCluster>& out, std::vector<shader::GpuClusterLod>& lods);
+// One record of each kind in the mesh's space, as the two above make them (and render/mesh_records.cpp):
+// a mesh's or a hierarchy's cluster (C: Cluster or LodCluster; a double-sided one has no cone); the run of
+// up to CLUSTER_MAX_TRIANGLES triangles from `first` of a mesh without clusters (a sphere around its box, no
+// cone); a hierarchy cluster's level-of-detail record; and that of a record always in the cut (no hierarchy).
+template <class C>
+shader::GpuCluster clusterRecord(const C& c, uint32_t instance, uint32_t flags) {
+  constexpr float kNoCone = 2.0f;
+  return {glm::vec4(c.center, c.radius),
+          glm::vec4(c.coneAxis, flags & CLUSTER_DOUBLE_SIDED ? kNoCone : c.coneCutoff),
+          instance,
+          c.firstTriangle,
+          c.triangleCount,
+          flags};
+}
+shader::GpuCluster triangleRunRecord(const Mesh& mesh, uint32_t first, uint32_t instance, uint32_t flags);
+inline shader::GpuClusterLod lodRecord(const LodCluster& c) {
+  return {c.sphere, c.parentSphere, glm::vec4(c.error, c.parentError, 0.0f, 0.0f)};
+}
+inline shader::GpuClusterLod alwaysInCut(glm::vec4 sphere) {  // its own error 0, no parent
+  return {sphere, sphere, glm::vec4(0.0f, shader::LOD_ERROR_INFINITE, 0.0f, 0.0f)};
+}
 // The sphere around the box of `spheres` that holds each (rounded outwards).
 glm::vec4 enclosingSphere(std::span<const glm::vec4> spheres);
 // The same in steps, for spheres spread over pieces (render/mesh_records.cpp): each piece's box

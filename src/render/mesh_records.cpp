@@ -28,7 +28,6 @@ MeshRecords buildMeshRecords(const Mesh& m, uint32_t flags, bool lods, unsigned 
   if (subtree != piece)
     throw Error("mesh records: pieces of " + std::to_string(piece) + " records, not " + std::to_string(CULL_LEAF_SIZE) +
                 " times a power of " + std::to_string(CULL_NODE_CHILDREN));
-  const float noCone = 2.0f;
   const bool hierarchy = lods && m.lod.levels > 0;
   const uint32_t triangles = uint32_t(m.indices.size() / 3);
   const size_t own = m.clusters.empty() ? (triangles + CLUSTER_MAX_TRIANGLES - 1) / CLUSTER_MAX_TRIANGLES : m.clusters.size();
@@ -49,29 +48,18 @@ MeshRecords buildMeshRecords(const Mesh& m, uint32_t flags, bool lods, unsigned 
   };
   const size_t pieces = (count + piece - 1) / piece;
   std::vector<Piece> parts(pieces);
-  auto record = [&](glm::vec3 centre, float radius, glm::vec3 axis, float cutoff, uint32_t first, uint32_t n) {
-    return shader::GpuCluster{
-        glm::vec4(centre, radius), glm::vec4(axis, flags & CLUSTER_DOUBLE_SIDED ? noCone : cutoff), 0, first, n, flags};
-  };
   parallelFor(pieces, use, [&](size_t k) {
     Piece& pc = parts[k];
     for (size_t i = k * piece; i < std::min(count, (k + 1) * piece); ++i) {
       shader::GpuCluster& c = r.clusters[i];
       if (i < own && !m.clusters.empty()) {
-        const Cluster& s = m.clusters[i];
-        c = record(s.center, s.radius, s.coneAxis, s.coneCutoff, s.firstTriangle, s.triangleCount);
-      } else if (i < own) {  // no clusters: runs of triangles, a sphere around their box
-        const uint32_t f = uint32_t(i * CLUSTER_MAX_TRIANGLES), n = std::min<uint32_t>(CLUSTER_MAX_TRIANGLES, triangles - f);
-        Bounds b;
-        for (uint32_t v = 3 * f; v < 3 * (f + n); ++v) b.extend(m.positions[m.indices[v]]);
-        const glm::vec3 centre = 0.5f * (b.min + b.max);
-        float radius = 0.0f;
-        for (uint32_t v = 3 * f; v < 3 * (f + n); ++v) radius = std::max(radius, glm::length(m.positions[m.indices[v]] - centre));
-        c = record(centre, radius, glm::vec3(0, 0, 1), noCone, f, n);
+        c = clusterRecord(m.clusters[i], 0, flags);
+      } else if (i < own) {  // no clusters: runs of triangles
+        c = triangleRunRecord(m, uint32_t(i * CLUSTER_MAX_TRIANGLES), 0, flags);
       } else {
         const LodCluster& s = m.lod.clusters[i];
         if (s.level == 0) throw unordered();
-        c = record(s.center, s.radius, s.coneAxis, s.coneCutoff, s.firstTriangle, s.triangleCount);
+        c = clusterRecord(s, 0, flags);
         if (i == own || s.level != m.lod.clusters[i - 1].level) pc.starts.push_back(uint32_t(i));
       }
       extendBySphere(pc.box, c.sphere);
@@ -80,9 +68,9 @@ MeshRecords buildMeshRecords(const Mesh& m, uint32_t flags, bool lods, unsigned 
       if (hierarchy) {
         const LodCluster& s = m.lod.clusters[i];
         if (i < own && s.level != 0) throw unordered();
-        l = {s.sphere, s.parentSphere, glm::vec4(s.error, s.parentError, 0.0f, 0.0f)};
-      } else {  // always in the cut: its own error 0, no parent
-        l = {c.sphere, c.sphere, glm::vec4(0.0f, shader::LOD_ERROR_INFINITE, 0.0f, 0.0f)};
+        l = lodRecord(s);
+      } else {
+        l = alwaysInCut(c.sphere);
       }
       extendBySphere(pc.lodBox, l.sphere);
       if (l.error.y < shader::LOD_ERROR_INFINITE) extendBySphere(pc.lodBox, l.parentSphere);
