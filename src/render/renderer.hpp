@@ -54,7 +54,7 @@ struct RenderSettings {
   bool clip = false;
   // Compute raster, scenes with a cluster hierarchy: the level-of-detail cut's projected error in pixels
   // (docs/virtual-geometry.md); 0: full detail, exactly the image without a hierarchy.
-  float lodError = 0.0f;  // rtr-view: --lod-error, default 1
+  float lodError = 0.0f;  // rtr-view: --lod-error, default 0 (full detail)
   // Compute raster: the frame's counters (hand-off, clipped and medium triangles, culling) read back for
   // cullStats() and the like: small copies between the passes (9 µs a frame on the H200). rtr-view --bench
   // times its frames without them and reads them in one frame after.

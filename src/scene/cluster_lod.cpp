@@ -367,10 +367,30 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
         r.sphere = merge(r.sphere, lodClusters[ids[k]].sphere);
         childError = std::max(childError, lodClusters[ids[k]].error);
       }
-      const Local l(tris, mesh);
-      const Indices simpler = simplifyGroup(l, r.error);
-      r.stats = {level - 1, uint32_t(g.size()), uint32_t(tris.size() / 3), 0, r.error, 0.0f, r.sphere.w};
-      if (simpler.empty() || simpler.size() * 6 > tris.size() * 5) return;  // stuck
+      auto stuck = [&](const Indices& s) { return s.empty() || s.size() * 6 > tris.size() * 5; };
+      Local l(tris, mesh);
+      Indices simpler = simplifyGroup(l, r.error);
+      bool welded = false;
+      if (stuck(simpler)) {
+        // Vertices at one position with different attributes (seams) are kept apart by the simplifier,
+        // and where many meet (the poles of a dense sphere, coincident in float) it locks them: the
+        // group cannot simplify. Then its triangles over one vertex per position, their own seams given
+        // up (the group's border, shared with other groups, stays locked).
+        Indices byPosition;
+        byPosition.reserve(tris.size());
+        for (size_t t = 0; t < tris.size(); t += 3) {
+          const uint32_t a = pos[tris[t]], b = pos[tris[t + 1]], c = pos[tris[t + 2]];
+          if (a != b && b != c && a != c) byPosition.insert(byPosition.end(), {a, b, c});
+        }
+        if (!byPosition.empty()) {
+          Local lw(byPosition, mesh);
+          float error = 0.0f;
+          Indices s = simplifyGroup(lw, error);
+          if (!stuck(s)) l = std::move(lw), simpler = std::move(s), r.error = error, welded = true;
+        }
+      }
+      r.stats = {level - 1, uint32_t(g.size()), uint32_t(tris.size() / 3), 0, r.error, 0.0f, r.sphere.w, welded};
+      if (stuck(simpler)) return;
       r.stats.trianglesOut = uint32_t(simpler.size() / 3);
       // The error also bounds the size of the triangles the simplification made: where it moves no
       // surface (a flat floor: error 0) it would otherwise make triangles that are drawn at any distance,

@@ -17,7 +17,9 @@ namespace rtr {
 // alone lets flat and ruled surfaces (floors, walls, columns) collapse into triangles of any size. With 8
 // the slivers a simplification with locked borders makes (they span its group) held whole groups under
 // a few pixels, and the temple's floor and columns stayed at full detail; 32 halves the 10M temple's 4K
-// cut with the tile pass's work within 2 % (docs/virtual-geometry.md, measured with rtr-lod-cut).
+// cut with the tile pass's work within 2 % (docs/virtual-geometry.md, measured with rtr-lod-cut). Bounding
+// the made triangles' area instead halves the cut again, but on the H200 the large-triangle pass then
+// costs what the raster saves (docs/virtual-geometry.md, "The size term's trade").
 constexpr float kLodEdgePerError = 32.0f;
 
 // What the build did with one group of clusters (rtr-lod-cut prints them per level): how far it simplified
@@ -29,12 +31,15 @@ struct LodGroupStats {
   float simplifierError = 0.0f;  // object space, what the simplifier reports
   float edgeError = 0.0f;        // the size term: longest new edge / kEdgePerError
   float radius = 0.0f;           // of the group's sphere
+  bool welded = false;           // simplified over one vertex per position (stuck with its seams kept)
 };
 
 // The hierarchy of `mesh` (positions, indices and its clusters, which become level 0: build them first,
-// scene/clusters.hpp). Deterministic, whatever the thread count (0: one per core). Groups whose
-// simplification cannot remove a sixth of their triangles (locked borders everywhere) are grouped again
-// with the next level's clusters; what is left when no group simplifies, or after 64 levels, are roots.
+// scene/clusters.hpp). Deterministic, whatever the thread count (0: one per core). A group whose
+// simplification cannot remove a sixth of its triangles is simplified again over one vertex per position
+// (its seams given up: where many vertices meet at a point the simplifier locks them); if that cannot
+// either (locked borders everywhere), its clusters are grouped again with the next level's; what is left
+// when no group simplifies, or after 64 levels, are roots.
 // `backfaceCone` as buildClusters' (false: the clusters above level 0 get cones that never cull).
 // `stats`, where given, receives one record per group, level by level.
 ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone = true, unsigned threads = 0,

@@ -40,23 +40,23 @@ void printBuild(const std::vector<LodGroupStats>& stats) {
   for (const LodGroupStats& s : stats) byLevel[s.level].push_back(&s);
   std::printf(
       "\nbuild, per level grouped (the groups' result is the next level):\n"
-      "| level | groups | alone | stuck (tris) | tris in → out | out / in | size term decides | simplifier error "
-      "median | size term median | size term / group radius median |\n|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n");
+      "| level | groups | alone | stuck (tris) | welded | tris in → out | out / in | size term decides | simplifier error "
+      "median | size term median | size term / group radius median |\n|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n");
   for (const auto& [level, groups] : byLevel) {
-    size_t alone = 0, stuck = 0, stuckTris = 0, in = 0, out = 0, sizeDecides = 0, simplified = 0;
+    size_t alone = 0, stuck = 0, stuckTris = 0, welded = 0, in = 0, out = 0, sizeDecides = 0, simplified = 0;
     std::vector<float> simp, edge, edgeRel;
     for (const LodGroupStats* g : groups) {
       if (g->clusters < 2) ++alone, stuckTris += g->trianglesIn;
       else if (g->trianglesOut == 0) ++stuck, stuckTris += g->trianglesIn;
       if (g->trianglesOut == 0) continue;
-      ++simplified;
+      ++simplified, welded += g->welded;
       in += g->trianglesIn, out += g->trianglesOut;
       sizeDecides += g->edgeError > g->simplifierError;
       simp.push_back(g->simplifierError), edge.push_back(g->edgeError);
       edgeRel.push_back(g->radius > 0 ? g->edgeError / g->radius : 0.0f);
     }
-    std::printf("| %u | %zu | %zu | %zu (%zu) | %zu → %zu | %.3f | %.1f %% | %.3g | %.3g | %.3f |\n", level, groups.size(), alone,
-                stuck, stuckTris, in, out, in ? double(out) / double(in) : 0.0,
+    std::printf("| %u | %zu | %zu | %zu (%zu) | %zu | %zu → %zu | %.3f | %.1f %% | %.3g | %.3g | %.3f |\n", level, groups.size(),
+                alone, stuck, stuckTris, welded, in, out, in ? double(out) / double(in) : 0.0,
                 simplified ? 100.0 * double(sizeDecides) / double(simplified) : 0.0, median(simp), median(edge), median(edgeRel));
   }
 }
