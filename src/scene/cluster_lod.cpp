@@ -8,6 +8,7 @@
 #include <cstring>
 #include <numeric>
 #include <span>
+#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -259,6 +260,21 @@ float longestNewEdge(const Indices& in, const Indices& out, const std::vector<gl
   return longest;
 }
 
+// A stuck group's triangles over one vertex per position, the group's first vertex there (so the
+// attributes are the group's own: a vertex elsewhere at that position, on another face of a crease,
+// shaded an engine's fins with the wrong normals), triangles with two corners at one position left out.
+Indices weldedByPosition(const Indices& tris, const std::vector<uint32_t>& pos) {
+  std::unordered_map<uint32_t, uint32_t> first;  // position id -> the group's first vertex there
+  auto one = [&](uint32_t v) { return first.try_emplace(pos[v], v).first->second; };
+  Indices out;
+  out.reserve(tris.size());
+  for (size_t t = 0; t < tris.size(); t += 3) {
+    const uint32_t a = one(tris[t]), b = one(tris[t + 1]), c = one(tris[t + 2]);
+    if (a != b && b != c && a != c) out.insert(out.end(), {a, b, c});
+  }
+  return out;
+}
+
 // Simplifies a group's triangles towards half, its border locked, over the group's own vertices (the
 // simplifier's cost follows the vertex count it is given). Returns the triangles (local vertices) and the
 // error in object-space units.
@@ -306,6 +322,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
   lodClusters.resize(n0);
   std::vector<Indices> current(n0);
   std::vector<uint32_t> ids(n0);
+  std::vector<uint8_t> stuckBefore(n0, 0);  // per current cluster: 1 where a group of it was stuck before
   parallelFor((n0 + kRecordPiece - 1) / kRecordPiece, threads, [&](size_t p) {
     for (size_t i = p * kRecordPiece; i < std::min(n0, (p + 1) * kRecordPiece); ++i) {
       const Cluster& mc = mesh.clusters[i];
@@ -371,17 +388,15 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
       Local l(tris, mesh);
       Indices simpler = simplifyGroup(l, r.error);
       bool welded = false;
-      if (stuck(simpler)) {
-        // Vertices at one position with different attributes (seams) are kept apart by the simplifier,
-        // and where many meet (the poles of a dense sphere, coincident in float) it locks them: the
-        // group cannot simplify. Then its triangles over one vertex per position, their own seams given
-        // up (the group's border, shared with other groups, stays locked).
-        Indices byPosition;
-        byPosition.reserve(tris.size());
-        for (size_t t = 0; t < tris.size(); t += 3) {
-          const uint32_t a = pos[tris[t]], b = pos[tris[t + 1]], c = pos[tris[t + 2]];
-          if (a != b && b != c && a != c) byPosition.insert(byPosition.end(), {a, b, c});
-        }
+      // Stuck before (grouped again since) and stuck again: vertices at one position with different
+      // attributes are kept apart by the simplifier (a seam), and where many meet (the poles of a dense
+      // sphere, its rings coincident in float) it locks them, whatever the grouping. Then the group is
+      // simplified again over one vertex per position: its own seams given up (a made triangle takes one
+      // of the group's vertices' attributes there), its border with other groups locked as before. Only
+      // then: a first-time stuck group mostly simplifies when grouped again, seams kept.
+      const bool again = std::any_of(g.begin(), g.end(), [&](uint32_t k) { return stuckBefore[k] > 0; });
+      if (stuck(simpler) && again) {
+        const Indices byPosition = weldedByPosition(tris, pos);
         if (!byPosition.empty()) {
           Local lw(byPosition, mesh);
           float error = 0.0f;
@@ -424,6 +439,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     if (!progress) break;
     std::vector<Indices> next(at.back().next);
     std::vector<uint32_t> nextIds(at.back().next);
+    std::vector<uint8_t> nextStuck(at.back().next, 0);
     const size_t firstCluster = lodClusters.size(), firstIndex = lodIndices.size();
     lodClusters.resize(firstCluster + at.back().cluster);
     lodIndices.resize(firstIndex + at.back().index);
@@ -433,6 +449,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
         size_t nx = at[gi].next, c = firstCluster + at[gi].cluster, ix = firstIndex + at[gi].index;
         for (uint32_t k : groups[gi]) {
           if (r.clusters.empty()) {
+            nextStuck[nx] = 1;
             next[nx] = std::move(current[k]), nextIds[nx++] = ids[k];
             continue;
           }
@@ -451,6 +468,7 @@ ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone, unsigned threads
     lod.levels = level + 1;
     current = std::move(next);
     ids = std::move(nextIds);
+    stuckBefore = std::move(nextStuck);
   }
   lod.clusters = std::move(lodClusters);
   lod.indices = std::move(lodIndices);

@@ -36,10 +36,10 @@ struct LodGroupStats {
 
 // The hierarchy of `mesh` (positions, indices and its clusters, which become level 0: build them first,
 // scene/clusters.hpp). Deterministic, whatever the thread count (0: one per core). A group whose
-// simplification cannot remove a sixth of its triangles is simplified again over one vertex per position
-// (its seams given up: where many vertices meet at a point the simplifier locks them); if that cannot
-// either (locked borders everywhere), its clusters are grouped again with the next level's; what is left
-// when no group simplifies, or after 64 levels, are roots.
+// simplification cannot remove a sixth of its triangles is stuck: its clusters are grouped again with the
+// next level's. Stuck again, it is simplified over one vertex per position (its own seams given up: where
+// many vertices meet at a point the simplifier locks them); what is left when no group simplifies, or
+// after 64 levels, are roots.
 // `backfaceCone` as buildClusters' (false: the clusters above level 0 get cones that never cull).
 // `stats`, where given, receives one record per group, level by level.
 ClusterLod buildClusterLod(const Mesh& mesh, bool backfaceCone = true, unsigned threads = 0,

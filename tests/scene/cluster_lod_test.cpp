@@ -331,6 +331,27 @@ TEST(ClusterLod, FarAwayASphereWithManyVerticesAtItsPolesIsAFewClusters) {
   }
 }
 
+// A group simplified over one vertex per position takes its own vertices there, not whichever vertex of
+// the mesh comes first at that position: that one may lie on another face of a crease, with another normal
+// (taking it shaded an engine's fins, glTF2 2CylinderEngine, with their neighbours' normals at 1 px). Here
+// every position first holds a vertex no triangle uses.
+TEST(ClusterLod, AGroupSimplifiedOverPositionsKeepsItsOwnVertices) {
+  const Mesh sphere = sphereAsWritten(100, 800, 2e-3f);
+  Mesh m;
+  const uint32_t n = uint32_t(sphere.positions.size());
+  for (const auto* source : {&sphere, &sphere}) {
+    m.positions.insert(m.positions.end(), source->positions.begin(), source->positions.end());
+    m.texcoords.insert(m.texcoords.end(), source->texcoords.begin(), source->texcoords.end());
+  }
+  for (uint32_t i : sphere.indices) m.indices.push_back(n + i);
+  m.normals = m.positions;
+  buildClusters(m, true);
+  const ClusterLod lod = buildClusterLod(m);
+  ASSERT_GE(lod.levels, 5u);
+  EXPECT_LE(cut(m, lod, {0, 0, 1000}, 1.0f).size() / 3, 8u * CLUSTER_MAX_TRIANGLES);  // the poles simplified
+  EXPECT_EQ(std::count_if(lod.indices.begin(), lod.indices.end(), [&](uint32_t v) { return v < n; }), 0);
+}
+
 // The hierarchy is the same, byte for byte, whatever the thread count: the vertices' position ids, a
 // level's edge listing, sorts and pairs, its groups' simplification and their assembly run in fixed
 // pieces. The mesh has more than one piece of each at level 0 (65 536 vertices, 1 024 clusters, 65 536
