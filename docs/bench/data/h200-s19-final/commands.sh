@@ -1,4 +1,4 @@
-# F8: dbbf04d (stuck groups simplified over one vertex per position): the Vulkan suite with validation, then
+# F9: the final hierarchy (stuck twice: welded over the group's own vertices): the Vulkan suite with validation, then
 # the report's scale group (100M bakes, start-up, frames; the 1 B grid)
 source .devz/p.sh b.tar.zst
 O=/tmp/o; mkdir -p $O
