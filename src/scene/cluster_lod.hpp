@@ -19,7 +19,7 @@ namespace rtr {
 // a few pixels, and the temple's floor and columns stayed at full detail; 32 halves the 10M temple's 4K
 // cut with the tile pass's work within 2 % (docs/virtual-geometry.md, measured with rtr-lod-cut). Bounding
 // the made triangles' area instead halves the cut again, but on the H200 the large-triangle pass then
-// costs what the raster saves (docs/virtual-geometry.md, "The size term's trade").
+// costs what the raster saves (docs/virtual-geometry.md, "The 100M cut's density, found").
 constexpr float kLodEdgePerError = 32.0f;
 
 // What the build did with one group of clusters (rtr-lod-cut prints them per level): how far it simplified

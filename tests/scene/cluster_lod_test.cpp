@@ -339,9 +339,9 @@ TEST(ClusterLod, AGroupSimplifiedOverPositionsKeepsItsOwnVertices) {
   const Mesh sphere = sphereAsWritten(100, 800, 2e-3f);
   Mesh m;
   const uint32_t n = uint32_t(sphere.positions.size());
-  for (const auto* source : {&sphere, &sphere}) {
-    m.positions.insert(m.positions.end(), source->positions.begin(), source->positions.end());
-    m.texcoords.insert(m.texcoords.end(), source->texcoords.begin(), source->texcoords.end());
+  for (int copy = 0; copy < 2; ++copy) {  // the unused vertices, then the sphere's own
+    m.positions.insert(m.positions.end(), sphere.positions.begin(), sphere.positions.end());
+    m.texcoords.insert(m.texcoords.end(), sphere.texcoords.begin(), sphere.texcoords.end());
   }
   for (uint32_t i : sphere.indices) m.indices.push_back(n + i);
   m.normals = m.positions;
